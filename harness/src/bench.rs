@@ -1,0 +1,177 @@
+//! `ppmc bench`: wall-clock figures for the emulator, printed as a Markdown
+//! table (the source of `docs/performance.md`). Timings live here and never
+//! in tests: the machines are shared and noisy.
+
+use clap::Args;
+use ppmc::emu::ModelConfig;
+use ppmc::protocol::{InitData, PulseCount, Status, Straps};
+use ppmc::target::{EmuTarget, Op, Reply, Target};
+use ppmc::time::Duration;
+use std::process::ExitCode;
+use std::time::Instant as WallClock;
+
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Repetitions of each case; the median is reported.
+    #[arg(long, default_value_t = 15)]
+    repeat: usize,
+}
+
+/// A named benchmark case.
+type Case = (&'static str, Box<dyn Fn() -> Outcome>);
+
+struct Outcome {
+    pulses: u64,
+    runs: usize,
+    virtual_time: Duration,
+}
+
+fn write_all(t: &mut EmuTarget, bytes: &[(bool, u8)]) {
+    let ops: Vec<Op> = bytes
+        .iter()
+        .map(|&(cmd, byte)| {
+            let wait_ibf = Some(Duration::from_secs(1));
+            if cmd {
+                Op::WriteCommand { byte, wait_ibf }
+            } else {
+                Op::WriteData { byte, wait_ibf }
+            }
+        })
+        .collect();
+    let _ = t.execute(&ops);
+}
+
+/// Initializes a 4-phase motor and runs one move to its end.
+fn one_move(init: InitData, cmd: u8, params: &[u8]) -> Outcome {
+    let Ok(mut t) = EmuTarget::new(Straps::default(), ModelConfig::default()) else {
+        return Outcome {
+            pulses: 0,
+            runs: 0,
+            virtual_time: Duration::ZERO,
+        };
+    };
+    let mut bytes = vec![(true, 0x02)];
+    bytes.extend(init.to_bytes().iter().map(|b| (false, *b)));
+    write_all(&mut t, &bytes);
+    let _ = t.execute(&[Op::Delay(Duration::from_millis(200))]);
+    let mut bytes = vec![(true, cmd)];
+    bytes.extend(params.iter().map(|b| (false, *b)));
+    write_all(&mut t, &bytes);
+    let start = t.chip().now();
+    let replies = t.execute(&[
+        Op::AwaitStatus {
+            mask: Status::BUSY,
+            value: Status::BUSY,
+            timeout: Duration::from_millis(10),
+        },
+        Op::AwaitStatus {
+            mask: Status::BUSY,
+            value: 0,
+            timeout: Duration::from_secs(3_600),
+        },
+    ]);
+    let end = replies
+        .ok()
+        .and_then(|r| r.last().map(Reply::at))
+        .unwrap_or(start);
+    Outcome {
+        pulses: t.chip().record().pulse_count(),
+        runs: t.chip().record().runs.len(),
+        virtual_time: end.saturating_since(start),
+    }
+}
+
+fn median_ms(mut samples: Vec<f64>) -> f64 {
+    samples.sort_by(f64::total_cmp);
+    samples.get(samples.len() / 2).copied().unwrap_or(0.0)
+}
+
+fn time_case(repeat: usize, f: impl Fn() -> Outcome) -> (f64, Outcome) {
+    let mut samples = Vec::with_capacity(repeat);
+    let mut last = None;
+    for _ in 0..repeat.max(1) {
+        let t0 = WallClock::now();
+        let o = f();
+        samples.push(t0.elapsed().as_secs_f64() * 1e3);
+        last = Some(o);
+    }
+    let outcome = last.unwrap_or(Outcome {
+        pulses: 0,
+        runs: 0,
+        virtual_time: Duration::ZERO,
+    });
+    (median_ms(samples), outcome)
+}
+
+pub fn run(args: BenchArgs) -> ExitCode {
+    let max_ramp = InitData {
+        rl: 200,
+        rh: 20,
+        pa: 11_220,
+    };
+    let short_ramp = InitData {
+        rl: 100,
+        rh: 20,
+        pa: 100,
+    };
+    let full = PulseCount::MAX.to_bytes();
+    let thousand = PulseCount::new(1_000).map_or([0; 3], PulseCount::to_bytes);
+    let cases: Vec<Case> = vec![
+        (
+            "accel/decel 16,777,216 steps, PA 11,220 (trapezoid)",
+            Box::new(move || one_move(max_ramp, 0x43, &full)),
+        ),
+        (
+            "accel/decel 1,000 steps, PA 100 (console example)",
+            Box::new(move || one_move(short_ramp, 0x43, &thousand)),
+        ),
+        (
+            "constant speed 1,000 steps, rate 100",
+            Box::new(move || {
+                one_move(
+                    short_ramp,
+                    0x44,
+                    &[100, thousand[0], thousand[1], thousand[2]],
+                )
+            }),
+        ),
+        (
+            "constant speed 16,777,216 steps, rate 100",
+            Box::new(move || one_move(short_ramp, 0x44, &[100, full[0], full[1], full[2]])),
+        ),
+    ];
+    println!("| case | median wall time | pulses | stored runs | virtual time |");
+    println!("|---|---:|---:|---:|---:|");
+    for (name, f) in &cases {
+        let (ms, o) = time_case(args.repeat, f);
+        println!(
+            "| {name} | {ms:.3} ms | {} | {} | {:.3} s |",
+            o.pulses,
+            o.runs,
+            o.virtual_time.as_secs_f64()
+        );
+    }
+    // Per-pulse expansion of the longest record, on request.
+    let (ms, pulses) = {
+        let Ok(mut t) = EmuTarget::new(Straps::default(), ModelConfig::default()) else {
+            return ExitCode::from(1);
+        };
+        let mut bytes = vec![(true, 0x02)];
+        bytes.extend(max_ramp.to_bytes().iter().map(|b| (false, *b)));
+        bytes.push((true, 0x43));
+        bytes.extend(full.iter().map(|b| (false, *b)));
+        write_all(&mut t, &bytes);
+        let _ = t.execute(&[Op::AwaitStatus {
+            mask: Status::BUSY,
+            value: 0,
+            timeout: Duration::from_secs(3_600),
+        }]);
+        let t0 = WallClock::now();
+        let n = t.chip().record().pulses().count();
+        (t0.elapsed().as_secs_f64() * 1e3, n)
+    };
+    println!(
+        "| per-pulse expansion of the 16,777,216-step record | {ms:.3} ms | {pulses} | - | - |"
+    );
+    ExitCode::SUCCESS
+}

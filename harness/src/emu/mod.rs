@@ -1,0 +1,10 @@
+//! The reference model of the PPMC-104BFP: a discrete-event simulation in
+//! virtual time, pure (no clock, file or port), following datasheet chapter 3.
+
+mod chip;
+pub mod config;
+mod motion;
+pub mod phase;
+
+pub use chip::{Chip, ChipError, PA_MAX, PA_MIN};
+pub use config::{AccelCurve, ConfigError, ModelConfig};

@@ -1,0 +1,108 @@
+//! Phase excitation sequences for S1..S5 (Section 3-2-1, notes N15).
+//!
+//! A pattern is a 5-bit value with S1 in bit 4 and S5 in bit 0, 1 meaning
+//! the phase is energized (independent of the output logic level). CW steps
+//! forward through the sequence, CCW backward.
+
+use crate::protocol::{Direction, Excitation, MotorType};
+
+/// The winding configuration frozen by the first initialization.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Winding {
+    pub motor: MotorType,
+    pub excitation: Excitation,
+}
+
+impl Winding {
+    /// Number of distinct steps before the sequence repeats.
+    pub fn steps_per_cycle(self) -> u32 {
+        let n = u32::from(self.motor.phases());
+        match self.excitation {
+            Excitation::TwoPhase => n,
+            Excitation::HalfStep => 2 * n,
+        }
+    }
+
+    /// Energized phases at step `index` (taken modulo the cycle).
+    pub fn pattern(self, index: u32) -> u8 {
+        let n = u32::from(self.motor.phases());
+        let i = index % self.steps_per_cycle();
+        let phases: &[u32] = match (self.excitation, self.motor) {
+            // Two adjacent phases: S1S2, S2S3, ...
+            (Excitation::TwoPhase, _) => &[i, i + 1],
+            // 2-3 phase on a 5-phase motor: S1S2, S1S2S3, S2S3, S2S3S4, ...
+            (Excitation::HalfStep, MotorType::FivePhase) => {
+                if i % 2 == 0 {
+                    &[i / 2, i / 2 + 1]
+                } else {
+                    &[i / 2, i / 2 + 1, i / 2 + 2]
+                }
+            }
+            // 1-2 phase: S1, S1S2, S2, S2S3, ...
+            (Excitation::HalfStep, _) => {
+                if i % 2 == 0 {
+                    &[i / 2]
+                } else {
+                    &[i / 2, i / 2 + 1]
+                }
+            }
+        };
+        phases
+            .iter()
+            .fold(0u8, |acc, p| acc | (0b1_0000 >> (p % n)))
+    }
+
+    /// The step index after `count` steps in `dir` from `index`.
+    pub fn advance(self, index: u32, dir: Direction, count: u64) -> u32 {
+        let cycle = u64::from(self.steps_per_cycle());
+        let k = count % cycle;
+        let i = u64::from(index) % cycle;
+        let next = match dir {
+            Direction::Cw => (i + k) % cycle,
+            Direction::Ccw => (i + cycle - k) % cycle,
+        };
+        next as u32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rstest::rstest;
+
+    fn seq(motor: MotorType, excitation: Excitation) -> Vec<u8> {
+        let w = Winding { motor, excitation };
+        (0..w.steps_per_cycle()).map(|i| w.pattern(i)).collect()
+    }
+
+    #[rstest]
+    #[case::three_phase_2ph(MotorType::ThreePhase, Excitation::TwoPhase, vec![0b11000, 0b01100, 0b10100])]
+    #[case::three_phase_1_2ph(MotorType::ThreePhase, Excitation::HalfStep,
+        vec![0b10000, 0b11000, 0b01000, 0b01100, 0b00100, 0b10100])]
+    #[case::four_phase_2ph(MotorType::FourPhase, Excitation::TwoPhase,
+        vec![0b11000, 0b01100, 0b00110, 0b10010])]
+    #[case::four_phase_1_2ph(MotorType::FourPhase, Excitation::HalfStep,
+        vec![0b10000, 0b11000, 0b01000, 0b01100, 0b00100, 0b00110, 0b00010, 0b10010])]
+    #[case::five_phase_2ph(MotorType::FivePhase, Excitation::TwoPhase,
+        vec![0b11000, 0b01100, 0b00110, 0b00011, 0b10001])]
+    #[case::five_phase_2_3ph(MotorType::FivePhase, Excitation::HalfStep,
+        vec![0b11000, 0b11100, 0b01100, 0b01110, 0b00110, 0b00111, 0b00011, 0b10011, 0b10001, 0b11001])]
+    fn s3_2_1_excitation_sequences(
+        #[case] motor: MotorType,
+        #[case] excitation: Excitation,
+        #[case] expected: Vec<u8>,
+    ) {
+        assert_eq!(seq(motor, excitation), expected);
+    }
+
+    #[test]
+    fn advance_wraps_both_ways() {
+        let w = Winding {
+            motor: MotorType::FourPhase,
+            excitation: Excitation::TwoPhase,
+        };
+        assert_eq!(w.advance(0, Direction::Cw, 5), 1);
+        assert_eq!(w.advance(0, Direction::Ccw, 1), 3);
+        assert_eq!(w.advance(2, Direction::Ccw, 16_777_216), 2);
+    }
+}
