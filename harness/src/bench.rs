@@ -161,11 +161,18 @@ pub fn run(args: BenchArgs) -> ExitCode {
         bytes.push((true, 0x43));
         bytes.extend(full.iter().map(|b| (false, *b)));
         write_all(&mut t, &bytes);
-        let _ = t.execute(&[Op::AwaitStatus {
-            mask: Status::BUSY,
-            value: 0,
-            timeout: Duration::from_secs(3_600),
-        }]);
+        let _ = t.execute(&[
+            Op::AwaitStatus {
+                mask: Status::BUSY,
+                value: Status::BUSY,
+                timeout: Duration::from_millis(10),
+            },
+            Op::AwaitStatus {
+                mask: Status::BUSY,
+                value: 0,
+                timeout: Duration::from_secs(3_600),
+            },
+        ]);
         let t0 = WallClock::now();
         let n = t.chip().record().pulses().count();
         (t0.elapsed().as_secs_f64() * 1e3, n)

@@ -1,0 +1,274 @@
+//! A host that follows the datasheet flowcharts, for the behaviour tests.
+//!
+//! It drives the emulator through the [`Target`] trait, so the tests also
+//! exercise the op / reply path every other front end uses.
+
+#![allow(dead_code)] // each test file uses a different part of the helper
+
+use ppmc::emu::{Chip, ModelConfig};
+use ppmc::protocol::{
+    Direction, ErrorCode, InitData, Input, MoveCommand, MoveKind, PulseCount, Status, Straps,
+};
+use ppmc::target::{EmuTarget, Op, Reply, Target};
+use ppmc::time::{Duration, Instant};
+
+pub const US: fn(u64) -> Duration = Duration::from_micros;
+pub const MS: fn(u64) -> Duration = Duration::from_millis;
+
+/// RL = 100, RH = 20, PA = 100: the console example of issue 2.
+pub const EXAMPLE_INIT: InitData = InitData {
+    rl: 100,
+    rh: 20,
+    pa: 100,
+};
+
+/// 4-phase motor, 2-phase excitation, negative logic, internal clock.
+pub const INIT_4PH: u8 = 0x02;
+
+pub struct Host {
+    pub t: EmuTarget,
+}
+
+impl Host {
+    pub fn new() -> Self {
+        Host::with(Straps::default(), ModelConfig::default())
+    }
+
+    pub fn with(straps: Straps, cfg: ModelConfig) -> Self {
+        Host {
+            t: EmuTarget::new(straps, cfg).expect("valid straps and config"),
+        }
+    }
+
+    pub fn chip(&self) -> &Chip {
+        self.t.chip()
+    }
+
+    pub fn now(&self) -> Instant {
+        self.t.chip().now()
+    }
+
+    fn one(&mut self, op: Op) -> Reply {
+        self.t.execute_one(op).expect("the emulator never fails")
+    }
+
+    /// Flowchart write: wait for IBF = 0, then write the command register.
+    /// Returns the time of the write.
+    pub fn wc(&mut self, byte: u8) -> Instant {
+        match self.one(Op::WriteCommand {
+            byte,
+            wait_ibf: Some(Duration::from_secs(1)),
+        }) {
+            Reply::Written { at } => at,
+            other => panic!("wc 0x{byte:02X}: {other:?}"),
+        }
+    }
+
+    /// Flowchart write of the data register.
+    pub fn wd(&mut self, byte: u8) -> Instant {
+        match self.one(Op::WriteData {
+            byte,
+            wait_ibf: Some(Duration::from_secs(1)),
+        }) {
+            Reply::Written { at } => at,
+            other => panic!("wd 0x{byte:02X}: {other:?}"),
+        }
+    }
+
+    /// Writes the command register at once, ignoring IBF (raw layer).
+    pub fn wc_now(&mut self, byte: u8) {
+        self.one(Op::WriteCommand {
+            byte,
+            wait_ibf: None,
+        });
+    }
+
+    /// Writes the data register at once, ignoring IBF (raw layer).
+    pub fn wd_now(&mut self, byte: u8) {
+        self.one(Op::WriteData {
+            byte,
+            wait_ibf: None,
+        });
+    }
+
+    /// A command and its data bytes, each after IBF = 0. Returns the time of
+    /// the final write.
+    pub fn send(&mut self, cmd: u8, data: &[u8]) -> Instant {
+        let mut at = self.wc(cmd);
+        for b in data {
+            at = self.wd(*b);
+        }
+        at
+    }
+
+    pub fn status(&self) -> Status {
+        self.t.chip().read_status()
+    }
+
+    /// Waits for the byte in the input buffer to be taken, then returns the
+    /// status: what the host sees once the chip has reacted.
+    pub fn settled_status(&mut self) -> Status {
+        self.await_flag(Status::IBF, false, MS(1000))
+            .expect("IBF clears");
+        self.status()
+    }
+
+    /// Flowchart read: wait for OBF = 1, then read the data register.
+    pub fn rd(&mut self) -> u8 {
+        match self.one(Op::ReadData {
+            wait_obf: Some(Duration::from_secs(1)),
+        }) {
+            Reply::Data { byte, .. } => byte,
+            other => panic!("rd: {other:?}"),
+        }
+    }
+
+    pub fn wait(&mut self, d: Duration) {
+        self.one(Op::Delay(d));
+    }
+
+    /// Waits for a status flag; `Some(waited)` or `None` on timeout.
+    pub fn await_flag(&mut self, mask: u8, value: bool, timeout: Duration) -> Option<Duration> {
+        match self.one(Op::AwaitStatus {
+            mask,
+            value: if value { mask } else { 0 },
+            timeout,
+        }) {
+            Reply::Awaited { waited, .. } => Some(waited),
+            _ => None,
+        }
+    }
+
+    pub fn set(&mut self, input: Input, asserted: bool) {
+        self.one(Op::SetInput { input, asserted });
+    }
+
+    /// Initialization with the given code and data, then waits until the
+    /// chip takes commands again.
+    pub fn init(&mut self, code: u8, data: InitData) {
+        self.send(code, &data.to_bytes());
+        self.wait(MS(200));
+    }
+
+    /// The console example's initialization: 4-phase, RL 100, RH 20, PA 100.
+    pub fn init_example(&mut self) {
+        self.init(INIT_4PH, EXAMPLE_INIT);
+    }
+
+    /// Issues a move and returns the time of its final write.
+    pub fn start(&mut self, cmd: MoveCommand, rate: Option<u8>, steps: Option<u32>) -> Instant {
+        let mut data = Vec::new();
+        if let Some(r) = rate {
+            data.push(r);
+        }
+        if let Some(n) = steps {
+            data.extend(PulseCount::new(n).expect("step count in range").to_bytes());
+        }
+        self.wait_ready();
+        self.send(Command::move_byte(cmd), &data)
+    }
+
+    /// Waits for BUSY = 0 and IBF = 0, as the flowcharts require before an
+    /// operation command.
+    pub fn wait_ready(&mut self) {
+        self.await_flag(Status::BUSY, false, Duration::from_secs(10_000))
+            .expect("BUSY clears");
+        self.await_flag(Status::IBF, false, MS(1000))
+            .expect("IBF clears");
+    }
+
+    /// Waits for BUSY to rise and fall again.
+    pub fn run_to_end(&mut self) {
+        self.await_flag(Status::BUSY, true, MS(5))
+            .expect("BUSY rises");
+        self.await_flag(Status::BUSY, false, Duration::from_secs(10_000))
+            .expect("BUSY falls");
+    }
+
+    /// Accel/decel move of `steps` in `dir` (interrupt enabled), run to end.
+    pub fn accel_move(&mut self, dir: Direction, steps: u32) {
+        self.start(
+            MoveCommand::new(MoveKind::AccelDecel, dir, true),
+            None,
+            Some(steps),
+        );
+        self.run_to_end();
+    }
+
+    /// Reads a register with the flowchart (BUSY = 0, IBF = 0, command,
+    /// then OBF = 1 before each byte).
+    pub fn read_reg(&mut self, code: u8, bytes: usize) -> Vec<u8> {
+        self.wait_ready();
+        self.wc(code);
+        (0..bytes).map(|_| self.rd()).collect()
+    }
+
+    pub fn finish_status(&mut self) -> u8 {
+        self.read_reg(0x80, 1)[0]
+    }
+
+    /// The remaining-pulses register as read (one less than the remainder).
+    pub fn remaining_read(&mut self) -> u32 {
+        let b = self.read_reg(0x83, 3);
+        u32::from_le_bytes([b[0], b[1], b[2], 0])
+    }
+
+    pub fn error(&self) -> Option<ErrorCode> {
+        self.status().error()
+    }
+
+    /// Pulses of the most recent move.
+    pub fn pulses(&self) -> u64 {
+        self.t.chip().record().last_move_pulses().count
+    }
+
+    /// Times of every pulse recorded so far.
+    pub fn pulse_times(&self) -> Vec<Instant> {
+        self.t.chip().record().pulses().map(|(t, _)| t).collect()
+    }
+
+    /// Time of the first pulse of the most recent move.
+    pub fn first_pulse(&self) -> Instant {
+        self.t
+            .chip()
+            .record()
+            .last_move_pulses()
+            .first
+            .expect("the move pulsed")
+    }
+
+    pub fn last_pulse(&self) -> Instant {
+        self.t
+            .chip()
+            .record()
+            .last_move_pulses()
+            .last
+            .expect("the move pulsed")
+    }
+
+    /// Time of the first pin event for `pin` with `value` at or after `from`.
+    pub fn pin_event(&self, pin: ppmc::protocol::Pin, value: u8, from: Instant) -> Option<Instant> {
+        self.t
+            .chip()
+            .record()
+            .pins
+            .iter()
+            .find(|e| e.pin == pin && e.value == value && e.at >= from)
+            .map(|e| e.at)
+    }
+}
+
+/// Encoding helper, kept here so the tests read as command names.
+pub struct Command;
+
+impl Command {
+    pub fn move_byte(cmd: MoveCommand) -> u8 {
+        ppmc::protocol::Command::Move(cmd).encode()
+    }
+}
+
+/// Whether `got` is within `permille` of `want`.
+pub fn within(got: Duration, want: Duration, permille: u64) -> bool {
+    let tol = want.scale(permille, 1000);
+    got >= want.saturating_sub(tol) && got <= want + tol
+}
