@@ -177,6 +177,12 @@ impl Host {
             .expect("IBF clears");
     }
 
+    /// Waits for BUSY = 0 (a move already under way ends).
+    pub fn await_idle(&mut self) {
+        self.await_flag(Status::BUSY, false, Duration::from_secs(10_000))
+            .expect("BUSY falls");
+    }
+
     /// Waits for BUSY to rise and fall again.
     pub fn run_to_end(&mut self) {
         self.await_flag(Status::BUSY, true, MS(5))
