@@ -3,7 +3,10 @@
 use std::io::Write;
 use std::process::{Command, Output, Stdio};
 
-const EXAMPLE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/examples/accel-1000-steps.ppmc");
+const EXAMPLE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../docs/examples/accel-1000-steps.ppmc"
+);
 
 fn ppmc(args: &[&str], stdin: &str) -> Output {
     let mut child = Command::new(env!("CARGO_BIN_EXE_ppmc"))
@@ -33,7 +36,10 @@ fn example_script_moves_1000_steps_cw() {
     let out = ppmc(&["console", EXAMPLE], "");
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
-    assert!(stdout.contains("pulses count=1000 cw=1000 ccw=0 "), "{stdout}");
+    assert!(
+        stdout.contains("pulses count=1000 cw=1000 ccw=0 "),
+        "{stdout}"
+    );
     assert!(stdout.contains(" min=42.000us "), "{stdout}");
     assert!(stdout.trim_end().ends_with("rd 0x83"), "{stdout}");
     insta::assert_snapshot!("accel_1000_steps", stdout);
@@ -42,7 +48,10 @@ fn example_script_moves_1000_steps_cw() {
 #[test]
 fn same_script_gives_byte_identical_output() {
     let a = ppmc(&["console", EXAMPLE], "");
-    let b = ppmc(&["console", "-"], &std::fs::read_to_string(EXAMPLE).expect("example"));
+    let b = ppmc(
+        &["console", "-"],
+        &std::fs::read_to_string(EXAMPLE).expect("example"),
+    );
     assert_eq!(a.stdout, b.stdout);
     assert!(!a.stdout.is_empty());
 }
@@ -51,7 +60,10 @@ fn same_script_gives_byte_identical_output() {
 fn a_bad_line_stops_with_its_number_and_exit_2_before_anything_runs() {
     let out = ppmc(&["console", "-e", "rs\nrs\nwc 0x1FF\nrs"], "");
     assert_eq!(out.status.code(), Some(2));
-    assert_eq!(text(&out.stderr).trim(), "line 3: `0x1FF` is out of range for a byte (0..=255)");
+    assert_eq!(
+        text(&out.stderr).trim(),
+        "line 3: `0x1FF` is out of range for a byte (0..=255)"
+    );
     assert!(out.stdout.is_empty(), "nothing ran: {}", text(&out.stdout));
 }
 
@@ -64,12 +76,18 @@ fn a_bad_line_in_a_file_names_the_file() {
     let out = ppmc(&["console", f.to_str().expect("utf-8 path")], "");
     assert_eq!(out.status.code(), Some(2));
     let err = text(&out.stderr);
-    assert!(err.contains("bad.ppmc: line 2: unknown op `frobnicate`"), "{err}");
+    assert!(
+        err.contains("bad.ppmc: line 2: unknown op `frobnicate`"),
+        "{err}"
+    );
 }
 
 #[test]
 fn stdin_script_and_result_lines() {
-    let out = ppmc(&["console"], "rs\nwc 0x87\nawait ibf=0 100us\nrs\nnow\npins\nrd!\n");
+    let out = ppmc(
+        &["console"],
+        "rs\nwc 0x87\nawait ibf=0 100us\nrs\nnow\npins\nrd!\n",
+    );
     assert!(out.status.success());
     assert_eq!(
         text(&out.stdout),
@@ -80,9 +98,15 @@ fn stdin_script_and_result_lines() {
 
 #[test]
 fn timeouts_are_results_not_errors() {
-    let out = ppmc(&["console", "--obf-timeout", "1ms"], "rd\nawait busy=1 2ms\n");
+    let out = ppmc(
+        &["console", "--obf-timeout", "1ms"],
+        "rd\nawait busy=1 2ms\n",
+    );
     assert!(out.status.success());
-    assert_eq!(text(&out.stdout), "rd timeout obf=0\nawait busy=1 timeout\n");
+    assert_eq!(
+        text(&out.stdout),
+        "rd timeout obf=0\nawait busy=1 timeout\n"
+    );
 }
 
 #[test]
@@ -100,6 +124,14 @@ fn straps_change_the_pulse_rate() {
     let script = "wc 0x02; wd 100; wd 20; wd 100; wd 0; wait 200ms; wc 0x44; wd 9; wd 9; wd 0; wd 0\nawait busy=1 1ms; await busy=0 1s; pulses";
     let out = ppmc(&["console", "--csel", "low", "-e", script], "");
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("count=10 cw=10 ccw=0"), "{}", text(&out.stdout));
-    assert!(text(&out.stdout).contains("min=80.000us max=80.000us"), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("count=10 cw=10 ccw=0"),
+        "{}",
+        text(&out.stdout)
+    );
+    assert!(
+        text(&out.stdout).contains("min=80.000us max=80.000us"),
+        "{}",
+        text(&out.stdout)
+    );
 }
