@@ -41,43 +41,46 @@ fn write_all(t: &mut EmuTarget, bytes: &[(bool, u8)]) {
     let _ = t.execute(&ops);
 }
 
-/// Initializes a 4-phase motor and runs one move to its end.
-fn one_move(init: InitData, cmd: u8, params: &[u8]) -> Outcome {
-    let Ok(mut t) = EmuTarget::new(Straps::default(), ModelConfig::default()) else {
-        return Outcome {
-            pulses: 0,
-            runs: 0,
-            virtual_time: Duration::ZERO,
-        };
-    };
+/// Initializes a 4-phase motor and runs one move to its end; returns the
+/// target and the virtual time the move took from its final write.
+fn run_move(init: InitData, cmd: u8, params: &[u8]) -> Option<(EmuTarget, Duration)> {
+    let mut t = EmuTarget::new(Straps::default(), ModelConfig::default()).ok()?;
     let mut bytes = vec![(true, 0x02)];
     bytes.extend(init.to_bytes().iter().map(|b| (false, *b)));
-    write_all(&mut t, &bytes);
-    let _ = t.execute(&[Op::Delay(Duration::from_millis(200))]);
-    let mut bytes = vec![(true, cmd)];
+    bytes.push((true, cmd));
     bytes.extend(params.iter().map(|b| (false, *b)));
     write_all(&mut t, &bytes);
     let start = t.chip().now();
-    let replies = t.execute(&[
-        Op::AwaitStatus {
-            mask: Status::BUSY,
-            value: Status::BUSY,
-            timeout: Duration::from_millis(10),
+    let replies = t
+        .execute(&[
+            Op::AwaitStatus {
+                mask: Status::BUSY,
+                value: Status::BUSY,
+                timeout: Duration::from_millis(10),
+            },
+            Op::AwaitStatus {
+                mask: Status::BUSY,
+                value: 0,
+                timeout: Duration::from_secs(3_600),
+            },
+        ])
+        .ok()?;
+    let end = replies.last().map_or(start, Reply::at);
+    Some((t, end.saturating_since(start)))
+}
+
+fn one_move(init: InitData, cmd: u8, params: &[u8]) -> Outcome {
+    match run_move(init, cmd, params) {
+        Some((t, virtual_time)) => Outcome {
+            pulses: t.chip().record().pulse_count(),
+            runs: t.chip().record().runs.len(),
+            virtual_time,
         },
-        Op::AwaitStatus {
-            mask: Status::BUSY,
-            value: 0,
-            timeout: Duration::from_secs(3_600),
+        None => Outcome {
+            pulses: 0,
+            runs: 0,
+            virtual_time: Duration::ZERO,
         },
-    ]);
-    let end = replies
-        .ok()
-        .and_then(|r| r.last().map(Reply::at))
-        .unwrap_or(start);
-    Outcome {
-        pulses: t.chip().record().pulse_count(),
-        runs: t.chip().record().runs.len(),
-        virtual_time: end.saturating_since(start),
     }
 }
 
@@ -152,35 +155,17 @@ pub fn run(args: BenchArgs) -> ExitCode {
         );
     }
     // Per-pulse expansion of the longest record, on request.
-    let (ms, pulses) = {
-        let Ok(mut t) = EmuTarget::new(Straps::default(), ModelConfig::default()) else {
-            return ExitCode::from(1);
-        };
-        let mut bytes = vec![(true, 0x02)];
-        bytes.extend(max_ramp.to_bytes().iter().map(|b| (false, *b)));
-        bytes.push((true, 0x43));
-        bytes.extend(full.iter().map(|b| (false, *b)));
-        write_all(&mut t, &bytes);
-        let _ = t.execute(&[
-            Op::AwaitStatus {
-                mask: Status::BUSY,
-                value: Status::BUSY,
-                timeout: Duration::from_millis(10),
-            },
-            Op::AwaitStatus {
-                mask: Status::BUSY,
-                value: 0,
-                timeout: Duration::from_secs(3_600),
-            },
-        ]);
-        let t0 = WallClock::now();
-        let mut n = 0u64;
-        for (at, _) in t.chip().record().pulses() {
-            std::hint::black_box(at);
-            n += 1;
-        }
-        (t0.elapsed().as_secs_f64() * 1e3, n)
+    let Some((t, _)) = run_move(max_ramp, 0x43, &full) else {
+        eprintln!("ppmc bench: the emulator could not be built");
+        return ExitCode::from(1);
     };
+    let t0 = WallClock::now();
+    let mut pulses = 0u64;
+    for (at, _) in t.chip().record().pulses() {
+        std::hint::black_box(at);
+        pulses += 1;
+    }
+    let ms = t0.elapsed().as_secs_f64() * 1e3;
     println!(
         "| per-pulse expansion of the 16,777,216-step record | {ms:.3} ms | {pulses} | - | - |"
     );
