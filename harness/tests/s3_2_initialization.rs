@@ -156,6 +156,9 @@ fn s3_2_1_external_clock_without_a_clock_never_pulses() {
         "stuck busy"
     );
     assert_eq!(h.pulses(), 0);
+    // Even waiting to the end of time ends, with no pulse.
+    assert!(h.await_flag(Status::BUSY, false, Duration::MAX).is_none());
+    assert_eq!(h.pulses(), 0);
 }
 
 #[test]

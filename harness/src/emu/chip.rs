@@ -294,10 +294,14 @@ impl Chip {
     /// the next pulse, so waiting costs O(1) per stretch.
     pub fn poll_at(&self) -> Option<Instant> {
         let timer = self.next_timer().map(|(at, _)| at);
-        let pulse = self.motion.as_ref().filter(|m| m.pulses_left()).map(|m| {
-            let (interval, count) = m.constant_stretch();
-            m.next_pulse + interval.saturating_mul(u64::from(count - 1))
-        });
+        let pulse = self
+            .motion
+            .as_ref()
+            .filter(|m| m.pulses_left() && m.next_pulse != Instant::NEVER)
+            .map(|m| {
+                let (interval, count) = m.constant_stretch();
+                m.next_pulse + interval.saturating_mul(u64::from(count - 1))
+            });
         match (timer, pulse) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
@@ -311,27 +315,29 @@ impl Chip {
             return;
         }
         loop {
-            let timer_at = self.next_timer().map_or(Instant::NEVER, |(at, _)| at);
+            let next_timer = self.next_timer();
+            let timer_at = next_timer.map_or(Instant::NEVER, |(at, _)| at);
             let horizon = timer_at.min(until);
             let pulse_at = self
                 .motion
                 .as_ref()
                 .filter(|m| m.pulses_left())
                 .map_or(Instant::NEVER, |m| m.next_pulse);
-            if pulse_at <= horizon {
+            // A move without a base clock has its next pulse at NEVER: it
+            // never comes, however far time is advanced.
+            if pulse_at <= horizon && pulse_at != Instant::NEVER {
                 self.now = self.now.max(pulse_at);
                 self.emit_pulses(horizon);
                 continue;
             }
-            if timer_at <= until {
-                if let Some((at, idx)) = self.next_timer() {
+            match next_timer {
+                Some((at, idx)) if at <= until => {
                     let (_, _, timer) = self.timers.remove(idx);
                     self.now = self.now.max(at);
                     self.fire(timer);
                 }
-                continue;
+                _ => break,
             }
-            break;
         }
         self.now = until;
     }
