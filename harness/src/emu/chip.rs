@@ -16,16 +16,15 @@
 
 use super::config::{ConfigError, ModelConfig};
 use super::motion::{accel_table, Motion, Profile};
-use super::phase::Winding;
 use crate::protocol::capture::{MoveStart, Pin, Pins, Record};
 use crate::protocol::{
     AuxInputStatus, ClockSource, Command, Direction, ErrorCode, FinishStatus, InitCommand,
     InitData, Input, InputSet, InputStatus, MoveCommand, MoveKind, OutputLogic, OutputStatus,
-    PulseCount, Register, Status, StatusField, StopCause, Straps, StrapsError,
+    PulseCount, Register, Status, StatusField, StopCause, Straps, StrapsError, Winding,
 };
 use crate::time::{Duration, Instant};
 use std::collections::VecDeque;
-use std::rc::Rc;
+use std::sync::Arc;
 
 /// Highest accepted number of acceleration pulses (Table 3-2 error 4, notes N5).
 pub const PA_MAX: u16 = 11_220;
@@ -72,7 +71,7 @@ struct Setup {
     stop_switching: bool,
     data: InitData,
     /// Acceleration table and high-speed period, `None` without a clock.
-    ramp: Option<(Rc<[Duration]>, Duration)>,
+    ramp: Option<(Arc<[Duration]>, Duration)>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -286,6 +285,27 @@ impl Chip {
             dir: self.dir,
             busy: self.busy,
         }
+    }
+
+    /// Pulses output so far by the move in progress (or the last move).
+    pub fn move_pulses(&self) -> u64 {
+        match &self.motion {
+            Some(m) => u64::from(m.emitted),
+            None => self.record.last_move_pulses().count,
+        }
+    }
+
+    /// When the `n`-th pulse (1-based) of the move in progress will come if
+    /// nothing changes its plan first; a later time in its current stretch
+    /// when `n` lies beyond it. `None` when no further pulse is planned.
+    pub fn predict_pulse(&self, n: u64) -> Option<Instant> {
+        let m = self.motion.as_ref().filter(|m| m.pulses_left())?;
+        if m.next_pulse == Instant::NEVER || n <= u64::from(m.emitted) {
+            return None;
+        }
+        let (interval, stretch) = m.constant_stretch();
+        let k = (n - u64::from(m.emitted)).min(u64::from(stretch));
+        Some(m.next_pulse + interval.saturating_mul(k - 1))
     }
 
     /// The next instant at which the status register, a pin or the
@@ -546,7 +566,10 @@ impl Chip {
                 data.rh,
                 data.pa,
             );
-            (Rc::from(table), self.straps.pulse_interval(data.rh, tclock))
+            (
+                Arc::from(table),
+                self.straps.pulse_interval(data.rh, tclock),
+            )
         });
         self.setup = Some(Setup {
             clock: cmd.clock,
@@ -620,7 +643,7 @@ impl Chip {
                 }
                 (
                     Profile::Ramped {
-                        table: Rc::clone(table),
+                        table: Arc::clone(table),
                         cruise: *cruise,
                     },
                     Some(first),
@@ -671,6 +694,7 @@ impl Chip {
             steps: total,
             first_run: self.record.runs.len(),
             phase_index: self.phase_index,
+            winding: if cmd.pout { None } else { self.winding },
         });
         self.motion = Some(motion);
         let rise = base + self.fw(self.cfg.busy_rise);

@@ -4,7 +4,6 @@
 mod chip;
 pub mod config;
 mod motion;
-pub mod phase;
 
 pub use chip::{Chip, ChipError, PA_MAX, PA_MIN};
 pub use config::{AccelCurve, ConfigError, ModelConfig};

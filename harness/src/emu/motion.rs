@@ -19,7 +19,7 @@
 use super::config::AccelCurve;
 use crate::protocol::{Direction, MoveKind, StopCause, Straps};
 use crate::time::{Duration, Instant};
-use std::rc::Rc;
+use std::sync::Arc;
 
 /// The periods a move is built from.
 #[derive(Debug, Clone)]
@@ -28,7 +28,7 @@ pub(crate) enum Profile {
     Constant { interval: Duration },
     /// `table[v]` for speed index `v < PA`, `cruise` at `v = PA`.
     Ramped {
-        table: Rc<[Duration]>,
+        table: Arc<[Duration]>,
         cruise: Duration,
     },
 }

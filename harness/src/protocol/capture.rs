@@ -8,6 +8,7 @@
 //! into single pulses on request.
 
 use super::command::{Direction, MoveKind};
+use super::phase::Winding;
 use crate::time::{Duration, Instant};
 
 /// `count` pulses in `dir`, the first at `start`, each `interval` after the
@@ -112,6 +113,9 @@ pub struct MoveStart {
     pub first_run: usize,
     /// Phase step index before the first pulse.
     pub phase_index: u32,
+    /// The excitation sequence the pulses step through; `None` in POUT mode
+    /// (the phases hold) or before any initialization.
+    pub winding: Option<Winding>,
 }
 
 /// Summary of a stretch of pulses, as the console's `pulses` prints it.

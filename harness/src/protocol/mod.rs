@@ -5,6 +5,7 @@
 
 pub mod capture;
 pub mod command;
+pub mod phase;
 pub mod rates;
 pub mod registers;
 pub mod timing;
@@ -14,6 +15,7 @@ pub use command::{
     ClockSource, Command, Direction, Excitation, InitCommand, InitData, MotorType, MoveCommand,
     MoveKind, OpFlags, OutputLogic, PulseCount, Register,
 };
+pub use phase::Winding;
 pub use rates::{Straps, StrapsError};
 pub use registers::{
     AuxInputStatus, ErrorCode, FinishStatus, Input, InputSet, InputStatus, OutputStatus, Status,

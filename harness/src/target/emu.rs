@@ -2,7 +2,7 @@
 
 use super::{Op, Reply, Target, TargetError, TargetInfo};
 use crate::emu::{Chip, ChipError, ModelConfig};
-use crate::protocol::{Status, Straps};
+use crate::protocol::{Record, Status, Straps};
 use crate::time::{Duration, Instant};
 
 /// The in-process emulator. Batches run instantly in wall time; waits are
@@ -10,12 +10,16 @@ use crate::time::{Duration, Instant};
 #[derive(Debug, Clone)]
 pub struct EmuTarget {
     chip: Chip,
+    straps: Straps,
+    cfg: ModelConfig,
 }
 
 impl EmuTarget {
     pub fn new(straps: Straps, cfg: ModelConfig) -> Result<Self, ChipError> {
         Ok(EmuTarget {
-            chip: Chip::new(straps, cfg)?,
+            chip: Chip::new(straps, cfg.clone())?,
+            straps,
+            cfg,
         })
     }
 
@@ -56,6 +60,32 @@ impl EmuTarget {
                 }
             }
         }
+    }
+
+    /// Waits until the move has output `count` pulses. Stops exactly at
+    /// that pulse, even inside a constant-rate stretch.
+    fn wait_pulses(&mut self, count: u64, timeout: Duration) -> Result<Instant, u64> {
+        let deadline = self.chip.now() + timeout;
+        loop {
+            if self.chip.move_pulses() >= count {
+                return Ok(self.chip.now());
+            }
+            let next = match (self.chip.predict_pulse(count), self.chip.poll_at()) {
+                (Some(a), Some(b)) => a.min(b),
+                (a, b) => match a.or(b) {
+                    Some(t) => t,
+                    None => break,
+                },
+            };
+            if next > deadline {
+                break;
+            }
+            let now = self.chip.now();
+            self.chip
+                .advance_to(next.max(now + Duration::from_nanos(1)).min(deadline));
+        }
+        self.chip.advance_to(deadline.max(self.chip.now()));
+        Err(self.chip.move_pulses())
     }
 
     fn status_at(&self) -> (Instant, Status) {
@@ -130,6 +160,22 @@ impl EmuTarget {
                 at: self.chip.now(),
                 summary: self.chip.record().last_move_pulses(),
             },
+            Op::AwaitPulses { count, timeout } => match self.wait_pulses(count, timeout) {
+                Ok(at) => Reply::PulsesReached { at },
+                Err(count) => Reply::PulsesTimedOut {
+                    at: self.chip.now(),
+                    count,
+                },
+            },
+            Op::Reset => {
+                // Straps and config were validated when the target was built.
+                if let Ok(chip) = Chip::new(self.straps, self.cfg.clone()) {
+                    self.chip = chip;
+                }
+                Reply::ResetDone {
+                    at: self.chip.now(),
+                }
+            }
         }
     }
 }
@@ -155,6 +201,10 @@ impl Target for EmuTarget {
                 ),
             ],
         }
+    }
+
+    fn capture(&mut self) -> Result<Record, TargetError> {
+        Ok(self.chip.record().clone())
     }
 
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {

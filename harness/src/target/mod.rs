@@ -12,7 +12,7 @@ mod emu;
 
 pub use self::emu::EmuTarget;
 
-use crate::protocol::{Input, Pins, PulseSummary, Status};
+use crate::protocol::{Input, Pins, PulseSummary, Record, Status};
 use crate::time::{Duration, Instant};
 use std::fmt;
 
@@ -50,6 +50,14 @@ pub enum Op {
     ReadPins,
     /// Summarize the pulses of the most recent move.
     ReadPulses,
+    /// Wait until the most recent move has output `count` pulses (at most
+    /// `timeout`), so that the next op acts right after that pulse: how a
+    /// scenario drives a limit switch "after N pulses" on the target's own
+    /// clock.
+    AwaitPulses { count: u64, timeout: Duration },
+    /// Hardware reset of the chip (the RESET pin): registers, inputs and the
+    /// capture start over, and the target's clock restarts at zero.
+    Reset,
 }
 
 /// The outcome of one [`Op`], stamped with the target's time when it ended.
@@ -101,6 +109,18 @@ pub enum Reply {
         at: Instant,
         summary: PulseSummary,
     },
+    /// The pulse count was reached; `at` is the time of that pulse.
+    PulsesReached {
+        at: Instant,
+    },
+    /// The move ended or the timeout passed first; `count` pulses were seen.
+    PulsesTimedOut {
+        at: Instant,
+        count: u64,
+    },
+    ResetDone {
+        at: Instant,
+    },
 }
 
 impl Reply {
@@ -117,7 +137,10 @@ impl Reply {
             | Reply::AwaitTimedOut { at, .. }
             | Reply::InputSet { at }
             | Reply::Pins { at, .. }
-            | Reply::Pulses { at, .. } => at,
+            | Reply::Pulses { at, .. }
+            | Reply::PulsesReached { at }
+            | Reply::PulsesTimedOut { at, .. }
+            | Reply::ResetDone { at } => at,
         }
     }
 }
@@ -158,8 +181,12 @@ pub struct TargetInfo {
 }
 
 /// A chip the harness can drive.
-pub trait Target {
+pub trait Target: Send {
     fn info(&self) -> TargetInfo;
+
+    /// Everything captured on the output side since the last reset: pulse
+    /// runs with the target's timestamps, pin changes, move starts.
+    fn capture(&mut self) -> Result<Record, TargetError>;
 
     /// Runs `ops` back to back and returns one reply per op, in order.
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError>;

@@ -4,7 +4,7 @@
 //! the phase is energized (independent of the output logic level). CW steps
 //! forward through the sequence, CCW backward.
 
-use crate::protocol::{Direction, Excitation, MotorType};
+use super::command::{Direction, Excitation, MotorType};
 
 /// The winding configuration frozen by the first initialization.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -50,6 +50,34 @@ impl Winding {
         phases
             .iter()
             .fold(0u8, |acc, p| acc | (0b1_0000 >> (p % n)))
+    }
+
+    /// Short name used in traces: `3ph-2`, `4ph-12`, `5ph-23`, ...
+    pub fn name(self) -> &'static str {
+        match (self.motor, self.excitation) {
+            (MotorType::ThreePhase, Excitation::TwoPhase) => "3ph-2",
+            (MotorType::ThreePhase, Excitation::HalfStep) => "3ph-12",
+            (MotorType::FourPhase, Excitation::TwoPhase) => "4ph-2",
+            (MotorType::FourPhase, Excitation::HalfStep) => "4ph-12",
+            (MotorType::FivePhase, Excitation::TwoPhase) => "5ph-2",
+            (MotorType::FivePhase, Excitation::HalfStep) => "5ph-23",
+        }
+    }
+
+    /// Inverse of [`Winding::name`].
+    pub fn from_name(s: &str) -> Option<Winding> {
+        let all = [
+            MotorType::ThreePhase,
+            MotorType::FourPhase,
+            MotorType::FivePhase,
+        ];
+        all.into_iter()
+            .flat_map(|motor| {
+                [Excitation::TwoPhase, Excitation::HalfStep]
+                    .into_iter()
+                    .map(move |excitation| Winding { motor, excitation })
+            })
+            .find(|w| w.name() == s)
     }
 
     /// The step index after `count` steps in `dir` from `index`.
