@@ -6,50 +6,12 @@
 //! [`run`] executes statements on a [`Target`] and prints one line per
 //! result.
 
+pub use crate::protocol::Flag;
 use crate::protocol::{Direction, Input, Status};
 use crate::target::{Op, Reply, Target, TargetError};
 use crate::time::Duration;
 use std::fmt;
 use std::io::{self, Write};
-
-/// A status flag that `await` can wait on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Flag {
-    Ibf,
-    Obf,
-    Busy,
-    Err,
-}
-
-impl Flag {
-    pub fn mask(self) -> u8 {
-        match self {
-            Flag::Ibf => Status::IBF,
-            Flag::Obf => Status::OBF,
-            Flag::Busy => Status::BUSY,
-            Flag::Err => Status::ERROR,
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Flag::Ibf => "ibf",
-            Flag::Obf => "obf",
-            Flag::Busy => "busy",
-            Flag::Err => "err",
-        }
-    }
-
-    fn parse(s: &str) -> Option<Flag> {
-        match s {
-            "ibf" => Some(Flag::Ibf),
-            "obf" => Some(Flag::Obf),
-            "busy" => Some(Flag::Busy),
-            "err" => Some(Flag::Err),
-            _ => None,
-        }
-    }
-}
 
 /// One console operation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -157,7 +119,7 @@ fn parse_stmt(text: &str) -> Result<Stmt, String> {
             let (flag, value) = args[0]
                 .split_once('=')
                 .ok_or_else(|| format!("`{}` should be <flag>=<0|1>", args[0]))?;
-            let flag = Flag::parse(&flag.to_ascii_lowercase())
+            let flag = Flag::from_name(&flag.to_ascii_lowercase())
                 .ok_or_else(|| format!("unknown flag `{flag}` (expected ibf, obf, busy or err)"))?;
             let value = match value {
                 "0" => false,

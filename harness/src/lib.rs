@@ -11,3 +11,4 @@ pub mod emu;
 pub mod protocol;
 pub mod target;
 pub mod time;
+pub mod trace;

@@ -18,7 +18,7 @@ pub use command::{
 pub use phase::Winding;
 pub use rates::{Straps, StrapsError};
 pub use registers::{
-    AuxInputStatus, ErrorCode, FinishStatus, Input, InputSet, InputStatus, OutputStatus, Status,
-    StatusField, StopCause,
+    AuxInputStatus, ErrorCode, FinishStatus, Flag, Input, InputSet, InputStatus, OutputStatus,
+    Status, StatusField, StopCause,
 };
 pub use timing::{TimingId, TimingRow, TABLE_3_3};

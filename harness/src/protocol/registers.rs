@@ -166,6 +166,45 @@ impl fmt::Debug for Status {
     }
 }
 
+/// A status register flag that a host can wait on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Flag {
+    Ibf,
+    Obf,
+    Busy,
+    Err,
+}
+
+impl Flag {
+    pub fn mask(self) -> u8 {
+        match self {
+            Flag::Ibf => Status::IBF,
+            Flag::Obf => Status::OBF,
+            Flag::Busy => Status::BUSY,
+            Flag::Err => Status::ERROR,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Flag::Ibf => "ibf",
+            Flag::Obf => "obf",
+            Flag::Busy => "busy",
+            Flag::Err => "err",
+        }
+    }
+
+    pub fn from_name(s: &str) -> Option<Flag> {
+        match s {
+            "ibf" => Some(Flag::Ibf),
+            "obf" => Some(Flag::Obf),
+            "busy" => Some(Flag::Busy),
+            "err" => Some(Flag::Err),
+            _ => None,
+        }
+    }
+}
+
 /// Why pulse output ended: finish status bits 6-3 (Section 3-4-1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum StopCause {

@@ -1,0 +1,647 @@
+//! Traces: what happened during one scenario, as text that diffs well.
+//!
+//! ```text
+//! ppmc-trace 1
+//! scenario s3_3_5_constant_speed_moves_n_steps
+//! section 3-3-5
+//! target emu
+//! detail sysclk_hz 16000000
+//! events
+//! 0.000us reset
+//! 200000.000us wc 0x44
+//! 200012.000us move constant cw steps=100 pout=0 winding=4ph-2 phase=0
+//! 200060.000us pin busy 1
+//! 200206.000us pulses cw n=100 dt=102.000us
+//! 200260.000us measure constant_first_pout 194.000us
+//! end
+//! ```
+//!
+//! One event per line, each stamped with the target's clock. Constant-rate
+//! pulse runs are one `pulses` line; acceleration ramps are one line per
+//! change of period. The `end` line makes a truncated file detectable. A
+//! golden file may start with insta's `---` front matter, which is skipped.
+//! [`Trace::parse`] reads back exactly what [`Trace::render`] writes.
+
+use crate::protocol::{Direction, Flag, Input, MoveKind, Pin, Record, Winding};
+use crate::time::{Duration, Instant};
+use std::fmt::{self, Write as _};
+
+/// The format version written in the first line.
+pub const TRACE_VERSION: u32 = 1;
+
+/// A complete trace of one scenario run.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Trace {
+    pub scenario: String,
+    pub section: String,
+    pub target: String,
+    /// Straps and other target facts, `key value`.
+    pub details: Vec<(String, String)>,
+    pub events: Vec<Event>,
+}
+
+/// One thing that happened at a point in the target's time.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Event {
+    pub at: Instant,
+    pub kind: EventKind,
+}
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum EventKind {
+    Bus(BusEvent),
+    /// A move started: its final byte was written at `at`.
+    Move {
+        kind: MoveKind,
+        dir: Direction,
+        pout: bool,
+        steps: u32,
+        winding: Option<Winding>,
+        phase: u32,
+    },
+    /// `count` pulses in `dir`, the first at `at`, `interval` apart.
+    Pulses {
+        dir: Direction,
+        count: u32,
+        interval: Duration,
+    },
+    Pin {
+        pin: Pin,
+        value: u8,
+    },
+    /// A measured latency; `name` is a Table 3-3 row or a scenario's own.
+    Measure {
+        name: String,
+        value: Duration,
+    },
+}
+
+/// A host-side bus transaction and what it observed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BusEvent {
+    WriteCommand(u8),
+    WriteData(u8),
+    /// A flowchart write that gave up because IBF stayed 1.
+    WriteTimedOut {
+        command: bool,
+        byte: u8,
+    },
+    ReadStatus(u8),
+    ReadData(u8),
+    ReadTimedOut,
+    Await {
+        flag: Flag,
+        value: bool,
+        /// `Some(waited)`, or `None` on timeout.
+        waited: Option<Duration>,
+        status: u8,
+    },
+    SetInput {
+        input: Input,
+        asserted: bool,
+    },
+    AwaitPulses {
+        count: u64,
+        reached: bool,
+    },
+    Reset,
+}
+
+/// A trace file that cannot be read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("line {line}: {message}")]
+pub struct TraceError {
+    pub line: usize,
+    pub message: String,
+}
+
+impl Trace {
+    /// Builds a trace from the driver's bus events and the target's capture,
+    /// merged in time order. At one instant: pin changes and pulses, then
+    /// bus transactions, then move starts, then measurements.
+    pub fn assemble(
+        scenario: &str,
+        section: &str,
+        target: &str,
+        details: Vec<(String, String)>,
+        bus: Vec<Event>,
+        capture: &Record,
+        measures: Vec<Event>,
+    ) -> Trace {
+        let mut tagged: Vec<(Instant, u8, usize, EventKind)> = Vec::new();
+        let mut seq = 0usize;
+        let mut push = |at: Instant, rank: u8, kind: EventKind, v: &mut Vec<_>| {
+            v.push((at, rank, seq, kind));
+            seq += 1;
+        };
+        for p in &capture.pins {
+            push(
+                p.at,
+                0,
+                EventKind::Pin {
+                    pin: p.pin,
+                    value: p.value,
+                },
+                &mut tagged,
+            );
+        }
+        for r in &capture.runs {
+            push(
+                r.start,
+                0,
+                EventKind::Pulses {
+                    dir: r.dir,
+                    count: r.count,
+                    interval: r.interval,
+                },
+                &mut tagged,
+            );
+        }
+        for e in bus {
+            push(e.at, 1, e.kind, &mut tagged);
+        }
+        for m in &capture.moves {
+            push(
+                m.at,
+                2,
+                EventKind::Move {
+                    kind: m.kind,
+                    dir: m.dir,
+                    pout: m.pout,
+                    steps: m.steps,
+                    winding: m.winding,
+                    phase: m.phase_index,
+                },
+                &mut tagged,
+            );
+        }
+        for e in measures {
+            push(e.at, 3, e.kind, &mut tagged);
+        }
+        tagged.sort_by_key(|(at, rank, seq, _)| (*at, *rank, *seq));
+        Trace {
+            scenario: scenario.to_string(),
+            section: section.to_string(),
+            target: target.to_string(),
+            details,
+            events: tagged
+                .into_iter()
+                .map(|(at, _, _, kind)| Event { at, kind })
+                .collect(),
+        }
+    }
+
+    /// The canonical text form.
+    pub fn render(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(s, "ppmc-trace {TRACE_VERSION}");
+        let _ = writeln!(s, "scenario {}", self.scenario);
+        let _ = writeln!(s, "section {}", self.section);
+        let _ = writeln!(s, "target {}", self.target);
+        for (k, v) in &self.details {
+            let _ = writeln!(s, "detail {k} {v}");
+        }
+        s.push_str("events\n");
+        for e in &self.events {
+            let _ = writeln!(s, "{} {}", e.at, e.kind);
+        }
+        s.push_str("end\n");
+        s
+    }
+
+    /// Parses the text form. Errors name the line (1-based, counting any
+    /// front matter) and what is wrong.
+    pub fn parse(text: &str) -> Result<Trace, TraceError> {
+        let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l)).peekable();
+        // insta front matter: `---` ... `---`.
+        if lines.peek().is_some_and(|(_, l)| l.trim() == "---") {
+            lines.next();
+            loop {
+                match lines.next() {
+                    Some((_, l)) if l.trim() == "---" => break,
+                    Some(_) => {}
+                    None => return Err(err(0, "front matter `---` is never closed")),
+                }
+            }
+        }
+        let mut next = |what: &str| -> Result<(usize, &str), TraceError> {
+            lines
+                .next()
+                .ok_or_else(|| err(0, format!("file ends before {what} (truncated?)")))
+        };
+        let (n, l) = next("the `ppmc-trace` header")?;
+        let version = l.strip_prefix("ppmc-trace ").ok_or_else(|| {
+            err(
+                n,
+                "not a ppmc trace: first line must be `ppmc-trace <version>`",
+            )
+        })?;
+        if version.trim() != TRACE_VERSION.to_string() {
+            return Err(err(
+                n,
+                format!(
+                    "trace format version {} is not supported (this ppmc reads version {TRACE_VERSION})",
+                    version.trim()
+                ),
+            ));
+        }
+        let mut field = |key: &str| -> Result<String, TraceError> {
+            let (n, l) = next(key)?;
+            l.strip_prefix(key)
+                .and_then(|r| r.strip_prefix(' '))
+                .map(str::to_string)
+                .ok_or_else(|| err(n, format!("expected `{key} <value>`, found `{l}`")))
+        };
+        let scenario = field("scenario")?;
+        let section = field("section")?;
+        let target = field("target")?;
+        let mut details = Vec::new();
+        let mut events = Vec::new();
+        let mut in_events = false;
+        let mut ended = false;
+        for (n, l) in lines {
+            if ended {
+                if l.trim().is_empty() {
+                    continue;
+                }
+                return Err(err(n, "text after `end`"));
+            }
+            if !in_events {
+                if l == "events" {
+                    in_events = true;
+                } else if let Some(rest) = l.strip_prefix("detail ") {
+                    let (k, v) = rest
+                        .split_once(' ')
+                        .ok_or_else(|| err(n, "expected `detail <key> <value>`"))?;
+                    details.push((k.to_string(), v.to_string()));
+                } else {
+                    return Err(err(
+                        n,
+                        format!("expected `detail` or `events`, found `{l}`"),
+                    ));
+                }
+                continue;
+            }
+            if l == "end" {
+                ended = true;
+                continue;
+            }
+            events.push(parse_event(l).map_err(|m| err(n, m))?);
+        }
+        if !ended {
+            return Err(err(
+                text.lines().count(),
+                "no `end` line: the trace is truncated",
+            ));
+        }
+        Ok(Trace {
+            scenario,
+            section,
+            target,
+            details,
+            events,
+        })
+    }
+}
+
+fn err(line: usize, message: impl Into<String>) -> TraceError {
+    TraceError {
+        line,
+        message: message.into(),
+    }
+}
+
+fn parse_time(s: &str) -> Result<Duration, String> {
+    s.parse::<Duration>()
+        .map_err(|e| format!("bad time `{s}`: {e}"))
+}
+
+fn parse_hex(s: &str) -> Result<u8, String> {
+    s.strip_prefix("0x")
+        .and_then(|h| u8::from_str_radix(h, 16).ok())
+        .ok_or_else(|| format!("expected a byte as 0xNN, found `{s}`"))
+}
+
+fn parse_dir(s: &str) -> Result<Direction, String> {
+    match s {
+        "cw" => Ok(Direction::Cw),
+        "ccw" => Ok(Direction::Ccw),
+        _ => Err(format!("expected cw or ccw, found `{s}`")),
+    }
+}
+
+fn kv<'a>(word: Option<&'a str>, key: &str) -> Result<&'a str, String> {
+    word.and_then(|w| w.strip_prefix(key))
+        .and_then(|w| w.strip_prefix('='))
+        .ok_or_else(|| format!("expected `{key}=...`"))
+}
+
+fn parse_num<T: std::str::FromStr>(s: &str, what: &str) -> Result<T, String> {
+    s.parse().map_err(|_| format!("bad {what} `{s}`"))
+}
+
+fn move_kind(name: &str) -> Option<MoveKind> {
+    MoveKind::ALL.into_iter().find(|k| k.name() == name)
+}
+
+fn pin_from(name: &str) -> Option<Pin> {
+    [
+        Pin::Busy,
+        Pin::Int,
+        Pin::Hold,
+        Pin::Aux,
+        Pin::Auxo,
+        Pin::Dir,
+        Pin::Phases,
+        Pin::Switching,
+    ]
+    .into_iter()
+    .find(|p| p.name() == name)
+}
+
+fn parse_event(line: &str) -> Result<Event, String> {
+    let mut w = line.split_whitespace();
+    let at = Instant::from_nanos(parse_time(w.next().ok_or("empty event line")?)?.as_nanos());
+    let key = w.next().ok_or("missing event name")?;
+    let kind = match key {
+        "wc" | "wd" => {
+            let b = parse_hex(w.next().ok_or("missing byte")?)?;
+            EventKind::Bus(if key == "wc" {
+                BusEvent::WriteCommand(b)
+            } else {
+                BusEvent::WriteData(b)
+            })
+        }
+        "wc-timeout" | "wd-timeout" => EventKind::Bus(BusEvent::WriteTimedOut {
+            command: key == "wc-timeout",
+            byte: parse_hex(w.next().ok_or("missing byte")?)?,
+        }),
+        "rs" => EventKind::Bus(BusEvent::ReadStatus(parse_hex(
+            w.next().ok_or("missing byte")?,
+        )?)),
+        "rd" => EventKind::Bus(BusEvent::ReadData(parse_hex(
+            w.next().ok_or("missing byte")?,
+        )?)),
+        "rd-timeout" => EventKind::Bus(BusEvent::ReadTimedOut),
+        "await" => {
+            let cond = w.next().ok_or("missing <flag>=<0|1>")?;
+            let (f, v) = cond.split_once('=').ok_or("expected <flag>=<0|1>")?;
+            let flag = Flag::from_name(f).ok_or_else(|| format!("unknown flag `{f}`"))?;
+            let value = match v {
+                "0" => false,
+                "1" => true,
+                _ => return Err(format!("flag value `{v}` should be 0 or 1")),
+            };
+            let waited = match w.next() {
+                Some("after") => Some(parse_time(w.next().ok_or("missing wait time")?)?),
+                Some("timeout") => None,
+                _ => return Err("expected `after <time>` or `timeout`".into()),
+            };
+            let status = parse_hex(kv(w.next(), "status")?)?;
+            EventKind::Bus(BusEvent::Await {
+                flag,
+                value,
+                waited,
+                status,
+            })
+        }
+        "set" => {
+            let name = w.next().ok_or("missing input")?;
+            let input = Input::from_name(name).ok_or_else(|| format!("unknown input `{name}`"))?;
+            let asserted = match w.next() {
+                Some("on") => true,
+                Some("off") => false,
+                _ => return Err("expected on or off".into()),
+            };
+            EventKind::Bus(BusEvent::SetInput { input, asserted })
+        }
+        "await-pulses" => {
+            let count = parse_num(w.next().ok_or("missing count")?, "pulse count")?;
+            let reached = match w.next() {
+                Some("reached") => true,
+                Some("timeout") => false,
+                _ => return Err("expected reached or timeout".into()),
+            };
+            EventKind::Bus(BusEvent::AwaitPulses { count, reached })
+        }
+        "reset" => EventKind::Bus(BusEvent::Reset),
+        "move" => {
+            let name = w.next().ok_or("missing move kind")?;
+            let kind = move_kind(name).ok_or_else(|| format!("unknown move `{name}`"))?;
+            let dir = parse_dir(w.next().ok_or("missing direction")?)?;
+            let steps = parse_num(kv(w.next(), "steps")?, "step count")?;
+            let pout = match kv(w.next(), "pout")? {
+                "0" => false,
+                "1" => true,
+                other => return Err(format!("pout should be 0 or 1, found `{other}`")),
+            };
+            let winding = match kv(w.next(), "winding")? {
+                "none" => None,
+                name => Some(
+                    Winding::from_name(name).ok_or_else(|| format!("unknown winding `{name}`"))?,
+                ),
+            };
+            let phase = parse_num(kv(w.next(), "phase")?, "phase index")?;
+            EventKind::Move {
+                kind,
+                dir,
+                pout,
+                steps,
+                winding,
+                phase,
+            }
+        }
+        "pulses" => {
+            let dir = parse_dir(w.next().ok_or("missing direction")?)?;
+            let count: u32 = parse_num(kv(w.next(), "n")?, "pulse count")?;
+            if count == 0 {
+                return Err("a pulse run has at least one pulse".into());
+            }
+            let interval = parse_time(kv(w.next(), "dt")?)?;
+            EventKind::Pulses {
+                dir,
+                count,
+                interval,
+            }
+        }
+        "pin" => {
+            let name = w.next().ok_or("missing pin")?;
+            let pin = pin_from(name).ok_or_else(|| format!("unknown pin `{name}`"))?;
+            let value = parse_num(w.next().ok_or("missing value")?, "pin value")?;
+            EventKind::Pin { pin, value }
+        }
+        "measure" => {
+            let name = w.next().ok_or("missing measurement name")?.to_string();
+            let value = parse_time(w.next().ok_or("missing value")?)?;
+            EventKind::Measure { name, value }
+        }
+        other => return Err(format!("unknown event `{other}`")),
+    };
+    if let Some(extra) = w.next() {
+        return Err(format!("unexpected `{extra}` at the end of the line"));
+    }
+    Ok(Event { at, kind })
+}
+
+impl fmt::Display for EventKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            EventKind::Bus(b) => write!(f, "{b}"),
+            EventKind::Move {
+                kind,
+                dir,
+                pout,
+                steps,
+                winding,
+                phase,
+            } => write!(
+                f,
+                "move {} {} steps={steps} pout={} winding={} phase={phase}",
+                kind.name(),
+                dir.name(),
+                u8::from(*pout),
+                winding.map_or("none", Winding::name)
+            ),
+            EventKind::Pulses {
+                dir,
+                count,
+                interval,
+            } => write!(f, "pulses {} n={count} dt={interval}", dir.name()),
+            EventKind::Pin { pin, value } => write!(f, "pin {} {value}", pin.name()),
+            EventKind::Measure { name, value } => write!(f, "measure {name} {value}"),
+        }
+    }
+}
+
+impl fmt::Display for BusEvent {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            BusEvent::WriteCommand(b) => write!(f, "wc 0x{b:02X}"),
+            BusEvent::WriteData(b) => write!(f, "wd 0x{b:02X}"),
+            BusEvent::WriteTimedOut { command, byte } => {
+                write!(
+                    f,
+                    "{}-timeout 0x{byte:02X}",
+                    if command { "wc" } else { "wd" }
+                )
+            }
+            BusEvent::ReadStatus(b) => write!(f, "rs 0x{b:02X}"),
+            BusEvent::ReadData(b) => write!(f, "rd 0x{b:02X}"),
+            BusEvent::ReadTimedOut => f.write_str("rd-timeout"),
+            BusEvent::Await {
+                flag,
+                value,
+                waited,
+                status,
+            } => {
+                write!(f, "await {}={} ", flag.name(), u8::from(value))?;
+                match waited {
+                    Some(d) => write!(f, "after {d}")?,
+                    None => f.write_str("timeout")?,
+                }
+                write!(f, " status=0x{status:02X}")
+            }
+            BusEvent::SetInput { input, asserted } => {
+                write!(
+                    f,
+                    "set {} {}",
+                    input.name(),
+                    if asserted { "on" } else { "off" }
+                )
+            }
+            BusEvent::AwaitPulses { count, reached } => write!(
+                f,
+                "await-pulses {count} {}",
+                if reached { "reached" } else { "timeout" }
+            ),
+            BusEvent::Reset => f.write_str("reset"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SAMPLE: &str = "ppmc-trace 1
+scenario demo
+section 3-3-5
+target emu
+detail sysclk_hz 16000000
+events
+0.000us reset
+200000.000us wc 0x44
+200006.000us wd 0x32
+200012.000us await busy=1 after 54.000us status=0x04
+200012.000us move constant cw steps=100 pout=0 winding=4ph-2 phase=0
+200060.000us pin busy 1
+200206.000us pulses cw n=100 dt=102.000us
+200300.000us set l1 on
+200300.000us await-pulses 5 reached
+200400.000us rd-timeout
+200500.000us wc-timeout 0x81
+200600.000us move accel-decel ccw steps=16777216 pout=1 winding=none phase=3
+200700.000us measure busy_rise 60.000us
+end
+";
+
+    #[test]
+    fn sample_round_trips_exactly() {
+        let t = Trace::parse(SAMPLE).expect("parses");
+        assert_eq!(t.render(), SAMPLE);
+        assert_eq!(t.events.len(), 13);
+    }
+
+    #[test]
+    fn insta_front_matter_is_skipped() {
+        let with = format!("---\nsource: harness/tests/golden.rs\n---\n{SAMPLE}");
+        assert_eq!(Trace::parse(&with), Trace::parse(SAMPLE));
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let bad = SAMPLE.replace("pulses cw n=100", "pulses cw n=x");
+        let e = Trace::parse(&bad).expect_err("bad count");
+        assert_eq!(e.line, 13);
+        assert!(e.message.contains("bad pulse count"), "{e}");
+
+        let truncated = &SAMPLE[..SAMPLE.len() - 4];
+        let e = Trace::parse(truncated).expect_err("no end");
+        assert!(e.message.contains("truncated"), "{e}");
+
+        let other = SAMPLE.replace("ppmc-trace 1", "ppmc-trace 7");
+        let e = Trace::parse(&other).expect_err("version");
+        assert_eq!(e.line, 1);
+        assert!(e.message.contains("version 7"), "{e}");
+
+        let e = Trace::parse("hello\n").expect_err("not a trace");
+        assert!(e.message.contains("not a ppmc trace"), "{e}");
+
+        let junk = format!("{SAMPLE}more\n");
+        assert!(Trace::parse(&junk)
+            .expect_err("after end")
+            .message
+            .contains("after `end`"));
+    }
+
+    proptest::proptest! {
+        /// Any text either parses or gives an error; it never panics.
+        #[test]
+        fn arbitrary_text_never_panics(s in "\\PC*") {
+            let _ = Trace::parse(&s);
+        }
+
+        /// Mutating one line of a valid trace never panics, and whatever
+        /// parses renders back to a trace that parses to the same value.
+        #[test]
+        fn mutated_traces_round_trip_or_fail_cleanly(line in 0usize..20, junk in "[ -~]{0,30}") {
+            let mut lines: Vec<&str> = SAMPLE.lines().collect();
+            let i = line % lines.len();
+            lines[i] = &junk;
+            let text = lines.join("\n");
+            if let Ok(t) = Trace::parse(&text) {
+                proptest::prop_assert_eq!(Trace::parse(&t.render()), Ok(t));
+            }
+        }
+    }
+}
