@@ -9,6 +9,18 @@
 pub mod console;
 pub mod emu;
 pub mod protocol;
+pub mod runner;
+pub mod scenario;
 pub mod target;
 pub mod time;
 pub mod trace;
+
+/// The conformance suite: every scenario file in `scenarios/`.
+#[allow(missing_docs)]
+pub mod suite {
+    include!(concat!(env!("OUT_DIR"), "/suite.rs"));
+}
+
+/// The harness's version and git revision, for run records.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+pub const GIT_REV: &str = env!("PPMC_GIT_REV");

@@ -201,6 +201,51 @@ pub const TABLE_3_3: &[TimingRow] = &[
 ];
 
 impl TimingId {
+    pub const ALL: [TimingId; 16] = [
+        TimingId::InitProcessing,
+        TimingId::InitOutputsSet,
+        TimingId::AccelFirstPout,
+        TimingId::AbnormalTermination,
+        TimingId::DecelStopProcessing,
+        TimingId::HighSpeedLimitAccel,
+        TimingId::HighSpeedLimitCruise,
+        TimingId::AuxOn,
+        TimingId::AuxOff,
+        TimingId::SingleStep,
+        TimingId::ConstantFirstPout,
+        TimingId::NextCommand,
+        TimingId::InterruptOutput,
+        TimingId::HoldOn,
+        TimingId::ExcitationOff,
+        TimingId::BusyRise,
+    ];
+
+    /// The name used in traces and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            TimingId::InitProcessing => "init_processing",
+            TimingId::InitOutputsSet => "init_outputs_set",
+            TimingId::AccelFirstPout => "accel_first_pout",
+            TimingId::AbnormalTermination => "abnormal_termination",
+            TimingId::DecelStopProcessing => "decel_stop_processing",
+            TimingId::HighSpeedLimitAccel => "high_speed_limit_accel",
+            TimingId::HighSpeedLimitCruise => "high_speed_limit_cruise",
+            TimingId::AuxOn => "aux_on",
+            TimingId::AuxOff => "aux_off",
+            TimingId::SingleStep => "single_step",
+            TimingId::ConstantFirstPout => "constant_first_pout",
+            TimingId::NextCommand => "next_command",
+            TimingId::InterruptOutput => "interrupt_output",
+            TimingId::HoldOn => "hold_on",
+            TimingId::ExcitationOff => "excitation_off",
+            TimingId::BusyRise => "busy_rise",
+        }
+    }
+
+    pub fn from_name(s: &str) -> Option<TimingId> {
+        TimingId::ALL.into_iter().find(|t| t.name() == s)
+    }
+
     /// The row of Table 3-3 with this id.
     pub fn row(self) -> &'static TimingRow {
         // Every id has exactly one row; the unit test below proves it.
@@ -249,6 +294,9 @@ mod tests {
             assert_eq!(row.id.row().id, row.id);
         }
         assert_eq!(TABLE_3_3.len(), 16);
+        for id in TimingId::ALL {
+            assert_eq!(TimingId::from_name(id.name()), Some(id));
+        }
     }
 
     #[test]

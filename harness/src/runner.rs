@@ -1,0 +1,172 @@
+//! Running a suite: choosing scenarios, running them one after another on
+//! a target, and keeping going when one fails or errors.
+
+use crate::scenario::{run_scenario, DriverOptions, Scenario, ScenarioResult, Verdict};
+use crate::target::{Op, Target};
+use crate::time::Duration;
+
+/// Which scenarios a run takes.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Selection {
+    /// Substring of the scenario name.
+    pub filter: Option<String>,
+    /// Every listed tag must be present.
+    pub tags: Vec<String>,
+    /// `(i, n)`: the i-th (1-based) of n interleaved shards.
+    pub shard: Option<(usize, usize)>,
+}
+
+impl Selection {
+    pub fn select(&self, all: &[Scenario]) -> Vec<Scenario> {
+        all.iter()
+            .filter(|s| {
+                self.filter
+                    .as_ref()
+                    .is_none_or(|f| s.name.contains(f.as_str()))
+            })
+            .filter(|s| self.tags.iter().all(|t| s.has_tag(t)))
+            .enumerate()
+            .filter(|(i, _)| self.shard.is_none_or(|(k, n)| i % n == k - 1))
+            .map(|(_, s)| *s)
+            .collect()
+    }
+}
+
+/// Parses `I/N` (1 <= I <= N).
+pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+    let (i, n) = s
+        .split_once('/')
+        .ok_or_else(|| format!("shard `{s}` should be I/N, e.g. 2/4"))?;
+    let i: usize = i
+        .parse()
+        .map_err(|_| format!("shard index `{i}` is not a number"))?;
+    let n: usize = n
+        .parse()
+        .map_err(|_| format!("shard count `{n}` is not a number"))?;
+    if n == 0 || i == 0 || i > n {
+        return Err(format!("shard {i}/{n}: need 1 <= I <= N"));
+    }
+    Ok((i, n))
+}
+
+/// Checks the suite's invariants: unique names, a section on each.
+pub fn validate_suite(all: &[Scenario]) -> Result<(), String> {
+    let mut names: Vec<&str> = all.iter().map(|s| s.name).collect();
+    names.sort_unstable();
+    if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+        return Err(format!("two scenarios are named `{}`", w[0]));
+    }
+    if let Some(s) = all.iter().find(|s| s.section.is_empty()) {
+        return Err(format!("scenario `{}` names no datasheet section", s.name));
+    }
+    Ok(())
+}
+
+/// Runs `scenarios` `repeat` times on `target`, calling `on_result` after
+/// each. After a harness error the target gets a health check (a reset);
+/// if that fails too the link is taken as dead and the scenarios left are
+/// reported as not run, so a broken cable does not read as a bad board.
+pub fn run_suite(
+    target: &mut dyn Target,
+    scenarios: &[Scenario],
+    repeat: usize,
+    opts: DriverOptions,
+    mut on_result: impl FnMut(&ScenarioResult),
+) -> Vec<ScenarioResult> {
+    let mut results = Vec::new();
+    let mut dead: Option<String> = None;
+    for _ in 0..repeat.max(1) {
+        for s in scenarios {
+            let r = match &dead {
+                Some(why) => ScenarioResult {
+                    name: s.name,
+                    section: s.section,
+                    tags: s.tags,
+                    verdict: Verdict::NotRun(format!("not run: {why}")),
+                    measurements: Vec::new(),
+                    trace: None,
+                    elapsed: Duration::ZERO,
+                },
+                None => {
+                    let r = run_scenario(target, s, opts);
+                    if matches!(r.verdict, Verdict::Error(_)) {
+                        if let Err(e) = target.execute(&[Op::Reset]) {
+                            dead = Some(format!("the target stopped answering ({e})"));
+                        }
+                    }
+                    r
+                }
+            };
+            on_result(&r);
+            results.push(r);
+        }
+    }
+    results
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::{Driver, Outcome};
+
+    fn ok(_: &mut Driver) -> Outcome {
+        Ok(())
+    }
+
+    fn suite() -> Vec<Scenario> {
+        vec![
+            Scenario::new("a_one", "3-1", "", &["x"], ok),
+            Scenario::new("b_two", "3-2", "", &["x", "y"], ok),
+            Scenario::new("c_three", "3-3", "", &["y"], ok),
+            Scenario::new("d_four", "3-4", "", &[], ok),
+        ]
+    }
+
+    fn names(v: Vec<Scenario>) -> Vec<&'static str> {
+        v.into_iter().map(|s| s.name).collect()
+    }
+
+    #[test]
+    fn selection_by_filter_tag_and_shard() {
+        let all = suite();
+        let sel = |f: Option<&str>, tags: &[&str], shard| Selection {
+            filter: f.map(String::from),
+            tags: tags.iter().map(|t| t.to_string()).collect(),
+            shard,
+        };
+        assert_eq!(
+            names(sel(Some("t"), &[], None).select(&all)),
+            vec!["a_one", "b_two", "c_three"]
+        );
+        assert_eq!(
+            names(sel(None, &["x", "y"], None).select(&all)),
+            vec!["b_two"]
+        );
+        assert_eq!(
+            names(sel(None, &[], Some((1, 2))).select(&all)),
+            vec!["a_one", "c_three"]
+        );
+        assert_eq!(
+            names(sel(None, &[], Some((2, 2))).select(&all)),
+            vec!["b_two", "d_four"]
+        );
+    }
+
+    #[test]
+    fn shard_syntax() {
+        assert_eq!(parse_shard("2/4"), Ok((2, 4)));
+        assert!(parse_shard("0/4").is_err());
+        assert!(parse_shard("5/4").is_err());
+        assert!(parse_shard("x").is_err());
+    }
+
+    #[test]
+    fn duplicate_names_are_refused() {
+        let mut all = suite();
+        all.push(Scenario::new("a_one", "3-1", "", &[], ok));
+        assert_eq!(
+            validate_suite(&all),
+            Err("two scenarios are named `a_one`".into())
+        );
+    }
+}

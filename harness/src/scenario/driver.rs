@@ -1,0 +1,1035 @@
+//! The driver a scenario is written against: flowchart-style helpers over a
+//! [`Target`], a raw layer to break the protocol on purpose, and
+//! expectations that stop the scenario at the first thing that went wrong.
+
+use super::grade::{Grade, Grading, Measurement};
+use super::{Failure, Move, Outcome, Stop};
+use crate::protocol::{
+    ClockSource, Direction, ErrorCode, Excitation, Flag, InitCommand, InitData, Input, MotorType,
+    OutputLogic, Pin, Pins, Record, Register, Status, StatusField, Straps, TimingId,
+};
+use crate::target::{Op, Reply, Target};
+use crate::time::{Duration, Instant};
+use crate::trace::{BusEvent, Event, EventKind};
+
+/// The initialization command and data, built up like the datasheet's
+/// Diagram 3-2.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Init {
+    pub cmd: InitCommand,
+    pub data: InitData,
+}
+
+impl Init {
+    /// A motor with 2-phase excitation, negative logic, the internal clock,
+    /// no stop switching, RL = 100, RH = 20, PA = 100.
+    pub fn new(motor: MotorType) -> Init {
+        Init {
+            cmd: InitCommand {
+                motor,
+                excitation: Excitation::TwoPhase,
+                logic: OutputLogic::Negative,
+                clock: ClockSource::Internal,
+                stop_switching: false,
+            },
+            data: InitData {
+                rl: 100,
+                rh: 20,
+                pa: 100,
+            },
+        }
+    }
+
+    /// The reference set-up of the suite: 4-phase, RL 100, RH 20, PA 100.
+    pub fn four_phase() -> Init {
+        Init::new(MotorType::FourPhase)
+    }
+
+    pub fn half_step(mut self) -> Init {
+        self.cmd.excitation = Excitation::HalfStep;
+        self
+    }
+
+    pub fn positive_logic(mut self) -> Init {
+        self.cmd.logic = OutputLogic::Positive;
+        self
+    }
+
+    pub fn external_clock(mut self) -> Init {
+        self.cmd.clock = ClockSource::External;
+        self
+    }
+
+    pub fn stop_switching(mut self) -> Init {
+        self.cmd.stop_switching = true;
+        self
+    }
+
+    pub fn rates(mut self, rl: u8, rh: u8) -> Init {
+        self.data.rl = rl;
+        self.data.rh = rh;
+        self
+    }
+
+    pub fn accel_pulses(mut self, pa: u16) -> Init {
+        self.data.pa = pa;
+        self
+    }
+
+    pub fn code(&self) -> u8 {
+        crate::protocol::Command::Init(self.cmd).encode()
+    }
+}
+
+/// Timeouts and limits of a [`Driver`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DriverOptions {
+    /// Flowchart writes wait at most this long for IBF = 0.
+    pub ibf_timeout: Duration,
+    /// Flowchart reads wait at most this long for OBF = 1.
+    pub obf_timeout: Duration,
+    /// An operation command must raise BUSY within this.
+    pub busy_timeout: Duration,
+    /// [`Driver::wait_idle`] waits at most this long for BUSY = 0.
+    pub idle_timeout: Duration,
+    /// Virtual time one scenario may use before it is stopped as an error.
+    pub budget: Duration,
+    pub grading: Grading,
+}
+
+impl Default for DriverOptions {
+    fn default() -> Self {
+        DriverOptions {
+            ibf_timeout: Duration::from_secs(1),
+            obf_timeout: Duration::from_millis(100),
+            busy_timeout: Duration::from_millis(5),
+            idle_timeout: Duration::from_secs(60),
+            budget: Duration::from_secs(120),
+            grading: Grading::default(),
+        }
+    }
+}
+
+/// Drives one scenario on a target and records what it saw.
+pub struct Driver<'t> {
+    target: &'t mut dyn Target,
+    opts: DriverOptions,
+    bus: Vec<Event>,
+    measurements: Vec<Measurement>,
+    now: Instant,
+    /// Final write of the most recent operation command.
+    anchor: Option<Instant>,
+    /// Final write of the most recent initialization.
+    init_write: Option<Instant>,
+    init: Option<Init>,
+    /// The most recent stop write, input edge or auxiliary command write.
+    trigger: Option<Instant>,
+    capture: Option<Record>,
+    straps: Straps,
+}
+
+impl std::fmt::Debug for Driver<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Driver")
+            .field("now", &self.now)
+            .field("anchor", &self.anchor)
+            .finish_non_exhaustive()
+    }
+}
+
+fn fail(
+    expectation: impl Into<String>,
+    expected: impl ToString,
+    got: impl ToString,
+    at: Instant,
+) -> Stop {
+    Stop::Failed(Failure {
+        expectation: expectation.into(),
+        expected: expected.to_string(),
+        got: got.to_string(),
+        at,
+    })
+}
+
+impl<'t> Driver<'t> {
+    pub fn new(target: &'t mut dyn Target, opts: DriverOptions) -> Self {
+        let straps = straps_of(&target.info().details);
+        Driver {
+            straps,
+            target,
+            opts,
+            bus: Vec::new(),
+            measurements: Vec::new(),
+            now: Instant::ZERO,
+            anchor: None,
+            init_write: None,
+            init: None,
+            trigger: None,
+            capture: None,
+        }
+    }
+
+    /// The bus events and measurements recorded so far.
+    pub(crate) fn into_parts(self) -> (Vec<Event>, Vec<Measurement>) {
+        (self.bus, self.measurements)
+    }
+
+    pub fn measurements(&self) -> &[Measurement] {
+        &self.measurements
+    }
+
+    /// How the target's board is strapped, as it reports it.
+    pub fn straps(&self) -> Straps {
+        self.straps
+    }
+
+    /// The pulse period of rate value `rate` on this board's internal clock
+    /// (Equations 3-1..3-4).
+    pub fn period(&self, rate: u8) -> Duration {
+        let t = self
+            .straps
+            .tclock(ClockSource::Internal)
+            .unwrap_or(Duration::from_micros(2));
+        self.straps.pulse_interval(rate, t)
+    }
+
+    /// The target's clock after the last operation.
+    pub fn now(&self) -> Instant {
+        self.now
+    }
+
+    // ----- raw layer -------------------------------------------------------
+
+    /// Runs ops on the target; a target failure stops the scenario as an
+    /// error (not the device's fault).
+    pub fn exec(&mut self, ops: &[Op]) -> Outcome<Vec<Reply>> {
+        if self.now.as_nanos() > self.opts.budget.as_nanos() {
+            return Err(Stop::Error(format!(
+                "scenario exceeded its time budget of {} (virtual time)",
+                self.opts.budget
+            )));
+        }
+        let replies = self
+            .target
+            .execute(ops)
+            .map_err(|e| Stop::Error(format!("target: {e}")))?;
+        if replies.len() != ops.len() {
+            return Err(Stop::Error(format!(
+                "target answered {} of {} operations",
+                replies.len(),
+                ops.len()
+            )));
+        }
+        if let Some(last) = replies.last() {
+            self.now = last.at();
+        }
+        self.capture = None;
+        Ok(replies)
+    }
+
+    fn one(&mut self, op: Op) -> Outcome<Reply> {
+        let mut r = self.exec(&[op])?;
+        r.pop().ok_or_else(|| Stop::Error("no reply".into()))
+    }
+
+    fn log(&mut self, at: Instant, e: BusEvent) {
+        self.bus.push(Event {
+            at,
+            kind: EventKind::Bus(e),
+        });
+    }
+
+    fn unexpected(&self, op: &str, reply: &Reply) -> Stop {
+        Stop::Error(format!("target answered {reply:?} to {op}"))
+    }
+
+    /// Hardware reset; every scenario starts with one.
+    pub fn reset(&mut self) -> Outcome {
+        let r = self.one(Op::Reset)?;
+        self.now = r.at();
+        self.log(r.at(), BusEvent::Reset);
+        self.anchor = None;
+        self.init_write = None;
+        self.init = None;
+        self.trigger = None;
+        Ok(())
+    }
+
+    fn write(&mut self, byte: u8, command: bool, wait: bool) -> Outcome<Instant> {
+        let wait_ibf = wait.then_some(self.opts.ibf_timeout);
+        let op = if command {
+            Op::WriteCommand { byte, wait_ibf }
+        } else {
+            Op::WriteData { byte, wait_ibf }
+        };
+        match self.one(op)? {
+            Reply::Written { at } => {
+                self.log(
+                    at,
+                    if command {
+                        BusEvent::WriteCommand(byte)
+                    } else {
+                        BusEvent::WriteData(byte)
+                    },
+                );
+                Ok(at)
+            }
+            Reply::WriteTimedOut { at, status } => {
+                self.log(at, BusEvent::WriteTimedOut { command, byte });
+                Err(fail(
+                    format!("IBF = 0 before writing 0x{byte:02X} (flowchart)"),
+                    format!("IBF = 0 within {}", self.opts.ibf_timeout),
+                    format!("status 0x{:02X}", status.0),
+                    at,
+                ))
+            }
+            other => Err(self.unexpected("a write", &other)),
+        }
+    }
+
+    /// Flowchart write of the command register (waits for IBF = 0).
+    pub fn command(&mut self, byte: u8) -> Outcome<Instant> {
+        self.write(byte, true, true)
+    }
+
+    /// Flowchart write of the data register.
+    pub fn data(&mut self, byte: u8) -> Outcome<Instant> {
+        self.write(byte, false, true)
+    }
+
+    /// Writes the command register at once, whatever IBF says.
+    pub fn raw_command(&mut self, byte: u8) -> Outcome<Instant> {
+        self.write(byte, true, false)
+    }
+
+    /// Writes the data register at once, whatever IBF says.
+    pub fn raw_data(&mut self, byte: u8) -> Outcome<Instant> {
+        self.write(byte, false, false)
+    }
+
+    /// Reads the status register.
+    pub fn status(&mut self) -> Outcome<Status> {
+        match self.one(Op::ReadStatus)? {
+            Reply::Status { at, status } => {
+                self.log(at, BusEvent::ReadStatus(status.0));
+                Ok(status)
+            }
+            other => Err(self.unexpected("rs", &other)),
+        }
+    }
+
+    /// Flowchart read of the data register (waits for OBF = 1).
+    pub fn read_data(&mut self) -> Outcome<u8> {
+        match self.one(Op::ReadData {
+            wait_obf: Some(self.opts.obf_timeout),
+        })? {
+            Reply::Data { at, byte } => {
+                self.log(at, BusEvent::ReadData(byte));
+                Ok(byte)
+            }
+            Reply::ReadTimedOut { at, status } => {
+                self.log(at, BusEvent::ReadTimedOut);
+                Err(fail(
+                    "OBF = 1 before reading (flowchart)",
+                    format!("OBF = 1 within {}", self.opts.obf_timeout),
+                    format!("status 0x{:02X}", status.0),
+                    at,
+                ))
+            }
+            other => Err(self.unexpected("rd", &other)),
+        }
+    }
+
+    /// Waits until `flag` has `value`; `Some(waited)` or `None` on timeout.
+    pub fn await_flag(
+        &mut self,
+        flag: Flag,
+        value: bool,
+        timeout: Duration,
+    ) -> Outcome<Option<Duration>> {
+        let mask = flag.mask();
+        match self.one(Op::AwaitStatus {
+            mask,
+            value: if value { mask } else { 0 },
+            timeout,
+        })? {
+            Reply::Awaited { at, waited, status } => {
+                self.log(
+                    at,
+                    BusEvent::Await {
+                        flag,
+                        value,
+                        waited: Some(waited),
+                        status: status.0,
+                    },
+                );
+                Ok(Some(waited))
+            }
+            Reply::AwaitTimedOut { at, status } => {
+                self.log(
+                    at,
+                    BusEvent::Await {
+                        flag,
+                        value,
+                        waited: None,
+                        status: status.0,
+                    },
+                );
+                Ok(None)
+            }
+            other => Err(self.unexpected("await", &other)),
+        }
+    }
+
+    /// Waits for a flag and fails the scenario if it does not come.
+    pub fn expect_flag(&mut self, flag: Flag, value: bool, timeout: Duration) -> Outcome<Duration> {
+        let at = self.now;
+        self.await_flag(flag, value, timeout)?.ok_or_else(|| {
+            fail(
+                format!("{} = {}", flag.name(), u8::from(value)),
+                format!("within {timeout}"),
+                "timeout",
+                at + timeout,
+            )
+        })
+    }
+
+    /// Lets time pass.
+    pub fn wait(&mut self, d: Duration) -> Outcome {
+        self.one(Op::Delay(d))?;
+        Ok(())
+    }
+
+    /// Drives an input (`on` = asserted, pin low). Counts as a trigger for
+    /// latency measurements.
+    pub fn set(&mut self, input: Input, on: bool) -> Outcome<Instant> {
+        let r = self.one(Op::SetInput {
+            input,
+            asserted: on,
+        })?;
+        self.log(
+            r.at(),
+            BusEvent::SetInput {
+                input,
+                asserted: on,
+            },
+        );
+        self.trigger = Some(r.at());
+        Ok(r.at())
+    }
+
+    /// Waits until the move in progress has output `n` pulses; the next op
+    /// acts right after that pulse, on the target's clock.
+    pub fn after_pulses(&mut self, n: u64) -> Outcome<Instant> {
+        match self.one(Op::AwaitPulses {
+            count: n,
+            timeout: self.opts.idle_timeout,
+        })? {
+            Reply::PulsesReached { at } => {
+                self.log(
+                    at,
+                    BusEvent::AwaitPulses {
+                        count: n,
+                        reached: true,
+                    },
+                );
+                Ok(at)
+            }
+            Reply::PulsesTimedOut { at, count } => {
+                self.log(
+                    at,
+                    BusEvent::AwaitPulses {
+                        count: n,
+                        reached: false,
+                    },
+                );
+                Err(fail(
+                    "pulses output so far",
+                    format!("at least {n}"),
+                    count,
+                    at,
+                ))
+            }
+            other => Err(self.unexpected("await-pulses", &other)),
+        }
+    }
+
+    /// The output pins now.
+    pub fn pins(&mut self) -> Outcome<Pins> {
+        match self.one(Op::ReadPins)? {
+            Reply::Pins { pins, .. } => Ok(pins),
+            other => Err(self.unexpected("pins", &other)),
+        }
+    }
+
+    /// The capture since reset (fetched once per change).
+    pub fn capture(&mut self) -> Outcome<&Record> {
+        if self.capture.is_none() {
+            let c = self
+                .target
+                .capture()
+                .map_err(|e| Stop::Error(format!("target capture: {e}")))?;
+            self.capture = Some(c);
+        }
+        self.capture
+            .as_ref()
+            .ok_or_else(|| Stop::Error("capture unavailable".into()))
+    }
+
+    // ----- flowchart helpers ---------------------------------------------
+
+    /// Waits for BUSY = 0, then IBF = 0: the condition every flowchart puts
+    /// before an operation command.
+    pub fn wait_ready(&mut self) -> Outcome {
+        let t = self.opts.idle_timeout;
+        self.expect_flag(Flag::Busy, false, t)?;
+        let t = self.opts.ibf_timeout;
+        self.expect_flag(Flag::Ibf, false, t)?;
+        Ok(())
+    }
+
+    /// The initialization flowchart (Diagram 3-3). Later writes wait for
+    /// the processing through IBF.
+    pub fn init(&mut self, init: Init) -> Outcome<Instant> {
+        self.wait_ready()?;
+        self.command(init.code())?;
+        let mut last = self.now;
+        for b in init.data.to_bytes() {
+            last = self.data(b)?;
+        }
+        self.init_write = Some(last);
+        self.init = Some(init);
+        Ok(last)
+    }
+
+    /// Issues a move by its flowchart and waits for BUSY = 1.
+    pub fn start(&mut self, m: Move) -> Outcome<Instant> {
+        let at = self.issue(m)?;
+        // The chip may still be busy with earlier work (an initialization):
+        // BUSY is due once it has taken the final byte.
+        let t = self.opts.ibf_timeout;
+        self.expect_flag(Flag::Ibf, false, t)?;
+        let t = self.opts.busy_timeout;
+        self.expect_flag(Flag::Busy, true, t)?;
+        Ok(at)
+    }
+
+    /// Issues a move's command and data without waiting for BUSY (for
+    /// scenarios that expect it to be refused).
+    pub fn issue(&mut self, m: Move) -> Outcome<Instant> {
+        self.wait_ready()?;
+        let mut at = self.command(m.code())?;
+        for b in m.params() {
+            at = self.data(b)?;
+        }
+        self.anchor = Some(at);
+        Ok(at)
+    }
+
+    /// Issues a move and waits for it to end.
+    pub fn run(&mut self, m: Move) -> Outcome<Instant> {
+        let at = self.start(m)?;
+        self.wait_idle()?;
+        Ok(at)
+    }
+
+    /// Waits for BUSY = 0 (the move ends).
+    pub fn wait_idle(&mut self) -> Outcome<Duration> {
+        let t = self.opts.idle_timeout;
+        self.expect_flag(Flag::Busy, false, t)
+    }
+
+    /// Immediate Stop (Section 3-3-1): writes 0x40 after IBF = 0.
+    pub fn immediate_stop(&mut self) -> Outcome<Instant> {
+        let at = self.command(0x40)?;
+        self.trigger = Some(at);
+        Ok(at)
+    }
+
+    /// Decelerating Stop (Section 3-3-2): writes 0x41 after IBF = 0.
+    pub fn decel_stop(&mut self) -> Outcome<Instant> {
+        let at = self.command(0x41)?;
+        self.trigger = Some(at);
+        Ok(at)
+    }
+
+    /// A command with no data that acts on an output (AUX ON/OFF, software
+    /// reset): writes it and marks it as the trigger.
+    pub fn trigger_command(&mut self, byte: u8) -> Outcome<Instant> {
+        let at = self.command(byte)?;
+        self.trigger = Some(at);
+        Ok(at)
+    }
+
+    /// A register read by its flowchart: BUSY = 0, IBF = 0, the command,
+    /// then OBF = 1 before each byte.
+    pub fn read_register(&mut self, reg: Register) -> Outcome<Vec<u8>> {
+        self.wait_ready()?;
+        self.command(reg.code())?;
+        (0..reg.byte_count()).map(|_| self.read_data()).collect()
+    }
+
+    /// Waits until the chip has taken the last byte written, then reads the
+    /// status register.
+    pub fn settled_status(&mut self) -> Outcome<Status> {
+        let t = self.opts.ibf_timeout;
+        self.expect_flag(Flag::Ibf, false, t)?;
+        self.status()
+    }
+
+    // ----- expectations --------------------------------------------------
+
+    /// A scenario's own check: fails with `what`, expected vs got, now.
+    pub fn check<T: PartialEq + std::fmt::Debug>(
+        &self,
+        what: &str,
+        expected: T,
+        got: T,
+    ) -> Outcome {
+        if expected != got {
+            return Err(fail(
+                what,
+                format!("{expected:?}"),
+                format!("{got:?}"),
+                self.now,
+            ));
+        }
+        Ok(())
+    }
+
+    /// Expects the error flag with `code` (Table 3-2).
+    pub fn expect_error(&mut self, code: ErrorCode) -> Outcome {
+        let s = self.settled_status()?;
+        match s.error() {
+            Some(e) if e == code => Ok(()),
+            _ => Err(fail(
+                "status error (Table 3-2)",
+                code,
+                describe_status(s),
+                self.now,
+            )),
+        }
+    }
+
+    /// Expects no error flag.
+    pub fn expect_no_error(&mut self) -> Outcome {
+        let s = self.settled_status()?;
+        if s.error_flag() {
+            return Err(fail(
+                "no error",
+                "error flag 0",
+                describe_status(s),
+                self.now,
+            ));
+        }
+        Ok(())
+    }
+
+    /// Expects status bits 6-4 to count `n` parameter bytes still wanted.
+    pub fn expect_params_remaining(&mut self, n: u8) -> Outcome {
+        let s = self.settled_status()?;
+        if s.field() != StatusField::ParamsRemaining(n) {
+            return Err(fail(
+                "parameter count (status bits 6-4)",
+                format!("{n} remaining"),
+                describe_status(s),
+                self.now,
+            ));
+        }
+        Ok(())
+    }
+
+    /// Expects `status & mask == value`.
+    pub fn expect_status(&mut self, mask: u8, value: u8) -> Outcome {
+        let s = self.status()?;
+        if s.0 & mask != value & mask {
+            return Err(fail(
+                format!("status & 0x{mask:02X}"),
+                format!("0x{:02X}", value & mask),
+                format!("0x{:02X}", s.0 & mask),
+                self.now,
+            ));
+        }
+        Ok(())
+    }
+
+    fn expect_register(&mut self, reg: Register, what: &str, expected: &[u8]) -> Outcome {
+        let got = self.read_register(reg)?;
+        if got != expected {
+            return Err(fail(what, hex(expected), hex(&got), self.now));
+        }
+        Ok(())
+    }
+
+    /// Reads the finish status (Section 3-4-1) and expects `value`.
+    pub fn expect_finish(&mut self, value: u8) -> Outcome {
+        self.expect_register(Register::FinishStatus, "finish status", &[value])
+    }
+
+    /// Reads the remaining pulses (Section 3-4-4) and expects `value` as
+    /// read (one less than the true remainder).
+    pub fn expect_remaining(&mut self, value: u32) -> Outcome {
+        let b = value.to_le_bytes();
+        self.expect_register(
+            Register::RemainingPulses,
+            "remaining pulses (read value)",
+            &b[..3],
+        )
+    }
+
+    pub fn expect_input_status(&mut self, value: u8) -> Outcome {
+        self.expect_register(Register::InputSignals, "input signal status", &[value])
+    }
+
+    pub fn expect_output_status(&mut self, value: u8) -> Outcome {
+        self.expect_register(Register::OutputSignals, "output signal status", &[value])
+    }
+
+    pub fn expect_aux_inputs(&mut self, value: u8) -> Outcome {
+        self.expect_register(Register::AuxInputs, "auxiliary input status", &[value])
+    }
+
+    /// Expects the most recent move to have output `n` pulses in `dir`.
+    pub fn expect_pulses(&mut self, n: u64, dir: Direction) -> Outcome {
+        let now = self.now;
+        let s = self.capture()?.last_move_pulses();
+        let got = if dir == Direction::Cw { s.cw } else { s.ccw };
+        if s.count != n || got != n {
+            return Err(fail(
+                format!("pulses {}", dir.name()),
+                n,
+                format!("{} ({} cw, {} ccw)", s.count, s.cw, s.ccw),
+                s.last.unwrap_or(now),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Expects the most recent move's pulse count within `lo..=hi`.
+    pub fn expect_pulses_between(&mut self, lo: u64, hi: u64) -> Outcome<u64> {
+        let now = self.now;
+        let s = self.capture()?.last_move_pulses();
+        if s.count < lo || s.count > hi {
+            return Err(fail(
+                "pulse count",
+                format!("{lo}..={hi}"),
+                s.count,
+                s.last.unwrap_or(now),
+            ));
+        }
+        Ok(s.count)
+    }
+
+    /// Expects the shortest and longest interval of the most recent move.
+    pub fn expect_intervals(&mut self, min: Duration, max: Duration) -> Outcome {
+        let now = self.now;
+        let s = self.capture()?.last_move_pulses();
+        let got = (s.min_interval, s.max_interval);
+        if got != (Some(min), Some(max)) {
+            return Err(fail(
+                "pulse intervals (min, max)",
+                format!("({min}, {max})"),
+                format!("({}, {})", opt(s.min_interval), opt(s.max_interval)),
+                s.first.unwrap_or(now),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Expects no pulse of the most recent move after `t`.
+    pub fn expect_no_pulses_after(&mut self, t: Instant) -> Outcome {
+        let late = self.pulses_after(t)?;
+        if let Some(first) = late.first() {
+            return Err(fail(format!("no pulse after {t}"), 0, late.len(), *first));
+        }
+        Ok(())
+    }
+
+    /// Times of the most recent move's pulses after `t`.
+    pub fn pulses_after(&mut self, t: Instant) -> Outcome<Vec<Instant>> {
+        let rec = self.capture()?;
+        let from = rec.moves.last().map_or(0, |m| m.first_run);
+        Ok(rec.runs[from..]
+            .iter()
+            .flat_map(|r| {
+                (0..r.count).map(move |i| r.start + r.interval.saturating_mul(u64::from(i)))
+            })
+            .filter(|p| *p > t)
+            .collect())
+    }
+
+    /// Expects the energized phases (S1 in bit 4).
+    pub fn expect_phases(&mut self, pattern: u8) -> Outcome {
+        let p = self.pins()?;
+        if p.phases != pattern {
+            return Err(fail(
+                "energized phases S1..S5",
+                format!("0b{pattern:05b}"),
+                format!("0b{:05b}", p.phases),
+                self.now,
+            ));
+        }
+        Ok(())
+    }
+
+    /// Expects output pins: each `Some` is checked.
+    pub fn expect_pins(
+        &mut self,
+        int: Option<bool>,
+        hold: Option<bool>,
+        aux: Option<bool>,
+        auxo: Option<u8>,
+    ) -> Outcome {
+        let p = self.pins()?;
+        let checks = [
+            ("INT*", int.map(u8::from), u8::from(p.int)),
+            ("HOLD", hold.map(u8::from), u8::from(p.hold)),
+            ("AUX*", aux.map(u8::from), u8::from(p.aux)),
+            ("AUXO0..3", auxo, p.auxo),
+        ];
+        for (name, want, got) in checks {
+            if let Some(w) = want {
+                if w != got {
+                    return Err(fail(format!("{name} asserted"), w, got, self.now));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    // ----- Table 3-3 measurements ---------------------------------------
+
+    fn record_measure(&mut self, id: TimingId, value: Duration, at: Instant) -> Outcome<Grade> {
+        let m = self.opts.grading.grade(id, value, at);
+        let grade = m.grade;
+        let (lo, hi) = (m.lo, m.hi);
+        self.measurements.push(m);
+        if grade == Grade::Fail {
+            return Err(Stop::Failed(Failure {
+                expectation: format!("{} (Table 3-3)", id.name()),
+                expected: format!("{lo}..={}", super::grade::fmt_hi(hi)),
+                got: value.to_string(),
+                at,
+            }));
+        }
+        Ok(grade)
+    }
+
+    fn pin_after(
+        &mut self,
+        pin: Pin,
+        value: Option<u8>,
+        from: Instant,
+    ) -> Outcome<Option<Instant>> {
+        Ok(self
+            .capture()?
+            .pins
+            .iter()
+            .find(|e| e.pin == pin && e.at >= from && value.is_none_or(|v| e.value == v))
+            .map(|e| e.at))
+    }
+
+    fn need(&self, what: &str, t: Option<Instant>) -> Outcome<Instant> {
+        t.ok_or_else(|| {
+            Stop::Error(format!(
+                "scenario bug: measuring needs {what}, which this scenario has not done"
+            ))
+        })
+    }
+
+    fn last_move_pulse_times(&mut self) -> Outcome<(Instant, Instant)> {
+        let now = self.now;
+        let s = self.capture()?.last_move_pulses();
+        match (s.first, s.last) {
+            (Some(a), Some(b)) => Ok((a, b)),
+            _ => Err(fail("the move output pulses", "at least 1", 0, now)),
+        }
+    }
+
+    /// Measures the Table 3-3 quantity `id` from what has happened so far
+    /// and grades it. A FAIL stops the scenario; MARGINAL is recorded.
+    pub fn expect_latency(&mut self, id: TimingId) -> Outcome<Duration> {
+        let (from, to) = match id {
+            TimingId::BusyRise => {
+                let a = self.need("an operation command", self.anchor)?;
+                (a, self.pin_after(Pin::Busy, Some(1), a)?)
+            }
+            TimingId::AccelFirstPout | TimingId::ConstantFirstPout => {
+                let a = self.need("an operation command", self.anchor)?;
+                let (first, _) = self.last_move_pulse_times()?;
+                (a, Some(first))
+            }
+            TimingId::SingleStep => {
+                let a = self.need("an operation command", self.anchor)?;
+                (a, self.pin_after(Pin::Busy, Some(0), a)?)
+            }
+            TimingId::InterruptOutput => {
+                let (_, last) = self.last_move_pulse_times()?;
+                (last, self.pin_after(Pin::Int, Some(1), last)?)
+            }
+            TimingId::HoldOn => {
+                let (_, last) = self.last_move_pulse_times()?;
+                (last, self.pin_after(Pin::Hold, Some(1), last)?)
+            }
+            TimingId::AbnormalTermination => {
+                let t = self.need("a stop or limit", self.trigger)?;
+                (t, self.pin_after(Pin::Busy, Some(0), t)?)
+            }
+            TimingId::AuxOn => {
+                let t = self.need("an AUX ON command", self.trigger)?;
+                (t, self.pin_after(Pin::Aux, Some(1), t)?)
+            }
+            TimingId::AuxOff => {
+                let t = self.need("an AUX OFF command", self.trigger)?;
+                (t, self.pin_after(Pin::Aux, Some(0), t)?)
+            }
+            TimingId::ExcitationOff => {
+                let t = self.need("a software reset", self.trigger)?;
+                (t, self.pin_after(Pin::Phases, Some(0), t)?)
+            }
+            TimingId::InitOutputsSet => {
+                let t = self.need("an initialization", self.init_write)?;
+                (t, self.pin_after(Pin::Phases, None, t)?)
+            }
+            TimingId::InitProcessing => return self.measure_init_processing(),
+            TimingId::NextCommand => return self.measure_next_command(),
+            TimingId::DecelStopProcessing
+            | TimingId::HighSpeedLimitAccel
+            | TimingId::HighSpeedLimitCruise => return self.expect_decel_start(id),
+        };
+        let now = self.now;
+        let to = to.ok_or_else(|| {
+            fail(
+                format!("{} (Table 3-3): the event it ends with", id.name()),
+                "observed",
+                "never happened",
+                now,
+            )
+        })?;
+        let value = to.saturating_since(from);
+        self.record_measure(id, value, to)?;
+        Ok(value)
+    }
+
+    /// Initialization processing: from the final data byte until the chip
+    /// takes the next command (an input status read, harmless).
+    fn measure_init_processing(&mut self) -> Outcome<Duration> {
+        let t = self.need("an initialization", self.init_write)?;
+        let timeout = self.opts.ibf_timeout;
+        self.expect_flag(Flag::Ibf, false, timeout)?;
+        self.raw_command(Register::InputSignals.code())?;
+        self.expect_flag(Flag::Ibf, false, timeout)?;
+        let value = self.now.saturating_since(t);
+        let at = self.now;
+        self.record_measure(TimingId::InitProcessing, value, at)?;
+        Ok(value)
+    }
+
+    /// Normal termination: the final POUT to the chip taking a command
+    /// written as soon as BUSY = 0.
+    fn measure_next_command(&mut self) -> Outcome<Duration> {
+        self.wait_idle()?;
+        let (_, last) = self.last_move_pulse_times()?;
+        self.raw_command(Register::InputSignals.code())?;
+        let timeout = self.opts.ibf_timeout;
+        self.expect_flag(Flag::Ibf, false, timeout)?;
+        let value = self.now.saturating_since(last);
+        let at = self.now;
+        self.record_measure(TimingId::NextCommand, value, at)?;
+        Ok(value)
+    }
+
+    /// The deceleration latencies: after the move, the pulse count says from
+    /// which pulse the deceleration started; it must be the first pulse
+    /// after the trigger plus a latency inside the row's band. A pass/fail
+    /// check, not a graded measurement: one run only brackets the latency
+    /// between two pulses. Returns the time from the trigger to that pulse.
+    fn expect_decel_start(&mut self, id: TimingId) -> Outcome<Duration> {
+        let t = self.need("a decelerating stop or high-speed limit", self.trigger)?;
+        let pa = self
+            .init
+            .map(|i| u64::from(i.data.pa))
+            .ok_or_else(|| Stop::Error("scenario bug: measuring needs an initialization".into()))?;
+        self.wait_idle()?;
+        let rec = self.capture()?;
+        let from = rec.moves.last().map_or(0, |m| m.first_run);
+        let times: Vec<Instant> = rec.runs[from..]
+            .iter()
+            .flat_map(|r| {
+                (0..r.count).map(move |i| r.start + r.interval.saturating_mul(u64::from(i)))
+            })
+            .collect();
+        let n = times.len() as u64;
+        // Pulse index the deceleration started from: at high speed the ramp
+        // takes PA more pulses after it; during acceleration from index j it
+        // takes j (notes N24).
+        let j1 = if id == TimingId::HighSpeedLimitAccel {
+            n / 2
+        } else {
+            n.saturating_sub(pa + 1)
+        };
+        let (lo, hi) = id.row().band_with_tolerance();
+        let first_after = |d: Duration| {
+            times
+                .iter()
+                .position(|p| *p > t + d)
+                .map_or(n, |i| i as u64)
+        };
+        let (j_lo, j_hi) = (first_after(lo), first_after(hi));
+        let start_time = times.get(j1 as usize).copied().unwrap_or(self.now);
+        if j1 < j_lo || j1 > j_hi {
+            return Err(Stop::Failed(Failure {
+                expectation: format!(
+                    "{} (Table 3-3): deceleration starts at the first pulse after the latency",
+                    id.name()
+                ),
+                expected: format!(
+                    "from pulse {j_lo}..={j_hi} (latency {lo}..={})",
+                    super::grade::fmt_hi(hi)
+                ),
+                got: format!("from pulse {j1}"),
+                at: start_time,
+            }));
+        }
+        // The latency itself lies between the pulse before j1 and j1; what is
+        // observable is how long after the trigger the first pulse of the
+        // deceleration came.
+        Ok(start_time.saturating_since(t))
+    }
+}
+
+/// Straps from a target's `details` (keys as [`crate::target::EmuTarget`]
+/// writes them); defaults where a key is missing.
+pub fn straps_of(details: &[(String, String)]) -> Straps {
+    let mut s = Straps::default();
+    for (k, v) in details {
+        match k.as_str() {
+            "sysclk_hz" => s.sysclk_hz = v.parse().unwrap_or(s.sysclk_hz),
+            "csel" => s.csel_high = v != "low",
+            "vsel" => s.vsel_high = v != "low",
+            "ext_clock_hz" => s.ext_clock_hz = v.parse().ok(),
+            _ => {}
+        }
+    }
+    s
+}
+
+fn describe_status(s: Status) -> String {
+    match s.field() {
+        StatusField::Error(e) => format!("0x{:02X} ({e})", s.0),
+        StatusField::ParamsRemaining(n) => {
+            format!("0x{:02X} (no error, {n} parameters wanted)", s.0)
+        }
+    }
+}
+
+fn hex(b: &[u8]) -> String {
+    b.iter()
+        .map(|x| format!("0x{x:02X}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+fn opt(d: Option<Duration>) -> String {
+    d.map_or("-".into(), |d| d.to_string())
+}

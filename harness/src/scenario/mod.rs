@@ -1,0 +1,323 @@
+//! Conformance scenarios: plain Rust functions over a [`Driver`].
+//!
+//! A scenario names the datasheet section it covers, carries tags, and
+//! either returns `Ok(())` or stops at the first expectation that failed.
+//! [`run_scenario`] runs one on a target from a hardware reset and returns
+//! its [`ScenarioResult`]: the verdict, the graded measurements and the
+//! trace.
+
+pub mod driver;
+pub mod grade;
+
+pub use driver::{Driver, DriverOptions, Init};
+pub use grade::{Grade, Grading, Measurement};
+
+use crate::protocol::{Command, Direction, MoveCommand, MoveKind, PulseCount};
+use crate::target::Target;
+use crate::time::{Duration, Instant};
+use crate::trace::{Event, EventKind, Trace};
+use std::fmt;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// What a scenario body returns.
+pub type Outcome<T = ()> = Result<T, Stop>;
+
+/// Why a scenario stopped before its end.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Stop {
+    /// The device did something the datasheet does not allow.
+    Failed(Failure),
+    /// The harness or the link failed (a target error, a scenario bug, the
+    /// time budget): not the device's fault.
+    Error(String),
+}
+
+/// An expectation that did not hold.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Failure {
+    pub expectation: String,
+    pub expected: String,
+    pub got: String,
+    /// When it happened, on the target's clock.
+    pub at: Instant,
+}
+
+impl fmt::Display for Failure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "at {}: {}: expected {}, got {}",
+            self.at, self.expectation, self.expected, self.got
+        )
+    }
+}
+
+/// One conformance scenario.
+#[derive(Clone, Copy)]
+pub struct Scenario {
+    /// Unique, `snake_case`, starting with the section: `s3_3_5_...`.
+    pub name: &'static str,
+    /// The datasheet section it proves, e.g. `3-3-5`.
+    pub section: &'static str,
+    /// One line on what it checks.
+    pub summary: &'static str,
+    pub tags: &'static [&'static str],
+    /// Virtual time the scenario may use.
+    pub budget: Duration,
+    pub body: fn(&mut Driver) -> Outcome,
+}
+
+impl fmt::Debug for Scenario {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Scenario")
+            .field("name", &self.name)
+            .field("section", &self.section)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Scenario {
+    pub const fn new(
+        name: &'static str,
+        section: &'static str,
+        summary: &'static str,
+        tags: &'static [&'static str],
+        body: fn(&mut Driver) -> Outcome,
+    ) -> Scenario {
+        Scenario {
+            name,
+            section,
+            summary,
+            tags,
+            budget: Duration::from_secs(120),
+            body,
+        }
+    }
+
+    /// Allows more virtual time (for moves of millions of steps).
+    pub const fn budget(mut self, budget: Duration) -> Scenario {
+        self.budget = budget;
+        self
+    }
+
+    pub fn has_tag(&self, tag: &str) -> bool {
+        self.tags.contains(&tag)
+    }
+}
+
+/// A move to issue: the command code and its data bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Move {
+    pub cmd: MoveCommand,
+    pub rate: Option<u8>,
+    pub steps: Option<PulseCount>,
+}
+
+impl Move {
+    fn new(kind: MoveKind, dir: Direction, rate: Option<u8>, steps: Option<u32>) -> Move {
+        Move {
+            cmd: MoveCommand::new(kind, dir, true),
+            rate,
+            // Out-of-range counts are a scenario bug; clamp into 1..=2^24.
+            steps: steps.map(|n| PulseCount::new(n.clamp(1, 1 << 24)).unwrap_or(PulseCount::MAX)),
+        }
+    }
+
+    /// Section 3-3-4: `steps` with the initialization's ramp.
+    pub fn accel(dir: Direction, steps: u32) -> Move {
+        Move::new(MoveKind::AccelDecel, dir, None, Some(steps))
+    }
+
+    /// Section 3-3-5: `steps` at pulse rate `rate`.
+    pub fn constant(dir: Direction, rate: u8, steps: u32) -> Move {
+        Move::new(MoveKind::Constant, dir, Some(rate), Some(steps))
+    }
+
+    /// Section 3-3-6: at `rate` until a limit.
+    pub fn continuous(dir: Direction, rate: u8) -> Move {
+        Move::new(MoveKind::ContinuousConstant, dir, Some(rate), None)
+    }
+
+    /// Section 3-3-7: ramp up and run at high speed until a limit.
+    pub fn high_speed(dir: Direction) -> Move {
+        Move::new(MoveKind::ContinuousHigh, dir, None, None)
+    }
+
+    /// Section 3-3-8: at `rate` until the origin signal.
+    pub fn origin(dir: Direction, rate: u8) -> Move {
+        Move::new(MoveKind::OriginSearch, dir, Some(rate), None)
+    }
+
+    /// Section 3-3-3: one step.
+    pub fn single_step(dir: Direction) -> Move {
+        Move::new(MoveKind::SingleStep, dir, None, None)
+    }
+
+    /// POUT mode (Sections 3-3-4, 3-3-7): pulses only, phases hold.
+    pub fn pout(mut self) -> Move {
+        self.cmd.pout = true;
+        self
+    }
+
+    /// Termination interrupt masked (bit 4 = 1).
+    pub fn masked(mut self) -> Move {
+        self.cmd.flags.interrupt = false;
+        self
+    }
+
+    pub fn code(&self) -> u8 {
+        Command::Move(self.cmd).encode()
+    }
+
+    /// The data bytes in flowchart order.
+    pub fn params(&self) -> Vec<u8> {
+        let mut v = Vec::new();
+        v.extend(self.rate);
+        if let Some(n) = self.steps {
+            v.extend(n.to_bytes());
+        }
+        v
+    }
+}
+
+/// How a scenario ended.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Verdict {
+    Passed,
+    /// Passed, with at least one measurement near a limit.
+    Marginal,
+    /// The device did something wrong.
+    Failed(Failure),
+    /// The harness or the link failed.
+    Error(String),
+    /// Never started (the run stopped before it).
+    NotRun(String),
+}
+
+impl Verdict {
+    pub fn label(&self) -> &'static str {
+        match self {
+            Verdict::Passed => "passed",
+            Verdict::Marginal => "marginal",
+            Verdict::Failed(_) => "failed",
+            Verdict::Error(_) => "error",
+            Verdict::NotRun(_) => "not run",
+        }
+    }
+
+    /// Whether the verdict lets a run pass (passed or marginal).
+    pub fn ok(&self) -> bool {
+        matches!(self, Verdict::Passed | Verdict::Marginal)
+    }
+
+    /// The one-line reason, for reports.
+    pub fn detail(&self) -> Option<String> {
+        match self {
+            Verdict::Passed => None,
+            Verdict::Marginal => Some("a measurement is near its limit".into()),
+            Verdict::Failed(f) => Some(f.to_string()),
+            Verdict::Error(e) | Verdict::NotRun(e) => Some(e.clone()),
+        }
+    }
+}
+
+/// Everything a run learned about one scenario.
+#[derive(Debug, Clone)]
+pub struct ScenarioResult {
+    pub name: &'static str,
+    pub section: &'static str,
+    pub tags: &'static [&'static str],
+    pub verdict: Verdict,
+    pub measurements: Vec<Measurement>,
+    /// `None` when the target could not deliver a capture.
+    pub trace: Option<Trace>,
+    /// Virtual time the scenario took on the target.
+    pub elapsed: Duration,
+}
+
+/// Runs one scenario from a hardware reset. A panic in the scenario body
+/// becomes an error verdict; the caller's run goes on.
+pub fn run_scenario(
+    target: &mut dyn Target,
+    scenario: &Scenario,
+    opts: DriverOptions,
+) -> ScenarioResult {
+    let opts = DriverOptions {
+        budget: scenario.budget,
+        ..opts
+    };
+    let info = target.info();
+    let mut driver = Driver::new(target, opts);
+    let outcome = catch_unwind(AssertUnwindSafe(|| {
+        driver.reset()?;
+        (scenario.body)(&mut driver)
+    }));
+    let outcome = match outcome {
+        Ok(o) => o,
+        Err(panic) => {
+            let msg = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "panic".into());
+            Err(Stop::Error(format!("scenario panicked: {msg}")))
+        }
+    };
+    let elapsed = driver.now().saturating_since(Instant::ZERO);
+    let capture = driver.capture().ok().cloned();
+    let (bus, measurements) = driver.into_parts();
+    let verdict = match outcome {
+        Ok(()) if measurements.iter().any(|m| m.grade == Grade::Marginal) => Verdict::Marginal,
+        Ok(()) => Verdict::Passed,
+        Err(Stop::Failed(f)) => Verdict::Failed(f),
+        Err(Stop::Error(e)) => Verdict::Error(e),
+    };
+    let measures: Vec<Event> = measurements
+        .iter()
+        .map(|m| Event {
+            at: m.at,
+            kind: EventKind::Measure {
+                name: m.name.clone(),
+                value: m.value,
+            },
+        })
+        .collect();
+    let trace = capture.map(|c| {
+        Trace::assemble(
+            scenario.name,
+            scenario.section,
+            &info.name,
+            info.details.clone(),
+            bus,
+            &c,
+            measures,
+        )
+    });
+    ScenarioResult {
+        name: scenario.name,
+        section: scenario.section,
+        tags: scenario.tags,
+        verdict,
+        measurements,
+        trace,
+        elapsed,
+    }
+}
+
+/// What scenario files import.
+pub mod prelude {
+    pub use super::{Driver, Init, Move, Outcome, Scenario};
+    pub use crate::protocol::Direction::{Ccw, Cw};
+    pub use crate::protocol::{Direction, ErrorCode, Flag, Input, MotorType, Register, TimingId};
+    pub use crate::time::Duration;
+
+    /// Microseconds.
+    pub const fn us(n: u64) -> Duration {
+        Duration::from_micros(n)
+    }
+
+    /// Milliseconds.
+    pub const fn ms(n: u64) -> Duration {
+        Duration::from_millis(n)
+    }
+}

@@ -1,0 +1,34 @@
+//! The whole conformance suite passes on the reference emulator.
+
+use ppmc::emu::ModelConfig;
+use ppmc::protocol::Straps;
+use ppmc::runner::{run_suite, validate_suite};
+use ppmc::scenario::DriverOptions;
+use ppmc::target::EmuTarget;
+
+#[test]
+fn every_scenario_passes_on_the_emulator() {
+    let all = ppmc::suite::all();
+    validate_suite(&all).expect("valid suite");
+    let mut t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+    let results = run_suite(&mut t, &all, 1, DriverOptions::default(), |_| {});
+    let bad: Vec<String> = results
+        .iter()
+        .filter(|r| r.verdict != ppmc::scenario::Verdict::Passed)
+        .map(|r| {
+            format!(
+                "{}: {} {}",
+                r.name,
+                r.verdict.label(),
+                r.verdict.detail().unwrap_or_default()
+            )
+        })
+        .collect();
+    assert!(
+        bad.is_empty(),
+        "{} of {} not passed:\n{}",
+        bad.len(),
+        results.len(),
+        bad.join("\n")
+    );
+}
