@@ -136,7 +136,7 @@ mod tests {
         };
         assert_eq!(
             names(sel(Some("t"), &[], None).select(&all)),
-            vec!["a_one", "b_two", "c_three"]
+            vec!["b_two", "c_three"]
         );
         assert_eq!(
             names(sel(None, &["x", "y"], None).select(&all)),

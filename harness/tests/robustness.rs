@@ -15,6 +15,8 @@ enum Step {
     Wait(u64),
     Input(usize, bool),
     Init,
+    /// A whole, well-formed move: command code and its data bytes.
+    Move(u8, Vec<u8>),
 }
 
 fn step() -> impl Strategy<Value = Step> {
@@ -30,9 +32,41 @@ fn step() -> impl Strategy<Value = Step> {
         .prop_map(Step::Command),
         any::<u8>().prop_map(Step::Data),
         Just(Step::Read),
+        // Mostly short waits, so that checks land inside moves and between
+        // a command and its first pulse; some long ones to finish moves.
+        (0u64..300_000).prop_map(Step::Wait),
+        (0u64..300_000).prop_map(Step::Wait),
         (0u64..20_000_000).prop_map(Step::Wait),
         (0usize..10, any::<bool>()).prop_map(|(i, b)| Step::Input(i, b)),
         Just(Step::Init),
+        (
+            prop::sample::select(vec![
+                (0x43u8, 3usize),
+                (0x44, 4),
+                (0x45, 1),
+                (0x46, 0),
+                (0x47, 1),
+                (0x4A, 0),
+                (0xC3, 3),
+                (0xC6, 0),
+                (0x5B, 3),
+                (0x4E, 0),
+            ]),
+            any::<u8>(),
+            0u8..3,
+            1u8..255,
+        )
+            .prop_map(|((code, n), lo, mid, rate)| {
+                let params = match n {
+                    3 => vec![lo, mid, 0],
+                    4 => vec![rate, lo, mid, 0],
+                    1 => vec![rate],
+                    _ => vec![],
+                };
+                Step::Move(code, params)
+            }),
+        Just(Step::Move(0x40, vec![])),
+        Just(Step::Move(0x41, vec![])),
     ]
 }
 
@@ -54,6 +88,14 @@ proptest! {
                     chip.advance_to(to);
                 }
                 Step::Input(i, b) => chip.set_input(Input::ALL[i], b),
+                Step::Move(code, params) => {
+                    chip.write_command(code);
+                    for b in params {
+                        let to = chip.now() + Duration::from_micros(10);
+                        chip.advance_to(to);
+                        chip.write_data(b);
+                    }
+                }
                 Step::Init => {
                     for (k, b) in [0x02u8, 100, 20, 100, 0].into_iter().enumerate() {
                         if k == 0 { chip.write_command(b) } else { chip.write_data(b) }
@@ -74,6 +116,15 @@ proptest! {
             last_pulses = pulses;
             if let Some(next) = chip.poll_at() {
                 prop_assert!(next >= chip.now(), "poll_at in the past");
+                // poll_at is honest: nothing observable changes before it.
+                if next > chip.now() + Duration::from_nanos(1) && next != Instant::NEVER {
+                    let mut probe = chip.clone();
+                    let (s0, p0) = (probe.read_status(), probe.pins());
+                    probe.advance_to(next - Duration::from_nanos(1));
+                    let (s1, p1) = (probe.read_status(), probe.pins());
+                    prop_assert_eq!(s0, s1, "status changed before poll_at {}", next);
+                    prop_assert_eq!((p0.int, p0.hold, p0.aux, p0.auxo, p0.busy, p0.dir), (p1.int, p1.hold, p1.aux, p1.auxo, p1.busy, p1.dir), "pins changed before poll_at {}", next);
+                }
             }
         }
         // Pulse times never go backward.

@@ -32,3 +32,14 @@ fn every_scenario_passes_on_the_emulator() {
         bad.join("\n")
     );
 }
+
+#[test]
+fn suite_has_the_scenario_files() {
+    let all = ppmc::suite::all();
+    let sections: std::collections::BTreeSet<&str> = all.iter().map(|s| s.section).collect();
+    eprintln!("{} scenarios over {} sections", all.len(), sections.len());
+    assert!(all.iter().any(|s| s.name == "e0_undefined_command_code"));
+    assert!(all
+        .iter()
+        .any(|s| s.name == "s3_2_2_over_speed_locks_out_the_host"));
+}

@@ -315,13 +315,9 @@ impl Chip {
     pub fn poll_at(&self) -> Option<Instant> {
         let timer = self.next_timer().map(|(at, _)| at);
         let pulse = self
-            .motion
-            .as_ref()
-            .filter(|m| m.pulses_left() && m.next_pulse != Instant::NEVER)
-            .map(|m| {
-                let (interval, count) = m.constant_stretch();
-                m.next_pulse + interval.saturating_mul(u64::from(count - 1))
-            });
+            .next_stretch()
+            .filter(|(first, _, _)| *first != Instant::NEVER)
+            .map(|(first, interval, count)| first + interval.saturating_mul(u64::from(count - 1)));
         match (timer, pulse) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
@@ -837,6 +833,33 @@ impl Chip {
         }
     }
 
+    /// Whether the move is in POUT mode with its high-speed limit asserted
+    /// and not yet acted on: it looks at the limit after every pulse until
+    /// high speed is reached (Section 3-3-4, notes N26).
+    fn pout_hs_check(m: &Motion, inputs: InputSet) -> bool {
+        m.pout
+            && m.kind.ramped()
+            && !m.decel_requested
+            && inputs.contains(Input::high_speed_limit_for(m.dir))
+    }
+
+    /// The pulses the move will output next without any decision in
+    /// between: `(first, interval, count)`. A whole constant-period stretch,
+    /// or one pulse where the model must look again after it (a ramp, the
+    /// first pulse, a pending POUT high-speed-limit check). Both [`Self::poll_at`] and
+    /// [`Self::emit_pulses`] use it, so waiting never skips a decision.
+    fn next_stretch(&self) -> Option<(Instant, Duration, u32)> {
+        let m = self.motion.as_ref().filter(|m| m.pulses_left())?;
+        let (interval, count) = m.constant_stretch();
+        // The first pulse samples the inputs (notes N27).
+        let count = if m.emitted == 0 || Self::pout_hs_check(m, self.inputs) {
+            count.min(1)
+        } else {
+            count
+        };
+        Some((m.next_pulse, interval, count))
+    }
+
     /// Emits the next pulses due at or before `horizon`: one ramp pulse, or a
     /// whole constant-period stretch in one step.
     fn emit_pulses(&mut self, horizon: Instant) {
@@ -846,33 +869,24 @@ impl Chip {
         if m.emitted == 0 {
             self.check_inputs_before_first_pulse();
         }
-        let hs = self
-            .motion
-            .as_ref()
-            .map(|m| Input::high_speed_limit_for(m.dir));
+        let Some(m) = self.motion.as_ref() else {
+            return;
+        };
+        let pout_hs_check = Self::pout_hs_check(m, self.inputs);
+        let Some((first, interval, stretch)) = self.next_stretch() else {
+            return;
+        };
         let Some(m) = self.motion.as_mut() else {
             return;
         };
-        if !m.pulses_left() {
-            return;
-        }
-        let (interval, stretch) = m.constant_stretch();
         let fit = if stretch <= 1 || interval == Duration::ZERO {
             stretch
         } else {
-            let span = horizon.saturating_since(m.next_pulse).as_nanos() / interval.as_nanos();
+            let span = horizon.saturating_since(first).as_nanos() / interval.as_nanos();
             u32::try_from(span.saturating_add(1))
                 .unwrap_or(u32::MAX)
                 .min(stretch)
         };
-        // POUT mode checks the high-speed limit on reaching high speed
-        // (Section 3-3-4): stop after the first pulse at speed to look.
-        let pout_hs_check = m.pout
-            && m.kind.ramped()
-            && !m.decel_requested
-            && hs.is_some_and(|i| self.inputs.contains(i));
-        let fit = if pout_hs_check { fit.min(1) } else { fit };
-        let first = m.next_pulse;
         let last = first + interval.saturating_mul(u64::from(fit - 1));
         let new_move = m.emitted == 0;
         let dir = m.dir;

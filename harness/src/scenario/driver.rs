@@ -400,8 +400,8 @@ impl<'t> Driver<'t> {
         Ok(())
     }
 
-    /// Drives an input (`on` = asserted, pin low). Counts as a trigger for
-    /// latency measurements.
+    /// Drives an input (`on` = asserted, pin low). An assertion counts as
+    /// the trigger for latency measurements.
     pub fn set(&mut self, input: Input, on: bool) -> Outcome<Instant> {
         let r = self.one(Op::SetInput {
             input,
@@ -414,7 +414,9 @@ impl<'t> Driver<'t> {
                 asserted: on,
             },
         );
-        self.trigger = Some(r.at());
+        if on {
+            self.trigger = Some(r.at());
+        }
         Ok(r.at())
     }
 
@@ -502,6 +504,16 @@ impl<'t> Driver<'t> {
         Ok(last)
     }
 
+    /// Initialization, then waiting out its processing time (Table 3-3 max
+    /// plus 1 %), so that what follows is timed from an idle chip.
+    pub fn init_and_wait(&mut self, init: Init) -> Outcome<Instant> {
+        let at = self.init(init)?;
+        let (_, max) = TimingId::InitProcessing.row().band_with_tolerance();
+        let until = at + max;
+        self.wait(until.saturating_since(self.now))?;
+        Ok(at)
+    }
+
     /// Issues a move by its flowchart and waits for BUSY = 1.
     pub fn start(&mut self, m: Move) -> Outcome<Instant> {
         let at = self.issue(m)?;
@@ -533,9 +545,10 @@ impl<'t> Driver<'t> {
         Ok(at)
     }
 
-    /// Waits for BUSY = 0 (the move ends).
+    /// Waits for BUSY = 0 (the move ends), at most the idle timeout or the
+    /// scenario's budget, whichever is longer.
     pub fn wait_idle(&mut self) -> Outcome<Duration> {
-        let t = self.opts.idle_timeout;
+        let t = self.opts.idle_timeout.max(self.opts.budget);
         self.expect_flag(Flag::Busy, false, t)
     }
 

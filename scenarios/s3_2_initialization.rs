@@ -1,0 +1,150 @@
+//! Section 3-2: initialization, its boundary values, clocks, the frozen
+//! winding rule, the ramp, and the speed limit.
+
+use crate::scenario::prelude::*;
+
+pub fn scenarios() -> Vec<Scenario> {
+    vec![
+        Scenario::new("s3_2_1_initialization_sets_the_phase_outputs", "3-2-1",
+            "the phase outputs are set 44 us after the final byte (Table 3-3)",
+            &["init", "timing", "phases"], outputs_set),
+        Scenario::new("s3_2_2_init_processing_with_pa_4", "3-2-2",
+            "initialization with the fewest acceleration pulses: 16.5 ms (Table 3-3 min)",
+            &["init", "timing", "boundary"], init_time_pa_4),
+        Scenario::new("s3_2_2_init_processing_with_pa_11220", "3-2-2",
+            "initialization with the most acceleration pulses: 162.8 ms (Table 3-3 max)",
+            &["init", "timing", "boundary"], init_time_pa_11220),
+        Scenario::new("s3_2_2_boundary_rates_are_accepted", "3-2-2",
+            "RL = 254, RH = 1 and RL = 21, RH = 20 are accepted",
+            &["init", "boundary"], boundary_rates),
+        Scenario::new("s3_2_1_winding_is_frozen_until_software_reset", "3-2-1",
+            "type, excitation and logic ignore re-initialization until a software reset",
+            &["init", "phases", "reset"], frozen_winding),
+        Scenario::new("s3_2_2_rates_change_by_reinitializing", "3-2-2",
+            "a new RH takes effect without a reset (Equation 3-1)",
+            &["init", "rates"], rates_change),
+        Scenario::new("s3_2_2_ramp_runs_from_rl_to_rh", "3-2-2",
+            "an accel/decel move spans the RL and RH periods and is symmetric",
+            &["init", "rates", "accel"], ramp_shape),
+        Scenario::new("s3_2_2_external_clock", "3-2-1",
+            "the external clock sets Tclock; with none fitted the chip never pulses",
+            &["init", "clock"], external_clock),
+        Scenario::new("s3_2_2_over_speed_locks_out_the_host", "3-2-2",
+            "above 27 kpps in phase mode the chip takes no host byte until it slows down",
+            &["init", "speed-limit"], over_speed),
+        Scenario::new("s3_2_2_pout_mode_allows_40_kpps", "3-2-2",
+            "the same 35.7 kpps is within the POUT-mode limit: commands are taken",
+            &["init", "speed-limit", "pout"], pout_speed_limit),
+    ]
+}
+
+fn outputs_set(d: &mut Driver) -> Outcome {
+    d.expect_phases(0)?;
+    d.init(Init::four_phase())?;
+    d.wait(ms(1))?;
+    d.expect_latency(TimingId::InitOutputsSet)?;
+    d.expect_phases(0b11000)
+}
+
+fn init_time_pa_4(d: &mut Driver) -> Outcome {
+    d.init(Init::four_phase().accel_pulses(4))?;
+    d.expect_no_error()?;
+    d.expect_latency(TimingId::InitProcessing)?;
+    d.run(Move::accel(Cw, 20))?;
+    d.expect_pulses(20, Cw)
+}
+
+fn init_time_pa_11220(d: &mut Driver) -> Outcome {
+    d.init(Init::four_phase().rates(200, 20).accel_pulses(11_220))?;
+    d.expect_no_error()?;
+    d.expect_latency(TimingId::InitProcessing)?;
+    d.run(Move::accel(Cw, 30))?;
+    d.expect_pulses(30, Cw)
+}
+
+fn boundary_rates(d: &mut Driver) -> Outcome {
+    d.init(Init::four_phase().rates(254, 1))?;
+    d.expect_no_error()?;
+    d.init(Init::four_phase().rates(21, 20))?;
+    d.expect_no_error()?;
+    d.run(Move::accel(Cw, 300))?;
+    let (lo, hi) = (d.period(20), d.period(21));
+    d.expect_intervals(lo, hi)
+}
+
+fn frozen_winding(d: &mut Driver) -> Outcome {
+    d.init(Init::four_phase())?;
+    // Ask for 3-phase, 1-2 excitation, positive logic: ignored.
+    d.init(Init::new(MotorType::ThreePhase).half_step().positive_logic())?;
+    d.expect_no_error()?;
+    d.run(Move::single_step(Cw))?;
+    d.expect_phases(0b01100)?;
+    // S2 S3 energized, negative logic: levels 10011; HOLD off; CW.
+    d.expect_output_status(0b1001_1000)?;
+    d.command(0xC0)?;
+    d.init(Init::new(MotorType::ThreePhase).half_step().positive_logic())?;
+    d.run(Move::single_step(Cw))?;
+    d.expect_phases(0b11000)?;
+    d.expect_output_status(0b1100_0000)
+}
+
+fn rates_change(d: &mut Driver) -> Outcome {
+    d.init(Init::four_phase())?;
+    d.run(Move::accel(Cw, 300))?;
+    let (fast, slow) = (d.period(20), d.period(100));
+    d.expect_intervals(fast, slow)?;
+    d.init(Init::four_phase().rates(100, 40))?;
+    d.run(Move::accel(Ccw, 300))?;
+    let fast = d.period(40);
+    d.expect_intervals(fast, slow)
+}
+
+fn ramp_shape(d: &mut Driver) -> Outcome {
+    d.init(Init::four_phase())?;
+    d.run(Move::accel(Cw, 1_000))?;
+    d.expect_pulses(1_000, Cw)?;
+    let (fast, slow) = (d.period(20), d.period(100));
+    d.expect_intervals(fast, slow)
+}
+
+fn external_clock(d: &mut Driver) -> Outcome {
+    d.init(Init::four_phase().external_clock())?;
+    match d.straps().ext_clock_hz {
+        Some(hz) => {
+            d.run(Move::constant(Cw, 99, 10))?;
+            let period = Duration::from_nanos((100 * 1_000_000_000 + u64::from(hz) / 2) / u64::from(hz));
+            d.expect_intervals(period, period)
+        }
+        None => {
+            d.start(Move::constant(Cw, 99, 10))?;
+            let idle = d.await_flag(Flag::Busy, false, ms(100))?;
+            d.check("BUSY without a base clock", None, idle)?;
+            d.expect_pulses(0, Cw)
+        }
+    }
+}
+
+fn over_speed(d: &mut Driver) -> Outcome {
+    d.init(Init::four_phase().rates(100, 10))?;
+    d.start(Move::accel(Cw, 5_000))?;
+    d.after_pulses(2_000)?;
+    d.raw_command(0x40)?;
+    let taken = d.await_flag(Flag::Ibf, false, ms(20))?;
+    d.check("IBF cleared while over the speed limit", None, taken)?;
+    d.wait_idle()?;
+    // Taken during the deceleration, once under the limit.
+    let n = d.expect_pulses_between(4_900, 4_999)?;
+    d.check("stopped before the end", true, n < 5_000)?;
+    d.expect_finish(0xC3)
+}
+
+fn pout_speed_limit(d: &mut Driver) -> Outcome {
+    d.init(Init::four_phase().rates(100, 13))?;
+    d.start(Move::accel(Cw, 5_000).pout())?;
+    d.after_pulses(2_000)?;
+    d.raw_command(Register::InputSignals.code())?;
+    d.expect_flag(Flag::Ibf, false, ms(1))?;
+    d.expect_error(ErrorCode::NotAllowedWhileBusy)?;
+    d.wait_idle()?;
+    d.expect_pulses(5_000, Cw)
+}
