@@ -1,0 +1,160 @@
+//! Section 3-5: switching parameters, AUX* ON/OFF, auxiliary outputs,
+//! software reset and recovery from it.
+
+use crate::scenario::prelude::*;
+
+pub fn scenarios() -> Vec<Scenario> {
+    vec![
+        Scenario::new("s3_5_1_default_switching_chops_the_phases", "3-5-1",
+            "with stop switching on, the phases chop at about 5.8 kHz once HOLD is on",
+            &["auxiliary", "switching", "phases"], default_switching),
+        Scenario::new("s3_5_1_switching_parameters", "3-5-1",
+            "Pon = 10, Poff = 20 give 57 us on, 93 us off (Equations 3-5, 3-6)",
+            &["auxiliary", "switching", "phases"], switching_params),
+        Scenario::new("s3_5_1_switching_parameters_while_busy", "3-5-1",
+            "the switching parameter command is refused during BUSY (error 1)",
+            &["auxiliary", "switching", "error", "busy"], switching_busy),
+        Scenario::new("s3_5_2_aux_on_off_before_initialization", "3-5-2",
+            "AUX ON / OFF work before initialization, 14 us each (Table 3-3)",
+            &["auxiliary", "aux", "timing"], aux_before_init),
+        Scenario::new("s3_5_2_aux_on_while_busy", "3-5-2",
+            "AUX ON is taken during a move without disturbing it",
+            &["auxiliary", "aux", "busy"], aux_while_busy),
+        Scenario::new("s3_5_3_aux_output_drives_auxo", "3-5-3",
+            "a 1 bit drives AUXO low; the upper nibble is ignored; works while BUSY",
+            &["auxiliary", "auxo", "busy"], aux_output),
+        Scenario::new("s3_5_4_software_reset_frees_the_motor", "3-5-4",
+            "software reset turns the phases off in 18 us (Table 3-3) and cancels initialization",
+            &["auxiliary", "reset", "timing", "phases"], software_reset),
+        Scenario::new("s3_5_4_software_reset_while_busy_is_aux_on", "3-5-4",
+            "software reset during a move is taken as AUX ON",
+            &["auxiliary", "reset", "aux", "busy"], reset_while_busy),
+        Scenario::new("s3_5_4_recovery_after_software_reset", "3-5-4",
+            "after a reset the chip takes a new initialization with another excitation and moves",
+            &["auxiliary", "reset", "recovery", "phases"], recovery),
+    ]
+}
+
+/// Samples the energized phases every `step` over `span`; returns the
+/// number of on-to-off and off-to-on changes seen.
+fn count_chops(d: &mut Driver, step: Duration, span: Duration) -> Result<(u32, u32), crate::scenario::Stop> {
+    let end = d.now() + span;
+    let mut last = d.pins()?.phases != 0;
+    let (mut offs, mut ons) = (0, 0);
+    while d.now() < end {
+        d.wait(step)?;
+        let on = d.pins()?.phases != 0;
+        if last && !on {
+            offs += 1;
+        }
+        if !last && on {
+            ons += 1;
+        }
+        last = on;
+    }
+    Ok((offs, ons))
+}
+
+fn default_switching(d: &mut Driver) -> Outcome {
+    d.init_and_wait(Init::four_phase().stop_switching())?;
+    // 65 us + 108.75 us = 173.75 us per cycle: 11 or 12 cycles in 2 ms.
+    let (offs, ons) = count_chops(d, us(5), ms(2))?;
+    d.check("chopping cycles in 2 ms", true, (11..=12).contains(&offs) && (11..=12).contains(&ons))?;
+    d.run(Move::accel(Cw, 20))?;
+    let (offs, _) = count_chops(d, us(5), ms(2))?;
+    d.check("no chopping until HOLD", 0, offs)
+}
+
+fn switching_params(d: &mut Driver) -> Outcome {
+    d.command(0x84)?;
+    d.data(10)?;
+    d.data(20)?;
+    d.expect_no_error()?;
+    d.init_and_wait(Init::four_phase().stop_switching())?;
+    // 57 us + 93 us = 150 us per cycle: 20 cycles in 3 ms.
+    let (offs, ons) = count_chops(d, us(3), ms(3))?;
+    d.check("chopping cycles in 3 ms", true, (19..=20).contains(&offs) && (19..=20).contains(&ons))
+}
+
+fn switching_busy(d: &mut Driver) -> Outcome {
+    d.init_and_wait(Init::four_phase())?;
+    d.start(Move::accel(Cw, 500))?;
+    d.command(0x84)?;
+    d.expect_error(ErrorCode::NotAllowedWhileBusy)
+}
+
+fn aux_before_init(d: &mut Driver) -> Outcome {
+    d.expect_pins(None, None, Some(false), Some(0))?;
+    d.trigger_command(0xC1)?;
+    d.wait(us(50))?;
+    d.expect_latency(TimingId::AuxOn)?;
+    d.expect_no_error()?;
+    d.expect_pins(None, None, Some(true), None)?;
+    d.trigger_command(0xC2)?;
+    d.wait(us(50))?;
+    d.expect_latency(TimingId::AuxOff)?;
+    d.expect_pins(None, None, Some(false), None)
+}
+
+fn aux_while_busy(d: &mut Driver) -> Outcome {
+    d.init_and_wait(Init::four_phase())?;
+    d.start(Move::accel(Cw, 500))?;
+    d.trigger_command(0xC1)?;
+    d.wait(us(50))?;
+    d.expect_no_error()?;
+    d.expect_latency(TimingId::AuxOn)?;
+    d.wait_idle()?;
+    d.expect_pulses(500, Cw)?;
+    d.expect_pins(None, None, Some(true), None)
+}
+
+fn aux_output(d: &mut Driver) -> Outcome {
+    d.command(0x86)?;
+    d.data(0b0101)?;
+    d.wait(us(50))?;
+    d.expect_pins(None, None, None, Some(0b0101))?;
+    d.init_and_wait(Init::four_phase())?;
+    d.start(Move::accel(Cw, 500))?;
+    d.command(0x86)?;
+    d.data(0xFA)?;
+    d.wait(us(50))?;
+    d.expect_no_error()?;
+    d.expect_pins(None, None, None, Some(0b1010))?;
+    d.wait_idle()?;
+    d.expect_pulses(500, Cw)
+}
+
+fn software_reset(d: &mut Driver) -> Outcome {
+    d.init_and_wait(Init::four_phase())?;
+    d.expect_phases(0b11000)?;
+    d.trigger_command(0xC0)?;
+    d.wait(us(50))?;
+    d.expect_latency(TimingId::ExcitationOff)?;
+    d.expect_phases(0)?;
+    d.command(Move::single_step(Cw).code())?;
+    d.expect_error(ErrorCode::NotInitialized)
+}
+
+fn reset_while_busy(d: &mut Driver) -> Outcome {
+    d.init_and_wait(Init::four_phase())?;
+    d.start(Move::accel(Cw, 500))?;
+    d.command(0xC0)?;
+    d.wait_idle()?;
+    d.expect_pulses(500, Cw)?;
+    d.expect_pins(None, None, Some(true), None)?;
+    d.run(Move::single_step(Cw))?;
+    d.expect_pulses(1, Cw)
+}
+
+fn recovery(d: &mut Driver) -> Outcome {
+    d.init_and_wait(Init::four_phase())?;
+    d.run(Move::accel(Cw, 101))?;
+    d.command(0xC0)?;
+    d.init_and_wait(Init::four_phase().half_step())?;
+    d.expect_phases(0b10000)?;
+    d.run(Move::accel(Cw, 3))?;
+    d.expect_pulses(3, Cw)?;
+    // S1 -> S1S2 -> S2 -> S2S3.
+    d.expect_phases(0b01100)?;
+    d.expect_finish(0x83)
+}
