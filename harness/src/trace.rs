@@ -467,7 +467,11 @@ fn parse_event(line: &str) -> Result<Event, String> {
         "pin" => {
             let name = w.next().ok_or("missing pin")?;
             let pin = pin_from(name).ok_or_else(|| format!("unknown pin `{name}`"))?;
-            let value = parse_num(w.next().ok_or("missing value")?, "pin value")?;
+            let text = w.next().ok_or("missing value")?;
+            let value = match text.strip_prefix("0b") {
+                Some(bits) => u8::from_str_radix(bits, 2).map_err(|_| format!("bad pin value `{text}`"))?,
+                None => parse_num(text, "pin value")?,
+            };
             EventKind::Pin { pin, value }
         }
         "measure" => {
@@ -507,7 +511,11 @@ impl fmt::Display for EventKind {
                 count,
                 interval,
             } => write!(f, "pulses {} n={count} dt={interval}", dir.name()),
-            EventKind::Pin { pin, value } => write!(f, "pin {} {value}", pin.name()),
+            EventKind::Pin { pin, value } => match pin {
+                Pin::Phases => write!(f, "pin {} 0b{value:05b}", pin.name()),
+                Pin::Auxo => write!(f, "pin {} 0b{value:04b}", pin.name()),
+                _ => write!(f, "pin {} {value}", pin.name()),
+            },
             EventKind::Measure { name, value } => write!(f, "measure {name} {value}"),
         }
     }
@@ -575,6 +583,8 @@ events
 200012.000us await busy=1 after 54.000us status=0x04
 200012.000us move constant cw steps=100 pout=0 winding=4ph-2 phase=0
 200060.000us pin busy 1
+200068.000us pin s 0b11000
+200070.000us pin auxo 0b0101
 200206.000us pulses cw n=100 dt=102.000us
 200300.000us set l1 on
 200300.000us await-pulses 5 reached
@@ -589,7 +599,7 @@ end
     fn sample_round_trips_exactly() {
         let t = Trace::parse(SAMPLE).expect("parses");
         assert_eq!(t.render(), SAMPLE);
-        assert_eq!(t.events.len(), 13);
+        assert_eq!(t.events.len(), 15);
     }
 
     #[test]
@@ -602,7 +612,7 @@ end
     fn errors_name_the_line() {
         let bad = SAMPLE.replace("pulses cw n=100", "pulses cw n=x");
         let e = Trace::parse(&bad).expect_err("bad count");
-        assert_eq!(e.line, 13);
+        assert_eq!(e.line, 15);
         assert!(e.message.contains("bad pulse count"), "{e}");
 
         let truncated = &SAMPLE[..SAMPLE.len() - 4];

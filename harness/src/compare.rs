@@ -1,0 +1,520 @@
+//! Comparing a trace with a golden trace, quantity by quantity.
+//!
+//! Events are aligned by their place in their own stream, never by absolute
+//! time: the n-th bus transaction with the n-th, the n-th pulse with the
+//! n-th, the n-th change of each pin with the n-th, the n-th measurement of
+//! a name with the n-th. Times are taken relative to the anchor, the write
+//! that started the move in progress (the `move` event), so a board whose
+//! clock runs a little differently still lines up.
+//!
+//! Each quantity has its own rule:
+//! - exactly: bus values (status bytes, read data, written bytes), error
+//!   codes, await outcomes, move kind / direction / steps / winding / start
+//!   phase (which fix the phase sequence), pulse count and direction, pin
+//!   values;
+//! - within a relative tolerance of the golden value: latencies (await
+//!   times, a move's first pulse, pin changes relative to the anchor) and
+//!   pulse intervals;
+//! - within Table 3-3 (with its 1 % note): measurements that name a row.
+//!
+//! The report is the first divergence in time, with the quantity, golden
+//! and got, and the allowed band.
+
+use crate::protocol::{Pin, TimingId};
+use crate::scenario::grade::fmt_hi;
+use crate::time::{Duration, Instant};
+use crate::trace::{BusEvent, EventKind, Trace};
+use std::collections::BTreeMap;
+use std::fmt;
+
+/// How far a timing may move before it counts as a divergence.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Tolerances {
+    /// Relative tolerance on latencies, in basis points (100 = 1 %).
+    pub latency_bp: u64,
+    /// Relative tolerance on pulse intervals, in basis points.
+    pub interval_bp: u64,
+    /// Absolute slack added to every timing band (timer resolution).
+    pub floor: Duration,
+}
+
+impl Default for Tolerances {
+    /// The datasheet's 1 % (Table 3-3 note) on latencies and intervals, and
+    /// 100 ns of timer resolution.
+    fn default() -> Self {
+        Tolerances {
+            latency_bp: 100,
+            interval_bp: 100,
+            floor: Duration::from_nanos(100),
+        }
+    }
+}
+
+impl Tolerances {
+    fn band(&self, golden: Duration, bp: u64) -> (Duration, Duration) {
+        let slack = golden.scale(bp, 10_000) + self.floor;
+        (golden.saturating_sub(slack), golden + slack)
+    }
+}
+
+/// The first place where a trace departs from its golden trace.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Divergence {
+    /// When, on the compared trace's clock (the golden's where the compared
+    /// trace has no such event).
+    pub at: Instant,
+    /// What differs: `pulse 42 interval`, `bus 7`, `pin busy change 2`, ...
+    pub quantity: String,
+    pub golden: String,
+    pub got: String,
+    /// What would have been accepted.
+    pub allowed: String,
+}
+
+impl fmt::Display for Divergence {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "at {}: {}: golden {}, got {} (allowed {})",
+            self.at, self.quantity, self.golden, self.got, self.allowed
+        )
+    }
+}
+
+/// One pulse, flattened, with the anchor it is timed from.
+#[derive(Debug, Clone, Copy)]
+struct Pulse {
+    at: Instant,
+    dir: crate::protocol::Direction,
+    /// Time of the move's start, for the first pulse of a move.
+    anchor: Instant,
+    first_of_move: bool,
+}
+
+/// The streams of a trace, each in order.
+#[derive(Debug, Default)]
+struct Streams {
+    bus: Vec<(Instant, BusEvent)>,
+    moves: Vec<(Instant, EventKind)>,
+    pulses: Vec<Pulse>,
+    pins: BTreeMap<Pin, Vec<(Instant, u8, Instant)>>,
+    measures: BTreeMap<String, Vec<(Instant, Duration)>>,
+}
+
+fn streams(t: &Trace) -> Streams {
+    let mut s = Streams::default();
+    let mut anchor = Instant::ZERO;
+    let mut pending_first = false;
+    for e in &t.events {
+        match &e.kind {
+            EventKind::Bus(b) => {
+                if *b == BusEvent::Reset {
+                    anchor = e.at;
+                }
+                s.bus.push((e.at, *b));
+            }
+            k @ EventKind::Move { .. } => {
+                anchor = e.at;
+                pending_first = true;
+                s.moves.push((e.at, k.clone()));
+            }
+            EventKind::Pulses {
+                dir,
+                count,
+                interval,
+            } => {
+                for i in 0..*count {
+                    s.pulses.push(Pulse {
+                        at: e.at + interval.saturating_mul(u64::from(i)),
+                        dir: *dir,
+                        anchor,
+                        first_of_move: pending_first && i == 0,
+                    });
+                }
+                pending_first = false;
+            }
+            EventKind::Pin { pin, value } => {
+                s.pins.entry(*pin).or_default().push((e.at, *value, anchor));
+            }
+            EventKind::Measure { name, value } => {
+                s.measures.entry(name.clone()).or_default().push((e.at, *value));
+            }
+        }
+    }
+    s
+}
+
+/// Keeps the earliest divergence.
+#[derive(Debug, Default)]
+struct First(Option<Divergence>);
+
+impl First {
+    fn offer(&mut self, d: Divergence) {
+        if self.0.as_ref().is_none_or(|cur| d.at < cur.at) {
+            self.0 = Some(d);
+        }
+    }
+
+    /// Whether anything at or after `at` can still be the first.
+    fn beaten_by(&self, at: Instant) -> bool {
+        self.0.as_ref().is_some_and(|cur| cur.at <= at)
+    }
+}
+
+fn within(got: Duration, (lo, hi): (Duration, Duration)) -> bool {
+    got >= lo && got <= hi
+}
+
+fn band_text((lo, hi): (Duration, Duration)) -> String {
+    format!("{lo}..={}", fmt_hi(hi))
+}
+
+/// Compares `got` with `golden`; `Ok(())` when every quantity is within
+/// its rule, else the first divergence in time.
+pub fn compare(golden: &Trace, got: &Trace, tol: &Tolerances) -> Result<(), Divergence> {
+    let g = streams(golden);
+    let o = streams(got);
+    let mut first = First::default();
+    compare_bus(&g, &o, tol, &mut first);
+    compare_moves(&g, &o, &mut first);
+    compare_pulses(&g, &o, tol, &mut first);
+    compare_pins(&g, &o, tol, &mut first);
+    compare_measures(&g, &o, tol, &mut first);
+    match first.0 {
+        Some(d) => Err(d),
+        None => Ok(()),
+    }
+}
+
+fn count_divergence<T>(what: &str, g: &[T], o: &[T], at: impl Fn(&T) -> Instant) -> Option<Divergence> {
+    if g.len() == o.len() {
+        return None;
+    }
+    let n = g.len().min(o.len());
+    let when = o.get(n).or(g.get(n)).map(at).unwrap_or_default();
+    Some(Divergence {
+        at: when,
+        quantity: format!("number of {what}"),
+        golden: g.len().to_string(),
+        got: o.len().to_string(),
+        allowed: "equal".into(),
+    })
+}
+
+fn compare_bus(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
+    for (i, ((_, ge), (ot, oe))) in g.bus.iter().zip(&o.bus).enumerate() {
+        if first.beaten_by(*ot) {
+            return;
+        }
+        let quantity = format!("bus transaction {} ({ge})", i + 1);
+        let mismatch = match (ge, oe) {
+            (
+                BusEvent::Await {
+                    flag: gf,
+                    value: gv,
+                    waited: gw,
+                    status: gs,
+                },
+                BusEvent::Await {
+                    flag: of,
+                    value: ov,
+                    waited: ow,
+                    status: os,
+                },
+            ) if gf == of && gv == ov => match (gw, ow) {
+                (Some(gw), Some(ow)) => {
+                    let band = tol.band(*gw, tol.latency_bp);
+                    if !within(*ow, band) {
+                        Some((format!("{quantity}: wait"), gw.to_string(), ow.to_string(), band_text(band)))
+                    } else if gs != os {
+                        Some((format!("{quantity}: status"), format!("0x{gs:02X}"), format!("0x{os:02X}"), "equal".into()))
+                    } else {
+                        None
+                    }
+                }
+                (None, None) if gs == os => None,
+                _ => Some((quantity.clone(), ge.to_string(), oe.to_string(), "equal".into())),
+            },
+            _ if ge == oe => None,
+            _ => Some((quantity.clone(), ge.to_string(), oe.to_string(), "equal".into())),
+        };
+        if let Some((quantity, golden, got, allowed)) = mismatch {
+            first.offer(Divergence {
+                at: *ot,
+                quantity,
+                golden,
+                got,
+                allowed,
+            });
+            return;
+        }
+    }
+    if let Some(d) = count_divergence("bus transactions", &g.bus, &o.bus, |e| e.0) {
+        first.offer(d);
+    }
+}
+
+fn compare_moves(g: &Streams, o: &Streams, first: &mut First) {
+    for (i, ((_, gm), (ot, om))) in g.moves.iter().zip(&o.moves).enumerate() {
+        if gm != om {
+            first.offer(Divergence {
+                at: *ot,
+                quantity: format!("move {}", i + 1),
+                golden: gm.to_string(),
+                got: om.to_string(),
+                allowed: "equal".into(),
+            });
+            return;
+        }
+    }
+    if let Some(d) = count_divergence("moves", &g.moves, &o.moves, |e| e.0) {
+        first.offer(d);
+    }
+}
+
+fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
+    for i in 0..g.pulses.len().min(o.pulses.len()) {
+        let (gp, op) = (g.pulses[i], o.pulses[i]);
+        if first.beaten_by(op.at) {
+            return;
+        }
+        let n = i + 1;
+        if gp.dir != op.dir {
+            first.offer(Divergence {
+                at: op.at,
+                quantity: format!("pulse {n} direction"),
+                golden: gp.dir.name().into(),
+                got: op.dir.name().into(),
+                allowed: "equal".into(),
+            });
+            return;
+        }
+        if gp.first_of_move != op.first_of_move {
+            first.offer(Divergence {
+                at: op.at,
+                quantity: format!("pulse {n}: which move it belongs to"),
+                golden: if gp.first_of_move { "first of a move" } else { "inside a move" }.into(),
+                got: if op.first_of_move { "first of a move" } else { "inside a move" }.into(),
+                allowed: "equal".into(),
+            });
+            return;
+        }
+        let (what, gd, od, bp) = if gp.first_of_move || i == 0 {
+            (
+                "delay from the move's start",
+                gp.at.saturating_since(gp.anchor),
+                op.at.saturating_since(op.anchor),
+                tol.latency_bp,
+            )
+        } else {
+            (
+                "interval",
+                gp.at.saturating_since(g.pulses[i - 1].at),
+                op.at.saturating_since(o.pulses[i - 1].at),
+                tol.interval_bp,
+            )
+        };
+        let band = tol.band(gd, bp);
+        if !within(od, band) {
+            first.offer(Divergence {
+                at: op.at,
+                quantity: format!("pulse {n} {what}"),
+                golden: gd.to_string(),
+                got: od.to_string(),
+                allowed: band_text(band),
+            });
+            return;
+        }
+    }
+    if let Some(d) = count_divergence("pulses", &g.pulses, &o.pulses, |p| p.at) {
+        first.offer(d);
+    }
+}
+
+fn compare_pins(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
+    let empty = Vec::new();
+    let pins: std::collections::BTreeSet<&Pin> = g.pins.keys().chain(o.pins.keys()).collect();
+    for pin in pins {
+        let gs = g.pins.get(pin).unwrap_or(&empty);
+        let os = o.pins.get(pin).unwrap_or(&empty);
+        let mut diverged = false;
+        for (i, (&(_, gv, ga), &(ot, ov, oa))) in gs.iter().zip(os).enumerate() {
+            if first.beaten_by(ot) {
+                break;
+            }
+            let quantity = format!("pin {} change {}", pin.name(), i + 1);
+            if gv != ov {
+                first.offer(Divergence {
+                    at: ot,
+                    quantity: format!("{quantity}: value"),
+                    golden: gv.to_string(),
+                    got: ov.to_string(),
+                    allowed: "equal".into(),
+                });
+                diverged = true;
+                break;
+            }
+            let gd = gs[i].0.saturating_since(ga);
+            let od = ot.saturating_since(oa);
+            let band = tol.band(gd, tol.latency_bp);
+            if !within(od, band) {
+                first.offer(Divergence {
+                    at: ot,
+                    quantity: format!("{quantity}: time from the move's start"),
+                    golden: gd.to_string(),
+                    got: od.to_string(),
+                    allowed: band_text(band),
+                });
+                diverged = true;
+                break;
+            }
+        }
+        if !diverged {
+            if let Some(d) = count_divergence(&format!("{} changes", pin.name()), gs, os, |e| e.0) {
+                first.offer(d);
+            }
+        }
+    }
+}
+
+fn compare_measures(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
+    let empty = Vec::new();
+    let names: std::collections::BTreeSet<&String> = g.measures.keys().chain(o.measures.keys()).collect();
+    for name in names {
+        let gs = g.measures.get(name).unwrap_or(&empty);
+        let os = o.measures.get(name).unwrap_or(&empty);
+        for (i, (&(_, gv), &(ot, ov))) in gs.iter().zip(os).enumerate() {
+            let quantity = format!("measurement {name} #{}", i + 1);
+            if let Some(id) = TimingId::from_name(name) {
+                let band = id.row().band_with_tolerance();
+                if !within(ov, band) {
+                    first.offer(Divergence {
+                        at: ot,
+                        quantity: format!("{quantity} (Table 3-3)"),
+                        golden: gv.to_string(),
+                        got: ov.to_string(),
+                        allowed: band_text(band),
+                    });
+                    break;
+                }
+            }
+            let band = tol.band(gv, tol.latency_bp);
+            if !within(ov, band) {
+                first.offer(Divergence {
+                    at: ot,
+                    quantity,
+                    golden: gv.to_string(),
+                    got: ov.to_string(),
+                    allowed: band_text(band),
+                });
+                break;
+            }
+        }
+        if let Some(d) = count_divergence(&format!("{name} measurements"), gs, os, |e| e.0) {
+            first.offer(d);
+        }
+    }
+}
+
+/// Scales every time in a trace by `num / den` (for tolerance tests and
+/// for simulating a board whose clock runs fast or slow).
+pub fn scale_times(t: &Trace, num: u64, den: u64) -> Trace {
+    let mut out = t.clone();
+    for e in &mut out.events {
+        e.at = Instant::from_nanos(Duration::from_nanos(e.at.as_nanos()).scale(num, den).as_nanos());
+        match &mut e.kind {
+            EventKind::Pulses { interval, .. } => *interval = interval.scale(num, den),
+            EventKind::Measure { value, .. } => *value = value.scale(num, den),
+            EventKind::Bus(BusEvent::Await {
+                waited: Some(w), ..
+            }) => *w = w.scale(num, den),
+            _ => {}
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOLDEN: &str = "ppmc-trace 1
+scenario demo
+section 3-3-5
+target emu
+events
+0.000us reset
+1000.000us wc 0x44
+1024.000us wd 0x00
+1030.000us move constant cw steps=4 pout=0 winding=4ph-2 phase=0
+1084.000us pin busy 1
+1084.000us await busy=1 after 60.000us status=0x04
+1218.000us pulses cw n=4 dt=102.000us
+1550.000us pin busy 0
+1600.000us measure constant_first_pout 194.000us
+end
+";
+
+    fn golden() -> Trace {
+        Trace::parse(GOLDEN).expect("golden parses")
+    }
+
+    #[test]
+    fn identical_traces_match() {
+        assert_eq!(compare(&golden(), &golden(), &Tolerances::default()), Ok(()));
+    }
+
+    #[test]
+    fn jitter_inside_the_tolerance_passes() {
+        let jittered = GOLDEN
+            .replace("1218.000us pulses cw n=4 dt=102.000us", "1218.500us pulses cw n=4 dt=102.800us")
+            .replace("after 60.000us", "after 60.500us");
+        let t = Trace::parse(&jittered).expect("parses");
+        assert_eq!(compare(&golden(), &t, &Tolerances::default()), Ok(()));
+        assert_eq!(compare(&golden(), &scale_times(&golden(), 1005, 1000), &Tolerances::default()), Ok(()));
+    }
+
+    #[test]
+    fn a_three_percent_slower_clock_is_caught_at_the_first_pulse_interval() {
+        let slow = scale_times(&golden(), 103, 100);
+        let d = compare(&golden(), &slow, &Tolerances::default()).expect_err("3 % off");
+        assert_eq!(d.quantity, "bus transaction 4 (await busy=1 after 60.000us status=0x04): wait");
+        assert_eq!(d.golden, "60.000us");
+        assert_eq!(d.got, "61.800us");
+    }
+
+    #[test]
+    fn a_lost_pulse_is_a_count_divergence() {
+        let t = Trace::parse(&GOLDEN.replace("n=4", "n=3")).expect("parses");
+        let d = compare(&golden(), &t, &Tolerances::default()).expect_err("pulse lost");
+        assert_eq!(d.quantity, "number of pulses");
+        assert_eq!((d.golden.as_str(), d.got.as_str()), ("4", "3"));
+    }
+
+    #[test]
+    fn a_different_status_value_is_exact() {
+        let t = Trace::parse(&GOLDEN.replace("status=0x04", "status=0x84")).expect("parses");
+        let d = compare(&golden(), &t, &Tolerances::default()).expect_err("status");
+        assert!(d.quantity.ends_with(": status"), "{d}");
+    }
+
+    #[test]
+    fn a_measurement_outside_table_3_3_fails_even_if_golden_agrees() {
+        let odd = GOLDEN.replace("measure constant_first_pout 194.000us", "measure constant_first_pout 200.000us");
+        let g = Trace::parse(&odd).expect("parses");
+        let d = compare(&g, &g, &Tolerances::default()).expect_err("out of band");
+        assert!(d.quantity.contains("Table 3-3"), "{d}");
+    }
+
+    #[test]
+    fn the_earliest_divergence_wins() {
+        let t = Trace::parse(
+            &GOLDEN
+                .replace("1550.000us pin busy 0", "1550.000us pin busy 1")
+                .replace("1218.000us pulses cw n=4 dt=102.000us", "1218.000us pulses ccw n=4 dt=102.000us"),
+        )
+        .expect("parses");
+        let d = compare(&golden(), &t, &Tolerances::default()).expect_err("two differences");
+        assert_eq!(d.quantity, "pulse 1 direction");
+    }
+}
