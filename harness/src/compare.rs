@@ -137,7 +137,10 @@ fn streams(t: &Trace) -> Streams {
                 s.pins.entry(*pin).or_default().push((e.at, *value, anchor));
             }
             EventKind::Measure { name, value } => {
-                s.measures.entry(name.clone()).or_default().push((e.at, *value));
+                s.measures
+                    .entry(name.clone())
+                    .or_default()
+                    .push((e.at, *value));
             }
         }
     }
@@ -186,7 +189,12 @@ pub fn compare(golden: &Trace, got: &Trace, tol: &Tolerances) -> Result<(), Dive
     }
 }
 
-fn count_divergence<T>(what: &str, g: &[T], o: &[T], at: impl Fn(&T) -> Instant) -> Option<Divergence> {
+fn count_divergence<T>(
+    what: &str,
+    g: &[T],
+    o: &[T],
+    at: impl Fn(&T) -> Instant,
+) -> Option<Divergence> {
     if g.len() == o.len() {
         return None;
     }
@@ -225,18 +233,38 @@ fn compare_bus(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
                 (Some(gw), Some(ow)) => {
                     let band = tol.band(*gw, tol.latency_bp);
                     if !within(*ow, band) {
-                        Some((format!("{quantity}: wait"), gw.to_string(), ow.to_string(), band_text(band)))
+                        Some((
+                            format!("{quantity}: wait"),
+                            gw.to_string(),
+                            ow.to_string(),
+                            band_text(band),
+                        ))
                     } else if gs != os {
-                        Some((format!("{quantity}: status"), format!("0x{gs:02X}"), format!("0x{os:02X}"), "equal".into()))
+                        Some((
+                            format!("{quantity}: status"),
+                            format!("0x{gs:02X}"),
+                            format!("0x{os:02X}"),
+                            "equal".into(),
+                        ))
                     } else {
                         None
                     }
                 }
                 (None, None) if gs == os => None,
-                _ => Some((quantity.clone(), ge.to_string(), oe.to_string(), "equal".into())),
+                _ => Some((
+                    quantity.clone(),
+                    ge.to_string(),
+                    oe.to_string(),
+                    "equal".into(),
+                )),
             },
             _ if ge == oe => None,
-            _ => Some((quantity.clone(), ge.to_string(), oe.to_string(), "equal".into())),
+            _ => Some((
+                quantity.clone(),
+                ge.to_string(),
+                oe.to_string(),
+                "equal".into(),
+            )),
         };
         if let Some((quantity, golden, got, allowed)) = mismatch {
             first.offer(Divergence {
@@ -293,8 +321,18 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First)
             first.offer(Divergence {
                 at: op.at,
                 quantity: format!("pulse {n}: which move it belongs to"),
-                golden: if gp.first_of_move { "first of a move" } else { "inside a move" }.into(),
-                got: if op.first_of_move { "first of a move" } else { "inside a move" }.into(),
+                golden: if gp.first_of_move {
+                    "first of a move"
+                } else {
+                    "inside a move"
+                }
+                .into(),
+                got: if op.first_of_move {
+                    "first of a move"
+                } else {
+                    "inside a move"
+                }
+                .into(),
                 allowed: "equal".into(),
             });
             return;
@@ -379,7 +417,8 @@ fn compare_pins(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
 
 fn compare_measures(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
     let empty = Vec::new();
-    let names: std::collections::BTreeSet<&String> = g.measures.keys().chain(o.measures.keys()).collect();
+    let names: std::collections::BTreeSet<&String> =
+        g.measures.keys().chain(o.measures.keys()).collect();
     for name in names {
         let gs = g.measures.get(name).unwrap_or(&empty);
         let os = o.measures.get(name).unwrap_or(&empty);
@@ -421,7 +460,11 @@ fn compare_measures(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut Firs
 pub fn scale_times(t: &Trace, num: u64, den: u64) -> Trace {
     let mut out = t.clone();
     for e in &mut out.events {
-        e.at = Instant::from_nanos(Duration::from_nanos(e.at.as_nanos()).scale(num, den).as_nanos());
+        e.at = Instant::from_nanos(
+            Duration::from_nanos(e.at.as_nanos())
+                .scale(num, den)
+                .as_nanos(),
+        );
         match &mut e.kind {
             EventKind::Pulses { interval, .. } => *interval = interval.scale(num, den),
             EventKind::Measure { value, .. } => *value = value.scale(num, den),
@@ -461,24 +504,40 @@ end
 
     #[test]
     fn identical_traces_match() {
-        assert_eq!(compare(&golden(), &golden(), &Tolerances::default()), Ok(()));
+        assert_eq!(
+            compare(&golden(), &golden(), &Tolerances::default()),
+            Ok(())
+        );
     }
 
     #[test]
     fn jitter_inside_the_tolerance_passes() {
         let jittered = GOLDEN
-            .replace("1218.000us pulses cw n=4 dt=102.000us", "1218.500us pulses cw n=4 dt=102.800us")
+            .replace(
+                "1218.000us pulses cw n=4 dt=102.000us",
+                "1218.500us pulses cw n=4 dt=102.800us",
+            )
             .replace("after 60.000us", "after 60.500us");
         let t = Trace::parse(&jittered).expect("parses");
         assert_eq!(compare(&golden(), &t, &Tolerances::default()), Ok(()));
-        assert_eq!(compare(&golden(), &scale_times(&golden(), 1005, 1000), &Tolerances::default()), Ok(()));
+        assert_eq!(
+            compare(
+                &golden(),
+                &scale_times(&golden(), 1005, 1000),
+                &Tolerances::default()
+            ),
+            Ok(())
+        );
     }
 
     #[test]
     fn a_three_percent_slower_clock_is_caught_at_the_first_pulse_interval() {
         let slow = scale_times(&golden(), 103, 100);
         let d = compare(&golden(), &slow, &Tolerances::default()).expect_err("3 % off");
-        assert_eq!(d.quantity, "bus transaction 4 (await busy=1 after 60.000us status=0x04): wait");
+        assert_eq!(
+            d.quantity,
+            "bus transaction 4 (await busy=1 after 60.000us status=0x04): wait"
+        );
         assert_eq!(d.golden, "60.000us");
         assert_eq!(d.got, "61.800us");
     }
@@ -500,7 +559,10 @@ end
 
     #[test]
     fn a_measurement_outside_table_3_3_fails_even_if_golden_agrees() {
-        let odd = GOLDEN.replace("measure constant_first_pout 194.000us", "measure constant_first_pout 200.000us");
+        let odd = GOLDEN.replace(
+            "measure constant_first_pout 194.000us",
+            "measure constant_first_pout 200.000us",
+        );
         let g = Trace::parse(&odd).expect("parses");
         let d = compare(&g, &g, &Tolerances::default()).expect_err("out of band");
         assert!(d.quantity.contains("Table 3-3"), "{d}");
@@ -511,7 +573,10 @@ end
         let t = Trace::parse(
             &GOLDEN
                 .replace("1550.000us pin busy 0", "1550.000us pin busy 1")
-                .replace("1218.000us pulses cw n=4 dt=102.000us", "1218.000us pulses ccw n=4 dt=102.000us"),
+                .replace(
+                    "1218.000us pulses cw n=4 dt=102.000us",
+                    "1218.000us pulses ccw n=4 dt=102.000us",
+                ),
         )
         .expect("parses");
         let d = compare(&golden(), &t, &Tolerances::default()).expect_err("two differences");

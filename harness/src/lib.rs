@@ -9,12 +9,15 @@
 pub mod compare;
 pub mod console;
 pub mod emu;
+pub mod golden;
 pub mod protocol;
+pub mod report;
 pub mod runner;
 pub mod scenario;
 pub mod target;
 pub mod time;
 pub mod trace;
+pub mod vcd_export;
 
 /// The conformance suite: every scenario file in `scenarios/`.
 #[allow(missing_docs)]

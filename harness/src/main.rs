@@ -1,6 +1,7 @@
 //! `ppmc`: the command-line front end.
 
 mod bench;
+mod cmd;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use ppmc::console::{self, ConsoleOptions, Line, ScriptError};
@@ -23,6 +24,22 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Run the conformance suite on a target (the emulator by default) and
+    /// grade it: passed, marginal, failed (the device), error (the harness or
+    /// link). Exit status 0 when all pass, 1 when any does not, 2 on bad usage.
+    Run(cmd::RunArgs),
+    /// List the scenarios with their section, tags and summary.
+    List(cmd::ListArgs),
+    /// Run scenarios and write their traces as golden files. Never overwrites
+    /// an existing golden file unless --bless is given; writes atomically.
+    Record(cmd::RecordArgs),
+    /// Compare a golden trace set with a second trace set (--traces) or with a
+    /// fresh run on a target, with tolerances; prints each scenario's verdict
+    /// and its first divergence.
+    Compare(cmd::CompareArgs),
+    /// Write a trace as a VCD waveform (POUT, DIR, S1..S5, INT, HOLD, AUX,
+    /// BUSY) for GTKWave or PulseView.
+    Export(cmd::ExportArgs),
     /// Run a bus script against a target and print one line per result.
     ///
     /// Reads the script from FILE, from -e, or from standard input. On a
@@ -90,7 +107,7 @@ enum Curve {
     LinearRate,
 }
 
-fn parse_duration(s: &str) -> Result<Duration, String> {
+pub(crate) fn parse_duration(s: &str) -> Result<Duration, String> {
     s.parse::<Duration>().map_err(|e| e.to_string())
 }
 
@@ -144,13 +161,18 @@ impl TargetArgs {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
+        Command::Run(args) => cmd::run(args),
+        Command::List(args) => cmd::list(args),
+        Command::Record(args) => cmd::record(args),
+        Command::Compare(args) => cmd::compare_cmd(args),
+        Command::Export(args) => cmd::export(args),
         Command::Console(args) => run_console(args),
         Command::Bench(args) => bench::run(args),
     }
 }
 
 /// Exit status 2: bad usage or bad input (the script, an option).
-fn usage_error(msg: impl std::fmt::Display) -> ExitCode {
+pub(crate) fn usage_error(msg: impl std::fmt::Display) -> ExitCode {
     eprintln!("ppmc: {msg}");
     ExitCode::from(2)
 }

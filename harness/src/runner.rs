@@ -63,7 +63,7 @@ pub fn validate_suite(all: &[Scenario]) -> Result<(), String> {
 }
 
 /// Runs `scenarios` `repeat` times on `target`, calling `on_result` after
-/// each. After a harness error the target gets a health check (a reset);
+/// each (it may amend the result, e.g. with a golden comparison). After a harness error the target gets a health check (a reset);
 /// if that fails too the link is taken as dead and the scenarios left are
 /// reported as not run, so a broken cable does not read as a bad board.
 pub fn run_suite(
@@ -71,13 +71,13 @@ pub fn run_suite(
     scenarios: &[Scenario],
     repeat: usize,
     opts: DriverOptions,
-    mut on_result: impl FnMut(&ScenarioResult),
+    mut on_result: impl FnMut(&mut ScenarioResult),
 ) -> Vec<ScenarioResult> {
     let mut results = Vec::new();
     let mut dead: Option<String> = None;
     for _ in 0..repeat.max(1) {
         for s in scenarios {
-            let r = match &dead {
+            let mut r = match &dead {
                 Some(why) => ScenarioResult {
                     name: s.name,
                     section: s.section,
@@ -97,7 +97,7 @@ pub fn run_suite(
                     r
                 }
             };
-            on_result(&r);
+            on_result(&mut r);
             results.push(r);
         }
     }

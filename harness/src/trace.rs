@@ -469,7 +469,9 @@ fn parse_event(line: &str) -> Result<Event, String> {
             let pin = pin_from(name).ok_or_else(|| format!("unknown pin `{name}`"))?;
             let text = w.next().ok_or("missing value")?;
             let value = match text.strip_prefix("0b") {
-                Some(bits) => u8::from_str_radix(bits, 2).map_err(|_| format!("bad pin value `{text}`"))?,
+                Some(bits) => {
+                    u8::from_str_radix(bits, 2).map_err(|_| format!("bad pin value `{text}`"))?
+                }
                 None => parse_num(text, "pin value")?,
             };
             EventKind::Pin { pin, value }

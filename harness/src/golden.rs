@@ -1,0 +1,202 @@
+//! Golden trace files: one per scenario, `golden/<scenario>.snap`.
+//!
+//! The files are insta snapshots (so `cargo insta review` accepts a changed
+//! emulator trace), which is a short `---` header and the trace text.
+//! Nothing here overwrites a file unless asked, and every write goes to a
+//! temporary file first and is renamed into place, so an interrupted write
+//! never leaves half a golden file.
+
+use crate::trace::{Trace, TraceError};
+use std::fs;
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+/// The front matter insta writes for `harness/tests/golden.rs`; `ppmc
+/// record` writes the same so both tools agree on the files.
+pub const SNAPSHOT_HEADER: &str = "---\nsource: harness/tests/golden.rs\n---\n";
+
+/// A golden file that cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum GoldenError {
+    /// No golden file for the scenario.
+    #[error("{path}: no golden trace for this scenario (record one with `ppmc record`)")]
+    Missing { path: PathBuf },
+    /// The file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: io::Error,
+    },
+    /// The file is not a valid trace (corrupt, truncated, another version).
+    #[error("{path}:{line}: {message}")]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    /// The file is a trace of another scenario.
+    #[error("{path}:2: this is the trace of scenario `{found}`, not `{expected}`")]
+    WrongScenario {
+        path: PathBuf,
+        expected: String,
+        found: String,
+    },
+    /// Writing would replace an existing golden file.
+    #[error("{path}: exists; pass --bless to replace golden files")]
+    Exists { path: PathBuf },
+}
+
+/// The file for `scenario` in `dir`: `<scenario>.snap`, or `<scenario>.trace`
+/// when only that exists (a trace set saved by `--artifacts`).
+pub fn path_for(dir: &Path, scenario: &str) -> PathBuf {
+    let snap = dir.join(format!("{scenario}.snap"));
+    let trace = dir.join(format!("{scenario}.trace"));
+    if !snap.exists() && trace.exists() {
+        trace
+    } else {
+        snap
+    }
+}
+
+/// Reads and checks the golden trace of `scenario`.
+pub fn load(dir: &Path, scenario: &str) -> Result<Trace, GoldenError> {
+    let path = path_for(dir, scenario);
+    let text = match fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Err(GoldenError::Missing { path }),
+        Err(source) => return Err(GoldenError::Io { path, source }),
+    };
+    let trace = Trace::parse(&text).map_err(|TraceError { line, message }| GoldenError::Parse {
+        path: path.clone(),
+        line,
+        message,
+    })?;
+    if trace.scenario != scenario {
+        return Err(GoldenError::WrongScenario {
+            path,
+            expected: scenario.to_string(),
+            found: trace.scenario,
+        });
+    }
+    Ok(trace)
+}
+
+/// What [`write`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Written {
+    Created,
+    Replaced,
+    Unchanged,
+}
+
+/// Writes `trace` as the golden file of its scenario in `dir`. An existing
+/// file with other content is replaced only with `bless`.
+pub fn write(dir: &Path, trace: &Trace, bless: bool) -> Result<Written, GoldenError> {
+    let path = dir.join(format!("{}.snap", trace.scenario));
+    let text = format!("{SNAPSHOT_HEADER}{}", trace.render());
+    let existing = match fs::read_to_string(&path) {
+        Ok(t) => Some(t),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+        Err(source) => return Err(GoldenError::Io { path, source }),
+    };
+    let outcome = match existing {
+        Some(t) if t == text => return Ok(Written::Unchanged),
+        Some(_) if !bless => return Err(GoldenError::Exists { path }),
+        Some(_) => Written::Replaced,
+        None => Written::Created,
+    };
+    write_atomic(&path, text.as_bytes()).map_err(|source| GoldenError::Io { path, source })?;
+    Ok(outcome)
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder
+/// and a rename, so readers see the old file or the new one, never half.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    fs::create_dir_all(dir)?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
+    {
+        let mut f = fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+    }
+    fs::rename(&tmp, path).inspect_err(|_| {
+        let _ = fs::remove_file(&tmp);
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmpdir(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("ppmc-golden-{tag}-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&d);
+        fs::create_dir_all(&d).expect("temp dir");
+        d
+    }
+
+    fn trace(name: &str) -> Trace {
+        Trace::parse(&format!(
+            "ppmc-trace 1\nscenario {name}\nsection 3-1\ntarget emu\nevents\n0.000us reset\nend\n"
+        ))
+        .expect("valid")
+    }
+
+    #[test]
+    fn write_never_overwrites_without_bless() {
+        let d = tmpdir("bless");
+        assert_eq!(
+            write(&d, &trace("a"), false).expect("new"),
+            Written::Created
+        );
+        assert_eq!(
+            write(&d, &trace("a"), false).expect("same"),
+            Written::Unchanged
+        );
+        let mut other = trace("a");
+        other.section = "3-2".into();
+        let before = fs::read_to_string(d.join("a.snap")).expect("exists");
+        assert!(matches!(
+            write(&d, &other, false),
+            Err(GoldenError::Exists { .. })
+        ));
+        assert_eq!(fs::read_to_string(d.join("a.snap")).expect("kept"), before);
+        assert_eq!(write(&d, &other, true).expect("blessed"), Written::Replaced);
+        assert_eq!(load(&d, "a").expect("loads"), other);
+        let leftovers: Vec<_> = fs::read_dir(&d)
+            .expect("dir")
+            .filter_map(Result::ok)
+            .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+            .collect();
+        assert!(leftovers.is_empty());
+    }
+
+    #[test]
+    fn bad_golden_files_name_path_and_line() {
+        let d = tmpdir("bad");
+        assert!(matches!(load(&d, "x"), Err(GoldenError::Missing { .. })));
+        fs::write(d.join("x.snap"), format!("{SNAPSHOT_HEADER}ppmc-trace 1\nscenario x\nsection 3\ntarget emu\nevents\n0.000us bogus\nend\n")).expect("write");
+        let e = load(&d, "x").expect_err("corrupt");
+        assert!(
+            e.to_string().ends_with("x.snap:9: unknown event `bogus`"),
+            "{e}"
+        );
+        fs::write(d.join("y.snap"), trace("x").render()).expect("write");
+        let e = load(&d, "y").expect_err("other scenario");
+        assert!(
+            e.to_string().contains("trace of scenario `x`, not `y`"),
+            "{e}"
+        );
+        fs::write(d.join("z.snap"), "ppmc-trace 1\nscenario z\n").expect("write");
+        assert!(load(&d, "z")
+            .expect_err("truncated")
+            .to_string()
+            .contains("truncated"));
+    }
+}
