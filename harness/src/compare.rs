@@ -81,14 +81,23 @@ impl fmt::Display for Divergence {
     }
 }
 
-/// One pulse, flattened, with the anchor it is timed from.
+/// A run of pulses, with the anchor its move is timed from.
 #[derive(Debug, Clone, Copy)]
-struct Pulse {
-    at: Instant,
+struct Run {
+    start: Instant,
+    interval: Duration,
+    count: u32,
     dir: crate::protocol::Direction,
-    /// Time of the move's start, for the first pulse of a move.
+    /// Time of the move's start.
     anchor: Instant,
+    /// Whether the run's first pulse is the first of its move.
     first_of_move: bool,
+}
+
+impl Run {
+    fn at(&self, i: u32) -> Instant {
+        self.start + self.interval.saturating_mul(u64::from(i))
+    }
 }
 
 /// The streams of a trace, each in order.
@@ -96,7 +105,7 @@ struct Pulse {
 struct Streams {
     bus: Vec<(Instant, BusEvent)>,
     moves: Vec<(Instant, EventKind)>,
-    pulses: Vec<Pulse>,
+    pulses: Vec<Run>,
     pins: BTreeMap<Pin, Vec<(Instant, u8, Instant)>>,
     measures: BTreeMap<String, Vec<(Instant, Duration)>>,
 }
@@ -123,14 +132,14 @@ fn streams(t: &Trace) -> Streams {
                 count,
                 interval,
             } => {
-                for i in 0..*count {
-                    s.pulses.push(Pulse {
-                        at: e.at + interval.saturating_mul(u64::from(i)),
-                        dir: *dir,
-                        anchor,
-                        first_of_move: pending_first && i == 0,
-                    });
-                }
+                s.pulses.push(Run {
+                    start: e.at,
+                    interval: *interval,
+                    count: *count,
+                    dir: *dir,
+                    anchor,
+                    first_of_move: pending_first,
+                });
                 pending_first = false;
             }
             EventKind::Pin { pin, value } => {
@@ -258,6 +267,55 @@ fn compare_bus(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
                     "equal".into(),
                 )),
             },
+            (
+                BusEvent::WriteCommand {
+                    byte: gb,
+                    waited: Some(gw),
+                },
+                BusEvent::WriteCommand {
+                    byte: ob,
+                    waited: Some(ow),
+                },
+            )
+            | (
+                BusEvent::WriteData {
+                    byte: gb,
+                    waited: Some(gw),
+                },
+                BusEvent::WriteData {
+                    byte: ob,
+                    waited: Some(ow),
+                },
+            )
+            | (
+                BusEvent::ReadData {
+                    byte: gb,
+                    waited: Some(gw),
+                },
+                BusEvent::ReadData {
+                    byte: ob,
+                    waited: Some(ow),
+                },
+            ) => {
+                let band = tol.band(*gw, tol.latency_bp);
+                if gb != ob {
+                    Some((
+                        format!("{quantity}: value"),
+                        format!("0x{gb:02X}"),
+                        format!("0x{ob:02X}"),
+                        "equal".into(),
+                    ))
+                } else if !within(*ow, band) {
+                    Some((
+                        format!("{quantity}: wait for IBF/OBF"),
+                        gw.to_string(),
+                        ow.to_string(),
+                        band_text(band),
+                    ))
+                } else {
+                    None
+                }
+            }
             _ if ge == oe => None,
             _ => Some((
                 quantity.clone(),
@@ -300,72 +358,132 @@ fn compare_moves(g: &Streams, o: &Streams, first: &mut First) {
     }
 }
 
+/// A position in a pulse stream: run index and pulse within the run.
+#[derive(Debug, Clone, Copy, Default)]
+struct Cursor {
+    run: usize,
+    pos: u32,
+}
+
+/// Compares the pulse streams run by run: a stretch where both traces keep
+/// one period costs one check, so a 16-million-pulse move compares in
+/// O(runs).
 fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
-    for i in 0..g.pulses.len().min(o.pulses.len()) {
-        let (gp, op) = (g.pulses[i], o.pulses[i]);
-        if first.beaten_by(op.at) {
+    let total = |runs: &[Run]| runs.iter().map(|r| u64::from(r.count)).sum::<u64>();
+    let (mut gc, mut oc) = (Cursor::default(), Cursor::default());
+    let mut n: u64 = 0; // pulses compared so far
+    let mut prev: Option<(Instant, Instant)> = None; // previous (golden, got) pulse
+    while gc.run < g.pulses.len() && oc.run < o.pulses.len() {
+        let (gr, or) = (g.pulses[gc.run], o.pulses[oc.run]);
+        let (gt, ot) = (gr.at(gc.pos), or.at(oc.pos));
+        if first.beaten_by(ot) {
             return;
         }
-        let n = i + 1;
-        if gp.dir != op.dir {
-            first.offer(Divergence {
-                at: op.at,
-                quantity: format!("pulse {n} direction"),
-                golden: gp.dir.name().into(),
-                got: op.dir.name().into(),
-                allowed: "equal".into(),
-            });
+        let k = n + 1;
+        let diverge = |quantity: String, golden: String, got: String, allowed: String| Divergence {
+            at: ot,
+            quantity,
+            golden,
+            got,
+            allowed,
+        };
+        // The pulse at the cursors, on its own.
+        if gr.dir != or.dir {
+            first.offer(diverge(
+                format!("pulse {k} direction"),
+                gr.dir.name().into(),
+                or.dir.name().into(),
+                "equal".into(),
+            ));
             return;
         }
-        if gp.first_of_move != op.first_of_move {
-            first.offer(Divergence {
-                at: op.at,
-                quantity: format!("pulse {n}: which move it belongs to"),
-                golden: if gp.first_of_move {
+        let (g_first, o_first) = (
+            gr.first_of_move && gc.pos == 0,
+            or.first_of_move && oc.pos == 0,
+        );
+        if g_first != o_first {
+            let what = |f: bool| {
+                if f {
                     "first of a move"
                 } else {
                     "inside a move"
                 }
-                .into(),
-                got: if op.first_of_move {
-                    "first of a move"
-                } else {
-                    "inside a move"
-                }
-                .into(),
-                allowed: "equal".into(),
-            });
+                .to_string()
+            };
+            first.offer(diverge(
+                format!("pulse {k}: which move it belongs to"),
+                what(g_first),
+                what(o_first),
+                "equal".into(),
+            ));
             return;
         }
-        let (what, gd, od, bp) = if gp.first_of_move || i == 0 {
-            (
-                "delay from the move's start",
-                gp.at.saturating_since(gp.anchor),
-                op.at.saturating_since(op.anchor),
-                tol.latency_bp,
-            )
-        } else {
-            (
+        let (what, gd, od, bp) = match prev {
+            Some((gp, op)) if !g_first => (
                 "interval",
-                gp.at.saturating_since(g.pulses[i - 1].at),
-                op.at.saturating_since(o.pulses[i - 1].at),
+                gt.saturating_since(gp),
+                ot.saturating_since(op),
                 tol.interval_bp,
-            )
+            ),
+            _ => (
+                "delay from the move's start",
+                gt.saturating_since(gr.anchor),
+                ot.saturating_since(or.anchor),
+                tol.latency_bp,
+            ),
         };
         let band = tol.band(gd, bp);
         if !within(od, band) {
-            first.offer(Divergence {
-                at: op.at,
-                quantity: format!("pulse {n} {what}"),
-                golden: gd.to_string(),
-                got: od.to_string(),
-                allowed: band_text(band),
-            });
+            first.offer(diverge(
+                format!("pulse {k} {what}"),
+                gd.to_string(),
+                od.to_string(),
+                band_text(band),
+            ));
             return;
         }
+        // The rest of the stretch both runs share: one period each.
+        let rest = (gr.count - gc.pos - 1).min(or.count - oc.pos - 1);
+        if rest > 0 {
+            let band = tol.band(gr.interval, tol.interval_bp);
+            if !within(or.interval, band) {
+                first.offer(Divergence {
+                    at: or.at(oc.pos + 1),
+                    quantity: format!("pulse {} interval", k + 1),
+                    golden: gr.interval.to_string(),
+                    got: or.interval.to_string(),
+                    allowed: band_text(band),
+                });
+                return;
+            }
+        }
+        gc.pos += rest;
+        oc.pos += rest;
+        n += u64::from(rest) + 1;
+        prev = Some((gr.at(gc.pos), or.at(oc.pos)));
+        for (c, runs) in [(&mut gc, &g.pulses), (&mut oc, &o.pulses)] {
+            c.pos += 1;
+            if c.pos >= runs[c.run].count {
+                c.run += 1;
+                c.pos = 0;
+            }
+        }
     }
-    if let Some(d) = count_divergence("pulses", &g.pulses, &o.pulses, |p| p.at) {
-        first.offer(d);
+    let (gn, on) = (total(&g.pulses), total(&o.pulses));
+    if gn != on {
+        let at = o
+            .pulses
+            .get(oc.run)
+            .map(|r| r.at(oc.pos))
+            .or_else(|| g.pulses.get(gc.run).map(|r| r.at(gc.pos)))
+            .unwrap_or_default();
+        first.offer(Divergence {
+            at,
+            quantity: "number of pulses".into(),
+            golden: gn.to_string(),
+            got: on.to_string(),
+            allowed: "equal".into(),
+        });
     }
 }
 

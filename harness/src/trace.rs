@@ -79,15 +79,28 @@ pub enum EventKind {
 /// A host-side bus transaction and what it observed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BusEvent {
-    WriteCommand(u8),
-    WriteData(u8),
+    /// A command register write; `waited` is how long the flowchart waited
+    /// for IBF = 0 first, `None` for a raw write (`wc!`).
+    WriteCommand {
+        byte: u8,
+        waited: Option<Duration>,
+    },
+    /// A data register write, as [`BusEvent::WriteCommand`].
+    WriteData {
+        byte: u8,
+        waited: Option<Duration>,
+    },
     /// A flowchart write that gave up because IBF stayed 1.
     WriteTimedOut {
         command: bool,
         byte: u8,
     },
     ReadStatus(u8),
-    ReadData(u8),
+    /// A data register read; `waited` for OBF = 1, `None` for `rd!`.
+    ReadData {
+        byte: u8,
+        waited: Option<Duration>,
+    },
     ReadTimedOut,
     Await {
         flag: Flag,
@@ -364,12 +377,17 @@ fn parse_event(line: &str) -> Result<Event, String> {
     let at = Instant::from_nanos(parse_time(w.next().ok_or("empty event line")?)?.as_nanos());
     let key = w.next().ok_or("missing event name")?;
     let kind = match key {
-        "wc" | "wd" => {
-            let b = parse_hex(w.next().ok_or("missing byte")?)?;
-            EventKind::Bus(if key == "wc" {
-                BusEvent::WriteCommand(b)
+        "wc" | "wd" | "wc!" | "wd!" => {
+            let byte = parse_hex(w.next().ok_or("missing byte")?)?;
+            let waited = if key.ends_with('!') {
+                None
             } else {
-                BusEvent::WriteData(b)
+                Some(parse_time(kv(w.next(), "waited")?)?)
+            };
+            EventKind::Bus(if key.starts_with("wc") {
+                BusEvent::WriteCommand { byte, waited }
+            } else {
+                BusEvent::WriteData { byte, waited }
             })
         }
         "wc-timeout" | "wd-timeout" => EventKind::Bus(BusEvent::WriteTimedOut {
@@ -379,9 +397,15 @@ fn parse_event(line: &str) -> Result<Event, String> {
         "rs" => EventKind::Bus(BusEvent::ReadStatus(parse_hex(
             w.next().ok_or("missing byte")?,
         )?)),
-        "rd" => EventKind::Bus(BusEvent::ReadData(parse_hex(
-            w.next().ok_or("missing byte")?,
-        )?)),
+        "rd" | "rd!" => {
+            let byte = parse_hex(w.next().ok_or("missing byte")?)?;
+            let waited = if key == "rd!" {
+                None
+            } else {
+                Some(parse_time(kv(w.next(), "waited")?)?)
+            };
+            EventKind::Bus(BusEvent::ReadData { byte, waited })
+        }
         "rd-timeout" => EventKind::Bus(BusEvent::ReadTimedOut),
         "await" => {
             let cond = w.next().ok_or("missing <flag>=<0|1>")?;
@@ -523,11 +547,24 @@ impl fmt::Display for EventKind {
     }
 }
 
+/// `wc 0x44 waited=6.000us`, or `wc! 0x44` for an op that did not wait.
+fn write_op(
+    f: &mut fmt::Formatter<'_>,
+    op: &str,
+    byte: u8,
+    waited: Option<Duration>,
+) -> fmt::Result {
+    match waited {
+        Some(w) => write!(f, "{op} 0x{byte:02X} waited={w}"),
+        None => write!(f, "{op}! 0x{byte:02X}"),
+    }
+}
+
 impl fmt::Display for BusEvent {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
-            BusEvent::WriteCommand(b) => write!(f, "wc 0x{b:02X}"),
-            BusEvent::WriteData(b) => write!(f, "wd 0x{b:02X}"),
+            BusEvent::WriteCommand { byte, waited } => write_op(f, "wc", byte, waited),
+            BusEvent::WriteData { byte, waited } => write_op(f, "wd", byte, waited),
             BusEvent::WriteTimedOut { command, byte } => {
                 write!(
                     f,
@@ -536,7 +573,7 @@ impl fmt::Display for BusEvent {
                 )
             }
             BusEvent::ReadStatus(b) => write!(f, "rs 0x{b:02X}"),
-            BusEvent::ReadData(b) => write!(f, "rd 0x{b:02X}"),
+            BusEvent::ReadData { byte, waited } => write_op(f, "rd", byte, waited),
             BusEvent::ReadTimedOut => f.write_str("rd-timeout"),
             BusEvent::Await {
                 flag,
@@ -580,8 +617,10 @@ target emu
 detail sysclk_hz 16000000
 events
 0.000us reset
-200000.000us wc 0x44
-200006.000us wd 0x32
+200000.000us wc 0x44 waited=0.000us
+200006.000us wd! 0x32
+200007.000us rd 0x83 waited=20.000us
+200008.000us rd! 0x00
 200012.000us await busy=1 after 54.000us status=0x04
 200012.000us move constant cw steps=100 pout=0 winding=4ph-2 phase=0
 200060.000us pin busy 1
@@ -601,7 +640,7 @@ end
     fn sample_round_trips_exactly() {
         let t = Trace::parse(SAMPLE).expect("parses");
         assert_eq!(t.render(), SAMPLE);
-        assert_eq!(t.events.len(), 15);
+        assert_eq!(t.events.len(), 17);
     }
 
     #[test]
@@ -614,7 +653,7 @@ end
     fn errors_name_the_line() {
         let bad = SAMPLE.replace("pulses cw n=100", "pulses cw n=x");
         let e = Trace::parse(&bad).expect_err("bad count");
-        assert_eq!(e.line, 15);
+        assert_eq!(e.line, 17);
         assert!(e.message.contains("bad pulse count"), "{e}");
 
         let truncated = &SAMPLE[..SAMPLE.len() - 4];

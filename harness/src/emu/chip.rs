@@ -244,7 +244,8 @@ impl Chip {
 
     /// Host read of the status register (A = H, RD low). No side effects.
     pub fn read_status(&self) -> Status {
-        Status::new(self.obf, self.inbuf.is_some(), self.busy, self.field)
+        let s = Status::new(self.obf, self.inbuf.is_some(), self.busy, self.field);
+        Status(s.0 | self.cfg.faults.status_stuck_high)
     }
 
     /// Host read of the data register (A = L, RD low). Reading with OBF = 0
@@ -408,6 +409,10 @@ impl Chip {
     }
 
     fn set_error(&mut self, e: ErrorCode) {
+        let e = match self.cfg.faults.swap_error {
+            Some((from, to)) if from == e => to,
+            _ => e,
+        };
         self.field = StatusField::Error(e);
         self.expect = Expect::Command;
     }
@@ -899,7 +904,14 @@ impl Chip {
         let done = m.emitted >= m.end;
         let at_speed = m.at_high_speed();
         let (id, kind, base) = (m.id, m.kind, m.base);
-        self.record.push_pulses(first, interval, fit, dir, new_move);
+        // Fault: the final pulse of the move never reaches the wire.
+        let on_wire = if done && self.cfg.faults.drop_last_pulse {
+            fit - 1
+        } else {
+            fit
+        };
+        self.record
+            .push_pulses(first, interval, on_wire, dir, new_move);
         if steps_phases {
             if let Some(w) = self.winding {
                 self.phase_index = w.advance(self.phase_index, dir, u64::from(fit));

@@ -6,4 +6,4 @@ pub mod config;
 mod motion;
 
 pub use chip::{Chip, ChipError, PA_MAX, PA_MIN};
-pub use config::{AccelCurve, ConfigError, ModelConfig};
+pub use config::{AccelCurve, ConfigError, Faults, ModelConfig};

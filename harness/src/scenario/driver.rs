@@ -263,13 +263,14 @@ impl<'t> Driver<'t> {
             Op::WriteData { byte, wait_ibf }
         };
         match self.one(op)? {
-            Reply::Written { at } => {
+            Reply::Written { at, waited } => {
+                let waited = wait.then_some(waited);
                 self.log(
                     at,
                     if command {
-                        BusEvent::WriteCommand(byte)
+                        BusEvent::WriteCommand { byte, waited }
                     } else {
-                        BusEvent::WriteData(byte)
+                        BusEvent::WriteData { byte, waited }
                     },
                 );
                 Ok(at)
@@ -323,8 +324,14 @@ impl<'t> Driver<'t> {
         match self.one(Op::ReadData {
             wait_obf: Some(self.opts.obf_timeout),
         })? {
-            Reply::Data { at, byte } => {
-                self.log(at, BusEvent::ReadData(byte));
+            Reply::Data { at, byte, waited } => {
+                self.log(
+                    at,
+                    BusEvent::ReadData {
+                        byte,
+                        waited: Some(waited),
+                    },
+                );
                 Ok(byte)
             }
             Reply::ReadTimedOut { at, status } => {
@@ -462,6 +469,77 @@ impl<'t> Driver<'t> {
             Reply::Pins { pins, .. } => Ok(pins),
             other => Err(self.unexpected("pins", &other)),
         }
+    }
+
+    /// Samples the output pins `n` times, `step` apart, in one batch (one
+    /// round trip on a board). Returns `(time, pins)` pairs.
+    pub fn sample_pins(&mut self, step: Duration, n: usize) -> Outcome<Vec<(Instant, Pins)>> {
+        let mut ops = Vec::with_capacity(2 * n);
+        for _ in 0..n {
+            ops.push(Op::ReadPins);
+            ops.push(Op::Delay(step));
+        }
+        let replies = self.exec(&ops)?;
+        Ok(replies
+            .into_iter()
+            .filter_map(|r| match r {
+                Reply::Pins { at, pins } => Some((at, pins)),
+                _ => None,
+            })
+            .collect())
+    }
+
+    /// Measures the stop-switching ON and OFF times (Section 3-5-1) by
+    /// sampling the phases every `step` over three cycles of the expected
+    /// period, and checks each within 1 % (plus the sampling step) of
+    /// `on` / `off`. Both are recorded as measurements.
+    pub fn expect_chopping(&mut self, on: Duration, off: Duration, step: Duration) -> Outcome {
+        let cycles = (on + off).saturating_mul(3);
+        let n = (cycles.as_nanos() / step.as_nanos().max(1)) as usize + 1;
+        let samples = self.sample_pins(step, n)?;
+        // Edges of "any phase energized".
+        let mut edges: Vec<(Instant, bool)> = Vec::new();
+        for w in samples.windows(2) {
+            let (a, b) = (w[0].1.phases != 0, w[1].1.phases != 0);
+            if a != b {
+                edges.push((w[1].0, b));
+            }
+        }
+        // A full ON stretch (rise .. fall) and a full OFF stretch (fall .. rise).
+        let stretch = |level: bool| {
+            edges
+                .windows(2)
+                .find(|w| w[0].1 == level && w[1].1 != level)
+                .map(|w| (w[1].0.saturating_since(w[0].0), w[1].0))
+        };
+        let now = self.now;
+        for (name, level, want) in [("switching_on", true, on), ("switching_off", false, off)] {
+            let Some((got, at)) = stretch(level) else {
+                return Err(fail(
+                    format!("{name}: stop switching chops the phases"),
+                    "ON and OFF stretches",
+                    "none seen",
+                    now,
+                ));
+            };
+            let slack = want.scale(1, 100) + step;
+            let m =
+                self.opts
+                    .grading
+                    .grade_in(name, want.saturating_sub(slack), want + slack, got, at);
+            let grade = m.grade;
+            let (lo, hi) = (m.lo, m.hi);
+            self.measurements.push(m);
+            if grade == Grade::Fail {
+                return Err(fail(
+                    format!("{name} (Equations 3-5..3-8)"),
+                    format!("{lo}..={hi}"),
+                    got,
+                    at,
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// The capture since reset (fetched once per change).

@@ -95,10 +95,14 @@ impl EmuTarget {
     fn run(&mut self, op: Op) -> Reply {
         match op {
             Op::WriteCommand { byte, wait_ibf } | Op::WriteData { byte, wait_ibf } => {
+                let mut waited = Duration::ZERO;
                 if let Some(timeout) = wait_ibf {
-                    if self.wait_for(Status::IBF, 0, timeout).is_err() {
-                        let (at, status) = self.status_at();
-                        return Reply::WriteTimedOut { at, status };
+                    match self.wait_for(Status::IBF, 0, timeout) {
+                        Ok(w) => waited = w,
+                        Err(()) => {
+                            let (at, status) = self.status_at();
+                            return Reply::WriteTimedOut { at, status };
+                        }
                     }
                 }
                 if matches!(op, Op::WriteCommand { .. }) {
@@ -108,6 +112,7 @@ impl EmuTarget {
                 }
                 Reply::Written {
                     at: self.chip.now(),
+                    waited,
                 }
             }
             Op::ReadStatus => {
@@ -115,16 +120,21 @@ impl EmuTarget {
                 Reply::Status { at, status }
             }
             Op::ReadData { wait_obf } => {
+                let mut waited = Duration::ZERO;
                 if let Some(timeout) = wait_obf {
-                    if self.wait_for(Status::OBF, Status::OBF, timeout).is_err() {
-                        let (at, status) = self.status_at();
-                        return Reply::ReadTimedOut { at, status };
+                    match self.wait_for(Status::OBF, Status::OBF, timeout) {
+                        Ok(w) => waited = w,
+                        Err(()) => {
+                            let (at, status) = self.status_at();
+                            return Reply::ReadTimedOut { at, status };
+                        }
                     }
                 }
                 let byte = self.chip.read_data();
                 Reply::Data {
                     at: self.chip.now(),
                     byte,
+                    waited,
                 }
             }
             Op::Delay(d) => {

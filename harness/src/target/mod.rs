@@ -63,9 +63,11 @@ pub enum Op {
 /// The outcome of one [`Op`], stamped with the target's time when it ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Reply {
-    /// A write happened at `at`.
+    /// A write happened at `at`, after waiting `waited` for IBF = 0 (zero
+    /// for a write without a wait).
     Written {
         at: Instant,
+        waited: Duration,
     },
     /// IBF stayed 1 for the whole wait; nothing was written.
     WriteTimedOut {
@@ -76,9 +78,11 @@ pub enum Reply {
         at: Instant,
         status: Status,
     },
+    /// A data register read at `at`, after waiting `waited` for OBF = 1.
     Data {
         at: Instant,
         byte: u8,
+        waited: Duration,
     },
     /// OBF stayed 0 for the whole wait; nothing was read.
     ReadTimedOut {
@@ -127,7 +131,7 @@ impl Reply {
     /// The target time at which the op completed.
     pub fn at(&self) -> Instant {
         match *self {
-            Reply::Written { at }
+            Reply::Written { at, .. }
             | Reply::WriteTimedOut { at, .. }
             | Reply::Status { at, .. }
             | Reply::Data { at, .. }
