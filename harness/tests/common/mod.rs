@@ -59,7 +59,7 @@ impl Host {
             byte,
             wait_ibf: Some(Duration::from_secs(1)),
         }) {
-            Reply::Written { at } => at,
+            Reply::Written { at, .. } => at,
             other => panic!("wc 0x{byte:02X}: {other:?}"),
         }
     }
@@ -70,7 +70,7 @@ impl Host {
             byte,
             wait_ibf: Some(Duration::from_secs(1)),
         }) {
-            Reply::Written { at } => at,
+            Reply::Written { at, .. } => at,
             other => panic!("wd 0x{byte:02X}: {other:?}"),
         }
     }
