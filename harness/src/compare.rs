@@ -586,9 +586,20 @@ pub fn scale_times(t: &Trace, num: u64, den: u64) -> Trace {
         match &mut e.kind {
             EventKind::Pulses { interval, .. } => *interval = interval.scale(num, den),
             EventKind::Measure { value, .. } => *value = value.scale(num, den),
-            EventKind::Bus(BusEvent::Await {
-                waited: Some(w), ..
-            }) => *w = w.scale(num, den),
+            EventKind::Bus(
+                BusEvent::Await {
+                    waited: Some(w), ..
+                }
+                | BusEvent::WriteCommand {
+                    waited: Some(w), ..
+                }
+                | BusEvent::WriteData {
+                    waited: Some(w), ..
+                }
+                | BusEvent::ReadData {
+                    waited: Some(w), ..
+                },
+            ) => *w = w.scale(num, den),
             _ => {}
         }
     }
@@ -605,8 +616,8 @@ section 3-3-5
 target emu
 events
 0.000us reset
-1000.000us wc 0x44
-1024.000us wd 0x00
+1000.000us wc 0x44 waited=0.000us
+1024.000us wd 0x00 waited=6.000us
 1030.000us move constant cw steps=4 pout=0 winding=4ph-2 phase=0
 1084.000us pin busy 1
 1084.000us await busy=1 after 60.000us status=0x04
@@ -649,15 +660,28 @@ end
     }
 
     #[test]
-    fn a_three_percent_slower_clock_is_caught_at_the_first_pulse_interval() {
+    fn a_three_percent_slower_clock_is_caught_at_the_first_wait() {
         let slow = scale_times(&golden(), 103, 100);
         let d = compare(&golden(), &slow, &Tolerances::default()).expect_err("3 % off");
         assert_eq!(
             d.quantity,
-            "bus transaction 4 (await busy=1 after 60.000us status=0x04): wait"
+            "bus transaction 3 (wd 0x00 waited=6.000us): wait for IBF/OBF"
         );
-        assert_eq!(d.golden, "60.000us");
-        assert_eq!(d.got, "61.800us");
+        assert_eq!(d.golden, "6.000us");
+        assert_eq!(d.got, "6.180us");
+        assert_eq!(d.allowed, "5.840us..=6.160us");
+    }
+
+    #[test]
+    fn an_interval_off_inside_a_run_is_found_in_one_step() {
+        let t =
+            Trace::parse(&GOLDEN.replace("n=4 dt=102.000us", "n=4 dt=104.000us")).expect("parses");
+        let d = compare(&golden(), &t, &Tolerances::default()).expect_err("2 % off");
+        assert_eq!(d.quantity, "pulse 2 interval");
+        assert_eq!(
+            (d.golden.as_str(), d.got.as_str()),
+            ("102.000us", "104.000us")
+        );
     }
 
     #[test]
