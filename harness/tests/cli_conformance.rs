@@ -1,0 +1,278 @@
+//! `ppmc run`, `record`, `compare` and `export` as a user runs them.
+
+use ppmc::compare::scale_times;
+use ppmc::trace::Trace;
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn ppmc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ppmc"))
+        .args(args)
+        .output()
+        .expect("ppmc runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn golden_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../golden")
+}
+
+fn tmpdir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ppmc-cli-{tag}-{}", std::process::id()));
+    let _ = fs::remove_dir_all(&d);
+    fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+#[test]
+fn run_passes_on_the_emulator_and_writes_valid_junit_and_json() {
+    let d = tmpdir("run");
+    let (junit, json) = (d.join("report.xml"), d.join("run.json"));
+    let out = ppmc(&[
+        "run",
+        "--junit",
+        s(&junit),
+        "--json",
+        s(&json),
+        "--board-rev",
+        "B2",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    let stdout = text(&out.stdout);
+    let n = ppmc::suite::all().len();
+    assert!(
+        stdout.contains(&format!("suite: {n} passed, 0 failed")),
+        "{stdout}"
+    );
+    let xml = fs::read_to_string(&junit).expect("junit written");
+    let report = quick_junit::Report::deserialize_from_str(&xml).expect("valid JUnit XML");
+    assert_eq!(report.tests, n);
+    assert_eq!(report.failures, 0);
+    let suite = &report.test_suites[0];
+    assert!(suite
+        .properties
+        .iter()
+        .any(|p| p.name.as_str() == "board_rev" && p.value.as_str() == "B2"));
+    let record: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&json).expect("json written"))
+            .expect("valid JSON");
+    assert_eq!(record["summary"]["passed"], n);
+    assert_eq!(record["run"]["board_rev"], "B2");
+    let with_measures = record["scenarios"]
+        .as_array()
+        .expect("scenarios")
+        .iter()
+        .find(|s| s["name"] == "s3_3_5_constant_speed_100_steps")
+        .expect("scenario in record");
+    assert_eq!(
+        with_measures["measurements"][0]["name"],
+        "constant_first_pout"
+    );
+    assert_eq!(with_measures["measurements"][0]["value_ns"], 194_000);
+    assert_eq!(with_measures["measurements"][0]["grade"], "PASS");
+}
+
+#[test]
+fn run_compares_with_golden_as_it_runs() {
+    let out = ppmc(&["run", "--golden", s(&golden_dir()), "--tag", "stop"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+}
+
+/// Writes a copy of the golden set with every time scaled by `num / den`.
+fn scaled_copy(tag: &str, num: u64, den: u64) -> PathBuf {
+    let d = tmpdir(tag);
+    for e in fs::read_dir(golden_dir()).expect("golden dir") {
+        let p = e.expect("entry").path();
+        if p.extension().is_some_and(|x| x == "snap") {
+            let t = Trace::parse(&fs::read_to_string(&p).expect("read")).expect("golden parses");
+            let scaled = scale_times(&t, num, den);
+            fs::write(d.join(p.file_name().expect("name")), scaled.render()).expect("write");
+        }
+    }
+    d
+}
+
+#[test]
+fn compare_passes_half_a_percent_and_fails_three_percent() {
+    let half = scaled_copy("half", 1005, 1000);
+    let out = ppmc(&["compare", s(&golden_dir()), "--traces", s(&half)]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    assert!(text(&out.stdout).contains(" 0 failed"));
+
+    let three = scaled_copy("three", 103, 100);
+    let out = ppmc(&["compare", s(&golden_dir()), "--traces", s(&three)]);
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("DIVERGE  s3_3_5_constant_speed_100_steps"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("first divergence at "), "{stdout}");
+    assert!(stdout.contains("(allowed "), "{stdout}");
+    // Loosen the tolerances and 3 % passes.
+    let out = ppmc(&[
+        "compare",
+        s(&golden_dir()),
+        "--traces",
+        s(&three),
+        "--latency-tol",
+        "4",
+        "--interval-tol",
+        "4",
+        "--filter",
+        "e0_",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+}
+
+#[test]
+fn export_writes_a_vcd_that_parses_back() {
+    let d = tmpdir("vcd");
+    let vcd_path = d.join("out.vcd");
+    let golden = golden_dir().join("s3_3_5_constant_speed_100_steps.snap");
+    let out = ppmc(&["export", s(&golden), "-o", s(&vcd_path)]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let bytes = fs::read(&vcd_path).expect("vcd written");
+    let mut parser = vcd::Parser::new(&bytes[..]);
+    let header = parser.parse_header().expect("header");
+    let pout = header.find_var(&["ppmc", "pout"]).expect("pout wire").code;
+    let rises = parser
+        .filter_map(Result::ok)
+        .filter(|c| matches!(c, vcd::Command::ChangeScalar(i, vcd::Value::V1) if *i == pout))
+        .count();
+    assert_eq!(rises, 100);
+}
+
+#[test]
+fn record_never_overwrites_without_bless() {
+    let d = tmpdir("record");
+    let args = |extra: &[&str]| {
+        let mut v = vec!["record", "--out", s(&d), "--filter", "e0_undefined"];
+        v.extend_from_slice(extra);
+        ppmc(&v)
+    };
+    let out = args(&[]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(text(&out.stdout).contains("1 created"));
+    let file = d.join("e0_undefined_command_code.snap");
+    let recorded = fs::read_to_string(&file).expect("recorded");
+    assert_eq!(
+        recorded,
+        fs::read_to_string(golden_dir().join("e0_undefined_command_code.snap")).expect("golden")
+    );
+    assert!(text(&args(&[]).stdout).contains("1 unchanged"));
+    let edited = recorded.replace("section 3-1-1", "section 9-9");
+    fs::write(&file, &edited).expect("edit");
+    let out = args(&[]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stdout).contains("pass --bless"),
+        "{}",
+        text(&out.stdout)
+    );
+    assert_eq!(
+        fs::read_to_string(&file).expect("kept"),
+        edited,
+        "untouched without --bless"
+    );
+    let out = args(&["--bless"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(fs::read_to_string(&file).expect("replaced"), recorded);
+}
+
+#[test]
+fn a_corrupt_golden_file_fails_its_scenario_alone_with_path_and_line() {
+    let g = tmpdir("corrupt");
+    for name in ["e0_undefined_command_code", "e3_data_without_a_command"] {
+        fs::copy(
+            golden_dir().join(format!("{name}.snap")),
+            g.join(format!("{name}.snap")),
+        )
+        .expect("copy");
+    }
+    let bad = g.join("e3_data_without_a_command.snap");
+    let text_ = fs::read_to_string(&bad).expect("read");
+    fs::write(&bad, text_.replacen(" wd ", " wq ", 1)).expect("corrupt");
+    let arts = tmpdir("artifacts");
+    let out = ppmc(&[
+        "run",
+        "--golden",
+        s(&g),
+        "--filter",
+        "e",
+        "--tag",
+        "error",
+        "--shard",
+        "1/1",
+        "--artifacts",
+        s(&arts),
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("PASS     e0_undefined_command_code"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("FAIL     e3_data_without_a_command"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("e3_data_without_a_command.snap:"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("unknown event `wq`"), "{stdout}");
+    // Scenarios with no golden file fail too, naming the missing file.
+    assert!(
+        stdout.contains("no golden trace for this scenario"),
+        "{stdout}"
+    );
+    assert!(arts.join("e3_data_without_a_command.trace").exists());
+    assert!(arts.join("e3_data_without_a_command.vcd").exists());
+    assert!(!arts.join("e0_undefined_command_code.trace").exists());
+}
+
+#[test]
+fn bad_usage_exits_2() {
+    for args in [
+        &["run", "--shard", "5/4"][..],
+        &["run", "--filter", "no_such_scenario"],
+        &["run", "--golden", "/no/such/dir"],
+        &["compare", "/no/such/dir", "--traces", "."],
+        &["export", "/no/such/file"],
+    ] {
+        let out = ppmc(args);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+        assert!(!text(&out.stderr).is_empty());
+    }
+}
+
+#[test]
+fn list_and_shards_cover_the_suite() {
+    let n = ppmc::suite::all().len();
+    let out = ppmc(&["list"]);
+    assert!(text(&out.stdout).contains(&format!("{n} scenarios")));
+    let count = |shard: &str| {
+        let out = ppmc(&["list", "--shard", shard]);
+        let t = text(&out.stdout);
+        t.lines()
+            .last()
+            .and_then(|l| l.split_whitespace().next())
+            .and_then(|k| k.parse::<usize>().ok())
+            .expect("count line")
+    };
+    assert_eq!(count("1/3") + count("2/3") + count("3/3"), n);
+}
