@@ -125,7 +125,11 @@ fn external_clock(d: &mut Driver) -> Outcome {
 }
 
 fn over_speed(d: &mut Driver) -> Outcome {
-    d.init(Init::four_phase().rates(100, 10))?;
+    // A high speed rate over the limit on this board (RH = 17 at 16 MHz).
+    let Some(rh) = d.speed_limit_rates(false).1 else {
+        return d.check("a rate over the speed limit exists on this board", true, false);
+    };
+    d.init(Init::four_phase().rates(100.max(rh + 1), rh))?;
     d.start(Move::accel(Cw, 5_000))?;
     d.after_pulses(2_000)?;
     d.raw_command(0x40)?;
@@ -139,7 +143,12 @@ fn over_speed(d: &mut Driver) -> Outcome {
 }
 
 fn pout_speed_limit(d: &mut Driver) -> Outcome {
-    d.init(Init::four_phase().rates(100, 13))?;
+    // A rate over the phase-mode limit but within POUT mode's (13 at 16 MHz).
+    let rh = match (d.speed_limit_rates(true).0, d.speed_limit_rates(false).1) {
+        (Some(a), Some(b)) if a <= b => a,
+        _ => return d.check("a rate between the POUT and phase-mode limits exists", true, false),
+    };
+    d.init(Init::four_phase().rates(100.max(rh + 1), rh))?;
     d.start(Move::accel(Cw, 5_000).pout())?;
     d.after_pulses(2_000)?;
     d.raw_command(Register::InputSignals.code())?;

@@ -105,7 +105,8 @@ fn output_status(d: &mut Driver) -> Outcome {
     d.expect_output_status(0b0011_1100)?;
     d.run(Move::accel(Ccw, 3))?;
     d.expect_output_status(0b1001_1010)?;
-    d.wait(ms(4))?;
+    let hold = d.fw(ms(4));
+    d.wait(hold)?;
     d.expect_latency(TimingId::HoldOn)?;
     d.expect_output_status(0b1001_1110)
 }

@@ -20,7 +20,7 @@
 //! The report is the first divergence in time, with the quantity, golden
 //! and got, and the allowed band.
 
-use crate::protocol::{Pin, TimingId};
+use crate::protocol::{Pin, Straps, TimingId};
 use crate::scenario::grade::fmt_hi;
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, EventKind, Trace};
@@ -191,7 +191,8 @@ pub fn compare(golden: &Trace, got: &Trace, tol: &Tolerances) -> Result<(), Dive
     compare_moves(&g, &o, &mut first);
     compare_pulses(&g, &o, tol, &mut first);
     compare_pins(&g, &o, tol, &mut first);
-    compare_measures(&g, &o, tol, &mut first);
+    let straps = Straps::from_details(&got.details);
+    compare_measures(&g, &o, tol, &straps, &mut first);
     match first.0 {
         Some(d) => Err(d),
         None => Ok(()),
@@ -533,7 +534,13 @@ fn compare_pins(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
     }
 }
 
-fn compare_measures(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
+fn compare_measures(
+    g: &Streams,
+    o: &Streams,
+    tol: &Tolerances,
+    straps: &Straps,
+    first: &mut First,
+) {
     let empty = Vec::new();
     let names: std::collections::BTreeSet<&String> =
         g.measures.keys().chain(o.measures.keys()).collect();
@@ -543,7 +550,7 @@ fn compare_measures(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut Firs
         for (i, (&(_, gv), &(ot, ov))) in gs.iter().zip(os).enumerate() {
             let quantity = format!("measurement {name} #{}", i + 1);
             if let Some(id) = TimingId::from_name(name) {
-                let band = id.row().band_with_tolerance();
+                let band = id.row().band_for(straps);
                 if !within(ov, band) {
                     first.offer(Divergence {
                         at: ot,

@@ -141,8 +141,8 @@ fn s3_3_2_decelerating_stop_at_high_speed_takes_pa_more_pulses() {
     h.wait(MS(12)); // at high speed
     let t = h.wc(0x41);
     h.await_idle();
-    // The pulse already being timed, then PA = 100 more.
-    assert_eq!(pulses_after(&h, t + US(17)), 101);
+    // The pulse already being timed and PA - 1 = 99 more: PA pulses.
+    assert_eq!(pulses_after(&h, t + US(17)), 100);
     let n = h.pulses() as u32;
     assert_eq!(h.finish_status(), 0xC3);
     assert_eq!(h.remaining_read(), 5_000 - n - 1);
@@ -333,7 +333,7 @@ fn s3_3_7_continuous_high_speed_decelerates_at_the_high_speed_limit() {
     h.wait(MS(1));
     h.set(Input::L4, false); // deceleration continues with the limit off
     h.await_idle();
-    assert_eq!(pulses_after(&h, t + US(17)), 101);
+    assert_eq!(pulses_after(&h, t + US(17)), 100);
     assert_eq!(h.finish_status(), 0x8E, "bit 3: high-speed limit, code 110");
 }
 
@@ -375,10 +375,10 @@ fn s3_3_4_pout_mode_ignores_the_high_speed_limit_while_accelerating() {
         Some(US(42)),
         "accelerated to high speed regardless"
     );
-    // Pulses 0..=100 ramp up (the period after pulse 100 is the first at
-    // high speed, where the limit is looked at), pulse 101 was already being
-    // timed when the deceleration began 17 us later, then PA = 100 more.
-    assert_eq!(s.count, 202);
+    // Pulses 0..=99 ramp up (the period after pulse 99 is the first at
+    // high speed, where the limit is looked at); pulse 100 was already being
+    // timed when the deceleration began 17 us later: it and 99 more.
+    assert_eq!(s.count, 200);
     assert_eq!(h.finish_status(), 0x8E);
 }
 

@@ -43,3 +43,23 @@ fn suite_has_the_scenario_files() {
         .iter()
         .any(|s| s.name == "s3_2_2_over_speed_locks_out_the_host"));
 }
+
+/// The scenarios take their rates and waits from the board's straps, so
+/// the suite passes on boards strapped differently from the reference.
+#[rstest::rstest]
+#[case::csel_low(Straps { csel_high: false, ..Straps::default() })]
+#[case::vsel_low(Straps { vsel_high: false, ..Straps::default() })]
+#[case::sysclk_20mhz(Straps { sysclk_hz: 20_000_000, ..Straps::default() })]
+#[case::sysclk_12_288mhz_csel_low_vsel_low(Straps { sysclk_hz: 12_288_000, csel_high: false, vsel_high: false, ext_clock_hz: None })]
+#[case::external_clock_fitted(Straps { ext_clock_hz: Some(500_000), ..Straps::default() })]
+fn every_scenario_passes_with_other_straps(#[case] straps: Straps) {
+    let all = ppmc::suite::all();
+    let mut t = EmuTarget::new(straps, ModelConfig::default()).expect("emulator");
+    let results = run_suite(&mut t, &all, 1, DriverOptions::default(), |_| {});
+    let bad: Vec<String> = results
+        .iter()
+        .filter(|r| !r.verdict.ok())
+        .map(|r| format!("{}: {}", r.name, r.verdict.detail().unwrap_or_default()))
+        .collect();
+    assert!(bad.is_empty(), "{straps:?}:\n{}", bad.join("\n"));
+}

@@ -5,12 +5,14 @@
 //! is `table[v(j)]`, where the speed index
 //!
 //! ```text
-//! v(j) = min(j, N - 2 - j, PA)        (PA = acceleration pulses)
+//! v(j) = min(j, N - 2 - j, PA - 1)    (PA = acceleration pulses)
 //! ```
 //!
-//! rises by one per pulse, holds at PA (the high speed) and falls by one per
-//! pulse at the end, so the acceleration and deceleration are mirror images
-//! and a move shorter than 2 x PA becomes a triangle on its own. A
+//! rises by one per pulse, holds at PA - 1 (the high speed: the PA
+//! acceleration pulses are pulses 0 .. PA-1, and the period after the last of
+//! them is RH's) and falls by one per pulse at the end. Acceleration and
+//! deceleration are mirror images, a move of 2 x PA steps just reaches RH and
+//! a shorter one is a triangle, as Section 3-3-4 says (notes N16). A
 //! deceleration started early (stop command or high-speed limit) from speed
 //! `c` at pulse `j0` caps the index at `c - 1 - (j - j0)`. Because the plan
 //! is a closed formula, a stretch at one period is emitted in O(1) whatever
@@ -26,15 +28,15 @@ use std::sync::Arc;
 pub(crate) enum Profile {
     /// One period for every pulse (constant-speed operations, single step).
     Constant { interval: Duration },
-    /// `table[v]` for speed index `v < PA`, `cruise` at `v = PA`.
+    /// `table[v]` for speed index `v < PA - 1`, `cruise` at `v = PA - 1`.
     Ramped {
         table: Arc<[Duration]>,
         cruise: Duration,
     },
 }
 
-/// Builds the acceleration table: the period after each of the PA
-/// acceleration pulses, from the start-up rate RL towards the high speed
+/// Builds the acceleration table: the periods between the PA acceleration
+/// pulses (PA - 1 of them), from the start-up rate RL towards the high speed
 /// rate RH, on the chip's rate grid `(R + 1) x Tclock (+ 7.5 us)`.
 pub(crate) fn accel_table(
     curve: AccelCurve,
@@ -45,8 +47,9 @@ pub(crate) fn accel_table(
     pa: u16,
 ) -> Vec<Duration> {
     let period = |r: u8| straps.pulse_interval(r, tclock);
-    let pa_f = f64::from(pa);
-    (0..pa)
+    let steps = pa.saturating_sub(1).max(1);
+    let pa_f = f64::from(steps);
+    (0..steps)
         .map(|v| {
             let r = match curve {
                 AccelCurve::LinearSpeed => {
@@ -132,7 +135,7 @@ impl Motion {
         }
     }
 
-    fn pa(&self) -> u32 {
+    fn cruise_index(&self) -> u32 {
         match &self.profile {
             Profile::Constant { .. } => 0,
             Profile::Ramped { table, .. } => table.len() as u32,
@@ -141,7 +144,7 @@ impl Motion {
 
     /// Speed index for the period after pulse `j`.
     fn speed(&self, j: u32) -> u32 {
-        let pa = i64::from(self.pa());
+        let pa = i64::from(self.cruise_index());
         let j = i64::from(j);
         let mut v = j.min(i64::from(self.total) - 2 - j).min(pa);
         if let Some((j0, c)) = self.decel {
@@ -182,7 +185,7 @@ impl Motion {
         match &self.profile {
             Profile::Constant { interval } => (*interval, left),
             Profile::Ramped { cruise, .. } => {
-                let pa = self.pa();
+                let pa = self.cruise_index();
                 if left > 1 && self.speed(j) == pa {
                     // Last pulse index whose following period is still cruise.
                     let mut c_end = i64::from(self.total) - 2 - i64::from(pa);
@@ -220,12 +223,12 @@ impl Motion {
         self.ramped()
             && self.emitted > 0
             && !self.decelerating()
-            && self.speed(self.emitted - 1) == self.pa()
+            && self.speed(self.emitted - 1) == self.cruise_index()
     }
 
-    /// Starts a deceleration from the present speed (Section 3-3-2: over
-    /// the acceleration pulses when at high speed). Returns whether the move
-    /// got shorter than planned.
+    /// Starts a deceleration from the present speed (Section 3-3-2: at high
+    /// speed the pulse being timed and PA - 1 more, PA pulses of
+    /// deceleration). Returns whether the move got shorter than planned.
     pub fn begin_decel(&mut self) -> bool {
         let j1 = self.emitted;
         let c = if j1 == 0 { 0 } else { self.speed(j1 - 1) };

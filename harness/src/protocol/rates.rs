@@ -68,6 +68,23 @@ impl Straps {
         Ok(())
     }
 
+    /// Straps from a target's `key value` details (`sysclk_hz`, `csel`,
+    /// `vsel`, `ext_clock_hz`), as targets and traces carry them; defaults
+    /// where a key is missing or unreadable.
+    pub fn from_details(details: &[(String, String)]) -> Straps {
+        let mut s = Straps::default();
+        for (k, v) in details {
+            match k.as_str() {
+                "sysclk_hz" => s.sysclk_hz = v.parse().unwrap_or(s.sysclk_hz),
+                "csel" => s.csel_high = v != "low",
+                "vsel" => s.vsel_high = v != "low",
+                "ext_clock_hz" => s.ext_clock_hz = v.parse().ok(),
+                _ => {}
+            }
+        }
+        s
+    }
+
     /// Base clock period Tclock for a clock source, rounded to 1 ns (see
     /// notes N9). `None` when the external clock is selected but no clock is
     /// fitted: the chip then never produces a pulse.

@@ -7,6 +7,7 @@
 //! had to be guessed from the flattened table, `docs/datasheet-notes.md` N20
 //! says why.
 
+use super::rates::Straps;
 use crate::time::Duration;
 
 /// The footnote of Table 3-3: "there may be an error of 1%".
@@ -270,9 +271,22 @@ impl TimingRow {
         }
     }
 
-    /// [`Self::band`] widened by the datasheet's 1 % on each side.
+    /// [`Self::band`] widened by the datasheet's 1 % on each side, at the
+    /// 16 MHz reference clock.
     pub fn band_with_tolerance(&self) -> (Duration, Duration) {
+        self.band_for(&Straps::default())
+    }
+
+    /// The band on a board with `straps`: the figures scaled from 16 MHz to
+    /// its system clock as firmware times are (notes N10), widened by 1 %.
+    pub fn band_for(&self, straps: &Straps) -> (Duration, Duration) {
         let (lo, hi) = self.band();
+        let lo = straps.firmware_time(lo);
+        let hi = if hi == Duration::MAX {
+            hi
+        } else {
+            straps.firmware_time(hi)
+        };
         let lo = lo.saturating_sub(lo.scale(DATASHEET_TOLERANCE_PERMILLE, 1_000));
         let hi = if hi == Duration::MAX {
             hi
@@ -309,6 +323,19 @@ mod tests {
         let (lo, hi) = TimingId::BusyRise.row().band_with_tolerance();
         assert_eq!(lo, Duration::from_nanos(26_730));
         assert_eq!(hi, Duration::from_nanos(113_120));
+    }
+
+    #[test]
+    fn s3_6_bands_scale_with_the_system_clock() {
+        let fast = Straps {
+            sysclk_hz: 20_000_000,
+            ..Straps::default()
+        };
+        let (lo, hi) = TimingId::ConstantFirstPout.row().band_for(&fast);
+        assert_eq!(
+            (lo, hi),
+            (Duration::from_nanos(153_648), Duration::from_nanos(156_752))
+        );
     }
 
     #[test]

@@ -153,7 +153,7 @@ fn fail(
 
 impl<'t> Driver<'t> {
     pub fn new(target: &'t mut dyn Target, opts: DriverOptions) -> Self {
-        let straps = straps_of(&target.info().details);
+        let straps = Straps::from_details(&target.info().details);
         Driver {
             straps,
             target,
@@ -191,6 +191,23 @@ impl<'t> Driver<'t> {
             .tclock(ClockSource::Internal)
             .unwrap_or(Duration::from_micros(2));
         self.straps.pulse_interval(rate, t)
+    }
+
+    /// A firmware time given at the datasheet's 16 MHz, on this board's
+    /// system clock (notes N10).
+    pub fn fw(&self, at_16mhz: Duration) -> Duration {
+        self.straps.firmware_time(at_16mhz)
+    }
+
+    /// The fastest rate value whose pulses stay within the speed limit
+    /// (Section 3-2-2), and the slowest that exceeds it, in phase mode or
+    /// POUT mode: `(within, over)`, either `None` if no rate value 1..=254
+    /// qualifies on this board.
+    pub fn speed_limit_rates(&self, pout: bool) -> (Option<u8>, Option<u8>) {
+        let limit = self.straps.min_interval(pout);
+        let within = (1..=254u8).find(|r| self.period(*r) >= limit);
+        let over = (1..=254u8).rev().find(|r| self.period(*r) < limit);
+        (within, over)
     }
 
     /// The target's clock after the last operation.
@@ -586,7 +603,7 @@ impl<'t> Driver<'t> {
     /// plus 1 %), so that what follows is timed from an idle chip.
     pub fn init_and_wait(&mut self, init: Init) -> Outcome<Instant> {
         let at = self.init(init)?;
-        let (_, max) = TimingId::InitProcessing.row().band_with_tolerance();
+        let (_, max) = TimingId::InitProcessing.row().band_for(&self.straps);
         let until = at + max;
         self.wait(until.saturating_since(self.now))?;
         Ok(at)
@@ -891,7 +908,7 @@ impl<'t> Driver<'t> {
     // ----- Table 3-3 measurements ---------------------------------------
 
     fn record_measure(&mut self, id: TimingId, value: Duration, at: Instant) -> Outcome<Grade> {
-        let m = self.opts.grading.grade(id, value, at);
+        let m = self.opts.grading.grade(id, &self.straps, value, at);
         let grade = m.grade;
         let (lo, hi) = (m.lo, m.hi);
         self.measurements.push(m);
@@ -1051,15 +1068,15 @@ impl<'t> Driver<'t> {
             })
             .collect();
         let n = times.len() as u64;
-        // Pulse index the deceleration started from: at high speed the ramp
-        // takes PA more pulses after it; during acceleration from index j it
-        // takes j (notes N24).
+        // Pulse index the deceleration started from: at high speed it and
+        // PA - 1 more make the PA pulses of deceleration; during acceleration
+        // from index j the ramp down takes j (notes N16, N24).
         let j1 = if id == TimingId::HighSpeedLimitAccel {
             n / 2
         } else {
-            n.saturating_sub(pa + 1)
+            n.saturating_sub(pa)
         };
-        let (lo, hi) = id.row().band_with_tolerance();
+        let (lo, hi) = id.row().band_for(&self.straps);
         let first_after = |d: Duration| {
             times
                 .iter()
@@ -1087,22 +1104,6 @@ impl<'t> Driver<'t> {
         // deceleration came.
         Ok(start_time.saturating_since(t))
     }
-}
-
-/// Straps from a target's `details` (keys as [`crate::target::EmuTarget`]
-/// writes them); defaults where a key is missing.
-pub fn straps_of(details: &[(String, String)]) -> Straps {
-    let mut s = Straps::default();
-    for (k, v) in details {
-        match k.as_str() {
-            "sysclk_hz" => s.sysclk_hz = v.parse().unwrap_or(s.sysclk_hz),
-            "csel" => s.csel_high = v != "low",
-            "vsel" => s.vsel_high = v != "low",
-            "ext_clock_hz" => s.ext_clock_hz = v.parse().ok(),
-            _ => {}
-        }
-    }
-    s
 }
 
 fn describe_status(s: Status) -> String {

@@ -7,7 +7,7 @@
 //! MARGINAL: it passes, but a hardware test station would flag the board
 //! for a look, as OpenHTF's marginal limits do.
 
-use crate::protocol::TimingId;
+use crate::protocol::{Straps, TimingId};
 use crate::time::{Duration, Instant};
 use std::fmt;
 
@@ -60,9 +60,16 @@ pub struct Measurement {
 }
 
 impl Grading {
-    /// Grades `value` against the Table 3-3 row `id`.
-    pub fn grade(&self, id: TimingId, value: Duration, at: Instant) -> Measurement {
-        let (lo, hi) = id.row().band_with_tolerance();
+    /// Grades `value` against the Table 3-3 row `id` on a board with
+    /// `straps`.
+    pub fn grade(
+        &self,
+        id: TimingId,
+        straps: &Straps,
+        value: Duration,
+        at: Instant,
+    ) -> Measurement {
+        let (lo, hi) = id.row().band_for(straps);
         self.grade_in(id.name(), lo, hi, value, at)
     }
 
@@ -130,7 +137,12 @@ mod tests {
 
     fn grade(id: TimingId, ns: u64) -> Grade {
         Grading::default()
-            .grade(id, Duration::from_nanos(ns), Instant::ZERO)
+            .grade(
+                id,
+                &Straps::default(),
+                Duration::from_nanos(ns),
+                Instant::ZERO,
+            )
             .grade
     }
 
