@@ -679,6 +679,43 @@ end
         assert_eq!(d.allowed, "5.840us..=6.160us");
     }
 
+    proptest::proptest! {
+        /// Timing jitter inside the tolerances never fails a comparison:
+        /// every pulse, pin change and wait moved by up to 0.2 us (intervals
+        /// then change by at most 0.4 us, inside 1 % of 102 us + 0.1 us).
+        #[test]
+        fn jitter_inside_the_tolerances_never_fails(jitter in proptest::collection::vec(-200i64..=200, 16)) {
+            let g = golden();
+            let mut t = g.clone();
+            // One event per pulse, so that each can move on its own.
+            let mut events = Vec::new();
+            for e in &t.events {
+                match &e.kind {
+                    EventKind::Pulses { dir, count, interval } => {
+                        for i in 0..*count {
+                            events.push(crate::trace::Event {
+                                at: e.at + interval.saturating_mul(u64::from(i)),
+                                kind: EventKind::Pulses { dir: *dir, count: 1, interval: Duration::ZERO },
+                            });
+                        }
+                    }
+                    _ => events.push(e.clone()),
+                }
+            }
+            for (i, e) in events.iter_mut().enumerate() {
+                let j = jitter[i % jitter.len()];
+                if !matches!(e.kind, EventKind::Move { .. } | EventKind::Bus(BusEvent::Reset)) {
+                    e.at = Instant::from_nanos((e.at.as_nanos() as i64 + j) as u64);
+                }
+                if let EventKind::Bus(BusEvent::Await { waited: Some(w), .. }) = &mut e.kind {
+                    *w = Duration::from_nanos((w.as_nanos() as i64 + j / 4) as u64);
+                }
+            }
+            t.events = events;
+            proptest::prop_assert_eq!(compare(&g, &t, &Tolerances::default()), Ok(()));
+        }
+    }
+
     #[test]
     fn an_interval_off_inside_a_run_is_found_in_one_step() {
         let t =

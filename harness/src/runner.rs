@@ -160,6 +160,56 @@ mod tests {
         assert!(parse_shard("x").is_err());
     }
 
+    fn panics(_: &mut Driver) -> Outcome {
+        panic!("scenario bug")
+    }
+
+    fn runs_forever(d: &mut Driver) -> Outcome {
+        d.init(crate::scenario::Init::four_phase())?;
+        d.start(crate::scenario::Move::continuous(
+            crate::protocol::Direction::Cw,
+            50,
+        ))?;
+        loop {
+            d.wait(crate::time::Duration::from_secs(1))?;
+        }
+    }
+
+    fn fails(d: &mut Driver) -> Outcome {
+        d.check("something", 1, 2)
+    }
+
+    #[test]
+    fn a_panic_or_an_overrun_fails_that_scenario_alone() {
+        let suite = vec![
+            Scenario::new("a_panics", "3-1", "", &[], panics),
+            Scenario::new("b_overruns", "3-1", "", &[], runs_forever)
+                .budget(crate::time::Duration::from_secs(5)),
+            Scenario::new("c_fails", "3-1", "", &[], fails),
+            Scenario::new("d_passes", "3-1", "", &[], ok),
+        ];
+        let mut t = crate::target::EmuTarget::new(Default::default(), Default::default())
+            .expect("emulator");
+        let r = run_suite(&mut t, &suite, 1, DriverOptions::default(), |_| {});
+        let v: Vec<&str> = r.iter().map(|r| r.verdict.label()).collect();
+        assert_eq!(v, vec!["error", "error", "failed", "passed"]);
+        assert!(r[0]
+            .verdict
+            .detail()
+            .unwrap_or_default()
+            .contains("panicked: scenario bug"));
+        assert!(r[1]
+            .verdict
+            .detail()
+            .unwrap_or_default()
+            .contains("time budget"));
+        assert!(r[2]
+            .verdict
+            .detail()
+            .unwrap_or_default()
+            .contains("expected 1, got 2"));
+    }
+
     #[test]
     fn duplicate_names_are_refused() {
         let mut all = suite();
