@@ -70,8 +70,18 @@ fn main() {
         .map(|s| s.trim().to_string())
         .unwrap_or_else(|| "unknown".into());
     println!("cargo:rustc-env=PPMC_GIT_REV={rev}");
-    let git_head = manifest.join("../.git/HEAD");
-    if git_head.exists() {
-        println!("cargo:rerun-if-changed={}", git_head.display());
+    // Rebuild the revision when HEAD moves: HEAD itself, the branch it
+    // names, and packed refs.
+    let git = manifest.join("../.git");
+    let head = git.join("HEAD");
+    if head.exists() {
+        println!("cargo:rerun-if-changed={}", head.display());
+        if let Some(r) = fs::read_to_string(&head)
+            .ok()
+            .and_then(|h| h.strip_prefix("ref: ").map(|r| r.trim().to_string()))
+        {
+            println!("cargo:rerun-if-changed={}", git.join(r).display());
+        }
+        println!("cargo:rerun-if-changed={}", git.join("packed-refs").display());
     }
 }
