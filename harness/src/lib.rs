@@ -6,6 +6,7 @@
 //! (one bus abstraction, many backends) ← [`console`] (bus scripts) ← the
 //! `ppmc` binary.
 
+pub mod bridge;
 pub mod compare;
 pub mod console;
 pub mod emu;

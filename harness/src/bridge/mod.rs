@@ -1,0 +1,7 @@
+//! The serial bus bridge: the link protocol a bridge microcontroller speaks
+//! (specified in `docs/bridge-protocol.md`), implemented once and shared by
+//! the host driver ([`crate::target::SerialTarget`]) and the bridge
+//! simulator ([`server`]).
+
+pub mod frame;
+pub mod wire;
