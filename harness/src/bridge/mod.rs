@@ -4,4 +4,5 @@
 //! simulator ([`server`]).
 
 pub mod frame;
+pub mod server;
 pub mod wire;

@@ -89,6 +89,9 @@ pub struct Hello {
     pub capture_capacity: u32,
     /// One bit per [`Input`] (bit = `Input::index`) that is wired.
     pub inputs_wired: u16,
+    /// The bridge runs in virtual time (a simulator answering at once),
+    /// so the host must not expect replies to take as long as their waits.
+    pub virtual_time: bool,
     /// Firmware name and version.
     pub firmware: String,
     /// The chip's board straps, `key=value` separated by spaces.
@@ -732,6 +735,7 @@ impl Response {
                 w.u16(h.max_payload);
                 w.u32(h.capture_capacity);
                 w.u16(h.inputs_wired);
+                w.u8(u8::from(h.virtual_time));
                 w.str(&h.firmware);
                 w.str(&h.straps);
             }
@@ -793,6 +797,7 @@ impl Response {
                 max_payload: r.u16()?,
                 capture_capacity: r.u32()?,
                 inputs_wired: r.u16()?,
+                virtual_time: r.bool("virtual time flag")?,
                 firmware: r.str()?,
                 straps: r.str()?,
             }),
@@ -1019,6 +1024,7 @@ mod tests {
             max_payload: 4096,
             capture_capacity: 65_536,
             inputs_wired: 0x3FF,
+            virtual_time: true,
             firmware: "ppmc-bridge-sim 0.1.0".into(),
             straps: "sysclk_hz=16000000 csel=high".into(),
         });

@@ -1,0 +1,316 @@
+//! The bridge side of the protocol, over the emulator: what `ppmc
+//! bridge-sim` serves, and the reference a firmware author can diff a real
+//! bridge against.
+//!
+//! [`BridgeServer::on_bytes`] takes bytes from the link and returns the
+//! bytes to send back. It keeps the last request and its response, so a
+//! request retransmitted with the same sequence number (because its
+//! response was lost or corrupted) is answered again without running twice:
+//! every retry the host makes is safe.
+
+use super::frame::{self, FrameDecoder, FrameError};
+use super::wire::{
+    BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer, PROTOCOL_VERSION,
+};
+use crate::target::{EmuTarget, Target};
+
+/// Most ops in one batch: keeps the largest reply inside one frame.
+pub const MAX_BATCH_OPS: u16 = 48;
+
+/// Records per capture chunk, sized to fit one frame.
+const CHUNK_RUNS: usize = 80;
+const CHUNK_PINS: usize = 120;
+const CHUNK_MOVES: usize = 40;
+
+/// A bridge in front of an emulated chip.
+#[derive(Debug)]
+pub struct BridgeServer {
+    target: EmuTarget,
+    decoder: FrameDecoder,
+    session: u32,
+    timer: Timer,
+    virtual_time: bool,
+    /// The last request payload and the response payload sent for it.
+    last: Option<(Vec<u8>, Vec<u8>)>,
+    /// Frames handled so far (for fault injection by the caller).
+    pub frames: u64,
+}
+
+impl BridgeServer {
+    /// `session` should differ between runs of the simulator.
+    pub fn new(target: EmuTarget, session: u32, virtual_time: bool) -> Self {
+        BridgeServer {
+            target,
+            decoder: FrameDecoder::new(),
+            session,
+            timer: Timer::NANOS,
+            virtual_time,
+            last: None,
+            frames: 0,
+        }
+    }
+
+    pub fn target(&self) -> &EmuTarget {
+        &self.target
+    }
+
+    /// Handles received bytes; returns the bytes to send back (whole
+    /// frames, possibly none).
+    pub fn on_bytes(&mut self, bytes: &[u8]) -> Vec<u8> {
+        self.decoder.extend(bytes);
+        let mut out = Vec::new();
+        loop {
+            match self.decoder.decode() {
+                Ok(Some(payload)) => {
+                    self.frames += 1;
+                    out.extend(frame::encode(&self.on_payload(&payload)));
+                }
+                Ok(None) => break,
+                Err(e) => {
+                    let code = match e {
+                        FrameError::TooLong => BridgeErrorCode::Overflow,
+                        _ => BridgeErrorCode::BadFrame,
+                    };
+                    let resp = Response::Error {
+                        code,
+                        detail: e.to_string(),
+                    };
+                    out.extend(frame::encode(&resp.encode(0, self.timer)));
+                }
+            }
+        }
+        out
+    }
+
+    /// The virtual time the emulator has reached (to pace `--realtime`).
+    pub fn now(&self) -> crate::time::Instant {
+        self.target.chip().now()
+    }
+
+    fn on_payload(&mut self, payload: &[u8]) -> Vec<u8> {
+        if let Some((req, resp)) = &self.last {
+            if req == payload {
+                return resp.clone();
+            }
+        }
+        let seq = payload.first().copied().unwrap_or(0);
+        let response = match Request::decode(payload, self.timer) {
+            Ok((_, req)) => self.handle(req),
+            Err(e) => Response::Error {
+                code: BridgeErrorCode::Malformed,
+                detail: e.to_string(),
+            },
+        };
+        let bytes = response.encode(seq, self.timer);
+        self.last = Some((payload.to_vec(), bytes.clone()));
+        bytes
+    }
+
+    fn handle(&mut self, req: Request) -> Response {
+        match req {
+            Request::Hello { version } if version != PROTOCOL_VERSION => Response::Error {
+                code: BridgeErrorCode::Version,
+                detail: format!("bridge speaks protocol {PROTOCOL_VERSION}, host {version}"),
+            },
+            Request::Hello { .. } => {
+                let straps = self
+                    .target
+                    .info()
+                    .details
+                    .iter()
+                    .map(|(k, v)| format!("{k}={v}"))
+                    .collect::<Vec<_>>()
+                    .join(" ");
+                Response::Hello(Hello {
+                    version: PROTOCOL_VERSION,
+                    session: self.session,
+                    timer_hz: self.timer.hz,
+                    max_batch_ops: MAX_BATCH_OPS,
+                    max_payload: frame::MAX_PAYLOAD as u16,
+                    capture_capacity: u32::MAX,
+                    inputs_wired: 0x3FF,
+                    virtual_time: self.virtual_time,
+                    firmware: format!("ppmc-bridge-sim {}", crate::VERSION),
+                    straps,
+                })
+            }
+            Request::Batch(ops) if ops.len() > usize::from(MAX_BATCH_OPS) => Response::Error {
+                code: BridgeErrorCode::Overflow,
+                detail: format!("{} ops in one batch, at most {MAX_BATCH_OPS}", ops.len()),
+            },
+            Request::Batch(ops) => match self.target.execute(&ops) {
+                Ok(replies) => Response::Batch(replies),
+                Err(e) => Response::Error {
+                    code: BridgeErrorCode::Malformed,
+                    detail: e.to_string(),
+                },
+            },
+            Request::Capture { runs, pins, moves } => {
+                let rec = self.target.chip().record();
+                let take = |from: u32, len: usize, max: usize| {
+                    let from = (from as usize).min(len);
+                    (from, (from + max).min(len))
+                };
+                let (r0, r1) = take(runs, rec.runs.len(), CHUNK_RUNS);
+                let (p0, p1) = take(pins, rec.pins.len(), CHUNK_PINS);
+                let (m0, m1) = take(moves, rec.moves.len(), CHUNK_MOVES);
+                Response::Capture(CaptureChunk {
+                    runs: rec.runs[r0..r1].to_vec(),
+                    pins: rec.pins[p0..p1].to_vec(),
+                    moves: rec.moves[m0..m1].to_vec(),
+                    overwritten_bytes: rec.overwritten_bytes,
+                    more: r1 < rec.runs.len() || p1 < rec.pins.len() || m1 < rec.moves.len(),
+                })
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emu::ModelConfig;
+    use crate::protocol::Straps;
+    use crate::target::{Op, Reply};
+    use crate::time::Duration;
+
+    fn server() -> BridgeServer {
+        let t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emu");
+        BridgeServer::new(t, 42, true)
+    }
+
+    fn ask(s: &mut BridgeServer, seq: u8, req: &Request) -> Response {
+        let out = s.on_bytes(&frame::encode(&req.encode(seq, Timer::NANOS)));
+        let mut d = FrameDecoder::new();
+        d.extend(&out);
+        let payload = d.decode().expect("valid frame").expect("one frame");
+        let (got_seq, resp) = Response::decode(&payload, Timer::NANOS).expect("decodes");
+        assert_eq!(got_seq, seq);
+        resp
+    }
+
+    #[test]
+    fn hello_announces_the_bridge() {
+        let mut s = server();
+        let Response::Hello(h) = ask(
+            &mut s,
+            1,
+            &Request::Hello {
+                version: PROTOCOL_VERSION,
+            },
+        ) else {
+            panic!("hello reply");
+        };
+        assert_eq!(
+            (h.session, h.timer_hz, h.max_batch_ops),
+            (42, 1_000_000_000, MAX_BATCH_OPS)
+        );
+        assert!(h.straps.contains("sysclk_hz=16000000"));
+        let r = ask(&mut s, 2, &Request::Hello { version: 99 });
+        assert!(matches!(
+            r,
+            Response::Error {
+                code: BridgeErrorCode::Version,
+                ..
+            }
+        ));
+    }
+
+    #[test]
+    fn a_retransmitted_request_is_answered_without_running_twice() {
+        let mut s = server();
+        let req = Request::Batch(vec![Op::Delay(Duration::from_millis(5))]);
+        let a = ask(&mut s, 7, &req);
+        let b = ask(&mut s, 7, &req);
+        assert_eq!(a, b);
+        assert_eq!(s.now().as_nanos(), 5_000_000, "the delay ran once");
+        ask(&mut s, 8, &req);
+        assert_eq!(s.now().as_nanos(), 10_000_000);
+    }
+
+    #[test]
+    fn corrupt_and_oversized_requests_get_error_codes() {
+        let mut s = server();
+        let mut bad = frame::encode(&Request::Hello { version: 1 }.encode(1, Timer::NANOS));
+        bad[2] ^= 0xFF;
+        let out = s.on_bytes(&bad);
+        let mut d = FrameDecoder::new();
+        d.extend(&out);
+        let (_, r) = Response::decode(&d.decode().expect("ok").expect("frame"), Timer::NANOS)
+            .expect("decodes");
+        assert!(matches!(
+            r,
+            Response::Error {
+                code: BridgeErrorCode::BadFrame,
+                ..
+            }
+        ));
+        let big = Request::Batch(vec![Op::ReadStatus; 49]);
+        assert!(matches!(
+            ask(&mut s, 3, &big),
+            Response::Error {
+                code: BridgeErrorCode::Overflow,
+                ..
+            }
+        ));
+    }
+
+    #[test]
+    fn capture_comes_in_chunks() {
+        let mut s = server();
+        let mut ops = vec![Op::WriteCommand {
+            byte: 0x06,
+            wait_ibf: None,
+        }];
+        for b in [100u8, 20, 100, 0] {
+            ops.push(Op::WriteData {
+                byte: b,
+                wait_ibf: Some(Duration::from_secs(1)),
+            });
+        }
+        ops.push(Op::Delay(Duration::from_millis(200)));
+        ask(&mut s, 1, &Request::Batch(ops));
+        for k in 0..30u8 {
+            let step = vec![
+                Op::WriteCommand {
+                    byte: 0x4A,
+                    wait_ibf: Some(Duration::from_secs(1)),
+                },
+                Op::AwaitStatus {
+                    mask: 4,
+                    value: 4,
+                    timeout: Duration::from_millis(5),
+                },
+                Op::AwaitStatus {
+                    mask: 4,
+                    value: 0,
+                    timeout: Duration::from_millis(5),
+                },
+                Op::Delay(Duration::from_micros(200 + u64::from(k))),
+            ];
+            let Response::Batch(r) = ask(&mut s, 2 + k, &Request::Batch(step)) else {
+                panic!("batch reply");
+            };
+            assert!(matches!(r[1], Reply::Awaited { .. }));
+        }
+        let (mut runs, mut pins, mut moves) = (0u32, 0u32, 0u32);
+        loop {
+            let Response::Capture(c) = ask(&mut s, 100, &Request::Capture { runs, pins, moves })
+            else {
+                panic!("capture reply");
+            };
+            runs += c.runs.len() as u32;
+            pins += c.pins.len() as u32;
+            moves += c.moves.len() as u32;
+            if !c.more {
+                break;
+            }
+        }
+        let rec = s.target().chip().record();
+        assert_eq!(
+            (runs as usize, pins as usize, moves as usize),
+            (rec.runs.len(), rec.pins.len(), rec.moves.len())
+        );
+        assert_eq!(moves, 30);
+    }
+}
