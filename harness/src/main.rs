@@ -7,7 +7,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use ppmc::console::{self, ConsoleOptions, Line, ScriptError};
 use ppmc::emu::{AccelCurve, ModelConfig};
 use ppmc::protocol::Straps;
-use ppmc::target::{EmuTarget, Target};
+use ppmc::target::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use ppmc::time::Duration;
 use std::io::{self, BufRead, IsTerminal, Read, Write};
 use std::path::PathBuf;
@@ -46,9 +46,45 @@ enum Command {
     /// terminal each line runs as you type it; otherwise the whole script is
     /// checked first and nothing runs if a line is wrong. See docs/console.md.
     Console(ConsoleArgs),
+    /// Serve the bus bridge protocol on a pseudo-terminal with the emulator
+    /// behind it, exactly as a board's bridge serves it over USB serial.
+    /// Prints the pty path; point `--target serial:<path>` at it.
+    BridgeSim(BridgeSimArgs),
     /// Measure the emulator's speed (maximum-length move, constant-rate
     /// stretches, per-pulse expansion) and print the figures.
     Bench(bench::BenchArgs),
+}
+
+#[derive(Debug, Args)]
+struct BridgeSimArgs {
+    #[command(flatten)]
+    target: TargetArgs,
+    /// Also make PATH a symbolic link to the pty (removed on exit).
+    #[arg(long, value_name = "PATH")]
+    link: Option<PathBuf>,
+    /// Pace replies to the wall clock instead of answering at once in
+    /// virtual time (to behave like a real board's timing).
+    #[arg(long)]
+    realtime: bool,
+    /// Probability of losing each byte on the link, e.g. 0.01.
+    #[arg(long, default_value_t = 0.0)]
+    drop_rate: f64,
+    /// Probability of flipping a bit in each byte on the link.
+    #[arg(long, default_value_t = 0.0)]
+    corrupt_rate: f64,
+    /// Stop answering after N frames (a hung bridge).
+    #[arg(long, value_name = "N")]
+    stall_after: Option<u64>,
+    /// Close the link after N frames (a cable pulled).
+    #[arg(long, value_name = "N")]
+    disconnect_after: Option<u64>,
+    /// Seed for the fault draws.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Run a deliberately faulty chip: drop-last-pulse, swap-error-A-B
+    /// (e.g. swap-error-3-4), status-stuck-0xNN.
+    #[arg(long = "chip-fault", value_name = "FAULT")]
+    chip_faults: Vec<String>,
 }
 
 #[derive(Debug, Args)]
@@ -74,7 +110,8 @@ struct ConsoleArgs {
 /// Which chip to drive, and how its board is strapped.
 #[derive(Debug, Args)]
 pub struct TargetArgs {
-    /// `emu` (the reference emulator).
+    /// `emu` (the reference emulator) or `serial:<path>[,baud=N]` (a board,
+    /// or `ppmc bridge-sim`, behind the serial bus bridge).
     #[arg(long, default_value = "emu")]
     target: String,
     /// System clock in MHz (fractions allowed, e.g. 12.288).
@@ -144,17 +181,26 @@ impl TargetArgs {
         }
     }
 
-    /// Opens the target named by `--target`.
+    /// Opens the target named by `--target`. A board target is health
+    /// checked on the way (hello, chip reset, status 0x00).
     pub fn open(&self) -> Result<Box<dyn Target>, String> {
-        match self.target.as_str() {
-            "emu" => {
-                let t = EmuTarget::new(self.straps()?, self.model()).map_err(|e| e.to_string())?;
-                Ok(Box::new(t))
-            }
-            other => Err(format!(
-                "unknown target `{other}`: this version supports `emu`"
-            )),
+        if self.target == "emu" {
+            let t = EmuTarget::new(self.straps()?, self.model()).map_err(|e| e.to_string())?;
+            return Ok(Box::new(t));
         }
+        if self.target.starts_with("serial:") {
+            let (path, baud) = ppmc::target::parse_spec(&self.target).ok_or_else(|| {
+                format!("bad target `{}`: write serial:<path>[,baud=N]", self.target)
+            })?;
+            let link = SerialLink::open(&path, baud).map_err(|e| e.to_string())?;
+            let t = SerialTarget::open(link, SerialOptions::default())
+                .map_err(|e| format!("infrastructure error: {e}"))?;
+            return Ok(Box::new(t));
+        }
+        Err(format!(
+            "unknown target `{}`: use `emu` or `serial:<path>[,baud=N]`",
+            self.target
+        ))
     }
 }
 
@@ -168,6 +214,7 @@ fn main() -> ExitCode {
         Command::Export(args) => cmd::export(args),
         Command::Console(args) => run_console(args),
         Command::Bench(args) => bench::run(args),
+        Command::BridgeSim(args) => bridge_sim(args),
     }
 }
 
@@ -253,4 +300,120 @@ fn interactive(target: &mut dyn Target, opts: &ConsoleOptions) -> ExitCode {
         }
     }
     ExitCode::SUCCESS
+}
+
+fn chip_faults(names: &[String]) -> Result<ppmc::emu::Faults, String> {
+    let mut f = ppmc::emu::Faults::default();
+    for n in names {
+        if n == "drop-last-pulse" {
+            f.drop_last_pulse = true;
+        } else if let Some(rest) = n.strip_prefix("swap-error-") {
+            let (a, b) = rest
+                .split_once('-')
+                .and_then(|(a, b)| Some((a.parse::<u8>().ok()?, b.parse::<u8>().ok()?)))
+                .filter(|(a, b)| *a < 8 && *b < 8)
+                .ok_or_else(|| {
+                    format!("--chip-fault {n}: write swap-error-A-B with A, B in 0..=7")
+                })?;
+            f.swap_error = Some((
+                ppmc::protocol::ErrorCode::from_number(a),
+                ppmc::protocol::ErrorCode::from_number(b),
+            ));
+        } else if let Some(hex) = n.strip_prefix("status-stuck-0x") {
+            f.status_stuck_high = u8::from_str_radix(hex, 16)
+                .map_err(|_| format!("--chip-fault {n}: write status-stuck-0xNN"))?;
+        } else {
+            return Err(format!(
+                "unknown --chip-fault `{n}` (drop-last-pulse, swap-error-A-B, status-stuck-0xNN)"
+            ));
+        }
+    }
+    Ok(f)
+}
+
+fn bridge_sim(args: BridgeSimArgs) -> ExitCode {
+    use ppmc::bridge::server::BridgeServer;
+    use ppmc::bridge::sim::{serve, LinkFaults, ServeEnd};
+    use serialport::SerialPort;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+
+    for (name, rate) in [
+        ("--drop-rate", args.drop_rate),
+        ("--corrupt-rate", args.corrupt_rate),
+    ] {
+        if !(0.0..=1.0).contains(&rate) {
+            return usage_error(format!("{name} {rate}: give a probability from 0 to 1"));
+        }
+    }
+    if args.target.target != "emu" {
+        return usage_error("bridge-sim serves the emulator; --target must be emu");
+    }
+    let straps = match args.target.straps() {
+        Ok(s) => s,
+        Err(e) => return usage_error(e),
+    };
+    let mut model = args.target.model();
+    model.faults = match chip_faults(&args.chip_faults) {
+        Ok(f) => f,
+        Err(e) => return usage_error(e),
+    };
+    let emu = match EmuTarget::new(straps, model) {
+        Ok(t) => t,
+        Err(e) => return usage_error(e),
+    };
+    let (mut master, slave) = match serialport::TTYPort::pair() {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("ppmc: cannot open a pseudo-terminal: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    let _ = master.set_timeout(std::time::Duration::from_millis(50));
+    let Some(path) = slave.name() else {
+        eprintln!("ppmc: the pseudo-terminal has no path");
+        return ExitCode::from(1);
+    };
+    if let Some(link) = &args.link {
+        let _ = std::fs::remove_file(link);
+        if let Err(e) = std::os::unix::fs::symlink(&path, link) {
+            eprintln!("ppmc: cannot link {} to {path}: {e}", link.display());
+            return ExitCode::from(1);
+        }
+    }
+    let session = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(1, |d| d.subsec_nanos() ^ (d.as_secs() as u32));
+    let mut server = BridgeServer::new(emu, session, !args.realtime);
+    println!("bridge-sim: serving on {path}");
+    println!("bridge-sim: run   ppmc run --target serial:{path}");
+    let _ = io::stdout().flush();
+    let stop = Arc::new(AtomicBool::new(false));
+    let faults = LinkFaults {
+        drop_rate: args.drop_rate,
+        corrupt_rate: args.corrupt_rate,
+        stall_after: args.stall_after,
+        disconnect_after: args.disconnect_after,
+        seed: args.seed,
+    };
+    let end = serve(&mut master, &mut server, faults, args.realtime, &stop);
+    if let Some(link) = &args.link {
+        let _ = std::fs::remove_file(link);
+    }
+    drop(slave);
+    let _ = stop.load(Ordering::Relaxed);
+    match end {
+        Ok(ServeEnd::Disconnected) => {
+            println!(
+                "bridge-sim: disconnected after {} frames (fault)",
+                server.frames
+            );
+            ExitCode::SUCCESS
+        }
+        Ok(ServeEnd::Stopped) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("ppmc: bridge-sim: {e}");
+            ExitCode::from(1)
+        }
+    }
 }

@@ -5,4 +5,5 @@
 
 pub mod frame;
 pub mod server;
+pub mod sim;
 pub mod wire;

@@ -9,8 +9,12 @@
 //! performs, never a host-side polling loop.
 
 mod emu;
+mod serial;
 
 pub use self::emu::EmuTarget;
+pub use self::serial::{
+    parse_spec, Link, LinkStats, SerialError, SerialLink, SerialOptions, SerialTarget,
+};
 
 use crate::protocol::{Input, Pins, PulseSummary, Record, Status};
 use crate::time::{Duration, Instant};

@@ -1,0 +1,573 @@
+//! A board behind the serial bus bridge: the [`Target`] backend that speaks
+//! the bridge protocol (`docs/bridge-protocol.md`) over a [`Link`].
+//!
+//! Every request carries a sequence number and the bridge answers a
+//! retransmitted request from its cache without running it again, so a
+//! lost or corrupted reply is simply asked for again. A link that vanishes
+//! (a USB re-enumeration) is reopened with backoff a bounded number of
+//! times; if the bridge comes back as a different session (it restarted)
+//! the run cannot go on safely and the error says so.
+
+use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
+use crate::bridge::frame::{self, FrameDecoder};
+use crate::bridge::server::MAX_BATCH_OPS;
+use crate::bridge::wire::{BridgeErrorCode, Hello, Request, Response, Timer, PROTOCOL_VERSION};
+use crate::protocol::Record;
+use std::fmt;
+use std::io::{self, Read, Write};
+use std::time::{Duration as WallDuration, Instant as WallInstant};
+
+/// A byte link to a bridge.
+pub trait Link: Send + fmt::Debug {
+    fn send(&mut self, bytes: &[u8]) -> io::Result<()>;
+    /// Reads what arrives within `timeout`; `Ok(0)` when nothing did.
+    fn recv(&mut self, buf: &mut [u8], timeout: WallDuration) -> io::Result<usize>;
+    /// Opens the link again after it failed.
+    fn reopen(&mut self) -> io::Result<()>;
+    /// What to call the link in messages: `serial:/dev/ttyACM0`.
+    fn name(&self) -> String;
+}
+
+/// A serial port (USB CDC, UART, or a pseudo-terminal) through `serialport`.
+pub struct SerialLink {
+    path: String,
+    baud: u32,
+    port: Option<Box<dyn serialport::SerialPort>>,
+}
+
+impl fmt::Debug for SerialLink {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("SerialLink")
+            .field("path", &self.path)
+            .field("baud", &self.baud)
+            .finish()
+    }
+}
+
+impl SerialLink {
+    pub fn open(path: &str, baud: u32) -> Result<SerialLink, SerialError> {
+        let mut link = SerialLink {
+            path: path.to_string(),
+            baud,
+            port: None,
+        };
+        link.reopen().map_err(|e| open_error(path, e))?;
+        Ok(link)
+    }
+
+    fn port(&mut self) -> io::Result<&mut Box<dyn serialport::SerialPort>> {
+        self.port
+            .as_mut()
+            .ok_or_else(|| io::Error::new(io::ErrorKind::NotConnected, "port closed"))
+    }
+}
+
+fn open_error(path: &str, e: io::Error) -> SerialError {
+    match e.kind() {
+        io::ErrorKind::NotFound => SerialError::PortMissing { path: path.into() },
+        io::ErrorKind::PermissionDenied => SerialError::PortBusy {
+            path: path.into(),
+            detail: e.to_string(),
+        },
+        _ if e.raw_os_error() == Some(16) => SerialError::PortBusy {
+            path: path.into(),
+            detail: e.to_string(),
+        },
+        _ => SerialError::Io {
+            path: path.into(),
+            source: e,
+        },
+    }
+}
+
+impl Link for SerialLink {
+    fn send(&mut self, bytes: &[u8]) -> io::Result<()> {
+        let port = self.port()?;
+        port.write_all(bytes)?;
+        port.flush()
+    }
+
+    fn recv(&mut self, buf: &mut [u8], timeout: WallDuration) -> io::Result<usize> {
+        let port = self.port()?;
+        port.set_timeout(timeout.max(WallDuration::from_millis(1)))
+            .map_err(io::Error::from)?;
+        match port.read(buf) {
+            Ok(0) => Err(io::Error::new(io::ErrorKind::UnexpectedEof, "link closed")),
+            Ok(n) => Ok(n),
+            Err(e)
+                if e.kind() == io::ErrorKind::TimedOut || e.kind() == io::ErrorKind::WouldBlock =>
+            {
+                Ok(0)
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    fn reopen(&mut self) -> io::Result<()> {
+        self.port = None;
+        let port = serialport::new(&self.path, self.baud)
+            .timeout(WallDuration::from_millis(100))
+            .open()
+            .map_err(io::Error::from)?;
+        self.port = Some(port);
+        Ok(())
+    }
+
+    fn name(&self) -> String {
+        format!("serial:{}", self.path)
+    }
+}
+
+/// Why talking to a bridge failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SerialError {
+    #[error("{path}: no such serial port (is the bridge plugged in?)")]
+    PortMissing { path: String },
+    #[error("{path}: port busy or not accessible ({detail}); is another program using it?")]
+    PortBusy { path: String, detail: String },
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: io::Error,
+    },
+    #[error("{link}: no bridge answering: no valid reply to {what} after {tries} tries")]
+    NoAnswer {
+        link: String,
+        what: String,
+        tries: u32,
+    },
+    #[error("{link}: bridge speaks protocol version {theirs}, this ppmc speaks {ours}")]
+    Version {
+        link: String,
+        ours: u16,
+        theirs: u16,
+    },
+    #[error("{link}: bridge reported {code:?} for {what}: {detail}")]
+    Bridge {
+        link: String,
+        what: String,
+        code: BridgeErrorCode,
+        detail: String,
+    },
+    #[error("{link}: the bridge's capture buffer overran; pulses were lost ({detail})")]
+    CaptureOverrun { link: String, detail: String },
+    #[error("{link}: unexpected reply to {what}: {detail}")]
+    Protocol {
+        link: String,
+        what: String,
+        detail: String,
+    },
+    #[error("{link}: link lost and not back after {attempts} reopen attempts ({last})")]
+    LinkLost {
+        link: String,
+        attempts: u32,
+        last: String,
+    },
+    #[error("{link}: the bridge restarted (session {old:08x} -> {new:08x}); the chip's state is unknown")]
+    Restarted { link: String, old: u32, new: u32 },
+    #[error("{link}: health check failed: {detail}")]
+    Unhealthy { link: String, detail: String },
+}
+
+impl SerialError {
+    pub fn kind(&self) -> TargetErrorKind {
+        match self {
+            SerialError::Version { .. } => TargetErrorKind::Unsupported,
+            SerialError::Bridge { .. } | SerialError::Protocol { .. } => TargetErrorKind::Other,
+            _ => TargetErrorKind::Link,
+        }
+    }
+}
+
+impl From<SerialError> for TargetError {
+    fn from(e: SerialError) -> Self {
+        TargetError {
+            kind: e.kind(),
+            message: e.to_string(),
+        }
+    }
+}
+
+/// Retry and timeout policy.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SerialOptions {
+    /// How long to wait for a reply beyond the time the batch itself needs.
+    pub reply_timeout: WallDuration,
+    /// Retransmissions of one request before giving up.
+    pub retries: u32,
+    /// Reopen attempts after the link vanished, with doubling backoff.
+    pub reopen_attempts: u32,
+    /// The first backoff.
+    pub backoff: WallDuration,
+}
+
+impl Default for SerialOptions {
+    fn default() -> Self {
+        SerialOptions {
+            reply_timeout: WallDuration::from_millis(1000),
+            retries: 4,
+            reopen_attempts: 5,
+            backoff: WallDuration::from_millis(100),
+        }
+    }
+}
+
+/// What the link has cost so far (for reports and `docs/performance.md`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LinkStats {
+    pub round_trips: u64,
+    pub retransmissions: u64,
+    pub corrupt_frames: u64,
+    pub reopens: u64,
+}
+
+/// A chip behind a bus bridge.
+#[derive(Debug)]
+pub struct SerialTarget<L: Link> {
+    link: L,
+    decoder: FrameDecoder,
+    seq: u8,
+    hello: Hello,
+    timer: Timer,
+    opts: SerialOptions,
+    pub stats: LinkStats,
+}
+
+impl<L: Link> SerialTarget<L> {
+    /// Says hello, then checks the board's health: a chip reset, and the
+    /// status register reading 0x00 after it.
+    pub fn open(link: L, opts: SerialOptions) -> Result<Self, SerialError> {
+        let mut t = SerialTarget {
+            link,
+            decoder: FrameDecoder::new(),
+            seq: 0,
+            hello: Hello {
+                version: PROTOCOL_VERSION,
+                session: 0,
+                timer_hz: Timer::NANOS.hz,
+                max_batch_ops: 1,
+                max_payload: 64,
+                capture_capacity: 0,
+                inputs_wired: 0,
+                virtual_time: false,
+                firmware: String::new(),
+                straps: String::new(),
+            },
+            timer: Timer::NANOS,
+            opts,
+            stats: LinkStats::default(),
+        };
+        t.hello = t.say_hello()?;
+        t.timer = Timer {
+            hz: t.hello.timer_hz,
+        };
+        let replies =
+            t.run_batch(&[Op::Reset, Op::ReadStatus])
+                .map_err(|e| SerialError::Unhealthy {
+                    link: t.link.name(),
+                    detail: e.to_string(),
+                })?;
+        match replies.get(1) {
+            Some(Reply::Status { status, .. }) if status.0 == 0 => Ok(t),
+            other => Err(SerialError::Unhealthy {
+                link: t.link.name(),
+                detail: format!("status after chip reset is {other:?}, expected 0x00"),
+            }),
+        }
+    }
+
+    pub fn hello(&self) -> &Hello {
+        &self.hello
+    }
+
+    fn say_hello(&mut self) -> Result<Hello, SerialError> {
+        match self.request(
+            &Request::Hello {
+                version: PROTOCOL_VERSION,
+            },
+            "hello",
+            WallDuration::ZERO,
+        )? {
+            Response::Hello(h) if h.version == PROTOCOL_VERSION => Ok(h),
+            Response::Hello(h) => Err(SerialError::Version {
+                link: self.link.name(),
+                ours: PROTOCOL_VERSION,
+                theirs: h.version,
+            }),
+            other => Err(self.unexpected("hello", &other)),
+        }
+    }
+
+    fn unexpected(&self, what: &str, r: &Response) -> SerialError {
+        match r {
+            Response::Error {
+                code: BridgeErrorCode::Version,
+                detail,
+            } => SerialError::Version {
+                link: self.link.name(),
+                ours: PROTOCOL_VERSION,
+                theirs: detail
+                    .split_whitespace()
+                    .find_map(|w| w.parse().ok())
+                    .unwrap_or(0),
+            },
+            Response::Error {
+                code: BridgeErrorCode::CaptureOverrun,
+                detail,
+            } => SerialError::CaptureOverrun {
+                link: self.link.name(),
+                detail: detail.clone(),
+            },
+            Response::Error { code, detail } => SerialError::Bridge {
+                link: self.link.name(),
+                what: what.into(),
+                code: *code,
+                detail: detail.clone(),
+            },
+            other => SerialError::Protocol {
+                link: self.link.name(),
+                what: what.into(),
+                detail: format!("{other:?}"),
+            },
+        }
+    }
+
+    /// Sends a request and waits for its reply, retransmitting on loss or
+    /// corruption and reopening a vanished link.
+    fn request(
+        &mut self,
+        req: &Request,
+        what: &str,
+        extra: WallDuration,
+    ) -> Result<Response, SerialError> {
+        self.seq = self.seq.wrapping_add(1);
+        let seq = self.seq;
+        let bytes = frame::encode(&req.encode(seq, self.timer));
+        let tries = self.opts.retries + 1;
+        for attempt in 0..tries {
+            if attempt > 0 {
+                self.stats.retransmissions += 1;
+            }
+            if let Err(e) = self.link.send(&bytes) {
+                self.recover(e)?;
+                continue;
+            }
+            self.stats.round_trips += 1;
+            match self.await_reply(seq, self.opts.reply_timeout + extra) {
+                Ok(Some(Response::Error {
+                    code: BridgeErrorCode::BadFrame,
+                    ..
+                })) => continue,
+                Ok(Some(r)) => return Ok(r),
+                Ok(None) => continue,
+                Err(e) => self.recover(e)?,
+            }
+        }
+        Err(SerialError::NoAnswer {
+            link: self.link.name(),
+            what: what.into(),
+            tries,
+        })
+    }
+
+    /// Reads until the reply to `seq` arrives (`Some`), the reply is lost or
+    /// corrupted (`None`, worth retransmitting), or the link fails.
+    fn await_reply(&mut self, seq: u8, timeout: WallDuration) -> io::Result<Option<Response>> {
+        let deadline = WallInstant::now() + timeout;
+        let mut buf = [0u8; 4096];
+        loop {
+            loop {
+                match self.decoder.decode() {
+                    Ok(Some(payload)) => match Response::decode(&payload, self.timer) {
+                        // A bad-frame error carries seq 0: our request was
+                        // garbled on the way.
+                        Ok((
+                            _,
+                            r @ Response::Error {
+                                code: BridgeErrorCode::BadFrame,
+                                ..
+                            },
+                        )) => {
+                            return Ok(Some(r));
+                        }
+                        Ok((s, r)) if s == seq => return Ok(Some(r)),
+                        Ok(_) => {} // a stale reply to an earlier try
+                        Err(_) => {
+                            self.stats.corrupt_frames += 1;
+                            return Ok(None);
+                        }
+                    },
+                    Ok(None) => break,
+                    Err(_) => {
+                        self.stats.corrupt_frames += 1;
+                        return Ok(None);
+                    }
+                }
+            }
+            let now = WallInstant::now();
+            if now >= deadline {
+                return Ok(None);
+            }
+            let n = self.link.recv(&mut buf, deadline - now)?;
+            self.decoder.extend(&buf[..n]);
+        }
+    }
+
+    /// Reopens a failed link with backoff; the bridge must still be the
+    /// same session, or the run cannot trust the chip's state.
+    fn recover(&mut self, e: io::Error) -> Result<(), SerialError> {
+        let mut last = e.to_string();
+        let mut wait = self.opts.backoff;
+        for _ in 0..self.opts.reopen_attempts {
+            std::thread::sleep(wait);
+            wait *= 2;
+            match self.link.reopen() {
+                Ok(()) => {
+                    self.stats.reopens += 1;
+                    self.decoder = FrameDecoder::new();
+                    let old = self.hello.session;
+                    let h = self.say_hello()?;
+                    if h.session != old {
+                        return Err(SerialError::Restarted {
+                            link: self.link.name(),
+                            old,
+                            new: h.session,
+                        });
+                    }
+                    return Ok(());
+                }
+                Err(e) => last = e.to_string(),
+            }
+        }
+        Err(SerialError::LinkLost {
+            link: self.link.name(),
+            attempts: self.opts.reopen_attempts,
+            last,
+        })
+    }
+
+    /// The wall time a batch may take on a real-time bridge.
+    fn batch_time(&self, ops: &[Op]) -> WallDuration {
+        if self.hello.virtual_time {
+            return WallDuration::ZERO;
+        }
+        let total: u64 = ops
+            .iter()
+            .map(|o| match *o {
+                Op::Delay(d) => d.as_nanos(),
+                Op::AwaitStatus { timeout, .. } | Op::AwaitPulses { timeout, .. } => {
+                    timeout.as_nanos()
+                }
+                Op::WriteCommand {
+                    wait_ibf: Some(t), ..
+                }
+                | Op::WriteData {
+                    wait_ibf: Some(t), ..
+                }
+                | Op::ReadData { wait_obf: Some(t) } => t.as_nanos(),
+                _ => 0,
+            })
+            .fold(0u64, u64::saturating_add);
+        WallDuration::from_nanos(total)
+    }
+
+    fn run_batch(&mut self, ops: &[Op]) -> Result<Vec<Reply>, SerialError> {
+        let mut out = Vec::with_capacity(ops.len());
+        let max = usize::from(self.hello.max_batch_ops.clamp(1, MAX_BATCH_OPS.max(1)));
+        for chunk in ops.chunks(max) {
+            let what = format!(
+                "a batch of {} ops starting with {:?}",
+                chunk.len(),
+                chunk[0]
+            );
+            let extra = self.batch_time(chunk);
+            match self.request(&Request::Batch(chunk.to_vec()), &what, extra)? {
+                Response::Batch(r) if r.len() == chunk.len() => out.extend(r),
+                other => return Err(self.unexpected(&what, &other)),
+            }
+        }
+        Ok(out)
+    }
+}
+
+impl<L: Link> Target for SerialTarget<L> {
+    fn info(&self) -> TargetInfo {
+        let mut details: Vec<(String, String)> = self
+            .hello
+            .straps
+            .split_whitespace()
+            .filter_map(|kv| kv.split_once('='))
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        details.push(("bridge_firmware".into(), self.hello.firmware.clone()));
+        details.push(("bridge_protocol".into(), self.hello.version.to_string()));
+        TargetInfo {
+            name: self.link.name(),
+            details,
+        }
+    }
+
+    fn capture(&mut self) -> Result<Record, TargetError> {
+        let mut rec = Record::default();
+        loop {
+            let req = Request::Capture {
+                runs: rec.runs.len() as u32,
+                pins: rec.pins.len() as u32,
+                moves: rec.moves.len() as u32,
+            };
+            match self.request(&req, "capture", WallDuration::ZERO)? {
+                Response::Capture(c) => {
+                    rec.runs.extend(c.runs);
+                    rec.pins.extend(c.pins);
+                    rec.moves.extend(c.moves);
+                    rec.overwritten_bytes = c.overwritten_bytes;
+                    if !c.more {
+                        return Ok(rec);
+                    }
+                }
+                other => return Err(self.unexpected("capture", &other).into()),
+            }
+        }
+    }
+
+    fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
+        Ok(self.run_batch(ops)?)
+    }
+}
+
+/// Parses `serial:<path>[,baud=N]`.
+pub fn parse_spec(spec: &str) -> Option<(String, u32)> {
+    let rest = spec.strip_prefix("serial:")?;
+    let mut parts = rest.split(',');
+    let path = parts.next().filter(|p| !p.is_empty())?.to_string();
+    let mut baud = 115_200;
+    for p in parts {
+        let (k, v) = p.split_once('=')?;
+        match k {
+            "baud" => baud = v.parse().ok().filter(|b| *b > 0)?,
+            _ => return None,
+        }
+    }
+    Some((path, baud))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn specs_parse() {
+        assert_eq!(
+            parse_spec("serial:/dev/ttyACM0"),
+            Some(("/dev/ttyACM0".into(), 115_200))
+        );
+        assert_eq!(
+            parse_spec("serial:/dev/pts/3,baud=921600"),
+            Some(("/dev/pts/3".into(), 921_600))
+        );
+        assert_eq!(parse_spec("serial:"), None);
+        assert_eq!(parse_spec("serial:/x,speed=1"), None);
+        assert_eq!(parse_spec("emu"), None);
+    }
+}
