@@ -10,7 +10,7 @@
 
 use super::frame::{self, FrameDecoder, FrameError};
 use super::wire::{
-    BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer, PROTOCOL_VERSION,
+    fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer, PROTOCOL_VERSION,
 };
 use crate::target::{EmuTarget, Target};
 
@@ -30,8 +30,8 @@ pub struct BridgeServer {
     session: u32,
     timer: Timer,
     virtual_time: bool,
-    /// The last request payload and the response payload sent for it.
-    last: Option<(Vec<u8>, Vec<u8>)>,
+    /// The last request payload and the frames sent for it.
+    last: Option<(Vec<u8>, Vec<Vec<u8>>)>,
     /// Frames handled so far (for fault injection by the caller).
     pub frames: u64,
 }
@@ -63,7 +63,9 @@ impl BridgeServer {
             match self.decoder.decode() {
                 Ok(Some(payload)) => {
                     self.frames += 1;
-                    out.extend(frame::encode(&self.on_payload(&payload)));
+                    for f in self.on_payload(&payload) {
+                        out.extend(frame::encode(&f));
+                    }
                 }
                 Ok(None) => break,
                 Err(e) => {
@@ -87,23 +89,39 @@ impl BridgeServer {
         self.target.chip().now()
     }
 
-    fn on_payload(&mut self, payload: &[u8]) -> Vec<u8> {
-        if let Some((req, resp)) = &self.last {
+    /// The frames answering one request payload.
+    fn on_payload(&mut self, payload: &[u8]) -> Vec<Vec<u8>> {
+        if let Some((req, frames)) = &self.last {
             if req == payload {
-                return resp.clone();
+                return frames.clone();
             }
         }
         let seq = payload.first().copied().unwrap_or(0);
-        let response = match Request::decode(payload, self.timer) {
+        let decoded = Request::decode(payload, self.timer);
+        if let Ok((s, Request::Resend { fragments })) = &decoded {
+            // Only for the request answered last.
+            return match &self.last {
+                Some((req, frames)) if req.first() == Some(s) => fragments
+                    .iter()
+                    .filter_map(|i| frames.get(usize::from(*i)).cloned())
+                    .collect(),
+                _ => vec![Response::Error {
+                    code: BridgeErrorCode::Malformed,
+                    detail: format!("no reply to sequence {s} to resend"),
+                }
+                .encode(seq, self.timer)],
+            };
+        }
+        let response = match decoded {
             Ok((_, req)) => self.handle(req),
             Err(e) => Response::Error {
                 code: BridgeErrorCode::Malformed,
                 detail: e.to_string(),
             },
         };
-        let bytes = response.encode(seq, self.timer);
-        self.last = Some((payload.to_vec(), bytes.clone()));
-        bytes
+        let frames = fragment(&response.encode(seq, self.timer));
+        self.last = Some((payload.to_vec(), frames.clone()));
+        frames
     }
 
     fn handle(&mut self, req: Request) -> Response {
@@ -145,15 +163,25 @@ impl BridgeServer {
                     detail: e.to_string(),
                 },
             },
-            Request::Capture { runs, pins, moves } => {
+            Request::Resend { .. } => Response::Error {
+                code: BridgeErrorCode::Malformed,
+                detail: "resend handled before dispatch".into(),
+            },
+            Request::Capture {
+                runs,
+                pins,
+                moves,
+                max,
+            } => {
                 let rec = self.target.chip().record();
+                let max = usize::from(max.max(1));
                 let take = |from: u32, len: usize, max: usize| {
                     let from = (from as usize).min(len);
                     (from, (from + max).min(len))
                 };
-                let (r0, r1) = take(runs, rec.runs.len(), CHUNK_RUNS);
-                let (p0, p1) = take(pins, rec.pins.len(), CHUNK_PINS);
-                let (m0, m1) = take(moves, rec.moves.len(), CHUNK_MOVES);
+                let (r0, r1) = take(runs, rec.runs.len(), CHUNK_RUNS.min(max));
+                let (p0, p1) = take(pins, rec.pins.len(), CHUNK_PINS.min(max));
+                let (m0, m1) = take(moves, rec.moves.len(), CHUNK_MOVES.min(max));
                 Response::Capture(CaptureChunk {
                     runs: rec.runs[r0..r1].to_vec(),
                     pins: rec.pins[p0..p1].to_vec(),
@@ -183,7 +211,13 @@ mod tests {
         let out = s.on_bytes(&frame::encode(&req.encode(seq, Timer::NANOS)));
         let mut d = FrameDecoder::new();
         d.extend(&out);
-        let payload = d.decode().expect("valid frame").expect("one frame");
+        let mut payload = Vec::new();
+        while let Some(f) = d.decode().expect("valid frame") {
+            match crate::bridge::wire::parse_fragment(&f) {
+                Some((_, _, _, data)) => payload.extend_from_slice(data),
+                None => payload = f,
+            }
+        }
         let (got_seq, resp) = Response::decode(&payload, Timer::NANOS).expect("decodes");
         assert_eq!(got_seq, seq);
         resp
@@ -295,8 +329,16 @@ mod tests {
         }
         let (mut runs, mut pins, mut moves) = (0u32, 0u32, 0u32);
         loop {
-            let Response::Capture(c) = ask(&mut s, 100, &Request::Capture { runs, pins, moves })
-            else {
+            let Response::Capture(c) = ask(
+                &mut s,
+                100,
+                &Request::Capture {
+                    runs,
+                    pins,
+                    moves,
+                    max: 50,
+                },
+            ) else {
                 panic!("capture reply");
             };
             runs += c.runs.len() as u32;

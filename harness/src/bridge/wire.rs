@@ -21,9 +21,11 @@ pub mod kind {
     pub const HELLO: u8 = 0x01;
     pub const BATCH: u8 = 0x02;
     pub const CAPTURE: u8 = 0x03;
+    pub const RESEND: u8 = 0x04;
     pub const HELLO_REPLY: u8 = 0x81;
     pub const BATCH_REPLY: u8 = 0x82;
     pub const CAPTURE_REPLY: u8 = 0x83;
+    pub const FRAGMENT: u8 = 0x84;
     pub const ERROR: u8 = 0xFF;
 }
 
@@ -106,12 +108,53 @@ pub enum Request {
     },
     /// Ops run back to back on the bridge; durations in ticks.
     Batch(Vec<Op>),
-    /// Capture records from these positions on.
+    /// Capture records from these positions on, at most `max` of each kind.
     Capture {
         runs: u32,
         pins: u32,
         moves: u32,
+        max: u16,
     },
+    /// Send these fragments of the reply to this same sequence number again.
+    Resend {
+        fragments: Vec<u8>,
+    },
+}
+
+/// Largest response payload sent as one frame; longer ones go as
+/// fragments of this many bytes, so that a noisy link loses little.
+pub const FRAGMENT_DATA: usize = 96;
+
+/// Splits a response payload into frame payloads: itself if short, else
+/// `seq, FRAGMENT, index, count, data`.
+pub fn fragment(payload: &[u8]) -> Vec<Vec<u8>> {
+    if payload.len() <= FRAGMENT_DATA {
+        return vec![payload.to_vec()];
+    }
+    let seq = payload.first().copied().unwrap_or(0);
+    let chunks: Vec<&[u8]> = payload.chunks(FRAGMENT_DATA).collect();
+    let count = chunks.len().min(255) as u8;
+    chunks
+        .iter()
+        .take(255)
+        .enumerate()
+        .map(|(i, c)| {
+            let mut f = vec![seq, kind::FRAGMENT, i as u8, count];
+            f.extend_from_slice(c);
+            f
+        })
+        .collect()
+}
+
+/// A fragment frame: `(seq, index, count, data)`, or `None` if the payload
+/// is not one.
+pub fn parse_fragment(payload: &[u8]) -> Option<(u8, u8, u8, &[u8])> {
+    match payload {
+        [seq, k, i, n, data @ ..] if *k == kind::FRAGMENT && *n > 0 && i < n => {
+            Some((*seq, *i, *n, data))
+        }
+        _ => None,
+    }
 }
 
 /// A chunk of the capture.
@@ -683,11 +726,24 @@ impl Request {
                     put_op(&mut w, o);
                 }
             }
-            Request::Capture { runs, pins, moves } => {
+            Request::Capture {
+                runs,
+                pins,
+                moves,
+                max,
+            } => {
                 w.u8(kind::CAPTURE);
                 w.u32(*runs);
                 w.u32(*pins);
                 w.u32(*moves);
+                w.u16(*max);
+            }
+            Request::Resend { fragments } => {
+                w.u8(kind::RESEND);
+                w.u8(fragments.len().min(255) as u8);
+                for f in fragments.iter().take(255) {
+                    w.u8(*f);
+                }
             }
         }
         w.0
@@ -711,7 +767,14 @@ impl Request {
                 runs: r.u32()?,
                 pins: r.u32()?,
                 moves: r.u32()?,
+                max: r.u16()?,
             },
+            kind::RESEND => {
+                let n = usize::from(r.u8()?);
+                Request::Resend {
+                    fragments: r.take(n)?.to_vec(),
+                }
+            }
             k => return Err(WireError::UnknownKind(k)),
         };
         r.end()?;
@@ -1060,6 +1123,32 @@ mod tests {
             detail: "full".into(),
         };
         assert_eq!(Response::decode(&err.encode(3, T), T), Ok((3, err)));
+    }
+
+    #[test]
+    fn long_replies_fragment_and_reassemble() {
+        let payload: Vec<u8> = (0..250u16).map(|i| i as u8).collect();
+        let frags = fragment(&payload);
+        assert_eq!(frags.len(), 3);
+        let mut whole = Vec::new();
+        for (i, f) in frags.iter().enumerate() {
+            let (seq, idx, n, data) = parse_fragment(f).expect("a fragment");
+            assert_eq!((seq, usize::from(idx), n), (0, i, 3));
+            whole.extend_from_slice(data);
+        }
+        assert_eq!(whole, payload);
+        assert_eq!(fragment(&[5, 1, 2]), vec![vec![5, 1, 2]]);
+        let r = Request::Resend {
+            fragments: vec![0, 2],
+        };
+        assert_eq!(Request::decode(&r.encode(4, T), T), Ok((4, r)));
+        let c = Request::Capture {
+            runs: 1,
+            pins: 2,
+            moves: 3,
+            max: 40,
+        };
+        assert_eq!(Request::decode(&c.encode(5, T), T), Ok((5, c)));
     }
 
     #[test]

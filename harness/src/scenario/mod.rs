@@ -264,14 +264,18 @@ pub fn run_scenario(
         }
     };
     let elapsed = driver.now().saturating_since(Instant::ZERO);
-    let capture = driver.capture().ok().cloned();
+    let capture = driver.capture().map(|c| c.clone());
     let (bus, measurements) = driver.into_parts();
-    let verdict = match outcome {
-        Ok(()) if measurements.iter().any(|m| m.grade == Grade::Marginal) => Verdict::Marginal,
-        Ok(()) => Verdict::Passed,
-        Err(Stop::Failed(f)) => Verdict::Failed(f),
-        Err(Stop::Error(e)) => Verdict::Error(e),
+    let verdict = match (outcome, &capture) {
+        // Without the capture the run cannot be shown or compared: the link
+        // failed, whatever the expectations said.
+        (Ok(()), Err(Stop::Error(e))) => Verdict::Error(e.clone()),
+        (Ok(()), _) if measurements.iter().any(|m| m.grade == Grade::Marginal) => Verdict::Marginal,
+        (Ok(()), _) => Verdict::Passed,
+        (Err(Stop::Failed(f)), _) => Verdict::Failed(f),
+        (Err(Stop::Error(e)), _) => Verdict::Error(e),
     };
+    let capture = capture.ok();
     let measures: Vec<Event> = measurements
         .iter()
         .map(|m| Event {

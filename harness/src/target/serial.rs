@@ -11,7 +11,9 @@
 use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
 use crate::bridge::frame::{self, FrameDecoder};
 use crate::bridge::server::MAX_BATCH_OPS;
-use crate::bridge::wire::{BridgeErrorCode, Hello, Request, Response, Timer, PROTOCOL_VERSION};
+use crate::bridge::wire::{
+    parse_fragment, BridgeErrorCode, Hello, Request, Response, Timer, PROTOCOL_VERSION,
+};
 use crate::protocol::Record;
 use std::fmt;
 use std::io::{self, Read, Write};
@@ -200,6 +202,9 @@ pub struct SerialOptions {
     pub reopen_attempts: u32,
     /// The first backoff.
     pub backoff: WallDuration,
+    /// After a corrupted frame, how long the line must stay silent before
+    /// the host asks again (rather than waiting out `reply_timeout`).
+    pub quiet: WallDuration,
 }
 
 impl Default for SerialOptions {
@@ -209,7 +214,56 @@ impl Default for SerialOptions {
             retries: 4,
             reopen_attempts: 5,
             backoff: WallDuration::from_millis(100),
+            quiet: WallDuration::from_millis(30),
         }
+    }
+}
+
+/// Largest request payload the host sends: small frames survive a noisy
+/// line, and a batch split over several requests runs the same.
+const MAX_REQUEST: usize = 128;
+
+/// Records asked for per capture request.
+const CAPTURE_CHUNK: u16 = 40;
+
+/// The fragments of a long reply received so far.
+#[derive(Debug, Default)]
+struct Fragments {
+    parts: Vec<Option<Vec<u8>>>,
+}
+
+impl Fragments {
+    /// Stores fragment `i` of `n`; true when all have arrived.
+    fn put(&mut self, i: u8, n: u8, data: &[u8]) -> bool {
+        if self.parts.len() != usize::from(n) {
+            self.parts = vec![None; usize::from(n)];
+        }
+        self.parts[usize::from(i)] = Some(data.to_vec());
+        self.parts.iter().all(Option::is_some)
+    }
+
+    fn received(&self) -> usize {
+        self.parts.iter().filter(|p| p.is_some()).count()
+    }
+
+    /// Indices still missing, if any fragment at all has arrived.
+    fn missing(&self) -> Option<Vec<u8>> {
+        (self.received() > 0).then(|| {
+            self.parts
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| p.is_none())
+                .map(|(i, _)| i as u8)
+                .collect()
+        })
+    }
+
+    fn take(&mut self) -> Vec<u8> {
+        std::mem::take(&mut self.parts)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .collect()
     }
 }
 
@@ -333,8 +387,10 @@ impl<L: Link> SerialTarget<L> {
         }
     }
 
-    /// Sends a request and waits for its reply, retransmitting on loss or
-    /// corruption and reopening a vanished link.
+    /// Sends a request and waits for its reply, asking again for what was
+    /// lost or corrupted (the whole reply, or the missing fragments of a
+    /// long one) and reopening a vanished link. Gives up after `retries`
+    /// attempts in a row that brought nothing new.
     fn request(
         &mut self,
         req: &Request,
@@ -343,73 +399,116 @@ impl<L: Link> SerialTarget<L> {
     ) -> Result<Response, SerialError> {
         self.seq = self.seq.wrapping_add(1);
         let seq = self.seq;
-        let bytes = frame::encode(&req.encode(seq, self.timer));
-        let tries = self.opts.retries + 1;
-        for attempt in 0..tries {
-            if attempt > 0 {
+        let full = frame::encode(&req.encode(seq, self.timer));
+        let mut frags = Fragments::default();
+        let mut next = full.clone();
+        let mut fruitless = 0;
+        let mut first = true;
+        while fruitless <= self.opts.retries {
+            if !first {
                 self.stats.retransmissions += 1;
             }
-            if let Err(e) = self.link.send(&bytes) {
+            first = false;
+            if let Err(e) = self.link.send(&next) {
                 self.recover(e)?;
+                frags = Fragments::default();
+                next = full.clone();
+                fruitless += 1;
                 continue;
             }
             self.stats.round_trips += 1;
-            match self.await_reply(seq, self.opts.reply_timeout + extra) {
+            let had = frags.received();
+            match self.await_reply(seq, self.opts.reply_timeout + extra, &mut frags) {
                 Ok(Some(Response::Error {
                     code: BridgeErrorCode::BadFrame,
                     ..
-                })) => continue,
+                })) => next = full.clone(),
                 Ok(Some(r)) => return Ok(r),
-                Ok(None) => continue,
-                Err(e) => self.recover(e)?,
+                Ok(None) => {
+                    next = match frags.missing() {
+                        Some(m) => {
+                            frame::encode(&Request::Resend { fragments: m }.encode(seq, self.timer))
+                        }
+                        None => full.clone(),
+                    }
+                }
+                Err(e) => {
+                    self.recover(e)?;
+                    frags = Fragments::default();
+                    next = full.clone();
+                }
+            }
+            if frags.received() > had {
+                fruitless = 0;
+            } else {
+                fruitless += 1;
             }
         }
         Err(SerialError::NoAnswer {
             link: self.link.name(),
             what: what.into(),
-            tries,
+            tries: self.opts.retries + 1,
         })
     }
 
-    /// Reads until the reply to `seq` arrives (`Some`), the reply is lost or
-    /// corrupted (`None`, worth retransmitting), or the link fails.
-    fn await_reply(&mut self, seq: u8, timeout: WallDuration) -> io::Result<Option<Response>> {
+    /// Reads until the reply to `seq` is complete (`Some`), or the link
+    /// goes quiet or the timeout passes without it (`None`: ask again).
+    fn await_reply(
+        &mut self,
+        seq: u8,
+        timeout: WallDuration,
+        frags: &mut Fragments,
+    ) -> io::Result<Option<Response>> {
         let deadline = WallInstant::now() + timeout;
+        // After a corrupted frame, stop waiting once the line is quiet.
+        let mut quiet_by: Option<WallInstant> = None;
         let mut buf = [0u8; 4096];
         loop {
             loop {
                 match self.decoder.decode() {
-                    Ok(Some(payload)) => match Response::decode(&payload, self.timer) {
-                        // A bad-frame error carries seq 0: our request was
-                        // garbled on the way.
-                        Ok((
-                            _,
-                            r @ Response::Error {
-                                code: BridgeErrorCode::BadFrame,
-                                ..
-                            },
-                        )) => {
-                            return Ok(Some(r));
+                    Ok(Some(payload)) => {
+                        if let Some((s, i, n, data)) = parse_fragment(&payload) {
+                            if s == seq && frags.put(i, n, data) {
+                                match Response::decode(&frags.take(), self.timer) {
+                                    Ok((_, r)) => return Ok(Some(r)),
+                                    Err(_) => self.stats.corrupt_frames += 1,
+                                }
+                            }
+                            continue;
                         }
-                        Ok((s, r)) if s == seq => return Ok(Some(r)),
-                        Ok(_) => {} // a stale reply to an earlier try
-                        Err(_) => {
-                            self.stats.corrupt_frames += 1;
-                            return Ok(None);
+                        match Response::decode(&payload, self.timer) {
+                            // A bad-frame error carries seq 0: our request was
+                            // garbled on the way.
+                            Ok((
+                                _,
+                                r @ Response::Error {
+                                    code: BridgeErrorCode::BadFrame,
+                                    ..
+                                },
+                            )) => {
+                                return Ok(Some(r));
+                            }
+                            Ok((s, r)) if s == seq => return Ok(Some(r)),
+                            Ok(_) => {} // a stale reply to an earlier try
+                            Err(_) => self.stats.corrupt_frames += 1,
                         }
-                    },
+                    }
                     Ok(None) => break,
                     Err(_) => {
                         self.stats.corrupt_frames += 1;
-                        return Ok(None);
+                        quiet_by = Some(WallInstant::now() + self.opts.quiet);
                     }
                 }
             }
             let now = WallInstant::now();
-            if now >= deadline {
+            let until = quiet_by.map_or(deadline, |q| q.min(deadline));
+            if now >= until {
                 return Ok(None);
             }
-            let n = self.link.recv(&mut buf, deadline - now)?;
+            let n = self.link.recv(&mut buf, until - now)?;
+            if n > 0 && quiet_by.is_some() {
+                quiet_by = Some(WallInstant::now() + self.opts.quiet);
+            }
             self.decoder.extend(&buf[..n]);
         }
     }
@@ -474,8 +573,22 @@ impl<L: Link> SerialTarget<L> {
 
     fn run_batch(&mut self, ops: &[Op]) -> Result<Vec<Reply>, SerialError> {
         let mut out = Vec::with_capacity(ops.len());
-        let max = usize::from(self.hello.max_batch_ops.clamp(1, MAX_BATCH_OPS.max(1)));
-        for chunk in ops.chunks(max) {
+        let max_ops = usize::from(self.hello.max_batch_ops.clamp(1, MAX_BATCH_OPS.max(1)));
+        let mut rest = ops;
+        while !rest.is_empty() {
+            // As many ops as fit one small request.
+            let mut n = 1;
+            while n < rest.len()
+                && n < max_ops
+                && Request::Batch(rest[..=n].to_vec())
+                    .encode(0, self.timer)
+                    .len()
+                    <= MAX_REQUEST
+            {
+                n += 1;
+            }
+            let (chunk, tail) = rest.split_at(n);
+            rest = tail;
             let what = format!(
                 "a batch of {} ops starting with {:?}",
                 chunk.len(),
@@ -515,6 +628,7 @@ impl<L: Link> Target for SerialTarget<L> {
                 runs: rec.runs.len() as u32,
                 pins: rec.pins.len() as u32,
                 moves: rec.moves.len() as u32,
+                max: CAPTURE_CHUNK,
             };
             match self.request(&req, "capture", WallDuration::ZERO)? {
                 Response::Capture(c) => {

@@ -1,0 +1,261 @@
+//! The board path, end to end over a real pseudo-terminal: the bridge
+//! simulator on the master side, the `serialport` driver on the slave path.
+
+use ppmc::bridge::server::BridgeServer;
+use ppmc::bridge::sim::{serve, LinkFaults, ServeEnd};
+use ppmc::emu::{Faults, ModelConfig};
+use ppmc::protocol::Straps;
+use ppmc::runner::run_suite;
+use ppmc::scenario::{DriverOptions, ScenarioResult, Verdict};
+use ppmc::target::{EmuTarget, SerialError, SerialLink, SerialOptions, SerialTarget};
+use serialport::SerialPort;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::Duration as WallDuration;
+
+/// A bridge simulator serving on its own thread.
+struct Sim {
+    path: String,
+    stop: Arc<AtomicBool>,
+    handle: Option<JoinHandle<Option<ServeEnd>>>,
+}
+
+impl Sim {
+    fn start(faults: LinkFaults, model: ModelConfig) -> Sim {
+        let (mut master, slave) = serialport::TTYPort::pair().expect("a pty");
+        master
+            .set_timeout(WallDuration::from_millis(20))
+            .expect("timeout");
+        let path = slave.name().expect("pty path");
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&stop);
+        let handle = std::thread::spawn(move || {
+            let _keep_open = slave;
+            let emu = EmuTarget::new(Straps::default(), model).expect("emulator");
+            let mut server = BridgeServer::new(emu, 0x5EED, true);
+            serve(&mut master, &mut server, faults, false, &flag).ok()
+        });
+        Sim {
+            path,
+            stop,
+            handle: Some(handle),
+        }
+    }
+
+    fn clean() -> Sim {
+        Sim::start(LinkFaults::default(), ModelConfig::default())
+    }
+
+    fn target(&self, opts: SerialOptions) -> Result<SerialTarget<SerialLink>, SerialError> {
+        SerialTarget::open(SerialLink::open(&self.path, 115_200)?, opts)
+    }
+}
+
+impl Drop for Sim {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+fn fast() -> SerialOptions {
+    SerialOptions {
+        reply_timeout: WallDuration::from_millis(60),
+        retries: 8,
+        reopen_attempts: 3,
+        backoff: WallDuration::from_millis(20),
+        quiet: WallDuration::from_millis(4),
+    }
+}
+
+fn in_process() -> Vec<ScenarioResult> {
+    let mut t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+    run_suite(
+        &mut t,
+        &ppmc::suite::all(),
+        1,
+        DriverOptions::default(),
+        |_| {},
+    )
+}
+
+#[test]
+fn the_whole_suite_over_the_pty_equals_the_in_process_run() {
+    let sim = Sim::clean();
+    let mut t = sim
+        .target(SerialOptions::default())
+        .expect("bridge answers");
+    let over_pty = run_suite(
+        &mut t,
+        &ppmc::suite::all(),
+        1,
+        DriverOptions::default(),
+        |_| {},
+    );
+    let local = in_process();
+    assert_eq!(over_pty.len(), local.len());
+    for (a, b) in over_pty.iter().zip(&local) {
+        assert_eq!(a.verdict, b.verdict, "{}", a.name);
+        let (ta, tb) = (
+            a.trace.as_ref().expect("trace"),
+            b.trace.as_ref().expect("trace"),
+        );
+        assert_eq!(ta.events, tb.events, "{}: same trace over the pty", a.name);
+        assert!(ta.target.starts_with("serial:/dev/"), "{}", ta.target);
+    }
+    assert_eq!(t.stats.retransmissions, 0);
+    assert!(t.stats.round_trips > 0);
+}
+
+#[test]
+fn corrupted_bytes_never_turn_into_wrong_values() {
+    let faults = LinkFaults {
+        corrupt_rate: 0.01,
+        seed: 7,
+        ..LinkFaults::default()
+    };
+    let sim = Sim::start(faults, ModelConfig::default());
+    let mut t = sim
+        .target(fast())
+        .expect("bridge answers through the noise");
+    let noisy = run_suite(
+        &mut t,
+        &ppmc::suite::all(),
+        1,
+        DriverOptions::default(),
+        |_| {},
+    );
+    let local = in_process();
+    let mut passed = 0;
+    for (a, b) in noisy.iter().zip(&local) {
+        match &a.verdict {
+            // A link error is allowed (and reported as such) ...
+            Verdict::Error(_) | Verdict::NotRun(_) => {}
+            // ... but whatever completed saw exactly what the chip did.
+            v => {
+                assert_eq!(v, &b.verdict, "{}", a.name);
+                let (ta, tb) = (
+                    a.trace.as_ref().expect("trace"),
+                    b.trace.as_ref().expect("trace"),
+                );
+                assert_eq!(
+                    ta.events, tb.events,
+                    "{}: no corrupted value got through",
+                    a.name
+                );
+                passed += 1;
+            }
+        }
+    }
+    eprintln!(
+        "{passed} of {} completed under 1% corruption; {:?}",
+        noisy.len(),
+        t.stats
+    );
+    assert!(t.stats.corrupt_frames > 0, "the noise was noticed");
+    assert!(
+        t.stats.retransmissions > 0,
+        "and repaired by retransmission"
+    );
+    let first_error = noisy.iter().find_map(|r| match &r.verdict {
+        Verdict::Error(e) => Some(format!("{}: {e}", r.name)),
+        _ => None,
+    });
+    assert!(
+        passed * 10 >= noisy.len() * 9,
+        "{passed} of {} completed; first error {first_error:?}",
+        noisy.len()
+    );
+}
+
+#[test]
+fn a_stalled_bridge_gives_a_timeout_naming_the_op() {
+    let sim = Sim::start(
+        LinkFaults {
+            stall_after: Some(4),
+            ..LinkFaults::default()
+        },
+        ModelConfig::default(),
+    );
+    let mut t = sim.target(fast()).expect("healthy before the stall");
+    let err = ppmc::target::Target::execute(&mut t, &[ppmc::target::Op::ReadStatus])
+        .map(|_| ())
+        .and_then(|_| {
+            ppmc::target::Target::execute(&mut t, &[ppmc::target::Op::ReadPins]).map(|_| ())
+        })
+        .expect_err("no answer");
+    assert_eq!(err.kind, ppmc::target::TargetErrorKind::Link);
+    assert!(
+        err.message.contains("no bridge answering"),
+        "{}",
+        err.message
+    );
+    assert!(
+        err.message.contains("ReadPins") || err.message.contains("ReadStatus"),
+        "{}",
+        err.message
+    );
+}
+
+#[test]
+fn an_unhealthy_board_is_refused_at_open() {
+    let sim = Sim::start(
+        LinkFaults::default(),
+        ModelConfig {
+            faults: Faults {
+                status_stuck_high: 0x08,
+                ..Faults::default()
+            },
+            ..ModelConfig::default()
+        },
+    );
+    let err = sim
+        .target(fast())
+        .expect_err("status is not 0x00 after reset");
+    assert!(matches!(err, SerialError::Unhealthy { .. }), "{err}");
+    assert!(err.to_string().contains("health check failed"), "{err}");
+}
+
+#[test]
+fn a_missing_port_says_so() {
+    let err = SerialLink::open("/dev/ppmc-no-such-port", 115_200).expect_err("missing");
+    assert!(err.to_string().contains("no such serial port"), "{err}");
+}
+
+#[test]
+fn a_disconnect_mid_run_ends_with_the_rest_not_run() {
+    let sim = Sim::start(
+        LinkFaults {
+            disconnect_after: Some(300),
+            ..LinkFaults::default()
+        },
+        ModelConfig::default(),
+    );
+    let mut t = sim.target(fast()).expect("bridge answers");
+    let results = run_suite(
+        &mut t,
+        &ppmc::suite::all(),
+        1,
+        DriverOptions::default(),
+        |_| {},
+    );
+    let labels: Vec<&str> = results.iter().map(|r| r.verdict.label()).collect();
+    let first_bad = labels
+        .iter()
+        .position(|l| *l != "passed")
+        .expect("the link dropped");
+    assert!(first_bad > 0, "some scenarios ran before the drop");
+    assert_eq!(labels[first_bad], "error");
+    assert!(
+        labels[first_bad + 1..].iter().all(|l| *l == "not run"),
+        "{labels:?}"
+    );
+    let detail = results[first_bad].verdict.detail().unwrap_or_default();
+    assert!(
+        detail.contains("link lost") || detail.contains("no bridge answering"),
+        "{detail}"
+    );
+}
