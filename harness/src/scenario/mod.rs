@@ -264,7 +264,7 @@ pub fn run_scenario(
         }
     };
     let elapsed = driver.now().saturating_since(Instant::ZERO);
-    let capture = driver.capture().map(|c| c.clone());
+    let capture = driver.capture().cloned();
     let (bus, measurements) = driver.into_parts();
     let verdict = match (outcome, &capture) {
         // Without the capture the run cannot be shown or compared: the link
