@@ -238,6 +238,12 @@ fn summary_lines(t: &Tally, results: usize) {
     );
 }
 
+impl RunArgs {
+    fn target_name(&self) -> String {
+        self.target.name().to_string()
+    }
+}
+
 pub fn run(args: RunArgs) -> ExitCode {
     let scenarios = match args.select.scenarios() {
         Ok(s) => s,
@@ -260,7 +266,41 @@ pub fn run(args: RunArgs) -> ExitCode {
     }
     let mut target = match args.target.open() {
         Ok(t) => t,
-        Err(e) => return crate::usage_error(e),
+        Err(e @ crate::OpenError::Infrastructure(_)) => {
+            // Nothing ran: say so in the reports too, so CI shows an
+            // infrastructure problem rather than a bad board.
+            let why = e.to_string();
+            let results: Vec<ScenarioResult> = scenarios
+                .iter()
+                .map(|s| ScenarioResult {
+                    name: s.name,
+                    section: s.section,
+                    tags: s.tags,
+                    verdict: Verdict::NotRun(why.clone()),
+                    measurements: Vec::new(),
+                    trace: None,
+                    elapsed: Duration::ZERO,
+                })
+                .collect();
+            let info = RunInfo::new(
+                &ppmc::target::TargetInfo {
+                    name: args.target_name(),
+                    details: Vec::new(),
+                },
+                args.board_rev.clone(),
+            );
+            let _ = args
+                .junit
+                .as_ref()
+                .map(|p| write_report(p, report::junit(&info, &results)));
+            let _ = args
+                .json
+                .as_ref()
+                .map(|p| write_report(p, report::json(&info, &results)));
+            summary_lines(&Tally::of(&results), results.len());
+            return e.exit();
+        }
+        Err(e) => return e.exit(),
     };
     let info = RunInfo::new(&target.info(), args.board_rev.clone());
     let opts = DriverOptions {
@@ -356,7 +396,7 @@ pub fn record(args: RecordArgs) -> ExitCode {
     };
     let mut target = match args.target.open() {
         Ok(t) => t,
-        Err(e) => return crate::usage_error(e),
+        Err(e) => return e.exit(),
     };
     let progress = Progress::new(scenarios.len());
     let mut counts = [0usize; 4]; // created, replaced, unchanged, refused

@@ -149,7 +149,7 @@ pub(crate) fn parse_duration(s: &str) -> Result<Duration, String> {
 }
 
 impl TargetArgs {
-    fn straps(&self) -> Result<Straps, String> {
+    pub(crate) fn straps(&self) -> Result<Straps, String> {
         let hz = |mhz: f64, what: &str| -> Result<u32, String> {
             let v = (mhz * 1e6).round();
             if v.is_finite() && v >= 1.0 && v <= f64::from(u32::MAX) {
@@ -171,7 +171,12 @@ impl TargetArgs {
         Ok(straps)
     }
 
-    fn model(&self) -> ModelConfig {
+    /// The `--target` text.
+    pub fn name(&self) -> &str {
+        &self.target
+    }
+
+    pub(crate) fn model(&self) -> ModelConfig {
         ModelConfig {
             accel_curve: match self.accel_curve {
                 Curve::LinearSpeed => AccelCurve::LinearSpeed,
@@ -183,24 +188,58 @@ impl TargetArgs {
 
     /// Opens the target named by `--target`. A board target is health
     /// checked on the way (hello, chip reset, status 0x00).
-    pub fn open(&self) -> Result<Box<dyn Target>, String> {
+    pub fn open(&self) -> Result<Box<dyn Target>, OpenError> {
         if self.target == "emu" {
-            let t = EmuTarget::new(self.straps()?, self.model()).map_err(|e| e.to_string())?;
+            let t = EmuTarget::new(self.straps().map_err(OpenError::Usage)?, self.model())
+                .map_err(|e| OpenError::Usage(e.to_string()))?;
             return Ok(Box::new(t));
         }
         if self.target.starts_with("serial:") {
             let (path, baud) = ppmc::target::parse_spec(&self.target).ok_or_else(|| {
-                format!("bad target `{}`: write serial:<path>[,baud=N]", self.target)
+                OpenError::Usage(format!(
+                    "bad target `{}`: write serial:<path>[,baud=N]",
+                    self.target
+                ))
             })?;
-            let link = SerialLink::open(&path, baud).map_err(|e| e.to_string())?;
-            let t = SerialTarget::open(link, SerialOptions::default())
-                .map_err(|e| format!("infrastructure error: {e}"))?;
+            let infra = |e: ppmc::target::SerialError| OpenError::Infrastructure(e.to_string());
+            let link = SerialLink::open(&path, baud).map_err(infra)?;
+            let t = SerialTarget::open(link, SerialOptions::default()).map_err(infra)?;
             return Ok(Box::new(t));
         }
-        Err(format!(
+        Err(OpenError::Usage(format!(
             "unknown target `{}`: use `emu` or `serial:<path>[,baud=N]`",
             self.target
-        ))
+        )))
+    }
+}
+
+/// Why a target could not be opened.
+#[derive(Debug)]
+pub enum OpenError {
+    /// The options are wrong (exit status 2).
+    Usage(String),
+    /// The board, bridge or link is not there or not healthy: not the
+    /// device's fault, and not the user's typing either (exit status 1).
+    Infrastructure(String),
+}
+
+impl std::fmt::Display for OpenError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            OpenError::Usage(m) => f.write_str(m),
+            OpenError::Infrastructure(m) => write!(f, "infrastructure error: {m}"),
+        }
+    }
+}
+
+impl OpenError {
+    /// Reports the error and gives the exit status.
+    pub fn exit(&self) -> ExitCode {
+        eprintln!("ppmc: {self}");
+        match self {
+            OpenError::Usage(_) => ExitCode::from(2),
+            OpenError::Infrastructure(_) => ExitCode::from(1),
+        }
     }
 }
 
@@ -232,7 +271,7 @@ fn run_console(args: ConsoleArgs) -> ExitCode {
     };
     let mut target = match args.target.open() {
         Ok(t) => t,
-        Err(e) => return usage_error(e),
+        Err(e) => return e.exit(),
     };
     let from_stdin = args.exec.is_none() && args.file.as_ref().is_none_or(|f| f.as_os_str() == "-");
     if from_stdin && io::stdin().is_terminal() {
@@ -385,9 +424,12 @@ fn bridge_sim(args: BridgeSimArgs) -> ExitCode {
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(1, |d| d.subsec_nanos() ^ (d.as_secs() as u32));
     let mut server = BridgeServer::new(emu, session, !args.realtime);
-    println!("bridge-sim: serving on {path}");
-    println!("bridge-sim: run   ppmc run --target serial:{path}");
-    let _ = io::stdout().flush();
+    // Nobody may be reading stdout (a closed pipe): never let that stop
+    // the bridge.
+    let mut out = io::stdout();
+    let _ = writeln!(out, "bridge-sim: serving on {path}");
+    let _ = writeln!(out, "bridge-sim: run   ppmc run --target serial:{path}");
+    let _ = out.flush();
     let stop = Arc::new(AtomicBool::new(false));
     let faults = LinkFaults {
         drop_rate: args.drop_rate,
@@ -404,7 +446,8 @@ fn bridge_sim(args: BridgeSimArgs) -> ExitCode {
     let _ = stop.load(Ordering::Relaxed);
     match end {
         Ok(ServeEnd::Disconnected) => {
-            println!(
+            let _ = writeln!(
+                io::stdout(),
                 "bridge-sim: disconnected after {} frames (fault)",
                 server.frames
             );

@@ -1,0 +1,151 @@
+//! `ppmc bridge-sim` in one process, `ppmc run` / `console` against it in
+//! another, as a user runs them.
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Output, Stdio};
+
+const EXAMPLE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../docs/examples/accel-1000-steps.ppmc"
+);
+
+/// A `ppmc bridge-sim` child process, killed when dropped.
+struct BridgeSim {
+    child: Child,
+    path: String,
+    _stdout: BufReader<std::process::ChildStdout>,
+}
+
+impl BridgeSim {
+    fn start(args: &[&str]) -> BridgeSim {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_ppmc"))
+            .arg("bridge-sim")
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("bridge-sim starts");
+        let stdout = child.stdout.take().expect("stdout piped");
+        let mut reader = BufReader::new(stdout);
+        let mut first = String::new();
+        reader
+            .read_line(&mut first)
+            .expect("bridge-sim prints its pty");
+        let path = first
+            .trim()
+            .strip_prefix("bridge-sim: serving on ")
+            .unwrap_or_else(|| panic!("unexpected first line `{first}`"))
+            .to_string();
+        BridgeSim {
+            child,
+            path,
+            _stdout: reader,
+        }
+    }
+
+    fn target(&self) -> String {
+        format!("serial:{}", self.path)
+    }
+}
+
+impl Drop for BridgeSim {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn ppmc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ppmc"))
+        .args(args)
+        .output()
+        .expect("ppmc runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    std::env::temp_dir().join(format!("ppmc-clibridge-{}-{name}", std::process::id()))
+}
+
+#[test]
+fn run_over_the_bridge_gives_the_same_verdicts_as_the_emulator() {
+    let sim = BridgeSim::start(&[]);
+    let over = ppmc(&["run", "--target", &sim.target()]);
+    let local = ppmc(&["run"]);
+    assert_eq!(over.status.code(), Some(0), "{}", text(&over.stdout));
+    assert_eq!(text(&over.stdout), text(&local.stdout));
+}
+
+#[test]
+fn console_over_the_bridge_prints_what_the_emulator_prints() {
+    let sim = BridgeSim::start(&[]);
+    let over = ppmc(&["console", "--target", &sim.target(), EXAMPLE]);
+    let local = ppmc(&["console", "--target", "emu", EXAMPLE]);
+    assert!(over.status.success(), "{}", text(&over.stderr));
+    assert_eq!(text(&over.stdout), text(&local.stdout));
+    assert!(text(&over.stdout).contains("rd 0x83"));
+}
+
+#[test]
+fn a_disconnect_mid_run_writes_the_partial_junit_and_exits_1() {
+    let sim = BridgeSim::start(&["--disconnect-after", "400"]);
+    let junit = tmp("partial.xml");
+    let out = ppmc(&[
+        "run",
+        "--target",
+        &sim.target(),
+        "--junit",
+        junit.to_str().expect("utf-8"),
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains("PASS "), "some ran: {stdout}");
+    assert!(stdout.contains("ERROR "), "{stdout}");
+    assert!(stdout.contains("NOT RUN "), "{stdout}");
+    let xml = std::fs::read_to_string(&junit).expect("JUnit written");
+    let report = quick_junit::Report::deserialize_from_str(&xml).expect("valid JUnit");
+    let n = ppmc::suite::all().len();
+    assert_eq!(report.tests, n);
+    assert!(report.errors >= 1);
+    assert!(
+        xml.matches("<skipped").count() > 0,
+        "the rest are marked not run"
+    );
+    let _ = std::fs::remove_file(junit);
+}
+
+#[test]
+fn a_missing_board_is_an_infrastructure_error_with_reports() {
+    let junit = tmp("missing.xml");
+    let out = ppmc(&[
+        "run",
+        "--target",
+        "serial:/dev/ppmc-no-such-port",
+        "--junit",
+        junit.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(err.contains("infrastructure error"), "{err}");
+    assert!(err.contains("no such serial port"), "{err}");
+    let xml = std::fs::read_to_string(&junit).expect("JUnit written");
+    assert_eq!(xml.matches("<skipped").count(), ppmc::suite::all().len());
+    let _ = std::fs::remove_file(junit);
+    // A malformed target is bad usage.
+    assert_eq!(ppmc(&["run", "--target", "serial:"]).status.code(), Some(2));
+}
+
+#[test]
+fn a_chip_fault_behind_the_bridge_is_caught() {
+    let sim = BridgeSim::start(&["--chip-fault", "swap-error-3-4"]);
+    let out = ppmc(&["run", "--target", &sim.target(), "--tag", "error"]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("FAIL     e3_data_without_a_command"),
+        "{stdout}"
+    );
+}
