@@ -10,6 +10,7 @@ pub mod bridge;
 pub mod compare;
 pub mod console;
 pub mod emu;
+pub mod fuzzing;
 pub mod golden;
 pub mod protocol;
 pub mod report;

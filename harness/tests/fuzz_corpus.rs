@@ -1,0 +1,121 @@
+//! Replays every committed fuzz input (seed corpus and regressions) through
+//! the target bodies in `ppmc::fuzzing`, on stable.
+
+use std::fs;
+use std::path::Path;
+
+fn replay(target: &str, body: fn(&[u8])) -> usize {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz");
+    let mut n = 0;
+    for dir in ["corpus", "regressions"] {
+        let Ok(entries) = fs::read_dir(root.join(dir).join(target)) else {
+            continue;
+        };
+        let mut files: Vec<_> = entries.filter_map(Result::ok).map(|e| e.path()).collect();
+        files.sort();
+        for f in files.into_iter().filter(|f| f.is_file()) {
+            let data = fs::read(&f).expect("readable corpus file");
+            let ok = std::panic::catch_unwind(|| body(&data));
+            assert!(ok.is_ok(), "{} fails", f.display());
+            n += 1;
+        }
+    }
+    n
+}
+
+#[test]
+fn frame_decoder_corpus_replays() {
+    let n = replay("frame_decoder", ppmc::fuzzing::frame_decoder);
+    assert!(n >= 8, "the seed corpus is there ({n} inputs)");
+}
+
+/// Writes the seed corpus of `frame_decoder`: one framed message of every
+/// kind, long replies in fragments, and some line noise. Run with
+/// `cargo test --test fuzz_corpus -- --ignored` after a protocol change.
+#[test]
+#[ignore]
+fn write_frame_decoder_seeds() {
+    use ppmc::bridge::frame::encode;
+    use ppmc::bridge::server::BridgeServer;
+    use ppmc::bridge::wire::{fragment, Request, Timer};
+    use ppmc::protocol::{Input, Straps};
+    use ppmc::target::{EmuTarget, Op};
+    use ppmc::time::Duration;
+
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/frame_decoder");
+    fs::create_dir_all(&dir).expect("corpus dir");
+    let t = Timer::NANOS;
+    let ops = vec![
+        Op::Reset,
+        Op::WriteCommand {
+            byte: 0x02,
+            wait_ibf: Some(Duration::from_secs(1)),
+        },
+        Op::WriteData {
+            byte: 100,
+            wait_ibf: None,
+        },
+        Op::ReadStatus,
+        Op::ReadData {
+            wait_obf: Some(Duration::from_millis(100)),
+        },
+        Op::Delay(Duration::from_millis(200)),
+        Op::AwaitStatus {
+            mask: 4,
+            value: 4,
+            timeout: Duration::from_millis(5),
+        },
+        Op::SetInput {
+            input: Input::L1,
+            asserted: true,
+        },
+        Op::ReadPins,
+        Op::ReadPulses,
+        Op::AwaitPulses {
+            count: 10,
+            timeout: Duration::from_secs(1),
+        },
+    ];
+    let requests = [
+        Request::Hello { version: 1 },
+        Request::Batch(ops.clone()),
+        Request::Capture {
+            runs: 0,
+            pins: 0,
+            moves: 0,
+            max: 40,
+        },
+        Request::Resend {
+            fragments: vec![0, 2],
+        },
+    ];
+    let mut server = BridgeServer::new(
+        EmuTarget::new(Straps::default(), Default::default()).expect("emu"),
+        1,
+        true,
+    );
+    let mut n = 0;
+    let mut put = |name: &str, bytes: &[u8]| {
+        fs::write(dir.join(name), bytes).expect("seed written");
+        n += 1;
+    };
+    for (i, r) in requests.iter().enumerate() {
+        let frame = encode(&r.encode(i as u8 + 1, t));
+        put(&format!("request-{i}"), &frame);
+        // The bridge's answer: whole or in fragments.
+        let answer = server.on_bytes(&frame);
+        put(&format!("response-{i}"), &answer);
+    }
+    let big: Vec<u8> = (0..300u16).map(|x| x as u8).collect();
+    let frags: Vec<u8> = fragment(&big).iter().flat_map(|f| encode(f)).collect();
+    put("fragments", &frags);
+    let mut bad = encode(&Request::Hello { version: 1 }.encode(9, t));
+    bad[2] ^= 0x10;
+    put("bad-crc", &bad);
+    put(
+        "noise-then-frame",
+        &[&[0x13, 0x77, 0x00][..], &encode(b"\x01\x01\x01\x00")].concat(),
+    );
+    put("empty-frames", &[0, 0, 0]);
+    assert!(n >= 12);
+}
