@@ -210,3 +210,17 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod cross_check {
+    /// Frames computed by an independent implementation (Python, from the
+    /// CRC catalogue and the COBS paper) for `docs/bridge-protocol.md`.
+    #[test]
+    fn matches_the_examples_in_the_protocol_document() {
+        assert_eq!(super::encode(&[0x01, 0x01, 0x01, 0x00]), HELLO);
+        assert_eq!(super::encode(&[0x02, 0x02, 0x01, 0x00, 0x12]), BATCH_RS);
+    }
+
+    const HELLO: &[u8] = &[0x04, 0x01, 0x01, 0x01, 0x03, 0x75, 0xF6, 0x00];
+    const BATCH_RS: &[u8] = &[0x04, 0x02, 0x02, 0x01, 0x04, 0x12, 0xA4, 0xBD, 0x00];
+}

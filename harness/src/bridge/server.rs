@@ -10,7 +10,8 @@
 
 use super::frame::{self, FrameDecoder, FrameError};
 use super::wire::{
-    fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer, PROTOCOL_VERSION,
+    fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer, WireError,
+    PROTOCOL_VERSION,
 };
 use crate::target::{EmuTarget, Target};
 
@@ -115,7 +116,12 @@ impl BridgeServer {
         let response = match decoded {
             Ok((_, req)) => self.handle(req),
             Err(e) => Response::Error {
-                code: BridgeErrorCode::Malformed,
+                code: match e {
+                    WireError::UnknownKind(_) | WireError::UnknownCode { .. } => {
+                        BridgeErrorCode::UnknownOp
+                    }
+                    _ => BridgeErrorCode::Malformed,
+                },
                 detail: e.to_string(),
             },
         };
@@ -276,6 +282,30 @@ mod tests {
             r,
             Response::Error {
                 code: BridgeErrorCode::BadFrame,
+                ..
+            }
+        ));
+        let unknown = s.on_bytes(&frame::encode(&[4, 0x02, 1, 0, 0x99]));
+        let mut d = FrameDecoder::new();
+        d.extend(&unknown);
+        let (_, r) = Response::decode(&d.decode().expect("ok").expect("frame"), Timer::NANOS)
+            .expect("decodes");
+        assert!(matches!(
+            r,
+            Response::Error {
+                code: BridgeErrorCode::UnknownOp,
+                ..
+            }
+        ));
+        let truncated = s.on_bytes(&frame::encode(&[5, 0x02, 1, 0, 0x10]));
+        let mut d = FrameDecoder::new();
+        d.extend(&truncated);
+        let (_, r) = Response::decode(&d.decode().expect("ok").expect("frame"), Timer::NANOS)
+            .expect("decodes");
+        assert!(matches!(
+            r,
+            Response::Error {
+                code: BridgeErrorCode::Malformed,
                 ..
             }
         ));
