@@ -169,5 +169,78 @@ pub fn run(args: BenchArgs) -> ExitCode {
     println!(
         "| per-pulse expansion of the 16,777,216-step record | {ms:.3} ms | {pulses} | - | - |"
     );
+    println!();
+    suite_over_bridge(args.repeat.clamp(1, 5))
+}
+
+/// The conformance suite in process and over a pseudo-terminal to the
+/// bridge simulator: wall time and round trips.
+fn suite_over_bridge(repeat: usize) -> ExitCode {
+    use ppmc::bridge::server::BridgeServer;
+    use ppmc::bridge::sim::{serve, LinkFaults};
+    use ppmc::runner::run_suite;
+    use ppmc::scenario::DriverOptions;
+    use ppmc::target::{SerialLink, SerialOptions, SerialTarget};
+    use serialport::SerialPort;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+
+    let suite = ppmc::suite::all();
+    let mut local = Vec::new();
+    for _ in 0..repeat {
+        let Ok(mut t) = EmuTarget::new(Straps::default(), ModelConfig::default()) else {
+            return ExitCode::from(1);
+        };
+        let t0 = WallClock::now();
+        run_suite(&mut t, &suite, 1, DriverOptions::default(), |_| {});
+        local.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    let Ok((mut master, slave)) = serialport::TTYPort::pair() else {
+        eprintln!("ppmc bench: no pseudo-terminal");
+        return ExitCode::from(1);
+    };
+    let _ = master.set_timeout(std::time::Duration::from_millis(20));
+    let path = slave.name().unwrap_or_default();
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let sim = std::thread::spawn(move || {
+        let _keep = slave;
+        if let Ok(emu) = EmuTarget::new(Straps::default(), ModelConfig::default()) {
+            let mut server = BridgeServer::new(emu, 1, true);
+            let _ = serve(
+                &mut master,
+                &mut server,
+                LinkFaults::default(),
+                false,
+                &flag,
+            );
+        }
+    });
+    let mut remote = Vec::new();
+    let mut trips = 0;
+    for _ in 0..repeat {
+        let target = SerialLink::open(&path, 115_200)
+            .and_then(|l| SerialTarget::open(l, SerialOptions::default()));
+        let Ok(mut t) = target else {
+            eprintln!("ppmc bench: the bridge simulator did not answer");
+            stop.store(true, Ordering::Relaxed);
+            return ExitCode::from(1);
+        };
+        let t0 = WallClock::now();
+        run_suite(&mut t, &suite, 1, DriverOptions::default(), |_| {});
+        remote.push(t0.elapsed().as_secs_f64() * 1e3);
+        trips = t.stats.round_trips;
+    }
+    stop.store(true, Ordering::Relaxed);
+    let _ = sim.join();
+    let (l, r) = (median_ms(local), median_ms(remote));
+    println!("| conformance suite ({} scenarios) | median wall time | round trips | round trips per scenario |", suite.len());
+    println!("|---|---:|---:|---:|");
+    println!("| in process (emulator) | {l:.1} ms | 0 | 0 |");
+    println!(
+        "| over a pty to `ppmc bridge-sim` | {r:.1} ms | {trips} | {:.1} |",
+        trips as f64 / suite.len() as f64
+    );
+    println!("\nover the pty / in process: {:.1}x", r / l.max(1e-9));
     ExitCode::SUCCESS
 }
