@@ -123,7 +123,7 @@ pub enum Request {
 
 /// Largest response payload sent as one frame; longer ones go as
 /// fragments of this many bytes, so that a noisy link loses little.
-pub const FRAGMENT_DATA: usize = 96;
+pub const FRAGMENT_DATA: usize = 48;
 
 /// Splits a response payload into frame payloads: itself if short, else
 /// `seq, FRAGMENT, index, count, data`.
@@ -1127,7 +1127,7 @@ mod tests {
 
     #[test]
     fn long_replies_fragment_and_reassemble() {
-        let payload: Vec<u8> = (0..250u16).map(|i| i as u8).collect();
+        let payload: Vec<u8> = (0..130u16).map(|i| i as u8).collect();
         let frags = fragment(&payload);
         assert_eq!(frags.len(), 3);
         let mut whole = Vec::new();

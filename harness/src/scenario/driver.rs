@@ -81,6 +81,44 @@ impl Init {
     }
 }
 
+/// One flowchart step: an op and how its reply is judged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Step {
+    Write {
+        byte: u8,
+        command: bool,
+        wait: bool,
+    },
+    Status,
+    ReadData,
+    /// `must`: a timeout fails the scenario.
+    Await {
+        flag: Flag,
+        value: bool,
+        timeout: Duration,
+        must: bool,
+    },
+}
+
+/// What a step gave back.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Done {
+    At(Instant),
+    Status(Status),
+    Byte(u8),
+    Waited(Option<Duration>),
+}
+
+impl Done {
+    /// The time of a write (for other steps the caller does not ask).
+    fn at(self) -> Instant {
+        match self {
+            Done::At(t) => t,
+            _ => Instant::ZERO,
+        }
+    }
+}
+
 /// Timeouts and limits of a [`Driver`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DriverOptions {
@@ -272,27 +310,60 @@ impl<'t> Driver<'t> {
         Ok(())
     }
 
-    fn write(&mut self, byte: u8, command: bool, wait: bool) -> Outcome<Instant> {
-        let wait_ibf = wait.then_some(self.opts.ibf_timeout);
-        let op = if command {
-            Op::WriteCommand { byte, wait_ibf }
-        } else {
-            Op::WriteData { byte, wait_ibf }
-        };
-        match self.one(op)? {
-            Reply::Written { at, waited } => {
-                let waited = wait.then_some(waited);
-                self.log(
-                    at,
-                    if command {
-                        BusEvent::WriteCommand { byte, waited }
-                    } else {
-                        BusEvent::WriteData { byte, waited }
-                    },
-                );
-                Ok(at)
+    /// The op a step sends.
+    fn step_op(&self, step: Step) -> Op {
+        match step {
+            Step::Write {
+                byte,
+                command,
+                wait,
+            } => {
+                let wait_ibf = wait.then_some(self.opts.ibf_timeout);
+                if command {
+                    Op::WriteCommand { byte, wait_ibf }
+                } else {
+                    Op::WriteData { byte, wait_ibf }
+                }
             }
-            Reply::WriteTimedOut { at, status } => {
+            Step::Status => Op::ReadStatus,
+            Step::ReadData => Op::ReadData {
+                wait_obf: Some(self.opts.obf_timeout),
+            },
+            Step::Await {
+                flag,
+                value,
+                timeout,
+                ..
+            } => Op::AwaitStatus {
+                mask: flag.mask(),
+                value: if value { flag.mask() } else { 0 },
+                timeout,
+            },
+        }
+    }
+
+    /// Logs a step's reply and judges it. `began` is when the step started
+    /// (the end of the step before it).
+    fn judge(&mut self, step: Step, reply: Reply, began: Instant) -> Outcome<Done> {
+        match (step, reply) {
+            (
+                Step::Write {
+                    byte,
+                    command,
+                    wait,
+                },
+                Reply::Written { at, waited },
+            ) => {
+                let waited = wait.then_some(waited);
+                let e = if command {
+                    BusEvent::WriteCommand { byte, waited }
+                } else {
+                    BusEvent::WriteData { byte, waited }
+                };
+                self.log(at, e);
+                Ok(Done::At(at))
+            }
+            (Step::Write { byte, command, .. }, Reply::WriteTimedOut { at, status }) => {
                 self.log(at, BusEvent::WriteTimedOut { command, byte });
                 Err(fail(
                     format!("IBF = 0 before writing 0x{byte:02X} (flowchart)"),
@@ -301,8 +372,100 @@ impl<'t> Driver<'t> {
                     at,
                 ))
             }
-            other => Err(self.unexpected("a write", &other)),
+            (Step::Status, Reply::Status { at, status }) => {
+                self.log(at, BusEvent::ReadStatus(status.0));
+                Ok(Done::Status(status))
+            }
+            (Step::ReadData, Reply::Data { at, byte, waited }) => {
+                self.log(
+                    at,
+                    BusEvent::ReadData {
+                        byte,
+                        waited: Some(waited),
+                    },
+                );
+                Ok(Done::Byte(byte))
+            }
+            (Step::ReadData, Reply::ReadTimedOut { at, status }) => {
+                self.log(at, BusEvent::ReadTimedOut);
+                Err(fail(
+                    "OBF = 1 before reading (flowchart)",
+                    format!("OBF = 1 within {}", self.opts.obf_timeout),
+                    format!("status 0x{:02X}", status.0),
+                    at,
+                ))
+            }
+            (Step::Await { flag, value, .. }, Reply::Awaited { at, waited, status }) => {
+                self.log(
+                    at,
+                    BusEvent::Await {
+                        flag,
+                        value,
+                        waited: Some(waited),
+                        status: status.0,
+                    },
+                );
+                Ok(Done::Waited(Some(waited)))
+            }
+            (
+                Step::Await {
+                    flag,
+                    value,
+                    timeout,
+                    must,
+                },
+                Reply::AwaitTimedOut { at, status },
+            ) => {
+                self.log(
+                    at,
+                    BusEvent::Await {
+                        flag,
+                        value,
+                        waited: None,
+                        status: status.0,
+                    },
+                );
+                if must {
+                    return Err(fail(
+                        format!("{} = {}", flag.name(), u8::from(value)),
+                        format!("within {timeout}"),
+                        "timeout",
+                        began + timeout,
+                    ));
+                }
+                Ok(Done::Waited(None))
+            }
+            (step, other) => Err(self.unexpected(&format!("{step:?}"), &other)),
         }
+    }
+
+    /// Runs flowchart steps as one batch (one round trip on a board), then
+    /// logs and judges the replies in order, stopping at the first failure.
+    fn steps(&mut self, steps: &[Step]) -> Outcome<Vec<Done>> {
+        let ops: Vec<Op> = steps.iter().map(|s| self.step_op(*s)).collect();
+        let mut began = self.now;
+        let replies = self.exec(&ops)?;
+        let mut out = Vec::with_capacity(steps.len());
+        for (step, reply) in steps.iter().zip(replies) {
+            let at = reply.at();
+            out.push(self.judge(*step, reply, began)?);
+            began = at;
+        }
+        Ok(out)
+    }
+
+    fn step(&mut self, step: Step) -> Outcome<Done> {
+        let mut v = self.steps(&[step])?;
+        v.pop().ok_or_else(|| Stop::Error("no reply".into()))
+    }
+
+    fn write(&mut self, byte: u8, command: bool, wait: bool) -> Outcome<Instant> {
+        self.step(Step::Write {
+            byte,
+            command,
+            wait,
+        })
+        .map(Done::at)
     }
 
     /// Flowchart write of the command register (waits for IBF = 0).
@@ -327,40 +490,17 @@ impl<'t> Driver<'t> {
 
     /// Reads the status register.
     pub fn status(&mut self) -> Outcome<Status> {
-        match self.one(Op::ReadStatus)? {
-            Reply::Status { at, status } => {
-                self.log(at, BusEvent::ReadStatus(status.0));
-                Ok(status)
-            }
-            other => Err(self.unexpected("rs", &other)),
+        match self.step(Step::Status)? {
+            Done::Status(s) => Ok(s),
+            _ => Err(Stop::Error("status read answered otherwise".into())),
         }
     }
 
     /// Flowchart read of the data register (waits for OBF = 1).
     pub fn read_data(&mut self) -> Outcome<u8> {
-        match self.one(Op::ReadData {
-            wait_obf: Some(self.opts.obf_timeout),
-        })? {
-            Reply::Data { at, byte, waited } => {
-                self.log(
-                    at,
-                    BusEvent::ReadData {
-                        byte,
-                        waited: Some(waited),
-                    },
-                );
-                Ok(byte)
-            }
-            Reply::ReadTimedOut { at, status } => {
-                self.log(at, BusEvent::ReadTimedOut);
-                Err(fail(
-                    "OBF = 1 before reading (flowchart)",
-                    format!("OBF = 1 within {}", self.opts.obf_timeout),
-                    format!("status 0x{:02X}", status.0),
-                    at,
-                ))
-            }
-            other => Err(self.unexpected("rd", &other)),
+        match self.step(Step::ReadData)? {
+            Done::Byte(b) => Ok(b),
+            _ => Err(Stop::Error("data read answered otherwise".into())),
         }
     }
 
@@ -371,51 +511,61 @@ impl<'t> Driver<'t> {
         value: bool,
         timeout: Duration,
     ) -> Outcome<Option<Duration>> {
-        let mask = flag.mask();
-        match self.one(Op::AwaitStatus {
-            mask,
-            value: if value { mask } else { 0 },
+        match self.step(Step::Await {
+            flag,
+            value,
             timeout,
+            must: false,
         })? {
-            Reply::Awaited { at, waited, status } => {
-                self.log(
-                    at,
-                    BusEvent::Await {
-                        flag,
-                        value,
-                        waited: Some(waited),
-                        status: status.0,
-                    },
-                );
-                Ok(Some(waited))
-            }
-            Reply::AwaitTimedOut { at, status } => {
-                self.log(
-                    at,
-                    BusEvent::Await {
-                        flag,
-                        value,
-                        waited: None,
-                        status: status.0,
-                    },
-                );
-                Ok(None)
-            }
-            other => Err(self.unexpected("await", &other)),
+            Done::Waited(w) => Ok(w),
+            _ => Err(Stop::Error("await answered otherwise".into())),
         }
     }
 
     /// Waits for a flag and fails the scenario if it does not come.
     pub fn expect_flag(&mut self, flag: Flag, value: bool, timeout: Duration) -> Outcome<Duration> {
-        let at = self.now;
-        self.await_flag(flag, value, timeout)?.ok_or_else(|| {
-            fail(
-                format!("{} = {}", flag.name(), u8::from(value)),
-                format!("within {timeout}"),
-                "timeout",
-                at + timeout,
-            )
-        })
+        match self.step(Step::Await {
+            flag,
+            value,
+            timeout,
+            must: true,
+        })? {
+            Done::Waited(Some(w)) => Ok(w),
+            _ => Err(Stop::Error("await answered otherwise".into())),
+        }
+    }
+
+    /// The two waits every flowchart puts before an operation command.
+    fn ready_steps(&self) -> [Step; 2] {
+        [
+            Step::Await {
+                flag: Flag::Busy,
+                value: false,
+                timeout: self.opts.idle_timeout,
+                must: true,
+            },
+            Step::Await {
+                flag: Flag::Ibf,
+                value: false,
+                timeout: self.opts.ibf_timeout,
+                must: true,
+            },
+        ]
+    }
+
+    /// A command and its data bytes, as flowchart writes.
+    fn command_steps(code: u8, data: &[u8]) -> Vec<Step> {
+        let mut v = vec![Step::Write {
+            byte: code,
+            command: true,
+            wait: true,
+        }];
+        v.extend(data.iter().map(|b| Step::Write {
+            byte: *b,
+            command: false,
+            wait: true,
+        }));
+        v
     }
 
     /// Lets time pass.
@@ -578,22 +728,17 @@ impl<'t> Driver<'t> {
     /// Waits for BUSY = 0, then IBF = 0: the condition every flowchart puts
     /// before an operation command.
     pub fn wait_ready(&mut self) -> Outcome {
-        let t = self.opts.idle_timeout;
-        self.expect_flag(Flag::Busy, false, t)?;
-        let t = self.opts.ibf_timeout;
-        self.expect_flag(Flag::Ibf, false, t)?;
-        Ok(())
+        let steps = self.ready_steps();
+        self.steps(&steps).map(|_| ())
     }
 
-    /// The initialization flowchart (Diagram 3-3). Later writes wait for
-    /// the processing through IBF.
+    /// The initialization flowchart (Diagram 3-3), as one batch. Later
+    /// writes wait for the processing through IBF.
     pub fn init(&mut self, init: Init) -> Outcome<Instant> {
-        self.wait_ready()?;
-        self.command(init.code())?;
-        let mut last = self.now;
-        for b in init.data.to_bytes() {
-            last = self.data(b)?;
-        }
+        let mut steps = self.ready_steps().to_vec();
+        steps.extend(Self::command_steps(init.code(), &init.data.to_bytes()));
+        let done = self.steps(&steps)?;
+        let last = done.last().map_or(self.now, |d| d.at());
         self.init_write = Some(last);
         self.init = Some(init);
         Ok(last)
@@ -609,26 +754,38 @@ impl<'t> Driver<'t> {
         Ok(at)
     }
 
-    /// Issues a move by its flowchart and waits for BUSY = 1.
+    /// Issues a move by its flowchart and waits for BUSY = 1, as one batch.
     pub fn start(&mut self, m: Move) -> Outcome<Instant> {
-        let at = self.issue(m)?;
+        let mut steps = self.ready_steps().to_vec();
+        steps.extend(Self::command_steps(m.code(), &m.params()));
+        let writes = steps.len();
         // The chip may still be busy with earlier work (an initialization):
         // BUSY is due once it has taken the final byte.
-        let t = self.opts.ibf_timeout;
-        self.expect_flag(Flag::Ibf, false, t)?;
-        let t = self.opts.busy_timeout;
-        self.expect_flag(Flag::Busy, true, t)?;
+        steps.push(Step::Await {
+            flag: Flag::Ibf,
+            value: false,
+            timeout: self.opts.ibf_timeout,
+            must: true,
+        });
+        steps.push(Step::Await {
+            flag: Flag::Busy,
+            value: true,
+            timeout: self.opts.busy_timeout,
+            must: true,
+        });
+        let done = self.steps(&steps)?;
+        let at = done.get(writes - 1).map_or(self.now, |d| d.at());
+        self.anchor = Some(at);
         Ok(at)
     }
 
     /// Issues a move's command and data without waiting for BUSY (for
     /// scenarios that expect it to be refused).
     pub fn issue(&mut self, m: Move) -> Outcome<Instant> {
-        self.wait_ready()?;
-        let mut at = self.command(m.code())?;
-        for b in m.params() {
-            at = self.data(b)?;
-        }
+        let mut steps = self.ready_steps().to_vec();
+        steps.extend(Self::command_steps(m.code(), &m.params()));
+        let done = self.steps(&steps)?;
+        let at = done.last().map_or(self.now, |d| d.at());
         self.anchor = Some(at);
         Ok(at)
     }
@@ -672,17 +829,35 @@ impl<'t> Driver<'t> {
     /// A register read by its flowchart: BUSY = 0, IBF = 0, the command,
     /// then OBF = 1 before each byte.
     pub fn read_register(&mut self, reg: Register) -> Outcome<Vec<u8>> {
-        self.wait_ready()?;
-        self.command(reg.code())?;
-        (0..reg.byte_count()).map(|_| self.read_data()).collect()
+        let mut steps = self.ready_steps().to_vec();
+        steps.extend(Self::command_steps(reg.code(), &[]));
+        steps.extend(std::iter::repeat_n(Step::ReadData, reg.byte_count()));
+        let done = self.steps(&steps)?;
+        Ok(done
+            .into_iter()
+            .filter_map(|d| match d {
+                Done::Byte(b) => Some(b),
+                _ => None,
+            })
+            .collect())
     }
 
     /// Waits until the chip has taken the last byte written, then reads the
-    /// status register.
+    /// status register (one batch).
     pub fn settled_status(&mut self) -> Outcome<Status> {
-        let t = self.opts.ibf_timeout;
-        self.expect_flag(Flag::Ibf, false, t)?;
-        self.status()
+        let steps = [
+            Step::Await {
+                flag: Flag::Ibf,
+                value: false,
+                timeout: self.opts.ibf_timeout,
+                must: true,
+            },
+            Step::Status,
+        ];
+        match self.steps(&steps)?.pop() {
+            Some(Done::Status(s)) => Ok(s),
+            _ => Err(Stop::Error("status read answered otherwise".into())),
+        }
     }
 
     // ----- expectations --------------------------------------------------

@@ -224,7 +224,7 @@ impl Default for SerialOptions {
 const MAX_REQUEST: usize = 128;
 
 /// Records asked for per capture request.
-const CAPTURE_CHUNK: u16 = 40;
+const CAPTURE_CHUNK: u16 = 300;
 
 /// The fragments of a long reply received so far.
 #[derive(Debug, Default)]
@@ -285,6 +285,8 @@ pub struct SerialTarget<L: Link> {
     hello: Hello,
     timer: Timer,
     opts: SerialOptions,
+    /// The capture fetched so far (since the last chip reset).
+    captured: Record,
     pub stats: LinkStats,
 }
 
@@ -310,6 +312,7 @@ impl<L: Link> SerialTarget<L> {
             },
             timer: Timer::NANOS,
             opts,
+            captured: Record::default(),
             stats: LinkStats::default(),
         };
         t.hello = t.say_hello()?;
@@ -621,23 +624,29 @@ impl<L: Link> Target for SerialTarget<L> {
         }
     }
 
+    /// Fetches what the bridge captured since the last fetch: new pin
+    /// changes and moves, and the pulse runs from the last one known on
+    /// (the last run may have grown).
     fn capture(&mut self) -> Result<Record, TargetError> {
-        let mut rec = Record::default();
         loop {
+            let from_run = self.captured.runs.len().saturating_sub(1);
             let req = Request::Capture {
-                runs: rec.runs.len() as u32,
-                pins: rec.pins.len() as u32,
-                moves: rec.moves.len() as u32,
+                runs: from_run as u32,
+                pins: self.captured.pins.len() as u32,
+                moves: self.captured.moves.len() as u32,
                 max: CAPTURE_CHUNK,
             };
             match self.request(&req, "capture", WallDuration::ZERO)? {
                 Response::Capture(c) => {
-                    rec.runs.extend(c.runs);
-                    rec.pins.extend(c.pins);
-                    rec.moves.extend(c.moves);
-                    rec.overwritten_bytes = c.overwritten_bytes;
+                    if !c.runs.is_empty() {
+                        self.captured.runs.truncate(from_run);
+                    }
+                    self.captured.runs.extend(c.runs);
+                    self.captured.pins.extend(c.pins);
+                    self.captured.moves.extend(c.moves);
+                    self.captured.overwritten_bytes = c.overwritten_bytes;
                     if !c.more {
-                        return Ok(rec);
+                        return Ok(self.captured.clone());
                     }
                 }
                 other => return Err(self.unexpected("capture", &other).into()),
@@ -646,6 +655,10 @@ impl<L: Link> Target for SerialTarget<L> {
     }
 
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
+        if ops.contains(&Op::Reset) {
+            // A chip reset clears the bridge's capture.
+            self.captured = Record::default();
+        }
         Ok(self.run_batch(ops)?)
     }
 }
