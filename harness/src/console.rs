@@ -290,11 +290,7 @@ fn to_op(stmt: Stmt, opts: &ConsoleOptions) -> Op {
             flag,
             value,
             timeout,
-        } => Op::AwaitStatus {
-            mask: flag.mask(),
-            value: if value { flag.mask() } else { 0 },
-            timeout: timeout.unwrap_or(opts.await_timeout),
-        },
+        } => Op::await_flag(flag, value, timeout.unwrap_or(opts.await_timeout)),
         Stmt::Set { input, asserted } => Op::SetInput { input, asserted },
         Stmt::Pins => Op::ReadPins,
         Stmt::Pulses => Op::ReadPulses,

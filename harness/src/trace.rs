@@ -357,21 +357,6 @@ fn move_kind(name: &str) -> Option<MoveKind> {
     MoveKind::ALL.into_iter().find(|k| k.name() == name)
 }
 
-fn pin_from(name: &str) -> Option<Pin> {
-    [
-        Pin::Busy,
-        Pin::Int,
-        Pin::Hold,
-        Pin::Aux,
-        Pin::Auxo,
-        Pin::Dir,
-        Pin::Phases,
-        Pin::Switching,
-    ]
-    .into_iter()
-    .find(|p| p.name() == name)
-}
-
 fn parse_event(line: &str) -> Result<Event, String> {
     let mut w = line.split_whitespace();
     let at = Instant::from_nanos(parse_time(w.next().ok_or("empty event line")?)?.as_nanos());
@@ -490,7 +475,7 @@ fn parse_event(line: &str) -> Result<Event, String> {
         }
         "pin" => {
             let name = w.next().ok_or("missing pin")?;
-            let pin = pin_from(name).ok_or_else(|| format!("unknown pin `{name}`"))?;
+            let pin = Pin::from_name(name).ok_or_else(|| format!("unknown pin `{name}`"))?;
             let text = w.next().ok_or("missing value")?;
             let value = match text.strip_prefix("0b") {
                 Some(bits) => {

@@ -387,32 +387,17 @@ impl<'a> R<'a> {
     }
 }
 
-const PINS: [Pin; 8] = [
-    Pin::Busy,
-    Pin::Int,
-    Pin::Hold,
-    Pin::Aux,
-    Pin::Auxo,
-    Pin::Dir,
-    Pin::Phases,
-    Pin::Switching,
-];
-
 fn pin_code(p: Pin) -> u8 {
-    PINS.iter().position(|x| *x == p).unwrap_or(0) as u8
+    Pin::ALL.iter().position(|x| *x == p).unwrap_or(0) as u8
 }
 
 fn winding_code(w: Option<Winding>) -> u8 {
-    let names = ["3ph-2", "3ph-12", "4ph-2", "4ph-12", "5ph-2", "5ph-23"];
-    w.and_then(|w| names.iter().position(|n| *n == w.name()))
+    w.and_then(|w| Winding::ALL.iter().position(|x| *x == w))
         .map_or(0, |i| i as u8 + 1)
 }
 
 fn winding_from(c: u8) -> Option<Winding> {
-    let names = ["3ph-2", "3ph-12", "4ph-2", "4ph-12", "5ph-2", "5ph-23"];
-    names
-        .get(usize::from(c).checked_sub(1)?)
-        .and_then(|n| Winding::from_name(n))
+    Winding::ALL.get(usize::from(c).checked_sub(1)?).copied()
 }
 
 /// Op codes inside a batch.
@@ -892,7 +877,7 @@ impl Response {
                     let at = r.time()?;
                     let pat = r.at;
                     let code = r.u8()?;
-                    let pin = *PINS.get(usize::from(code)).ok_or(WireError::BadValue {
+                    let pin = *Pin::ALL.get(usize::from(code)).ok_or(WireError::BadValue {
                         at: pat,
                         field: "pin",
                         value: u64::from(code),

@@ -55,6 +55,21 @@ pub enum Pin {
 }
 
 impl Pin {
+    pub const ALL: [Pin; 8] = [
+        Pin::Busy,
+        Pin::Int,
+        Pin::Hold,
+        Pin::Aux,
+        Pin::Auxo,
+        Pin::Dir,
+        Pin::Phases,
+        Pin::Switching,
+    ];
+
+    pub fn from_name(s: &str) -> Option<Pin> {
+        Pin::ALL.into_iter().find(|p| p.name() == s)
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Pin::Busy => "busy",

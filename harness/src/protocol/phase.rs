@@ -64,20 +64,38 @@ impl Winding {
         }
     }
 
+    /// Every motor type and excitation method, in the order of their wire
+    /// codes 1..=6 (`docs/bridge-protocol.md` section 7).
+    pub const ALL: [Winding; 6] = [
+        Winding {
+            motor: MotorType::ThreePhase,
+            excitation: Excitation::TwoPhase,
+        },
+        Winding {
+            motor: MotorType::ThreePhase,
+            excitation: Excitation::HalfStep,
+        },
+        Winding {
+            motor: MotorType::FourPhase,
+            excitation: Excitation::TwoPhase,
+        },
+        Winding {
+            motor: MotorType::FourPhase,
+            excitation: Excitation::HalfStep,
+        },
+        Winding {
+            motor: MotorType::FivePhase,
+            excitation: Excitation::TwoPhase,
+        },
+        Winding {
+            motor: MotorType::FivePhase,
+            excitation: Excitation::HalfStep,
+        },
+    ];
+
     /// Inverse of [`Winding::name`].
     pub fn from_name(s: &str) -> Option<Winding> {
-        let all = [
-            MotorType::ThreePhase,
-            MotorType::FourPhase,
-            MotorType::FivePhase,
-        ];
-        all.into_iter()
-            .flat_map(|motor| {
-                [Excitation::TwoPhase, Excitation::HalfStep]
-                    .into_iter()
-                    .map(move |excitation| Winding { motor, excitation })
-            })
-            .find(|w| w.name() == s)
+        Winding::ALL.into_iter().find(|w| w.name() == s)
     }
 
     /// The step index after `count` steps in `dir` from `index`.

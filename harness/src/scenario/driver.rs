@@ -334,11 +334,7 @@ impl<'t> Driver<'t> {
                 value,
                 timeout,
                 ..
-            } => Op::AwaitStatus {
-                mask: flag.mask(),
-                value: if value { flag.mask() } else { 0 },
-                timeout,
-            },
+            } => Op::await_flag(flag, value, timeout),
         }
     }
 

@@ -16,7 +16,7 @@ pub use self::serial::{
     parse_spec, Link, LinkStats, SerialError, SerialLink, SerialOptions, SerialTarget,
 };
 
-use crate::protocol::{Input, Pins, PulseSummary, Record, Status};
+use crate::protocol::{Flag, Input, Pins, PulseSummary, Record, Status};
 use crate::time::{Duration, Instant};
 use std::fmt;
 
@@ -62,6 +62,17 @@ pub enum Op {
     /// Hardware reset of the chip (the RESET pin): registers, inputs and the
     /// capture start over, and the target's clock restarts at zero.
     Reset,
+}
+
+impl Op {
+    /// Wait until a status flag has `value`, at most `timeout`.
+    pub fn await_flag(flag: Flag, value: bool, timeout: Duration) -> Op {
+        Op::AwaitStatus {
+            mask: flag.mask(),
+            value: if value { flag.mask() } else { 0 },
+            timeout,
+        }
+    }
 }
 
 /// The outcome of one [`Op`], stamped with the target's time when it ended.
