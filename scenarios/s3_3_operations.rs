@@ -196,9 +196,9 @@ fn immediate_stop_accel(d: &mut Driver) -> Outcome {
     ready(d)?;
     d.start(Move::accel(Ccw, 5_000))?;
     d.after_pulses(300)?;
-    let t = d.immediate_stop()?;
+    d.immediate_stop()?;
     d.wait_idle()?;
-    d.expect_no_pulses_after(t + us(10))?;
+    d.expect_no_pulses_after_trigger(us(10))?;
     d.expect_latency(TimingId::AbnormalTermination)?;
     let n = d.expect_pulses_between(300, 301)?;
     d.expect_finish(0xC3)?;
@@ -242,9 +242,9 @@ fn constant_decel_stop(d: &mut Driver) -> Outcome {
     ready(d)?;
     d.start(Move::constant(Cw, 50, 500))?;
     d.after_pulses(100)?;
-    let t = d.decel_stop()?;
+    d.decel_stop()?;
     d.wait_idle()?;
-    d.expect_no_pulses_after(t + us(10))?;
+    d.expect_no_pulses_after_trigger(us(10))?;
     d.expect_finish(0xC4)
 }
 
@@ -254,9 +254,9 @@ fn continuous_l1(d: &mut Driver) -> Outcome {
     d.after_pulses(200)?;
     d.set(Input::L2, true)?;
     d.after_pulses(400)?;
-    let t = d.set(Input::L1, true)?;
+    d.set(Input::L1, true)?;
     d.wait_idle()?;
-    d.expect_no_pulses_after(t)?;
+    d.expect_no_pulses_after_trigger(Duration::ZERO)?;
     d.expect_pulses(400, Cw)?;
     d.expect_finish(0x95)?;
     d.expect_remaining(16_777_216 - 400 - 1)
@@ -329,9 +329,9 @@ fn accel_l1(d: &mut Driver) -> Outcome {
     ready(d)?;
     d.start(Move::accel(Cw, 2_000))?;
     d.after_pulses(700)?;
-    let t = d.set(Input::L1, true)?;
+    d.set(Input::L1, true)?;
     d.wait_idle()?;
-    d.expect_no_pulses_after(t)?;
+    d.expect_no_pulses_after_trigger(Duration::ZERO)?;
     d.expect_latency(TimingId::AbnormalTermination)?;
     d.expect_pulses(700, Cw)?;
     d.expect_finish(0x93)?;
@@ -353,9 +353,9 @@ fn accel_alm(d: &mut Driver) -> Outcome {
     ready(d)?;
     d.start(Move::accel(Ccw, 2_000))?;
     d.after_pulses(150)?;
-    let t = d.set(Input::Alm, true)?;
+    d.set(Input::Alm, true)?;
     d.wait_idle()?;
-    d.expect_no_pulses_after(t)?;
+    d.expect_no_pulses_after_trigger(Duration::ZERO)?;
     d.expect_pulses(150, Ccw)?;
     d.expect_finish(0xA3)
 }
@@ -383,9 +383,9 @@ fn origin_cnp(d: &mut Driver) -> Outcome {
     ready(d)?;
     d.start(Move::origin(Ccw, 30))?;
     d.after_pulses(777)?;
-    let t = d.set(Input::Cnp, true)?;
+    d.set(Input::Cnp, true)?;
     d.wait_idle()?;
-    d.expect_no_pulses_after(t)?;
+    d.expect_no_pulses_after_trigger(Duration::ZERO)?;
     d.expect_pulses(777, Ccw)?;
     d.expect_finish(0x87)?;
     d.expect_remaining(16_777_216 - 777 - 1)

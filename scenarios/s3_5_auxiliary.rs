@@ -39,10 +39,10 @@ pub fn scenarios() -> Vec<Scenario> {
 /// number of on-to-off and off-to-on changes seen. (Used where nothing
 /// should chop; [`Driver::expect_chopping`] measures real chopping.)
 fn count_chops(d: &mut Driver, step: Duration, span: Duration) -> Result<(u32, u32), crate::scenario::Stop> {
-    let end = d.now() + span;
+    let end = d.now()? + span;
     let mut last = d.pins()?.phases != 0;
     let (mut offs, mut ons) = (0, 0);
-    while d.now() < end {
+    while d.now()? < end {
         d.wait(step)?;
         let on = d.pins()?.phases != 0;
         if last && !on {

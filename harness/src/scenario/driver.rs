@@ -81,7 +81,7 @@ impl Init {
     }
 }
 
-/// One flowchart step: an op and how its reply is judged.
+/// One step: an op and how its reply is judged.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Step {
     Write {
@@ -98,26 +98,74 @@ enum Step {
         timeout: Duration,
         must: bool,
     },
+    Delay(Duration),
+    Set {
+        input: Input,
+        on: bool,
+    },
+    AwaitPulses {
+        count: u64,
+        timeout: Duration,
+    },
+    Reset,
+    Pins,
 }
 
 /// What a step gave back.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Done {
-    At(Instant),
+    At,
     Status(Status),
     Byte(u8),
     Waited(Option<Duration>),
+    Pins(Pins),
 }
 
-impl Done {
-    /// The time of a write (for other steps the caller does not ask).
-    fn at(self) -> Instant {
-        match self {
-            Done::At(t) => t,
-            _ => Instant::ZERO,
-        }
-    }
+/// What the driver remembers of a step once it has run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Role {
+    Plain,
+    /// The final byte of an initialization.
+    InitWrite,
+    /// The final byte of an operation command: the anchor of measurements.
+    Anchor,
+    /// A stop, an input edge or an auxiliary command: the trigger of
+    /// latency measurements.
+    Trigger,
 }
+
+/// A deferred expectation, judged on the replies of its group.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Check {
+    Bytes {
+        what: &'static str,
+        expected: Vec<u8>,
+    },
+    Error(ErrorCode),
+    NoError,
+    Params(u8),
+    StatusMask {
+        mask: u8,
+        value: u8,
+    },
+    Phases(u8),
+    Pins {
+        int: Option<bool>,
+        hold: Option<bool>,
+        aux: Option<bool>,
+        auxo: Option<u8>,
+    },
+}
+
+/// Steps queued to go to the target together, and what to check of them.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct Group {
+    steps: Vec<(Step, Role)>,
+    check: Option<Check>,
+}
+
+/// Most groups the driver queues before it sends them anyway.
+const MAX_QUEUED: usize = 64;
 
 /// Timeouts and limits of a [`Driver`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -164,6 +212,8 @@ pub struct Driver<'t> {
     trigger: Option<Instant>,
     capture: Option<Record>,
     straps: Straps,
+    /// Steps not yet sent (see [`Driver::flush`]).
+    queue: Vec<Group>,
 }
 
 impl std::fmt::Debug for Driver<'_> {
@@ -204,6 +254,7 @@ impl<'t> Driver<'t> {
             init: None,
             trigger: None,
             capture: None,
+            queue: Vec::new(),
         }
     }
 
@@ -248,16 +299,27 @@ impl<'t> Driver<'t> {
         (within, over)
     }
 
-    /// The target's clock after the last operation.
-    pub fn now(&self) -> Instant {
+    /// The target's clock, once everything queued has run.
+    pub fn now(&mut self) -> Outcome<Instant> {
+        self.flush()?;
+        Ok(self.now)
+    }
+
+    /// The clock as of the last op sent (for reports).
+    pub(crate) fn clock(&self) -> Instant {
         self.now
     }
 
     // ----- raw layer -------------------------------------------------------
 
-    /// Runs ops on the target; a target failure stops the scenario as an
-    /// error (not the device's fault).
+    /// Runs ops on the target (after everything queued); a target failure
+    /// stops the scenario as an error (not the device's fault).
     pub fn exec(&mut self, ops: &[Op]) -> Outcome<Vec<Reply>> {
+        self.flush()?;
+        self.send(ops)
+    }
+
+    fn send(&mut self, ops: &[Op]) -> Outcome<Vec<Reply>> {
         if self.now.as_nanos() > self.opts.budget.as_nanos() {
             return Err(Stop::Error(format!(
                 "scenario exceeded its time budget of {} (virtual time)",
@@ -282,11 +344,6 @@ impl<'t> Driver<'t> {
         Ok(replies)
     }
 
-    fn one(&mut self, op: Op) -> Outcome<Reply> {
-        let mut r = self.exec(&[op])?;
-        r.pop().ok_or_else(|| Stop::Error("no reply".into()))
-    }
-
     fn log(&mut self, at: Instant, e: BusEvent) {
         self.bus.push(Event {
             at,
@@ -298,16 +355,86 @@ impl<'t> Driver<'t> {
         Stop::Error(format!("target answered {reply:?} to {op}"))
     }
 
+    /// Queues steps (and a check of their replies) to go with the next
+    /// flush: on a board, one round trip per point where the scenario must
+    /// see a result rather than one per call.
+    fn enqueue(&mut self, steps: Vec<(Step, Role)>, check: Option<Check>) -> Outcome {
+        self.queue.push(Group { steps, check });
+        if self.queue.len() >= MAX_QUEUED {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    fn plain(steps: impl IntoIterator<Item = Step>) -> Vec<(Step, Role)> {
+        steps.into_iter().map(|s| (s, Role::Plain)).collect()
+    }
+
+    /// Sends everything queued as one batch, then logs and judges the
+    /// replies in order, stopping at the first failure. Ops queued after a
+    /// failing one have run on the target too; the verdict and the failure
+    /// are those of the first failing step.
+    pub fn flush(&mut self) -> Outcome {
+        if self.queue.is_empty() {
+            return Ok(());
+        }
+        let groups = std::mem::take(&mut self.queue);
+        let ops: Vec<Op> = groups
+            .iter()
+            .flat_map(|g| g.steps.iter().map(|(s, _)| self.step_op(*s)))
+            .collect();
+        let mut began = self.now;
+        let mut replies = self.send(&ops)?.into_iter();
+        for g in groups {
+            let mut done = Vec::with_capacity(g.steps.len());
+            for (step, role) in g.steps {
+                let reply = replies
+                    .next()
+                    .ok_or_else(|| Stop::Error("target answered too few operations".into()))?;
+                let at = reply.at();
+                done.push(self.judge(step, reply, began)?);
+                match role {
+                    Role::Plain => {}
+                    Role::InitWrite => self.init_write = Some(at),
+                    Role::Anchor => self.anchor = Some(at),
+                    Role::Trigger => self.trigger = Some(at),
+                }
+                began = at;
+            }
+            if let Some(c) = g.check {
+                self.judge_check(&c, &done, began)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Runs steps now (after everything queued) and returns their results.
+    fn steps(&mut self, steps: &[Step]) -> Outcome<Vec<Done>> {
+        self.flush()?;
+        let ops: Vec<Op> = steps.iter().map(|s| self.step_op(*s)).collect();
+        let mut began = self.now;
+        let replies = self.send(&ops)?;
+        let mut out = Vec::with_capacity(steps.len());
+        for (step, reply) in steps.iter().zip(replies) {
+            let at = reply.at();
+            out.push(self.judge(*step, reply, began)?);
+            began = at;
+        }
+        Ok(out)
+    }
+
+    fn step(&mut self, step: Step) -> Outcome<Done> {
+        let mut v = self.steps(&[step])?;
+        v.pop().ok_or_else(|| Stop::Error("no reply".into()))
+    }
+
     /// Hardware reset; every scenario starts with one.
     pub fn reset(&mut self) -> Outcome {
-        let r = self.one(Op::Reset)?;
-        self.now = r.at();
-        self.log(r.at(), BusEvent::Reset);
         self.anchor = None;
         self.init_write = None;
         self.init = None;
         self.trigger = None;
-        Ok(())
+        self.enqueue(Self::plain([Step::Reset]), None)
     }
 
     /// The op a step sends.
@@ -335,6 +462,14 @@ impl<'t> Driver<'t> {
                 timeout,
                 ..
             } => Op::await_flag(flag, value, timeout),
+            Step::Delay(d) => Op::Delay(d),
+            Step::Set { input, on } => Op::SetInput {
+                input,
+                asserted: on,
+            },
+            Step::AwaitPulses { count, timeout } => Op::AwaitPulses { count, timeout },
+            Step::Reset => Op::Reset,
+            Step::Pins => Op::ReadPins,
         }
     }
 
@@ -357,7 +492,7 @@ impl<'t> Driver<'t> {
                     BusEvent::WriteData { byte, waited }
                 };
                 self.log(at, e);
-                Ok(Done::At(at))
+                Ok(Done::At)
             }
             (Step::Write { byte, command, .. }, Reply::WriteTimedOut { at, status }) => {
                 self.log(at, BusEvent::WriteTimedOut { command, byte });
@@ -431,57 +566,185 @@ impl<'t> Driver<'t> {
                 }
                 Ok(Done::Waited(None))
             }
+            (Step::Delay(_), Reply::Delayed { .. }) => Ok(Done::At),
+            (Step::Set { input, on }, Reply::InputSet { at }) => {
+                self.log(
+                    at,
+                    BusEvent::SetInput {
+                        input,
+                        asserted: on,
+                    },
+                );
+                Ok(Done::At)
+            }
+            (Step::AwaitPulses { count, .. }, Reply::PulsesReached { at }) => {
+                self.log(
+                    at,
+                    BusEvent::AwaitPulses {
+                        count,
+                        reached: true,
+                    },
+                );
+                Ok(Done::At)
+            }
+            (Step::AwaitPulses { count: n, .. }, Reply::PulsesTimedOut { at, count }) => {
+                self.log(
+                    at,
+                    BusEvent::AwaitPulses {
+                        count: n,
+                        reached: false,
+                    },
+                );
+                Err(fail(
+                    "pulses output so far",
+                    format!("at least {n}"),
+                    count,
+                    at,
+                ))
+            }
+            (Step::Reset, Reply::ResetDone { at }) => {
+                self.log(at, BusEvent::Reset);
+                Ok(Done::At)
+            }
+            (Step::Pins, Reply::Pins { pins, .. }) => Ok(Done::Pins(pins)),
             (step, other) => Err(self.unexpected(&format!("{step:?}"), &other)),
         }
     }
 
-    /// Runs flowchart steps as one batch (one round trip on a board), then
-    /// logs and judges the replies in order, stopping at the first failure.
-    fn steps(&mut self, steps: &[Step]) -> Outcome<Vec<Done>> {
-        let ops: Vec<Op> = steps.iter().map(|s| self.step_op(*s)).collect();
-        let mut began = self.now;
-        let replies = self.exec(&ops)?;
-        let mut out = Vec::with_capacity(steps.len());
-        for (step, reply) in steps.iter().zip(replies) {
-            let at = reply.at();
-            out.push(self.judge(*step, reply, began)?);
-            began = at;
+    /// Judges a deferred expectation on the results of its group; `at` is
+    /// when the group's last step ended.
+    fn judge_check(&self, c: &Check, done: &[Done], at: Instant) -> Outcome {
+        let status = done.iter().rev().find_map(|d| match d {
+            Done::Status(s) => Some(*s),
+            _ => None,
+        });
+        let pins = done.iter().rev().find_map(|d| match d {
+            Done::Pins(p) => Some(*p),
+            _ => None,
+        });
+        match (c, status, pins) {
+            (Check::Bytes { what, expected }, _, _) => {
+                let got: Vec<u8> = done
+                    .iter()
+                    .filter_map(|d| match d {
+                        Done::Byte(b) => Some(*b),
+                        _ => None,
+                    })
+                    .collect();
+                if &got != expected {
+                    return Err(fail(*what, hex(expected), hex(&got), at));
+                }
+            }
+            (Check::Error(code), Some(s), _) => {
+                if s.error() != Some(*code) {
+                    return Err(fail(
+                        "status error (Table 3-2)",
+                        code,
+                        describe_status(s),
+                        at,
+                    ));
+                }
+            }
+            (Check::NoError, Some(s), _) => {
+                if s.error_flag() {
+                    return Err(fail("no error", "error flag 0", describe_status(s), at));
+                }
+            }
+            (Check::Params(n), Some(s), _) => {
+                if s.field() != StatusField::ParamsRemaining(*n) {
+                    return Err(fail(
+                        "parameter count (status bits 6-4)",
+                        format!("{n} remaining"),
+                        describe_status(s),
+                        at,
+                    ));
+                }
+            }
+            (Check::StatusMask { mask, value }, Some(s), _) => {
+                if s.0 & mask != value & mask {
+                    return Err(fail(
+                        format!("status & 0x{mask:02X}"),
+                        format!("0x{:02X}", value & mask),
+                        format!("0x{:02X}", s.0 & mask),
+                        at,
+                    ));
+                }
+            }
+            (Check::Phases(pattern), _, Some(p)) => {
+                if p.phases != *pattern {
+                    return Err(fail(
+                        "energized phases S1..S5",
+                        format!("0b{pattern:05b}"),
+                        format!("0b{:05b}", p.phases),
+                        at,
+                    ));
+                }
+            }
+            (
+                Check::Pins {
+                    int,
+                    hold,
+                    aux,
+                    auxo,
+                },
+                _,
+                Some(p),
+            ) => {
+                let checks = [
+                    ("INT*", int.map(u8::from), u8::from(p.int)),
+                    ("HOLD", hold.map(u8::from), u8::from(p.hold)),
+                    ("AUX*", aux.map(u8::from), u8::from(p.aux)),
+                    ("AUXO0..3", *auxo, p.auxo),
+                ];
+                for (name, want, got) in checks {
+                    if let Some(w) = want {
+                        if w != got {
+                            return Err(fail(format!("{name} asserted"), w, got, at));
+                        }
+                    }
+                }
+            }
+            (c, _, _) => {
+                return Err(Stop::Error(format!(
+                    "scenario bug: check {c:?} has no reply to judge"
+                )))
+            }
         }
-        Ok(out)
+        Ok(())
     }
 
-    fn step(&mut self, step: Step) -> Outcome<Done> {
-        let mut v = self.steps(&[step])?;
-        v.pop().ok_or_else(|| Stop::Error("no reply".into()))
-    }
-
-    fn write(&mut self, byte: u8, command: bool, wait: bool) -> Outcome<Instant> {
-        self.step(Step::Write {
-            byte,
-            command,
-            wait,
-        })
-        .map(Done::at)
+    fn write(&mut self, byte: u8, command: bool, wait: bool, role: Role) -> Outcome {
+        self.enqueue(
+            vec![(
+                Step::Write {
+                    byte,
+                    command,
+                    wait,
+                },
+                role,
+            )],
+            None,
+        )
     }
 
     /// Flowchart write of the command register (waits for IBF = 0).
-    pub fn command(&mut self, byte: u8) -> Outcome<Instant> {
-        self.write(byte, true, true)
+    pub fn command(&mut self, byte: u8) -> Outcome {
+        self.write(byte, true, true, Role::Plain)
     }
 
     /// Flowchart write of the data register.
-    pub fn data(&mut self, byte: u8) -> Outcome<Instant> {
-        self.write(byte, false, true)
+    pub fn data(&mut self, byte: u8) -> Outcome {
+        self.write(byte, false, true, Role::Plain)
     }
 
     /// Writes the command register at once, whatever IBF says.
-    pub fn raw_command(&mut self, byte: u8) -> Outcome<Instant> {
-        self.write(byte, true, false)
+    pub fn raw_command(&mut self, byte: u8) -> Outcome {
+        self.write(byte, true, false, Role::Plain)
     }
 
     /// Writes the data register at once, whatever IBF says.
-    pub fn raw_data(&mut self, byte: u8) -> Outcome<Instant> {
-        self.write(byte, false, false)
+    pub fn raw_data(&mut self, byte: u8) -> Outcome {
+        self.write(byte, false, false, Role::Plain)
     }
 
     /// Reads the status register.
@@ -519,16 +782,16 @@ impl<'t> Driver<'t> {
     }
 
     /// Waits for a flag and fails the scenario if it does not come.
-    pub fn expect_flag(&mut self, flag: Flag, value: bool, timeout: Duration) -> Outcome<Duration> {
-        match self.step(Step::Await {
-            flag,
-            value,
-            timeout,
-            must: true,
-        })? {
-            Done::Waited(Some(w)) => Ok(w),
-            _ => Err(Stop::Error("await answered otherwise".into())),
-        }
+    pub fn expect_flag(&mut self, flag: Flag, value: bool, timeout: Duration) -> Outcome {
+        self.enqueue(
+            Self::plain([Step::Await {
+                flag,
+                value,
+                timeout,
+                must: true,
+            }]),
+            None,
+        )
     }
 
     /// The two waits every flowchart puts before an operation command.
@@ -549,88 +812,50 @@ impl<'t> Driver<'t> {
         ]
     }
 
-    /// A command and its data bytes, as flowchart writes.
-    fn command_steps(code: u8, data: &[u8]) -> Vec<Step> {
-        let mut v = vec![Step::Write {
-            byte: code,
-            command: true,
-            wait: true,
-        }];
-        v.extend(data.iter().map(|b| Step::Write {
-            byte: *b,
-            command: false,
-            wait: true,
-        }));
-        v
+    /// A command and its data bytes, as flowchart writes; the final byte
+    /// takes `role`.
+    fn command_steps(code: u8, data: &[u8], role: Role) -> Vec<(Step, Role)> {
+        let n = data.len() + 1;
+        std::iter::once((code, true))
+            .chain(data.iter().map(|b| (*b, false)))
+            .enumerate()
+            .map(|(i, (byte, command))| {
+                (
+                    Step::Write {
+                        byte,
+                        command,
+                        wait: true,
+                    },
+                    if i + 1 == n { role } else { Role::Plain },
+                )
+            })
+            .collect()
     }
 
     /// Lets time pass.
     pub fn wait(&mut self, d: Duration) -> Outcome {
-        self.one(Op::Delay(d))?;
-        Ok(())
+        self.enqueue(Self::plain([Step::Delay(d)]), None)
     }
 
     /// Drives an input (`on` = asserted, pin low). An assertion counts as
     /// the trigger for latency measurements.
-    pub fn set(&mut self, input: Input, on: bool) -> Outcome<Instant> {
-        let r = self.one(Op::SetInput {
-            input,
-            asserted: on,
-        })?;
-        self.log(
-            r.at(),
-            BusEvent::SetInput {
-                input,
-                asserted: on,
-            },
-        );
-        if on {
-            self.trigger = Some(r.at());
-        }
-        Ok(r.at())
+    pub fn set(&mut self, input: Input, on: bool) -> Outcome {
+        let role = if on { Role::Trigger } else { Role::Plain };
+        self.enqueue(vec![(Step::Set { input, on }, role)], None)
     }
 
     /// Waits until the move in progress has output `n` pulses; the next op
     /// acts right after that pulse, on the target's clock.
-    pub fn after_pulses(&mut self, n: u64) -> Outcome<Instant> {
-        match self.one(Op::AwaitPulses {
-            count: n,
-            timeout: self.opts.idle_timeout,
-        })? {
-            Reply::PulsesReached { at } => {
-                self.log(
-                    at,
-                    BusEvent::AwaitPulses {
-                        count: n,
-                        reached: true,
-                    },
-                );
-                Ok(at)
-            }
-            Reply::PulsesTimedOut { at, count } => {
-                self.log(
-                    at,
-                    BusEvent::AwaitPulses {
-                        count: n,
-                        reached: false,
-                    },
-                );
-                Err(fail(
-                    "pulses output so far",
-                    format!("at least {n}"),
-                    count,
-                    at,
-                ))
-            }
-            other => Err(self.unexpected("await-pulses", &other)),
-        }
+    pub fn after_pulses(&mut self, n: u64) -> Outcome {
+        let timeout = self.opts.idle_timeout;
+        self.enqueue(Self::plain([Step::AwaitPulses { count: n, timeout }]), None)
     }
 
     /// The output pins now.
     pub fn pins(&mut self) -> Outcome<Pins> {
-        match self.one(Op::ReadPins)? {
-            Reply::Pins { pins, .. } => Ok(pins),
-            other => Err(self.unexpected("pins", &other)),
+        match self.step(Step::Pins)? {
+            Done::Pins(p) => Ok(p),
+            _ => Err(Stop::Error("pins read answered otherwise".into())),
         }
     }
 
@@ -705,8 +930,10 @@ impl<'t> Driver<'t> {
         Ok(())
     }
 
-    /// The capture since reset (fetched once per change).
+    /// The capture since reset (fetched once per change, after everything
+    /// queued has run).
     pub fn capture(&mut self) -> Outcome<&Record> {
+        self.flush()?;
         if self.capture.is_none() {
             let c = self
                 .target
@@ -724,112 +951,113 @@ impl<'t> Driver<'t> {
     /// Waits for BUSY = 0, then IBF = 0: the condition every flowchart puts
     /// before an operation command.
     pub fn wait_ready(&mut self) -> Outcome {
-        let steps = self.ready_steps();
-        self.steps(&steps).map(|_| ())
+        let steps = Self::plain(self.ready_steps());
+        self.enqueue(steps, None)
     }
 
-    /// The initialization flowchart (Diagram 3-3), as one batch. Later
-    /// writes wait for the processing through IBF.
-    pub fn init(&mut self, init: Init) -> Outcome<Instant> {
-        let mut steps = self.ready_steps().to_vec();
-        steps.extend(Self::command_steps(init.code(), &init.data.to_bytes()));
-        let done = self.steps(&steps)?;
-        let last = done.last().map_or(self.now, |d| d.at());
-        self.init_write = Some(last);
+    /// The initialization flowchart (Diagram 3-3). Later writes wait for
+    /// the processing through IBF.
+    pub fn init(&mut self, init: Init) -> Outcome {
+        let mut steps = Self::plain(self.ready_steps());
+        steps.extend(Self::command_steps(
+            init.code(),
+            &init.data.to_bytes(),
+            Role::InitWrite,
+        ));
         self.init = Some(init);
-        Ok(last)
+        self.enqueue(steps, None)
     }
 
     /// Initialization, then waiting out its processing time (Table 3-3 max
-    /// plus 1 %), so that what follows is timed from an idle chip.
-    pub fn init_and_wait(&mut self, init: Init) -> Outcome<Instant> {
-        let at = self.init(init)?;
+    /// plus 1 %, from the final byte), so that what follows is timed from an
+    /// idle chip.
+    pub fn init_and_wait(&mut self, init: Init) -> Outcome {
+        self.init(init)?;
         let (_, max) = TimingId::InitProcessing.row().band_for(&self.straps);
-        let until = at + max;
-        self.wait(until.saturating_since(self.now))?;
-        Ok(at)
+        self.wait(max)
     }
 
-    /// Issues a move by its flowchart and waits for BUSY = 1, as one batch.
-    pub fn start(&mut self, m: Move) -> Outcome<Instant> {
-        let mut steps = self.ready_steps().to_vec();
-        steps.extend(Self::command_steps(m.code(), &m.params()));
-        let writes = steps.len();
+    /// Issues a move by its flowchart and waits for BUSY = 1.
+    pub fn start(&mut self, m: Move) -> Outcome {
+        let mut steps = Self::plain(self.ready_steps());
+        steps.extend(Self::command_steps(m.code(), &m.params(), Role::Anchor));
         // The chip may still be busy with earlier work (an initialization):
         // BUSY is due once it has taken the final byte.
-        steps.push(Step::Await {
-            flag: Flag::Ibf,
-            value: false,
-            timeout: self.opts.ibf_timeout,
-            must: true,
-        });
-        steps.push(Step::Await {
-            flag: Flag::Busy,
-            value: true,
-            timeout: self.opts.busy_timeout,
-            must: true,
-        });
-        let done = self.steps(&steps)?;
-        let at = done.get(writes - 1).map_or(self.now, |d| d.at());
-        self.anchor = Some(at);
-        Ok(at)
+        steps.extend(Self::plain([
+            Step::Await {
+                flag: Flag::Ibf,
+                value: false,
+                timeout: self.opts.ibf_timeout,
+                must: true,
+            },
+            Step::Await {
+                flag: Flag::Busy,
+                value: true,
+                timeout: self.opts.busy_timeout,
+                must: true,
+            },
+        ]));
+        self.enqueue(steps, None)
     }
 
     /// Issues a move's command and data without waiting for BUSY (for
     /// scenarios that expect it to be refused).
-    pub fn issue(&mut self, m: Move) -> Outcome<Instant> {
-        let mut steps = self.ready_steps().to_vec();
-        steps.extend(Self::command_steps(m.code(), &m.params()));
-        let done = self.steps(&steps)?;
-        let at = done.last().map_or(self.now, |d| d.at());
-        self.anchor = Some(at);
-        Ok(at)
+    pub fn issue(&mut self, m: Move) -> Outcome {
+        let mut steps = Self::plain(self.ready_steps());
+        steps.extend(Self::command_steps(m.code(), &m.params(), Role::Anchor));
+        self.enqueue(steps, None)
     }
 
     /// Issues a move and waits for it to end.
-    pub fn run(&mut self, m: Move) -> Outcome<Instant> {
-        let at = self.start(m)?;
-        self.wait_idle()?;
-        Ok(at)
+    pub fn run(&mut self, m: Move) -> Outcome {
+        self.start(m)?;
+        self.wait_idle()
     }
 
     /// Waits for BUSY = 0 (the move ends), at most the idle timeout or the
     /// scenario's budget, whichever is longer.
-    pub fn wait_idle(&mut self) -> Outcome<Duration> {
+    pub fn wait_idle(&mut self) -> Outcome {
         let t = self.opts.idle_timeout.max(self.opts.budget);
         self.expect_flag(Flag::Busy, false, t)
     }
 
     /// Immediate Stop (Section 3-3-1): writes 0x40 after IBF = 0.
-    pub fn immediate_stop(&mut self) -> Outcome<Instant> {
-        let at = self.command(0x40)?;
-        self.trigger = Some(at);
-        Ok(at)
+    pub fn immediate_stop(&mut self) -> Outcome {
+        self.write(0x40, true, true, Role::Trigger)
     }
 
     /// Decelerating Stop (Section 3-3-2): writes 0x41 after IBF = 0.
-    pub fn decel_stop(&mut self) -> Outcome<Instant> {
-        let at = self.command(0x41)?;
-        self.trigger = Some(at);
-        Ok(at)
+    pub fn decel_stop(&mut self) -> Outcome {
+        self.write(0x41, true, true, Role::Trigger)
     }
 
     /// A command with no data that acts on an output (AUX ON/OFF, software
     /// reset): writes it and marks it as the trigger.
-    pub fn trigger_command(&mut self, byte: u8) -> Outcome<Instant> {
-        let at = self.command(byte)?;
-        self.trigger = Some(at);
-        Ok(at)
+    pub fn trigger_command(&mut self, byte: u8) -> Outcome {
+        self.write(byte, true, true, Role::Trigger)
     }
 
     /// A register read by its flowchart: BUSY = 0, IBF = 0, the command,
     /// then OBF = 1 before each byte.
+    fn register_steps(&self, reg: Register) -> Vec<(Step, Role)> {
+        let mut steps = Self::plain(self.ready_steps());
+        steps.extend(Self::command_steps(reg.code(), &[], Role::Plain));
+        steps.extend(Self::plain(std::iter::repeat_n(
+            Step::ReadData,
+            reg.byte_count(),
+        )));
+        steps
+    }
+
+    /// Reads a register (after everything queued) and returns its bytes.
     pub fn read_register(&mut self, reg: Register) -> Outcome<Vec<u8>> {
-        let mut steps = self.ready_steps().to_vec();
-        steps.extend(Self::command_steps(reg.code(), &[]));
-        steps.extend(std::iter::repeat_n(Step::ReadData, reg.byte_count()));
-        let done = self.steps(&steps)?;
-        Ok(done
+        let steps: Vec<Step> = self
+            .register_steps(reg)
+            .into_iter()
+            .map(|(s, _)| s)
+            .collect();
+        Ok(self
+            .steps(&steps)?
             .into_iter()
             .filter_map(|d| match d {
                 Done::Byte(b) => Some(b),
@@ -839,9 +1067,9 @@ impl<'t> Driver<'t> {
     }
 
     /// Waits until the chip has taken the last byte written, then reads the
-    /// status register (one batch).
-    pub fn settled_status(&mut self) -> Outcome<Status> {
-        let steps = [
+    /// status register: the steps of the status expectations.
+    fn settled_status_steps(&self) -> Vec<(Step, Role)> {
+        Self::plain([
             Step::Await {
                 flag: Flag::Ibf,
                 value: false,
@@ -849,11 +1077,7 @@ impl<'t> Driver<'t> {
                 must: true,
             },
             Step::Status,
-        ];
-        match self.steps(&steps)?.pop() {
-            Some(Done::Status(s)) => Ok(s),
-            _ => Err(Stop::Error("status read answered otherwise".into())),
-        }
+        ])
     }
 
     // ----- expectations --------------------------------------------------
@@ -878,66 +1102,39 @@ impl<'t> Driver<'t> {
 
     /// Expects the error flag with `code` (Table 3-2).
     pub fn expect_error(&mut self, code: ErrorCode) -> Outcome {
-        let s = self.settled_status()?;
-        match s.error() {
-            Some(e) if e == code => Ok(()),
-            _ => Err(fail(
-                "status error (Table 3-2)",
-                code,
-                describe_status(s),
-                self.now,
-            )),
-        }
+        let steps = self.settled_status_steps();
+        self.enqueue(steps, Some(Check::Error(code)))
     }
 
     /// Expects no error flag.
     pub fn expect_no_error(&mut self) -> Outcome {
-        let s = self.settled_status()?;
-        if s.error_flag() {
-            return Err(fail(
-                "no error",
-                "error flag 0",
-                describe_status(s),
-                self.now,
-            ));
-        }
-        Ok(())
+        let steps = self.settled_status_steps();
+        self.enqueue(steps, Some(Check::NoError))
     }
 
     /// Expects status bits 6-4 to count `n` parameter bytes still wanted.
     pub fn expect_params_remaining(&mut self, n: u8) -> Outcome {
-        let s = self.settled_status()?;
-        if s.field() != StatusField::ParamsRemaining(n) {
-            return Err(fail(
-                "parameter count (status bits 6-4)",
-                format!("{n} remaining"),
-                describe_status(s),
-                self.now,
-            ));
-        }
-        Ok(())
+        let steps = self.settled_status_steps();
+        self.enqueue(steps, Some(Check::Params(n)))
     }
 
     /// Expects `status & mask == value`.
     pub fn expect_status(&mut self, mask: u8, value: u8) -> Outcome {
-        let s = self.status()?;
-        if s.0 & mask != value & mask {
-            return Err(fail(
-                format!("status & 0x{mask:02X}"),
-                format!("0x{:02X}", value & mask),
-                format!("0x{:02X}", s.0 & mask),
-                self.now,
-            ));
-        }
-        Ok(())
+        self.enqueue(
+            Self::plain([Step::Status]),
+            Some(Check::StatusMask { mask, value }),
+        )
     }
 
-    fn expect_register(&mut self, reg: Register, what: &str, expected: &[u8]) -> Outcome {
-        let got = self.read_register(reg)?;
-        if got != expected {
-            return Err(fail(what, hex(expected), hex(&got), self.now));
-        }
-        Ok(())
+    fn expect_register(&mut self, reg: Register, what: &'static str, expected: &[u8]) -> Outcome {
+        let steps = self.register_steps(reg);
+        self.enqueue(
+            steps,
+            Some(Check::Bytes {
+                what,
+                expected: expected.to_vec(),
+            }),
+        )
     }
 
     /// Reads the finish status (Section 3-4-1) and expects `value`.
@@ -1037,18 +1234,17 @@ impl<'t> Driver<'t> {
             .collect())
     }
 
+    /// Expects no pulse of the most recent move later than `margin` after
+    /// the last trigger (a stop write or an input edge).
+    pub fn expect_no_pulses_after_trigger(&mut self, margin: Duration) -> Outcome {
+        self.flush()?;
+        let t = self.need("a stop or an input edge", self.trigger)?;
+        self.expect_no_pulses_after(t + margin)
+    }
+
     /// Expects the energized phases (S1 in bit 4).
     pub fn expect_phases(&mut self, pattern: u8) -> Outcome {
-        let p = self.pins()?;
-        if p.phases != pattern {
-            return Err(fail(
-                "energized phases S1..S5",
-                format!("0b{pattern:05b}"),
-                format!("0b{:05b}", p.phases),
-                self.now,
-            ));
-        }
-        Ok(())
+        self.enqueue(Self::plain([Step::Pins]), Some(Check::Phases(pattern)))
     }
 
     /// Expects output pins: each `Some` is checked.
@@ -1059,21 +1255,15 @@ impl<'t> Driver<'t> {
         aux: Option<bool>,
         auxo: Option<u8>,
     ) -> Outcome {
-        let p = self.pins()?;
-        let checks = [
-            ("INT*", int.map(u8::from), u8::from(p.int)),
-            ("HOLD", hold.map(u8::from), u8::from(p.hold)),
-            ("AUX*", aux.map(u8::from), u8::from(p.aux)),
-            ("AUXO0..3", auxo, p.auxo),
-        ];
-        for (name, want, got) in checks {
-            if let Some(w) = want {
-                if w != got {
-                    return Err(fail(format!("{name} asserted"), w, got, self.now));
-                }
-            }
-        }
-        Ok(())
+        self.enqueue(
+            Self::plain([Step::Pins]),
+            Some(Check::Pins {
+                int,
+                hold,
+                aux,
+                auxo,
+            }),
+        )
     }
 
     // ----- Table 3-3 measurements ---------------------------------------
@@ -1128,6 +1318,7 @@ impl<'t> Driver<'t> {
     /// Measures the Table 3-3 quantity `id` from what has happened so far
     /// and grades it. A FAIL stops the scenario; MARGINAL is recorded.
     pub fn expect_latency(&mut self, id: TimingId) -> Outcome<Duration> {
+        self.flush()?;
         let (from, to) = match id {
             TimingId::BusyRise => {
                 let a = self.need("an operation command", self.anchor)?;
@@ -1198,6 +1389,7 @@ impl<'t> Driver<'t> {
         self.expect_flag(Flag::Ibf, false, timeout)?;
         self.raw_command(Register::InputSignals.code())?;
         self.expect_flag(Flag::Ibf, false, timeout)?;
+        self.flush()?;
         let value = self.now.saturating_since(t);
         let at = self.now;
         self.record_measure(TimingId::InitProcessing, value, at)?;
@@ -1212,6 +1404,7 @@ impl<'t> Driver<'t> {
         self.raw_command(Register::InputSignals.code())?;
         let timeout = self.opts.ibf_timeout;
         self.expect_flag(Flag::Ibf, false, timeout)?;
+        self.flush()?;
         let value = self.now.saturating_since(last);
         let at = self.now;
         self.record_measure(TimingId::NextCommand, value, at)?;

@@ -250,7 +250,9 @@ pub fn run_scenario(
     let mut driver = Driver::new(target, opts);
     let outcome = catch_unwind(AssertUnwindSafe(|| {
         driver.reset()?;
-        (scenario.body)(&mut driver)
+        (scenario.body)(&mut driver)?;
+        // Deferred steps and checks still to run and judge.
+        driver.flush()
     }));
     let outcome = match outcome {
         Ok(o) => o,
@@ -263,7 +265,7 @@ pub fn run_scenario(
             Err(Stop::Error(format!("scenario panicked: {msg}")))
         }
     };
-    let elapsed = driver.now().saturating_since(Instant::ZERO);
+    let elapsed = driver.clock().saturating_since(Instant::ZERO);
     let capture = driver.capture().cloned();
     let (bus, measurements) = driver.into_parts();
     let verdict = match (outcome, &capture) {

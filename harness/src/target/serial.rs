@@ -170,6 +170,10 @@ pub enum SerialError {
     Restarted { link: String, old: u32, new: u32 },
     #[error("{link}: health check failed: {detail}")]
     Unhealthy { link: String, detail: String },
+    /// A request of `len` bytes kept arriving garbled; the bridge has not
+    /// run it. Batches are then sent in smaller requests.
+    #[error("{link}: a {len}-byte request keeps arriving garbled")]
+    Garbled { link: String, len: usize },
 }
 
 impl SerialError {
@@ -219,12 +223,27 @@ impl Default for SerialOptions {
     }
 }
 
-/// Largest request payload the host sends: small frames survive a noisy
-/// line, and a batch split over several requests runs the same.
-const MAX_REQUEST: usize = 128;
+/// Request payload sizes the host adapts between: large on a clean line
+/// (fewer round trips), small on a noisy one (small frames survive it). A
+/// batch split over several requests runs the same.
+const MAX_REQUEST: usize = 1024;
+const MIN_REQUEST: usize = 48;
 
 /// Records asked for per capture request.
 const CAPTURE_CHUNK: u16 = 300;
+
+/// What the bridge says of a request that kept arriving garbled.
+#[derive(Debug)]
+enum Ran {
+    /// It never ran it: safe to send its ops again, split.
+    No,
+    /// It ran it; here is the whole reply.
+    Yes(Response),
+    /// It ran it; some fragments of the reply have arrived.
+    Partly,
+    /// No clear answer: keep asking for the reply.
+    Unknown,
+}
 
 /// The fragments of a long reply received so far.
 #[derive(Debug, Default)]
@@ -287,6 +306,9 @@ pub struct SerialTarget<L: Link> {
     opts: SerialOptions,
     /// The capture fetched so far (since the last chip reset).
     captured: Record,
+    /// The request size in force: halved when a request needed asking
+    /// again, doubled back after clean ones.
+    request_size: usize,
     pub stats: LinkStats,
 }
 
@@ -313,6 +335,7 @@ impl<L: Link> SerialTarget<L> {
             timer: Timer::NANOS,
             opts,
             captured: Record::default(),
+            request_size: MAX_REQUEST,
             stats: LinkStats::default(),
         };
         t.hello = t.say_hello()?;
@@ -402,10 +425,13 @@ impl<L: Link> SerialTarget<L> {
     ) -> Result<Response, SerialError> {
         self.seq = self.seq.wrapping_add(1);
         let seq = self.seq;
-        let full = frame::encode(&req.encode(seq, self.timer));
+        let payload = req.encode(seq, self.timer);
+        let splittable = payload.len() > MIN_REQUEST;
+        let full = frame::encode(&payload);
         let mut frags = Fragments::default();
         let mut next = full.clone();
         let mut fruitless = 0;
+        let mut garbled = 0;
         let mut first = true;
         while fruitless <= self.opts.retries {
             if !first {
@@ -425,7 +451,31 @@ impl<L: Link> SerialTarget<L> {
                 Ok(Some(Response::Error {
                     code: BridgeErrorCode::BadFrame,
                     ..
-                })) => next = full.clone(),
+                })) => {
+                    garbled += 1;
+                    next = full.clone();
+                    if garbled >= 2 && frags.received() == 0 && splittable {
+                        // Too long for this line? Only if the bridge never
+                        // ran it: a bad-frame error does not say which frame
+                        // was bad, so ask before splitting.
+                        match self.ran(seq, &mut frags)? {
+                            Ran::No => {
+                                return Err(SerialError::Garbled {
+                                    link: self.link.name(),
+                                    len: payload.len(),
+                                })
+                            }
+                            Ran::Yes(r) => return Ok(r),
+                            Ran::Partly | Ran::Unknown => {
+                                if let Some(m) = frags.missing() {
+                                    next = frame::encode(
+                                        &Request::Resend { fragments: m }.encode(seq, self.timer),
+                                    );
+                                }
+                            }
+                        }
+                    }
+                }
                 Ok(Some(r)) => return Ok(r),
                 Ok(None) => {
                     next = match frags.missing() {
@@ -452,6 +502,40 @@ impl<L: Link> SerialTarget<L> {
             what: what.into(),
             tries: self.opts.retries + 1,
         })
+    }
+
+    /// Asks the bridge whether it ran request `seq` (a RESEND of its first
+    /// reply fragment): it answers with the cached reply if it did, and with
+    /// an error naming the sequence if it did not.
+    fn ran(&mut self, seq: u8, frags: &mut Fragments) -> Result<Ran, SerialError> {
+        let probe = frame::encode(&Request::Resend { fragments: vec![0] }.encode(seq, self.timer));
+        for _ in 0..=self.opts.retries {
+            self.stats.retransmissions += 1;
+            if let Err(e) = self.link.send(&probe) {
+                self.recover(e)?;
+                return Ok(Ran::Unknown);
+            }
+            self.stats.round_trips += 1;
+            let before = frags.received();
+            match self.await_reply(seq, self.opts.reply_timeout, frags) {
+                Ok(Some(Response::Error {
+                    code: BridgeErrorCode::Malformed,
+                    detail,
+                })) if detail.contains("no reply to sequence") => return Ok(Ran::No),
+                Ok(Some(Response::Error {
+                    code: BridgeErrorCode::BadFrame,
+                    ..
+                })) => {}
+                Ok(Some(r)) => return Ok(Ran::Yes(r)),
+                Ok(None) if frags.received() > before => return Ok(Ran::Partly),
+                Ok(None) => {}
+                Err(e) => {
+                    self.recover(e)?;
+                    return Ok(Ran::Unknown);
+                }
+            }
+        }
+        Ok(Ran::Unknown)
     }
 
     /// Reads until the reply to `seq` is complete (`Some`), or the link
@@ -579,14 +663,14 @@ impl<L: Link> SerialTarget<L> {
         let max_ops = usize::from(self.hello.max_batch_ops.clamp(1, MAX_BATCH_OPS.max(1)));
         let mut rest = ops;
         while !rest.is_empty() {
-            // As many ops as fit one small request.
+            // As many ops as fit one request of the size in force.
             let mut n = 1;
             while n < rest.len()
                 && n < max_ops
                 && Request::Batch(rest[..=n].to_vec())
                     .encode(0, self.timer)
                     .len()
-                    <= MAX_REQUEST
+                    <= self.request_size
             {
                 n += 1;
             }
@@ -598,7 +682,24 @@ impl<L: Link> SerialTarget<L> {
                 chunk[0]
             );
             let extra = self.batch_time(chunk);
-            match self.request(&Request::Batch(chunk.to_vec()), &what, extra)? {
+            let asked_again = self.stats.retransmissions;
+            let reply = match self.request(&Request::Batch(chunk.to_vec()), &what, extra) {
+                Err(SerialError::Garbled { .. }) if self.request_size > MIN_REQUEST => {
+                    // Not run: send the same ops again in smaller requests.
+                    self.request_size = (self.request_size / 2).max(MIN_REQUEST);
+                    rest = ops_from(ops, out.len());
+                    continue;
+                }
+                other => other?,
+            };
+            // Noisy line: smaller requests (and so smaller replies); clean:
+            // back up towards the largest.
+            self.request_size = if self.stats.retransmissions > asked_again {
+                (self.request_size / 2).max(MIN_REQUEST)
+            } else {
+                (self.request_size * 2).min(MAX_REQUEST)
+            };
+            match reply {
                 Response::Batch(r) if r.len() == chunk.len() => out.extend(r),
                 other => return Err(self.unexpected(&what, &other)),
             }
@@ -661,6 +762,11 @@ impl<L: Link> Target for SerialTarget<L> {
         }
         Ok(self.run_batch(ops)?)
     }
+}
+
+/// The ops of `ops` from index `from` on.
+fn ops_from(ops: &[Op], from: usize) -> &[Op] {
+    &ops[from.min(ops.len())..]
 }
 
 /// Parses `serial:<path>[,baud=N]`.
