@@ -35,23 +35,21 @@ pub fn scenarios() -> Vec<Scenario> {
     ]
 }
 
-/// Samples the energized phases every `step` over `span`; returns the
-/// number of on-to-off and off-to-on changes seen. (Used where nothing
-/// should chop; [`Driver::expect_chopping`] measures real chopping.)
+/// Samples the energized phases every `step` over `span` (one batch);
+/// returns the number of on-to-off and off-to-on changes seen. (Used where
+/// nothing should chop; [`Driver::expect_chopping`] measures real chopping.)
 fn count_chops(d: &mut Driver, step: Duration, span: Duration) -> Result<(u32, u32), crate::scenario::Stop> {
-    let end = d.now()? + span;
-    let mut last = d.pins()?.phases != 0;
+    let n = (span.as_nanos() / step.as_nanos().max(1)) as usize + 1;
+    let samples = d.sample_pins(step, n)?;
     let (mut offs, mut ons) = (0, 0);
-    while d.now()? < end {
-        d.wait(step)?;
-        let on = d.pins()?.phases != 0;
-        if last && !on {
+    for w in samples.windows(2) {
+        let (a, b) = (w[0].1.phases != 0, w[1].1.phases != 0);
+        if a && !b {
             offs += 1;
         }
-        if !last && on {
+        if !a && b {
             ons += 1;
         }
-        last = on;
     }
     Ok((offs, ons))
 }

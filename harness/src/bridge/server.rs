@@ -15,8 +15,9 @@ use super::wire::{
 };
 use crate::target::{EmuTarget, Target};
 
-/// Most ops in one batch: keeps the largest reply inside one frame.
-pub const MAX_BATCH_OPS: u16 = 48;
+/// Most ops in one batch: keeps the largest reply (128 x 69 bytes) within
+/// 255 fragments.
+pub const MAX_BATCH_OPS: u16 = 128;
 
 /// Records per capture chunk, sized so that a reply fits in 255 fragments.
 const CHUNK_RUNS: usize = 300;
@@ -302,7 +303,7 @@ mod tests {
             code(collect(&truncated).1),
             Some(BridgeErrorCode::Malformed)
         );
-        let big = Request::Batch(vec![Op::ReadStatus; 49]);
+        let big = Request::Batch(vec![Op::ReadStatus; usize::from(MAX_BATCH_OPS) + 1]);
         assert_eq!(code(ask(&mut s, 3, &big)), Some(BridgeErrorCode::Overflow));
     }
 

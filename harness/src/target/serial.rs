@@ -226,7 +226,7 @@ impl Default for SerialOptions {
 /// Request payload sizes the host adapts between: large on a clean line
 /// (fewer round trips), small on a noisy one (small frames survive it). A
 /// batch split over several requests runs the same.
-const MAX_REQUEST: usize = 1024;
+const MAX_REQUEST: usize = 2048;
 const MIN_REQUEST: usize = 48;
 
 /// Records asked for per capture request.
