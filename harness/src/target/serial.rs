@@ -788,6 +788,171 @@ pub fn parse_spec(spec: &str) -> Option<(String, u32)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bridge::server::BridgeServer;
+    use crate::emu::ModelConfig;
+    use crate::protocol::Straps;
+    use crate::target::EmuTarget;
+
+    /// A link straight into a bridge server, which fails on demand.
+    #[derive(Debug)]
+    struct MemLink {
+        server: BridgeServer,
+        pending: Vec<u8>,
+        fail_sends: u32,
+        fail_reopens: u32,
+        restart_on_reopen: bool,
+    }
+
+    impl MemLink {
+        fn new() -> MemLink {
+            MemLink {
+                server: Self::bridge(1),
+                pending: Vec::new(),
+                fail_sends: 0,
+                fail_reopens: 0,
+                restart_on_reopen: false,
+            }
+        }
+
+        fn bridge(session: u32) -> BridgeServer {
+            let emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emu");
+            BridgeServer::new(emu, session, true)
+        }
+    }
+
+    impl Link for MemLink {
+        fn send(&mut self, bytes: &[u8]) -> io::Result<()> {
+            if self.fail_sends > 0 {
+                self.fail_sends -= 1;
+                return Err(io::Error::new(io::ErrorKind::BrokenPipe, "unplugged"));
+            }
+            let out = self.server.on_bytes(bytes);
+            self.pending.extend(out);
+            Ok(())
+        }
+
+        fn recv(&mut self, buf: &mut [u8], _timeout: WallDuration) -> io::Result<usize> {
+            let n = self.pending.len().min(buf.len());
+            buf[..n].copy_from_slice(&self.pending[..n]);
+            self.pending.drain(..n);
+            Ok(n)
+        }
+
+        fn reopen(&mut self) -> io::Result<()> {
+            if self.fail_reopens > 0 {
+                self.fail_reopens -= 1;
+                return Err(io::Error::new(io::ErrorKind::NotFound, "no such port"));
+            }
+            self.pending.clear();
+            if self.restart_on_reopen {
+                self.server = Self::bridge(2);
+            }
+            Ok(())
+        }
+
+        fn name(&self) -> String {
+            "mem".into()
+        }
+    }
+
+    fn quick() -> SerialOptions {
+        SerialOptions {
+            reply_timeout: WallDuration::from_millis(20),
+            retries: 2,
+            reopen_attempts: 3,
+            backoff: WallDuration::from_millis(1),
+            quiet: WallDuration::from_millis(1),
+        }
+    }
+
+    #[test]
+    fn a_vanished_port_is_reopened_and_the_run_goes_on() {
+        let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+        t.link.fail_sends = 1;
+        t.link.fail_reopens = 2;
+        let r = t.execute(&[Op::ReadStatus]).expect("recovered");
+        assert!(matches!(r[0], Reply::Status { .. }));
+        assert_eq!(t.stats.reopens, 1);
+    }
+
+    #[test]
+    fn a_port_that_stays_gone_ends_with_link_lost() {
+        let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+        t.link.fail_sends = 1;
+        t.link.fail_reopens = 10;
+        let e = t.execute(&[Op::ReadStatus]).expect_err("gone");
+        assert_eq!(e.kind, TargetErrorKind::Link);
+        assert!(
+            e.message
+                .contains("link lost and not back after 3 reopen attempts"),
+            "{}",
+            e.message
+        );
+    }
+
+    #[test]
+    fn a_restarted_bridge_is_not_trusted() {
+        let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+        t.link.fail_sends = 1;
+        t.link.restart_on_reopen = true;
+        let e = t.execute(&[Op::ReadStatus]).expect_err("restarted");
+        assert!(e.message.contains("the bridge restarted"), "{}", e.message);
+    }
+
+    #[test]
+    fn a_bridge_of_another_protocol_version_is_refused() {
+        // A bridge that answers hello with version 2.
+        #[derive(Debug)]
+        struct V2(Vec<u8>);
+        impl Link for V2 {
+            fn send(&mut self, bytes: &[u8]) -> io::Result<()> {
+                let mut d = FrameDecoder::new();
+                d.extend(bytes);
+                if let Ok(Some(p)) = d.decode() {
+                    let seq = p[0];
+                    let hello = Response::Hello(Hello {
+                        version: 2,
+                        session: 1,
+                        timer_hz: 1_000_000_000,
+                        max_batch_ops: 1,
+                        max_payload: 64,
+                        capture_capacity: 0,
+                        inputs_wired: 0,
+                        virtual_time: true,
+                        firmware: "future".into(),
+                        straps: String::new(),
+                    });
+                    self.0
+                        .extend(frame::encode(&hello.encode(seq, Timer::NANOS)));
+                }
+                Ok(())
+            }
+            fn recv(&mut self, buf: &mut [u8], _: WallDuration) -> io::Result<usize> {
+                let n = self.0.len().min(buf.len());
+                buf[..n].copy_from_slice(&self.0[..n]);
+                self.0.drain(..n);
+                Ok(n)
+            }
+            fn reopen(&mut self) -> io::Result<()> {
+                Ok(())
+            }
+            fn name(&self) -> String {
+                "v2".into()
+            }
+        }
+        let e = SerialTarget::open(V2(Vec::new()), quick()).expect_err("version");
+        assert!(
+            matches!(
+                e,
+                SerialError::Version {
+                    theirs: 2,
+                    ours: 1,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
 
     #[test]
     fn specs_parse() {
