@@ -1083,12 +1083,15 @@ impl<'t> Driver<'t> {
     // ----- expectations --------------------------------------------------
 
     /// A scenario's own check: fails with `what`, expected vs got, now.
+    /// Everything queued is judged first, so an earlier failure is the one
+    /// reported.
     pub fn check<T: PartialEq + std::fmt::Debug>(
-        &self,
+        &mut self,
         what: &str,
         expected: T,
         got: T,
     ) -> Outcome {
+        self.flush()?;
         if expected != got {
             return Err(fail(
                 what,
