@@ -160,6 +160,11 @@ fn corrupted_bytes_never_turn_into_wrong_values() {
         t.stats.retransmissions > 0,
         "and repaired by retransmission"
     );
+    for r in &noisy {
+        if let Verdict::Error(e) = &r.verdict {
+            eprintln!("link error in {}: {e}", r.name);
+        }
+    }
     let first_error = noisy.iter().find_map(|r| match &r.verdict {
         Verdict::Error(e) => Some(format!("{}: {e}", r.name)),
         _ => None,

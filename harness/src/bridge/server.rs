@@ -179,24 +179,49 @@ impl BridgeServer {
                 pins,
                 moves,
                 max,
-            } => {
-                let rec = self.target.chip().record();
-                let max = usize::from(max.max(1));
-                let take = |from: u32, len: usize, max: usize| {
-                    let from = (from as usize).min(len);
-                    (from, (from + max).min(len))
-                };
-                let (r0, r1) = take(runs, rec.runs.len(), CHUNK_RUNS.min(max));
-                let (p0, p1) = take(pins, rec.pins.len(), CHUNK_PINS.min(max));
-                let (m0, m1) = take(moves, rec.moves.len(), CHUNK_MOVES.min(max));
-                Response::Capture(CaptureChunk {
-                    runs: rec.runs[r0..r1].to_vec(),
-                    pins: rec.pins[p0..p1].to_vec(),
-                    moves: rec.moves[m0..m1].to_vec(),
-                    overwritten_bytes: rec.overwritten_bytes,
-                    more: r1 < rec.runs.len() || p1 < rec.pins.len() || m1 < rec.moves.len(),
-                })
+            } => Response::Capture(self.chunk(runs, pins, moves, max)),
+            Request::BatchCapture { ops, .. } if ops.len() > usize::from(MAX_BATCH_OPS) => {
+                Response::Error {
+                    code: BridgeErrorCode::Overflow,
+                    detail: format!("{} ops in one batch, at most {MAX_BATCH_OPS}", ops.len()),
+                }
             }
+            Request::BatchCapture {
+                ops,
+                runs,
+                pins,
+                moves,
+                max,
+            } => match self.target.execute(&ops) {
+                Ok(replies) => Response::BatchCapture {
+                    replies,
+                    capture: self.chunk(runs, pins, moves, max),
+                },
+                Err(e) => Response::Error {
+                    code: BridgeErrorCode::Malformed,
+                    detail: e.to_string(),
+                },
+            },
+        }
+    }
+
+    /// Up to `max` capture records of each kind from these positions on.
+    fn chunk(&self, runs: u32, pins: u32, moves: u32, max: u16) -> CaptureChunk {
+        let rec = self.target.chip().record();
+        let max = usize::from(max.max(1));
+        let take = |from: u32, len: usize, max: usize| {
+            let from = (from as usize).min(len);
+            (from, (from + max).min(len))
+        };
+        let (r0, r1) = take(runs, rec.runs.len(), CHUNK_RUNS.min(max));
+        let (p0, p1) = take(pins, rec.pins.len(), CHUNK_PINS.min(max));
+        let (m0, m1) = take(moves, rec.moves.len(), CHUNK_MOVES.min(max));
+        CaptureChunk {
+            runs: rec.runs[r0..r1].to_vec(),
+            pins: rec.pins[p0..p1].to_vec(),
+            moves: rec.moves[m0..m1].to_vec(),
+            overwritten_bytes: rec.overwritten_bytes,
+            more: r1 < rec.runs.len() || p1 < rec.pins.len() || m1 < rec.moves.len(),
         }
     }
 }
@@ -372,5 +397,62 @@ mod tests {
             (rec.runs.len(), rec.pins.len(), rec.moves.len())
         );
         assert_eq!(moves, 30);
+    }
+
+    #[test]
+    fn batch_capture_runs_the_ops_then_returns_the_capture_after_them() {
+        let mut s = server();
+        // Initialization (as in `capture_comes_in_chunks`), then a single
+        // step (0x4A): one move and one pulse run.
+        let mut ops = vec![Op::WriteCommand {
+            byte: 0x06,
+            wait_ibf: None,
+        }];
+        for b in [100u8, 20, 100, 0] {
+            ops.push(Op::WriteData {
+                byte: b,
+                wait_ibf: Some(Duration::from_secs(1)),
+            });
+        }
+        ops.extend([
+            Op::Delay(Duration::from_millis(200)),
+            Op::WriteCommand {
+                byte: 0x4A,
+                wait_ibf: Some(Duration::from_secs(1)),
+            },
+            Op::Delay(Duration::from_millis(5)),
+        ]);
+        let Response::BatchCapture { replies, capture } = ask(
+            &mut s,
+            1,
+            &Request::BatchCapture {
+                ops: ops.clone(),
+                runs: 0,
+                pins: 0,
+                moves: 0,
+                max: 60,
+            },
+        ) else {
+            panic!("batch-capture reply");
+        };
+        assert_eq!(replies.len(), ops.len());
+        let rec = s.target().chip().record();
+        assert_eq!(capture.moves.len(), rec.moves.len());
+        assert_eq!(capture.runs, rec.runs);
+        assert!(!capture.moves.is_empty(), "the step's move is in the chunk");
+        let too_many = Request::BatchCapture {
+            ops: vec![Op::ReadStatus; usize::from(MAX_BATCH_OPS) + 1],
+            runs: 0,
+            pins: 0,
+            moves: 0,
+            max: 60,
+        };
+        assert!(matches!(
+            ask(&mut s, 2, &too_many),
+            Response::Error {
+                code: BridgeErrorCode::Overflow,
+                ..
+            }
+        ));
     }
 }

@@ -22,10 +22,12 @@ pub mod kind {
     pub const BATCH: u8 = 0x02;
     pub const CAPTURE: u8 = 0x03;
     pub const RESEND: u8 = 0x04;
+    pub const BATCH_CAPTURE: u8 = 0x05;
     pub const HELLO_REPLY: u8 = 0x81;
     pub const BATCH_REPLY: u8 = 0x82;
     pub const CAPTURE_REPLY: u8 = 0x83;
     pub const FRAGMENT: u8 = 0x84;
+    pub const BATCH_CAPTURE_REPLY: u8 = 0x85;
     pub const ERROR: u8 = 0xFF;
 }
 
@@ -119,6 +121,15 @@ pub enum Request {
     Resend {
         fragments: Vec<u8>,
     },
+    /// A batch, then the capture from these positions on: one round trip
+    /// where a host needs both.
+    BatchCapture {
+        ops: Vec<Op>,
+        runs: u32,
+        pins: u32,
+        moves: u32,
+        max: u16,
+    },
 }
 
 /// Largest response payload sent as one frame; longer ones go as
@@ -174,6 +185,11 @@ pub enum Response {
     Hello(Hello),
     Batch(Vec<Reply>),
     Capture(CaptureChunk),
+    /// The replies to a BATCH_CAPTURE's ops, then the capture chunk.
+    BatchCapture {
+        replies: Vec<Reply>,
+        capture: CaptureChunk,
+    },
     Error {
         code: BridgeErrorCode,
         detail: String,
@@ -693,6 +709,102 @@ fn move_kind_from(at: usize, c: u8) -> Result<MoveKind, WireError> {
         })
 }
 
+fn put_capture(w: &mut W, c: &CaptureChunk) {
+    w.u16(c.runs.len() as u16);
+    for run in &c.runs {
+        w.u64(run.start.as_nanos());
+        w.dur(run.interval);
+        w.u32(run.count);
+        w.u8(u8::from(run.dir.bit()));
+    }
+    w.u16(c.pins.len() as u16);
+    for p in &c.pins {
+        w.time(p.at);
+        w.u8(pin_code(p.pin));
+        w.u8(p.value);
+    }
+    w.u16(c.moves.len() as u16);
+    for m in &c.moves {
+        w.time(m.at);
+        w.u8(move_kind_code(m.kind));
+        w.u8(u8::from(m.dir.bit()));
+        w.u8(u8::from(m.pout));
+        w.u32(m.steps);
+        w.u8(winding_code(m.winding));
+        w.u32(m.phase_index);
+        w.u32(m.first_run as u32);
+    }
+    w.u64(c.overwritten_bytes);
+    w.u8(u8::from(c.more));
+}
+
+fn get_capture(r: &mut R) -> Result<CaptureChunk, WireError> {
+    let mut c = CaptureChunk::default();
+    let n = r.count(21)?;
+    for _ in 0..n {
+        let start = r.time()?;
+        let interval = r.dur()?;
+        let count = r.u32()?;
+        let dir = r.dir()?;
+        c.runs.push(PulseRun {
+            start,
+            interval,
+            count,
+            dir,
+        });
+    }
+    let n = r.count(10)?;
+    for _ in 0..n {
+        let at = r.time()?;
+        let pat = r.at;
+        let code = r.u8()?;
+        let pin = *Pin::ALL.get(usize::from(code)).ok_or(WireError::BadValue {
+            at: pat,
+            field: "pin",
+            value: u64::from(code),
+        })?;
+        c.pins.push(PinEvent {
+            at,
+            pin,
+            value: r.u8()?,
+        });
+    }
+    let n = r.count(24)?;
+    for _ in 0..n {
+        let at = r.time()?;
+        let kat = r.at;
+        let kind = move_kind_from(kat, r.u8()?)?;
+        let dir = r.dir()?;
+        let pout = r.bool("pout")?;
+        let steps = r.u32()?;
+        let wat = r.at;
+        let wc = r.u8()?;
+        let winding = winding_from(wc);
+        if wc != 0 && winding.is_none() {
+            return Err(WireError::BadValue {
+                at: wat,
+                field: "winding",
+                value: u64::from(wc),
+            });
+        }
+        let phase_index = r.u32()?;
+        let first_run = r.u32()? as usize;
+        c.moves.push(MoveStart {
+            at,
+            kind,
+            dir,
+            pout,
+            steps,
+            first_run,
+            phase_index,
+            winding,
+        });
+    }
+    c.overwritten_bytes = r.u64()?;
+    c.more = r.bool("more")?;
+    Ok(c)
+}
+
 impl Request {
     /// The frame payload for this request with sequence number `seq`,
     /// times in ticks of `timer`.
@@ -718,6 +830,23 @@ impl Request {
                 max,
             } => {
                 w.u8(kind::CAPTURE);
+                w.u32(*runs);
+                w.u32(*pins);
+                w.u32(*moves);
+                w.u16(*max);
+            }
+            Request::BatchCapture {
+                ops,
+                runs,
+                pins,
+                moves,
+                max,
+            } => {
+                w.u8(kind::BATCH_CAPTURE);
+                w.u16(ops.len() as u16);
+                for o in ops {
+                    put_op(&mut w, o);
+                }
                 w.u32(*runs);
                 w.u32(*pins);
                 w.u32(*moves);
@@ -754,6 +883,20 @@ impl Request {
                 moves: r.u32()?,
                 max: r.u16()?,
             },
+            kind::BATCH_CAPTURE => {
+                let n = r.count(1)?;
+                let mut ops = Vec::with_capacity(n);
+                for _ in 0..n {
+                    ops.push(get_op(&mut r)?);
+                }
+                Request::BatchCapture {
+                    ops,
+                    runs: r.u32()?,
+                    pins: r.u32()?,
+                    moves: r.u32()?,
+                    max: r.u16()?,
+                }
+            }
             kind::RESEND => {
                 let n = usize::from(r.u8()?);
                 Request::Resend {
@@ -796,32 +939,15 @@ impl Response {
             }
             Response::Capture(c) => {
                 w.u8(kind::CAPTURE_REPLY);
-                w.u16(c.runs.len() as u16);
-                for run in &c.runs {
-                    w.u64(run.start.as_nanos());
-                    w.dur(run.interval);
-                    w.u32(run.count);
-                    w.u8(u8::from(run.dir.bit()));
+                put_capture(&mut w, c);
+            }
+            Response::BatchCapture { replies, capture } => {
+                w.u8(kind::BATCH_CAPTURE_REPLY);
+                w.u16(replies.len() as u16);
+                for rp in replies {
+                    put_reply(&mut w, rp);
                 }
-                w.u16(c.pins.len() as u16);
-                for p in &c.pins {
-                    w.time(p.at);
-                    w.u8(pin_code(p.pin));
-                    w.u8(p.value);
-                }
-                w.u16(c.moves.len() as u16);
-                for m in &c.moves {
-                    w.time(m.at);
-                    w.u8(move_kind_code(m.kind));
-                    w.u8(u8::from(m.dir.bit()));
-                    w.u8(u8::from(m.pout));
-                    w.u32(m.steps);
-                    w.u8(winding_code(m.winding));
-                    w.u32(m.phase_index);
-                    w.u32(m.first_run as u32);
-                }
-                w.u64(c.overwritten_bytes);
-                w.u8(u8::from(c.more));
+                put_capture(&mut w, capture);
             }
             Response::Error { code, detail } => {
                 w.u8(kind::ERROR);
@@ -857,71 +983,17 @@ impl Response {
                 }
                 Response::Batch(v)
             }
-            kind::CAPTURE_REPLY => {
-                let mut c = CaptureChunk::default();
-                let n = r.count(21)?;
+            kind::CAPTURE_REPLY => Response::Capture(get_capture(&mut r)?),
+            kind::BATCH_CAPTURE_REPLY => {
+                let n = r.count(9)?;
+                let mut replies = Vec::with_capacity(n);
                 for _ in 0..n {
-                    let start = r.time()?;
-                    let interval = r.dur()?;
-                    let count = r.u32()?;
-                    let dir = r.dir()?;
-                    c.runs.push(PulseRun {
-                        start,
-                        interval,
-                        count,
-                        dir,
-                    });
+                    replies.push(get_reply(&mut r)?);
                 }
-                let n = r.count(10)?;
-                for _ in 0..n {
-                    let at = r.time()?;
-                    let pat = r.at;
-                    let code = r.u8()?;
-                    let pin = *Pin::ALL.get(usize::from(code)).ok_or(WireError::BadValue {
-                        at: pat,
-                        field: "pin",
-                        value: u64::from(code),
-                    })?;
-                    c.pins.push(PinEvent {
-                        at,
-                        pin,
-                        value: r.u8()?,
-                    });
+                Response::BatchCapture {
+                    replies,
+                    capture: get_capture(&mut r)?,
                 }
-                let n = r.count(24)?;
-                for _ in 0..n {
-                    let at = r.time()?;
-                    let kat = r.at;
-                    let kind = move_kind_from(kat, r.u8()?)?;
-                    let dir = r.dir()?;
-                    let pout = r.bool("pout")?;
-                    let steps = r.u32()?;
-                    let wat = r.at;
-                    let wc = r.u8()?;
-                    let winding = winding_from(wc);
-                    if wc != 0 && winding.is_none() {
-                        return Err(WireError::BadValue {
-                            at: wat,
-                            field: "winding",
-                            value: u64::from(wc),
-                        });
-                    }
-                    let phase_index = r.u32()?;
-                    let first_run = r.u32()? as usize;
-                    c.moves.push(MoveStart {
-                        at,
-                        kind,
-                        dir,
-                        pout,
-                        steps,
-                        first_run,
-                        phase_index,
-                        winding,
-                    });
-                }
-                c.overwritten_bytes = r.u64()?;
-                c.more = r.bool("more")?;
-                Response::Capture(c)
             }
             kind::ERROR => Response::Error {
                 code: BridgeErrorCode::from_code(r.u8()?),
@@ -1134,6 +1206,31 @@ mod tests {
             max: 40,
         };
         assert_eq!(Request::decode(&c.encode(5, T), T), Ok((5, c)));
+        let bc = Request::BatchCapture {
+            ops: sample_ops(),
+            runs: 4,
+            pins: 5,
+            moves: 6,
+            max: 60,
+        };
+        assert_eq!(Request::decode(&bc.encode(6, T), T), Ok((6, bc)));
+        let reply = Response::BatchCapture {
+            replies: vec![Reply::Delayed {
+                at: Instant::from_nanos(77),
+            }],
+            capture: CaptureChunk {
+                runs: vec![],
+                pins: vec![PinEvent {
+                    at: Instant::from_nanos(9),
+                    pin: Pin::Busy,
+                    value: 1,
+                }],
+                moves: vec![],
+                overwritten_bytes: 0,
+                more: false,
+            },
+        };
+        assert_eq!(Response::decode(&reply.encode(6, T), T), Ok((6, reply)));
     }
 
     #[test]

@@ -320,16 +320,31 @@ impl<'t> Driver<'t> {
     }
 
     fn send(&mut self, ops: &[Op]) -> Outcome<Vec<Reply>> {
+        self.send_then(ops, false)
+    }
+
+    /// Runs ops on the target; with `capture`, also fetches the capture
+    /// after them (one round trip less on a board).
+    fn send_then(&mut self, ops: &[Op], capture: bool) -> Outcome<Vec<Reply>> {
         if self.now.as_nanos() > self.opts.budget.as_nanos() {
             return Err(Stop::Error(format!(
                 "scenario exceeded its time budget of {} (virtual time)",
                 self.opts.budget
             )));
         }
-        let replies = self
-            .target
-            .execute(ops)
-            .map_err(|e| Stop::Error(format!("target: {e}")))?;
+        let (replies, record) = if capture {
+            let (replies, record) = self
+                .target
+                .execute_then_capture(ops)
+                .map_err(|e| Stop::Error(format!("target: {e}")))?;
+            (replies, Some(record))
+        } else {
+            let replies = self
+                .target
+                .execute(ops)
+                .map_err(|e| Stop::Error(format!("target: {e}")))?;
+            (replies, None)
+        };
         if replies.len() != ops.len() {
             return Err(Stop::Error(format!(
                 "target answered {} of {} operations",
@@ -340,7 +355,7 @@ impl<'t> Driver<'t> {
         if let Some(last) = replies.last() {
             self.now = last.at();
         }
-        self.capture = None;
+        self.capture = record;
         Ok(replies)
     }
 
@@ -375,6 +390,18 @@ impl<'t> Driver<'t> {
     /// failing one have run on the target too; the verdict and the failure
     /// are those of the first failing step.
     pub fn flush(&mut self) -> Outcome {
+        self.flush_then(false)
+    }
+
+    /// Flushes what is queued at the end of a scenario, fetching the
+    /// capture in the same round trip.
+    pub fn finish(&mut self) -> Outcome {
+        self.flush_then(true)
+    }
+
+    /// [`Driver::flush`]; with `capture`, the capture after the batch comes
+    /// back with it.
+    fn flush_then(&mut self, capture: bool) -> Outcome {
         if self.queue.is_empty() {
             return Ok(());
         }
@@ -384,7 +411,7 @@ impl<'t> Driver<'t> {
             .flat_map(|g| g.steps.iter().map(|(s, _)| self.step_op(*s)))
             .collect();
         let mut began = self.now;
-        let mut replies = self.send(&ops)?.into_iter();
+        let mut replies = self.send_then(&ops, capture)?.into_iter();
         for g in groups {
             let mut done = Vec::with_capacity(g.steps.len());
             for (step, role) in g.steps {
@@ -933,7 +960,7 @@ impl<'t> Driver<'t> {
     /// The capture since reset (fetched once per change, after everything
     /// queued has run).
     pub fn capture(&mut self) -> Outcome<&Record> {
-        self.flush()?;
+        self.flush_then(true)?;
         if self.capture.is_none() {
             let c = self
                 .target

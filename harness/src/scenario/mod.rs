@@ -251,8 +251,9 @@ pub fn run_scenario(
     let outcome = catch_unwind(AssertUnwindSafe(|| {
         driver.reset()?;
         (scenario.body)(&mut driver)?;
-        // Deferred steps and checks still to run and judge.
-        driver.flush()
+        // Deferred steps and checks still to run and judge; the capture
+        // comes back with them.
+        driver.finish()
     }));
     let outcome = match outcome {
         Ok(o) => o,

@@ -210,6 +210,13 @@ pub trait Target: Send {
     /// Runs `ops` back to back and returns one reply per op, in order.
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError>;
 
+    /// Runs `ops`, then returns the capture too: one round trip on a board
+    /// where a caller needs both.
+    fn execute_then_capture(&mut self, ops: &[Op]) -> Result<(Vec<Reply>, Record), TargetError> {
+        let replies = self.execute(ops)?;
+        Ok((replies, self.capture()?))
+    }
+
     /// Runs one op.
     fn execute_one(&mut self, op: Op) -> Result<Reply, TargetError> {
         let mut replies = self.execute(std::slice::from_ref(&op))?;

@@ -12,7 +12,8 @@ use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
 use crate::bridge::frame::{self, FrameDecoder};
 use crate::bridge::server::MAX_BATCH_OPS;
 use crate::bridge::wire::{
-    parse_fragment, BridgeErrorCode, Hello, Request, Response, Timer, PROTOCOL_VERSION,
+    parse_fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer,
+    PROTOCOL_VERSION,
 };
 use crate::protocol::Record;
 use std::fmt;
@@ -342,13 +343,13 @@ impl<L: Link> SerialTarget<L> {
         t.timer = Timer {
             hz: t.hello.timer_hz,
         };
-        let replies =
-            t.run_batch(&[Op::Reset, Op::ReadStatus])
-                .map_err(|e| SerialError::Unhealthy {
-                    link: t.link.name(),
-                    detail: e.to_string(),
-                })?;
-        match replies.get(1) {
+        let replies = t
+            .run_batch(&[Op::Reset, Op::ReadStatus], false)
+            .map_err(|e| SerialError::Unhealthy {
+                link: t.link.name(),
+                detail: e.to_string(),
+            })?;
+        match replies.0.get(1) {
             Some(Reply::Status { status, .. }) if status.0 == 0 => Ok(t),
             other => Err(SerialError::Unhealthy {
                 link: t.link.name(),
@@ -658,8 +659,39 @@ impl<L: Link> SerialTarget<L> {
         WallDuration::from_nanos(total)
     }
 
-    fn run_batch(&mut self, ops: &[Op]) -> Result<Vec<Reply>, SerialError> {
+    /// Where the next capture fetch starts: the last pulse run known (it
+    /// may have grown), and the pin changes and moves after those known.
+    fn capture_from(&self) -> (u32, u32, u32) {
+        (
+            self.captured.runs.len().saturating_sub(1) as u32,
+            self.captured.pins.len() as u32,
+            self.captured.moves.len() as u32,
+        )
+    }
+
+    /// Adds a capture chunk fetched from [`Self::capture_from`]; returns
+    /// whether more records remain.
+    fn absorb(&mut self, c: CaptureChunk) -> bool {
+        let from_run = self.captured.runs.len().saturating_sub(1);
+        if !c.runs.is_empty() {
+            self.captured.runs.truncate(from_run);
+        }
+        self.captured.runs.extend(c.runs);
+        self.captured.pins.extend(c.pins);
+        self.captured.moves.extend(c.moves);
+        self.captured.overwritten_bytes = c.overwritten_bytes;
+        c.more
+    }
+
+    /// Runs `ops` in requests of the size in force; with `capture` and a
+    /// clean link, the last request also fetches the first capture chunk.
+    fn run_batch(
+        &mut self,
+        ops: &[Op],
+        capture: bool,
+    ) -> Result<(Vec<Reply>, Option<CaptureChunk>), SerialError> {
         let mut out = Vec::with_capacity(ops.len());
+        let mut chunk_out = None;
         let max_ops = usize::from(self.hello.max_batch_ops.clamp(1, MAX_BATCH_OPS.max(1)));
         let mut rest = ops;
         while !rest.is_empty() {
@@ -683,7 +715,21 @@ impl<L: Link> SerialTarget<L> {
             );
             let extra = self.batch_time(chunk);
             let asked_again = self.stats.retransmissions;
-            let reply = match self.request(&Request::Batch(chunk.to_vec()), &what, extra) {
+            // The capture rides along only on a clean link: on a noisy one
+            // (requests shrunk) a longer reply is likelier to need resending.
+            let req = if capture && rest.is_empty() && self.request_size >= MAX_REQUEST {
+                let (runs, pins, moves) = self.capture_from();
+                Request::BatchCapture {
+                    ops: chunk.to_vec(),
+                    runs,
+                    pins,
+                    moves,
+                    max: CAPTURE_CHUNK,
+                }
+            } else {
+                Request::Batch(chunk.to_vec())
+            };
+            let reply = match self.request(&req, &what, extra) {
                 Err(SerialError::Garbled { .. }) if self.request_size > MIN_REQUEST => {
                     // Not run: send the same ops again in smaller requests.
                     self.request_size = (self.request_size / 2).max(MIN_REQUEST);
@@ -701,10 +747,14 @@ impl<L: Link> SerialTarget<L> {
             };
             match reply {
                 Response::Batch(r) if r.len() == chunk.len() => out.extend(r),
+                Response::BatchCapture { replies, capture } if replies.len() == chunk.len() => {
+                    out.extend(replies);
+                    chunk_out = Some(capture);
+                }
                 other => return Err(self.unexpected(&what, &other)),
             }
         }
-        Ok(out)
+        Ok((out, chunk_out))
     }
 }
 
@@ -730,23 +780,16 @@ impl<L: Link> Target for SerialTarget<L> {
     /// (the last run may have grown).
     fn capture(&mut self) -> Result<Record, TargetError> {
         loop {
-            let from_run = self.captured.runs.len().saturating_sub(1);
+            let (runs, pins, moves) = self.capture_from();
             let req = Request::Capture {
-                runs: from_run as u32,
-                pins: self.captured.pins.len() as u32,
-                moves: self.captured.moves.len() as u32,
+                runs,
+                pins,
+                moves,
                 max: CAPTURE_CHUNK,
             };
             match self.request(&req, "capture", WallDuration::ZERO)? {
                 Response::Capture(c) => {
-                    if !c.runs.is_empty() {
-                        self.captured.runs.truncate(from_run);
-                    }
-                    self.captured.runs.extend(c.runs);
-                    self.captured.pins.extend(c.pins);
-                    self.captured.moves.extend(c.moves);
-                    self.captured.overwritten_bytes = c.overwritten_bytes;
-                    if !c.more {
+                    if !self.absorb(c) {
                         return Ok(self.captured.clone());
                     }
                 }
@@ -755,12 +798,25 @@ impl<L: Link> Target for SerialTarget<L> {
         }
     }
 
+    fn execute_then_capture(&mut self, ops: &[Op]) -> Result<(Vec<Reply>, Record), TargetError> {
+        if ops.contains(&Op::Reset) {
+            self.captured = Record::default();
+        }
+        let (replies, chunk) = self.run_batch(ops, true)?;
+        if let Some(c) = chunk {
+            if !self.absorb(c) {
+                return Ok((replies, self.captured.clone()));
+            }
+        }
+        Ok((replies, self.capture()?))
+    }
+
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
         if ops.contains(&Op::Reset) {
             // A chip reset clears the bridge's capture.
             self.captured = Record::default();
         }
-        Ok(self.run_batch(ops)?)
+        Ok(self.run_batch(ops, false)?.0)
     }
 }
 
