@@ -3,8 +3,12 @@
 //! input in `fuzz/corpus/<target>/` and `fuzz/regressions/<target>/`
 //! through the same code (`harness/tests/fuzz_corpus.rs`).
 
+pub mod bus;
+pub mod oracle;
+
 use crate::bridge::frame::{self, FrameDecoder};
 use crate::bridge::wire::{Request, Response, Timer};
+use crate::emu::ModelConfig;
 
 /// The bridge link's frame decoder and message decoders on arbitrary
 /// bytes: never a panic; every frame that decodes re-encodes to the same
@@ -42,5 +46,22 @@ pub fn frame_decoder(data: &[u8]) {
                 assert_eq!(Response::decode(&bytes, Timer::NANOS), Ok((seq, resp)));
             }
         }
+    }
+}
+
+/// Bus byte stream (see [`bus`]) into a fresh emulator; every invariant of
+/// `docs/invariants.md` checked after every op. A break panics with the
+/// invariant's id first, so libFuzzer's crash message buckets it.
+pub fn bus_bytes(data: &[u8]) {
+    bus_bytes_with(data, ModelConfig::default());
+}
+
+/// [`bus_bytes`] on a model with a configuration (e.g. an injected fault).
+pub fn bus_bytes_with(data: &[u8], cfg: ModelConfig) {
+    let ops = bus::decode(data);
+    match oracle::check(&ops, cfg) {
+        Ok(None) => {}
+        Ok(Some(v)) => panic!("invariant {v}"),
+        Err(e) => panic!("the model refused its configuration: {e}"),
     }
 }
