@@ -2,6 +2,7 @@
 
 mod bench;
 mod cmd;
+mod fuzz_cmd;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use ppmc::console::{self, ConsoleOptions, Line, ScriptError};
@@ -53,6 +54,9 @@ enum Command {
     /// Measure the emulator's speed (maximum-length move, constant-rate
     /// stretches, per-pulse expansion) and print the figures.
     Bench(bench::BenchArgs),
+    /// Work with fuzz findings: `ppmc fuzz reproduce <crash-file>` prints a
+    /// `bus_bytes` input as a console script with the invariant it breaks.
+    Fuzz(fuzz_cmd::FuzzArgs),
 }
 
 #[derive(Debug, Args)]
@@ -254,6 +258,7 @@ fn main() -> ExitCode {
         Command::Console(args) => run_console(args),
         Command::Bench(args) => bench::run(args),
         Command::BridgeSim(args) => bridge_sim(args),
+        Command::Fuzz(args) => fuzz_cmd::run(args),
     }
 }
 
