@@ -332,9 +332,8 @@ mod tests {
         assert_eq!(code(ask(&mut s, 3, &big)), Some(BridgeErrorCode::Overflow));
     }
 
-    #[test]
-    fn capture_comes_in_chunks() {
-        let mut s = server();
+    /// Initialization (Section 3-2) and time for it to finish.
+    fn init_ops() -> Vec<Op> {
         let mut ops = vec![Op::WriteCommand {
             byte: 0x06,
             wait_ibf: None,
@@ -346,7 +345,13 @@ mod tests {
             });
         }
         ops.push(Op::Delay(Duration::from_millis(200)));
-        ask(&mut s, 1, &Request::Batch(ops));
+        ops
+    }
+
+    #[test]
+    fn capture_comes_in_chunks() {
+        let mut s = server();
+        ask(&mut s, 1, &Request::Batch(init_ops()));
         for k in 0..30u8 {
             let step = vec![
                 Op::WriteCommand {
@@ -402,20 +407,10 @@ mod tests {
     #[test]
     fn batch_capture_runs_the_ops_then_returns_the_capture_after_them() {
         let mut s = server();
-        // Initialization (as in `capture_comes_in_chunks`), then a single
-        // step (0x4A): one move and one pulse run.
-        let mut ops = vec![Op::WriteCommand {
-            byte: 0x06,
-            wait_ibf: None,
-        }];
-        for b in [100u8, 20, 100, 0] {
-            ops.push(Op::WriteData {
-                byte: b,
-                wait_ibf: Some(Duration::from_secs(1)),
-            });
-        }
+        // Initialization, then a single step (0x4A): one move and one
+        // pulse run.
+        let mut ops = init_ops();
         ops.extend([
-            Op::Delay(Duration::from_millis(200)),
             Op::WriteCommand {
                 byte: 0x4A,
                 wait_ibf: Some(Duration::from_secs(1)),

@@ -690,6 +690,10 @@ impl<L: Link> SerialTarget<L> {
         ops: &[Op],
         capture: bool,
     ) -> Result<(Vec<Reply>, Option<CaptureChunk>), SerialError> {
+        if ops.contains(&Op::Reset) {
+            // A chip reset clears the bridge's capture.
+            self.captured = Record::default();
+        }
         let mut out = Vec::with_capacity(ops.len());
         let mut chunk_out = None;
         let max_ops = usize::from(self.hello.max_batch_ops.clamp(1, MAX_BATCH_OPS.max(1)));
@@ -799,9 +803,6 @@ impl<L: Link> Target for SerialTarget<L> {
     }
 
     fn execute_then_capture(&mut self, ops: &[Op]) -> Result<(Vec<Reply>, Record), TargetError> {
-        if ops.contains(&Op::Reset) {
-            self.captured = Record::default();
-        }
         let (replies, chunk) = self.run_batch(ops, true)?;
         if let Some(c) = chunk {
             if !self.absorb(c) {
@@ -812,10 +813,6 @@ impl<L: Link> Target for SerialTarget<L> {
     }
 
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
-        if ops.contains(&Op::Reset) {
-            // A chip reset clears the bridge's capture.
-            self.captured = Record::default();
-        }
         Ok(self.run_batch(ops, false)?.0)
     }
 }
