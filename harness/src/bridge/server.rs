@@ -13,7 +13,7 @@ use super::wire::{
     fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer, WireError,
     PROTOCOL_VERSION,
 };
-use crate::target::{EmuTarget, Target};
+use crate::target::{EmuTarget, Op, Reply, Target};
 
 /// Most ops in one batch: keeps the largest reply (128 x 69 bytes) within
 /// 255 fragments.
@@ -159,16 +159,9 @@ impl BridgeServer {
                     straps,
                 })
             }
-            Request::Batch(ops) if ops.len() > usize::from(MAX_BATCH_OPS) => Response::Error {
-                code: BridgeErrorCode::Overflow,
-                detail: format!("{} ops in one batch, at most {MAX_BATCH_OPS}", ops.len()),
-            },
-            Request::Batch(ops) => match self.target.execute(&ops) {
+            Request::Batch(ops) => match self.run_ops(&ops) {
                 Ok(replies) => Response::Batch(replies),
-                Err(e) => Response::Error {
-                    code: BridgeErrorCode::Malformed,
-                    detail: e.to_string(),
-                },
+                Err(e) => e,
             },
             Request::Resend { .. } => Response::Error {
                 code: BridgeErrorCode::Malformed,
@@ -180,29 +173,35 @@ impl BridgeServer {
                 moves,
                 max,
             } => Response::Capture(self.chunk(runs, pins, moves, max)),
-            Request::BatchCapture { ops, .. } if ops.len() > usize::from(MAX_BATCH_OPS) => {
-                Response::Error {
-                    code: BridgeErrorCode::Overflow,
-                    detail: format!("{} ops in one batch, at most {MAX_BATCH_OPS}", ops.len()),
-                }
-            }
             Request::BatchCapture {
                 ops,
                 runs,
                 pins,
                 moves,
                 max,
-            } => match self.target.execute(&ops) {
+            } => match self.run_ops(&ops) {
                 Ok(replies) => Response::BatchCapture {
                     replies,
                     capture: self.chunk(runs, pins, moves, max),
                 },
-                Err(e) => Response::Error {
-                    code: BridgeErrorCode::Malformed,
-                    detail: e.to_string(),
-                },
+                Err(e) => e,
             },
         }
+    }
+
+    /// Runs a batch's ops within the batch limit; the error response
+    /// otherwise.
+    fn run_ops(&mut self, ops: &[Op]) -> Result<Vec<Reply>, Response> {
+        if ops.len() > usize::from(MAX_BATCH_OPS) {
+            return Err(Response::Error {
+                code: BridgeErrorCode::Overflow,
+                detail: format!("{} ops in one batch, at most {MAX_BATCH_OPS}", ops.len()),
+            });
+        }
+        self.target.execute(ops).map_err(|e| Response::Error {
+            code: BridgeErrorCode::Malformed,
+            detail: e.to_string(),
+        })
     }
 
     /// Up to `max` capture records of each kind from these positions on.

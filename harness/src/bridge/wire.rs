@@ -449,6 +449,49 @@ mod rep {
     pub const RESET_DONE: u8 = 0x0E;
 }
 
+/// A `count` u16, then the ops (BATCH, BATCH_CAPTURE).
+fn put_ops(w: &mut W, ops: &[Op]) {
+    w.u16(ops.len() as u16);
+    for o in ops {
+        put_op(w, o);
+    }
+}
+
+fn get_ops(r: &mut R) -> Result<Vec<Op>, WireError> {
+    let n = r.count(1)?;
+    let mut ops = Vec::with_capacity(n);
+    for _ in 0..n {
+        ops.push(get_op(r)?);
+    }
+    Ok(ops)
+}
+
+/// A `count` u16, then the replies (BATCH_REPLY, BATCH_CAPTURE_REPLY).
+fn put_replies(w: &mut W, replies: &[Reply]) {
+    w.u16(replies.len() as u16);
+    for rp in replies {
+        put_reply(w, rp);
+    }
+}
+
+fn get_replies(r: &mut R) -> Result<Vec<Reply>, WireError> {
+    let n = r.count(9)?;
+    let mut v = Vec::with_capacity(n);
+    for _ in 0..n {
+        v.push(get_reply(r)?);
+    }
+    Ok(v)
+}
+
+/// Where a capture fetch starts, and its chunk size (CAPTURE,
+/// BATCH_CAPTURE).
+fn put_capture_from(w: &mut W, runs: u32, pins: u32, moves: u32, max: u16) {
+    w.u32(runs);
+    w.u32(pins);
+    w.u32(moves);
+    w.u16(max);
+}
+
 fn put_op(w: &mut W, o: &Op) {
     match *o {
         Op::WriteCommand { byte, wait_ibf } | Op::WriteData { byte, wait_ibf } => {
@@ -818,10 +861,7 @@ impl Request {
             }
             Request::Batch(ops) => {
                 w.u8(kind::BATCH);
-                w.u16(ops.len() as u16);
-                for o in ops {
-                    put_op(&mut w, o);
-                }
+                put_ops(&mut w, ops);
             }
             Request::Capture {
                 runs,
@@ -830,10 +870,7 @@ impl Request {
                 max,
             } => {
                 w.u8(kind::CAPTURE);
-                w.u32(*runs);
-                w.u32(*pins);
-                w.u32(*moves);
-                w.u16(*max);
+                put_capture_from(&mut w, *runs, *pins, *moves, *max);
             }
             Request::BatchCapture {
                 ops,
@@ -843,14 +880,8 @@ impl Request {
                 max,
             } => {
                 w.u8(kind::BATCH_CAPTURE);
-                w.u16(ops.len() as u16);
-                for o in ops {
-                    put_op(&mut w, o);
-                }
-                w.u32(*runs);
-                w.u32(*pins);
-                w.u32(*moves);
-                w.u16(*max);
+                put_ops(&mut w, ops);
+                put_capture_from(&mut w, *runs, *pins, *moves, *max);
             }
             Request::Resend { fragments } => {
                 w.u8(kind::RESEND);
@@ -869,14 +900,7 @@ impl Request {
         let seq = r.u8()?;
         let req = match r.u8()? {
             kind::HELLO => Request::Hello { version: r.u16()? },
-            kind::BATCH => {
-                let n = r.count(1)?;
-                let mut ops = Vec::with_capacity(n);
-                for _ in 0..n {
-                    ops.push(get_op(&mut r)?);
-                }
-                Request::Batch(ops)
-            }
+            kind::BATCH => Request::Batch(get_ops(&mut r)?),
             kind::CAPTURE => Request::Capture {
                 runs: r.u32()?,
                 pins: r.u32()?,
@@ -884,11 +908,7 @@ impl Request {
                 max: r.u16()?,
             },
             kind::BATCH_CAPTURE => {
-                let n = r.count(1)?;
-                let mut ops = Vec::with_capacity(n);
-                for _ in 0..n {
-                    ops.push(get_op(&mut r)?);
-                }
+                let ops = get_ops(&mut r)?;
                 Request::BatchCapture {
                     ops,
                     runs: r.u32()?,
@@ -932,10 +952,7 @@ impl Response {
             }
             Response::Batch(replies) => {
                 w.u8(kind::BATCH_REPLY);
-                w.u16(replies.len() as u16);
-                for rp in replies {
-                    put_reply(&mut w, rp);
-                }
+                put_replies(&mut w, replies);
             }
             Response::Capture(c) => {
                 w.u8(kind::CAPTURE_REPLY);
@@ -943,10 +960,7 @@ impl Response {
             }
             Response::BatchCapture { replies, capture } => {
                 w.u8(kind::BATCH_CAPTURE_REPLY);
-                w.u16(replies.len() as u16);
-                for rp in replies {
-                    put_reply(&mut w, rp);
-                }
+                put_replies(&mut w, replies);
                 put_capture(&mut w, capture);
             }
             Response::Error { code, detail } => {
@@ -975,21 +989,10 @@ impl Response {
                 firmware: r.str()?,
                 straps: r.str()?,
             }),
-            kind::BATCH_REPLY => {
-                let n = r.count(9)?;
-                let mut v = Vec::with_capacity(n);
-                for _ in 0..n {
-                    v.push(get_reply(&mut r)?);
-                }
-                Response::Batch(v)
-            }
+            kind::BATCH_REPLY => Response::Batch(get_replies(&mut r)?),
             kind::CAPTURE_REPLY => Response::Capture(get_capture(&mut r)?),
             kind::BATCH_CAPTURE_REPLY => {
-                let n = r.count(9)?;
-                let mut replies = Vec::with_capacity(n);
-                for _ in 0..n {
-                    replies.push(get_reply(&mut r)?);
-                }
+                let replies = get_replies(&mut r)?;
                 Response::BatchCapture {
                     replies,
                     capture: get_capture(&mut r)?,
