@@ -1,6 +1,8 @@
 //! The board path, end to end over a real pseudo-terminal: the bridge
 //! simulator on the master side, the `serialport` driver on the slave path.
 
+mod common;
+
 use ppmc::bridge::server::BridgeServer;
 use ppmc::bridge::sim::{serve, LinkFaults, ServeEnd};
 use ppmc::emu::{Faults, ModelConfig};
@@ -72,14 +74,7 @@ fn fast() -> SerialOptions {
 }
 
 fn in_process() -> Vec<ScenarioResult> {
-    let mut t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
-    run_suite(
-        &mut t,
-        &ppmc::suite::all(),
-        1,
-        DriverOptions::default(),
-        |_| {},
-    )
+    common::suite_in_process()
 }
 
 #[test]

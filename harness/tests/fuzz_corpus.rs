@@ -1,6 +1,8 @@
 //! Replays every committed fuzz input (seed corpus and regressions) through
 //! the target bodies in `ppmc::fuzzing`, on stable.
 
+mod common;
+
 use std::fs;
 use std::path::Path;
 
@@ -142,22 +144,10 @@ fn the_suite_as_fuzz_ops_keeps_every_invariant() {
 }
 
 fn suite_traces() -> Vec<(&'static str, ppmc::trace::Trace)> {
-    use ppmc::emu::ModelConfig;
-    use ppmc::protocol::Straps;
-    use ppmc::runner::run_suite;
-    use ppmc::scenario::DriverOptions;
-    use ppmc::target::EmuTarget;
-    let mut t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
-    run_suite(
-        &mut t,
-        &ppmc::suite::all(),
-        1,
-        DriverOptions::default(),
-        |_| {},
-    )
-    .into_iter()
-    .filter_map(|r| Some((r.name, r.trace?)))
-    .collect()
+    common::suite_in_process()
+        .into_iter()
+        .filter_map(|r| Some((r.name, r.trace?)))
+        .collect()
 }
 
 /// Writes the seed corpus of `bus_bytes`: the bus traffic of every

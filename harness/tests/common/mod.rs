@@ -278,3 +278,16 @@ pub fn within(got: Duration, want: Duration, permille: u64) -> bool {
     let tol = want.scale(permille, 1000);
     got >= want.saturating_sub(tol) && got <= want + tol
 }
+
+/// The whole conformance suite on the default emulator (default straps and
+/// model), as `ppmc run` runs it.
+pub fn suite_in_process() -> Vec<ppmc::scenario::ScenarioResult> {
+    let mut t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+    ppmc::runner::run_suite(
+        &mut t,
+        &ppmc::suite::all(),
+        1,
+        ppmc::scenario::DriverOptions::default(),
+        |_| {},
+    )
+}
