@@ -10,6 +10,7 @@ pub use crate::protocol::Flag;
 use crate::protocol::{Direction, Input, Status};
 use crate::target::{Op, Reply, Target, TargetError};
 use crate::time::Duration;
+use crate::trace::BusEvent;
 use std::fmt;
 use std::io::{self, Write};
 
@@ -270,7 +271,8 @@ pub enum ConsoleError {
     },
 }
 
-fn to_op(stmt: Stmt, opts: &ConsoleOptions) -> Op {
+/// The target op a statement runs as.
+pub fn to_op(stmt: Stmt, opts: &ConsoleOptions) -> Op {
     let wait_ibf = |wait: bool| wait.then_some(opts.ibf_timeout);
     match stmt {
         Stmt::WriteCommand { byte, wait } => Op::WriteCommand {
@@ -296,6 +298,56 @@ fn to_op(stmt: Stmt, opts: &ConsoleOptions) -> Op {
         Stmt::Pulses => Op::ReadPulses,
         Stmt::Now => Op::Delay(Duration::ZERO),
     }
+}
+
+/// The bus transaction a statement's reply shows, as traces record it
+/// (`None` for statements that touch no register or pin: `wait`, `pins`,
+/// `pulses`, `now`).
+pub fn bus_event(stmt: Stmt, reply: &Reply) -> Option<BusEvent> {
+    Some(match (stmt, *reply) {
+        (Stmt::WriteCommand { byte, wait }, Reply::Written { waited, .. }) => {
+            BusEvent::WriteCommand {
+                byte,
+                waited: wait.then_some(waited),
+            }
+        }
+        (Stmt::WriteData { byte, wait }, Reply::Written { waited, .. }) => BusEvent::WriteData {
+            byte,
+            waited: wait.then_some(waited),
+        },
+        (Stmt::WriteCommand { byte, .. }, Reply::WriteTimedOut { .. }) => BusEvent::WriteTimedOut {
+            command: true,
+            byte,
+        },
+        (Stmt::WriteData { byte, .. }, Reply::WriteTimedOut { .. }) => BusEvent::WriteTimedOut {
+            command: false,
+            byte,
+        },
+        (Stmt::ReadStatus, Reply::Status { status, .. }) => BusEvent::ReadStatus(status.0),
+        (Stmt::ReadData { wait }, Reply::Data { byte, waited, .. }) => BusEvent::ReadData {
+            byte,
+            waited: wait.then_some(waited),
+        },
+        (Stmt::ReadData { .. }, Reply::ReadTimedOut { .. }) => BusEvent::ReadTimedOut,
+        (Stmt::Await { flag, value, .. }, Reply::Awaited { waited, status, .. }) => {
+            BusEvent::Await {
+                flag,
+                value,
+                waited: Some(waited),
+                status: status.0,
+            }
+        }
+        (Stmt::Await { flag, value, .. }, Reply::AwaitTimedOut { status, .. }) => BusEvent::Await {
+            flag,
+            value,
+            waited: None,
+            status: status.0,
+        },
+        (Stmt::Set { input, asserted }, Reply::InputSet { .. }) => {
+            BusEvent::SetInput { input, asserted }
+        }
+        _ => return None,
+    })
 }
 
 fn opt_time<T: fmt::Display>(t: Option<T>) -> String {

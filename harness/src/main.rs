@@ -85,8 +85,9 @@ struct BridgeSimArgs {
     /// Seed for the fault draws.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Run a deliberately faulty chip: drop-last-pulse, swap-error-A-B
-    /// (e.g. swap-error-3-4), status-stuck-0xNN.
+    /// Run a deliberately faulty chip: a name from the board-fault catalogue
+    /// (`ppmc fault-matrix --list`), swap-error-A-B (e.g. swap-error-3-4) or
+    /// status-stuck-0xNN. Repeat to combine.
     #[arg(long = "chip-fault", value_name = "FAULT")]
     chip_faults: Vec<String>,
 }
@@ -346,35 +347,6 @@ fn interactive(target: &mut dyn Target, opts: &ConsoleOptions) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-fn chip_faults(names: &[String]) -> Result<ppmc::emu::Faults, String> {
-    let mut f = ppmc::emu::Faults::default();
-    for n in names {
-        if n == "drop-last-pulse" {
-            f.drop_last_pulse = true;
-        } else if let Some(rest) = n.strip_prefix("swap-error-") {
-            let (a, b) = rest
-                .split_once('-')
-                .and_then(|(a, b)| Some((a.parse::<u8>().ok()?, b.parse::<u8>().ok()?)))
-                .filter(|(a, b)| *a < 8 && *b < 8)
-                .ok_or_else(|| {
-                    format!("--chip-fault {n}: write swap-error-A-B with A, B in 0..=7")
-                })?;
-            f.swap_error = Some((
-                ppmc::protocol::ErrorCode::from_number(a),
-                ppmc::protocol::ErrorCode::from_number(b),
-            ));
-        } else if let Some(hex) = n.strip_prefix("status-stuck-0x") {
-            f.status_stuck_high = u8::from_str_radix(hex, 16)
-                .map_err(|_| format!("--chip-fault {n}: write status-stuck-0xNN"))?;
-        } else {
-            return Err(format!(
-                "unknown --chip-fault `{n}` (drop-last-pulse, swap-error-A-B, status-stuck-0xNN)"
-            ));
-        }
-    }
-    Ok(f)
-}
-
 fn bridge_sim(args: BridgeSimArgs) -> ExitCode {
     use ppmc::bridge::server::BridgeServer;
     use ppmc::bridge::sim::{serve, LinkFaults, ServeEnd};
@@ -398,10 +370,11 @@ fn bridge_sim(args: BridgeSimArgs) -> ExitCode {
         Err(e) => return usage_error(e),
     };
     let mut model = args.target.model();
-    model.faults = match chip_faults(&args.chip_faults) {
-        Ok(f) => f,
-        Err(e) => return usage_error(e),
-    };
+    for name in &args.chip_faults {
+        if let Err(e) = ppmc::emu::faults::apply_named(name, &mut model) {
+            return usage_error(format!("--chip-fault: {e}"));
+        }
+    }
     let emu = match EmuTarget::new(straps, model) {
         Ok(t) => t,
         Err(e) => return usage_error(e),

@@ -167,3 +167,65 @@ fn write_bus_bytes_seeds() {
         .expect("seed written");
     }
 }
+
+#[test]
+fn typed_actions_corpus_replays() {
+    let n = replay("typed_actions", ppmc::fuzzing::typed_actions);
+    assert!(n >= 16, "the seed corpus is there ({n} inputs)");
+}
+
+#[test]
+fn trace_text_corpus_replays() {
+    let n = replay("trace_text", ppmc::fuzzing::trace_text);
+    assert!(n >= 8, "the seed corpus is there ({n} inputs)");
+}
+
+/// The typed seeds reach the deep states the target exists for: moves
+/// that end, and moves stopped early (a remaining-pulses read of a
+/// stopped move is judged by the oracle).
+#[test]
+fn typed_seeds_move_the_motor() {
+    use ppmc::emu::ModelConfig;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/typed_actions");
+    let mut moving = 0;
+    for e in fs::read_dir(root)
+        .expect("typed seeds")
+        .filter_map(Result::ok)
+    {
+        let data = fs::read(e.path()).expect("seed");
+        let acts = ppmc::fuzzing::typed_program(&data);
+        let (ops, found) = ppmc::fuzzing::lower(&acts, ModelConfig::default());
+        assert_eq!(found, None, "{}", e.path().display());
+        let mut c = ppmc::fuzzing::oracle::Checker::new(ModelConfig::default()).expect("chip");
+        for op in ops {
+            c.apply(op).expect("no break");
+        }
+        if c.chip().record().pulse_count() > 0 {
+            moving += 1;
+        }
+    }
+    assert!(moving >= 8, "{moving} typed seeds move the motor");
+}
+
+/// Writes the seed corpus of `typed_actions` (deterministic: seeded random
+/// bytes, each decoding to a few dozen actions) and of `trace_text` (a few
+/// suite traces). Run with `cargo test --test fuzz_corpus -- --ignored`.
+#[test]
+#[ignore]
+fn write_typed_and_trace_seeds() {
+    use rand::{Rng, SeedableRng};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus");
+    let typed = root.join("typed_actions");
+    fs::create_dir_all(&typed).expect("corpus dir");
+    for seed in 0..24u64 {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        let len = rng.random_range(64..384);
+        let bytes: Vec<u8> = (0..len).map(|_| rng.random()).collect();
+        fs::write(typed.join(format!("random-{seed:02}.bin")), bytes).expect("seed written");
+    }
+    let traces = root.join("trace_text");
+    fs::create_dir_all(&traces).expect("corpus dir");
+    for (name, trace) in suite_traces().into_iter().step_by(10) {
+        fs::write(traces.join(format!("{name}.trace")), trace.render()).expect("seed written");
+    }
+}

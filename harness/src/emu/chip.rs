@@ -252,7 +252,7 @@ impl Chip {
     /// returns the stale latch (Section 3-1-1 (1): "the data are invalid").
     pub fn read_data(&mut self) -> u8 {
         if self.obf {
-            self.obf = false;
+            self.obf = self.cfg.faults.obf_sticky;
             if !self.out_pending.is_empty() {
                 let at = self.now + self.fw(self.cfg.obf_next);
                 self.schedule(at, Timer::ObfReady);
@@ -433,6 +433,7 @@ impl Chip {
             }
             Command::ImmediateStop(_) => self.stop_command_immediate(base),
             Command::DecelStop(_) => self.stop_command_decel(base),
+            Command::SoftwareReset(_) if busy && self.cfg.faults.reset_quirk_missing => {}
             Command::SoftwareReset(_) | Command::AuxOn(_) if busy => {
                 self.schedule(base + self.fw(self.cfg.aux_switch), Timer::Aux(true));
             }
@@ -486,7 +487,12 @@ impl Chip {
         }
         buf[usize::from(got)] = byte;
         got += 1;
-        self.field = StatusField::ParamsRemaining(need - got);
+        let due = if self.cfg.faults.params_not_counted && got < need {
+            need
+        } else {
+            need - got
+        };
+        self.field = StatusField::ParamsRemaining(due);
         if got < need {
             self.expect = Expect::Params {
                 cmd,
@@ -505,10 +511,13 @@ impl Chip {
                 self.switch_off = self.straps.switching_off_time(buf[1]);
             }
             Command::AuxOutput => {
-                self.schedule(
-                    base + self.fw(self.cfg.aux_output),
-                    Timer::Auxo(buf[0] & 0x0F),
-                );
+                let bits = buf[0] & 0x0F;
+                let bits = if self.cfg.faults.auxo_reversed {
+                    bits.reverse_bits() >> 4
+                } else {
+                    bits
+                };
+                self.schedule(base + self.fw(self.cfg.aux_output), Timer::Auxo(bits));
             }
             _ => {}
         }
@@ -518,7 +527,9 @@ impl Chip {
         let bytes: Vec<u8> = match reg {
             Register::FinishStatus => {
                 let value = self.finish.0;
-                self.finish = self.finish.without_polling();
+                if !self.cfg.faults.finish_flag_sticky {
+                    self.finish = self.finish.without_polling();
+                }
                 self.set_int(false);
                 vec![value]
             }
@@ -528,7 +539,12 @@ impl Chip {
                 vec![OutputStatus::new(self.dir, self.hold, levels).0]
             }
             Register::RemainingPulses => {
-                let [lo, mid, hi, _] = self.remaining.saturating_sub(1).to_le_bytes();
+                let value = if self.cfg.faults.remaining_off_by_one {
+                    self.remaining
+                } else {
+                    self.remaining.saturating_sub(1)
+                };
+                let [lo, mid, hi, _] = value.to_le_bytes();
                 vec![lo, mid, hi]
             }
             Register::AuxInputs => vec![AuxInputStatus::from_inputs(self.inputs).0],
@@ -711,7 +727,7 @@ impl Chip {
         let Some(m) = self.motion.as_ref() else {
             return;
         };
-        if !m.kind.ramped() {
+        if !m.kind.ramped() || self.cfg.faults.decel_stop_immediate {
             // Constant-speed moves have no deceleration: stop at once (N13).
             self.halt(StopCause::StopCommand, base);
             return;
@@ -745,11 +761,14 @@ impl Chip {
         }
         let now = self.now;
         let (dir, kind, pout) = (m.dir, m.kind, m.pout);
-        if input == Input::Alm {
+        let mut only = InputSet::default();
+        only.set(input, true);
+        let seen = self.seen_inputs(only, dir);
+        if seen.contains(Input::Alm) {
             self.halt(StopCause::Alarm, now);
-        } else if input == Input::limit_for(dir) {
+        } else if seen.contains(Input::limit_for(dir)) {
             self.halt(StopCause::Limit, now);
-        } else if input == Input::Cnp && kind == MoveKind::OriginSearch {
+        } else if seen.contains(Input::Cnp) && kind == MoveKind::OriginSearch {
             self.halt(StopCause::Completed, now);
         } else if input == Input::high_speed_limit_for(dir) && kind.ramped() {
             self.high_speed_limit(pout);
@@ -820,7 +839,7 @@ impl Chip {
         };
         let (dir, kind, pout) = (m.dir, m.kind, m.pout);
         let now = self.now;
-        let inputs = self.inputs;
+        let inputs = self.seen_inputs(self.inputs, dir);
         if inputs.contains(Input::Alm) {
             self.halt(StopCause::Alarm, now);
         } else if inputs.contains(Input::limit_for(dir)) {
@@ -836,6 +855,22 @@ impl Chip {
                 }
             }
         }
+    }
+
+    /// The inputs as the firmware sees them during a move in `dir`: all of
+    /// them, unless a board fault hides one.
+    fn seen_inputs(&self, mut inputs: InputSet, dir: Direction) -> InputSet {
+        let f = &self.cfg.faults;
+        if f.alarm_ignored {
+            inputs.set(Input::Alm, false);
+        }
+        if f.origin_ignored {
+            inputs.set(Input::Cnp, false);
+        }
+        if f.limit_ignored == Some(dir) {
+            inputs.set(Input::limit_for(dir), false);
+        }
+        inputs
     }
 
     /// Whether the move is in POUT mode with its high-speed limit asserted
@@ -914,7 +949,10 @@ impl Chip {
             .push_pulses(first, interval, on_wire, dir, new_move);
         if steps_phases {
             if let Some(w) = self.winding {
-                self.phase_index = w.advance(self.phase_index, dir, u64::from(fit));
+                // Fault: the first step of each move never reaches the phases.
+                let skipped = u64::from(new_move && self.cfg.faults.phase_step_skipped);
+                let steps = u64::from(fit) - skipped;
+                self.phase_index = w.advance(self.phase_index, dir, steps);
             }
         }
         self.now = last;
@@ -980,7 +1018,12 @@ impl Chip {
                 self.hold_epoch += 1;
                 self.set_hold(false);
                 self.set_switching(None);
-                if let Some(dir) = self.motion.as_ref().map(|m| m.dir) {
+                let shown = |d: Direction| match (d, self.cfg.faults.dir_inverted) {
+                    (d, false) => d,
+                    (Direction::Cw, true) => Direction::Ccw,
+                    (Direction::Ccw, true) => Direction::Cw,
+                };
+                if let Some(dir) = self.motion.as_ref().map(|m| shown(m.dir)) {
                     if dir != self.dir {
                         self.dir = dir;
                         self.record.pin(now, Pin::Dir, u8::from(dir.bit()));
@@ -1031,7 +1074,7 @@ impl Chip {
         self.record.pin(now, Pin::Busy, 0);
         self.finish = FinishStatus::new(m.kind, m.cause, true);
         self.remaining = m.remaining();
-        if m.interrupt {
+        if m.interrupt || self.cfg.faults.int_unmasked {
             self.set_int(true);
         }
         let next = if m.kind == MoveKind::SingleStep {
@@ -1063,6 +1106,9 @@ impl Chip {
     }
 
     fn set_hold(&mut self, on: bool) {
+        if on && self.cfg.faults.hold_stuck_off {
+            return;
+        }
         if self.hold != on {
             self.hold = on;
             self.record.pin(self.now, Pin::Hold, u8::from(on));

@@ -6,24 +6,8 @@
 //! it gives a range; `docs/datasheet-notes.md` says where each default comes
 //! from.
 
-use crate::protocol::ErrorCode;
+use super::faults::Faults;
 use crate::time::Duration;
-
-/// Deliberate departures from the datasheet, for checking that the suite,
-/// the golden comparison and the fuzzers catch a bad board. A clean chip has
-/// none ([`Faults::default`]).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Faults {
-    /// The last pulse of every move is lost on the POUT wire (the chip
-    /// counts it as output).
-    pub drop_last_pulse: bool,
-    /// The chip reports the second error number where the datasheet says
-    /// the first.
-    pub swap_error: Option<(ErrorCode, ErrorCode)>,
-    /// Status register bits that read 1 whatever the chip says (a data bus
-    /// line stuck high on the board).
-    pub status_stuck_high: u8,
-}
 
 /// Shape of the acceleration ramp from the start-up rate RL to the high
 /// speed rate RH over PA pulses. The datasheet defers the curve to chapter 1,

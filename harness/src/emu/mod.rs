@@ -3,7 +3,9 @@
 
 mod chip;
 pub mod config;
+pub mod faults;
 mod motion;
 
 pub use chip::{Chip, ChipError, PA_MAX, PA_MIN};
-pub use config::{AccelCurve, ConfigError, Faults, ModelConfig};
+pub use config::{AccelCurve, ConfigError, ModelConfig};
+pub use faults::{BoardFault, Faults};

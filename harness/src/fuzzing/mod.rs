@@ -3,12 +3,14 @@
 //! input in `fuzz/corpus/<target>/` and `fuzz/regressions/<target>/`
 //! through the same code (`harness/tests/fuzz_corpus.rs`).
 
+pub mod actions;
 pub mod bus;
 pub mod oracle;
 
 use crate::bridge::frame::{self, FrameDecoder};
 use crate::bridge::wire::{Request, Response, Timer};
 use crate::emu::ModelConfig;
+use crate::time::Duration;
 
 /// The bridge link's frame decoder and message decoders on arbitrary
 /// bytes: never a panic; every frame that decodes re-encodes to the same
@@ -64,6 +66,131 @@ pub fn bus_bytes_with(data: &[u8], cfg: ModelConfig) {
         Ok(Some(v)) => panic!("invariant {v}"),
         Err(e) => panic!("the model refused its configuration: {e}"),
     }
+}
+
+/// Structure-aware target: the input's bytes as typed [`actions::Action`]s
+/// (derive `Arbitrary`) after a valid initialization, run with the
+/// flowchart's waits on a fresh emulator under the same oracle as
+/// [`bus_bytes`].
+pub fn typed_actions(data: &[u8]) {
+    typed_actions_with(data, ModelConfig::default());
+}
+
+/// [`typed_actions`] on a model with a configuration.
+pub fn typed_actions_with(data: &[u8], cfg: ModelConfig) {
+    let (_, found) = lower(&typed_program(data), cfg);
+    if let Some(v) = found {
+        panic!("invariant {v}");
+    }
+}
+
+/// The actions a `typed_actions` input runs: a valid initialization, then
+/// whatever its bytes decode to.
+pub fn typed_program(data: &[u8]) -> Vec<actions::Action> {
+    let mut acts = vec![actions::Action::default_init()];
+    acts.extend(actions::decode(data));
+    acts
+}
+
+/// The trace text parser on arbitrary bytes: never a panic; a text that
+/// parses renders to a text that parses to the same trace and renders to
+/// the same bytes.
+pub fn trace_text(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    if let Ok(t) = crate::trace::Trace::parse(text) {
+        let once = t.render();
+        let again = crate::trace::Trace::parse(&once).expect("a rendered trace parses");
+        assert_eq!(again.render(), once, "trace render round trip");
+    }
+}
+
+/// Runs typed actions under the oracle and returns the bus ops that ran
+/// (the flowchart's waits become the time that passed, to the
+/// microsecond), with the first invariant break. The ops replay as a
+/// `bus_bytes` input, so every finding has one bus-level form.
+pub fn lower(
+    acts: &[actions::Action],
+    cfg: ModelConfig,
+) -> (Vec<bus::BusOp>, Option<oracle::Violation>) {
+    use crate::console::Stmt;
+    use crate::protocol::Status;
+    let mut ops = Vec::new();
+    let Ok(mut c) = oracle::Checker::new(cfg) else {
+        return (ops, None);
+    };
+    let run = |c: &mut oracle::Checker, op: bus::BusOp, ops: &mut Vec<bus::BusOp>| {
+        ops.push(op);
+        c.apply(op)
+    };
+    // Lets time pass until `ready` holds or `timeout` is spent.
+    let wait = |c: &mut oracle::Checker,
+                ops: &mut Vec<bus::BusOp>,
+                ready: &dyn Fn(Status) -> bool,
+                timeout: Duration|
+     -> Result<(), oracle::Violation> {
+        let deadline = c.chip().now() + timeout;
+        while !ready(c.chip().read_status()) && c.chip().now() < deadline {
+            let now = c.chip().now();
+            let next = c.chip().poll_at().unwrap_or(deadline).min(deadline);
+            let us = next.saturating_since(now).as_nanos().div_ceil(1_000).max(1);
+            for op in bus::advances(Duration::from_micros(us)) {
+                ops.push(op);
+                c.apply(op)?;
+            }
+        }
+        Ok(())
+    };
+    let second = Duration::from_secs(1);
+    let result = (|| {
+        for a in acts {
+            for s in a.stmts() {
+                match s {
+                    Stmt::WriteCommand { byte, wait: w } | Stmt::WriteData { byte, wait: w } => {
+                        if w {
+                            wait(&mut c, &mut ops, &|s| !s.ibf(), second)?;
+                        }
+                        let op = if matches!(s, Stmt::WriteCommand { .. }) {
+                            bus::BusOp::Command(byte)
+                        } else {
+                            bus::BusOp::Data(byte)
+                        };
+                        run(&mut c, op, &mut ops)?;
+                    }
+                    Stmt::ReadData { wait: w } => {
+                        if w {
+                            wait(&mut c, &mut ops, &|s| s.obf(), second)?;
+                        }
+                        run(&mut c, bus::BusOp::ReadData, &mut ops)?;
+                    }
+                    Stmt::Await {
+                        flag,
+                        value,
+                        timeout,
+                    } => {
+                        let mask = flag.mask();
+                        let want = if value { mask } else { 0 };
+                        let t = timeout.unwrap_or(second);
+                        wait(&mut c, &mut ops, &|s| s.0 & mask == want, t)?;
+                        run(&mut c, bus::BusOp::ReadStatus, &mut ops)?;
+                    }
+                    Stmt::ReadStatus => run(&mut c, bus::BusOp::ReadStatus, &mut ops)?,
+                    Stmt::Wait(d) => {
+                        for op in bus::advances(d) {
+                            run(&mut c, op, &mut ops)?;
+                        }
+                    }
+                    Stmt::Set { input, asserted } => {
+                        run(&mut c, bus::BusOp::Input { input, asserted }, &mut ops)?
+                    }
+                    Stmt::Pins | Stmt::Pulses | Stmt::Now => {}
+                }
+            }
+        }
+        c.finish()
+    })();
+    (ops, result.err())
 }
 
 /// A `bus_bytes` input as a bus script in the console language

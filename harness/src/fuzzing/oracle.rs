@@ -5,7 +5,7 @@
 use super::bus::BusOp;
 use crate::emu::{Chip, ChipError, ModelConfig};
 use crate::protocol::capture::{Pin, Record};
-use crate::protocol::{Status, StatusField, Straps};
+use crate::protocol::{Command, FinishStatus, Register, Status, StatusField, Straps};
 use crate::time::Instant;
 use crate::trace::Trace;
 use std::fmt;
@@ -36,31 +36,96 @@ impl fmt::Display for Violation {
 
 /// Runs `ops` on a fresh chip and returns the first invariant break.
 pub fn check(ops: &[BusOp], cfg: ModelConfig) -> Result<Option<Violation>, ChipError> {
-    let mut chip = Chip::new(Straps::default(), cfg)?;
-    let mut last_now = chip.now();
-    for (i, op) in ops.iter().enumerate() {
-        let fail = |invariant, detail: String| {
-            Ok(Some(Violation {
-                invariant,
-                op: i,
-                detail,
-            }))
+    let mut c = Checker::new(cfg)?;
+    for op in ops {
+        if let Err(v) = c.apply(*op) {
+            return Ok(Some(v));
+        }
+    }
+    Ok(c.finish().err())
+}
+
+/// A register read in progress, as the host sees it.
+#[derive(Debug)]
+struct Reading {
+    command: u8,
+    /// IBF has been seen at 0 since the command was written, so the chip
+    /// took it (rather than losing it to a later write).
+    taken: bool,
+    bytes: Vec<u8>,
+}
+
+/// The oracle as a state machine: a fresh chip, fed one op at a time, each
+/// checked as it goes; [`Checker::finish`] checks the whole record.
+#[derive(Debug)]
+pub struct Checker {
+    chip: Chip,
+    ops: usize,
+    last_now: Instant,
+    /// The command last written, and the data bytes read since (with
+    /// OBF = 1, once the chip has taken the command).
+    reading: Option<Reading>,
+    /// Moves ended (BUSY falls) when the finish status was last read.
+    stops_at_finish_read: usize,
+}
+
+impl Checker {
+    pub fn new(cfg: ModelConfig) -> Result<Checker, ChipError> {
+        let chip = Chip::new(Straps::default(), cfg)?;
+        Ok(Checker {
+            last_now: chip.now(),
+            chip,
+            ops: 0,
+            reading: None,
+            stops_at_finish_read: 0,
+        })
+    }
+
+    /// The chip under test.
+    pub fn chip(&self) -> &Chip {
+        &self.chip
+    }
+
+    /// Ops applied so far.
+    pub fn ops(&self) -> usize {
+        self.ops
+    }
+
+    /// Applies one op and checks the invariants it can break.
+    pub fn apply(&mut self, op: BusOp) -> Result<(), Violation> {
+        let i = self.ops;
+        self.ops += 1;
+        let fail = |invariant, detail: String| Violation {
+            invariant,
+            op: i,
+            detail,
         };
-        match *op {
+        let chip = &mut self.chip;
+        let ibf_before = chip.read_status().ibf();
+        if ibf_before && matches!(op, BusOp::Command(_) | BusOp::Data(_)) {
+            // The byte waiting may be the read command: it could be lost.
+            if self.reading.as_ref().is_some_and(|r| !r.taken) {
+                self.reading = None;
+            }
+        }
+        match op {
             BusOp::Command(b) => {
                 chip.write_command(b);
+                self.reading = Some(Reading {
+                    command: b,
+                    taken: false,
+                    bytes: Vec::new(),
+                });
             }
-            BusOp::Data(b) => {
-                chip.write_data(b);
-            }
+            BusOp::Data(b) => chip.write_data(b),
             BusOp::ReadStatus => {
                 let s = chip.read_status();
-                if let Some(v) = status_breaks(s) {
-                    return fail(v.0, v.1);
+                if let Some((invariant, detail)) = status_breaks(s) {
+                    return Err(fail(invariant, detail));
                 }
                 let line = busy_level(chip.record(), chip.now());
                 if s.busy() != line {
-                    return fail(
+                    return Err(fail(
                         "busy-status-matches",
                         format!(
                             "status 0x{:02X} reads BUSY={} at {} while the BUSY line is {}",
@@ -69,43 +134,104 @@ pub fn check(ops: &[BusOp], cfg: ModelConfig) -> Result<Option<Violation>, ChipE
                             chip.now(),
                             u8::from(line)
                         ),
-                    );
+                    ));
                 }
             }
             BusOp::ReadData => {
-                chip.read_data();
+                let s = chip.read_status();
+                let byte = chip.read_data();
+                if s.obf() {
+                    if let Some(r) = self.reading.as_mut().filter(|r| r.taken) {
+                        r.bytes.push(byte);
+                    }
+                    if let Some((invariant, detail)) = self.register_breaks() {
+                        return Err(fail(invariant, detail));
+                    }
+                }
             }
             BusOp::Input { input, asserted } => chip.set_input(input, asserted),
             BusOp::Advance(d) => chip.advance_to(chip.now() + d),
         }
-        if chip.now() < last_now {
-            return fail(
-                "time-monotonic",
-                format!("the clock went from {last_now} back to {}", chip.now()),
-            );
+        if let Some(r) = self.reading.as_mut() {
+            r.taken |= !self.chip.read_status().ibf();
         }
-        last_now = chip.now();
+        let now = self.chip.now();
+        if now < self.last_now {
+            return Err(fail(
+                "time-monotonic",
+                format!("the clock went from {} back to {now}", self.last_now),
+            ));
+        }
+        self.last_now = now;
+        Ok(())
     }
-    // The record only grows, so its own invariants are checked once, at
-    // the end (per op they would cost time quadratic in its length).
-    let last = ops.len().saturating_sub(1);
-    let at_end = |invariant, detail| {
-        Ok(Some(Violation {
+
+    /// The record's own invariants, checked once at the end (per op they
+    /// would cost time quadratic in its length).
+    pub fn finish(&self) -> Result<(), Violation> {
+        let rec = self.chip.record();
+        let at_end = |invariant, detail| Violation {
             invariant,
-            op: last,
+            op: self.ops.saturating_sub(1),
             detail,
-        }))
-    };
-    if let Some(d) = pulse_outside_busy(chip.record()) {
-        return at_end("busy-covers-pulses", d);
+        };
+        if let Some(d) = pulse_outside_busy(rec) {
+            return Err(at_end("busy-covers-pulses", d));
+        }
+        if let Some(d) = record_breaks(rec) {
+            return Err(at_end("record-ordered", d));
+        }
+        if let Some(d) = trace_round_trip(rec) {
+            return Err(at_end("trace-round-trip", d));
+        }
+        Ok(())
     }
-    if let Some(d) = record_breaks(chip.record()) {
-        return at_end("record-ordered", d);
+
+    /// Checks a register read once all its bytes are in: the remaining
+    /// pulses (Section 3-4-4) and the finish status polling flag (3-4-1).
+    fn register_breaks(&mut self) -> Option<(&'static str, String)> {
+        let Reading { command, bytes, .. } = self.reading.as_ref()?;
+        let rec = self.chip.record();
+        match Command::decode(*command) {
+            Command::Read(Register::RemainingPulses) if bytes.len() == 3 => {
+                let read = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], 0]);
+                let m = rec.moves.last()?;
+                let out = rec.last_move_pulses().count;
+                let steps = u64::from(m.steps);
+                let want = if out >= steps { 0 } else { steps - out - 1 };
+                (u64::from(read) != want).then(|| {
+                    (
+                        "remaining-pulses",
+                        format!(
+                            "remaining pulses read {read} after a move of {steps} steps \
+                             that output {out} pulses; expected {want}"
+                        ),
+                    )
+                })
+            }
+            Command::Read(Register::FinishStatus) if bytes.len() == 1 => {
+                let stops = rec
+                    .pins
+                    .iter()
+                    .filter(|p| p.pin == Pin::Busy && p.value == 0)
+                    .count();
+                let since = stops - self.stops_at_finish_read;
+                self.stops_at_finish_read = stops;
+                let flag = FinishStatus(bytes[0]).polling();
+                (flag && since == 0).then(|| {
+                    (
+                        "finish-flag-once",
+                        format!(
+                            "finish status 0x{:02X} has the polling flag set, but no move \
+                             ended since the last finish status read",
+                            bytes[0]
+                        ),
+                    )
+                })
+            }
+            _ => None,
+        }
     }
-    if let Some(d) = trace_round_trip(chip.record()) {
-        return at_end("trace-round-trip", d);
-    }
-    Ok(None)
 }
 
 /// Section 3-1-1, Diagram 3-1: bit 3 reads 0; without an error, bits 6-4
@@ -293,6 +419,83 @@ mod tests {
             .expect("chip")
             .expect("a break");
         assert_eq!(v.invariant, "status-params");
+    }
+
+    /// `init_and_step`, then a register read: command, wait, its bytes.
+    fn then_read(register: u8, bytes: usize) -> Vec<BusOp> {
+        let mut ops = init_and_step();
+        ops.push(Command(register));
+        for _ in 0..bytes {
+            ops.push(Advance(Duration::from_micros(50)));
+            ops.push(ReadData);
+        }
+        ops
+    }
+
+    fn faulty(name: &str) -> ModelConfig {
+        crate::emu::faults::find(name)
+            .expect("in the catalogue")
+            .model()
+    }
+
+    /// Section 3-4-4: a constant-speed move of 101 steps (count 100)
+    /// stopped by L1;
+    /// the remaining pulses read one less than the remainder. A board
+    /// reading the remainder itself breaks the invariant.
+    #[test]
+    fn remaining_pulses_off_by_one_is_caught_at_the_third_byte() {
+        use crate::protocol::{Command as C, Direction, Input as In, MoveCommand, MoveKind};
+        let mut ops = init_and_step();
+        let constant = C::Move(MoveCommand::new(MoveKind::Constant, Direction::Cw, false));
+        ops.push(Command(constant.encode()));
+        for b in [60, 100, 0, 0] {
+            ops.extend([Advance(Duration::from_micros(50)), Data(b)]);
+        }
+        ops.push(Advance(Duration::from_millis(3)));
+        ops.push(Input {
+            input: In::L1,
+            asserted: true,
+        });
+        ops.push(Advance(Duration::from_millis(5)));
+        ops.push(Command(0x83));
+        for _ in 0..3 {
+            ops.extend([Advance(Duration::from_micros(50)), ReadData]);
+        }
+        assert_eq!(check(&ops, ModelConfig::default()).expect("chip"), None);
+        let v = check(&ops, faulty("remaining-off-by-one"))
+            .expect("chip")
+            .expect("a break");
+        assert_eq!((v.invariant, v.op), ("remaining-pulses", ops.len() - 1));
+        assert!(v.detail.contains("after a move of 101 steps"), "{v}");
+    }
+
+    /// Section 3-4-1: the polling flag is set once per stop; a second read
+    /// with no move in between must show it cleared.
+    #[test]
+    fn a_sticky_polling_flag_is_caught_on_the_second_read() {
+        let mut ops = then_read(0x80, 1);
+        ops.push(Command(0x80));
+        ops.push(Advance(Duration::from_micros(50)));
+        ops.push(ReadData);
+        assert_eq!(check(&ops, ModelConfig::default()).expect("chip"), None);
+        let v = check(&ops, faulty("finish-flag-sticky"))
+            .expect("chip")
+            .expect("a break");
+        assert_eq!((v.invariant, v.op), ("finish-flag-once", ops.len() - 1));
+    }
+
+    /// A read command lost to a later write (IBF = 1) says nothing about
+    /// the bytes that follow: stale output is not taken for its answer.
+    #[test]
+    fn bytes_of_a_lost_read_command_are_not_judged() {
+        let mut ops = then_read(0x83, 1);
+        // A remaining-pulses read, overwritten at once by a data byte: the
+        // chip never takes it, and the stale bytes are not its answer.
+        ops.extend([Command(0x83), Data(0), Advance(Duration::from_micros(50))]);
+        ops.extend([ReadData, ReadData, ReadData]);
+        let cfg = faulty("remaining-off-by-one");
+        let v = check(&ops, cfg).expect("chip");
+        assert_eq!(v, None);
     }
 
     #[test]
