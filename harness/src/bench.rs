@@ -176,14 +176,10 @@ pub fn run(args: BenchArgs) -> ExitCode {
 /// The conformance suite in process and over a pseudo-terminal to the
 /// bridge simulator: wall time and round trips.
 fn suite_over_bridge(repeat: usize) -> ExitCode {
-    use ppmc::bridge::server::BridgeServer;
-    use ppmc::bridge::sim::{serve, LinkFaults};
+    use ppmc::bridge::sim::{LinkFaults, PtyBridge};
     use ppmc::runner::run_suite;
     use ppmc::scenario::DriverOptions;
     use ppmc::target::{SerialLink, SerialOptions, SerialTarget};
-    use serialport::SerialPort;
-    use std::sync::atomic::{AtomicBool, Ordering};
-    use std::sync::Arc;
 
     let suite = ppmc::suite::all();
     let mut local = Vec::new();
@@ -195,27 +191,17 @@ fn suite_over_bridge(repeat: usize) -> ExitCode {
         run_suite(&mut t, &suite, 1, DriverOptions::default(), |_| {});
         local.push(t0.elapsed().as_secs_f64() * 1e3);
     }
-    let Ok((mut master, slave)) = serialport::TTYPort::pair() else {
-        eprintln!("ppmc bench: no pseudo-terminal");
-        return ExitCode::from(1);
-    };
-    let _ = master.set_timeout(std::time::Duration::from_millis(20));
-    let path = slave.name().unwrap_or_default();
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
-    let sim = std::thread::spawn(move || {
-        let _keep = slave;
-        if let Ok(emu) = EmuTarget::new(Straps::default(), ModelConfig::default()) {
-            let mut server = BridgeServer::new(emu, 1, true);
-            let _ = serve(
-                &mut master,
-                &mut server,
-                LinkFaults::default(),
-                false,
-                &flag,
-            );
+    let sim = EmuTarget::new(Straps::default(), ModelConfig::default())
+        .map_err(|e| e.to_string())
+        .and_then(|emu| PtyBridge::start(emu, LinkFaults::default()).map_err(|e| e.to_string()));
+    let sim = match sim {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("ppmc bench: no bridge simulator: {e}");
+            return ExitCode::from(1);
         }
-    });
+    };
+    let path = sim.path().to_string();
     let mut remote = Vec::new();
     let mut trips = 0;
     for _ in 0..repeat {
@@ -223,7 +209,6 @@ fn suite_over_bridge(repeat: usize) -> ExitCode {
             .and_then(|l| SerialTarget::open(l, SerialOptions::default()));
         let Ok(mut t) = target else {
             eprintln!("ppmc bench: the bridge simulator did not answer");
-            stop.store(true, Ordering::Relaxed);
             return ExitCode::from(1);
         };
         let t0 = WallClock::now();
@@ -231,8 +216,7 @@ fn suite_over_bridge(repeat: usize) -> ExitCode {
         remote.push(t0.elapsed().as_secs_f64() * 1e3);
         trips = t.stats.round_trips;
     }
-    stop.store(true, Ordering::Relaxed);
-    let _ = sim.join();
+    sim.stop();
     let (l, r) = (median_ms(local), median_ms(remote));
     println!("| conformance suite ({} scenarios) | median wall time | round trips | round trips per scenario |", suite.len());
     println!("|---|---:|---:|---:|");

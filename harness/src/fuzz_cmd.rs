@@ -1,38 +1,105 @@
-//! `ppmc fuzz`: turning fuzz findings into something people can read.
+//! `ppmc fuzz`: turning fuzz findings into something people can read and
+//! keep, and differential runs against a target.
 
 use clap::{Args, Subcommand};
-use std::path::PathBuf;
+use ppmc::emu::ModelConfig;
+use ppmc::fuzzing::finding::{self, InputKind};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct FuzzArgs {
     #[command(subcommand)]
-    command: FuzzCommand,
+    command: Option<FuzzCommand>,
+    /// Without a subcommand: a differential run (see `ppmc fuzz run --help`).
+    #[command(flatten)]
+    run: crate::diff_cmd::DiffArgs,
 }
 
 #[derive(Debug, Subcommand)]
 enum FuzzCommand {
-    /// Print a `bus_bytes` input (a crash file from fuzz/artifacts/, or a
-    /// corpus entry) as a bus script in the console language, with the
-    /// invariant it breaks on the emulator. Paste it into `ppmc console` to
-    /// replay it. Exit status 1 when the input breaks an invariant, 0 when
-    /// it breaks none, 2 when the file cannot be read.
+    /// Print a fuzz input (a crash file from fuzz/artifacts/, or a corpus
+    /// entry) as a bus script in the console language, with the invariant
+    /// it breaks on the emulator. Paste it into `ppmc console` to replay it.
+    /// Exit status 1 when the input breaks an invariant, 0 when it breaks
+    /// none, 2 when the file cannot be read.
     Reproduce {
-        /// The input file.
-        file: PathBuf,
+        #[command(flatten)]
+        input: InputArgs,
     },
+    /// Shrink a fuzz input while the same invariant still breaks: drop ops,
+    /// merge and shorten waits, zero data bytes. Writes the result as a
+    /// `bus_bytes` input (`<file>.min` unless -o) and prints its bus
+    /// script. Exit status 0 when minimized, 1 when the input breaks no
+    /// invariant, 2 on a usage or file error.
+    Minimize {
+        #[command(flatten)]
+        input: InputArgs,
+        /// Where to write the minimized input.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Write a fuzz input (best minimized first) as a Rust scenario file in
+    /// scenarios/, named after the invariant it breaks
+    /// (`fuzz_<invariant>_<n>.rs`; never overwrites). The scenario replays
+    /// the bus ops and fails while the invariant breaks. Exit status 0 when
+    /// written, 1 when the input breaks no invariant, 2 on a usage or file
+    /// error.
+    ToScenario {
+        #[command(flatten)]
+        input: InputArgs,
+        /// The scenario directory.
+        #[arg(long, default_value = "scenarios")]
+        dir: PathBuf,
+    },
+    /// A differential run: a seeded stream of protocol-respecting actions
+    /// against a target and the emulator side by side (the default when no
+    /// subcommand is given).
+    Run(crate::diff_cmd::DiffArgs),
+}
+
+#[derive(Debug, Args)]
+struct InputArgs {
+    /// The input file.
+    file: PathBuf,
+    /// Which fuzz target the input is for.
+    #[arg(long, value_enum, default_value = "bus-bytes")]
+    kind: InputKind,
+    /// Judge on an emulator with this board fault (`ppmc fault-matrix
+    /// --list`); repeat to combine. Default: the clean emulator.
+    #[arg(long = "chip-fault", value_name = "FAULT")]
+    chip_faults: Vec<String>,
+}
+
+impl InputArgs {
+    /// The model, the input's bytes and its bus ops.
+    fn load(&self) -> Result<(ModelConfig, Vec<ppmc::fuzzing::bus::BusOp>), ExitCode> {
+        let mut cfg = ModelConfig::default();
+        for name in &self.chip_faults {
+            if let Err(e) = ppmc::emu::faults::apply_named(name, &mut cfg) {
+                return Err(crate::usage_error(format!("--chip-fault: {e}")));
+            }
+        }
+        let data = std::fs::read(&self.file)
+            .map_err(|e| crate::usage_error(format!("cannot read {}: {e}", self.file.display())))?;
+        let ops = finding::ops_of(&data, self.kind, &cfg);
+        Ok((cfg, ops))
+    }
 }
 
 pub fn run(args: FuzzArgs) -> ExitCode {
     match args.command {
-        FuzzCommand::Reproduce { file } => {
-            let data = match std::fs::read(&file) {
-                Ok(d) => d,
-                Err(e) => {
-                    return crate::usage_error(format!("cannot read {}: {e}", file.display()))
-                }
+        None => crate::diff_cmd::run(args.run),
+        Some(FuzzCommand::Run(a)) => crate::diff_cmd::run(a),
+        Some(FuzzCommand::Reproduce { input }) => {
+            let (cfg, ops) = match input.load() {
+                Ok(x) => x,
+                Err(code) => return code,
             };
-            let (script, found) = ppmc::fuzzing::reproducer(&data, &file.display().to_string());
+            let data = finding::to_bytes(&ops);
+            let source = input.file.display().to_string();
+            let (script, found) = ppmc::fuzzing::reproducer_with(&data, &source, cfg);
             print!("{script}");
             if found.is_some() {
                 ExitCode::from(1)
@@ -40,5 +107,94 @@ pub fn run(args: FuzzArgs) -> ExitCode {
                 ExitCode::SUCCESS
             }
         }
+        Some(FuzzCommand::Minimize { input, output }) => {
+            let (cfg, ops) = match input.load() {
+                Ok(x) => x,
+                Err(code) => return code,
+            };
+            let Some(v) = finding::first_break(&ops, &cfg) else {
+                eprintln!(
+                    "ppmc fuzz minimize: {} breaks no invariant on this model; nothing to minimize",
+                    input.file.display()
+                );
+                return ExitCode::from(1);
+            };
+            let Some(m) = finding::minimize(&ops, &cfg, v.invariant) else {
+                eprintln!(
+                    "ppmc fuzz minimize: the break of {} is not reproducible",
+                    v.invariant
+                );
+                return ExitCode::from(1);
+            };
+            let out = output.unwrap_or_else(|| with_suffix(&input.file, "min"));
+            let bytes = finding::to_bytes(&m.ops);
+            if let Err(e) = ppmc::golden::write_atomic(&out, &bytes) {
+                return crate::usage_error(format!("cannot write {}: {e}", out.display()));
+            }
+            eprintln!(
+                "ppmc fuzz minimize: {} ops -> {} ops ({} oracle runs), invariant {} still breaks; wrote {}",
+                ops.len(),
+                m.ops.len(),
+                m.tries,
+                m.violation.invariant,
+                out.display()
+            );
+            let cfg2 = cfg.clone();
+            let (script, _) =
+                ppmc::fuzzing::reproducer_with(&bytes, &out.display().to_string(), cfg2);
+            print!("{script}");
+            ExitCode::SUCCESS
+        }
+        Some(FuzzCommand::ToScenario { input, dir }) => {
+            let (cfg, ops) = match input.load() {
+                Ok(x) => x,
+                Err(code) => return code,
+            };
+            let Some(v) = finding::first_break(&ops, &cfg) else {
+                eprintln!(
+                    "ppmc fuzz to-scenario: {} breaks no invariant on this model; \
+                     a regression scenario would pass already",
+                    input.file.display()
+                );
+                return ExitCode::from(1);
+            };
+            if !dir.is_dir() {
+                return crate::usage_error(format!(
+                    "{} is not a directory: run from the repository root or give --dir",
+                    dir.display()
+                ));
+            }
+            let (stem, path) = (1..)
+                .map(|n| {
+                    let stem = finding::scenario_stem(v.invariant, n);
+                    let path = dir.join(format!("{stem}.rs"));
+                    (stem, path)
+                })
+                .find(|(_, p)| !p.exists())
+                .unwrap_or_default();
+            let text = finding::scenario_file(
+                &stem,
+                &ops[..=v.op.min(ops.len().saturating_sub(1))],
+                &v,
+                &input.file.display().to_string(),
+            );
+            if let Err(e) = ppmc::golden::write_atomic(&path, text.as_bytes()) {
+                return crate::usage_error(format!("cannot write {}: {e}", path.display()));
+            }
+            println!(
+                "wrote {} (scenario {stem}, invariant {}, {} ops); `cargo test` runs it",
+                path.display(),
+                v.invariant,
+                v.op + 1
+            );
+            ExitCode::SUCCESS
+        }
     }
+}
+
+fn with_suffix(p: &Path, suffix: &str) -> PathBuf {
+    let mut s = p.as_os_str().to_owned();
+    s.push(".");
+    s.push(suffix);
+    PathBuf::from(s)
 }

@@ -10,6 +10,7 @@ pub mod bridge;
 pub mod compare;
 pub mod console;
 pub mod emu;
+pub mod fault_matrix;
 pub mod fuzzing;
 pub mod golden;
 pub mod protocol;

@@ -2,7 +2,9 @@
 
 mod bench;
 mod cmd;
+mod diff_cmd;
 mod fuzz_cmd;
+mod matrix_cmd;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use ppmc::console::{self, ConsoleOptions, Line, ScriptError};
@@ -54,9 +56,16 @@ enum Command {
     /// Measure the emulator's speed (maximum-length move, constant-rate
     /// stretches, per-pulse expansion) and print the figures.
     Bench(bench::BenchArgs),
-    /// Work with fuzz findings: `ppmc fuzz reproduce <crash-file>` prints a
-    /// `bus_bytes` input as a console script with the invariant it breaks.
+    /// Fuzzing: a differential run against a target (`ppmc fuzz --target
+    /// serial:<pty> --seed N`), and findings made into regression tests
+    /// (`reproduce`, `minimize`, `to-scenario`).
     Fuzz(fuzz_cmd::FuzzArgs),
+    /// Run every catalogued board fault (and the clean board) behind
+    /// `bridge-sim` on a pty against the conformance suite, the golden
+    /// traces and a bounded differential fuzz; print which caught each and
+    /// how fast. Exit status 0 when every fault is caught and the clean
+    /// board by nothing, 1 otherwise.
+    FaultMatrix(matrix_cmd::MatrixArgs),
 }
 
 #[derive(Debug, Args)]
@@ -154,7 +163,7 @@ pub(crate) fn parse_duration(s: &str) -> Result<Duration, String> {
 }
 
 impl TargetArgs {
-    pub(crate) fn straps(&self) -> Result<Straps, String> {
+    pub fn straps(&self) -> Result<Straps, String> {
         let hz = |mhz: f64, what: &str| -> Result<u32, String> {
             let v = (mhz * 1e6).round();
             if v.is_finite() && v >= 1.0 && v <= f64::from(u32::MAX) {
@@ -181,7 +190,7 @@ impl TargetArgs {
         &self.target
     }
 
-    pub(crate) fn model(&self) -> ModelConfig {
+    pub fn model(&self) -> ModelConfig {
         ModelConfig {
             accel_curve: match self.accel_curve {
                 Curve::LinearSpeed => AccelCurve::LinearSpeed,
@@ -260,6 +269,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench::run(args),
         Command::BridgeSim(args) => bridge_sim(args),
         Command::Fuzz(args) => fuzz_cmd::run(args),
+        Command::FaultMatrix(args) => matrix_cmd::run(args),
     }
 }
 

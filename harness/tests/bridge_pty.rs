@@ -3,46 +3,21 @@
 
 mod common;
 
-use ppmc::bridge::server::BridgeServer;
-use ppmc::bridge::sim::{serve, LinkFaults, ServeEnd};
+use ppmc::bridge::sim::{LinkFaults, PtyBridge};
 use ppmc::emu::{Faults, ModelConfig};
 use ppmc::protocol::Straps;
 use ppmc::runner::run_suite;
 use ppmc::scenario::{DriverOptions, ScenarioResult, Verdict};
 use ppmc::target::{EmuTarget, SerialError, SerialLink, SerialOptions, SerialTarget};
-use serialport::SerialPort;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
-use std::thread::JoinHandle;
 use std::time::Duration as WallDuration;
 
 /// A bridge simulator serving on its own thread.
-struct Sim {
-    path: String,
-    stop: Arc<AtomicBool>,
-    handle: Option<JoinHandle<Option<ServeEnd>>>,
-}
+struct Sim(PtyBridge);
 
 impl Sim {
     fn start(faults: LinkFaults, model: ModelConfig) -> Sim {
-        let (mut master, slave) = serialport::TTYPort::pair().expect("a pty");
-        master
-            .set_timeout(WallDuration::from_millis(20))
-            .expect("timeout");
-        let path = slave.name().expect("pty path");
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&stop);
-        let handle = std::thread::spawn(move || {
-            let _keep_open = slave;
-            let emu = EmuTarget::new(Straps::default(), model).expect("emulator");
-            let mut server = BridgeServer::new(emu, 0x5EED, true);
-            serve(&mut master, &mut server, faults, false, &flag).ok()
-        });
-        Sim {
-            path,
-            stop,
-            handle: Some(handle),
-        }
+        let emu = EmuTarget::new(Straps::default(), model).expect("emulator");
+        Sim(PtyBridge::start(emu, faults).expect("a pty"))
     }
 
     fn clean() -> Sim {
@@ -50,16 +25,7 @@ impl Sim {
     }
 
     fn target(&self, opts: SerialOptions) -> Result<SerialTarget<SerialLink>, SerialError> {
-        SerialTarget::open(SerialLink::open(&self.path, 115_200)?, opts)
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(h) = self.handle.take() {
-            let _ = h.join();
-        }
+        SerialTarget::open(SerialLink::open(self.0.path(), 115_200)?, opts)
     }
 }
 

@@ -133,3 +133,60 @@ pub fn serve<P: Read + Write>(
     }
     Ok(ServeEnd::Stopped)
 }
+
+/// A bridge simulator serving an emulator on its own thread, on a fresh
+/// pseudo-terminal: what tests, `ppmc bench` and `ppmc fault-matrix` point
+/// a serial target at. Dropping it stops the thread.
+#[derive(Debug)]
+pub struct PtyBridge {
+    path: String,
+    stop: Arc<AtomicBool>,
+    handle: Option<std::thread::JoinHandle<Option<ServeEnd>>>,
+}
+
+impl PtyBridge {
+    /// Serves `emu` (in virtual time) with `faults` on the link.
+    pub fn start(emu: crate::target::EmuTarget, faults: LinkFaults) -> io::Result<PtyBridge> {
+        use serialport::SerialPort;
+        let (mut master, slave) = serialport::TTYPort::pair().map_err(io::Error::other)?;
+        master
+            .set_timeout(WallDuration::from_millis(20))
+            .map_err(io::Error::other)?;
+        let path = slave
+            .name()
+            .ok_or_else(|| io::Error::other("the pseudo-terminal has no path"))?;
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&stop);
+        let handle = std::thread::spawn(move || {
+            let _keep_open = slave;
+            let mut server = BridgeServer::new(emu, 0x5EED, true);
+            serve(&mut master, &mut server, faults, false, &flag).ok()
+        });
+        Ok(PtyBridge {
+            path,
+            stop,
+            handle: Some(handle),
+        })
+    }
+
+    /// The pty's path, for `serial:<path>`.
+    pub fn path(&self) -> &str {
+        &self.path
+    }
+
+    /// Stops serving; how the serve loop ended (`None` if it failed).
+    pub fn stop(mut self) -> Option<ServeEnd> {
+        self.halt()
+    }
+
+    fn halt(&mut self) -> Option<ServeEnd> {
+        self.stop.store(true, Ordering::Relaxed);
+        self.handle.take().and_then(|h| h.join().ok().flatten())
+    }
+}
+
+impl Drop for PtyBridge {
+    fn drop(&mut self) {
+        self.halt();
+    }
+}

@@ -5,7 +5,10 @@
 
 pub mod actions;
 pub mod bus;
+pub mod differential;
+pub mod finding;
 pub mod oracle;
+pub mod replay;
 
 use crate::bridge::frame::{self, FrameDecoder};
 use crate::bridge::wire::{Request, Response, Timer};

@@ -14,6 +14,27 @@ use std::fmt;
 /// Section 3-2): the most bits 6-4 can show without an error.
 const MAX_PARAMS: u8 = 4;
 
+/// Every invariant id with the datasheet section it comes from.
+pub const INVARIANTS: &[(&str, &str)] = &[
+    ("status-bit3", "3-1-1"),
+    ("status-params", "3-1-1"),
+    ("busy-status-matches", "3-1-1"),
+    ("remaining-pulses", "3-4-4"),
+    ("finish-flag-once", "3-4-1"),
+    ("busy-covers-pulses", "3-1-1"),
+    ("time-monotonic", "model"),
+    ("record-ordered", "model"),
+    ("trace-round-trip", "trace format"),
+];
+
+/// The datasheet section an invariant comes from.
+pub fn section(invariant: &str) -> &'static str {
+    INVARIANTS
+        .iter()
+        .find(|(id, _)| *id == invariant)
+        .map_or("model", |(_, s)| s)
+}
+
 /// An invariant break: which invariant, after which op, and what was seen.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Violation {
@@ -55,44 +76,34 @@ struct Reading {
     bytes: Vec<u8>,
 }
 
-/// The oracle as a state machine: a fresh chip, fed one op at a time, each
-/// checked as it goes; [`Checker::finish`] checks the whole record.
-#[derive(Debug)]
-pub struct Checker {
-    chip: Chip,
+/// What the host saw of one op: the status register just before and just
+/// after it (reading it has no side effect, Section 3-1-1), what a read
+/// returned, and the time the op ended.
+#[derive(Debug, Clone, Copy)]
+pub struct Seen {
+    pub before: Status,
+    pub after: Status,
+    /// The status byte of a `ReadStatus`, the byte of a `ReadData`.
+    pub value: Option<u8>,
+    pub at: Instant,
+}
+
+/// The invariants, judged from what the host sees of each op and from the
+/// capture (as of each op's time). The same judge runs on the emulator's
+/// chip ([`Checker`]) and on any target's replies ([`super::replay`]).
+#[derive(Debug, Default)]
+pub struct Judge {
     ops: usize,
-    last_now: Instant,
-    /// The command last written, and the data bytes read since (with
-    /// OBF = 1, once the chip has taken the command).
+    last_at: Instant,
     reading: Option<Reading>,
     /// Moves ended (BUSY falls) when the finish status was last read.
     stops_at_finish_read: usize,
 }
 
-impl Checker {
-    pub fn new(cfg: ModelConfig) -> Result<Checker, ChipError> {
-        let chip = Chip::new(Straps::default(), cfg)?;
-        Ok(Checker {
-            last_now: chip.now(),
-            chip,
-            ops: 0,
-            reading: None,
-            stops_at_finish_read: 0,
-        })
-    }
-
-    /// The chip under test.
-    pub fn chip(&self) -> &Chip {
-        &self.chip
-    }
-
-    /// Ops applied so far.
-    pub fn ops(&self) -> usize {
-        self.ops
-    }
-
-    /// Applies one op and checks the invariants it can break.
-    pub fn apply(&mut self, op: BusOp) -> Result<(), Violation> {
+impl Judge {
+    /// Judges op number `self.ops` given what was seen of it and the
+    /// capture, which may run past `seen.at` (it is looked at as of then).
+    pub fn op(&mut self, op: BusOp, seen: Seen, rec: &Record) -> Result<(), Violation> {
         let i = self.ops;
         self.ops += 1;
         let fail = |invariant, detail: String| Violation {
@@ -100,30 +111,26 @@ impl Checker {
             op: i,
             detail,
         };
-        let chip = &mut self.chip;
-        let ibf_before = chip.read_status().ibf();
-        if ibf_before && matches!(op, BusOp::Command(_) | BusOp::Data(_)) {
+        if seen.before.ibf() && matches!(op, BusOp::Command(_) | BusOp::Data(_)) {
             // The byte waiting may be the read command: it could be lost.
             if self.reading.as_ref().is_some_and(|r| !r.taken) {
                 self.reading = None;
             }
         }
-        match op {
-            BusOp::Command(b) => {
-                chip.write_command(b);
+        match (op, seen.value) {
+            (BusOp::Command(b), _) => {
                 self.reading = Some(Reading {
                     command: b,
                     taken: false,
                     bytes: Vec::new(),
                 });
             }
-            BusOp::Data(b) => chip.write_data(b),
-            BusOp::ReadStatus => {
-                let s = chip.read_status();
+            (BusOp::ReadStatus, Some(v)) => {
+                let s = Status(v);
                 if let Some((invariant, detail)) = status_breaks(s) {
                     return Err(fail(invariant, detail));
                 }
-                let line = busy_level(chip.record(), chip.now());
+                let line = busy_level(rec, seen.at);
                 if s.busy() != line {
                     return Err(fail(
                         "busy-status-matches",
@@ -131,45 +138,38 @@ impl Checker {
                             "status 0x{:02X} reads BUSY={} at {} while the BUSY line is {}",
                             s.0,
                             u8::from(s.busy()),
-                            chip.now(),
+                            seen.at,
                             u8::from(line)
                         ),
                     ));
                 }
             }
-            BusOp::ReadData => {
-                let s = chip.read_status();
-                let byte = chip.read_data();
-                if s.obf() {
-                    if let Some(r) = self.reading.as_mut().filter(|r| r.taken) {
-                        r.bytes.push(byte);
-                    }
-                    if let Some((invariant, detail)) = self.register_breaks() {
-                        return Err(fail(invariant, detail));
-                    }
+            (BusOp::ReadData, Some(byte)) if seen.before.obf() => {
+                if let Some(r) = self.reading.as_mut().filter(|r| r.taken) {
+                    r.bytes.push(byte);
+                }
+                if let Some((invariant, detail)) = self.register_breaks(rec, seen.at) {
+                    return Err(fail(invariant, detail));
                 }
             }
-            BusOp::Input { input, asserted } => chip.set_input(input, asserted),
-            BusOp::Advance(d) => chip.advance_to(chip.now() + d),
+            _ => {}
         }
         if let Some(r) = self.reading.as_mut() {
-            r.taken |= !self.chip.read_status().ibf();
+            r.taken |= !seen.after.ibf();
         }
-        let now = self.chip.now();
-        if now < self.last_now {
+        if seen.at < self.last_at {
             return Err(fail(
                 "time-monotonic",
-                format!("the clock went from {} back to {now}", self.last_now),
+                format!("the clock went from {} back to {}", self.last_at, seen.at),
             ));
         }
-        self.last_now = now;
+        self.last_at = seen.at;
         Ok(())
     }
 
-    /// The record's own invariants, checked once at the end (per op they
-    /// would cost time quadratic in its length).
-    pub fn finish(&self) -> Result<(), Violation> {
-        let rec = self.chip.record();
+    /// The whole capture's invariants, once at the end (per op they would
+    /// cost time quadratic in its length).
+    pub fn finish(&self, rec: &Record) -> Result<(), Violation> {
         let at_end = |invariant, detail| Violation {
             invariant,
             op: self.ops.saturating_sub(1),
@@ -189,14 +189,20 @@ impl Checker {
 
     /// Checks a register read once all its bytes are in: the remaining
     /// pulses (Section 3-4-4) and the finish status polling flag (3-4-1).
-    fn register_breaks(&mut self) -> Option<(&'static str, String)> {
+    /// The chip takes a read command only when BUSY = 0, so the move the
+    /// register tells of has ended by `at`.
+    fn register_breaks(&mut self, rec: &Record, at: Instant) -> Option<(&'static str, String)> {
         let Reading { command, bytes, .. } = self.reading.as_ref()?;
-        let rec = self.chip.record();
         match Command::decode(*command) {
             Command::Read(Register::RemainingPulses) if bytes.len() == 3 => {
                 let read = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], 0]);
-                let m = rec.moves.last()?;
-                let out = rec.last_move_pulses().count;
+                let k = rec.moves.iter().rposition(|m| m.at <= at)?;
+                let m = &rec.moves[k];
+                let runs_end = rec.moves.get(k + 1).map_or(rec.runs.len(), |n| n.first_run);
+                let out: u64 = rec.runs[m.first_run.min(runs_end)..runs_end]
+                    .iter()
+                    .map(|r| pulses_until(r, at))
+                    .sum();
                 let steps = u64::from(m.steps);
                 let want = if out >= steps { 0 } else { steps - out - 1 };
                 (u64::from(read) != want).then(|| {
@@ -213,9 +219,9 @@ impl Checker {
                 let stops = rec
                     .pins
                     .iter()
-                    .filter(|p| p.pin == Pin::Busy && p.value == 0)
+                    .filter(|p| p.pin == Pin::Busy && p.value == 0 && p.at <= at)
                     .count();
-                let since = stops - self.stops_at_finish_read;
+                let since = stops.saturating_sub(self.stops_at_finish_read);
                 self.stops_at_finish_read = stops;
                 let flag = FinishStatus(bytes[0]).polling();
                 (flag && since == 0).then(|| {
@@ -231,6 +237,83 @@ impl Checker {
             }
             _ => None,
         }
+    }
+}
+
+/// Pulses of a run at or before `t`.
+fn pulses_until(r: &crate::protocol::PulseRun, t: Instant) -> u64 {
+    if r.start > t {
+        return 0;
+    }
+    let n = match r.interval.as_nanos() {
+        0 => u64::from(r.count),
+        i => t.saturating_since(r.start).as_nanos() / i + 1,
+    };
+    n.min(u64::from(r.count))
+}
+
+/// The oracle on the emulator: a fresh chip, fed one op at a time, each
+/// judged as it goes; [`Checker::finish`] judges the whole record.
+#[derive(Debug)]
+pub struct Checker {
+    chip: Chip,
+    judge: Judge,
+}
+
+impl Checker {
+    pub fn new(cfg: ModelConfig) -> Result<Checker, ChipError> {
+        Ok(Checker {
+            chip: Chip::new(Straps::default(), cfg)?,
+            judge: Judge::default(),
+        })
+    }
+
+    /// The chip under test.
+    pub fn chip(&self) -> &Chip {
+        &self.chip
+    }
+
+    /// Ops applied so far.
+    pub fn ops(&self) -> usize {
+        self.judge.ops
+    }
+
+    /// Applies one op and judges it.
+    pub fn apply(&mut self, op: BusOp) -> Result<(), Violation> {
+        let chip = &mut self.chip;
+        let before = chip.read_status();
+        let value = match op {
+            BusOp::Command(b) => {
+                chip.write_command(b);
+                None
+            }
+            BusOp::Data(b) => {
+                chip.write_data(b);
+                None
+            }
+            BusOp::ReadStatus => Some(before.0),
+            BusOp::ReadData => Some(chip.read_data()),
+            BusOp::Input { input, asserted } => {
+                chip.set_input(input, asserted);
+                None
+            }
+            BusOp::Advance(d) => {
+                chip.advance_to(chip.now() + d);
+                None
+            }
+        };
+        let seen = Seen {
+            before,
+            after: chip.read_status(),
+            value,
+            at: chip.now(),
+        };
+        self.judge.op(op, seen, chip.record())
+    }
+
+    /// The record's own invariants, checked once at the end.
+    pub fn finish(&self) -> Result<(), Violation> {
+        self.judge.finish(self.chip.record())
     }
 }
 

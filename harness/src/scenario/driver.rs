@@ -312,6 +312,33 @@ impl<'t> Driver<'t> {
 
     // ----- raw layer -------------------------------------------------------
 
+    /// Replays fuzz bus ops from a chip reset and judges them by the fuzz
+    /// oracle's invariants (`docs/invariants.md`): the body of a regression
+    /// scenario written by `ppmc fuzz to-scenario`.
+    pub fn replay_bus(&mut self, ops: &[crate::fuzzing::bus::BusOp]) -> Outcome {
+        use crate::fuzzing::{oracle, replay};
+        self.reset()?;
+        let replies = self.exec(&replay::probed_ops(ops))?;
+        let capture = self.capture()?.clone();
+        match replay::judge(ops, &replies, &capture) {
+            Err(e) => Err(Stop::Error(e)),
+            Ok(None) => Ok(()),
+            Ok(Some(f)) => {
+                let v = f.violation;
+                Err(fail(
+                    format!(
+                        "invariant {} (Section {})",
+                        v.invariant,
+                        oracle::section(v.invariant)
+                    ),
+                    "holds",
+                    format!("broken after op {}: {}", v.op, v.detail),
+                    f.at,
+                ))
+            }
+        }
+    }
+
     /// Runs ops on the target (after everything queued); a target failure
     /// stops the scenario as an error (not the device's fault).
     pub fn exec(&mut self, ops: &[Op]) -> Outcome<Vec<Reply>> {

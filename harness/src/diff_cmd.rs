@@ -1,0 +1,159 @@
+//! `ppmc fuzz [run] --target <t>`: a differential run against a target.
+
+use crate::TargetArgs;
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use ppmc::fuzzing::differential::{self, DiffSettings};
+use ppmc::target::{EmuTarget, Target};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant as WallClock;
+
+#[derive(Debug, Args)]
+pub struct DiffArgs {
+    #[command(flatten)]
+    target: TargetArgs,
+    /// Seed of the action stream; the seed alone replays a run. Default: one
+    /// taken from the clock, printed so that the run can be replayed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Actions to run (each a command with its parameter bytes, a wait, an
+    /// input change or a register read, with the flowchart's waits).
+    #[arg(long, default_value_t = 1_000)]
+    ops: usize,
+    /// Stop after this much wall time (e.g. 30s, 5m is 300s) even if
+    /// --ops are not done.
+    #[arg(long, value_parser = crate::parse_duration)]
+    duration: Option<ppmc::time::Duration>,
+    /// Where to write the minimized reproducer (a console script).
+    /// Default: fuzz-diff-<seed>.ppmc in the current directory.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Most replays spent minimizing a departure on the target.
+    #[arg(long, default_value_t = 200)]
+    minimize_budget: usize,
+    /// With --target emu: run the target emulator with this board fault
+    /// (`ppmc fault-matrix --list`) against the clean reference.
+    #[arg(long = "chip-fault", value_name = "FAULT")]
+    chip_faults: Vec<String>,
+}
+
+pub fn run(args: DiffArgs) -> ExitCode {
+    let straps = match args.target.straps() {
+        Ok(s) => s,
+        Err(e) => return crate::usage_error(e),
+    };
+    let mut target: Box<dyn Target> = if args.target.name() == "emu" {
+        let mut model = args.target.model();
+        for name in &args.chip_faults {
+            if let Err(e) = ppmc::emu::faults::apply_named(name, &mut model) {
+                return crate::usage_error(format!("--chip-fault: {e}"));
+            }
+        }
+        match EmuTarget::new(straps, model) {
+            Ok(t) => Box::new(t),
+            Err(e) => return crate::usage_error(e),
+        }
+    } else if !args.chip_faults.is_empty() {
+        return crate::usage_error(
+            "--chip-fault applies to --target emu; a bridge simulator takes it as `ppmc bridge-sim --chip-fault`",
+        );
+    } else {
+        match args.target.open() {
+            Ok(t) => t,
+            Err(e) => return e.exit(),
+        }
+    };
+    let seed = args.seed.unwrap_or_else(|| {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(1, |d| d.as_nanos() as u64)
+    });
+    let settings = DiffSettings {
+        straps,
+        reference: args.target.model(),
+        ..DiffSettings::default()
+    };
+    let name = args.target.name().to_string();
+    eprintln!(
+        "ppmc fuzz: seed {seed}, {} actions against {name} (replay with --seed {seed})",
+        args.ops
+    );
+    let acts = differential::program(seed, args.ops);
+    let bar = ProgressBar::new(acts.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} actions {elapsed} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let t0 = WallClock::now();
+    let limit = args
+        .duration
+        .map(|d| std::time::Duration::from_nanos(d.as_nanos()));
+    let mut done = 0;
+    let result = differential::run(target.as_mut(), &acts, &settings, |n| {
+        done = n;
+        bar.set_position(n as u64);
+        limit.is_none_or(|l| t0.elapsed() < l)
+    });
+    bar.finish_and_clear();
+    let departure = match result {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("ppmc fuzz: infrastructure error after {done} actions: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    let Some(d) = departure else {
+        println!(
+            "seed {seed}: {done} actions in {:.1} s, no departure from the emulator",
+            t0.elapsed().as_secs_f64()
+        );
+        return ExitCode::SUCCESS;
+    };
+    let dv = &d.divergence;
+    println!(
+        "seed {seed}: departs after action {} at {}: {}: emulator {}, target {} (allowed {})",
+        d.action + 1,
+        dv.at,
+        dv.quantity,
+        dv.golden,
+        dv.got,
+        dv.allowed
+    );
+    let (small, small_d) = match differential::minimize(
+        target.as_mut(),
+        &acts[..=d.action],
+        &settings,
+        args.minimize_budget,
+    ) {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("ppmc fuzz: infrastructure error while minimizing: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    let (acts_out, d_out) = match small_d {
+        Some(sd) => (small, sd),
+        // Not reproducible from a reset (a flaky board): keep the whole run.
+        None => {
+            eprintln!(
+                "ppmc fuzz: the departure did not repeat from a reset; keeping the whole run"
+            );
+            (acts[..=d.action].to_vec(), d.clone())
+        }
+    };
+    let out = args
+        .output
+        .unwrap_or_else(|| PathBuf::from(format!("fuzz-diff-{seed}.ppmc")));
+    let text = differential::script(&acts_out, &d_out, seed, &name);
+    if let Err(e) = ppmc::golden::write_atomic(&out, text.as_bytes()) {
+        eprintln!("ppmc fuzz: cannot write {}: {e}", out.display());
+        return ExitCode::from(2);
+    }
+    println!(
+        "minimized to {} actions; reproducer written to {}",
+        acts_out.len(),
+        out.display()
+    );
+    ExitCode::from(1)
+}

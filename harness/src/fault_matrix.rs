@@ -1,0 +1,169 @@
+//! The fault matrix: each board fault of the catalogue (and the clean
+//! board) against the three checks a user has: the conformance suite, the
+//! golden trace comparison, and a bounded differential fuzz against the
+//! emulator. Which caught it, with what, after how much wall time.
+
+use crate::compare::{compare, Tolerances};
+use crate::fuzzing::differential::{self, DiffSettings};
+use crate::runner::run_suite;
+use crate::scenario::{DriverOptions, Scenario, Verdict};
+use crate::target::{Target, TargetError};
+use std::path::Path;
+use std::time::{Duration as WallDuration, Instant as WallClock};
+
+/// A check that caught a fault: what it saw first, and the wall time from
+/// the start of that check to the moment it was seen.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Catch {
+    pub first: String,
+    pub after: WallDuration,
+}
+
+/// One row: a board and what each check made of it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Row {
+    /// The fault's name, or `clean`.
+    pub board: String,
+    pub suite: Option<Catch>,
+    pub golden: Option<Catch>,
+    pub fuzz: Option<Catch>,
+}
+
+impl Row {
+    pub fn caught(&self) -> bool {
+        self.suite.is_some() || self.golden.is_some() || self.fuzz.is_some()
+    }
+}
+
+/// How much differential fuzzing a row gets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FuzzBudget {
+    /// Seeds tried, from 0.
+    pub seeds: u64,
+    /// Actions per seed.
+    pub actions: usize,
+}
+
+impl Default for FuzzBudget {
+    fn default() -> Self {
+        FuzzBudget {
+            seeds: 8,
+            actions: 300,
+        }
+    }
+}
+
+/// Runs the three checks on `target`. A target failure (the link) is an
+/// error, not a catch.
+pub fn check_board(
+    board: &str,
+    target: &mut dyn Target,
+    suite: &[Scenario],
+    golden_dir: &Path,
+    budget: FuzzBudget,
+) -> Result<Row, TargetError> {
+    let t0 = WallClock::now();
+    let mut first_fail: Option<Catch> = None;
+    let mut first_divergence: Option<Catch> = None;
+    let mut link_error: Option<String> = None;
+    run_suite(target, suite, 1, DriverOptions::default(), |r| {
+        match &r.verdict {
+            Verdict::Error(e) | Verdict::NotRun(e) if link_error.is_none() => {
+                link_error = Some(format!("{}: {e}", r.name));
+            }
+            v if !v.ok() && first_fail.is_none() => {
+                first_fail = Some(Catch {
+                    first: format!("{}: {}", r.name, v.detail().unwrap_or_default()),
+                    after: t0.elapsed(),
+                });
+            }
+            _ => {}
+        }
+        if first_divergence.is_some() {
+            return;
+        }
+        let Some(trace) = r.trace.as_ref() else {
+            return;
+        };
+        let diverged = match crate::golden::load(golden_dir, r.name) {
+            Ok(g) => compare(&g, trace, &Tolerances::default()).err().map(|d| {
+                format!(
+                    "{}: {} at {}: golden {}, got {}",
+                    r.name, d.quantity, d.at, d.golden, d.got
+                )
+            }),
+            Err(e) => Some(format!("{}: {e}", r.name)),
+        };
+        if let Some(first) = diverged {
+            first_divergence = Some(Catch {
+                first,
+                after: t0.elapsed(),
+            });
+        }
+    });
+    if let Some(message) = link_error {
+        return Err(TargetError {
+            kind: crate::target::TargetErrorKind::Link,
+            message,
+        });
+    }
+    let t1 = WallClock::now();
+    let settings = DiffSettings::default();
+    let mut fuzz = None;
+    for seed in 0..budget.seeds {
+        let acts = differential::program(seed, budget.actions);
+        if let Some(d) = differential::run(target, &acts, &settings, |_| true)? {
+            let dv = d.divergence;
+            fuzz = Some(Catch {
+                first: format!(
+                    "seed {seed} action {}: {}: emulator {}, target {}",
+                    d.action + 1,
+                    dv.quantity,
+                    dv.golden,
+                    dv.got
+                ),
+                after: t1.elapsed(),
+            });
+            break;
+        }
+    }
+    Ok(Row {
+        board: board.to_string(),
+        suite: first_fail,
+        golden: first_divergence,
+        fuzz,
+    })
+}
+
+/// The matrix as a Markdown table, with a verdict per row.
+pub fn render(rows: &[Row]) -> String {
+    let cell = |c: &Option<Catch>| match c {
+        Some(c) => format!("{:.0} ms", c.after.as_secs_f64() * 1e3),
+        None => "-".into(),
+    };
+    let mut s = String::from(
+        "| board | conformance suite | golden traces | differential fuzz | verdict |\n|---|---:|---:|---:|---|\n",
+    );
+    for r in rows {
+        let verdict = match (r.board == "clean", r.caught()) {
+            (true, false) => "no false alarm",
+            (true, true) => "FALSE ALARM",
+            (false, true) => "caught",
+            (false, false) => "MISSED",
+        };
+        s.push_str(&format!(
+            "| {} | {} | {} | {} | {verdict} |\n",
+            r.board,
+            cell(&r.suite),
+            cell(&r.golden),
+            cell(&r.fuzz)
+        ));
+    }
+    s
+}
+
+/// Whether the matrix is as it must be: every fault caught, the clean
+/// board by nothing.
+pub fn all_as_expected(rows: &[Row]) -> bool {
+    rows.iter().all(|r| r.caught() != (r.board == "clean"))
+}

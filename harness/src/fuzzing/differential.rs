@@ -1,0 +1,298 @@
+//! Differential runs: a seeded stream of typed actions
+//! ([`super::actions`]) on a target and on the reference emulator side by
+//! side, compared after every action with `ppmc compare`'s rules (status
+//! bytes, read data, waits and pulse timing within the tolerances, pulse
+//! counts exactly). The seed alone replays a run.
+
+use super::actions::{self, Action};
+use crate::compare::{compare, Divergence, Tolerances};
+use crate::console::{self, ConsoleOptions};
+use crate::emu::ModelConfig;
+use crate::protocol::{Record, Status, Straps};
+use crate::target::{EmuTarget, Op, Reply, Target, TargetError, TargetErrorKind};
+use crate::trace::{Event, EventKind, Trace};
+use rand::{Rng, SeedableRng};
+use std::fmt::Write as _;
+
+/// The actions of run `seed`: a valid initialization, then `n - 1` actions
+/// decoded from the seed's random bytes.
+pub fn program(seed: u64, n: usize) -> Vec<Action> {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let mut acts = vec![Action::default_init()];
+    while acts.len() < n {
+        let bytes: Vec<u8> = (0..256).map(|_| rng.random()).collect();
+        acts.extend(actions::decode(&bytes));
+    }
+    acts.truncate(n.max(1));
+    acts
+}
+
+/// Where a run first departed from the emulator.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Departure {
+    /// Index of the action after which it was seen.
+    pub action: usize,
+    pub divergence: Divergence,
+}
+
+/// One side of a run: a target and what it has shown so far.
+struct Side<'a> {
+    target: &'a mut dyn Target,
+    bus: Vec<Event>,
+    capture: Record,
+}
+
+impl Side<'_> {
+    fn run(&mut self, stmts: &[console::Stmt], ops: &[Op]) -> Result<Status, TargetError> {
+        let (replies, capture) = self.target.execute_then_capture(ops)?;
+        if replies.len() != ops.len() {
+            return Err(TargetError {
+                kind: TargetErrorKind::Other,
+                message: format!(
+                    "target answered {} of {} operations",
+                    replies.len(),
+                    ops.len()
+                ),
+            });
+        }
+        for (s, r) in stmts.iter().zip(&replies) {
+            if let Some(kind) = console::bus_event(*s, r) {
+                self.bus.push(Event {
+                    at: r.at(),
+                    kind: EventKind::Bus(kind),
+                });
+            }
+        }
+        self.capture = capture;
+        match replies.last() {
+            Some(Reply::Status { status, .. }) => Ok(*status),
+            other => Err(TargetError {
+                kind: TargetErrorKind::Other,
+                message: format!("expected the closing status read, got {other:?}"),
+            }),
+        }
+    }
+
+    fn trace(&self, name: &str, with_capture: bool) -> Trace {
+        let empty = Record::default();
+        let capture = if with_capture { &self.capture } else { &empty };
+        Trace::assemble(
+            name,
+            "-",
+            self.target.info().name.as_str(),
+            Vec::new(),
+            self.bus.clone(),
+            capture,
+            Vec::new(),
+        )
+    }
+}
+
+/// A differential run's settings.
+#[derive(Debug, Clone, Default)]
+pub struct DiffSettings {
+    pub straps: Straps,
+    /// The reference model (the clean emulator by default).
+    pub reference: ModelConfig,
+    pub tolerances: Tolerances,
+    pub console: ConsoleOptions,
+}
+
+
+/// Runs `acts` on `target` (from a chip reset) and on a fresh reference
+/// emulator, comparing after every action; stops at the first departure.
+/// `progress` is called after each action with the number done, and may
+/// stop the run early by returning false.
+pub fn run(
+    target: &mut dyn Target,
+    acts: &[Action],
+    s: &DiffSettings,
+    mut progress: impl FnMut(usize) -> bool,
+) -> Result<Option<Departure>, TargetError> {
+    let mut reference = EmuTarget::new(s.straps, s.reference.clone()).map_err(|e| TargetError {
+        kind: TargetErrorKind::Other,
+        message: format!("reference emulator: {e}"),
+    })?;
+    target.execute(&[Op::Reset])?;
+    let mut got = Side {
+        target,
+        bus: Vec::new(),
+        capture: Record::default(),
+    };
+    let mut want = Side {
+        target: &mut reference,
+        bus: Vec::new(),
+        capture: Record::default(),
+    };
+    for (i, a) in acts.iter().enumerate() {
+        let mut stmts = a.stmts();
+        // Every action ends with a status read: what the host sees, and
+        // whether the chip is idle so that the pulses can be compared.
+        stmts.push(console::Stmt::ReadStatus);
+        let ops: Vec<Op> = stmts
+            .iter()
+            .map(|st| console::to_op(*st, &s.console))
+            .collect();
+        let idle = !want.run(&stmts, &ops)?.busy();
+        got.run(&stmts, &ops)?;
+        // Pulses are compared when the chip is idle, so a board's clock
+        // a hair off the emulator's cannot split a move differently.
+        if let Err(divergence) = compare(
+            &want.trace("differential", idle),
+            &got.trace("differential", idle),
+            &s.tolerances,
+        ) {
+            return Ok(Some(Departure {
+                action: i,
+                divergence,
+            }));
+        }
+        if !progress(i + 1) {
+            break;
+        }
+    }
+    // At the end, everything.
+    if let Err(divergence) = compare(
+        &want.trace("differential", true),
+        &got.trace("differential", true),
+        &s.tolerances,
+    ) {
+        return Ok(Some(Departure {
+            action: acts.len().saturating_sub(1),
+            divergence,
+        }));
+    }
+    Ok(None)
+}
+
+/// Shrinks a departing run on the target: drops chunks of actions (halving
+/// the chunk size down to single actions) while the run still departs, at
+/// most `budget` replays. Returns the actions and their departure.
+pub fn minimize(
+    target: &mut dyn Target,
+    acts: &[Action],
+    s: &DiffSettings,
+    budget: usize,
+) -> Result<(Vec<Action>, Option<Departure>), TargetError> {
+    let mut tries = 1;
+    let departs = |target: &mut dyn Target, acts: &[Action]| run(target, acts, s, |_| true);
+    let Some(mut d) = departs(target, acts)? else {
+        return Ok((acts.to_vec(), None));
+    };
+    let mut best: Vec<Action> = acts[..=d.action.min(acts.len() - 1)].to_vec();
+    let mut chunk = best.len().div_ceil(2).max(1);
+    'outer: loop {
+        let mut i = 1; // the initialization stays
+        while i < best.len() {
+            if tries >= budget {
+                break 'outer;
+            }
+            let mut cand = best.clone();
+            cand.drain(i..(i + chunk).min(cand.len()));
+            tries += 1;
+            match departs(target, &cand)? {
+                Some(nd) => {
+                    cand.truncate(nd.action + 1);
+                    best = cand;
+                    d = nd;
+                }
+                None => i += chunk,
+            }
+        }
+        if chunk == 1 {
+            break;
+        }
+        chunk = chunk.div_ceil(2);
+    }
+    Ok((best, Some(d)))
+}
+
+/// The reproducer: a console script of the actions, headed by how to
+/// replay it and what departed.
+pub fn script(acts: &[Action], d: &Departure, seed: u64, target: &str) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "# differential reproducer: seed {seed}, target {target}, {} actions",
+        acts.len()
+    );
+    let dv = &d.divergence;
+    let _ = writeln!(
+        out,
+        "# departs after action {} at {}: {}: emulator {}, target {} (allowed {})",
+        d.action + 1,
+        dv.at,
+        dv.quantity,
+        dv.golden,
+        dv.got,
+        dv.allowed
+    );
+    let _ = writeln!(
+        out,
+        "# replay: ppmc console --target emu FILE; ppmc console --target {target} FILE; diff the two"
+    );
+    for (i, a) in acts.iter().enumerate() {
+        let _ = writeln!(out, "# action {}", i + 1);
+        for st in a.stmts() {
+            let _ = writeln!(out, "{st}");
+        }
+        let _ = writeln!(out, "rs");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emu::faults;
+
+    fn emu(cfg: ModelConfig) -> EmuTarget {
+        EmuTarget::new(Straps::default(), cfg).expect("emulator")
+    }
+
+    #[test]
+    fn a_seed_gives_one_program() {
+        assert_eq!(program(7, 50), program(7, 50));
+        assert_ne!(program(7, 50), program(8, 50));
+        assert_eq!(program(7, 50)[0], Action::default_init());
+        assert_eq!(program(7, 50).len(), 50);
+    }
+
+    #[test]
+    fn the_emulator_against_itself_never_departs() {
+        let mut t = emu(ModelConfig::default());
+        for seed in 0..4 {
+            let d = run(
+                &mut t,
+                &program(seed, 120),
+                &DiffSettings::default(),
+                |_| true,
+            );
+            assert_eq!(d.expect("runs"), None, "seed {seed}");
+        }
+    }
+
+    /// A board that reads remaining pulses one too many departs, and the
+    /// minimized run still does, in fewer actions, with the departure in a
+    /// read byte.
+    #[test]
+    fn a_faulty_board_departs_and_minimizes() {
+        let cfg = faults::find("remaining-off-by-one").expect("fault").model();
+        let mut t = emu(cfg);
+        let s = DiffSettings::default();
+        let found = (0..40).find_map(|seed| {
+            let acts = program(seed, 300);
+            run(&mut t, &acts, &s, |_| true)
+                .expect("runs")
+                .map(|d| (seed, acts, d))
+        });
+        let (seed, acts, d) = found.expect("some seed of 40 finds it");
+        let (small, d2) = minimize(&mut t, &acts, &s, 300).expect("runs");
+        let d2 = d2.expect("still departs");
+        assert!(small.len() <= d.action + 1, "{} actions", small.len());
+        assert!(d2.divergence.quantity.contains("bus transaction"), "{d2:?}");
+        let text = script(&small, &d2, seed, "emu");
+        assert!(text.contains(&format!("seed {seed}")));
+        assert!(console::parse_script(&text).is_ok(), "{text}");
+    }
+}

@@ -1,0 +1,288 @@
+//! From a fuzz finding to a regression test: read a crash file of any
+//! target as bus ops, shrink it op-aware while the same invariant still
+//! breaks, and write it as a Rust scenario file.
+
+use super::bus::{self, BusOp};
+use super::oracle::{self, Violation};
+use crate::emu::ModelConfig;
+use crate::time::Duration;
+use std::fmt::Write as _;
+
+/// The fuzz targets whose inputs are bus programs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum InputKind {
+    /// A `bus_bytes` input: ops separated by `FUZZ`.
+    BusBytes,
+    /// A `typed_actions` input: typed actions (derive `Arbitrary`).
+    TypedActions,
+}
+
+/// The bus ops an input runs on a model with `cfg`.
+pub fn ops_of(data: &[u8], kind: InputKind, cfg: &ModelConfig) -> Vec<BusOp> {
+    match kind {
+        InputKind::BusBytes => bus::decode(data),
+        InputKind::TypedActions => super::lower(&super::typed_program(data), cfg.clone()).0,
+    }
+}
+
+/// The first break of `ops` on a model with `cfg`.
+pub fn first_break(ops: &[BusOp], cfg: &ModelConfig) -> Option<Violation> {
+    oracle::check(ops, cfg.clone()).ok().flatten()
+}
+
+/// How a minimization went.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Minimized {
+    pub ops: Vec<BusOp>,
+    pub violation: Violation,
+    /// Oracle runs spent.
+    pub tries: usize,
+}
+
+/// Shrinks `ops` while `invariant` still breaks on `cfg`: cut what follows
+/// the break, drop chunks of ops (halving the chunk size down to single
+/// ops), merge neighbouring waits, shorten each wait (binary search) and
+/// zero data bytes, until a whole pass changes nothing. `None` when `ops`
+/// does not break `invariant` to begin with.
+pub fn minimize(ops: &[BusOp], cfg: &ModelConfig, invariant: &str) -> Option<Minimized> {
+    let mut tries = 0;
+    let mut breaks = |ops: &[BusOp]| -> Option<Violation> {
+        tries += 1;
+        first_break(ops, cfg).filter(|v| v.invariant == invariant)
+    };
+    let mut best = ops.to_vec();
+    let mut v = breaks(&best)?;
+    loop {
+        let before = best.clone();
+        // Nothing after the op where the break shows matters.
+        best.truncate(v.op + 1);
+        // Drop chunks, largest first.
+        let mut chunk = best.len().div_ceil(2).max(1);
+        loop {
+            let mut i = 0;
+            while i < best.len() {
+                let mut cand = best.clone();
+                cand.drain(i..(i + chunk).min(cand.len()));
+                match breaks(&cand) {
+                    Some(nv) => {
+                        best = cand;
+                        v = nv;
+                    }
+                    None => i += chunk,
+                }
+            }
+            if chunk == 1 {
+                break;
+            }
+            chunk = chunk.div_ceil(2);
+        }
+        // Merge neighbouring waits.
+        let merged = merge_waits(&best);
+        if merged != best {
+            if let Some(nv) = breaks(&merged) {
+                best = merged;
+                v = nv;
+            }
+        }
+        // Shorten each wait, and zero data bytes.
+        for i in 0..best.len() {
+            match best[i] {
+                BusOp::Advance(d) => {
+                    let (mut lo, mut hi) = (0u64, d.as_nanos() / 1_000);
+                    while lo < hi {
+                        let mid = lo + (hi - lo) / 2;
+                        let mut cand = best.clone();
+                        cand[i] = BusOp::Advance(Duration::from_micros(mid));
+                        match breaks(&cand) {
+                            Some(nv) => {
+                                hi = mid;
+                                best = cand;
+                                v = nv;
+                            }
+                            None => lo = mid + 1,
+                        }
+                    }
+                }
+                BusOp::Data(b) if b != 0 => {
+                    let mut cand = best.clone();
+                    cand[i] = BusOp::Data(0);
+                    if let Some(nv) = breaks(&cand) {
+                        best = cand;
+                        v = nv;
+                    }
+                }
+                _ => {}
+            }
+        }
+        // Waits shortened to nothing are dropped.
+        let cand: Vec<BusOp> = best
+            .iter()
+            .copied()
+            .filter(|op| *op != BusOp::Advance(Duration::ZERO))
+            .collect();
+        if cand != best {
+            if let Some(nv) = breaks(&cand) {
+                best = cand;
+                v = nv;
+            }
+        }
+        if best == before {
+            break;
+        }
+    }
+    Some(Minimized {
+        ops: best,
+        violation: v,
+        tries,
+    })
+}
+
+/// Neighbouring waits as one.
+fn merge_waits(ops: &[BusOp]) -> Vec<BusOp> {
+    let mut out: Vec<BusOp> = Vec::with_capacity(ops.len());
+    for op in ops {
+        match (out.last_mut(), op) {
+            (Some(BusOp::Advance(a)), BusOp::Advance(b)) => *a += *b,
+            _ => out.push(*op),
+        }
+    }
+    out
+}
+
+/// The ops as a `bus_bytes` input (long waits split so each op holds its
+/// wait exactly).
+pub fn to_bytes(ops: &[BusOp]) -> Vec<u8> {
+    let split: Vec<BusOp> = ops
+        .iter()
+        .flat_map(|op| match op {
+            BusOp::Advance(d) => bus::advances(*d),
+            other => vec![*other],
+        })
+        .collect();
+    bus::encode(&split)
+}
+
+/// A scenario name for a break of `invariant`: `fuzz_<invariant>_<n>`.
+pub fn scenario_stem(invariant: &str, n: usize) -> String {
+    format!("fuzz_{}_{n}", invariant.replace('-', "_"))
+}
+
+/// A Rust scenario file (for `scenarios/`) that replays `ops` and fails
+/// while `v` still breaks: the body of `ppmc fuzz to-scenario`.
+pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> String {
+    let section = oracle::section(v.invariant);
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "//! Regression scenario from a fuzz finding: invariant `{}` (Section {section},\n\
+         //! docs/invariants.md) broke after op {}: {}.\n\
+         //! Written by `ppmc fuzz to-scenario` from {source}.\n\
+         //! It fails while the bug is there; once fixed, record its golden trace\n\
+         //! (`ppmc record --filter {stem}`).\n",
+        v.invariant,
+        v.op,
+        v.detail.replace('\n', " "),
+    );
+    s.push_str("use crate::fuzzing::bus::BusOp::{self, *};\n");
+    s.push_str("use crate::scenario::prelude::*;\n\n");
+    s.push_str("pub fn scenarios() -> Vec<Scenario> {\n    vec![Scenario::new(\n");
+    let _ = writeln!(s, "        {stem:?},");
+    let _ = writeln!(s, "        {section:?},");
+    let _ = writeln!(
+        s,
+        "        {:?},",
+        format!("fuzz finding: {} must hold", v.invariant)
+    );
+    s.push_str("        &[\"fuzz\", \"regression\"],\n        replay,\n    )]\n}\n\n");
+    s.push_str("/// The minimized bus script, one op per line (console form in comments).\n");
+    s.push_str("const OPS: &[BusOp] = &[\n");
+    for op in ops {
+        let code = match *op {
+            BusOp::Command(b) => format!("Command(0x{b:02X})"),
+            BusOp::Data(b) => format!("Data(0x{b:02X})"),
+            BusOp::ReadStatus => "ReadStatus".into(),
+            BusOp::ReadData => "ReadData".into(),
+            BusOp::Input { input, asserted } => {
+                format!("Input {{ input: Input::{input:?}, asserted: {asserted} }}")
+            }
+            BusOp::Advance(d) => format!("Advance(Duration::from_nanos({}))", d.as_nanos()),
+        };
+        let _ = writeln!(s, "    {code}, // {op}");
+    }
+    s.push_str("];\n\nfn replay(d: &mut Driver) -> Outcome {\n    d.replay_bus(OPS)\n}\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emu::faults;
+
+    fn noisy_remaining_finding() -> Vec<BusOp> {
+        // A seed of the suite whose traffic reads the remaining pulses after
+        // a stop, with noise ops around.
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../fuzz/corpus/bus_bytes/s3_3_1_immediate_stop_and_resume.bin");
+        bus::decode(&std::fs::read(dir).expect("seed"))
+    }
+
+    /// The minimizer keeps the break, and shrinks a 40-odd op seed to a
+    /// handful: the injected remaining-pulses bug needs an initialization,
+    /// a move, a stop and a read.
+    #[test]
+    fn minimizing_keeps_the_invariant_and_shrinks_the_input() {
+        let cfg = faults::find("remaining-off-by-one").expect("fault").model();
+        let ops = noisy_remaining_finding();
+        let v = first_break(&ops, &cfg).expect("the fault breaks it");
+        assert_eq!(v.invariant, "remaining-pulses");
+        let m = minimize(&ops, &cfg, "remaining-pulses").expect("minimized");
+        assert_eq!(m.violation.invariant, "remaining-pulses");
+        assert!(
+            m.ops.len() < ops.len() / 2,
+            "{} of {}",
+            m.ops.len(),
+            ops.len()
+        );
+        assert_eq!(
+            first_break(&m.ops, &cfg).map(|v| v.invariant),
+            Some("remaining-pulses")
+        );
+        // The clean model keeps the invariant on the minimized input.
+        assert_eq!(first_break(&m.ops, &ModelConfig::default()), None);
+        // As bytes it is the same program.
+        assert_eq!(
+            merge_waits(&bus::decode(&to_bytes(&m.ops))),
+            merge_waits(&m.ops)
+        );
+        // An input that breaks nothing cannot be minimized for it.
+        assert_eq!(
+            minimize(&ops, &ModelConfig::default(), "remaining-pulses"),
+            None
+        );
+    }
+
+    #[test]
+    fn the_scenario_file_names_the_invariant_and_lists_every_op() {
+        let v = Violation {
+            invariant: "remaining-pulses",
+            op: 1,
+            detail: "read 5".into(),
+        };
+        let ops = [
+            BusOp::Command(0x83),
+            BusOp::Advance(Duration::from_micros(3)),
+            BusOp::Input {
+                input: crate::protocol::Input::L2,
+                asserted: true,
+            },
+        ];
+        let stem = scenario_stem(v.invariant, 2);
+        assert_eq!(stem, "fuzz_remaining_pulses_2");
+        let text = scenario_file(&stem, &ops, &v, "crash-1");
+        assert!(text.contains("\"3-4-4\""), "{text}");
+        assert!(text.contains("Command(0x83), // wc! 0x83"), "{text}");
+        assert!(text.contains("Advance(Duration::from_nanos(3000)), // wait 3us"));
+        assert!(text.contains("Input { input: Input::L2, asserted: true }, // set l2 on"));
+        assert!(text.contains("d.replay_bus(OPS)"));
+    }
+}

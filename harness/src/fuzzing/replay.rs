@@ -1,0 +1,98 @@
+//! Bus ops replayed on any target, judged by the same invariants as on the
+//! emulator ([`super::oracle::Judge`]). Around every op the status register
+//! is read (a read with no side effect, Section 3-1-1), because the judge
+//! needs IBF and OBF as the host saw them: that is how a reproducer runs on
+//! a board, and how a regression scenario made from a finding checks it.
+
+use super::bus::BusOp;
+use super::oracle::{Judge, Seen, Violation};
+use crate::protocol::Record;
+use crate::target::{Op, Reply, Target, TargetError};
+
+/// Target ops per bus op: status, the op, status.
+pub const OPS_PER_BUS_OP: usize = 3;
+
+/// The target ops that replay `ops`, each between two status reads.
+pub fn probed_ops(ops: &[BusOp]) -> Vec<Op> {
+    let mut out = Vec::with_capacity(ops.len() * OPS_PER_BUS_OP);
+    for op in ops {
+        let main = match *op {
+            BusOp::Command(byte) => Op::WriteCommand {
+                byte,
+                wait_ibf: None,
+            },
+            BusOp::Data(byte) => Op::WriteData {
+                byte,
+                wait_ibf: None,
+            },
+            BusOp::ReadStatus => Op::ReadStatus,
+            BusOp::ReadData => Op::ReadData { wait_obf: None },
+            BusOp::Input { input, asserted } => Op::SetInput { input, asserted },
+            BusOp::Advance(d) => Op::Delay(d),
+        };
+        out.extend([Op::ReadStatus, main, Op::ReadStatus]);
+    }
+    out
+}
+
+/// A finding on a target: the break, and when (target clock) its op ended.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Found {
+    pub violation: Violation,
+    pub at: crate::time::Instant,
+}
+
+/// Judges the replies to [`probed_ops`]`(ops)` and the capture after them.
+/// `Err` when the replies do not fit the ops (a target bug, not a finding).
+pub fn judge(ops: &[BusOp], replies: &[Reply], capture: &Record) -> Result<Option<Found>, String> {
+    if replies.len() != ops.len() * OPS_PER_BUS_OP {
+        return Err(format!(
+            "the target answered {} of {} operations",
+            replies.len(),
+            ops.len() * OPS_PER_BUS_OP
+        ));
+    }
+    let status = |r: &Reply| match *r {
+        Reply::Status { status, .. } => Ok(status),
+        other => Err(format!("expected a status reply, got {other:?}")),
+    };
+    let mut judge = Judge::default();
+    let mut last_at = crate::time::Instant::ZERO;
+    for (op, r) in ops.iter().zip(replies.chunks(OPS_PER_BUS_OP)) {
+        let value = match (op, &r[1]) {
+            (BusOp::ReadStatus, Reply::Status { status, .. }) => Some(status.0),
+            (BusOp::ReadData, Reply::Data { byte, .. }) => Some(*byte),
+            (BusOp::ReadStatus | BusOp::ReadData, other) => {
+                return Err(format!("expected a read reply to {op}, got {other:?}"))
+            }
+            _ => None,
+        };
+        let seen = Seen {
+            before: status(&r[0])?,
+            after: status(&r[2])?,
+            value,
+            at: r[1].at(),
+        };
+        last_at = seen.at;
+        if let Err(violation) = judge.op(*op, seen, capture) {
+            return Ok(Some(Found {
+                violation,
+                at: seen.at,
+            }));
+        }
+    }
+    Ok(judge.finish(capture).err().map(|violation| Found {
+        violation,
+        at: last_at,
+    }))
+}
+
+/// Replays `ops` on `target` from a chip reset and judges them.
+pub fn replay(target: &mut dyn Target, ops: &[BusOp]) -> Result<Option<Found>, TargetError> {
+    target.execute(&[Op::Reset])?;
+    let (replies, capture) = target.execute_then_capture(&probed_ops(ops))?;
+    judge(ops, &replies, &capture).map_err(|message| TargetError {
+        kind: crate::target::TargetErrorKind::Other,
+        message,
+    })
+}

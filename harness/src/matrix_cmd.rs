@@ -1,0 +1,156 @@
+//! `ppmc fault-matrix`: every catalogued board fault against the suite,
+//! the golden traces and a bounded differential fuzz, over the pty.
+
+use clap::Args;
+use ppmc::bridge::sim::{LinkFaults, PtyBridge};
+use ppmc::emu::faults::{self, CATALOGUE};
+use ppmc::emu::ModelConfig;
+use ppmc::fault_matrix::{self, FuzzBudget, Row};
+use ppmc::protocol::Straps;
+use ppmc::target::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, Args)]
+pub struct MatrixArgs {
+    /// List the board faults with what each does and the datasheet section
+    /// it breaks, and exit.
+    #[arg(long)]
+    list: bool,
+    /// Only these faults (repeatable); the clean board is always a row.
+    #[arg(long = "fault", value_name = "NAME")]
+    only: Vec<String>,
+    /// Run each board in process instead of behind `bridge-sim` on a pty.
+    #[arg(long)]
+    in_process: bool,
+    /// Differential fuzz seeds per board.
+    #[arg(long, default_value_t = 8)]
+    fuzz_seeds: u64,
+    /// Actions per differential fuzz seed.
+    #[arg(long, default_value_t = 300)]
+    fuzz_actions: usize,
+    /// Golden trace directory.
+    #[arg(long, default_value = "golden")]
+    golden: PathBuf,
+    /// Also write the matrix and what each check saw first (Markdown).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+}
+
+pub fn run(args: MatrixArgs) -> ExitCode {
+    if args.list {
+        println!("| fault | section | what the board does |\n|---|---|---|");
+        for f in CATALOGUE {
+            println!("| `{}` | {} | {} |", f.name, f.section, f.what);
+        }
+        return ExitCode::SUCCESS;
+    }
+    if !args.golden.is_dir() {
+        return crate::usage_error(format!(
+            "{} is not a directory: run from the repository root or give --golden",
+            args.golden.display()
+        ));
+    }
+    let mut boards: Vec<(String, ModelConfig)> = vec![("clean".into(), ModelConfig::default())];
+    for f in CATALOGUE {
+        if args.only.is_empty() || args.only.iter().any(|n| n == f.name) {
+            boards.push((f.name.to_string(), f.model()));
+        }
+    }
+    if let Some(unknown) = args.only.iter().find(|n| faults::find(n).is_none()) {
+        return crate::usage_error(format!(
+            "--fault {unknown}: not in the catalogue (see --list)"
+        ));
+    }
+    let suite = ppmc::suite::all();
+    let budget = FuzzBudget {
+        seeds: args.fuzz_seeds,
+        actions: args.fuzz_actions,
+    };
+    let mut rows: Vec<Row> = Vec::new();
+    for (i, (name, model)) in boards.into_iter().enumerate() {
+        eprint!("[{}/{}] {name} ... ", i + 1, CATALOGUE.len() + 1);
+        let row = match board_row(&name, model, args.in_process, &suite, &args.golden, budget) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("infrastructure error");
+                eprintln!("ppmc fault-matrix: {name}: {e}");
+                return ExitCode::from(1);
+            }
+        };
+        eprintln!("{}", if row.caught() { "caught" } else { "not caught" });
+        rows.push(row);
+    }
+    let table = fault_matrix::render(&rows);
+    print!("{table}");
+    if let Some(path) = &args.output {
+        let mut text = table.clone();
+        text.push_str("\nWhat each check saw first:\n\n");
+        for r in &rows {
+            for (check, c) in [
+                ("suite", &r.suite),
+                ("golden", &r.golden),
+                ("fuzz", &r.fuzz),
+            ] {
+                if let Some(c) = c {
+                    text.push_str(&format!(
+                        "- `{}` / {check}: {}\n",
+                        r.board,
+                        c.first.replace('\n', " ")
+                    ));
+                }
+            }
+        }
+        if let Err(e) = ppmc::golden::write_atomic(path, text.as_bytes()) {
+            return crate::usage_error(format!("cannot write {}: {e}", path.display()));
+        }
+    }
+    if fault_matrix::all_as_expected(&rows) {
+        println!("\nevery fault caught, no false alarm on the clean board");
+        ExitCode::SUCCESS
+    } else {
+        println!("\nthe matrix is NOT as it must be (see MISSED / FALSE ALARM above)");
+        ExitCode::from(1)
+    }
+}
+
+fn board_row(
+    name: &str,
+    model: ModelConfig,
+    in_process: bool,
+    suite: &[ppmc::scenario::Scenario],
+    golden: &std::path::Path,
+    budget: FuzzBudget,
+) -> Result<Row, String> {
+    let emu = EmuTarget::new(Straps::default(), model).map_err(|e| e.to_string())?;
+    if in_process {
+        let mut t = emu;
+        return fault_matrix::check_board(name, &mut t, suite, golden, budget)
+            .map_err(|e| e.to_string());
+    }
+    let sim = PtyBridge::start(emu, LinkFaults::default()).map_err(|e| e.to_string())?;
+    let t0 = std::time::Instant::now();
+    let link = SerialLink::open(sim.path(), 115_200).map_err(|e| e.to_string())?;
+    let mut t: Box<dyn Target> = match SerialTarget::open(link, SerialOptions::default()) {
+        Ok(t) => Box::new(t),
+        // The run's health check (hello, chip reset, status 0x00) refuses
+        // the board before any scenario: `ppmc run` stops right there.
+        Err(e) if e.to_string().contains("health check") => {
+            return Ok(Row {
+                board: name.to_string(),
+                suite: Some(fault_matrix::Catch {
+                    first: format!("refused by the health check: {e}"),
+                    after: t0.elapsed(),
+                }),
+                golden: None,
+                fuzz: None,
+            })
+        }
+        Err(e) => return Err(e.to_string()),
+    };
+    let row = fault_matrix::check_board(name, t.as_mut(), suite, golden, budget)
+        .map_err(|e| e.to_string());
+    drop(t);
+    sim.stop();
+    row
+}
