@@ -149,3 +149,49 @@ fn a_chip_fault_behind_the_bridge_is_caught() {
         "{stdout}"
     );
 }
+
+/// `ppmc fuzz --target serial:<pty>` against a bridge simulator running a
+/// faulty chip: the run departs from the emulator, is minimized on the
+/// target and the reproducer is written; against a clean one it does not.
+#[test]
+fn differential_fuzz_over_the_pty() {
+    let clean = BridgeSim::start(&[]);
+    let out = ppmc(&[
+        "fuzz",
+        "--target",
+        &clean.target(),
+        "--seed",
+        "5",
+        "--ops",
+        "200",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    let bad = BridgeSim::start(&["--chip-fault", "dir-inverted"]);
+    let file = std::env::temp_dir().join(format!("ppmc-diff-pty-{}.ppmc", std::process::id()));
+    let out = ppmc(&[
+        "fuzz",
+        "--target",
+        &bad.target(),
+        "--seed",
+        "5",
+        "--ops",
+        "200",
+        "-o",
+        file.to_str().expect("p"),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&file).expect("reproducer written");
+    assert!(text.contains(&format!("target {}", bad.target())), "{text}");
+    let _ = std::fs::remove_file(&file);
+}

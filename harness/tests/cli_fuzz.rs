@@ -31,3 +31,156 @@ fn reproduce_of_a_missing_file_is_a_usage_error_naming_it() {
     let err = String::from_utf8(out.stderr).expect("utf-8");
     assert!(err.contains("no/such/crash-file"), "{err}");
 }
+
+fn scratch(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("ppmc-cli-fuzz-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("scratch dir");
+    d
+}
+
+const STOP_SEED: &str = "../fuzz/corpus/bus_bytes/s3_3_1_immediate_stop_and_resume.bin";
+
+/// The finding loop of the README on an injected bug (the board fault
+/// `remaining-off-by-one`, Section 3-4-4): minimize shrinks the input and
+/// keeps the break; to-scenario writes a scenario named after it; a second
+/// to-scenario never overwrites the first.
+#[test]
+fn minimize_then_to_scenario_on_an_injected_bug() {
+    let dir = scratch("loop");
+    let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join(STOP_SEED);
+    let input = dir.join("crash-1");
+    std::fs::copy(&seed, &input).expect("copy");
+    let inp = input.to_str().expect("path");
+    let fault = ["--chip-fault", "remaining-off-by-one"];
+
+    let out = ppmc(&[&["fuzz", "minimize", inp][..], &fault[..]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("invariant remaining-pulses still breaks"),
+        "{err}"
+    );
+    let min = dir.join("crash-1.min");
+    let before = ppmc::fuzzing::bus::decode(&std::fs::read(&input).expect("input")).len();
+    let after = ppmc::fuzzing::bus::decode(&std::fs::read(&min).expect("minimized")).len();
+    assert!(after * 2 < before, "{before} ops -> {after}");
+    let script = String::from_utf8(out.stdout).expect("utf-8");
+    assert!(
+        script.contains("# breaks: invariant remaining-pulses"),
+        "{script}"
+    );
+
+    // On the clean emulator the minimized input breaks nothing: exit 0.
+    let clean = ppmc(&["fuzz", "reproduce", min.to_str().expect("path")]);
+    assert_eq!(clean.status.code(), Some(0));
+
+    let scen = dir.join("scenarios");
+    std::fs::create_dir_all(&scen).expect("dir");
+    let min_s = min.to_str().expect("path");
+    let args = [
+        &[
+            "fuzz",
+            "to-scenario",
+            min_s,
+            "--dir",
+            scen.to_str().expect("p"),
+        ][..],
+        &fault[..],
+    ]
+    .concat();
+    let out = ppmc(&args);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let file = scen.join("fuzz_remaining_pulses_1.rs");
+    let text = std::fs::read_to_string(&file).expect("scenario written");
+    assert!(text.contains("\"fuzz_remaining_pulses_1\""), "{text}");
+    assert!(text.contains("\"3-4-4\""), "{text}");
+    assert!(text.contains("d.replay_bus(OPS)"));
+    let again = ppmc(&args);
+    assert_eq!(again.status.code(), Some(0));
+    assert!(scen.join("fuzz_remaining_pulses_2.rs").exists());
+    assert_eq!(
+        std::fs::read_to_string(&file).expect("first"),
+        text,
+        "not overwritten"
+    );
+
+    // An input that breaks nothing makes no scenario.
+    let none = ppmc(&[
+        "fuzz",
+        "to-scenario",
+        min_s,
+        "--dir",
+        scen.to_str().expect("p"),
+    ]);
+    assert_eq!(none.status.code(), Some(1));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The structure-aware target's inputs go through the same loop.
+#[test]
+fn typed_inputs_reproduce_as_bus_scripts() {
+    let seed =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/typed_actions/random-00.bin");
+    let out = ppmc(&[
+        "fuzz",
+        "reproduce",
+        "--kind",
+        "typed-actions",
+        seed.to_str().expect("p"),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8(out.stdout).expect("utf-8");
+    // The valid initialization every typed program starts with.
+    assert!(text.contains("wc! 0x02"), "{text}");
+    ppmc::console::parse_script(&text).expect("a console script");
+}
+
+/// `ppmc fuzz` (differential) on the emulator against itself finds
+/// nothing; against an emulator with a board fault it departs, minimizes
+/// and writes a console script that replays. The seed alone replays it.
+#[test]
+fn a_differential_run_finds_a_faulty_emulator_and_writes_a_reproducer() {
+    let out = ppmc(&["fuzz", "--seed", "3", "--ops", "300"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("no departure"));
+
+    let dir = scratch("diff");
+    let repro = dir.join("r.ppmc");
+    let run = |path: &Path| {
+        ppmc(&[
+            "fuzz",
+            "--seed",
+            "3",
+            "--ops",
+            "400",
+            "--chip-fault",
+            "remaining-off-by-one",
+            "-o",
+            path.to_str().expect("p"),
+        ])
+    };
+    let out = run(&repro);
+    assert_eq!(out.status.code(), Some(1));
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(said.contains("departs after action"), "{said}");
+    let text = std::fs::read_to_string(&repro).expect("reproducer");
+    assert!(
+        text.starts_with("# differential reproducer: seed 3"),
+        "{text}"
+    );
+    ppmc::console::parse_script(&text).expect("replayable");
+    let again = dir.join("r2.ppmc");
+    run(&again);
+    assert_eq!(
+        std::fs::read_to_string(&again).expect("again"),
+        text,
+        "the seed replays"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

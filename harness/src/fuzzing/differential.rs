@@ -98,7 +98,6 @@ pub struct DiffSettings {
     pub console: ConsoleOptions,
 }
 
-
 /// Runs `acts` on `target` (from a chip reset) and on a fresh reference
 /// emulator, comparing after every action; stops at the first departure.
 /// `progress` is called after each action with the number done, and may

@@ -196,7 +196,7 @@ pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> 
     s.push_str("        &[\"fuzz\", \"regression\"],\n        replay,\n    )]\n}\n\n");
     s.push_str("/// The minimized bus script, one op per line (console form in comments).\n");
     s.push_str("const OPS: &[BusOp] = &[\n");
-    for op in ops {
+    for op in &merge_waits(ops) {
         let code = match *op {
             BusOp::Command(b) => format!("Command(0x{b:02X})"),
             BusOp::Data(b) => format!("Data(0x{b:02X})"),

@@ -312,13 +312,33 @@ impl<'t> Driver<'t> {
 
     // ----- raw layer -------------------------------------------------------
 
-    /// Replays fuzz bus ops from a chip reset and judges them by the fuzz
-    /// oracle's invariants (`docs/invariants.md`): the body of a regression
-    /// scenario written by `ppmc fuzz to-scenario`.
+    /// Replays fuzz bus ops and judges them by the fuzz oracle's invariants
+    /// (`docs/invariants.md`): the body of a regression scenario written by
+    /// `ppmc fuzz to-scenario` (the scenario starts from a chip reset). The
+    /// trace shows the ops' bus transactions, not the status probes around
+    /// them.
     pub fn replay_bus(&mut self, ops: &[crate::fuzzing::bus::BusOp]) -> Outcome {
+        use crate::fuzzing::bus::BusOp;
         use crate::fuzzing::{oracle, replay};
-        self.reset()?;
         let replies = self.exec(&replay::probed_ops(ops))?;
+        for (op, r) in ops.iter().zip(replies.chunks(replay::OPS_PER_BUS_OP)) {
+            let e = match (*op, r.get(1)) {
+                (BusOp::Command(byte), _) => BusEvent::WriteCommand { byte, waited: None },
+                (BusOp::Data(byte), _) => BusEvent::WriteData { byte, waited: None },
+                (BusOp::ReadStatus, Some(Reply::Status { status, .. })) => {
+                    BusEvent::ReadStatus(status.0)
+                }
+                (BusOp::ReadData, Some(Reply::Data { byte, .. })) => BusEvent::ReadData {
+                    byte: *byte,
+                    waited: None,
+                },
+                (BusOp::Input { input, asserted }, _) => BusEvent::SetInput { input, asserted },
+                _ => continue,
+            };
+            if let Some(r) = r.get(1) {
+                self.log(r.at(), e);
+            }
+        }
         let capture = self.capture()?.clone();
         match replay::judge(ops, &replies, &capture) {
             Err(e) => Err(Stop::Error(e)),
