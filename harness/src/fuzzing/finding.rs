@@ -202,9 +202,11 @@ pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> 
             BusOp::Data(b) => format!("Data(0x{b:02X})"),
             BusOp::ReadStatus => "ReadStatus".into(),
             BusOp::ReadData => "ReadData".into(),
-            BusOp::Input { input, asserted } => {
-                format!("Input {{ input: Input::{input:?}, asserted: {asserted} }}")
-            }
+            // Qualified: the prelude's `Input` (the pin) and the op's
+            // variant share a name.
+            BusOp::Input { input, asserted } => format!(
+                "BusOp::Input {{ input: crate::protocol::Input::{input:?}, asserted: {asserted} }}"
+            ),
             BusOp::Advance(d) => format!("Advance(Duration::from_nanos({}))", d.as_nanos()),
         };
         let _ = writeln!(s, "    {code}, // {op}");
@@ -282,7 +284,9 @@ mod tests {
         assert!(text.contains("\"3-4-4\""), "{text}");
         assert!(text.contains("Command(0x83), // wc! 0x83"), "{text}");
         assert!(text.contains("Advance(Duration::from_nanos(3000)), // wait 3us"));
-        assert!(text.contains("Input { input: Input::L2, asserted: true }, // set l2 on"));
+        assert!(text.contains(
+            "BusOp::Input { input: crate::protocol::Input::L2, asserted: true }, // set l2 on"
+        ));
         assert!(text.contains("d.replay_bus(OPS)"));
     }
 }

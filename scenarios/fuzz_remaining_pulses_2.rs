@@ -1,0 +1,48 @@
+//! Regression scenario from a fuzz finding: invariant `remaining-pulses` (Section 3-4-4,
+//! docs/invariants.md) broke after op 23: remaining pulses read 0 after a move of 16777216 steps that output 0 pulses; expected 16777215.
+//! Written by `ppmc fuzz to-scenario` from fuzz/regressions/bus_bytes/remaining-pulses-from-empty-corpus.bin.
+//! It fails while the bug is there; once fixed, record its golden trace
+//! (`ppmc record --filter fuzz_remaining_pulses_2`).
+
+use crate::fuzzing::bus::BusOp::{self, *};
+use crate::scenario::prelude::*;
+
+pub fn scenarios() -> Vec<Scenario> {
+    vec![Scenario::new(
+        "fuzz_remaining_pulses_2",
+        "3-4-4",
+        "fuzz finding: remaining-pulses must hold",
+        &["fuzz", "regression"],
+        replay,
+    )]
+}
+
+/// The minimized bus script, one op per line (console form in comments).
+const OPS: &[BusOp] = &[
+    BusOp::Input { input: crate::protocol::Input::L1, asserted: true }, // set l1 on
+    Command(0x06), // wc! 0x06
+    Advance(Duration::from_nanos(6000)), // wait 6us
+    Data(0x40), // wd! 0x40
+    Advance(Duration::from_nanos(6000)), // wait 6us
+    Data(0x01), // wd! 0x01
+    Advance(Duration::from_nanos(6000)), // wait 6us
+    Data(0xFF), // wd! 0xFF
+    Advance(Duration::from_nanos(6000)), // wait 6us
+    Data(0x00), // wd! 0x00
+    Advance(Duration::from_nanos(6000)), // wait 6us
+    Command(0x55), // wc! 0x55
+    Advance(Duration::from_nanos(19769000)), // wait 19769us
+    Data(0x00), // wd! 0x00
+    Advance(Duration::from_nanos(214000)), // wait 214us
+    Command(0x83), // wc! 0x83
+    Advance(Duration::from_nanos(150000)), // wait 150us
+    ReadData, // rd!
+    Advance(Duration::from_nanos(10000)), // wait 10us
+    ReadData, // rd!
+    Advance(Duration::from_nanos(10000)), // wait 10us
+    ReadData, // rd!
+];
+
+fn replay(d: &mut Driver) -> Outcome {
+    d.replay_bus(OPS)
+}
