@@ -225,6 +225,20 @@ impl Trace {
     /// Parses the text form. Errors name the line (1-based, counting any
     /// front matter) and what is wrong.
     pub fn parse(text: &str) -> Result<Trace, TraceError> {
+        // A trace is plain text: a control character (a stray CR, a NUL)
+        // is corruption, and would not survive a render (found by the
+        // `trace_text` fuzz target). `lines()` already takes CRLF endings.
+        for (i, l) in text.lines().enumerate() {
+            if let Some(c) = l.chars().find(|c| c.is_control()) {
+                return Err(err(
+                    i + 1,
+                    format!(
+                        "control character U+{:04X} in the trace (a trace is plain text)",
+                        u32::from(c)
+                    ),
+                ));
+            }
+        }
         let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l)).peekable();
         // insta front matter: `---` ... `---`.
         if lines.peek().is_some_and(|(_, l)| l.trim() == "---") {
@@ -652,6 +666,14 @@ end
 
         let e = Trace::parse("hello\n").expect_err("not a trace");
         assert!(e.message.contains("not a ppmc trace"), "{e}");
+
+        // A stray CR inside a line (not a CRLF ending) is refused: it would
+        // not survive a render. CRLF files parse as LF ones.
+        let cr = SAMPLE.replace("target emu", "target emu\r\r");
+        let e = Trace::parse(&cr).expect_err("control character");
+        assert!(e.message.contains("U+000D"), "{e}");
+        let crlf = SAMPLE.replace('\n', "\r\n");
+        assert_eq!(Trace::parse(&crlf), Trace::parse(SAMPLE));
 
         let junk = format!("{SAMPLE}more\n");
         assert!(Trace::parse(&junk)
