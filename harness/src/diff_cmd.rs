@@ -110,16 +110,7 @@ pub fn run(args: DiffArgs) -> ExitCode {
         );
         return ExitCode::SUCCESS;
     };
-    let dv = &d.divergence;
-    println!(
-        "seed {seed}: departs after action {} at {}: {}: emulator {}, target {} (allowed {})",
-        d.action + 1,
-        dv.at,
-        dv.quantity,
-        dv.golden,
-        dv.got,
-        dv.allowed
-    );
+    println!("seed {seed}: {d}");
     let (small, small_d) = match differential::minimize(
         target.as_mut(),
         &acts[..=d.action],

@@ -53,6 +53,29 @@ enum FuzzCommand {
         #[arg(long, default_value = "scenarios")]
         dir: PathBuf,
     },
+    /// Bucket findings by the invariant each breaks: a thousand crashes of
+    /// one bug are one line, with the shortest input to minimize. Takes
+    /// files and directories (e.g. fuzz/artifacts/bus_bytes/). Exit status
+    /// 1 when any input breaks an invariant.
+    Triage {
+        /// Input files or directories of inputs.
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
+    /// Domain coverage of a corpus: which commands were written in which
+    /// chip state, which error codes and finish causes were reached, which
+    /// inputs changed during a move; and what never was. Markdown on
+    /// standard output.
+    Coverage {
+        /// Corpus files or directories (e.g. fuzz/corpus/bus_bytes/).
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// Which fuzz target the inputs are for.
+        #[arg(long, value_enum, default_value = "bus-bytes")]
+        kind: InputKind,
+    },
     /// A differential run: a seeded stream of protocol-respecting actions
     /// against a target and the emulator side by side (the default when no
     /// subcommand is given).
@@ -60,10 +83,8 @@ enum FuzzCommand {
 }
 
 #[derive(Debug, Args)]
-struct InputArgs {
-    /// The input file.
-    file: PathBuf,
-    /// Which fuzz target the input is for.
+struct ModelArgs {
+    /// Which fuzz target the inputs are for.
     #[arg(long, value_enum, default_value = "bus-bytes")]
     kind: InputKind,
     /// Judge on an emulator with this board fault (`ppmc fault-matrix
@@ -72,18 +93,66 @@ struct InputArgs {
     chip_faults: Vec<String>,
 }
 
-impl InputArgs {
-    /// The model, the input's bytes and its bus ops.
-    fn load(&self) -> Result<(ModelConfig, Vec<ppmc::fuzzing::bus::BusOp>), ExitCode> {
+impl ModelArgs {
+    fn model(&self) -> Result<ModelConfig, ExitCode> {
         let mut cfg = ModelConfig::default();
         for name in &self.chip_faults {
             if let Err(e) = ppmc::emu::faults::apply_named(name, &mut cfg) {
                 return Err(crate::usage_error(format!("--chip-fault: {e}")));
             }
         }
+        Ok(cfg)
+    }
+}
+
+/// The inputs under `paths` (files, or the files of directories, sorted),
+/// as bus ops.
+fn load_inputs(
+    paths: &[PathBuf],
+    kind: InputKind,
+    cfg: &ModelConfig,
+) -> Result<Vec<(String, Vec<ppmc::fuzzing::bus::BusOp>)>, ExitCode> {
+    let mut files = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            let rd = std::fs::read_dir(p)
+                .map_err(|e| crate::usage_error(format!("cannot read {}: {e}", p.display())))?;
+            let mut v: Vec<PathBuf> = rd
+                .filter_map(Result::ok)
+                .map(|e| e.path())
+                .filter(|f| f.is_file())
+                .collect();
+            v.sort();
+            files.extend(v);
+        } else {
+            files.push(p.clone());
+        }
+    }
+    files
+        .into_iter()
+        .map(|f| {
+            let data = std::fs::read(&f)
+                .map_err(|e| crate::usage_error(format!("cannot read {}: {e}", f.display())))?;
+            Ok((f.display().to_string(), finding::ops_of(&data, kind, cfg)))
+        })
+        .collect()
+}
+
+#[derive(Debug, Args)]
+struct InputArgs {
+    /// The input file.
+    file: PathBuf,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+impl InputArgs {
+    /// The model, the input's bytes and its bus ops.
+    fn load(&self) -> Result<(ModelConfig, Vec<ppmc::fuzzing::bus::BusOp>), ExitCode> {
+        let cfg = self.model.model()?;
         let data = std::fs::read(&self.file)
             .map_err(|e| crate::usage_error(format!("cannot read {}: {e}", self.file.display())))?;
-        let ops = finding::ops_of(&data, self.kind, &cfg);
+        let ops = finding::ops_of(&data, self.model.kind, &cfg);
         Ok((cfg, ops))
     }
 }
@@ -92,6 +161,50 @@ pub fn run(args: FuzzArgs) -> ExitCode {
     match args.command {
         None => crate::diff_cmd::run(args.run),
         Some(FuzzCommand::Run(a)) => crate::diff_cmd::run(a),
+        Some(FuzzCommand::Triage { paths, model }) => {
+            let cfg = match model.model() {
+                Ok(c) => c,
+                Err(code) => return code,
+            };
+            let inputs = match load_inputs(&paths, model.kind, &cfg) {
+                Ok(v) => v,
+                Err(code) => return code,
+            };
+            let (buckets, clean) = ppmc::fuzzing::campaign::triage(&inputs, &cfg);
+            println!("| invariant | inputs | shortest input | its ops | break |\n|---|---:|---|---:|---|");
+            for b in &buckets {
+                let (name, n, v) = &b.smallest;
+                println!(
+                    "| {} | {} | {name} | {n} | after op {}: {} |",
+                    b.invariant,
+                    b.inputs.len(),
+                    v.op,
+                    v.detail
+                );
+            }
+            println!(
+                "\n{} inputs: {} findings in {} buckets, {} break nothing",
+                inputs.len(),
+                inputs.len() - clean.len(),
+                buckets.len(),
+                clean.len()
+            );
+            if buckets.is_empty() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }
+        Some(FuzzCommand::Coverage { paths, kind }) => {
+            let cfg = ModelConfig::default();
+            let inputs = match load_inputs(&paths, kind, &cfg) {
+                Ok(v) => v,
+                Err(code) => return code,
+            };
+            let ops: Vec<_> = inputs.into_iter().map(|(_, o)| o).collect();
+            print!("{}", ppmc::fuzzing::campaign::Coverage::of(&ops).render());
+            ExitCode::SUCCESS
+        }
         Some(FuzzCommand::Reproduce { input }) => {
             let (cfg, ops) = match input.load() {
                 Ok(x) => x,

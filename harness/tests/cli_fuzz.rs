@@ -184,3 +184,32 @@ fn a_differential_run_finds_a_faulty_emulator_and_writes_a_reproducer() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A directory of findings of one bug is one bucket; the coverage report
+/// names what the corpus never reached.
+#[test]
+fn triage_buckets_and_coverage_reports() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz");
+    let corpus = root.join("corpus/bus_bytes");
+    let c = corpus.to_str().expect("p");
+    let out = ppmc(&["fuzz", "triage", c, "--chip-fault", "remaining-off-by-one"]);
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("| remaining-pulses |"))
+        .collect();
+    assert_eq!(rows.len(), 1, "{text}");
+    assert!(text.contains("in 1 buckets"), "{text}");
+    let clean = ppmc(&["fuzz", "triage", c]);
+    assert_eq!(clean.status.code(), Some(0));
+
+    let out = ppmc(&["fuzz", "coverage", c]);
+    assert_eq!(out.status.code(), Some(0));
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(report.starts_with("# Domain coverage of "), "{report}");
+    assert!(report.contains("| initialization |"), "{report}");
+    assert!(report.contains("## How moves ended"), "{report}");
+    let missing = ppmc(&["fuzz", "coverage", "no/such/dir"]);
+    assert_eq!(missing.status.code(), Some(2));
+}

@@ -231,6 +231,12 @@ impl Chip {
         self.setup.is_some()
     }
 
+    /// The finish status register as the chip holds it (reading it through
+    /// the bus, 0x80, clears the polling flag; this does not).
+    pub fn finish_status(&self) -> FinishStatus {
+        self.finish
+    }
+
     /// Host write to the command register (A = H, WR low). A byte written
     /// while IBF = 1 replaces the one waiting (Section 3-1-1 (2)).
     pub fn write_command(&mut self, byte: u8) {

@@ -35,6 +35,23 @@ pub struct Departure {
     pub divergence: Divergence,
 }
 
+impl std::fmt::Display for Departure {
+    /// `departs after action N at T: <quantity>: emulator X, target Y (allowed Z)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let dv = &self.divergence;
+        write!(
+            f,
+            "departs after action {} at {}: {}: emulator {}, target {} (allowed {})",
+            self.action + 1,
+            dv.at,
+            dv.quantity,
+            dv.golden,
+            dv.got,
+            dv.allowed
+        )
+    }
+}
+
 /// One side of a run: a target and what it has shown so far.
 struct Side<'a> {
     target: &'a mut dyn Target,
@@ -215,17 +232,7 @@ pub fn script(acts: &[Action], d: &Departure, seed: u64, target: &str) -> String
         "# differential reproducer: seed {seed}, target {target}, {} actions",
         acts.len()
     );
-    let dv = &d.divergence;
-    let _ = writeln!(
-        out,
-        "# departs after action {} at {}: {}: emulator {}, target {} (allowed {})",
-        d.action + 1,
-        dv.at,
-        dv.quantity,
-        dv.golden,
-        dv.got,
-        dv.allowed
-    );
+    let _ = writeln!(out, "# {d}");
     let _ = writeln!(
         out,
         "# replay: ppmc console --target emu FILE; ppmc console --target {target} FILE; diff the two"

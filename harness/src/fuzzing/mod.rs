@@ -5,6 +5,7 @@
 
 pub mod actions;
 pub mod bus;
+pub mod campaign;
 pub mod differential;
 pub mod finding;
 pub mod oracle;

@@ -1,0 +1,322 @@
+//! What a fuzzing session shows besides code coverage: findings bucketed by
+//! the invariant that broke, and the domain coverage of a corpus (which
+//! commands in which chip state, which error codes, finish causes and
+//! inputs it reached), so that a user sees what was not exercised.
+
+use super::bus::BusOp;
+use super::oracle::{Checker, Violation};
+use crate::emu::ModelConfig;
+use crate::protocol::{Command, ErrorCode, Input, MoveKind, StatusField};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// One bucket of findings: every input that broke one invariant.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Bucket {
+    pub invariant: &'static str,
+    /// Names of the inputs, in the order given.
+    pub inputs: Vec<String>,
+    /// The input with the fewest ops, and its break: the one to minimize.
+    pub smallest: (String, usize, Violation),
+}
+
+/// Buckets `(name, ops)` inputs by the invariant each breaks on `cfg`;
+/// also returns the names of those that break none.
+pub fn triage(inputs: &[(String, Vec<BusOp>)], cfg: &ModelConfig) -> (Vec<Bucket>, Vec<String>) {
+    let mut buckets: BTreeMap<&'static str, Bucket> = BTreeMap::new();
+    let mut clean = Vec::new();
+    for (name, ops) in inputs {
+        let Some(v) = super::finding::first_break(ops, cfg) else {
+            clean.push(name.clone());
+            continue;
+        };
+        let b = buckets.entry(v.invariant).or_insert_with(|| Bucket {
+            invariant: v.invariant,
+            inputs: Vec::new(),
+            smallest: (name.clone(), ops.len(), v.clone()),
+        });
+        b.inputs.push(name.clone());
+        if ops.len() < b.smallest.1 {
+            b.smallest = (name.clone(), ops.len(), v);
+        }
+    }
+    (buckets.into_values().collect(), clean)
+}
+
+/// The chip state a command meets, as the datasheet's error rules see it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ChipState {
+    /// Not initialized (after reset or software reset).
+    Uninitialized,
+    /// Initialized, no move.
+    Idle,
+    /// A move under way (BUSY = 1).
+    Moving,
+}
+
+impl ChipState {
+    pub const ALL: [ChipState; 3] = [ChipState::Uninitialized, ChipState::Idle, ChipState::Moving];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ChipState::Uninitialized => "uninitialized",
+            ChipState::Idle => "idle",
+            ChipState::Moving => "moving",
+        }
+    }
+}
+
+/// The command classes the report counts (one per chapter-3 command).
+fn command_class(byte: u8) -> String {
+    match Command::decode(byte) {
+        Command::Init(_) => "initialization".into(),
+        Command::Move(m) => m.kind.name().to_string(),
+        Command::ImmediateStop(_) => "immediate stop".into(),
+        Command::DecelStop(_) => "decelerating stop".into(),
+        Command::SoftwareReset(_) => "software reset".into(),
+        Command::AuxOn(_) => "aux on".into(),
+        Command::AuxOff(_) => "aux off".into(),
+        Command::Read(r) => format!("read {}", r.name()),
+        Command::SwitchingParams => "switching parameters".into(),
+        Command::AuxOutput => "aux output".into(),
+        Command::Undefined(_) => "undefined code".into(),
+    }
+}
+
+/// Every command class, for listing what was never reached.
+fn all_command_classes() -> Vec<String> {
+    let mut v: Vec<String> = (0..=255u8).map(command_class).collect();
+    v.sort();
+    v.dedup();
+    v
+}
+
+/// Domain coverage of a corpus.
+#[derive(Debug, Default, Clone, PartialEq, Eq)]
+pub struct Coverage {
+    pub inputs: usize,
+    /// (command class, state it was written in) -> count.
+    pub commands: BTreeMap<(String, ChipState), u64>,
+    /// Error numbers seen in the status register.
+    pub errors: BTreeMap<u8, u64>,
+    /// (move kind, how it ended) -> count; from the finish status the
+    /// model keeps.
+    pub finishes: BTreeMap<(String, String), u64>,
+    /// Inputs asserted while a move was under way.
+    pub inputs_while_moving: BTreeMap<&'static str, u64>,
+}
+
+impl Coverage {
+    /// Runs every input on the clean model and counts what it reached.
+    pub fn of(inputs: &[Vec<BusOp>]) -> Coverage {
+        let mut c = Coverage {
+            inputs: inputs.len(),
+            ..Coverage::default()
+        };
+        for ops in inputs {
+            c.add(ops);
+        }
+        c
+    }
+
+    fn add(&mut self, ops: &[BusOp]) {
+        let Ok(mut k) = Checker::new(ModelConfig::default()) else {
+            return;
+        };
+        let mut moves_seen = 0;
+        for op in ops {
+            let chip = k.chip();
+            let state = if chip.read_status().busy() {
+                ChipState::Moving
+            } else if chip.initialized() {
+                ChipState::Idle
+            } else {
+                ChipState::Uninitialized
+            };
+            match *op {
+                BusOp::Command(b) => {
+                    *self.commands.entry((command_class(b), state)).or_default() += 1;
+                }
+                BusOp::Input {
+                    input,
+                    asserted: true,
+                } if state == ChipState::Moving => {
+                    *self.inputs_while_moving.entry(input.name()).or_default() += 1;
+                }
+                _ => {}
+            }
+            // Oracle breaks are the fuzz targets' business, not coverage's.
+            let _ = k.apply(*op);
+            let chip = k.chip();
+            if let StatusField::Error(e) = chip.read_status().field() {
+                *self.errors.entry(e.number()).or_default() += 1;
+            }
+            let rec = chip.record();
+            let ended = rec
+                .pins
+                .iter()
+                .filter(|p| p.pin == crate::protocol::Pin::Busy && p.value == 0)
+                .count();
+            if ended > moves_seen {
+                moves_seen = ended;
+                let f = chip.finish_status();
+                let kind = MoveKind::ALL
+                    .iter()
+                    .find(|m| m.code() == f.op_code())
+                    .map_or("?", |m| m.name());
+                let cause = if f.alarm() {
+                    "alarm"
+                } else if f.limit() {
+                    "limit"
+                } else if f.high_speed_limit() {
+                    "high-speed limit"
+                } else if f.stop_command() {
+                    "stop command"
+                } else {
+                    "completed"
+                };
+                *self
+                    .finishes
+                    .entry((kind.to_string(), cause.to_string()))
+                    .or_default() += 1;
+            }
+        }
+    }
+
+    /// The report, with what was never reached listed after each table.
+    pub fn render(&self) -> String {
+        let mut s = format!("# Domain coverage of {} inputs\n\n", self.inputs);
+        s.push_str("## Commands by chip state\n\n| command | uninitialized | idle | moving |\n|---|---:|---:|---:|\n");
+        let mut never = Vec::new();
+        for class in all_command_classes() {
+            let counts: Vec<u64> = ChipState::ALL
+                .iter()
+                .map(|st| {
+                    self.commands
+                        .get(&(class.clone(), *st))
+                        .copied()
+                        .unwrap_or(0)
+                })
+                .collect();
+            for (st, n) in ChipState::ALL.iter().zip(&counts) {
+                if *n == 0 {
+                    never.push(format!("{class} while {}", st.name()));
+                }
+            }
+            let _ = writeln!(
+                s,
+                "| {class} | {} | {} | {} |",
+                counts[0], counts[1], counts[2]
+            );
+        }
+        let _ = writeln!(s, "\nNever reached: {}.\n", list(&never));
+        s.push_str(
+            "## Error codes (Table 3-2)\n\n| error | status reads showing it |\n|---|---:|\n",
+        );
+        let mut never = Vec::new();
+        for e in ErrorCode::ALL {
+            let n = self.errors.get(&e.number()).copied().unwrap_or(0);
+            if n == 0 {
+                never.push(e.number().to_string());
+            }
+            let _ = writeln!(s, "| {} | {n} |", e.number());
+        }
+        let _ = writeln!(s, "\nNever reached: {}.\n", list(&never));
+        s.push_str("## How moves ended (finish status, 3-4-1)\n\n| move | ended by | count |\n|---|---|---:|\n");
+        for ((kind, cause), n) in &self.finishes {
+            let _ = writeln!(s, "| {kind} | {cause} | {n} |");
+        }
+        let never: Vec<String> = MoveKind::ALL
+            .iter()
+            .filter(|m| !self.finishes.keys().any(|(k, _)| k == m.name()))
+            .map(|m| m.name().to_string())
+            .collect();
+        let _ = writeln!(s, "\nMoves never ended: {}.\n", list(&never));
+        s.push_str("## Inputs asserted during a move\n\n| input | count |\n|---|---:|\n");
+        let mut never = Vec::new();
+        for i in Input::ALL {
+            let n = self.inputs_while_moving.get(i.name()).copied().unwrap_or(0);
+            if n == 0 {
+                never.push(i.name().to_string());
+            }
+            let _ = writeln!(s, "| {} | {n} |", i.name());
+        }
+        let _ = writeln!(s, "\nNever reached: {}.", list(&never));
+        s
+    }
+}
+
+fn list(v: &[String]) -> String {
+    if v.is_empty() {
+        "nothing".into()
+    } else {
+        v.join(", ")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emu::faults;
+    use crate::fuzzing::bus;
+
+    fn seeds() -> Vec<(String, Vec<BusOp>)> {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/bus_bytes");
+        let mut v: Vec<(String, Vec<BusOp>)> = std::fs::read_dir(dir)
+            .expect("corpus")
+            .filter_map(Result::ok)
+            .map(|e| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                (name, bus::decode(&std::fs::read(e.path()).expect("seed")))
+            })
+            .collect();
+        v.sort_by(|a, b| a.0.cmp(&b.0));
+        v
+    }
+
+    /// Many inputs breaking one invariant are one bucket, represented by
+    /// the shortest; inputs that break nothing are listed apart.
+    #[test]
+    fn findings_are_bucketed_by_invariant() {
+        let cfg = faults::find("remaining-off-by-one").expect("fault").model();
+        let (buckets, clean) = triage(&seeds(), &cfg);
+        assert_eq!(buckets.len(), 1, "{buckets:?}");
+        let b = &buckets[0];
+        assert_eq!(b.invariant, "remaining-pulses");
+        assert!(b.inputs.len() >= 5, "{}", b.inputs.len());
+        assert!(b.inputs.contains(&b.smallest.0));
+        assert_eq!(b.inputs.len() + clean.len(), seeds().len());
+        let (none, all_clean) = triage(&seeds(), &ModelConfig::default());
+        assert!(none.is_empty());
+        assert_eq!(all_clean.len(), seeds().len());
+    }
+
+    /// The suite's traffic reaches every move kind, ended, and errors; the
+    /// report lists what it never reached.
+    #[test]
+    fn the_seed_corpus_coverage_report() {
+        let ops: Vec<Vec<BusOp>> = seeds().into_iter().map(|(_, o)| o).collect();
+        let c = Coverage::of(&ops);
+        assert_eq!(c.inputs, ops.len());
+        for m in MoveKind::ALL {
+            assert!(
+                c.finishes.keys().any(|(k, _)| k == m.name()),
+                "{}",
+                m.name()
+            );
+        }
+        assert!(c.errors.len() >= 6, "{:?}", c.errors);
+        assert!(c
+            .commands
+            .contains_key(&("initialization".to_string(), ChipState::Uninitialized)));
+        let text = c.render();
+        assert!(text.contains("## Commands by chip state"));
+        assert!(text.contains("Never reached:"));
+        // Empty corpus: everything is listed as never reached.
+        let empty = Coverage::of(&[]).render();
+        assert!(
+            empty.contains("Never reached: 0, 1, 2, 3, 4, 5, 6, 7."),
+            "{empty}"
+        );
+    }
+}
