@@ -68,8 +68,9 @@ pub fn run(args: MatrixArgs) -> ExitCode {
         actions: args.fuzz_actions,
     };
     let mut rows: Vec<Row> = Vec::new();
+    let total = boards.len();
     for (i, (name, model)) in boards.into_iter().enumerate() {
-        eprint!("[{}/{}] {name} ... ", i + 1, CATALOGUE.len() + 1);
+        eprint!("[{}/{total}] {name} ... ", i + 1);
         let row = match board_row(&name, model, args.in_process, &suite, &args.golden, budget) {
             Ok(r) => r,
             Err(e) => {
