@@ -45,10 +45,8 @@ pub fn run(args: DiffArgs) -> ExitCode {
     };
     let mut target: Box<dyn Target> = if args.target.name() == "emu" {
         let mut model = args.target.model();
-        for name in &args.chip_faults {
-            if let Err(e) = ppmc::emu::faults::apply_named(name, &mut model) {
-                return crate::usage_error(format!("--chip-fault: {e}"));
-            }
+        if let Err(e) = ppmc::emu::faults::apply_all(&args.chip_faults, &mut model) {
+            return crate::usage_error(format!("--chip-fault: {e}"));
         }
         match EmuTarget::new(straps, model) {
             Ok(t) => Box::new(t),

@@ -96,11 +96,8 @@ struct ModelArgs {
 impl ModelArgs {
     fn model(&self) -> Result<ModelConfig, ExitCode> {
         let mut cfg = ModelConfig::default();
-        for name in &self.chip_faults {
-            if let Err(e) = ppmc::emu::faults::apply_named(name, &mut cfg) {
-                return Err(crate::usage_error(format!("--chip-fault: {e}")));
-            }
-        }
+        ppmc::emu::faults::apply_all(&self.chip_faults, &mut cfg)
+            .map_err(|e| crate::usage_error(format!("--chip-fault: {e}")))?;
         Ok(cfg)
     }
 }
@@ -252,9 +249,8 @@ pub fn run(args: FuzzArgs) -> ExitCode {
                 m.violation.invariant,
                 out.display()
             );
-            let cfg2 = cfg.clone();
             let (script, _) =
-                ppmc::fuzzing::reproducer_with(&bytes, &out.display().to_string(), cfg2);
+                ppmc::fuzzing::reproducer_with(&bytes, &out.display().to_string(), cfg);
             print!("{script}");
             ExitCode::SUCCESS
         }

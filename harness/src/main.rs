@@ -380,10 +380,8 @@ fn bridge_sim(args: BridgeSimArgs) -> ExitCode {
         Err(e) => return usage_error(e),
     };
     let mut model = args.target.model();
-    for name in &args.chip_faults {
-        if let Err(e) = ppmc::emu::faults::apply_named(name, &mut model) {
-            return usage_error(format!("--chip-fault: {e}"));
-        }
+    if let Err(e) = ppmc::emu::faults::apply_all(&args.chip_faults, &mut model) {
+        return usage_error(format!("--chip-fault: {e}"));
     }
     let emu = match EmuTarget::new(straps, model) {
         Ok(t) => t,

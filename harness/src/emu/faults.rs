@@ -304,6 +304,12 @@ pub fn apply_named(name: &str, cfg: &mut ModelConfig) -> Result<(), String> {
     ))
 }
 
+/// Puts every named fault into `cfg` ([`apply_named`] each, in order); the
+/// error names the first fault that is not known.
+pub fn apply_all<S: AsRef<str>>(names: &[S], cfg: &mut ModelConfig) -> Result<(), String> {
+    names.iter().try_for_each(|n| apply_named(n.as_ref(), cfg))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
