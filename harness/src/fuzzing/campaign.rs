@@ -123,7 +123,8 @@ impl Coverage {
         let Ok(mut k) = Checker::new(ModelConfig::default()) else {
             return;
         };
-        let mut moves_seen = 0;
+        // Pin events already looked at: only new ones can be a move's end.
+        let mut pins_seen = 0;
         for op in ops {
             let chip = k.chip();
             let state = if chip.read_status().busy() {
@@ -151,14 +152,14 @@ impl Coverage {
             if let StatusField::Error(e) = chip.read_status().field() {
                 *self.errors.entry(e.number()).or_default() += 1;
             }
-            let rec = chip.record();
-            let ended = rec
-                .pins
+            let pins = &chip.record().pins;
+            let ended = pins
+                .get(pins_seen..)
+                .unwrap_or_default()
                 .iter()
-                .filter(|p| p.pin == crate::protocol::Pin::Busy && p.value == 0)
-                .count();
-            if ended > moves_seen {
-                moves_seen = ended;
+                .any(|p| p.pin == crate::protocol::Pin::Busy && p.value == 0);
+            pins_seen = pins.len();
+            if ended {
                 let f = chip.finish_status();
                 let kind = MoveKind::ALL
                     .iter()
