@@ -362,12 +362,7 @@ impl<'t> Driver<'t> {
     /// Runs ops on the target (after everything queued); a target failure
     /// stops the scenario as an error (not the device's fault).
     pub fn exec(&mut self, ops: &[Op]) -> Outcome<Vec<Reply>> {
-        self.flush()?;
-        self.send(ops)
-    }
-
-    fn send(&mut self, ops: &[Op]) -> Outcome<Vec<Reply>> {
-        self.send_then(ops, false)
+        Ok(self.flush_with(ops, false)?.1)
     }
 
     /// Runs ops on the target; with `capture`, also fetches the capture
@@ -452,13 +447,29 @@ impl<'t> Driver<'t> {
         if self.queue.is_empty() {
             return Ok(());
         }
+        self.flush_with(&[], capture).map(drop)
+    }
+
+    /// Sends everything queued and then `extra` as one batch (one round trip
+    /// on a board), judges the queued groups as [`Driver::flush`] does, and
+    /// returns when `extra` began (the end of the last queued op) and the
+    /// replies to `extra`. With `capture`, the capture after the batch comes
+    /// back with it.
+    fn flush_with(&mut self, extra: &[Op], capture: bool) -> Outcome<(Instant, Vec<Reply>)> {
         let groups = std::mem::take(&mut self.queue);
-        let ops: Vec<Op> = groups
+        let mut ops: Vec<Op> = groups
             .iter()
             .flat_map(|g| g.steps.iter().map(|(s, _)| self.step_op(*s)))
             .collect();
+        let queued = ops.len();
+        ops.extend_from_slice(extra);
         let mut began = self.now;
-        let mut replies = self.send_then(&ops, capture)?.into_iter();
+        if ops.is_empty() {
+            return Ok((began, Vec::new()));
+        }
+        let mut replies = self.send_then(&ops, capture)?;
+        let tail = replies.split_off(queued);
+        let mut replies = replies.into_iter();
         for g in groups {
             let mut done = Vec::with_capacity(g.steps.len());
             for (step, role) in g.steps {
@@ -479,15 +490,14 @@ impl<'t> Driver<'t> {
                 self.judge_check(&c, &done, began)?;
             }
         }
-        Ok(())
+        Ok((began, tail))
     }
 
-    /// Runs steps now (after everything queued) and returns their results.
+    /// Runs steps now (with everything queued before them, in one batch)
+    /// and returns their results.
     fn steps(&mut self, steps: &[Step]) -> Outcome<Vec<Done>> {
-        self.flush()?;
         let ops: Vec<Op> = steps.iter().map(|s| self.step_op(*s)).collect();
-        let mut began = self.now;
-        let replies = self.send(&ops)?;
+        let (mut began, replies) = self.flush_with(&ops, false)?;
         let mut out = Vec::with_capacity(steps.len());
         for (step, reply) in steps.iter().zip(replies) {
             let at = reply.at();
@@ -1375,6 +1385,12 @@ impl<'t> Driver<'t> {
             .map(|e| e.at))
     }
 
+    /// [`Driver::need`] of a time set by a queued step: flushes first.
+    fn flushed(&mut self, what: &str, t: fn(&Self) -> Option<Instant>) -> Outcome<Instant> {
+        self.flush()?;
+        self.need(what, t(self))
+    }
+
     fn need(&self, what: &str, t: Option<Instant>) -> Outcome<Instant> {
         t.ok_or_else(|| {
             Stop::Error(format!(
@@ -1395,19 +1411,18 @@ impl<'t> Driver<'t> {
     /// Measures the Table 3-3 quantity `id` from what has happened so far
     /// and grades it. A FAIL stops the scenario; MARGINAL is recorded.
     pub fn expect_latency(&mut self, id: TimingId) -> Outcome<Duration> {
-        self.flush()?;
         let (from, to) = match id {
             TimingId::BusyRise => {
-                let a = self.need("an operation command", self.anchor)?;
+                let a = self.flushed("an operation command", |d| d.anchor)?;
                 (a, self.pin_after(Pin::Busy, Some(1), a)?)
             }
             TimingId::AccelFirstPout | TimingId::ConstantFirstPout => {
-                let a = self.need("an operation command", self.anchor)?;
+                let a = self.flushed("an operation command", |d| d.anchor)?;
                 let (first, _) = self.last_move_pulse_times()?;
                 (a, Some(first))
             }
             TimingId::SingleStep => {
-                let a = self.need("an operation command", self.anchor)?;
+                let a = self.flushed("an operation command", |d| d.anchor)?;
                 (a, self.pin_after(Pin::Busy, Some(0), a)?)
             }
             TimingId::InterruptOutput => {
@@ -1419,23 +1434,23 @@ impl<'t> Driver<'t> {
                 (last, self.pin_after(Pin::Hold, Some(1), last)?)
             }
             TimingId::AbnormalTermination => {
-                let t = self.need("a stop or limit", self.trigger)?;
+                let t = self.flushed("a stop or limit", |d| d.trigger)?;
                 (t, self.pin_after(Pin::Busy, Some(0), t)?)
             }
             TimingId::AuxOn => {
-                let t = self.need("an AUX ON command", self.trigger)?;
+                let t = self.flushed("an AUX ON command", |d| d.trigger)?;
                 (t, self.pin_after(Pin::Aux, Some(1), t)?)
             }
             TimingId::AuxOff => {
-                let t = self.need("an AUX OFF command", self.trigger)?;
+                let t = self.flushed("an AUX OFF command", |d| d.trigger)?;
                 (t, self.pin_after(Pin::Aux, Some(0), t)?)
             }
             TimingId::ExcitationOff => {
-                let t = self.need("a software reset", self.trigger)?;
+                let t = self.flushed("a software reset", |d| d.trigger)?;
                 (t, self.pin_after(Pin::Phases, Some(0), t)?)
             }
             TimingId::InitOutputsSet => {
-                let t = self.need("an initialization", self.init_write)?;
+                let t = self.flushed("an initialization", |d| d.init_write)?;
                 (t, self.pin_after(Pin::Phases, None, t)?)
             }
             TimingId::InitProcessing => return self.measure_init_processing(),
@@ -1461,12 +1476,11 @@ impl<'t> Driver<'t> {
     /// Initialization processing: from the final data byte until the chip
     /// takes the next command (an input status read, harmless).
     fn measure_init_processing(&mut self) -> Outcome<Duration> {
-        let t = self.need("an initialization", self.init_write)?;
         let timeout = self.opts.ibf_timeout;
         self.expect_flag(Flag::Ibf, false, timeout)?;
         self.raw_command(Register::InputSignals.code())?;
         self.expect_flag(Flag::Ibf, false, timeout)?;
-        self.flush()?;
+        let t = self.flushed("an initialization", |d| d.init_write)?;
         let value = self.now.saturating_since(t);
         let at = self.now;
         self.record_measure(TimingId::InitProcessing, value, at)?;
@@ -1477,11 +1491,12 @@ impl<'t> Driver<'t> {
     /// written as soon as BUSY = 0.
     fn measure_next_command(&mut self) -> Outcome<Duration> {
         self.wait_idle()?;
-        let (_, last) = self.last_move_pulse_times()?;
         self.raw_command(Register::InputSignals.code())?;
         let timeout = self.opts.ibf_timeout;
         self.expect_flag(Flag::Ibf, false, timeout)?;
-        self.flush()?;
+        // The move had ended before the command: its last pulse is in the
+        // capture fetched with the batch.
+        let (_, last) = self.last_move_pulse_times()?;
         let value = self.now.saturating_since(last);
         let at = self.now;
         self.record_measure(TimingId::NextCommand, value, at)?;
@@ -1494,12 +1509,12 @@ impl<'t> Driver<'t> {
     /// check, not a graded measurement: one run only brackets the latency
     /// between two pulses. Returns the time from the trigger to that pulse.
     fn expect_decel_start(&mut self, id: TimingId) -> Outcome<Duration> {
-        let t = self.need("a decelerating stop or high-speed limit", self.trigger)?;
         let pa = self
             .init
             .map(|i| u64::from(i.data.pa))
             .ok_or_else(|| Stop::Error("scenario bug: measuring needs an initialization".into()))?;
         self.wait_idle()?;
+        let t = self.flushed("a decelerating stop or high-speed limit", |d| d.trigger)?;
         let rec = self.capture()?;
         let from = rec.moves.last().map_or(0, |m| m.first_run);
         let times: Vec<Instant> = rec.runs[from..]

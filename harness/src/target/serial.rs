@@ -307,6 +307,10 @@ pub struct SerialTarget<L: Link> {
     opts: SerialOptions,
     /// The capture fetched so far (since the last chip reset).
     captured: Record,
+    /// `captured` is the whole capture as of now: the last request brought
+    /// the rest of it back, and the bridge's chip has not moved on since
+    /// (it runs in virtual time, so nothing happens between requests).
+    captured_current: bool,
     /// The request size in force: halved when a request needed asking
     /// again, doubled back after clean ones.
     request_size: usize,
@@ -336,6 +340,7 @@ impl<L: Link> SerialTarget<L> {
             timer: Timer::NANOS,
             opts,
             captured: Record::default(),
+            captured_current: false,
             request_size: MAX_REQUEST,
             stats: LinkStats::default(),
         };
@@ -344,12 +349,12 @@ impl<L: Link> SerialTarget<L> {
             hz: t.hello.timer_hz,
         };
         let replies = t
-            .run_batch(&[Op::Reset, Op::ReadStatus], false)
+            .run_batch(&[Op::Reset, Op::ReadStatus])
             .map_err(|e| SerialError::Unhealthy {
                 link: t.link.name(),
                 detail: e.to_string(),
             })?;
-        match replies.0.get(1) {
+        match replies.get(1) {
             Some(Reply::Status { status, .. }) if status.0 == 0 => Ok(t),
             other => Err(SerialError::Unhealthy {
                 link: t.link.name(),
@@ -447,6 +452,7 @@ impl<L: Link> SerialTarget<L> {
                 continue;
             }
             self.stats.round_trips += 1;
+            if std::env::var_os("PPMC_DBG").is_some() { eprintln!("TRIP {what} len={}", payload.len()); }
             let had = frags.received();
             match self.await_reply(seq, self.opts.reply_timeout + extra, &mut frags) {
                 Ok(Some(Response::Error {
@@ -683,19 +689,18 @@ impl<L: Link> SerialTarget<L> {
         c.more
     }
 
-    /// Runs `ops` in requests of the size in force; with `capture` and a
-    /// clean link, the last request also fetches the first capture chunk.
-    fn run_batch(
-        &mut self,
-        ops: &[Op],
-        capture: bool,
-    ) -> Result<(Vec<Reply>, Option<CaptureChunk>), SerialError> {
+    /// Runs `ops` in requests of the size in force. On a clean link the last
+    /// request also brings back the capture since the last fetch (what the
+    /// bridge has not sent yet, up to one chunk), so that reading the
+    /// capture after a batch, which every scenario does, costs no round
+    /// trip of its own.
+    fn run_batch(&mut self, ops: &[Op]) -> Result<Vec<Reply>, SerialError> {
+        self.captured_current = false;
         if ops.contains(&Op::Reset) {
             // A chip reset clears the bridge's capture.
             self.captured = Record::default();
         }
         let mut out = Vec::with_capacity(ops.len());
-        let mut chunk_out = None;
         let max_ops = usize::from(self.hello.max_batch_ops.clamp(1, MAX_BATCH_OPS.max(1)));
         let mut rest = ops;
         while !rest.is_empty() {
@@ -721,7 +726,7 @@ impl<L: Link> SerialTarget<L> {
             let asked_again = self.stats.retransmissions;
             // The capture rides along only on a clean link: on a noisy one
             // (requests shrunk) a longer reply is likelier to need resending.
-            let req = if capture && rest.is_empty() && self.request_size >= MAX_REQUEST {
+            let req = if rest.is_empty() && self.request_size >= MAX_REQUEST {
                 let (runs, pins, moves) = self.capture_from();
                 Request::BatchCapture {
                     ops: chunk.to_vec(),
@@ -753,12 +758,13 @@ impl<L: Link> SerialTarget<L> {
                 Response::Batch(r) if r.len() == chunk.len() => out.extend(r),
                 Response::BatchCapture { replies, capture } if replies.len() == chunk.len() => {
                     out.extend(replies);
-                    chunk_out = Some(capture);
+                    let more = self.absorb(capture);
+                    self.captured_current = !more && self.hello.virtual_time;
                 }
                 other => return Err(self.unexpected(&what, &other)),
             }
         }
-        Ok((out, chunk_out))
+        Ok(out)
     }
 }
 
@@ -781,9 +787,10 @@ impl<L: Link> Target for SerialTarget<L> {
 
     /// Fetches what the bridge captured since the last fetch: new pin
     /// changes and moves, and the pulse runs from the last one known on
-    /// (the last run may have grown).
+    /// (the last run may have grown). Costs nothing when the last batch
+    /// brought the rest of the capture back with it.
     fn capture(&mut self) -> Result<Record, TargetError> {
-        loop {
+        while !self.captured_current {
             let (runs, pins, moves) = self.capture_from();
             let req = Request::Capture {
                 runs,
@@ -794,26 +801,18 @@ impl<L: Link> Target for SerialTarget<L> {
             match self.request(&req, "capture", WallDuration::ZERO)? {
                 Response::Capture(c) => {
                     if !self.absorb(c) {
-                        return Ok(self.captured.clone());
+                        break;
                     }
                 }
                 other => return Err(self.unexpected("capture", &other).into()),
             }
         }
-    }
-
-    fn execute_then_capture(&mut self, ops: &[Op]) -> Result<(Vec<Reply>, Record), TargetError> {
-        let (replies, chunk) = self.run_batch(ops, true)?;
-        if let Some(c) = chunk {
-            if !self.absorb(c) {
-                return Ok((replies, self.captured.clone()));
-            }
-        }
-        Ok((replies, self.capture()?))
+        self.captured_current = self.hello.virtual_time;
+        Ok(self.captured.clone())
     }
 
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
-        Ok(self.run_batch(ops, false)?.0)
+        Ok(self.run_batch(ops)?)
     }
 }
 
