@@ -195,7 +195,7 @@ fn a_missing_port_says_so() {
 fn a_disconnect_mid_run_ends_with_the_rest_not_run() {
     let sim = Sim::start(
         LinkFaults {
-            disconnect_after: Some(120),
+            disconnect_after: Some(60),
             ..LinkFaults::default()
         },
         ModelConfig::default(),

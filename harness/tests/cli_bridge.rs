@@ -91,7 +91,7 @@ fn console_over_the_bridge_prints_what_the_emulator_prints() {
 
 #[test]
 fn a_disconnect_mid_run_writes_the_partial_junit_and_exits_1() {
-    let sim = BridgeSim::start(&["--disconnect-after", "120"]);
+    let sim = BridgeSim::start(&["--disconnect-after", "40"]);
     let junit = tmp("partial.xml");
     let out = ppmc(&[
         "run",

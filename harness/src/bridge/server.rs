@@ -10,8 +10,8 @@
 
 use super::frame::{self, FrameDecoder, FrameError};
 use super::wire::{
-    fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer, WireError,
-    PROTOCOL_VERSION,
+    self, fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer, WireError,
+    MAX_REPLY, PROTOCOL_VERSION,
 };
 use crate::target::{EmuTarget, Op, Reply, Target};
 
@@ -126,7 +126,19 @@ impl BridgeServer {
                 detail: e.to_string(),
             },
         };
-        let frames = fragment(&response.encode(seq, self.timer));
+        let mut reply = response.encode(seq, self.timer);
+        if reply.len() > MAX_REPLY {
+            // Never a truncated reply: the host asked for too much at once.
+            reply = Response::Error {
+                code: BridgeErrorCode::Overflow,
+                detail: format!(
+                    "the reply takes {} bytes, more than {MAX_REPLY}; send fewer ops",
+                    reply.len()
+                ),
+            }
+            .encode(seq, self.timer);
+        }
+        let frames = fragment(&reply);
         self.last = Some((payload.to_vec(), frames.clone()));
         frames
     }
@@ -180,10 +192,20 @@ impl BridgeServer {
                 moves,
                 max,
             } => match self.run_ops(&ops) {
-                Ok(replies) => Response::BatchCapture {
-                    replies,
-                    capture: self.chunk(runs, pins, moves, max),
-                },
+                Ok(replies) => {
+                    // The capture takes what room the replies leave.
+                    let mut max = max;
+                    loop {
+                        let r = Response::BatchCapture {
+                            replies: replies.clone(),
+                            capture: self.chunk(runs, pins, moves, max),
+                        };
+                        if max <= 1 || r.encode(0, self.timer).len() <= MAX_REPLY {
+                            break r;
+                        }
+                        max /= 2;
+                    }
+                }
                 Err(e) => e,
             },
         }
@@ -192,10 +214,11 @@ impl BridgeServer {
     /// Runs a batch's ops within the batch limit; the error response
     /// otherwise.
     fn run_ops(&mut self, ops: &[Op]) -> Result<Vec<Reply>, Response> {
-        if ops.len() > usize::from(MAX_BATCH_OPS) {
+        let wire_ops = wire::wire_ops(ops).len();
+        if wire_ops > usize::from(MAX_BATCH_OPS) {
             return Err(Response::Error {
                 code: BridgeErrorCode::Overflow,
-                detail: format!("{} ops in one batch, at most {MAX_BATCH_OPS}", ops.len()),
+                detail: format!("{wire_ops} ops in one batch, at most {MAX_BATCH_OPS}"),
             });
         }
         self.target.execute(ops).map_err(|e| Response::Error {
@@ -448,5 +471,106 @@ mod tests {
                 ..
             }
         ));
+    }
+
+    /// Initialization, then a constant-speed move (Section 3-3-5) of
+    /// `steps` at rate 100, and its pulse period.
+    fn moving_ops(steps: u32) -> (Vec<Op>, Duration) {
+        use crate::protocol::{ClockSource, Command, Direction, MoveCommand, MoveKind, Straps};
+        let mut ops = init_ops();
+        let cmd = Command::Move(MoveCommand::new(MoveKind::Constant, Direction::Cw, false));
+        let count = (steps - 1).to_le_bytes();
+        ops.push(Op::WriteCommand {
+            byte: cmd.encode(),
+            wait_ibf: Some(Duration::from_secs(1)),
+        });
+        for b in [100, count[0], count[1], count[2]] {
+            ops.push(Op::WriteData {
+                byte: b,
+                wait_ibf: Some(Duration::from_secs(1)),
+            });
+        }
+        let st = Straps::default();
+        let tclock = st.tclock(ClockSource::Internal).expect("internal clock");
+        (ops, st.pulse_interval(100, tclock))
+    }
+
+    /// `pairs` pin samples `step` apart.
+    fn samples(pairs: usize, step: Duration) -> Vec<Op> {
+        (0..pairs)
+            .flat_map(|_| [Op::ReadPins, Op::Delay(step)])
+            .collect()
+    }
+
+    #[test]
+    fn a_reply_too_long_for_255_fragments_is_an_overflow_error_not_cut_short() {
+        // Sampled between one and two pulse periods apart, every sample of a
+        // phase-stepping move differs from the one before: no run-length
+        // saving, so 20 SAMPLE ops of 512 samples need about 60 KB.
+        let (init, period) = moving_ops(100_000);
+        let ops = samples(20 * wire::MAX_SAMPLES, period.scale(13, 10));
+        let mut reference = server();
+        reference.target.execute(&init).expect("runs");
+        let replies = reference.target.execute(&ops).expect("runs");
+        let len = Response::Batch(replies).encode(1, Timer::NANOS).len();
+        assert!(len > MAX_REPLY, "precondition: the reply is {len} bytes");
+        let mut s = server();
+        ask(&mut s, 1, &Request::Batch(init));
+        let r = ask(&mut s, 2, &Request::Batch(ops));
+        assert!(
+            matches!(
+                &r,
+                Response::Error {
+                    code: BridgeErrorCode::Overflow,
+                    detail,
+                } if detail.contains("send fewer ops")
+            ),
+            "{r:?}"
+        );
+    }
+
+    #[test]
+    fn the_capture_chunk_shrinks_to_fit_beside_a_long_batch_reply() {
+        let mut s = server();
+        ask(&mut s, 1, &Request::Batch(init_ops()));
+        // Many moves: a capture far longer than what fits beside the reply.
+        for k in 0..200u8 {
+            let step = vec![
+                Op::WriteCommand {
+                    byte: 0x4A,
+                    wait_ibf: Some(Duration::from_secs(1)),
+                },
+                Op::Delay(Duration::from_micros(300)),
+            ];
+            ask(&mut s, k.wrapping_add(2), &Request::Batch(step));
+        }
+        let rec = s.target().chip().record();
+        assert!(
+            rec.pins.len() >= 300,
+            "precondition: {} pin changes",
+            rec.pins.len()
+        );
+        // 128 pulse summaries: the longest reply entries there are.
+        let ops = vec![Op::ReadPulses; usize::from(MAX_BATCH_OPS)];
+        let req = Request::BatchCapture {
+            ops,
+            runs: 0,
+            pins: 0,
+            moves: 0,
+            max: 300,
+        };
+        let out = s.on_bytes(&frame::encode(&req.encode(100, Timer::NANOS)));
+        let (seq, r) = collect(&out);
+        assert_eq!(seq, 100);
+        let Response::BatchCapture { replies, capture } = r else {
+            panic!("batch-capture reply");
+        };
+        assert_eq!(replies.len(), usize::from(MAX_BATCH_OPS));
+        assert!(capture.more, "the rest of the capture is left for later");
+        assert!(!capture.moves.is_empty(), "as much as fits came along");
+        let len = Response::BatchCapture { replies, capture }
+            .encode(100, Timer::NANOS)
+            .len();
+        assert!(len <= MAX_REPLY, "{len} bytes");
     }
 }

@@ -14,7 +14,7 @@ use crate::target::{Op, Reply};
 use crate::time::{Duration, Instant};
 
 /// The protocol version this build speaks.
-pub const PROTOCOL_VERSION: u16 = 1;
+pub const PROTOCOL_VERSION: u16 = 2;
 
 /// Message kinds (the second payload byte).
 pub mod kind {
@@ -136,8 +136,12 @@ pub enum Request {
 /// fragments of this many bytes, so that a noisy link loses little.
 pub const FRAGMENT_DATA: usize = 48;
 
+/// The longest response payload: 255 fragments.
+pub const MAX_REPLY: usize = 255 * FRAGMENT_DATA;
+
 /// Splits a response payload into frame payloads: itself if short, else
-/// `seq, FRAGMENT, index, count, data`.
+/// `seq, FRAGMENT, index, count, data`. A payload over [`MAX_REPLY`] loses
+/// its tail; the bridge never sends one (it answers OVERFLOW instead).
 pub fn fragment(payload: &[u8]) -> Vec<Vec<u8>> {
     if payload.len() <= FRAGMENT_DATA {
         return vec![payload.to_vec()];
@@ -228,11 +232,17 @@ impl Timer {
     pub const NANOS: Timer = Timer { hz: 1_000_000_000 };
 
     pub fn to_ticks(self, ns: u64) -> u64 {
+        if self.hz == Self::NANOS.hz {
+            return ns;
+        }
         let t = u128::from(ns) * u128::from(self.hz) / 1_000_000_000;
         u64::try_from(t).unwrap_or(u64::MAX)
     }
 
     pub fn to_nanos(self, ticks: u64) -> u64 {
+        if self.hz == Self::NANOS.hz {
+            return ticks;
+        }
         if self.hz == 0 {
             return u64::MAX;
         }
@@ -367,6 +377,22 @@ impl<'a> R<'a> {
         let n = usize::from(self.u8()?);
         Ok(String::from_utf8_lossy(self.take(n)?).into_owned())
     }
+    fn peek(&self) -> Option<u8> {
+        self.b.get(self.at).copied()
+    }
+    /// A sample count: 2..=MAX_SAMPLES.
+    fn samples(&mut self) -> Result<usize, WireError> {
+        let at = self.at;
+        let n = usize::from(self.u16()?);
+        if !(2..=MAX_SAMPLES).contains(&n) {
+            return Err(WireError::BadValue {
+                at,
+                field: "sample count",
+                value: n as u64,
+            });
+        }
+        Ok(n)
+    }
     fn count(&mut self, max_item: usize) -> Result<usize, WireError> {
         let at = self.at;
         let n = usize::from(self.u16()?);
@@ -429,6 +455,7 @@ mod op {
     pub const PULSES: u8 = 0x18;
     pub const AWAIT_PULSES: u8 = 0x19;
     pub const RESET: u8 = 0x1A;
+    pub const SAMPLE: u8 = 0x1B;
 }
 
 /// Reply codes inside a batch reply.
@@ -447,13 +474,106 @@ mod rep {
     pub const PULSES_REACHED: u8 = 0x0C;
     pub const PULSES_TIMEOUT: u8 = 0x0D;
     pub const RESET_DONE: u8 = 0x0E;
+    pub const SAMPLES: u8 = 0x0F;
 }
 
-/// A `count` u16, then the ops (BATCH, BATCH_CAPTURE).
+/// Most pin samples one SAMPLE op (or one SAMPLES reply entry) stands for.
+pub const MAX_SAMPLES: usize = 512;
+
+/// The largest reply entry of a plain op on the wire (PULSES).
+pub const MAX_REPLY_ENTRY: usize = 69;
+
+/// A SAMPLES entry without its runs: code, time, step, samples, runs.
+const SAMPLES_HEAD: usize = 1 + 8 + 8 + 2 + 2;
+
+/// One SAMPLES run: count, then the pins.
+const SAMPLES_RUN: usize = 2 + 4;
+
+/// The number of `(ReadPins, Delay(step))` pairs, all with the same step,
+/// that `ops` starts with, at most [`MAX_SAMPLES`].
+fn sample_pairs(ops: &[Op]) -> usize {
+    let Some(Op::Delay(step)) = ops.get(1) else {
+        return 0;
+    };
+    ops.chunks_exact(2)
+        .take(MAX_SAMPLES)
+        .take_while(|p| matches!(p, [Op::ReadPins, Op::Delay(s)] if s == step))
+        .count()
+}
+
+/// How a batch goes on the wire: for each wire op in order, how many ops
+/// of `ops` it stands for. Two or more `(ReadPins, Delay(step))` pairs in a
+/// row with the same step are one SAMPLE op (twice the sample count); any
+/// other op is itself (1).
+pub fn wire_ops(ops: &[Op]) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < ops.len() {
+        let n = match sample_pairs(&ops[i..]) {
+            pairs @ 2.. => 2 * pairs,
+            _ => 1,
+        };
+        out.push(n);
+        i += n;
+    }
+    out
+}
+
+/// The bytes one wire op (a group from [`wire_ops`]) takes in a request.
+pub fn wire_op_len(group: &[Op], timer: Timer) -> usize {
+    let mut w = W(Vec::with_capacity(16), timer);
+    put_wire_op(&mut w, group);
+    w.0.len()
+}
+
+/// The most bytes the reply entry to one wire op can take.
+pub fn worst_reply_len(group: &[Op]) -> usize {
+    match group {
+        [] => 0,
+        [o] => worst_reply_entry(o),
+        _ => SAMPLES_HEAD + SAMPLES_RUN * (group.len() / 2),
+    }
+}
+
+/// The most bytes the reply entry to a plain op can take: code, time, and
+/// the longest of the replies it may get.
+fn worst_reply_entry(o: &Op) -> usize {
+    1 + 8
+        + match o {
+            Op::WriteCommand { .. } | Op::WriteData { .. } => 8,
+            Op::ReadStatus => 1,
+            Op::ReadData { .. } | Op::AwaitStatus { .. } => 1 + 8,
+            Op::Delay(_) | Op::SetInput { .. } | Op::Reset => 0,
+            Op::ReadPins => 4,
+            Op::ReadPulses => MAX_REPLY_ENTRY - 9,
+            Op::AwaitPulses { .. } => 8,
+        }
+}
+
+fn put_wire_op(w: &mut W, group: &[Op]) {
+    match (group, group.len() / 2) {
+        ([Op::ReadPins, Op::Delay(step), ..], pairs) if pairs >= 2 => {
+            w.u8(op::SAMPLE);
+            w.u16(pairs as u16);
+            w.dur(*step);
+        }
+        _ => {
+            if let Some(o) = group.first() {
+                put_op(w, o);
+            }
+        }
+    }
+}
+
+/// A `count` u16 of wire ops, then the wire ops (BATCH, BATCH_CAPTURE).
 fn put_ops(w: &mut W, ops: &[Op]) {
-    w.u16(ops.len() as u16);
-    for o in ops {
-        put_op(w, o);
+    let groups = wire_ops(ops);
+    w.u16(groups.len() as u16);
+    let mut rest = ops;
+    for n in groups {
+        let (group, tail) = rest.split_at(n);
+        put_wire_op(w, group);
+        rest = tail;
     }
 }
 
@@ -461,16 +581,97 @@ fn get_ops(r: &mut R) -> Result<Vec<Op>, WireError> {
     let n = r.count(1)?;
     let mut ops = Vec::with_capacity(n);
     for _ in 0..n {
-        ops.push(get_op(r)?);
+        if r.peek() == Some(op::SAMPLE) {
+            r.u8()?;
+            let pairs = r.samples()?;
+            let step = r.dur()?;
+            for _ in 0..pairs {
+                ops.push(Op::ReadPins);
+                ops.push(Op::Delay(step));
+            }
+        } else {
+            ops.push(get_op(r)?);
+        }
     }
     Ok(ops)
 }
 
-/// A `count` u16, then the replies (BATCH_REPLY, BATCH_CAPTURE_REPLY).
+/// The run of regular pin samples that `replies` starts with, in ticks of
+/// `timer`: `(pairs, first time, step)` when at least two
+/// `(Pins, Delayed)` pairs follow each other on one grid (each pins read at
+/// the end of the delay before it, each delay `step` long), at most
+/// [`MAX_SAMPLES`].
+fn sample_replies(replies: &[Reply], timer: Timer) -> Option<(usize, u64, u64)> {
+    let tick = |i: Instant| timer.to_ticks(i.as_nanos());
+    let (t0, step) = match replies {
+        [Reply::Pins { at, .. }, Reply::Delayed { at: end }, ..] => {
+            (tick(*at), tick(*end).checked_sub(tick(*at))?)
+        }
+        _ => return None,
+    };
+    let pairs = replies
+        .chunks_exact(2)
+        .take(MAX_SAMPLES)
+        .enumerate()
+        .take_while(|(i, p)| {
+            let at = step.checked_mul(*i as u64).and_then(|d| t0.checked_add(d));
+            let end = at.and_then(|a| a.checked_add(step));
+            matches!(p, [Reply::Pins { at: a, .. }, Reply::Delayed { at: e }]
+                if Some(tick(*a)) == at && Some(tick(*e)) == end)
+        })
+        .count();
+    (pairs >= 2).then_some((pairs, t0, step))
+}
+
+/// A `count` u16 of reply entries, then the entries (BATCH_REPLY,
+/// BATCH_CAPTURE_REPLY). A run of regular pin samples is one SAMPLES entry.
 fn put_replies(w: &mut W, replies: &[Reply]) {
-    w.u16(replies.len() as u16);
-    for rp in replies {
-        put_reply(w, rp);
+    let count_at = w.0.len();
+    w.u16(0);
+    let mut entries: u16 = 0;
+    let mut rest = replies;
+    while !rest.is_empty() {
+        let n = match sample_replies(rest, w.1) {
+            Some((pairs, t0, step)) => {
+                put_samples(w, &rest[..2 * pairs], t0, step);
+                2 * pairs
+            }
+            None => {
+                put_reply(w, &rest[0]);
+                1
+            }
+        };
+        rest = &rest[n..];
+        entries = entries.saturating_add(1);
+    }
+    w.0[count_at..count_at + 2].copy_from_slice(&entries.to_le_bytes());
+}
+
+/// A SAMPLES entry: first time and step (ticks), the sample count, then
+/// the pins as runs of equal samples.
+fn put_samples(w: &mut W, pairs: &[Reply], t0: u64, step: u64) {
+    let pins: Vec<Pins> = pairs
+        .iter()
+        .filter_map(|r| match r {
+            Reply::Pins { pins, .. } => Some(*pins),
+            _ => None,
+        })
+        .collect();
+    let mut runs: Vec<(u16, Pins)> = Vec::new();
+    for p in pins.iter().copied() {
+        match runs.last_mut() {
+            Some((n, q)) if *q == p => *n += 1,
+            _ => runs.push((1, p)),
+        }
+    }
+    w.u8(rep::SAMPLES);
+    w.u64(t0);
+    w.u64(step);
+    w.u16(pins.len() as u16);
+    w.u16(runs.len() as u16);
+    for (n, p) in runs {
+        w.u16(n);
+        put_pins(w, &p);
     }
 }
 
@@ -478,9 +679,81 @@ fn get_replies(r: &mut R) -> Result<Vec<Reply>, WireError> {
     let n = r.count(9)?;
     let mut v = Vec::with_capacity(n);
     for _ in 0..n {
-        v.push(get_reply(r)?);
+        if r.peek() == Some(rep::SAMPLES) {
+            get_samples(r, &mut v)?;
+        } else {
+            v.push(get_reply(r)?);
+        }
     }
     Ok(v)
+}
+
+fn get_samples(r: &mut R, out: &mut Vec<Reply>) -> Result<(), WireError> {
+    r.u8()?;
+    let (t0, step) = (r.u64()?, r.u64()?);
+    let at = r.at;
+    let samples = r.samples()?;
+    let runs = r.count(SAMPLES_RUN)?;
+    let timer = r.timer;
+    let time = |ticks: Option<u64>| {
+        ticks
+            .map(|t| Instant::from_nanos(timer.to_nanos(t)))
+            .ok_or(WireError::BadValue {
+                at,
+                field: "sample time",
+                value: t0,
+            })
+    };
+    let mut i: u64 = 0;
+    for _ in 0..runs {
+        let n = r.u16()?;
+        let pins = get_pins(r)?;
+        for _ in 0..n {
+            let start = step.checked_mul(i).and_then(|d| t0.checked_add(d));
+            out.push(Reply::Pins {
+                at: time(start)?,
+                pins,
+            });
+            out.push(Reply::Delayed {
+                at: time(start.and_then(|s| s.checked_add(step)))?,
+            });
+            i += 1;
+        }
+    }
+    if i != samples as u64 {
+        return Err(WireError::BadValue {
+            at,
+            field: "sample count (runs add up to another)",
+            value: i,
+        });
+    }
+    Ok(())
+}
+
+fn put_pins(w: &mut W, pins: &Pins) {
+    let flags = u8::from(pins.int)
+        | u8::from(pins.hold) << 1
+        | u8::from(pins.aux) << 2
+        | u8::from(pins.dir.bit()) << 3
+        | u8::from(pins.busy) << 4;
+    w.u8(flags);
+    w.u8(pins.auxo);
+    w.u8(pins.phases);
+    w.u8(pins.phase_levels);
+}
+
+fn get_pins(r: &mut R) -> Result<Pins, WireError> {
+    let flags = r.u8()?;
+    Ok(Pins {
+        int: flags & 1 != 0,
+        hold: flags & 2 != 0,
+        aux: flags & 4 != 0,
+        dir: Direction::from_bit(flags & 8 != 0),
+        busy: flags & 16 != 0,
+        auxo: r.u8()?,
+        phases: r.u8()?,
+        phase_levels: r.u8()?,
+    })
 }
 
 /// Where a capture fetch starts, and its chunk size (CAPTURE,
@@ -625,15 +898,7 @@ fn put_reply(w: &mut W, rp: &Reply) {
         Reply::Pins { at, pins } => {
             w.u8(rep::PINS);
             w.time(at);
-            let flags = u8::from(pins.int)
-                | u8::from(pins.hold) << 1
-                | u8::from(pins.aux) << 2
-                | u8::from(pins.dir.bit()) << 3
-                | u8::from(pins.busy) << 4;
-            w.u8(flags);
-            w.u8(pins.auxo);
-            w.u8(pins.phases);
-            w.u8(pins.phase_levels);
+            put_pins(w, &pins);
         }
         Reply::Pulses { at, summary } => {
             w.u8(rep::PULSES);
@@ -699,22 +964,10 @@ fn get_reply(r: &mut R) -> Result<Reply, WireError> {
             status: Status(r.u8()?),
         },
         rep::INPUT_SET => Reply::InputSet { at },
-        rep::PINS => {
-            let flags = r.u8()?;
-            Reply::Pins {
-                at,
-                pins: Pins {
-                    int: flags & 1 != 0,
-                    hold: flags & 2 != 0,
-                    aux: flags & 4 != 0,
-                    dir: Direction::from_bit(flags & 8 != 0),
-                    busy: flags & 16 != 0,
-                    auxo: r.u8()?,
-                    phases: r.u8()?,
-                    phase_levels: r.u8()?,
-                },
-            }
-        }
+        rep::PINS => Reply::Pins {
+            at,
+            pins: get_pins(r)?,
+        },
         rep::PULSES => Reply::Pulses {
             at,
             summary: PulseSummary {
@@ -1133,6 +1386,50 @@ mod tests {
             Reply::PulsesTimedOut { at, count: 3 },
             Reply::ResetDone { at },
         ];
+        // Each reply fits the worst case of the op it answers.
+        let ops = sample_ops();
+        let answers = |r: &Reply| -> Vec<&Op> {
+            ops.iter()
+                .filter(|o| {
+                    matches!(
+                        (o, r),
+                        (
+                            Op::WriteCommand { .. } | Op::WriteData { .. },
+                            Reply::Written { .. } | Reply::WriteTimedOut { .. }
+                        ) | (Op::ReadStatus, Reply::Status { .. })
+                            | (
+                                Op::ReadData { .. },
+                                Reply::Data { .. } | Reply::ReadTimedOut { .. }
+                            )
+                            | (Op::Delay(_), Reply::Delayed { .. })
+                            | (
+                                Op::AwaitStatus { .. },
+                                Reply::Awaited { .. } | Reply::AwaitTimedOut { .. }
+                            )
+                            | (Op::SetInput { .. }, Reply::InputSet { .. })
+                            | (Op::ReadPins, Reply::Pins { .. })
+                            | (Op::ReadPulses, Reply::Pulses { .. })
+                            | (
+                                Op::AwaitPulses { .. },
+                                Reply::PulsesReached { .. } | Reply::PulsesTimedOut { .. }
+                            )
+                            | (Op::Reset, Reply::ResetDone { .. })
+                    )
+                })
+                .collect()
+        };
+        for r in &replies {
+            let mut w = W(Vec::new(), T);
+            put_reply(&mut w, r);
+            let ops = answers(r);
+            assert!(!ops.is_empty(), "{r:?}");
+            for o in ops {
+                assert!(
+                    w.0.len() <= worst_reply_len(std::slice::from_ref(o)),
+                    "{r:?}"
+                );
+            }
+        }
         let resp = Response::Batch(replies);
         assert_eq!(Response::decode(&resp.encode(9, T), T), Ok((9, resp)));
     }
@@ -1258,6 +1555,136 @@ mod tests {
             Response::decode(&[1, kind::BATCH_REPLY, 0xFF, 0xFF], T),
             Err(WireError::BadValue { field: "count", .. })
         ));
+    }
+
+    fn pins(phases: u8) -> Pins {
+        Pins {
+            int: false,
+            hold: true,
+            aux: false,
+            auxo: 0,
+            phases,
+            phase_levels: !phases & 0x1F,
+            dir: Direction::Cw,
+            busy: true,
+        }
+    }
+
+    #[test]
+    fn pin_samples_go_as_sample_ops_and_samples_entries() {
+        let step = Duration::from_nanos(250);
+        let mut ops = vec![Op::Reset];
+        for _ in 0..1500 {
+            ops.extend([Op::ReadPins, Op::Delay(step)]);
+        }
+        ops.push(Op::ReadPins);
+        // 1,500 samples: two SAMPLEs of the most, one of the rest; the lone
+        // read at the end stays a PINS op.
+        assert_eq!(
+            wire_ops(&ops),
+            vec![1, 2 * MAX_SAMPLES, 2 * MAX_SAMPLES, 2 * 476, 1]
+        );
+        let req = Request::Batch(ops);
+        let bytes = req.encode(3, T);
+        assert!(bytes.len() < 40, "{} bytes", bytes.len());
+        assert_eq!(Request::decode(&bytes, T), Ok((3, req)));
+
+        // Replies on one grid: the phases change every 7 samples.
+        let mut replies = vec![Reply::ResetDone {
+            at: Instant::from_nanos(10),
+        }];
+        for i in 0..1500u64 {
+            let at = Instant::from_nanos(10 + 250 * i);
+            let p = pins(1 << ((i / 7) % 4));
+            replies.extend([
+                Reply::Pins { at, pins: p },
+                Reply::Delayed {
+                    at: Instant::from_nanos(10 + 250 * (i + 1)),
+                },
+            ]);
+        }
+        let resp = Response::Batch(replies.clone());
+        let bytes = resp.encode(3, T);
+        // 215 runs of 6 bytes, not 3,000 entries of 9 to 13.
+        assert!(bytes.len() < 1_400, "{} bytes", bytes.len());
+        assert_eq!(Response::decode(&bytes, T), Ok((3, resp)));
+
+        // Off the grid (a read late by 1 ns), the run stops there and the
+        // rest still comes back exact.
+        if let Some(Reply::Pins { at, .. }) = replies.get_mut(2 * 700 + 1) {
+            *at = Instant::from_nanos(at.as_nanos() + 1);
+        }
+        let resp = Response::Batch(replies);
+        assert_eq!(Response::decode(&resp.encode(4, T), T), Ok((4, resp)));
+    }
+
+    #[test]
+    fn a_sample_count_out_of_range_is_refused() {
+        for n in [0u16, 1, MAX_SAMPLES as u16 + 1] {
+            let mut b = vec![1, kind::BATCH, 1, 0, op::SAMPLE];
+            b.extend(n.to_le_bytes());
+            b.extend(250u64.to_le_bytes());
+            assert!(matches!(
+                Request::decode(&b, T),
+                Err(WireError::BadValue {
+                    field: "sample count",
+                    ..
+                })
+            ));
+        }
+    }
+
+    fn arb_op() -> impl Strategy<Value = Op> {
+        prop_oneof![
+            Just(Op::ReadPins),
+            Just(Op::ReadStatus),
+            (0u64..3).prop_map(|d| Op::Delay(Duration::from_nanos(250 * d))),
+        ]
+    }
+
+    fn arb_reply() -> impl Strategy<Value = Reply> {
+        prop_oneof![
+            (0u64..4, 0u8..3).prop_map(|(t, p)| Reply::Pins {
+                at: Instant::from_nanos(100 * t),
+                pins: pins(p),
+            }),
+            (0u64..4).prop_map(|t| Reply::Delayed {
+                at: Instant::from_nanos(100 * t)
+            }),
+            (0u64..4).prop_map(|t| Reply::Status {
+                at: Instant::from_nanos(100 * t),
+                status: Status(0),
+            }),
+        ]
+    }
+
+    proptest! {
+        #[test]
+        fn any_batch_round_trips(ops in prop::collection::vec(arb_op(), 0..400)) {
+            let req = Request::Batch(ops);
+            prop_assert_eq!(Request::decode(&req.encode(1, T), T), Ok((1, req)));
+        }
+
+        #[test]
+        fn any_reply_list_round_trips(
+            mut replies in prop::collection::vec(arb_reply(), 0..400),
+            grid in 0usize..200,
+        ) {
+            // Lay a stretch on a grid, so that SAMPLES entries occur.
+            for (j, r) in replies.iter_mut().skip(grid).take(150).enumerate() {
+                let k = (j / 2) as u64;
+                *r = if j % 2 == 0 {
+                    Reply::Pins {
+                        at: Instant::from_nanos(1_000 + 100 * k),
+                        pins: pins((j / 10) as u8 % 3),
+                    }
+                } else {
+                    Reply::Delayed { at: Instant::from_nanos(1_000 + 100 * (k + 1)) }
+                };
+            }
+            let resp = Response::Batch(replies);
+            prop_assert_eq!(Response::decode(&resp.encode(1, T), T), Ok((1, resp)));
+        }
     }
 
     proptest! {

@@ -12,7 +12,7 @@ use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
 use crate::bridge::frame::{self, FrameDecoder};
 use crate::bridge::server::MAX_BATCH_OPS;
 use crate::bridge::wire::{
-    parse_fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer,
+    self, parse_fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer,
     PROTOCOL_VERSION,
 };
 use crate::protocol::Record;
@@ -230,6 +230,11 @@ impl Default for SerialOptions {
 const MAX_REQUEST: usize = 2048;
 const MIN_REQUEST: usize = 48;
 
+/// The most bytes the reply entries to one request may take, at worst:
+/// with the capture chunk the bridge adds (which it shrinks to fit), a
+/// reply stays within [`wire::MAX_REPLY`].
+const REPLY_ENTRIES_BUDGET: usize = 10 * 1024;
+
 /// Records asked for per capture request.
 const CAPTURE_CHUNK: u16 = 300;
 
@@ -348,12 +353,12 @@ impl<L: Link> SerialTarget<L> {
         t.timer = Timer {
             hz: t.hello.timer_hz,
         };
-        let replies = t
-            .run_batch(&[Op::Reset, Op::ReadStatus])
-            .map_err(|e| SerialError::Unhealthy {
-                link: t.link.name(),
-                detail: e.to_string(),
-            })?;
+        let replies =
+            t.run_batch(&[Op::Reset, Op::ReadStatus])
+                .map_err(|e| SerialError::Unhealthy {
+                    link: t.link.name(),
+                    detail: e.to_string(),
+                })?;
         match replies.get(1) {
             Some(Reply::Status { status, .. }) if status.0 == 0 => Ok(t),
             other => Err(SerialError::Unhealthy {
@@ -452,7 +457,6 @@ impl<L: Link> SerialTarget<L> {
                 continue;
             }
             self.stats.round_trips += 1;
-            if std::env::var_os("PPMC_DBG").is_some() { eprintln!("TRIP {what} len={}", payload.len()); }
             let had = frags.received();
             match self.await_reply(seq, self.opts.reply_timeout + extra, &mut frags) {
                 Ok(Some(Response::Error {
@@ -689,6 +693,27 @@ impl<L: Link> SerialTarget<L> {
         c.more
     }
 
+    /// How many of `ops` go in the next request (at least one): as many
+    /// wire ops as fit the request size in force and the bridge's batch
+    /// limit, whose replies cannot outgrow [`REPLY_ENTRIES_BUDGET`].
+    fn next_request_len(&self, ops: &[Op], max_ops: usize) -> usize {
+        // seq, kind, count; BATCH_CAPTURE adds where the capture starts.
+        let mut bytes = 4 + 14;
+        let mut reply = 0;
+        let mut n = 0;
+        for (i, group) in wire::wire_ops(ops).into_iter().enumerate() {
+            let g = &ops[n..n + group];
+            bytes += wire::wire_op_len(g, self.timer);
+            reply += wire::worst_reply_len(g);
+            if i > 0 && (i >= max_ops || bytes > self.request_size || reply > REPLY_ENTRIES_BUDGET)
+            {
+                break;
+            }
+            n += group;
+        }
+        n
+    }
+
     /// Runs `ops` in requests of the size in force. On a clean link the last
     /// request also brings back the capture since the last fetch (what the
     /// bridge has not sent yet, up to one chunk), so that reading the
@@ -704,17 +729,7 @@ impl<L: Link> SerialTarget<L> {
         let max_ops = usize::from(self.hello.max_batch_ops.clamp(1, MAX_BATCH_OPS.max(1)));
         let mut rest = ops;
         while !rest.is_empty() {
-            // As many ops as fit one request of the size in force.
-            let mut n = 1;
-            while n < rest.len()
-                && n < max_ops
-                && Request::Batch(rest[..=n].to_vec())
-                    .encode(0, self.timer)
-                    .len()
-                    <= self.request_size
-            {
-                n += 1;
-            }
+            let n = self.next_request_len(rest, max_ops);
             let (chunk, tail) = rest.split_at(n);
             rest = tail;
             let what = format!(
@@ -844,6 +859,7 @@ mod tests {
     use crate::emu::ModelConfig;
     use crate::protocol::Straps;
     use crate::target::EmuTarget;
+    use crate::time::Duration;
 
     /// A link straight into a bridge server, which fails on demand.
     #[derive(Debug)]
@@ -917,6 +933,42 @@ mod tests {
         }
     }
 
+    /// Pin samples of a phase-stepping move (Section 3-3-5), `n` of them
+    /// `step` apart, taken by a scenario driver on `t`.
+    fn sample_a_move(
+        t: &mut dyn Target,
+        step: fn(Duration) -> Duration,
+        n: usize,
+    ) -> Vec<(crate::time::Instant, crate::protocol::Pins)> {
+        use crate::protocol::Direction;
+        use crate::scenario::{Driver, DriverOptions, Init, Move};
+        let mut d = Driver::new(t, DriverOptions::default());
+        d.reset().expect("reset");
+        d.init_and_wait(Init::four_phase()).expect("init");
+        d.start(Move::constant(Direction::Cw, 100, 50_000))
+            .expect("move");
+        let period = d.period(100);
+        d.sample_pins(step(period), n).expect("samples")
+    }
+
+    #[test]
+    fn pin_sampling_costs_a_round_trip_per_1500_samples_and_matches_the_emulator() {
+        // On the pulse grid, and off it (every sample then differs from the
+        // one before: no run-length saving at all).
+        let steps: [fn(Duration) -> Duration; 2] = [|p| p, |p| p.scale(13, 10)];
+        for step in steps {
+            let mut emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emu");
+            let want = sample_a_move(&mut emu, step, 3_000);
+            let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+            let before = t.stats.round_trips;
+            let got = sample_a_move(&mut t, step, 3_000);
+            assert_eq!(got, want);
+            // One batch for everything before the samples and the first
+            // ~1,500 of them, one for the rest (it was 47 at 128 ops each).
+            assert_eq!(t.stats.round_trips - before, 2);
+        }
+    }
+
     #[test]
     fn a_vanished_port_is_reopened_and_the_run_goes_on() {
         let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
@@ -953,7 +1005,7 @@ mod tests {
 
     #[test]
     fn a_bridge_of_another_protocol_version_is_refused() {
-        // A bridge that answers hello with version 2.
+        // A bridge that answers hello with the next protocol version.
         #[derive(Debug)]
         struct V2(Vec<u8>);
         impl Link for V2 {
@@ -963,7 +1015,7 @@ mod tests {
                 if let Ok(Some(p)) = d.decode() {
                     let seq = p[0];
                     let hello = Response::Hello(Hello {
-                        version: 2,
+                        version: PROTOCOL_VERSION + 1,
                         session: 1,
                         timer_hz: 1_000_000_000,
                         max_batch_ops: 1,
@@ -997,8 +1049,8 @@ mod tests {
             matches!(
                 e,
                 SerialError::Version {
-                    theirs: 2,
-                    ours: 1,
+                    theirs: 3,
+                    ours: 2,
                     ..
                 }
             ),
