@@ -79,6 +79,12 @@ struct BridgeSimArgs {
     /// virtual time (to behave like a real board's timing).
     #[arg(long)]
     realtime: bool,
+    /// Pulse runs plus pin changes the bridge's capture buffer holds; past
+    /// that, capture requests answer CAPTURE_OVERRUN until the next chip
+    /// reset (to try a host against a board with a small buffer). Default:
+    /// unlimited.
+    #[arg(long, value_name = "N", default_value_t = u32::MAX, hide_default_value = true)]
+    capture_capacity: u32,
     /// Probability of losing each byte on the link, e.g. 0.01.
     #[arg(long, default_value_t = 0.0)]
     drop_rate: f64,
@@ -409,7 +415,8 @@ fn bridge_sim(args: BridgeSimArgs) -> ExitCode {
     let session = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(1, |d| d.subsec_nanos() ^ (d.as_secs() as u32));
-    let mut server = BridgeServer::new(emu, session, !args.realtime);
+    let mut server = BridgeServer::new(emu, session, !args.realtime)
+        .with_capture_capacity(args.capture_capacity);
     // Nobody may be reading stdout (a closed pipe): never let that stop
     // the bridge.
     let mut out = io::stdout();

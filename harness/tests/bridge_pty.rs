@@ -225,3 +225,66 @@ fn a_disconnect_mid_run_ends_with_the_rest_not_run() {
         "{detail}"
     );
 }
+
+#[test]
+fn a_realtime_bridge_takes_as_long_as_its_waits_and_the_host_waits_for_it() {
+    use ppmc::bridge::sim::BridgeOptions;
+    use ppmc::target::{Op, Reply, Target};
+    use ppmc::time::Duration;
+    let emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+    let bridge = BridgeOptions {
+        realtime: true,
+        ..BridgeOptions::default()
+    };
+    let sim = Sim(PtyBridge::start_with(emu, LinkFaults::default(), bridge).expect("a pty"));
+    // A reply timeout shorter than the batch: the host must allow for the
+    // batch's own delay on a bridge that says it runs in real time.
+    let opts = SerialOptions {
+        reply_timeout: WallDuration::from_millis(100),
+        ..fast()
+    };
+    let mut t = sim.target(opts).expect("bridge answers");
+    assert!(!t.hello().virtual_time);
+    let began = std::time::Instant::now();
+    let r = t
+        .execute(&[Op::Delay(Duration::from_millis(400)), Op::ReadStatus])
+        .expect("the host waited for the delay");
+    let took = began.elapsed();
+    // A lower bound only: the machine may be slow, never early.
+    assert!(took >= WallDuration::from_millis(400), "{took:?}");
+    assert!(
+        matches!(r[1], Reply::Status { at, .. } if at.as_nanos() >= 400_000_000),
+        "{r:?}"
+    );
+    assert_eq!(t.stats.retransmissions, 0, "no reply was given up on");
+}
+
+#[test]
+fn a_capture_overrun_is_an_error_of_that_scenario_and_the_run_goes_on() {
+    use ppmc::bridge::sim::BridgeOptions;
+    let emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+    // Room for a few pulse runs: the 1,000-step ramp needs about 80.
+    let bridge = BridgeOptions {
+        capture_capacity: 40,
+        ..BridgeOptions::default()
+    };
+    let sim = Sim(PtyBridge::start_with(emu, LinkFaults::default(), bridge).expect("a pty"));
+    let mut t = sim.target(fast()).expect("bridge answers");
+    assert_eq!(t.hello().capture_capacity, 40);
+    let pick = |name: &str| {
+        ppmc::suite::all()
+            .into_iter()
+            .find(|s| s.name == name)
+            .expect("in the suite")
+    };
+    let scenarios = [
+        pick("s3_3_4_accel_1000_steps_cw"),
+        pick("s3_3_3_single_step_cw_then_ccw"),
+    ];
+    let results = run_suite(&mut t, &scenarios, 1, DriverOptions::default(), |_| {});
+    let labels: Vec<&str> = results.iter().map(|r| r.verdict.label()).collect();
+    assert_eq!(labels, ["error", "passed"]);
+    let detail = results[0].verdict.detail().unwrap_or_default();
+    assert!(detail.contains("capture buffer overran"), "{detail}");
+    assert!(detail.contains("the buffer holds 40"), "{detail}");
+}

@@ -215,12 +215,33 @@ mod tests {
 mod cross_check {
     /// Frames computed by an independent implementation (Python, from the
     /// CRC catalogue and the COBS paper) for `docs/bridge-protocol.md`.
+    use crate::bridge::wire::{Request, Timer, PROTOCOL_VERSION};
+    use crate::target::Op;
+    use crate::time::Duration;
+
     #[test]
     fn matches_the_examples_in_the_protocol_document() {
-        assert_eq!(super::encode(&[0x01, 0x01, 0x01, 0x00]), HELLO);
-        assert_eq!(super::encode(&[0x02, 0x02, 0x01, 0x00, 0x12]), BATCH_RS);
+        let hello = Request::Hello {
+            version: PROTOCOL_VERSION,
+        }
+        .encode(1, Timer::NANOS);
+        assert_eq!(hello, [0x01, 0x01, 0x02, 0x00]);
+        assert_eq!(super::encode(&hello), HELLO);
+        let rs = Request::Batch(vec![Op::ReadStatus]).encode(2, Timer::NANOS);
+        assert_eq!(super::encode(&rs), BATCH_RS);
+        let samples = Request::Batch(
+            (0..3)
+                .flat_map(|_| [Op::ReadPins, Op::Delay(Duration::from_nanos(250))])
+                .collect(),
+        )
+        .encode(3, Timer::NANOS);
+        assert_eq!(super::encode(&samples), BATCH_SAMPLE);
     }
 
-    const HELLO: &[u8] = &[0x04, 0x01, 0x01, 0x01, 0x03, 0x75, 0xF6, 0x00];
+    const HELLO: &[u8] = &[0x04, 0x01, 0x01, 0x02, 0x03, 0x26, 0xA3, 0x00];
     const BATCH_RS: &[u8] = &[0x04, 0x02, 0x02, 0x01, 0x04, 0x12, 0xA4, 0xBD, 0x00];
+    const BATCH_SAMPLE: &[u8] = &[
+        0x04, 0x03, 0x02, 0x01, 0x03, 0x1B, 0x03, 0x02, 0xFA, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01,
+        0x03, 0x30, 0xFC, 0x00,
+    ];
 }

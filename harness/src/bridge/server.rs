@@ -32,6 +32,10 @@ pub struct BridgeServer {
     session: u32,
     timer: Timer,
     virtual_time: bool,
+    /// Pulse runs plus pin changes the capture buffer holds (as announced
+    /// in HELLO_REPLY); beyond it the capture is overrun until the next
+    /// chip reset.
+    capture_capacity: u32,
     /// The last request payload and the frames sent for it.
     last: Option<(Vec<u8>, Vec<Vec<u8>>)>,
     /// Frames handled so far (for fault injection by the caller).
@@ -47,9 +51,18 @@ impl BridgeServer {
             session,
             timer: Timer::NANOS,
             virtual_time,
+            capture_capacity: u32::MAX,
             last: None,
             frames: 0,
         }
+    }
+
+    /// A bridge whose capture buffer holds `records` pulse runs plus pin
+    /// changes: past that, capture requests answer CAPTURE_OVERRUN until
+    /// the next chip reset, as a board with a small buffer would.
+    pub fn with_capture_capacity(mut self, records: u32) -> Self {
+        self.capture_capacity = records;
+        self
     }
 
     pub fn target(&self) -> &EmuTarget {
@@ -89,6 +102,13 @@ impl BridgeServer {
     /// The virtual time the emulator has reached (to pace `--realtime`).
     pub fn now(&self) -> crate::time::Instant {
         self.target.chip().now()
+    }
+
+    /// Lets `d` pass on the chip between requests, as it does on a board
+    /// while the host is busy elsewhere (`--realtime`).
+    pub fn pass_time(&mut self, d: crate::time::Duration) {
+        // A delay cannot fail on the emulator; nothing to report if it did.
+        let _ = self.target.execute(&[Op::Delay(d)]);
     }
 
     /// The frames answering one request payload.
@@ -164,7 +184,7 @@ impl BridgeServer {
                     timer_hz: self.timer.hz,
                     max_batch_ops: MAX_BATCH_OPS,
                     max_payload: frame::MAX_PAYLOAD as u16,
-                    capture_capacity: u32::MAX,
+                    capture_capacity: self.capture_capacity,
                     inputs_wired: 0x3FF,
                     virtual_time: self.virtual_time,
                     firmware: format!("ppmc-bridge-sim {}", crate::VERSION),
@@ -184,7 +204,10 @@ impl BridgeServer {
                 pins,
                 moves,
                 max,
-            } => Response::Capture(self.chunk(runs, pins, moves, max)),
+            } => match self.overrun() {
+                Some(held) => self.overrun_error(held),
+                None => Response::Capture(self.chunk(runs, pins, moves, max)),
+            },
             Request::BatchCapture {
                 ops,
                 runs,
@@ -192,6 +215,9 @@ impl BridgeServer {
                 moves,
                 max,
             } => match self.run_ops(&ops) {
+                Err(e) => e,
+                // The ops ran, but what they left is not all there.
+                Ok(_) if let Some(held) = self.overrun() => self.overrun_error(held),
                 Ok(replies) => {
                     // The capture takes what room the replies leave.
                     let mut max = max;
@@ -206,7 +232,6 @@ impl BridgeServer {
                         max /= 2;
                     }
                 }
-                Err(e) => e,
             },
         }
     }
@@ -225,6 +250,24 @@ impl BridgeServer {
             code: BridgeErrorCode::Malformed,
             detail: e.to_string(),
         })
+    }
+
+    /// The records captured since the last reset, if more than the
+    /// capture buffer holds.
+    fn overrun(&self) -> Option<usize> {
+        let rec = self.target.chip().record();
+        let held = rec.runs.len() + rec.pins.len();
+        (held > self.capture_capacity as usize).then_some(held)
+    }
+
+    fn overrun_error(&self, held: usize) -> Response {
+        Response::Error {
+            code: BridgeErrorCode::CaptureOverrun,
+            detail: format!(
+                "{held} records captured since the last reset; the buffer holds {}",
+                self.capture_capacity
+            ),
+        }
     }
 
     /// Up to `max` capture records of each kind from these positions on.

@@ -3,6 +3,7 @@
 //! to the wall clock.
 
 use super::server::BridgeServer;
+use crate::time::{Duration, Instant};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use std::io::{self, Read, Write};
@@ -33,6 +34,26 @@ impl Default for LinkFaults {
             stall_after: None,
             disconnect_after: None,
             seed: 1,
+        }
+    }
+}
+
+/// How the simulated bridge itself behaves, as opposed to its link.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BridgeOptions {
+    /// Hold each reply until the wall clock has caught up with the
+    /// emulator's virtual time, and announce real time in HELLO_REPLY.
+    pub realtime: bool,
+    /// Pulse runs plus pin changes the capture buffer holds (see
+    /// [`BridgeServer::with_capture_capacity`]).
+    pub capture_capacity: u32,
+}
+
+impl Default for BridgeOptions {
+    fn default() -> Self {
+        BridgeOptions {
+            realtime: false,
+            capture_capacity: u32::MAX,
         }
     }
 }
@@ -72,8 +93,13 @@ impl Faulty {
 }
 
 /// Serves the bridge protocol on `port` until `stop` is set or the
-/// disconnect fault fires. With `realtime`, replies are held back until the
-/// wall clock has caught up with the emulator's virtual time.
+/// disconnect fault fires.
+///
+/// With `realtime`, the chip's clock follows the wall clock, as a board's
+/// does: the time between requests passes on the chip too (a move goes on
+/// while the host is away), and each reply is held back until the request
+/// has taken as long on the wall clock as its ops took on the chip. Runs
+/// are then no longer repeatable, exactly as on a board.
 pub fn serve<P: Read + Write>(
     port: &mut P,
     server: &mut BridgeServer,
@@ -85,8 +111,8 @@ pub fn serve<P: Read + Write>(
         f: faults,
         rng: StdRng::seed_from_u64(faults.seed),
     };
-    let started = WallInstant::now();
-    let virtual_start = server.now();
+    // When the chip's clock last caught up with the wall clock.
+    let mut synced = WallInstant::now();
     let mut buf = [0u8; 4096];
     while !stop.load(Ordering::Relaxed) {
         let n = match port.read(&mut buf) {
@@ -112,6 +138,13 @@ pub fn serve<P: Read + Write>(
             continue;
         }
         let incoming = faulty.apply(&buf[..n]);
+        let began = WallInstant::now();
+        if realtime {
+            server.pass_time(Duration::from_nanos(
+                began.saturating_duration_since(synced).as_nanos() as u64,
+            ));
+        }
+        let before = server.now();
         let reply = server.on_bytes(&incoming);
         if faults.disconnect_after.is_some_and(|k| server.frames >= k) {
             return Ok(ServeEnd::Disconnected);
@@ -120,12 +153,18 @@ pub fn serve<P: Read + Write>(
             continue;
         }
         if realtime {
-            let ahead = server.now().saturating_since(virtual_start);
-            let wall = WallDuration::from_nanos(ahead.as_nanos());
-            let elapsed = started.elapsed();
-            if wall > elapsed {
-                std::thread::sleep(wall - elapsed);
+            // A chip reset restarts the clock at zero: count from there.
+            let after = server.now();
+            let ran = if after >= before {
+                after.saturating_since(before)
+            } else {
+                after.saturating_since(Instant::ZERO)
+            };
+            let due = began + WallDuration::from_nanos(ran.as_nanos());
+            if let Some(wait) = due.checked_duration_since(WallInstant::now()) {
+                std::thread::sleep(wait);
             }
+            synced = due;
         }
         let outgoing = faulty.apply(&reply);
         port.write_all(&outgoing)?;
@@ -147,6 +186,16 @@ pub struct PtyBridge {
 impl PtyBridge {
     /// Serves `emu` (in virtual time) with `faults` on the link.
     pub fn start(emu: crate::target::EmuTarget, faults: LinkFaults) -> io::Result<PtyBridge> {
+        Self::start_with(emu, faults, BridgeOptions::default())
+    }
+
+    /// Serves `emu` as a bridge set up by `bridge`, with `faults` on the
+    /// link.
+    pub fn start_with(
+        emu: crate::target::EmuTarget,
+        faults: LinkFaults,
+        bridge: BridgeOptions,
+    ) -> io::Result<PtyBridge> {
         use serialport::SerialPort;
         let (mut master, slave) = serialport::TTYPort::pair().map_err(io::Error::other)?;
         master
@@ -159,8 +208,9 @@ impl PtyBridge {
         let flag = Arc::clone(&stop);
         let handle = std::thread::spawn(move || {
             let _keep_open = slave;
-            let mut server = BridgeServer::new(emu, 0x5EED, true);
-            serve(&mut master, &mut server, faults, false, &flag).ok()
+            let mut server = BridgeServer::new(emu, 0x5EED, !bridge.realtime)
+                .with_capture_capacity(bridge.capture_capacity);
+            serve(&mut master, &mut server, faults, bridge.realtime, &flag).ok()
         });
         Ok(PtyBridge {
             path,

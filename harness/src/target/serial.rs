@@ -970,6 +970,22 @@ mod tests {
     }
 
     #[test]
+    fn a_busy_or_forbidden_port_says_another_program_may_hold_it() {
+        // (A real second open cannot be refused here: CI runs as root, and
+        // root passes the exclusive lock serialport takes on the port.)
+        for e in [
+            io::Error::from_raw_os_error(16), // EBUSY
+            io::Error::new(io::ErrorKind::PermissionDenied, "denied"),
+        ] {
+            let msg = open_error("/dev/ttyACM0", e).to_string();
+            assert!(msg.starts_with("/dev/ttyACM0: port busy"), "{msg}");
+            assert!(msg.contains("another program"), "{msg}");
+        }
+        let missing = open_error("/dev/ttyACM9", io::ErrorKind::NotFound.into());
+        assert!(missing.to_string().contains("no such serial port"));
+    }
+
+    #[test]
     fn a_vanished_port_is_reopened_and_the_run_goes_on() {
         let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
         t.link.fail_sends = 1;
