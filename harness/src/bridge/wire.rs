@@ -231,11 +231,14 @@ impl Timer {
     /// The simulator's timer: one tick per nanosecond.
     pub const NANOS: Timer = Timer { hz: 1_000_000_000 };
 
+    /// Nanoseconds to ticks, to the nearest tick: so that ticks turned into
+    /// nanoseconds ([`Timer::to_nanos`], which truncates) and back are the
+    /// same ticks for any timer up to 500 MHz.
     pub fn to_ticks(self, ns: u64) -> u64 {
         if self.hz == Self::NANOS.hz {
             return ns;
         }
-        let t = u128::from(ns) * u128::from(self.hz) / 1_000_000_000;
+        let t = (u128::from(ns) * u128::from(self.hz) + 500_000_000) / 1_000_000_000;
         u64::try_from(t).unwrap_or(u64::MAX)
     }
 
@@ -1268,6 +1271,24 @@ mod tests {
     use proptest::prelude::*;
 
     const T: Timer = Timer::NANOS;
+
+    #[test]
+    fn ticks_survive_the_trip_through_nanoseconds() {
+        for hz in [
+            1_000_000,
+            16_000_000,
+            48_000_000,
+            72_000_000,
+            84_000_000,
+            168_000_000,
+            480_000_000,
+        ] {
+            let t = Timer { hz };
+            for k in (0..2_000).chain([u64::from(u32::MAX), 1 << 40]) {
+                assert_eq!(t.to_ticks(t.to_nanos(k)), k, "{hz} Hz, {k} ticks");
+            }
+        }
+    }
 
     #[test]
     fn a_16mhz_timer_converts_both_ways() {
