@@ -283,7 +283,7 @@ fn a_capture_overrun_is_an_error_of_that_scenario_and_the_run_goes_on() {
     ];
     let results = run_suite(&mut t, &scenarios, 1, DriverOptions::default(), |_| {});
     let labels: Vec<&str> = results.iter().map(|r| r.verdict.label()).collect();
-    assert_eq!(labels, ["error", "passed"]);
+    assert_eq!(labels, ["error", "passed"], "{:?}", results[1].verdict);
     let detail = results[0].verdict.detail().unwrap_or_default();
     assert!(detail.contains("capture buffer overran"), "{detail}");
     assert!(detail.contains("the buffer holds 40"), "{detail}");

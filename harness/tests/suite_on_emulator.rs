@@ -63,3 +63,36 @@ fn every_scenario_passes_with_other_straps(#[case] straps: Straps) {
         .collect();
     assert!(bad.is_empty(), "{straps:?}:\n{}", bad.join("\n"));
 }
+
+/// Section 3-3-3 single steps, checked with pulse expectations that are
+/// queued behind later moves: each is judged on the capture as it stood
+/// where the scenario asked, not as it stands when the batch comes back.
+fn steps_then_expect(d: &mut ppmc::scenario::Driver, first_cw: u64) -> ppmc::scenario::Outcome {
+    use ppmc::scenario::prelude::*;
+    d.init_and_wait(Init::four_phase())?;
+    d.run(Move::single_step(Cw))?;
+    d.expect_pulses(first_cw, Cw)?;
+    // The next move's final byte is written the instant the first one ends.
+    d.run(Move::single_step(Ccw))?;
+    d.expect_pulses(1, Ccw)
+}
+
+#[test]
+fn s3_3_3_deferred_pulse_expectations_see_the_capture_where_they_were_asked() {
+    use ppmc::scenario::{run_scenario, Scenario, Verdict};
+    let mut t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+    let pass = Scenario::new("pass", "3-3-3", "", &[], |d| steps_then_expect(d, 1));
+    let r = run_scenario(&mut t, &pass, DriverOptions::default());
+    assert_eq!(r.verdict, Verdict::Passed, "{:?}", r.verdict);
+    // Asking for two: the failure names the first move's count, not the
+    // second move's (which has run by the time the batch is judged).
+    let fail = Scenario::new("fail", "3-3-3", "", &[], |d| steps_then_expect(d, 2));
+    let r = run_scenario(&mut t, &fail, DriverOptions::default());
+    let Verdict::Failed(f) = &r.verdict else {
+        panic!("{:?}", r.verdict);
+    };
+    assert_eq!(
+        (f.expectation.as_str(), f.got.as_str()),
+        ("pulses cw", "1 (1 cw, 0 ccw)")
+    );
+}

@@ -11,11 +11,11 @@
 //! decoder has already dropped it and goes on with the next. Both the host
 //! driver and the bridge simulator use this one implementation.
 
-use crc::{Crc, CRC_16_IBM_3740};
+use crc::{Crc, Table, CRC_16_IBM_3740};
 
 /// CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF), called IBM-3740 in the
 /// CRC catalogue.
-const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
+const CRC16: Crc<u16, Table<16>> = Crc::<u16, Table<16>>::new(&CRC_16_IBM_3740);
 
 /// Largest payload a frame may carry (before CRC and COBS).
 pub const MAX_PAYLOAD: usize = 4096;

@@ -243,6 +243,35 @@ impl Record {
         s
     }
 
+    /// The record as it stood at `t`: the pulses, pin changes and moves up
+    /// to and including `t`, a pulse run cut at its last pulse by then.
+    pub fn until(&self, t: Instant) -> Record {
+        let runs = self
+            .runs
+            .iter()
+            .filter(|r| r.start <= t)
+            .map(|r| {
+                let mut r = *r;
+                if r.last() > t {
+                    // `last` is after `start`, so the interval is not zero.
+                    let on_time =
+                        t.saturating_since(r.start).as_nanos() / r.interval.as_nanos().max(1) + 1;
+                    r.count = u32::try_from(on_time).unwrap_or(r.count).min(r.count);
+                    if r.count == 1 {
+                        r.interval = Duration::ZERO;
+                    }
+                }
+                r
+            })
+            .collect();
+        Record {
+            runs,
+            pins: self.pins.iter().filter(|p| p.at <= t).copied().collect(),
+            moves: self.moves.iter().filter(|m| m.at <= t).copied().collect(),
+            overwritten_bytes: self.overwritten_bytes,
+        }
+    }
+
     /// Total number of pulses recorded.
     pub fn pulse_count(&self) -> u64 {
         self.runs.iter().map(|r| u64::from(r.count)).sum()
@@ -280,6 +309,30 @@ mod tests {
         assert_eq!(r.runs.len(), 3);
         assert_eq!(r.pulse_count(), 104);
         assert_eq!(r.pulses().count(), 104);
+    }
+
+    #[test]
+    fn until_cuts_the_record_at_an_instant() {
+        let mut r = Record::default();
+        let d = Duration::from_micros(10);
+        r.push_pulses(t(0), d, 100, Direction::Cw, true);
+        r.push_pulses(t(2000), d, 5, Direction::Ccw, true);
+        r.pin(t(995), Pin::Busy, 0);
+        r.pin(t(1500), Pin::Int, 1);
+        // Pulses at 0, 10, ..., 500: 51 of them, the one at 500 included.
+        let cut = r.until(t(500));
+        assert_eq!(cut.runs.len(), 1);
+        assert_eq!(cut.pulse_count(), 51);
+        assert_eq!(cut.runs[0].last(), t(500));
+        assert!(cut.pins.is_empty());
+        let cut = r.until(t(1999));
+        assert_eq!((cut.pulse_count(), cut.pins.len()), (100, 2));
+        // One pulse left of a run: its interval is zero, as for any
+        // one-pulse run.
+        let cut = r.until(t(2005));
+        assert_eq!(cut.runs[1].count, 1);
+        assert_eq!(cut.runs[1].interval, Duration::ZERO);
+        assert_eq!(r.until(t(10_000)), r);
     }
 
     #[test]

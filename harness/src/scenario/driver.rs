@@ -134,9 +134,25 @@ enum Role {
     Trigger,
 }
 
-/// A deferred expectation, judged on the replies of its group.
+/// A deferred expectation, judged on the replies of its group, or on the
+/// capture as it stood where the check was queued.
 #[derive(Debug, Clone, PartialEq, Eq)]
 enum Check {
+    /// The most recent move output `n` pulses, all in `dir`.
+    Pulses {
+        n: u64,
+        dir: Direction,
+    },
+    /// The shortest and longest interval of the most recent move.
+    Intervals {
+        min: Duration,
+        max: Duration,
+    },
+    /// No pulse of the most recent move after this time.
+    NoPulsesAfter(Instant),
+    /// No pulse of the most recent move later than this after the last
+    /// trigger.
+    NoPulsesAfterTrigger(Duration),
     Bytes {
         what: &'static str,
         expected: Vec<u8>,
@@ -457,6 +473,10 @@ impl<'t> Driver<'t> {
     /// back with it.
     fn flush_with(&mut self, extra: &[Op], capture: bool) -> Outcome<(Instant, Vec<Reply>)> {
         let groups = std::mem::take(&mut self.queue);
+        let capture = capture
+            || groups
+                .iter()
+                .any(|g| g.check.as_ref().is_some_and(Check::on_capture));
         let mut ops: Vec<Op> = groups
             .iter()
             .flat_map(|g| g.steps.iter().map(|(s, _)| self.step_op(*s)))
@@ -698,6 +718,26 @@ impl<'t> Driver<'t> {
     /// Judges a deferred expectation on the results of its group; `at` is
     /// when the group's last step ended.
     fn judge_check(&self, c: &Check, done: &[Done], at: Instant) -> Outcome {
+        if c.on_capture() {
+            let mut rec = self
+                .capture
+                .as_ref()
+                .ok_or_else(|| Stop::Error("the capture did not come back".into()))?
+                .until(at);
+            // A move is recorded at the time of its final byte, and a write
+            // takes no time: a move at the cut belongs before the check only
+            // if the write was.
+            let wrote_at_cut = self.bus.iter().rev().take_while(|e| e.at == at).any(|e| {
+                matches!(
+                    e.kind,
+                    EventKind::Bus(BusEvent::WriteCommand { .. } | BusEvent::WriteData { .. })
+                )
+            });
+            if !wrote_at_cut {
+                rec.moves.retain(|m| m.at < at);
+            }
+            return self.judge_capture(c, &rec, at);
+        }
         let status = done.iter().rev().find_map(|d| match d {
             Done::Status(s) => Some(*s),
             _ => None,
@@ -791,6 +831,47 @@ impl<'t> Driver<'t> {
             (c, _, _) => {
                 return Err(Stop::Error(format!(
                     "scenario bug: check {c:?} has no reply to judge"
+                )))
+            }
+        }
+        Ok(())
+    }
+
+    /// Judges a check of the capture `rec`, cut at `at` where the check
+    /// was queued.
+    fn judge_capture(&self, c: &Check, rec: &Record, at: Instant) -> Outcome {
+        let s = rec.last_move_pulses();
+        match *c {
+            Check::Pulses { n, dir } => {
+                let got = if dir == Direction::Cw { s.cw } else { s.ccw };
+                if s.count != n || got != n {
+                    return Err(fail(
+                        format!("pulses {}", dir.name()),
+                        n,
+                        format!("{} ({} cw, {} ccw)", s.count, s.cw, s.ccw),
+                        s.last.unwrap_or(at),
+                    ));
+                }
+            }
+            Check::Intervals { min, max } => {
+                let got = (s.min_interval, s.max_interval);
+                if got != (Some(min), Some(max)) {
+                    return Err(fail(
+                        "pulse intervals (min, max)",
+                        format!("({min}, {max})"),
+                        format!("({}, {})", opt(s.min_interval), opt(s.max_interval)),
+                        s.first.unwrap_or(at),
+                    ));
+                }
+            }
+            Check::NoPulsesAfter(t) => no_pulses_after(rec, t)?,
+            Check::NoPulsesAfterTrigger(margin) => {
+                let t = self.need("a stop or an input edge", self.trigger)?;
+                no_pulses_after(rec, t + margin)?;
+            }
+            _ => {
+                return Err(Stop::Error(format!(
+                    "scenario bug: check {c:?} is not one of the capture"
                 )))
             }
         }
@@ -1252,20 +1333,11 @@ impl<'t> Driver<'t> {
         self.expect_register(Register::AuxInputs, "auxiliary input status", &[value])
     }
 
-    /// Expects the most recent move to have output `n` pulses in `dir`.
+    /// Expects the most recent move to have output `n` pulses in `dir`,
+    /// judged on the capture as it stands now (deferred: no round trip of
+    /// its own on a board).
     pub fn expect_pulses(&mut self, n: u64, dir: Direction) -> Outcome {
-        let now = self.now;
-        let s = self.capture()?.last_move_pulses();
-        let got = if dir == Direction::Cw { s.cw } else { s.ccw };
-        if s.count != n || got != n {
-            return Err(fail(
-                format!("pulses {}", dir.name()),
-                n,
-                format!("{} ({} cw, {} ccw)", s.count, s.cw, s.ccw),
-                s.last.unwrap_or(now),
-            ));
-        }
-        Ok(())
+        self.enqueue(Vec::new(), Some(Check::Pulses { n, dir }))
     }
 
     /// Expects the most recent move's pulse count within `lo..=hi`.
@@ -1283,29 +1355,16 @@ impl<'t> Driver<'t> {
         Ok(s.count)
     }
 
-    /// Expects the shortest and longest interval of the most recent move.
+    /// Expects the shortest and longest interval of the most recent move
+    /// (deferred, as [`Driver::expect_pulses`]).
     pub fn expect_intervals(&mut self, min: Duration, max: Duration) -> Outcome {
-        let now = self.now;
-        let s = self.capture()?.last_move_pulses();
-        let got = (s.min_interval, s.max_interval);
-        if got != (Some(min), Some(max)) {
-            return Err(fail(
-                "pulse intervals (min, max)",
-                format!("({min}, {max})"),
-                format!("({}, {})", opt(s.min_interval), opt(s.max_interval)),
-                s.first.unwrap_or(now),
-            ));
-        }
-        Ok(())
+        self.enqueue(Vec::new(), Some(Check::Intervals { min, max }))
     }
 
-    /// Expects no pulse of the most recent move after `t`.
+    /// Expects no pulse of the most recent move after `t` (deferred, as
+    /// [`Driver::expect_pulses`]).
     pub fn expect_no_pulses_after(&mut self, t: Instant) -> Outcome {
-        let late = self.pulses_after(t)?;
-        if let Some(first) = late.first() {
-            return Err(fail(format!("no pulse after {t}"), 0, late.len(), *first));
-        }
-        Ok(())
+        self.enqueue(Vec::new(), Some(Check::NoPulsesAfter(t)))
     }
 
     /// Times of the most recent move's pulses after `t`.
@@ -1324,9 +1383,7 @@ impl<'t> Driver<'t> {
     /// Expects no pulse of the most recent move later than `margin` after
     /// the last trigger (a stop write or an input edge).
     pub fn expect_no_pulses_after_trigger(&mut self, margin: Duration) -> Outcome {
-        self.flush()?;
-        let t = self.need("a stop or an input edge", self.trigger)?;
-        self.expect_no_pulses_after(t + margin)
+        self.enqueue(Vec::new(), Some(Check::NoPulsesAfterTrigger(margin)))
     }
 
     /// Expects the energized phases (S1 in bit 4).
@@ -1559,6 +1616,44 @@ impl<'t> Driver<'t> {
         // observable is how long after the trigger the first pulse of the
         // deceleration came.
         Ok(start_time.saturating_since(t))
+    }
+}
+
+impl Check {
+    /// Whether the check is judged on the capture rather than on replies.
+    fn on_capture(&self) -> bool {
+        matches!(
+            self,
+            Check::Pulses { .. }
+                | Check::Intervals { .. }
+                | Check::NoPulsesAfter(_)
+                | Check::NoPulsesAfterTrigger(_)
+        )
+    }
+}
+
+/// Fails if the most recent move of `rec` has a pulse after `t`.
+fn no_pulses_after(rec: &Record, t: Instant) -> Outcome {
+    let from = rec.moves.last().map_or(0, |m| m.first_run);
+    let (mut late, mut first) = (0u64, None);
+    for r in rec.runs.get(from..).unwrap_or_default() {
+        let count = u64::from(r.count);
+        // Pulses of the run at or before `t`.
+        let on_time = if r.start > t {
+            0
+        } else if r.interval == Duration::ZERO {
+            count
+        } else {
+            (t.saturating_since(r.start).as_nanos() / r.interval.as_nanos() + 1).min(count)
+        };
+        if on_time < count {
+            first.get_or_insert(r.start + r.interval.saturating_mul(on_time));
+            late += count - on_time;
+        }
+    }
+    match first {
+        Some(first) => Err(fail(format!("no pulse after {t}"), 0, late, first)),
+        None => Ok(()),
     }
 }
 
