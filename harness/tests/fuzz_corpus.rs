@@ -79,8 +79,16 @@ fn write_frame_decoder_seeds() {
         },
     ];
     let requests = [
-        Request::Hello { version: 1 },
+        Request::Hello {
+            version: ppmc::bridge::wire::PROTOCOL_VERSION,
+        },
         Request::Batch(ops.clone()),
+        // Pin samples: a SAMPLE op, answered with a SAMPLES entry.
+        Request::Batch(
+            (0..40)
+                .flat_map(|_| [Op::ReadPins, Op::Delay(Duration::from_micros(7))])
+                .collect(),
+        ),
         Request::Capture {
             runs: 0,
             pins: 0,
