@@ -134,8 +134,8 @@ impl BridgeServer {
                 .encode(seq, self.timer)],
             };
         }
-        let response = match decoded {
-            Ok((_, req)) => self.handle(req),
+        let mut reply = match decoded {
+            Ok((_, req)) => self.respond(seq, req),
             Err(e) => Response::Error {
                 code: match e {
                     WireError::UnknownKind(_) | WireError::UnknownCode { .. } => {
@@ -144,9 +144,9 @@ impl BridgeServer {
                     _ => BridgeErrorCode::Malformed,
                 },
                 detail: e.to_string(),
-            },
+            }
+            .encode(seq, self.timer),
         };
-        let mut reply = response.encode(seq, self.timer);
         if reply.len() > MAX_REPLY {
             // Never a truncated reply: the host asked for too much at once.
             reply = Response::Error {
@@ -161,6 +161,44 @@ impl BridgeServer {
         let frames = fragment(&reply);
         self.last = Some((payload.to_vec(), frames.clone()));
         frames
+    }
+
+    /// The encoded response to `req`.
+    fn respond(&mut self, seq: u8, req: Request) -> Vec<u8> {
+        match req {
+            Request::BatchCapture {
+                ops,
+                runs,
+                pins,
+                moves,
+                max,
+            } => match self.run_ops(&ops) {
+                Err(e) => e.encode(seq, self.timer),
+                // The ops ran, but what they left is not all there.
+                Ok(_) if let Some(held) = self.overrun() => {
+                    self.overrun_error(held).encode(seq, self.timer)
+                }
+                Ok(replies) => {
+                    // The capture takes what room the replies leave.
+                    let mut max = max;
+                    let mut r = Response::BatchCapture {
+                        replies,
+                        capture: self.chunk(runs, pins, moves, max),
+                    };
+                    loop {
+                        let bytes = r.encode(seq, self.timer);
+                        if max <= 1 || bytes.len() <= MAX_REPLY {
+                            break bytes;
+                        }
+                        max /= 2;
+                        if let Response::BatchCapture { capture, .. } = &mut r {
+                            *capture = self.chunk(runs, pins, moves, max);
+                        }
+                    }
+                }
+            },
+            req => self.handle(req).encode(seq, self.timer),
+        }
     }
 
     fn handle(&mut self, req: Request) -> Response {
@@ -208,30 +246,9 @@ impl BridgeServer {
                 Some(held) => self.overrun_error(held),
                 None => Response::Capture(self.chunk(runs, pins, moves, max)),
             },
-            Request::BatchCapture {
-                ops,
-                runs,
-                pins,
-                moves,
-                max,
-            } => match self.run_ops(&ops) {
-                Err(e) => e,
-                // The ops ran, but what they left is not all there.
-                Ok(_) if let Some(held) = self.overrun() => self.overrun_error(held),
-                Ok(replies) => {
-                    // The capture takes what room the replies leave.
-                    let mut max = max;
-                    loop {
-                        let r = Response::BatchCapture {
-                            replies: replies.clone(),
-                            capture: self.chunk(runs, pins, moves, max),
-                        };
-                        if max <= 1 || r.encode(0, self.timer).len() <= MAX_REPLY {
-                            break r;
-                        }
-                        max /= 2;
-                    }
-                }
+            Request::BatchCapture { .. } => Response::Error {
+                code: BridgeErrorCode::Malformed,
+                detail: "batch-capture handled before dispatch".into(),
             },
         }
     }
