@@ -1,8 +1,11 @@
 //! `ppmc bridge-sim` in one process, `ppmc run` / `console` against it in
 //! another, as a user runs them.
 
+mod common;
+
+use common::{ppmc, text};
 use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Stdio};
 
 const EXAMPLE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -53,17 +56,6 @@ impl Drop for BridgeSim {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
-}
-
-fn ppmc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ppmc"))
-        .args(args)
-        .output()
-        .expect("ppmc runs")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
 }
 
 fn tmp(name: &str) -> std::path::PathBuf {

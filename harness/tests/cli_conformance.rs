@@ -1,21 +1,13 @@
 //! `ppmc run`, `record`, `compare` and `export` as a user runs them.
 
+mod common;
+
+use common::{ppmc, text};
+
 use ppmc::compare::scale_times;
 use ppmc::trace::Trace;
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn ppmc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ppmc"))
-        .args(args)
-        .output()
-        .expect("ppmc runs")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
 
 fn golden_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../golden")

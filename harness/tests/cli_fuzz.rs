@@ -1,14 +1,9 @@
 //! `ppmc fuzz reproduce` from the command line.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn ppmc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ppmc"))
-        .args(args)
-        .output()
-        .expect("ppmc runs")
-}
+use common::ppmc;
+use std::path::Path;
 
 #[test]
 fn reproduce_prints_a_console_script_of_a_corpus_input() {

@@ -1,5 +1,8 @@
 //! The `ppmc console` binary as a user runs it.
 
+mod common;
+
+use common::text;
 use std::io::Write;
 use std::process::{Command, Output, Stdio};
 
@@ -23,10 +26,6 @@ fn ppmc(args: &[&str], stdin: &str) -> Output {
         .write_all(stdin.as_bytes())
         .expect("script written");
     child.wait_with_output().expect("ppmc finishes")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
 }
 
 /// Issue 2's acceptance script: 1,000 CW pulses, 42 us shortest interval,
