@@ -1367,19 +1367,6 @@ impl<'t> Driver<'t> {
         self.enqueue(Vec::new(), Some(Check::NoPulsesAfter(t)))
     }
 
-    /// Times of the most recent move's pulses after `t`.
-    pub fn pulses_after(&mut self, t: Instant) -> Outcome<Vec<Instant>> {
-        let rec = self.capture()?;
-        let from = rec.moves.last().map_or(0, |m| m.first_run);
-        Ok(rec.runs[from..]
-            .iter()
-            .flat_map(|r| {
-                (0..r.count).map(move |i| r.start + r.interval.saturating_mul(u64::from(i)))
-            })
-            .filter(|p| *p > t)
-            .collect())
-    }
-
     /// Expects no pulse of the most recent move later than `margin` after
     /// the last trigger (a stop write or an input edge).
     pub fn expect_no_pulses_after_trigger(&mut self, margin: Duration) -> Outcome {
