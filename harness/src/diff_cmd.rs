@@ -45,7 +45,7 @@ pub fn run(args: DiffArgs) -> ExitCode {
     };
     let mut target: Box<dyn Target> = if args.target.name() == "emu" {
         let mut model = args.target.model();
-        if let Err(e) = ppmc::emu::faults::apply_all(&args.chip_faults, &mut model) {
+        if let Err(e) = ppmc::faults::apply_all(&args.chip_faults, &mut model) {
             return crate::usage_error(format!("--chip-fault: {e}"));
         }
         match EmuTarget::new(straps, model) {

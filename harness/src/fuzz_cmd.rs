@@ -96,7 +96,7 @@ struct ModelArgs {
 impl ModelArgs {
     fn model(&self) -> Result<ModelConfig, ExitCode> {
         let mut cfg = ModelConfig::default();
-        ppmc::emu::faults::apply_all(&self.chip_faults, &mut cfg)
+        ppmc::faults::apply_all(&self.chip_faults, &mut cfg)
             .map_err(|e| crate::usage_error(format!("--chip-fault: {e}")))?;
         Ok(cfg)
     }

@@ -9,18 +9,18 @@
 pub mod bridge;
 pub mod compare;
 pub mod console;
-pub mod emu;
 pub mod fault_matrix;
+pub mod faults;
 pub mod fuzzing;
 pub mod golden;
-pub mod protocol;
 pub mod report;
 pub mod runner;
 pub mod scenario;
 pub mod target;
-pub mod time;
 pub mod trace;
 pub mod vcd_export;
+
+pub use ppmc_core::{bus, emu, protocol, time};
 
 /// The conformance suite: every scenario file in `scenarios/`.
 #[allow(missing_docs)]

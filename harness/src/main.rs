@@ -364,7 +364,7 @@ fn interactive(target: &mut dyn Target, opts: &ConsoleOptions) -> ExitCode {
 }
 
 fn bridge_sim(args: BridgeSimArgs) -> ExitCode {
-    use ppmc::bridge::server::BridgeServer;
+    use ppmc::bridge::sim::engine;
     use ppmc::bridge::sim::{serve, LinkFaults, ServeEnd};
     use serialport::SerialPort;
     use std::sync::atomic::{AtomicBool, Ordering};
@@ -386,7 +386,7 @@ fn bridge_sim(args: BridgeSimArgs) -> ExitCode {
         Err(e) => return usage_error(e),
     };
     let mut model = args.target.model();
-    if let Err(e) = ppmc::emu::faults::apply_all(&args.chip_faults, &mut model) {
+    if let Err(e) = ppmc::faults::apply_all(&args.chip_faults, &mut model) {
         return usage_error(format!("--chip-fault: {e}"));
     }
     let emu = match EmuTarget::new(straps, model) {
@@ -415,8 +415,8 @@ fn bridge_sim(args: BridgeSimArgs) -> ExitCode {
     let session = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(1, |d| d.subsec_nanos() ^ (d.as_secs() as u32));
-    let mut server = BridgeServer::new(emu, session, !args.realtime)
-        .with_capture_capacity(args.capture_capacity);
+    let mut server =
+        engine(emu, session, !args.realtime).with_capture_capacity(args.capture_capacity);
     // Nobody may be reading stdout (a closed pipe): never let that stop
     // the bridge.
     let mut out = io::stdout();

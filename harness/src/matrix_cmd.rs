@@ -3,9 +3,9 @@
 
 use clap::Args;
 use ppmc::bridge::sim::{LinkFaults, PtyBridge};
-use ppmc::emu::faults::{self, CATALOGUE};
 use ppmc::emu::ModelConfig;
 use ppmc::fault_matrix::{self, FuzzBudget, Row};
+use ppmc::faults::{self, CATALOGUE};
 use ppmc::protocol::Straps;
 use ppmc::target::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use std::path::PathBuf;

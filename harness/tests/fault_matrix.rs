@@ -2,9 +2,9 @@
 //! catalogue is caught by the conformance suite, the golden comparison or
 //! a bounded differential fuzz, and the clean board by none of them.
 
-use ppmc::emu::faults::CATALOGUE;
 use ppmc::emu::ModelConfig;
 use ppmc::fault_matrix::{all_as_expected, check_board, render, FuzzBudget};
+use ppmc::faults::CATALOGUE;
 use ppmc::protocol::Straps;
 use ppmc::target::EmuTarget;
 use std::path::Path;
@@ -80,7 +80,7 @@ fn the_committed_fuzz_regression_fails_only_with_its_bug() {
             .verdict
     };
     assert!(run(ModelConfig::default()).ok());
-    let bug = ppmc::emu::faults::find("remaining-off-by-one")
+    let bug = ppmc::faults::find("remaining-off-by-one")
         .expect("fault")
         .model();
     match run(bug) {

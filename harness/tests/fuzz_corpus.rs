@@ -38,7 +38,7 @@ fn frame_decoder_corpus_replays() {
 #[ignore]
 fn write_frame_decoder_seeds() {
     use ppmc::bridge::frame::encode;
-    use ppmc::bridge::server::BridgeServer;
+    use ppmc::bridge::sim::engine;
     use ppmc::bridge::wire::{fragment, Request, Timer};
     use ppmc::protocol::{Input, Straps};
     use ppmc::target::{EmuTarget, Op};
@@ -99,7 +99,7 @@ fn write_frame_decoder_seeds() {
             fragments: vec![0, 2],
         },
     ];
-    let mut server = BridgeServer::new(
+    let mut server = engine(
         EmuTarget::new(Straps::default(), Default::default()).expect("emu"),
         1,
         true,

@@ -1,9 +1,8 @@
-//! The serial bus bridge: the link protocol a bridge microcontroller speaks
-//! (specified in `docs/bridge-protocol.md`), implemented once and shared by
-//! the host driver ([`crate::target::SerialTarget`]) and the bridge
-//! simulator ([`server`]).
+//! The serial bus bridge. The link protocol (framing, messages) and the
+//! bridge engine live in `ppmc-core` and are re-exported here; this module
+//! adds what needs an operating system: the bridge simulator's I/O loop on
+//! a pseudo-terminal ([`sim`]).
 
-pub mod frame;
-pub mod server;
+pub use ppmc_core::bridge::{engine, frame, wire};
+
 pub mod sim;
-pub mod wire;

@@ -1,8 +1,10 @@
-//! The bridge simulator's I/O loop: a [`BridgeServer`] on a byte port (the
-//! master side of a pseudo-terminal), with optional line faults and pacing
-//! to the wall clock.
+//! The bridge simulator's I/O loop: the bridge engine over the reference
+//! model ([`SimEngine`]) on a byte port (the master side of a
+//! pseudo-terminal), with optional line faults and pacing to the wall clock.
 
-use super::server::BridgeServer;
+use super::engine::BridgeEngine;
+use crate::bus::EmuBus;
+use crate::target::EmuTarget;
 use crate::time::{Duration, Instant};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -10,6 +12,20 @@ use std::io::{self, Read, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration as WallDuration, Instant as WallInstant};
+
+/// What `ppmc bridge-sim` runs: the bridge engine over the reference model.
+pub type SimEngine = BridgeEngine<EmuBus>;
+
+/// The simulator's engine in front of `emu`; `session` should differ
+/// between runs.
+pub fn engine(emu: EmuTarget, session: u32, virtual_time: bool) -> SimEngine {
+    BridgeEngine::new(
+        emu.into_bus(),
+        session,
+        virtual_time,
+        format!("ppmc-bridge-sim {}", crate::VERSION),
+    )
+}
 
 /// How the simulated link or board misbehaves.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,7 +61,7 @@ pub struct BridgeOptions {
     /// emulator's virtual time, and announce real time in HELLO_REPLY.
     pub realtime: bool,
     /// Pulse runs plus pin changes the capture buffer holds (see
-    /// [`BridgeServer::with_capture_capacity`]).
+    /// [`BridgeEngine::with_capture_capacity`]).
     pub capture_capacity: u32,
 }
 
@@ -102,7 +118,7 @@ impl Faulty {
 /// are then no longer repeatable, exactly as on a board.
 pub fn serve<P: Read + Write>(
     port: &mut P,
-    server: &mut BridgeServer,
+    server: &mut SimEngine,
     faults: LinkFaults,
     realtime: bool,
     stop: &Arc<AtomicBool>,
@@ -185,14 +201,14 @@ pub struct PtyBridge {
 
 impl PtyBridge {
     /// Serves `emu` (in virtual time) with `faults` on the link.
-    pub fn start(emu: crate::target::EmuTarget, faults: LinkFaults) -> io::Result<PtyBridge> {
+    pub fn start(emu: EmuTarget, faults: LinkFaults) -> io::Result<PtyBridge> {
         Self::start_with(emu, faults, BridgeOptions::default())
     }
 
     /// Serves `emu` as a bridge set up by `bridge`, with `faults` on the
     /// link.
     pub fn start_with(
-        emu: crate::target::EmuTarget,
+        emu: EmuTarget,
         faults: LinkFaults,
         bridge: BridgeOptions,
     ) -> io::Result<PtyBridge> {
@@ -208,7 +224,7 @@ impl PtyBridge {
         let flag = Arc::clone(&stop);
         let handle = std::thread::spawn(move || {
             let _keep_open = slave;
-            let mut server = BridgeServer::new(emu, 0x5EED, !bridge.realtime)
+            let mut server = engine(emu, 0x5EED, !bridge.realtime)
                 .with_capture_capacity(bridge.capture_capacity);
             serve(&mut master, &mut server, faults, bridge.realtime, &flag).ok()
         });

@@ -258,7 +258,7 @@ fn list(v: &[String]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emu::faults;
+    use crate::faults;
     use crate::fuzzing::bus;
 
     fn seeds() -> Vec<(String, Vec<BusOp>)> {

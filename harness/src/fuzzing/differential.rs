@@ -250,7 +250,7 @@ pub fn script(acts: &[Action], d: &Departure, seed: u64, target: &str) -> String
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emu::faults;
+    use crate::faults;
 
     fn emu(cfg: ModelConfig) -> EmuTarget {
         EmuTarget::new(Straps::default(), cfg).expect("emulator")

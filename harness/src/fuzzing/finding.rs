@@ -218,7 +218,7 @@ pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emu::faults;
+    use crate::faults;
 
     fn noisy_remaining_finding() -> Vec<BusOp> {
         // A seed of the suite whose traffic reads the remaining pulses after

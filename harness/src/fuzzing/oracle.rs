@@ -516,9 +516,7 @@ mod tests {
     }
 
     fn faulty(name: &str) -> ModelConfig {
-        crate::emu::faults::find(name)
-            .expect("in the catalogue")
-            .model()
+        crate::faults::find(name).expect("in the catalogue").model()
     }
 
     /// Section 3-4-4: a constant-speed move of 101 steps (count 100)

@@ -10,7 +10,7 @@
 
 use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
 use crate::bridge::frame::{self, FrameDecoder};
-use crate::bridge::server::MAX_BATCH_OPS;
+use crate::bridge::wire::MAX_BATCH_OPS;
 use crate::bridge::wire::{
     self, parse_fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer,
     PROTOCOL_VERSION,
@@ -855,7 +855,7 @@ pub fn parse_spec(spec: &str) -> Option<(String, u32)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bridge::server::BridgeServer;
+    use crate::bridge::sim::{engine, SimEngine};
     use crate::emu::ModelConfig;
     use crate::protocol::Straps;
     use crate::target::EmuTarget;
@@ -864,7 +864,7 @@ mod tests {
     /// A link straight into a bridge server, which fails on demand.
     #[derive(Debug)]
     struct MemLink {
-        server: BridgeServer,
+        server: SimEngine,
         pending: Vec<u8>,
         fail_sends: u32,
         fail_reopens: u32,
@@ -882,9 +882,9 @@ mod tests {
             }
         }
 
-        fn bridge(session: u32) -> BridgeServer {
+        fn bridge(session: u32) -> SimEngine {
             let emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emu");
-            BridgeServer::new(emu, session, true)
+            engine(emu, session, true)
         }
     }
 

@@ -6,7 +6,7 @@
 //! it gives a range; `docs/datasheet-notes.md` says where each default comes
 //! from.
 
-use super::faults::Faults;
+use super::hooks::Faults;
 use crate::time::Duration;
 
 /// Shape of the acceleration ramp from the start-up rate RL to the high
@@ -214,6 +214,7 @@ impl ModelConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use alloc::string::ToString;
 
     #[test]
     fn default_config_is_valid() {

@@ -21,7 +21,8 @@
 use super::config::AccelCurve;
 use crate::protocol::{Direction, MoveKind, StopCause, Straps};
 use crate::time::{Duration, Instant};
-use std::sync::Arc;
+use alloc::sync::Arc;
+use alloc::vec::Vec;
 
 /// The periods a move is built from.
 #[derive(Debug, Clone)]
@@ -58,11 +59,11 @@ pub(crate) fn accel_table(
                     let speed = sl + (sh - sl) * f64::from(v) / pa_f;
                     let target_ns = 1e9 / speed;
                     let off = straps.vsel_offset(tclock).as_nanos() as f64;
-                    let r = ((target_ns - off) / tclock.as_nanos() as f64).round() - 1.0;
+                    let r = libm::round((target_ns - off) / tclock.as_nanos() as f64) - 1.0;
                     r.clamp(f64::from(rh), f64::from(rl)) as u8
                 }
                 AccelCurve::LinearRate => {
-                    let drop = (f64::from(rl - rh) * f64::from(v) / pa_f).round() as u8;
+                    let drop = libm::round(f64::from(rl - rh) * f64::from(v) / pa_f) as u8;
                     rl - drop
                 }
             };

@@ -6,6 +6,7 @@
 
 use super::command::ClockSource;
 use crate::time::Duration;
+use alloc::string::String;
 
 /// The system clock the datasheet's timing figures were taken at (Diagram
 /// 3-5 "16MHz default"); firmware times scale with `16 MHz / SysClk`.

@@ -11,6 +11,7 @@
 //! decoder has already dropped it and goes on with the next. Both the host
 //! driver and the bridge simulator use this one implementation.
 
+use alloc::vec::Vec;
 use crc::{Crc, Table, CRC_16_IBM_3740};
 
 /// CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF), called IBM-3740 in the
@@ -88,7 +89,7 @@ impl FrameDecoder {
                 return Ok(None);
             };
             let frame: Vec<u8> = self.buf.drain(..=end).take(end).collect();
-            if std::mem::take(&mut self.skipping) {
+            if core::mem::take(&mut self.skipping) {
                 // The tail of an over-long frame, already reported.
                 continue;
             }
@@ -216,7 +217,7 @@ mod cross_check {
     /// Frames computed by an independent implementation (Python, from the
     /// CRC catalogue and the COBS paper) for `docs/bridge-protocol.md`.
     use crate::bridge::wire::{Request, Timer, PROTOCOL_VERSION};
-    use crate::target::Op;
+    use crate::bus::Op;
     use crate::time::Duration;
 
     #[test]

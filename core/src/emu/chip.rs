@@ -23,8 +23,10 @@ use crate::protocol::{
     PulseCount, Register, Status, StatusField, StopCause, Straps, StrapsError, Winding,
 };
 use crate::time::{Duration, Instant};
-use std::collections::VecDeque;
-use std::sync::Arc;
+use alloc::collections::VecDeque;
+use alloc::sync::Arc;
+use alloc::vec;
+use alloc::vec::Vec;
 
 /// Highest accepted number of acceleration pulses (Table 3-2 error 4, notes N5).
 pub const PA_MAX: u16 = 11_220;

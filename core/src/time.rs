@@ -5,9 +5,11 @@
 //! the host's wall clock. Both types are plain `u64` nanosecond counts wrapped
 //! so that a time and a length of time cannot be mixed up.
 
-use std::fmt;
-use std::ops::{Add, AddAssign, Sub};
-use std::str::FromStr;
+use alloc::string::String;
+use alloc::string::ToString;
+use core::fmt;
+use core::ops::{Add, AddAssign, Sub};
+use core::str::FromStr;
 
 /// A point in virtual time, in nanoseconds since the target was reset.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]

@@ -3,9 +3,9 @@
 
 mod chip;
 pub mod config;
-pub mod faults;
+pub mod hooks;
 mod motion;
 
 pub use chip::{Chip, ChipError, PA_MAX, PA_MIN};
 pub use config::{AccelCurve, ConfigError, ModelConfig};
-pub use faults::{BoardFault, Faults};
+pub use hooks::Faults;

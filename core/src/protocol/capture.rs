@@ -10,6 +10,7 @@
 use super::command::{Direction, MoveKind};
 use super::phase::Winding;
 use crate::time::{Duration, Instant};
+use alloc::vec::Vec;
 
 /// `count` pulses in `dir`, the first at `start`, each `interval` after the
 /// previous one (`interval` is zero when `count` is 1).

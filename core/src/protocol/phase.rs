@@ -114,6 +114,7 @@ impl Winding {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use alloc::vec::Vec;
     use rstest::rstest;
 
     fn seq(motor: MotorType, excitation: Excitation) -> Vec<u8> {

@@ -8,7 +8,7 @@
 //! Bit positions are interpreted from the flattened diagrams; see
 //! `docs/datasheet-notes.md` (N1 to N4) for the reasoning.
 
-use std::fmt;
+use core::fmt;
 
 /// Direction of motor rotation: operation command bit 3 (Diagram 3-6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

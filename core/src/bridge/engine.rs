@@ -1,8 +1,9 @@
-//! The bridge side of the protocol, over the emulator: what `ppmc
-//! bridge-sim` serves, and the reference a firmware author can diff a real
-//! bridge against.
+//! The bridge side of the protocol: the request executor a bridge runs,
+//! over any [`Bus`]. `ppmc bridge-sim` runs it over the reference model
+//! ([`crate::bus::EmuBus`]); a bridge firmware runs the same code over the
+//! real chip.
 //!
-//! [`BridgeServer::on_bytes`] takes bytes from the link and returns the
+//! [`BridgeEngine::on_bytes`] takes bytes from the link and returns the
 //! bytes to send back. It keeps the last request and its response, so a
 //! request retransmitted with the same sequence number (because its
 //! response was lost or corrupted) is answered again without running twice:
@@ -11,23 +12,26 @@
 use super::frame::{self, FrameDecoder, FrameError};
 use super::wire::{
     self, fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer, WireError,
-    MAX_REPLY, PROTOCOL_VERSION,
+    MAX_BATCH_OPS, MAX_REPLY, PROTOCOL_VERSION,
 };
-use crate::target::{EmuTarget, Op, Reply, Target};
-
-/// Most ops in one batch: keeps the largest reply (128 x 69 bytes) within
-/// 255 fragments.
-pub const MAX_BATCH_OPS: u16 = 128;
+use crate::bus::{Bus, Op, Reply};
+use crate::time::{Duration, Instant};
+use alloc::format;
+use alloc::string::{String, ToString};
+use alloc::vec;
+use alloc::vec::Vec;
 
 /// Records per capture chunk, sized so that a reply fits in 255 fragments.
 const CHUNK_RUNS: usize = 300;
 const CHUNK_PINS: usize = 300;
 const CHUNK_MOVES: usize = 60;
 
-/// A bridge in front of an emulated chip.
+/// A bridge in front of a chip.
 #[derive(Debug)]
-pub struct BridgeServer {
-    target: EmuTarget,
+pub struct BridgeEngine<B> {
+    bus: B,
+    /// What HELLO_REPLY says the bridge runs.
+    firmware: String,
     decoder: FrameDecoder,
     session: u32,
     timer: Timer,
@@ -42,11 +46,14 @@ pub struct BridgeServer {
     pub frames: u64,
 }
 
-impl BridgeServer {
-    /// `session` should differ between runs of the simulator.
-    pub fn new(target: EmuTarget, session: u32, virtual_time: bool) -> Self {
-        BridgeServer {
-            target,
+impl<B: Bus> BridgeEngine<B> {
+    /// `session` should differ between runs of the bridge (a bridge that
+    /// restarts must not reuse it); `firmware` names the bridge in
+    /// HELLO_REPLY.
+    pub fn new(bus: B, session: u32, virtual_time: bool, firmware: impl Into<String>) -> Self {
+        BridgeEngine {
+            bus,
+            firmware: firmware.into(),
             decoder: FrameDecoder::new(),
             session,
             timer: Timer::NANOS,
@@ -65,8 +72,8 @@ impl BridgeServer {
         self
     }
 
-    pub fn target(&self) -> &EmuTarget {
-        &self.target
+    pub fn bus(&self) -> &B {
+        &self.bus
     }
 
     /// Handles received bytes; returns the bytes to send back (whole
@@ -100,15 +107,14 @@ impl BridgeServer {
     }
 
     /// The virtual time the emulator has reached (to pace `--realtime`).
-    pub fn now(&self) -> crate::time::Instant {
-        self.target.chip().now()
+    pub fn now(&self) -> Instant {
+        self.bus.now()
     }
 
     /// Lets `d` pass on the chip between requests, as it does on a board
     /// while the host is busy elsewhere (`--realtime`).
-    pub fn pass_time(&mut self, d: crate::time::Duration) {
-        // A delay cannot fail on the emulator; nothing to report if it did.
-        let _ = self.target.execute(&[Op::Delay(d)]);
+    pub fn pass_time(&mut self, d: Duration) {
+        self.bus.run(Op::Delay(d));
     }
 
     /// The frames answering one request payload.
@@ -208,14 +214,15 @@ impl BridgeServer {
                 detail: format!("bridge speaks protocol {PROTOCOL_VERSION}, host {version}"),
             },
             Request::Hello { .. } => {
-                let straps = self
-                    .target
-                    .info()
-                    .details
-                    .iter()
-                    .map(|(k, v)| format!("{k}={v}"))
-                    .collect::<Vec<_>>()
-                    .join(" ");
+                let s = self.bus.straps();
+                let level = |high: bool| if high { "high" } else { "low" };
+                let straps = format!(
+                    "sysclk_hz={} csel={} vsel={} ext_clock_hz={}",
+                    s.sysclk_hz,
+                    level(s.csel_high),
+                    level(s.vsel_high),
+                    s.ext_clock_hz.map_or("none".to_string(), |h| h.to_string()),
+                );
                 Response::Hello(Hello {
                     version: PROTOCOL_VERSION,
                     session: self.session,
@@ -225,7 +232,7 @@ impl BridgeServer {
                     capture_capacity: self.capture_capacity,
                     inputs_wired: 0x3FF,
                     virtual_time: self.virtual_time,
-                    firmware: format!("ppmc-bridge-sim {}", crate::VERSION),
+                    firmware: self.firmware.clone(),
                     straps,
                 })
             }
@@ -263,16 +270,13 @@ impl BridgeServer {
                 detail: format!("{wire_ops} ops in one batch, at most {MAX_BATCH_OPS}"),
             });
         }
-        self.target.execute(ops).map_err(|e| Response::Error {
-            code: BridgeErrorCode::Malformed,
-            detail: e.to_string(),
-        })
+        Ok(ops.iter().map(|op| self.bus.run(*op)).collect())
     }
 
     /// The records captured since the last reset, if more than the
     /// capture buffer holds.
     fn overrun(&self) -> Option<usize> {
-        let rec = self.target.chip().record();
+        let rec = self.bus.record();
         let held = rec.runs.len() + rec.pins.len();
         (held > self.capture_capacity as usize).then_some(held)
     }
@@ -289,7 +293,7 @@ impl BridgeServer {
 
     /// Up to `max` capture records of each kind from these positions on.
     fn chunk(&self, runs: u32, pins: u32, moves: u32, max: u16) -> CaptureChunk {
-        let rec = self.target.chip().record();
+        let rec = self.bus.record();
         let max = usize::from(max.max(1));
         let take = |from: u32, len: usize, max: usize| {
             let from = (from as usize).min(len);
@@ -311,14 +315,14 @@ impl BridgeServer {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bus::EmuBus;
     use crate::emu::ModelConfig;
     use crate::protocol::Straps;
-    use crate::target::{Op, Reply};
-    use crate::time::Duration;
+    use alloc::vec;
 
-    fn server() -> BridgeServer {
-        let t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emu");
-        BridgeServer::new(t, 42, true)
+    fn server() -> BridgeEngine<EmuBus> {
+        let bus = EmuBus::new(Straps::default(), ModelConfig::default()).expect("emu");
+        BridgeEngine::new(bus, 42, true, "test-bridge")
     }
 
     /// The response in `out`, reassembled from its fragments.
@@ -335,7 +339,7 @@ mod tests {
         Response::decode(&payload, Timer::NANOS).expect("decodes")
     }
 
-    fn ask(s: &mut BridgeServer, seq: u8, req: &Request) -> Response {
+    fn ask(s: &mut BridgeEngine<EmuBus>, seq: u8, req: &Request) -> Response {
         let out = s.on_bytes(&frame::encode(&req.encode(seq, Timer::NANOS)));
         let mut d = FrameDecoder::new();
         d.extend(&out);
@@ -478,7 +482,7 @@ mod tests {
                 break;
             }
         }
-        let rec = s.target().chip().record();
+        let rec = s.bus().record();
         assert_eq!(
             (runs as usize, pins as usize, moves as usize),
             (rec.runs.len(), rec.pins.len(), rec.moves.len())
@@ -513,7 +517,7 @@ mod tests {
             panic!("batch-capture reply");
         };
         assert_eq!(replies.len(), ops.len());
-        let rec = s.target().chip().record();
+        let rec = s.bus().record();
         assert_eq!(capture.moves.len(), rec.moves.len());
         assert_eq!(capture.runs, rec.runs);
         assert!(!capture.moves.is_empty(), "the step's move is in the chunk");
@@ -570,8 +574,10 @@ mod tests {
         let (init, period) = moving_ops(100_000);
         let ops = samples(20 * wire::MAX_SAMPLES, period.scale(13, 10));
         let mut reference = server();
-        reference.target.execute(&init).expect("runs");
-        let replies = reference.target.execute(&ops).expect("runs");
+        init.iter().for_each(|op| {
+            reference.bus.run(*op);
+        });
+        let replies: Vec<Reply> = ops.iter().map(|op| reference.bus.run(*op)).collect();
         let len = Response::Batch(replies).encode(1, Timer::NANOS).len();
         assert!(len > MAX_REPLY, "precondition: the reply is {len} bytes");
         let mut s = server();
@@ -604,7 +610,7 @@ mod tests {
             ];
             ask(&mut s, k.wrapping_add(2), &Request::Batch(step));
         }
-        let rec = s.target().chip().record();
+        let rec = s.bus().record();
         assert!(
             rec.pins.len() >= 300,
             "precondition: {} pin changes",

@@ -6,7 +6,7 @@
 //! recovered from the flattened diagrams.
 
 use super::command::{Direction, MoveKind};
-use std::fmt;
+use core::fmt;
 
 /// Error numbers of Table 3-2, reported in status bits 6-4 with bit 7 set.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

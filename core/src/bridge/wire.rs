@@ -6,12 +6,15 @@
 //! [`Request::decode`] and [`Response::decode`] check every length and
 //! value and never panic; `docs/bridge-protocol.md` is the specification.
 
+use crate::bus::{Op, Reply};
 use crate::protocol::capture::MoveStart;
 use crate::protocol::{
     Direction, Input, MoveKind, Pin, PinEvent, Pins, PulseRun, PulseSummary, Status, Winding,
 };
-use crate::target::{Op, Reply};
 use crate::time::{Duration, Instant};
+use alloc::string::String;
+use alloc::vec;
+use alloc::vec::Vec;
 
 /// The protocol version this build speaks.
 pub const PROTOCOL_VERSION: u16 = 2;
@@ -485,6 +488,11 @@ pub const MAX_SAMPLES: usize = 512;
 
 /// The largest reply entry of a plain op on the wire (PULSES).
 pub const MAX_REPLY_ENTRY: usize = 69;
+
+/// Most ops one batch may carry: the largest reply (128 x
+/// [`MAX_REPLY_ENTRY`] bytes) then stays within 255 fragments. A bridge
+/// may announce fewer in HELLO_REPLY, never more.
+pub const MAX_BATCH_OPS: u16 = 128;
 
 /// A SAMPLES entry without its runs: code, time, step, samples, runs.
 const SAMPLES_HEAD: usize = 1 + 8 + 8 + 2 + 2;
@@ -1446,7 +1454,7 @@ mod tests {
             assert!(!ops.is_empty(), "{r:?}");
             for o in ops {
                 assert!(
-                    w.0.len() <= worst_reply_len(std::slice::from_ref(o)),
+                    w.0.len() <= worst_reply_len(core::slice::from_ref(o)),
                     "{r:?}"
                 );
             }

@@ -1,0 +1,12 @@
+//! The serial bus bridge: the link protocol a bridge microcontroller speaks
+//! (specified in `docs/bridge-protocol.md`), implemented once and shared by
+//! the host driver (`ppmc`'s serial backend), the bridge simulator and the
+//! bridge firmware.
+//!
+//! [`frame`] turns payloads into self-delimiting frames and back, [`wire`]
+//! turns requests and responses into payloads and back, and [`engine`] is
+//! the bridge's request executor over any [`crate::bus::Bus`].
+
+pub mod engine;
+pub mod frame;
+pub mod wire;

@@ -1,0 +1,384 @@
+//! The bus vocabulary every driver of the chip speaks: an [`Op`] is one
+//! bus-level operation (a register access, a wait, an input change, a look
+//! at the pins or the pulse capture), a [`Reply`] its outcome stamped with
+//! the time it ended on the clock of whoever ran it.
+//!
+//! A batch of ops runs back to back on the chip's side, which is why
+//! waiting (for IBF, OBF, BUSY) is an op, never a host-side polling loop:
+//! on a board behind the bus bridge a batch costs one round trip.
+//!
+//! [`Bus`] is what the bridge engine ([`crate::bridge::engine`]) drives: a
+//! chip bus plus its pins and a pulse capture. [`EmuBus`] is the reference
+//! model behind it; a bridge firmware implements it over the real chip.
+
+use crate::emu::{Chip, ChipError, ModelConfig};
+use crate::protocol::{Flag, Input, Pins, PulseSummary, Record, Status, Straps};
+use crate::time::{Duration, Instant};
+
+/// One bus-level operation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Op {
+    /// Write the command register. With `wait_ibf`, first wait up to that
+    /// long for IBF = 0 as the datasheet flowcharts do, and skip the write
+    /// if IBF stays 1; without, write at once.
+    WriteCommand {
+        byte: u8,
+        wait_ibf: Option<Duration>,
+    },
+    /// Write the data register; `wait_ibf` as for [`Op::WriteCommand`].
+    WriteData {
+        byte: u8,
+        wait_ibf: Option<Duration>,
+    },
+    /// Read the status register.
+    ReadStatus,
+    /// Read the data register. With `wait_obf`, first wait up to that long
+    /// for OBF = 1 and skip the read if it stays 0.
+    ReadData { wait_obf: Option<Duration> },
+    /// Let time pass.
+    Delay(Duration),
+    /// Wait until `status & mask == value`, at most `timeout`.
+    AwaitStatus {
+        mask: u8,
+        value: u8,
+        timeout: Duration,
+    },
+    /// Drive an input: `asserted` = the active-low pin pulled low.
+    SetInput { input: Input, asserted: bool },
+    /// Sample the output pins.
+    ReadPins,
+    /// Summarize the pulses of the most recent move.
+    ReadPulses,
+    /// Wait until the most recent move has output `count` pulses (at most
+    /// `timeout`), so that the next op acts right after that pulse: how a
+    /// scenario drives a limit switch "after N pulses" on the target's own
+    /// clock.
+    AwaitPulses { count: u64, timeout: Duration },
+    /// Hardware reset of the chip (the RESET pin): registers, inputs and the
+    /// capture start over, and the target's clock restarts at zero.
+    Reset,
+}
+
+impl Op {
+    /// Wait until a status flag has `value`, at most `timeout`.
+    pub fn await_flag(flag: Flag, value: bool, timeout: Duration) -> Op {
+        Op::AwaitStatus {
+            mask: flag.mask(),
+            value: if value { flag.mask() } else { 0 },
+            timeout,
+        }
+    }
+}
+
+/// The outcome of one [`Op`], stamped with the target's time when it ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reply {
+    /// A write happened at `at`, after waiting `waited` for IBF = 0 (zero
+    /// for a write without a wait).
+    Written {
+        at: Instant,
+        waited: Duration,
+    },
+    /// IBF stayed 1 for the whole wait; nothing was written.
+    WriteTimedOut {
+        at: Instant,
+        status: Status,
+    },
+    Status {
+        at: Instant,
+        status: Status,
+    },
+    /// A data register read at `at`, after waiting `waited` for OBF = 1.
+    Data {
+        at: Instant,
+        byte: u8,
+        waited: Duration,
+    },
+    /// OBF stayed 0 for the whole wait; nothing was read.
+    ReadTimedOut {
+        at: Instant,
+        status: Status,
+    },
+    Delayed {
+        at: Instant,
+    },
+    /// The condition held after `waited`.
+    Awaited {
+        at: Instant,
+        waited: Duration,
+        status: Status,
+    },
+    AwaitTimedOut {
+        at: Instant,
+        status: Status,
+    },
+    InputSet {
+        at: Instant,
+    },
+    Pins {
+        at: Instant,
+        pins: Pins,
+    },
+    Pulses {
+        at: Instant,
+        summary: PulseSummary,
+    },
+    /// The pulse count was reached; `at` is the time of that pulse.
+    PulsesReached {
+        at: Instant,
+    },
+    /// The move ended or the timeout passed first; `count` pulses were seen.
+    PulsesTimedOut {
+        at: Instant,
+        count: u64,
+    },
+    ResetDone {
+        at: Instant,
+    },
+}
+
+impl Reply {
+    /// The target time at which the op completed.
+    pub fn at(&self) -> Instant {
+        match *self {
+            Reply::Written { at, .. }
+            | Reply::WriteTimedOut { at, .. }
+            | Reply::Status { at, .. }
+            | Reply::Data { at, .. }
+            | Reply::ReadTimedOut { at, .. }
+            | Reply::Delayed { at }
+            | Reply::Awaited { at, .. }
+            | Reply::AwaitTimedOut { at, .. }
+            | Reply::InputSet { at }
+            | Reply::Pins { at, .. }
+            | Reply::Pulses { at, .. }
+            | Reply::PulsesReached { at }
+            | Reply::PulsesTimedOut { at, .. }
+            | Reply::ResetDone { at } => at,
+        }
+    }
+}
+
+/// A chip bus plus its pins and a pulse capture: what the bridge engine
+/// drives. The reference model implements it ([`EmuBus`]); a bridge
+/// firmware implements it over the real chip's bus, pins and edge capture.
+pub trait Bus {
+    /// Runs one op on the bus's own clock and says how it ended.
+    fn run(&mut self, op: Op) -> Reply;
+
+    /// Everything captured on the output side since the last reset.
+    fn record(&self) -> &Record;
+
+    /// The chip's straps (system clock, CSEL, VSEL, external clock).
+    fn straps(&self) -> Straps;
+
+    /// The bus's clock: time since the last reset.
+    fn now(&self) -> Instant;
+}
+
+/// The reference model as a [`Bus`]: ops run in virtual time, and waits
+/// are resolved exactly by jumping from one model event to the next.
+#[derive(Debug, Clone)]
+pub struct EmuBus {
+    chip: Chip,
+    cfg: ModelConfig,
+}
+
+impl EmuBus {
+    pub fn new(straps: Straps, cfg: ModelConfig) -> Result<Self, ChipError> {
+        Ok(EmuBus {
+            chip: Chip::new(straps, cfg.clone())?,
+            cfg,
+        })
+    }
+
+    pub fn chip(&self) -> &Chip {
+        &self.chip
+    }
+
+    pub fn chip_mut(&mut self) -> &mut Chip {
+        &mut self.chip
+    }
+
+    /// The model configuration the chip was built with (and is rebuilt
+    /// with on [`Op::Reset`]).
+    pub fn config(&self) -> &ModelConfig {
+        &self.cfg
+    }
+
+    /// Waits until `status & mask == value` or `timeout` has passed.
+    /// `Ok(waited)` or `Err(())` on timeout; the chip's clock stands at the
+    /// moment the condition first held, or at the deadline.
+    fn wait_for(&mut self, mask: u8, value: u8, timeout: Duration) -> Result<Duration, ()> {
+        let start = self.chip.now();
+        let deadline = start + timeout;
+        loop {
+            let now = self.chip.now();
+            if self.chip.read_status().0 & mask == value {
+                return Ok(now.saturating_since(start));
+            }
+            match self.chip.poll_at() {
+                Some(t) if t > now && t <= deadline => self.chip.advance_to(t),
+                // Due now: advancing to `now` has processed it already, so a
+                // second look cannot change anything before the next event.
+                Some(t) if t <= now => {
+                    self.chip.advance_to(now + Duration::from_nanos(1));
+                }
+                _ => {
+                    self.chip.advance_to(deadline);
+                    let status = self.chip.read_status();
+                    return if status.0 & mask == value {
+                        Ok(timeout)
+                    } else {
+                        Err(())
+                    };
+                }
+            }
+        }
+    }
+
+    /// Waits until the move has output `count` pulses. Stops exactly at
+    /// that pulse, even inside a constant-rate stretch.
+    fn wait_pulses(&mut self, count: u64, timeout: Duration) -> Result<Instant, u64> {
+        let deadline = self.chip.now() + timeout;
+        loop {
+            if self.chip.move_pulses() >= count {
+                return Ok(self.chip.now());
+            }
+            let next = match (self.chip.predict_pulse(count), self.chip.poll_at()) {
+                (Some(a), Some(b)) => a.min(b),
+                (a, b) => match a.or(b) {
+                    Some(t) => t,
+                    None => break,
+                },
+            };
+            if next > deadline {
+                break;
+            }
+            let now = self.chip.now();
+            self.chip
+                .advance_to(next.max(now + Duration::from_nanos(1)).min(deadline));
+        }
+        self.chip.advance_to(deadline.max(self.chip.now()));
+        Err(self.chip.move_pulses())
+    }
+
+    fn status_at(&self) -> (Instant, Status) {
+        (self.chip.now(), self.chip.read_status())
+    }
+
+    fn run_op(&mut self, op: Op) -> Reply {
+        match op {
+            Op::WriteCommand { byte, wait_ibf } | Op::WriteData { byte, wait_ibf } => {
+                let mut waited = Duration::ZERO;
+                if let Some(timeout) = wait_ibf {
+                    match self.wait_for(Status::IBF, 0, timeout) {
+                        Ok(w) => waited = w,
+                        Err(()) => {
+                            let (at, status) = self.status_at();
+                            return Reply::WriteTimedOut { at, status };
+                        }
+                    }
+                }
+                if matches!(op, Op::WriteCommand { .. }) {
+                    self.chip.write_command(byte);
+                } else {
+                    self.chip.write_data(byte);
+                }
+                Reply::Written {
+                    at: self.chip.now(),
+                    waited,
+                }
+            }
+            Op::ReadStatus => {
+                let (at, status) = self.status_at();
+                Reply::Status { at, status }
+            }
+            Op::ReadData { wait_obf } => {
+                let mut waited = Duration::ZERO;
+                if let Some(timeout) = wait_obf {
+                    match self.wait_for(Status::OBF, Status::OBF, timeout) {
+                        Ok(w) => waited = w,
+                        Err(()) => {
+                            let (at, status) = self.status_at();
+                            return Reply::ReadTimedOut { at, status };
+                        }
+                    }
+                }
+                let byte = self.chip.read_data();
+                Reply::Data {
+                    at: self.chip.now(),
+                    byte,
+                    waited,
+                }
+            }
+            Op::Delay(d) => {
+                let to = self.chip.now() + d;
+                self.chip.advance_to(to);
+                Reply::Delayed { at: to }
+            }
+            Op::AwaitStatus {
+                mask,
+                value,
+                timeout,
+            } => match self.wait_for(mask, value & mask, timeout) {
+                Ok(waited) => {
+                    let (at, status) = self.status_at();
+                    Reply::Awaited { at, waited, status }
+                }
+                Err(()) => {
+                    let (at, status) = self.status_at();
+                    Reply::AwaitTimedOut { at, status }
+                }
+            },
+            Op::SetInput { input, asserted } => {
+                self.chip.set_input(input, asserted);
+                Reply::InputSet {
+                    at: self.chip.now(),
+                }
+            }
+            Op::ReadPins => Reply::Pins {
+                at: self.chip.now(),
+                pins: self.chip.pins(),
+            },
+            Op::ReadPulses => Reply::Pulses {
+                at: self.chip.now(),
+                summary: self.chip.record().last_move_pulses(),
+            },
+            Op::AwaitPulses { count, timeout } => match self.wait_pulses(count, timeout) {
+                Ok(at) => Reply::PulsesReached { at },
+                Err(count) => Reply::PulsesTimedOut {
+                    at: self.chip.now(),
+                    count,
+                },
+            },
+            Op::Reset => {
+                // Straps and config were validated when the target was built.
+                if let Ok(chip) = Chip::new(*self.chip.straps(), self.cfg.clone()) {
+                    self.chip = chip;
+                }
+                Reply::ResetDone {
+                    at: self.chip.now(),
+                }
+            }
+        }
+    }
+}
+
+impl Bus for EmuBus {
+    fn run(&mut self, op: Op) -> Reply {
+        self.run_op(op)
+    }
+
+    fn record(&self) -> &Record {
+        self.chip.record()
+    }
+
+    fn straps(&self) -> Straps {
+        *self.chip.straps()
+    }
+
+    fn now(&self) -> Instant {
+        self.chip.now()
+    }
+}
