@@ -7,6 +7,7 @@
 //! `ppmc` binary.
 
 pub mod bridge;
+pub mod cli;
 pub mod compare;
 pub mod console;
 pub mod fault_matrix;
@@ -21,12 +22,6 @@ pub mod trace;
 pub mod vcd_export;
 
 pub use ppmc_core::{bus, emu, protocol, time};
-
-/// The conformance suite: every scenario file in `scenarios/`.
-#[allow(missing_docs)]
-pub mod suite {
-    include!(concat!(env!("OUT_DIR"), "/suite.rs"));
-}
 
 /// The harness's version and git revision, for run records.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

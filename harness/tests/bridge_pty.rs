@@ -51,7 +51,7 @@ fn the_whole_suite_over_the_pty_equals_the_in_process_run() {
         .expect("bridge answers");
     let over_pty = run_suite(
         &mut t,
-        &ppmc::suite::all(),
+        &ppmc_scenarios::all(),
         1,
         DriverOptions::default(),
         |_| {},
@@ -84,7 +84,7 @@ fn corrupted_bytes_never_turn_into_wrong_values() {
         .expect("bridge answers through the noise");
     let noisy = run_suite(
         &mut t,
-        &ppmc::suite::all(),
+        &ppmc_scenarios::all(),
         1,
         DriverOptions::default(),
         |_| {},
@@ -203,7 +203,7 @@ fn a_disconnect_mid_run_ends_with_the_rest_not_run() {
     let mut t = sim.target(fast()).expect("bridge answers");
     let results = run_suite(
         &mut t,
-        &ppmc::suite::all(),
+        &ppmc_scenarios::all(),
         1,
         DriverOptions::default(),
         |_| {},
@@ -272,7 +272,7 @@ fn a_capture_overrun_is_an_error_of_that_scenario_and_the_run_goes_on() {
     let mut t = sim.target(fast()).expect("bridge answers");
     assert_eq!(t.hello().capture_capacity, 40);
     let pick = |name: &str| {
-        ppmc::suite::all()
+        ppmc_scenarios::all()
             .into_iter()
             .find(|s| s.name == name)
             .expect("in the suite")

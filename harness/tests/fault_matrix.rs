@@ -8,12 +8,11 @@ use ppmc::faults::CATALOGUE;
 use ppmc::protocol::Straps;
 use ppmc::target::EmuTarget;
 use std::path::Path;
-use std::process::Command;
 
 #[test]
 fn every_fault_is_caught_and_the_clean_board_is_not() {
     let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("../golden");
-    let suite = ppmc::suite::all();
+    let suite = ppmc_scenarios::all();
     let mut rows = Vec::new();
     let boards = std::iter::once(("clean", ModelConfig::default()))
         .chain(CATALOGUE.iter().map(|f| (f.name, f.model())));
@@ -27,40 +26,6 @@ fn every_fault_is_caught_and_the_clean_board_is_not() {
     assert!(!rows[0].caught(), "{table}");
 }
 
-/// The command over the pty, as a user runs it, on two faults.
-#[test]
-fn the_command_runs_over_the_pty() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let out = Command::new(env!("CARGO_BIN_EXE_ppmc"))
-        .current_dir(&root)
-        .args([
-            "fault-matrix",
-            "--fault",
-            "dir-inverted",
-            "--fault",
-            "status-bit3-stuck",
-        ])
-        .output()
-        .expect("ppmc runs");
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(out.status.code(), Some(0), "{text}");
-    assert!(
-        text.contains("| clean | - | - | - | no false alarm |"),
-        "{text}"
-    );
-    assert!(text.contains("| dir-inverted |"), "{text}");
-    assert!(text.contains("every fault caught"), "{text}");
-    let listed = Command::new(env!("CARGO_BIN_EXE_ppmc"))
-        .args(["fault-matrix", "--list"])
-        .output()
-        .expect("ppmc runs");
-    let list = String::from_utf8_lossy(&listed.stdout);
-    assert_eq!(
-        list.lines().filter(|l| l.starts_with("| `")).count(),
-        CATALOGUE.len()
-    );
-}
-
 /// The regression scenario `to-scenario` made from the minimized finding
 /// of the injected remaining-pulses bug (Section 3-4-4) fails on a chip
 /// with that bug, naming the invariant, and passes on the clean one.
@@ -68,7 +33,7 @@ fn the_command_runs_over_the_pty() {
 fn the_committed_fuzz_regression_fails_only_with_its_bug() {
     use ppmc::runner::run_suite;
     use ppmc::scenario::{DriverOptions, Verdict};
-    let suite: Vec<_> = ppmc::suite::all()
+    let suite: Vec<_> = ppmc_scenarios::all()
         .into_iter()
         .filter(|s| s.name == "fuzz_remaining_pulses_1")
         .collect();

@@ -129,7 +129,7 @@ fn mutants() -> Vec<(String, ModelConfig)> {
 fn run_mutant(cfg: ModelConfig) -> Vec<ScenarioResult> {
     let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("../golden");
     let mut t = EmuTarget::new(Straps::default(), cfg).expect("valid mutant");
-    let all = ppmc::suite::all();
+    let all = ppmc_scenarios::all();
     run_suite(&mut t, &all, 1, DriverOptions::default(), |r| {
         if !r.verdict.ok() {
             return;
@@ -157,7 +157,7 @@ fn failures(results: &[ScenarioResult]) -> BTreeMap<&'static str, String> {
 
 #[test]
 fn every_mutant_is_caught_and_every_scenario_catches_one() {
-    let all: Vec<&str> = ppmc::suite::all().iter().map(|s| s.name).collect();
+    let all: Vec<&str> = ppmc_scenarios::all().iter().map(|s| s.name).collect();
     let mut killed_by: BTreeMap<&str, Vec<String>> = BTreeMap::new();
     let mut survivors = Vec::new();
     for (name, cfg) in mutants() {

@@ -8,7 +8,7 @@ use ppmc::target::EmuTarget;
 
 #[test]
 fn every_scenario_passes_on_the_emulator() {
-    let all = ppmc::suite::all();
+    let all = ppmc_scenarios::all();
     validate_suite(&all).expect("valid suite");
     let mut t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
     let results = run_suite(&mut t, &all, 1, DriverOptions::default(), |_| {});
@@ -35,7 +35,7 @@ fn every_scenario_passes_on_the_emulator() {
 
 #[test]
 fn suite_has_the_scenario_files() {
-    let all = ppmc::suite::all();
+    let all = ppmc_scenarios::all();
     let sections: std::collections::BTreeSet<&str> = all.iter().map(|s| s.section).collect();
     eprintln!("{} scenarios over {} sections", all.len(), sections.len());
     assert!(all.iter().any(|s| s.name == "e0_undefined_command_code"));
@@ -53,7 +53,7 @@ fn suite_has_the_scenario_files() {
 #[case::sysclk_12_288mhz_csel_low_vsel_low(Straps { sysclk_hz: 12_288_000, csel_high: false, vsel_high: false, ext_clock_hz: None })]
 #[case::external_clock_fitted(Straps { ext_clock_hz: Some(500_000), ..Straps::default() })]
 fn every_scenario_passes_with_other_straps(#[case] straps: Straps) {
-    let all = ppmc::suite::all();
+    let all = ppmc_scenarios::all();
     let mut t = EmuTarget::new(straps, ModelConfig::default()).expect("emulator");
     let results = run_suite(&mut t, &all, 1, DriverOptions::default(), |_| {});
     let bad: Vec<String> = results

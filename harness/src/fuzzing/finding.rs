@@ -183,17 +183,22 @@ pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> 
         v.op,
         v.detail.replace('\n', " "),
     );
-    s.push_str("use crate::fuzzing::bus::BusOp::{self, *};\n");
-    s.push_str("use crate::scenario::prelude::*;\n\n");
-    s.push_str("pub fn scenarios() -> Vec<Scenario> {\n    vec![Scenario::new(\n");
-    let _ = writeln!(s, "        {stem:?},");
-    let _ = writeln!(s, "        {section:?},");
+    s.push_str("use ppmc::fuzzing::bus::BusOp::{self, *};\n");
+    s.push_str("use ppmc::fuzzing::replay::regression;\n");
+    s.push_str("use ppmc::scenario::prelude::*;\n\n");
     let _ = writeln!(
         s,
-        "        {:?},",
-        format!("fuzz finding: {} must hold", v.invariant)
+        "pub fn scenarios() -> Vec<Scenario> {{\n    vec![{stem}()]\n}}\n"
     );
-    s.push_str("        &[\"fuzz\", \"regression\"],\n        replay,\n    )]\n}\n\n");
+    let _ = writeln!(s, "/// fuzz finding: {} must hold", v.invariant);
+    let _ = writeln!(
+        s,
+        "#[scenario(section = {section:?}, tags(\"fuzz\", \"regression\"))]"
+    );
+    let _ = writeln!(
+        s,
+        "fn {stem}(d: &mut Driver) -> Outcome {{\n    regression(d, OPS)\n}}\n"
+    );
     s.push_str("/// The minimized bus script, one op per line (console form in comments).\n");
     s.push_str("const OPS: &[BusOp] = &[\n");
     for op in &merge_waits(ops) {
@@ -205,13 +210,13 @@ pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> 
             // Qualified: the prelude's `Input` (the pin) and the op's
             // variant share a name.
             BusOp::Input { input, asserted } => format!(
-                "BusOp::Input {{ input: crate::protocol::Input::{input:?}, asserted: {asserted} }}"
+                "BusOp::Input {{ input: ppmc::protocol::Input::{input:?}, asserted: {asserted} }}"
             ),
             BusOp::Advance(d) => format!("Advance(Duration::from_nanos({}))", d.as_nanos()),
         };
         let _ = writeln!(s, "    {code}, // {op}");
     }
-    s.push_str("];\n\nfn replay(d: &mut Driver) -> Outcome {\n    d.replay_bus(OPS)\n}\n");
+    s.push_str("];\n");
     s
 }
 
@@ -281,12 +286,13 @@ mod tests {
         let stem = scenario_stem(v.invariant, 2);
         assert_eq!(stem, "fuzz_remaining_pulses_2");
         let text = scenario_file(&stem, &ops, &v, "crash-1");
-        assert!(text.contains("\"3-4-4\""), "{text}");
+        assert!(text.contains("section = \"3-4-4\""), "{text}");
         assert!(text.contains("Command(0x83), // wc! 0x83"), "{text}");
         assert!(text.contains("Advance(Duration::from_nanos(3000)), // wait 3us"));
         assert!(text.contains(
-            "BusOp::Input { input: crate::protocol::Input::L2, asserted: true }, // set l2 on"
+            "BusOp::Input { input: ppmc::protocol::Input::L2, asserted: true }, // set l2 on"
         ));
-        assert!(text.contains("d.replay_bus(OPS)"));
+        assert!(text.contains("regression(d, OPS)"));
+        assert!(text.contains("fn fuzz_remaining_pulses_2(d: &mut Driver)"));
     }
 }

@@ -5,9 +5,55 @@
 //! a board, and how a regression scenario made from a finding checks it.
 
 use super::bus::BusOp;
-use super::oracle::{Judge, Seen, Violation};
+use super::oracle::{self, Judge, Seen, Violation};
 use crate::protocol::Record;
+use crate::scenario::{Driver, Failure, Outcome, Stop};
 use crate::target::{Op, Reply, Target, TargetError};
+use crate::trace::BusEvent;
+
+/// The body of a regression scenario written by `ppmc fuzz to-scenario`:
+/// replays `ops` (the scenario starts from a chip reset) and judges them by
+/// the fuzz oracle's invariants (`docs/invariants.md`). The trace shows the
+/// ops' bus transactions, not the status probes around them.
+pub fn regression(d: &mut Driver, ops: &[BusOp]) -> Outcome {
+    let replies = d.exec(&probed_ops(ops))?;
+    for (op, r) in ops.iter().zip(replies.chunks(OPS_PER_BUS_OP)) {
+        let e = match (*op, r.get(1)) {
+            (BusOp::Command(byte), _) => BusEvent::WriteCommand { byte, waited: None },
+            (BusOp::Data(byte), _) => BusEvent::WriteData { byte, waited: None },
+            (BusOp::ReadStatus, Some(Reply::Status { status, .. })) => {
+                BusEvent::ReadStatus(status.0)
+            }
+            (BusOp::ReadData, Some(Reply::Data { byte, .. })) => BusEvent::ReadData {
+                byte: *byte,
+                waited: None,
+            },
+            (BusOp::Input { input, asserted }, _) => BusEvent::SetInput { input, asserted },
+            _ => continue,
+        };
+        if let Some(r) = r.get(1) {
+            d.log_bus(r.at(), e);
+        }
+    }
+    let capture = d.capture()?.clone();
+    match judge(ops, &replies, &capture) {
+        Err(e) => Err(Stop::Error(e)),
+        Ok(None) => Ok(()),
+        Ok(Some(f)) => {
+            let v = f.violation;
+            Err(Stop::Failed(Failure {
+                expectation: format!(
+                    "invariant {} (Section {})",
+                    v.invariant,
+                    oracle::section(v.invariant)
+                ),
+                expected: "holds".into(),
+                got: format!("broken after op {}: {}", v.op, v.detail),
+                at: f.at,
+            }))
+        }
+    }
+}
 
 /// Target ops per bus op: status, the op, status.
 pub const OPS_PER_BUS_OP: usize = 3;

@@ -328,53 +328,6 @@ impl<'t> Driver<'t> {
 
     // ----- raw layer -------------------------------------------------------
 
-    /// Replays fuzz bus ops and judges them by the fuzz oracle's invariants
-    /// (`docs/invariants.md`): the body of a regression scenario written by
-    /// `ppmc fuzz to-scenario` (the scenario starts from a chip reset). The
-    /// trace shows the ops' bus transactions, not the status probes around
-    /// them.
-    pub fn replay_bus(&mut self, ops: &[crate::fuzzing::bus::BusOp]) -> Outcome {
-        use crate::fuzzing::bus::BusOp;
-        use crate::fuzzing::{oracle, replay};
-        let replies = self.exec(&replay::probed_ops(ops))?;
-        for (op, r) in ops.iter().zip(replies.chunks(replay::OPS_PER_BUS_OP)) {
-            let e = match (*op, r.get(1)) {
-                (BusOp::Command(byte), _) => BusEvent::WriteCommand { byte, waited: None },
-                (BusOp::Data(byte), _) => BusEvent::WriteData { byte, waited: None },
-                (BusOp::ReadStatus, Some(Reply::Status { status, .. })) => {
-                    BusEvent::ReadStatus(status.0)
-                }
-                (BusOp::ReadData, Some(Reply::Data { byte, .. })) => BusEvent::ReadData {
-                    byte: *byte,
-                    waited: None,
-                },
-                (BusOp::Input { input, asserted }, _) => BusEvent::SetInput { input, asserted },
-                _ => continue,
-            };
-            if let Some(r) = r.get(1) {
-                self.log(r.at(), e);
-            }
-        }
-        let capture = self.capture()?.clone();
-        match replay::judge(ops, &replies, &capture) {
-            Err(e) => Err(Stop::Error(e)),
-            Ok(None) => Ok(()),
-            Ok(Some(f)) => {
-                let v = f.violation;
-                Err(fail(
-                    format!(
-                        "invariant {} (Section {})",
-                        v.invariant,
-                        oracle::section(v.invariant)
-                    ),
-                    "holds",
-                    format!("broken after op {}: {}", v.op, v.detail),
-                    f.at,
-                ))
-            }
-        }
-    }
-
     /// Runs ops on the target (after everything queued); a target failure
     /// stops the scenario as an error (not the device's fault).
     pub fn exec(&mut self, ops: &[Op]) -> Outcome<Vec<Reply>> {
@@ -417,7 +370,9 @@ impl<'t> Driver<'t> {
         Ok(replies)
     }
 
-    fn log(&mut self, at: Instant, e: BusEvent) {
+    /// Puts a bus transaction into the scenario's trace: for code that
+    /// runs raw ops with [`Driver::exec`] and wants them shown.
+    pub fn log_bus(&mut self, at: Instant, e: BusEvent) {
         self.bus.push(Event {
             at,
             kind: EventKind::Bus(e),
@@ -595,11 +550,11 @@ impl<'t> Driver<'t> {
                 } else {
                     BusEvent::WriteData { byte, waited }
                 };
-                self.log(at, e);
+                self.log_bus(at, e);
                 Ok(Done::At)
             }
             (Step::Write { byte, command, .. }, Reply::WriteTimedOut { at, status }) => {
-                self.log(at, BusEvent::WriteTimedOut { command, byte });
+                self.log_bus(at, BusEvent::WriteTimedOut { command, byte });
                 Err(fail(
                     format!("IBF = 0 before writing 0x{byte:02X} (flowchart)"),
                     format!("IBF = 0 within {}", self.opts.ibf_timeout),
@@ -608,11 +563,11 @@ impl<'t> Driver<'t> {
                 ))
             }
             (Step::Status, Reply::Status { at, status }) => {
-                self.log(at, BusEvent::ReadStatus(status.0));
+                self.log_bus(at, BusEvent::ReadStatus(status.0));
                 Ok(Done::Status(status))
             }
             (Step::ReadData, Reply::Data { at, byte, waited }) => {
-                self.log(
+                self.log_bus(
                     at,
                     BusEvent::ReadData {
                         byte,
@@ -622,7 +577,7 @@ impl<'t> Driver<'t> {
                 Ok(Done::Byte(byte))
             }
             (Step::ReadData, Reply::ReadTimedOut { at, status }) => {
-                self.log(at, BusEvent::ReadTimedOut);
+                self.log_bus(at, BusEvent::ReadTimedOut);
                 Err(fail(
                     "OBF = 1 before reading (flowchart)",
                     format!("OBF = 1 within {}", self.opts.obf_timeout),
@@ -631,7 +586,7 @@ impl<'t> Driver<'t> {
                 ))
             }
             (Step::Await { flag, value, .. }, Reply::Awaited { at, waited, status }) => {
-                self.log(
+                self.log_bus(
                     at,
                     BusEvent::Await {
                         flag,
@@ -651,7 +606,7 @@ impl<'t> Driver<'t> {
                 },
                 Reply::AwaitTimedOut { at, status },
             ) => {
-                self.log(
+                self.log_bus(
                     at,
                     BusEvent::Await {
                         flag,
@@ -672,7 +627,7 @@ impl<'t> Driver<'t> {
             }
             (Step::Delay(_), Reply::Delayed { .. }) => Ok(Done::At),
             (Step::Set { input, on }, Reply::InputSet { at }) => {
-                self.log(
+                self.log_bus(
                     at,
                     BusEvent::SetInput {
                         input,
@@ -682,7 +637,7 @@ impl<'t> Driver<'t> {
                 Ok(Done::At)
             }
             (Step::AwaitPulses { count, .. }, Reply::PulsesReached { at }) => {
-                self.log(
+                self.log_bus(
                     at,
                     BusEvent::AwaitPulses {
                         count,
@@ -692,7 +647,7 @@ impl<'t> Driver<'t> {
                 Ok(Done::At)
             }
             (Step::AwaitPulses { count: n, .. }, Reply::PulsesTimedOut { at, count }) => {
-                self.log(
+                self.log_bus(
                     at,
                     BusEvent::AwaitPulses {
                         count: n,
@@ -707,7 +662,7 @@ impl<'t> Driver<'t> {
                 ))
             }
             (Step::Reset, Reply::ResetDone { at }) => {
-                self.log(at, BusEvent::Reset);
+                self.log_bus(at, BusEvent::Reset);
                 Ok(Done::At)
             }
             (Step::Pins, Reply::Pins { pins, .. }) => Ok(Done::Pins(pins)),

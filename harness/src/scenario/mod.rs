@@ -11,6 +11,8 @@ pub mod grade;
 
 pub use driver::{Driver, DriverOptions, Init};
 pub use grade::{Grade, Grading, Measurement};
+/// Declares a scenario where it is written; see the `ppmc-macros` crate.
+pub use ppmc_macros::scenario;
 
 use crate::protocol::{Command, Direction, MoveCommand, MoveKind, PulseCount};
 use crate::target::Target;
@@ -313,7 +315,7 @@ pub fn run_scenario(
 
 /// What scenario files import.
 pub mod prelude {
-    pub use super::{Driver, Init, Move, Outcome, Scenario};
+    pub use super::{scenario, Driver, Init, Move, Outcome, Scenario};
     pub use crate::protocol::Direction::{Ccw, Cw};
     pub use crate::protocol::{Direction, ErrorCode, Flag, Input, MotorType, Register, TimingId};
     pub use crate::time::Duration;

@@ -285,22 +285,9 @@ pub fn suite_in_process() -> Vec<ppmc::scenario::ScenarioResult> {
     let mut t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
     ppmc::runner::run_suite(
         &mut t,
-        &ppmc::suite::all(),
+        &ppmc_scenarios::all(),
         1,
         ppmc::scenario::DriverOptions::default(),
         |_| {},
     )
-}
-
-/// Runs the `ppmc` binary with `args`, as a user would from a shell.
-pub fn ppmc(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_ppmc"))
-        .args(args)
-        .output()
-        .expect("ppmc runs")
-}
-
-/// Output bytes as text.
-pub fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
 }

@@ -6,17 +6,18 @@
 //! It fails while the bug is there; once fixed, record its golden trace
 //! (`ppmc record --filter fuzz_remaining_pulses_1`).
 
-use crate::fuzzing::bus::BusOp::{self, *};
-use crate::scenario::prelude::*;
+use ppmc::fuzzing::bus::BusOp::{self, *};
+use ppmc::fuzzing::replay::regression;
+use ppmc::scenario::prelude::*;
 
 pub fn scenarios() -> Vec<Scenario> {
-    vec![Scenario::new(
-        "fuzz_remaining_pulses_1",
-        "3-4-4",
-        "fuzz finding: remaining-pulses must hold",
-        &["fuzz", "regression"],
-        replay,
-    )]
+    vec![fuzz_remaining_pulses_1()]
+}
+
+/// fuzz finding: remaining-pulses must hold
+#[scenario(section = "3-4-4", tags("fuzz", "regression"))]
+fn fuzz_remaining_pulses_1(d: &mut Driver) -> Outcome {
+    regression(d, OPS)
 }
 
 /// The minimized bus script, one op per line (console form in comments).
@@ -51,7 +52,3 @@ const OPS: &[BusOp] = &[
     Advance(Duration::from_nanos(10000)), // wait 10us
     ReadData, // rd!
 ];
-
-fn replay(d: &mut Driver) -> Outcome {
-    d.replay_bus(OPS)
-}

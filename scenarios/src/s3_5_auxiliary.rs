@@ -1,44 +1,26 @@
 //! Section 3-5: switching parameters, AUX* ON/OFF, auxiliary outputs,
 //! software reset and recovery from it.
 
-use crate::scenario::prelude::*;
+use ppmc::scenario::prelude::*;
 
 pub fn scenarios() -> Vec<Scenario> {
     vec![
-        Scenario::new("s3_5_1_default_switching_chops_the_phases", "3-5-1",
-            "with stop switching on, the phases chop at about 5.8 kHz once HOLD is on",
-            &["auxiliary", "switching", "phases"], default_switching),
-        Scenario::new("s3_5_1_switching_parameters", "3-5-1",
-            "Pon = 10, Poff = 20 give 57 us on, 93 us off (Equations 3-5, 3-6)",
-            &["auxiliary", "switching", "phases"], switching_params),
-        Scenario::new("s3_5_1_switching_parameters_while_busy", "3-5-1",
-            "the switching parameter command is refused during BUSY (error 1)",
-            &["auxiliary", "switching", "error", "busy"], switching_busy),
-        Scenario::new("s3_5_2_aux_on_off_before_initialization", "3-5-2",
-            "AUX ON / OFF work before initialization, 14 us each (Table 3-3)",
-            &["auxiliary", "aux", "timing"], aux_before_init),
-        Scenario::new("s3_5_2_aux_on_while_busy", "3-5-2",
-            "AUX ON is taken during a move without disturbing it",
-            &["auxiliary", "aux", "busy"], aux_while_busy),
-        Scenario::new("s3_5_3_aux_output_drives_auxo", "3-5-3",
-            "a 1 bit drives AUXO low; the upper nibble is ignored; works while BUSY",
-            &["auxiliary", "auxo", "busy"], aux_output),
-        Scenario::new("s3_5_4_software_reset_frees_the_motor", "3-5-4",
-            "software reset turns the phases off in 18 us (Table 3-3) and cancels initialization",
-            &["auxiliary", "reset", "timing", "phases"], software_reset),
-        Scenario::new("s3_5_4_software_reset_while_busy_is_aux_on", "3-5-4",
-            "software reset during a move is taken as AUX ON",
-            &["auxiliary", "reset", "aux", "busy"], reset_while_busy),
-        Scenario::new("s3_5_4_recovery_after_software_reset", "3-5-4",
-            "after a reset the chip takes a new initialization with another excitation and moves",
-            &["auxiliary", "reset", "recovery", "phases"], recovery),
+        s3_5_1_default_switching_chops_the_phases(),
+        s3_5_1_switching_parameters(),
+        s3_5_1_switching_parameters_while_busy(),
+        s3_5_2_aux_on_off_before_initialization(),
+        s3_5_2_aux_on_while_busy(),
+        s3_5_3_aux_output_drives_auxo(),
+        s3_5_4_software_reset_frees_the_motor(),
+        s3_5_4_software_reset_while_busy_is_aux_on(),
+        s3_5_4_recovery_after_software_reset(),
     ]
 }
 
 /// Samples the energized phases every `step` over `span` (one batch);
 /// returns the number of on-to-off and off-to-on changes seen. (Used where
 /// nothing should chop; [`Driver::expect_chopping`] measures real chopping.)
-fn count_chops(d: &mut Driver, step: Duration, span: Duration) -> Result<(u32, u32), crate::scenario::Stop> {
+fn count_chops(d: &mut Driver, step: Duration, span: Duration) -> Result<(u32, u32), ppmc::scenario::Stop> {
     let n = (span.as_nanos() / step.as_nanos().max(1)) as usize + 1;
     let samples = d.sample_pins(step, n)?;
     let (mut offs, mut ons) = (0, 0);
@@ -54,7 +36,9 @@ fn count_chops(d: &mut Driver, step: Duration, span: Duration) -> Result<(u32, u
     Ok((offs, ons))
 }
 
-fn default_switching(d: &mut Driver) -> Outcome {
+/// with stop switching on, the phases chop at about 5.8 kHz once HOLD is on
+#[scenario(tags("auxiliary", "switching", "phases"))]
+fn s3_5_1_default_switching_chops_the_phases(d: &mut Driver) -> Outcome {
     d.init_and_wait(Init::four_phase().stop_switching())?;
     // Diagram 3-5: 65 us ON, 108.75 us OFF at 16 MHz.
     let (on, off) = (d.fw(us(65)), d.fw(Duration::from_nanos(108_750)));
@@ -64,7 +48,9 @@ fn default_switching(d: &mut Driver) -> Outcome {
     d.check("no chopping until HOLD", 0, offs)
 }
 
-fn switching_params(d: &mut Driver) -> Outcome {
+/// Pon = 10, Poff = 20 give 57 us on, 93 us off (Equations 3-5, 3-6)
+#[scenario(tags("auxiliary", "switching", "phases"))]
+fn s3_5_1_switching_parameters(d: &mut Driver) -> Outcome {
     d.command(0x84)?;
     d.data(10)?;
     d.data(20)?;
@@ -74,14 +60,18 @@ fn switching_params(d: &mut Driver) -> Outcome {
     d.expect_chopping(on, off, Duration::from_nanos(250))
 }
 
-fn switching_busy(d: &mut Driver) -> Outcome {
+/// the switching parameter command is refused during BUSY (error 1)
+#[scenario(tags("auxiliary", "switching", "error", "busy"))]
+fn s3_5_1_switching_parameters_while_busy(d: &mut Driver) -> Outcome {
     d.init_and_wait(Init::four_phase())?;
     d.start(Move::accel(Cw, 500))?;
     d.command(0x84)?;
     d.expect_error(ErrorCode::NotAllowedWhileBusy)
 }
 
-fn aux_before_init(d: &mut Driver) -> Outcome {
+/// AUX ON / OFF work before initialization, 14 us each (Table 3-3)
+#[scenario(tags("auxiliary", "aux", "timing"))]
+fn s3_5_2_aux_on_off_before_initialization(d: &mut Driver) -> Outcome {
     d.expect_pins(None, None, Some(false), Some(0))?;
     d.trigger_command(0xC1)?;
     d.wait(us(50))?;
@@ -94,7 +84,9 @@ fn aux_before_init(d: &mut Driver) -> Outcome {
     d.expect_pins(None, None, Some(false), None)
 }
 
-fn aux_while_busy(d: &mut Driver) -> Outcome {
+/// AUX ON is taken during a move without disturbing it
+#[scenario(tags("auxiliary", "aux", "busy"))]
+fn s3_5_2_aux_on_while_busy(d: &mut Driver) -> Outcome {
     d.init_and_wait(Init::four_phase())?;
     d.start(Move::accel(Cw, 500))?;
     d.trigger_command(0xC1)?;
@@ -106,7 +98,9 @@ fn aux_while_busy(d: &mut Driver) -> Outcome {
     d.expect_pins(None, None, Some(true), None)
 }
 
-fn aux_output(d: &mut Driver) -> Outcome {
+/// a 1 bit drives AUXO low; the upper nibble is ignored; works while BUSY
+#[scenario(tags("auxiliary", "auxo", "busy"))]
+fn s3_5_3_aux_output_drives_auxo(d: &mut Driver) -> Outcome {
     d.command(0x86)?;
     d.data(0b0101)?;
     d.wait(us(50))?;
@@ -122,7 +116,9 @@ fn aux_output(d: &mut Driver) -> Outcome {
     d.expect_pulses(500, Cw)
 }
 
-fn software_reset(d: &mut Driver) -> Outcome {
+/// software reset turns the phases off in 18 us (Table 3-3) and cancels initialization
+#[scenario(tags("auxiliary", "reset", "timing", "phases"))]
+fn s3_5_4_software_reset_frees_the_motor(d: &mut Driver) -> Outcome {
     d.init_and_wait(Init::four_phase())?;
     d.expect_phases(0b11000)?;
     d.trigger_command(0xC0)?;
@@ -133,7 +129,9 @@ fn software_reset(d: &mut Driver) -> Outcome {
     d.expect_error(ErrorCode::NotInitialized)
 }
 
-fn reset_while_busy(d: &mut Driver) -> Outcome {
+/// software reset during a move is taken as AUX ON
+#[scenario(tags("auxiliary", "reset", "aux", "busy"))]
+fn s3_5_4_software_reset_while_busy_is_aux_on(d: &mut Driver) -> Outcome {
     d.init_and_wait(Init::four_phase())?;
     d.start(Move::accel(Cw, 500))?;
     d.command(0xC0)?;
@@ -144,7 +142,9 @@ fn reset_while_busy(d: &mut Driver) -> Outcome {
     d.expect_pulses(1, Cw)
 }
 
-fn recovery(d: &mut Driver) -> Outcome {
+/// after a reset the chip takes a new initialization with another excitation and moves
+#[scenario(tags("auxiliary", "reset", "recovery", "phases"))]
+fn s3_5_4_recovery_after_software_reset(d: &mut Driver) -> Outcome {
     d.init_and_wait(Init::four_phase())?;
     d.run(Move::accel(Cw, 101))?;
     d.command(0xC0)?;

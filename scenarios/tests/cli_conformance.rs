@@ -39,7 +39,7 @@ fn run_passes_on_the_emulator_and_writes_valid_junit_and_json() {
     ]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
     let stdout = text(&out.stdout);
-    let n = ppmc::suite::all().len();
+    let n = ppmc_scenarios::all().len();
     assert!(
         stdout.contains(&format!("suite: {n} passed, 0 failed")),
         "{stdout}"
@@ -254,7 +254,7 @@ fn bad_usage_exits_2() {
 
 #[test]
 fn list_and_shards_cover_the_suite() {
-    let n = ppmc::suite::all().len();
+    let n = ppmc_scenarios::all().len();
     let out = ppmc(&["list"]);
     assert!(text(&out.stdout).contains(&format!("{n} scenarios")));
     let count = |shard: &str| {

@@ -1,36 +1,18 @@
 //! Section 3-4: the internal register read commands.
 
-use crate::scenario::prelude::*;
+use ppmc::scenario::prelude::*;
 
 pub fn scenarios() -> Vec<Scenario> {
     vec![
-        Scenario::new("s3_4_1_polling_flag_set_at_stop_cleared_by_read", "3-4-1",
-            "finish status bit 7 is set when a move stops and cleared by reading it",
-            &["read", "finish-status"], polling_flag),
-        Scenario::new("s3_4_1_finish_read_releases_int", "3-4-1",
-            "INT* stays asserted until the finish status is read",
-            &["read", "finish-status", "interrupt"], int_release),
-        Scenario::new("s3_4_2_input_status_l1_l2", "3-4-2",
-            "input status reads L1 and L2 as pin levels (asserted = 0)",
-            &["read", "input", "limit"], input_limits),
-        Scenario::new("s3_4_2_input_status_l3_l4", "3-4-2",
-            "input status bits 0 and 1 are the high-speed limits L4 and L3",
-            &["read", "input", "hs-limit"], input_hs_limits),
-        Scenario::new("s3_4_2_input_status_alm_cnp", "3-4-2",
-            "input status bits 4 and 5 are ALM and CNP",
-            &["read", "input", "alarm"], input_alm_cnp),
-        Scenario::new("s3_4_5_aux_input_status", "3-4-5",
-            "AUXI0..3 read in bits 0..3 as pin levels; bits 7-4 read 0",
-            &["read", "input", "aux"], aux_inputs),
-        Scenario::new("s3_4_3_output_status_dir_hold_phases", "3-4-3",
-            "output status: direction of the last move, HOLD 3.4 ms after it, phase levels",
-            &["read", "output", "hold", "phases", "timing"], output_status),
-        Scenario::new("s3_4_4_remaining_reads_one_less", "3-4-4",
-            "after a limit stop the remaining pulses read one less than the remainder",
-            &["read", "remaining", "limit"], remaining_one_less),
-        Scenario::new("s3_4_4_remainder_of_one_reads_zero", "3-4-4",
-            "a true remainder of 1 reads 0; finish status bits 3-6 tell it from a complete move",
-            &["read", "remaining", "boundary"], remainder_one),
+        s3_4_1_polling_flag_set_at_stop_cleared_by_read(),
+        s3_4_1_finish_read_releases_int(),
+        s3_4_2_input_status_l1_l2(),
+        s3_4_2_input_status_l3_l4(),
+        s3_4_2_input_status_alm_cnp(),
+        s3_4_5_aux_input_status(),
+        s3_4_3_output_status_dir_hold_phases(),
+        s3_4_4_remaining_reads_one_less(),
+        s3_4_4_remainder_of_one_reads_zero(),
     ]
 }
 
@@ -39,7 +21,9 @@ fn ready(d: &mut Driver) -> Outcome {
     Ok(())
 }
 
-fn polling_flag(d: &mut Driver) -> Outcome {
+/// finish status bit 7 is set when a move stops and cleared by reading it
+#[scenario(tags("read", "finish-status"))]
+fn s3_4_1_polling_flag_set_at_stop_cleared_by_read(d: &mut Driver) -> Outcome {
     ready(d)?;
     d.expect_finish(0x00)?;
     d.run(Move::accel(Cw, 10))?;
@@ -49,7 +33,9 @@ fn polling_flag(d: &mut Driver) -> Outcome {
     d.expect_finish(0x84)
 }
 
-fn int_release(d: &mut Driver) -> Outcome {
+/// INT* stays asserted until the finish status is read
+#[scenario(tags("read", "finish-status", "interrupt"))]
+fn s3_4_1_finish_read_releases_int(d: &mut Driver) -> Outcome {
     ready(d)?;
     d.run(Move::accel(Cw, 10))?;
     d.expect_pins(Some(true), None, None, None)?;
@@ -59,7 +45,9 @@ fn int_release(d: &mut Driver) -> Outcome {
     d.expect_pins(Some(false), None, None, None)
 }
 
-fn input_limits(d: &mut Driver) -> Outcome {
+/// input status reads L1 and L2 as pin levels (asserted = 0)
+#[scenario(tags("read", "input", "limit"))]
+fn s3_4_2_input_status_l1_l2(d: &mut Driver) -> Outcome {
     d.expect_input_status(0x3F)?;
     d.set(Input::L1, true)?;
     d.expect_input_status(0x37)?;
@@ -69,14 +57,18 @@ fn input_limits(d: &mut Driver) -> Outcome {
     d.expect_input_status(0x3B)
 }
 
-fn input_hs_limits(d: &mut Driver) -> Outcome {
+/// input status bits 0 and 1 are the high-speed limits L4 and L3
+#[scenario(tags("read", "input", "hs-limit"))]
+fn s3_4_2_input_status_l3_l4(d: &mut Driver) -> Outcome {
     d.set(Input::L4, true)?;
     d.expect_input_status(0x3E)?;
     d.set(Input::L3, true)?;
     d.expect_input_status(0x3C)
 }
 
-fn input_alm_cnp(d: &mut Driver) -> Outcome {
+/// input status bits 4 and 5 are ALM and CNP
+#[scenario(tags("read", "input", "alarm"))]
+fn s3_4_2_input_status_alm_cnp(d: &mut Driver) -> Outcome {
     d.set(Input::Alm, true)?;
     d.expect_input_status(0x2F)?;
     d.set(Input::Cnp, true)?;
@@ -86,7 +78,9 @@ fn input_alm_cnp(d: &mut Driver) -> Outcome {
     d.expect_input_status(0x0F)
 }
 
-fn aux_inputs(d: &mut Driver) -> Outcome {
+/// AUXI0..3 read in bits 0..3 as pin levels; bits 7-4 read 0
+#[scenario(tags("read", "input", "aux"))]
+fn s3_4_5_aux_input_status(d: &mut Driver) -> Outcome {
     d.expect_aux_inputs(0x0F)?;
     d.set(Input::Auxi0, true)?;
     d.expect_aux_inputs(0x0E)?;
@@ -99,7 +93,9 @@ fn aux_inputs(d: &mut Driver) -> Outcome {
     d.expect_aux_inputs(0x00)
 }
 
-fn output_status(d: &mut Driver) -> Outcome {
+/// output status: direction of the last move, HOLD 3.4 ms after it, phase levels
+#[scenario(tags("read", "output", "hold", "phases", "timing"))]
+fn s3_4_3_output_status_dir_hold_phases(d: &mut Driver) -> Outcome {
     ready(d)?;
     // Stopped since initialization: HOLD, S1 S2 energized (negative logic).
     d.expect_output_status(0b0011_1100)?;
@@ -111,7 +107,9 @@ fn output_status(d: &mut Driver) -> Outcome {
     d.expect_output_status(0b1001_1110)
 }
 
-fn remaining_one_less(d: &mut Driver) -> Outcome {
+/// after a limit stop the remaining pulses read one less than the remainder
+#[scenario(tags("read", "remaining", "limit"))]
+fn s3_4_4_remaining_reads_one_less(d: &mut Driver) -> Outcome {
     ready(d)?;
     d.start(Move::constant(Cw, 50, 300))?;
     d.after_pulses(123)?;
@@ -122,7 +120,9 @@ fn remaining_one_less(d: &mut Driver) -> Outcome {
     d.expect_remaining(300 - 123 - 1)
 }
 
-fn remainder_one(d: &mut Driver) -> Outcome {
+/// a true remainder of 1 reads 0; finish status bits 3-6 tell it from a complete move
+#[scenario(tags("read", "remaining", "boundary"))]
+fn s3_4_4_remainder_of_one_reads_zero(d: &mut Driver) -> Outcome {
     ready(d)?;
     d.start(Move::constant(Cw, 50, 3))?;
     d.after_pulses(2)?;

@@ -1,31 +1,17 @@
 //! Section 3-2-1: every motor type and excitation method steps S1..S5
 //! through its sequence, one step per pulse, both ways, in both logics.
 
-use crate::scenario::prelude::*;
+use ppmc::scenario::prelude::*;
 
 pub fn scenarios() -> Vec<Scenario> {
     vec![
-        Scenario::new("s3_2_1_three_phase_two_phase_excitation", "3-2-1",
-            "3-phase, 2-phase excitation: S1S2, S2S3, S3S1",
-            &["init", "phases", "excitation"], three_two),
-        Scenario::new("s3_2_1_three_phase_one_two_excitation", "3-2-1",
-            "3-phase, 1-2 phase excitation: six steps",
-            &["init", "phases", "excitation"], three_half),
-        Scenario::new("s3_2_1_four_phase_two_phase_excitation", "3-2-1",
-            "4-phase, 2-phase excitation: four steps",
-            &["init", "phases", "excitation"], four_two),
-        Scenario::new("s3_2_1_four_phase_one_two_excitation", "3-2-1",
-            "4-phase, 1-2 phase excitation: eight steps",
-            &["init", "phases", "excitation"], four_half),
-        Scenario::new("s3_2_1_five_phase_two_phase_excitation", "3-2-1",
-            "5-phase, 2-phase excitation: five steps",
-            &["init", "phases", "excitation"], five_two),
-        Scenario::new("s3_2_1_five_phase_two_three_excitation", "3-2-1",
-            "5-phase, 2-3 phase excitation: ten steps",
-            &["init", "phases", "excitation"], five_half),
-        Scenario::new("s3_2_1_positive_logic_levels", "3-2-1",
-            "positive logic drives energized phases high in the output status",
-            &["init", "phases", "logic", "read"], positive_logic),
+        s3_2_1_three_phase_two_phase_excitation(),
+        s3_2_1_three_phase_one_two_excitation(),
+        s3_2_1_four_phase_two_phase_excitation(),
+        s3_2_1_four_phase_one_two_excitation(),
+        s3_2_1_five_phase_two_phase_excitation(),
+        s3_2_1_five_phase_two_three_excitation(),
+        s3_2_1_positive_logic_levels(),
     ]
 }
 
@@ -45,11 +31,15 @@ fn sequence(d: &mut Driver, init: Init, cycle: &[u8]) -> Outcome {
     d.expect_phases(cycle[back])
 }
 
-fn three_two(d: &mut Driver) -> Outcome {
+/// 3-phase, 2-phase excitation: S1S2, S2S3, S3S1
+#[scenario(tags("init", "phases", "excitation"))]
+fn s3_2_1_three_phase_two_phase_excitation(d: &mut Driver) -> Outcome {
     sequence(d, Init::new(MotorType::ThreePhase), &[0b11000, 0b01100, 0b10100])
 }
 
-fn three_half(d: &mut Driver) -> Outcome {
+/// 3-phase, 1-2 phase excitation: six steps
+#[scenario(tags("init", "phases", "excitation"))]
+fn s3_2_1_three_phase_one_two_excitation(d: &mut Driver) -> Outcome {
     sequence(
         d,
         Init::new(MotorType::ThreePhase).half_step(),
@@ -57,11 +47,15 @@ fn three_half(d: &mut Driver) -> Outcome {
     )
 }
 
-fn four_two(d: &mut Driver) -> Outcome {
+/// 4-phase, 2-phase excitation: four steps
+#[scenario(tags("init", "phases", "excitation"))]
+fn s3_2_1_four_phase_two_phase_excitation(d: &mut Driver) -> Outcome {
     sequence(d, Init::four_phase(), &[0b11000, 0b01100, 0b00110, 0b10010])
 }
 
-fn four_half(d: &mut Driver) -> Outcome {
+/// 4-phase, 1-2 phase excitation: eight steps
+#[scenario(tags("init", "phases", "excitation"))]
+fn s3_2_1_four_phase_one_two_excitation(d: &mut Driver) -> Outcome {
     sequence(
         d,
         Init::four_phase().half_step(),
@@ -69,7 +63,9 @@ fn four_half(d: &mut Driver) -> Outcome {
     )
 }
 
-fn five_two(d: &mut Driver) -> Outcome {
+/// 5-phase, 2-phase excitation: five steps
+#[scenario(tags("init", "phases", "excitation"))]
+fn s3_2_1_five_phase_two_phase_excitation(d: &mut Driver) -> Outcome {
     sequence(
         d,
         Init::new(MotorType::FivePhase),
@@ -77,7 +73,9 @@ fn five_two(d: &mut Driver) -> Outcome {
     )
 }
 
-fn five_half(d: &mut Driver) -> Outcome {
+/// 5-phase, 2-3 phase excitation: ten steps
+#[scenario(tags("init", "phases", "excitation"))]
+fn s3_2_1_five_phase_two_three_excitation(d: &mut Driver) -> Outcome {
     sequence(
         d,
         Init::new(MotorType::FivePhase).half_step(),
@@ -88,7 +86,9 @@ fn five_half(d: &mut Driver) -> Outcome {
     )
 }
 
-fn positive_logic(d: &mut Driver) -> Outcome {
+/// positive logic drives energized phases high in the output status
+#[scenario(tags("init", "phases", "logic", "read"))]
+fn s3_2_1_positive_logic_levels(d: &mut Driver) -> Outcome {
     d.init_and_wait(Init::new(MotorType::FivePhase).positive_logic())?;
     // S1 S2 energized and high; HOLD on; CW.
     d.expect_output_status(0b1100_0100)?;

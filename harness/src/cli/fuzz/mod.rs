@@ -1,9 +1,11 @@
 //! `ppmc fuzz`: turning fuzz findings into something people can read and
 //! keep, and differential runs against a target.
 
+mod run;
+
+use crate::emu::ModelConfig;
+use crate::fuzzing::finding::{self, InputKind};
 use clap::{Args, Subcommand};
-use ppmc::emu::ModelConfig;
-use ppmc::fuzzing::finding::{self, InputKind};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -14,7 +16,7 @@ pub struct FuzzArgs {
     command: Option<FuzzCommand>,
     /// Without a subcommand: a differential run (see `ppmc fuzz run --help`).
     #[command(flatten)]
-    run: crate::diff_cmd::DiffArgs,
+    run: run::DiffArgs,
 }
 
 #[derive(Debug, Subcommand)]
@@ -41,7 +43,7 @@ enum FuzzCommand {
         output: Option<PathBuf>,
     },
     /// Write a fuzz input (best minimized first) as a Rust scenario file in
-    /// scenarios/, named after the invariant it breaks
+    /// scenarios/src/, named after the invariant it breaks
     /// (`fuzz_<invariant>_<n>.rs`; never overwrites). The scenario replays
     /// the bus ops and fails while the invariant breaks. Exit status 0 when
     /// written, 1 when the input breaks no invariant, 2 on a usage or file
@@ -50,7 +52,7 @@ enum FuzzCommand {
         #[command(flatten)]
         input: InputArgs,
         /// The scenario directory.
-        #[arg(long, default_value = "scenarios")]
+        #[arg(long, default_value = "scenarios/src")]
         dir: PathBuf,
     },
     /// Bucket findings by the invariant each breaks: a thousand crashes of
@@ -79,7 +81,7 @@ enum FuzzCommand {
     /// A differential run: a seeded stream of protocol-respecting actions
     /// against a target and the emulator side by side (the default when no
     /// subcommand is given).
-    Run(crate::diff_cmd::DiffArgs),
+    Run(run::DiffArgs),
 }
 
 #[derive(Debug, Args)]
@@ -96,8 +98,8 @@ struct ModelArgs {
 impl ModelArgs {
     fn model(&self) -> Result<ModelConfig, ExitCode> {
         let mut cfg = ModelConfig::default();
-        ppmc::faults::apply_all(&self.chip_faults, &mut cfg)
-            .map_err(|e| crate::usage_error(format!("--chip-fault: {e}")))?;
+        crate::faults::apply_all(&self.chip_faults, &mut cfg)
+            .map_err(|e| crate::cli::usage_error(format!("--chip-fault: {e}")))?;
         Ok(cfg)
     }
 }
@@ -108,12 +110,13 @@ fn load_inputs(
     paths: &[PathBuf],
     kind: InputKind,
     cfg: &ModelConfig,
-) -> Result<Vec<(String, Vec<ppmc::fuzzing::bus::BusOp>)>, ExitCode> {
+) -> Result<Vec<(String, Vec<crate::fuzzing::bus::BusOp>)>, ExitCode> {
     let mut files = Vec::new();
     for p in paths {
         if p.is_dir() {
-            let rd = std::fs::read_dir(p)
-                .map_err(|e| crate::usage_error(format!("cannot read {}: {e}", p.display())))?;
+            let rd = std::fs::read_dir(p).map_err(|e| {
+                crate::cli::usage_error(format!("cannot read {}: {e}", p.display()))
+            })?;
             let mut v: Vec<PathBuf> = rd
                 .filter_map(Result::ok)
                 .map(|e| e.path())
@@ -128,8 +131,9 @@ fn load_inputs(
     files
         .into_iter()
         .map(|f| {
-            let data = std::fs::read(&f)
-                .map_err(|e| crate::usage_error(format!("cannot read {}: {e}", f.display())))?;
+            let data = std::fs::read(&f).map_err(|e| {
+                crate::cli::usage_error(format!("cannot read {}: {e}", f.display()))
+            })?;
             Ok((f.display().to_string(), finding::ops_of(&data, kind, cfg)))
         })
         .collect()
@@ -145,10 +149,11 @@ struct InputArgs {
 
 impl InputArgs {
     /// The model, the input's bytes and its bus ops.
-    fn load(&self) -> Result<(ModelConfig, Vec<ppmc::fuzzing::bus::BusOp>), ExitCode> {
+    fn load(&self) -> Result<(ModelConfig, Vec<crate::fuzzing::bus::BusOp>), ExitCode> {
         let cfg = self.model.model()?;
-        let data = std::fs::read(&self.file)
-            .map_err(|e| crate::usage_error(format!("cannot read {}: {e}", self.file.display())))?;
+        let data = std::fs::read(&self.file).map_err(|e| {
+            crate::cli::usage_error(format!("cannot read {}: {e}", self.file.display()))
+        })?;
         let ops = finding::ops_of(&data, self.model.kind, &cfg);
         Ok((cfg, ops))
     }
@@ -156,8 +161,8 @@ impl InputArgs {
 
 pub fn run(args: FuzzArgs) -> ExitCode {
     match args.command {
-        None => crate::diff_cmd::run(args.run),
-        Some(FuzzCommand::Run(a)) => crate::diff_cmd::run(a),
+        None => run::run(args.run),
+        Some(FuzzCommand::Run(a)) => run::run(a),
         Some(FuzzCommand::Triage { paths, model }) => {
             let cfg = match model.model() {
                 Ok(c) => c,
@@ -167,7 +172,7 @@ pub fn run(args: FuzzArgs) -> ExitCode {
                 Ok(v) => v,
                 Err(code) => return code,
             };
-            let (buckets, clean) = ppmc::fuzzing::campaign::triage(&inputs, &cfg);
+            let (buckets, clean) = crate::fuzzing::campaign::triage(&inputs, &cfg);
             println!("| invariant | inputs | shortest input | its ops | break |\n|---|---:|---|---:|---|");
             for b in &buckets {
                 let (name, n, v) = &b.smallest;
@@ -199,7 +204,7 @@ pub fn run(args: FuzzArgs) -> ExitCode {
                 Err(code) => return code,
             };
             let ops: Vec<_> = inputs.into_iter().map(|(_, o)| o).collect();
-            print!("{}", ppmc::fuzzing::campaign::Coverage::of(&ops).render());
+            print!("{}", crate::fuzzing::campaign::Coverage::of(&ops).render());
             ExitCode::SUCCESS
         }
         Some(FuzzCommand::Reproduce { input }) => {
@@ -209,7 +214,7 @@ pub fn run(args: FuzzArgs) -> ExitCode {
             };
             let data = finding::to_bytes(&ops);
             let source = input.file.display().to_string();
-            let (script, found) = ppmc::fuzzing::reproducer_with(&data, &source, cfg);
+            let (script, found) = crate::fuzzing::reproducer_with(&data, &source, cfg);
             print!("{script}");
             if found.is_some() {
                 ExitCode::from(1)
@@ -238,8 +243,8 @@ pub fn run(args: FuzzArgs) -> ExitCode {
             };
             let out = output.unwrap_or_else(|| with_suffix(&input.file, "min"));
             let bytes = finding::to_bytes(&m.ops);
-            if let Err(e) = ppmc::golden::write_atomic(&out, &bytes) {
-                return crate::usage_error(format!("cannot write {}: {e}", out.display()));
+            if let Err(e) = crate::golden::write_atomic(&out, &bytes) {
+                return crate::cli::usage_error(format!("cannot write {}: {e}", out.display()));
             }
             eprintln!(
                 "ppmc fuzz minimize: {} ops -> {} ops ({} oracle runs), invariant {} still breaks; wrote {}",
@@ -250,7 +255,7 @@ pub fn run(args: FuzzArgs) -> ExitCode {
                 out.display()
             );
             let (script, _) =
-                ppmc::fuzzing::reproducer_with(&bytes, &out.display().to_string(), cfg);
+                crate::fuzzing::reproducer_with(&bytes, &out.display().to_string(), cfg);
             print!("{script}");
             ExitCode::SUCCESS
         }
@@ -268,7 +273,7 @@ pub fn run(args: FuzzArgs) -> ExitCode {
                 return ExitCode::from(1);
             };
             if !dir.is_dir() {
-                return crate::usage_error(format!(
+                return crate::cli::usage_error(format!(
                     "{} is not a directory: run from the repository root or give --dir",
                     dir.display()
                 ));
@@ -287,11 +292,12 @@ pub fn run(args: FuzzArgs) -> ExitCode {
                 &v,
                 &input.file.display().to_string(),
             );
-            if let Err(e) = ppmc::golden::write_atomic(&path, text.as_bytes()) {
-                return crate::usage_error(format!("cannot write {}: {e}", path.display()));
+            if let Err(e) = crate::golden::write_atomic(&path, text.as_bytes()) {
+                return crate::cli::usage_error(format!("cannot write {}: {e}", path.display()));
             }
             println!(
-                "wrote {} (scenario {stem}, invariant {}, {} ops); `cargo test` runs it",
+                "wrote {} (scenario {stem}, invariant {}, {} ops); add `{stem}` to the \
+                 suite! list in scenarios/src/lib.rs, and `cargo test` runs it",
                 path.display(),
                 v.invariant,
                 v.op + 1

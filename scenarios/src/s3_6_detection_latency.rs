@@ -3,31 +3,17 @@
 //! just outside the row's band before a pulse whose time is known, so that
 //! a latency 1 % off the datasheet figure moves the deceleration by a pulse.
 
-use crate::scenario::prelude::*;
+use ppmc::scenario::prelude::*;
 
 pub fn scenarios() -> Vec<Scenario> {
     vec![
-        Scenario::new("s3_6_decel_stop_17us_not_before", "3-6",
-            "a Decelerating Stop 16.6 us before a pulse: that pulse is still output at speed",
-            &["timing", "decel-stop", "latency-probe"], decel_early),
-        Scenario::new("s3_6_decel_stop_17us_not_after", "3-6",
-            "a Decelerating Stop 17.4 us before a pulse: the deceleration starts from it",
-            &["timing", "decel-stop", "latency-probe"], decel_late),
-        Scenario::new("s3_6_hs_limit_cruise_17us_not_before", "3-6",
-            "L3 at high speed 16.6 us before a pulse: that pulse is still output at speed",
-            &["timing", "hs-limit", "latency-probe"], hs_cruise_early),
-        Scenario::new("s3_6_hs_limit_cruise_17us_not_after", "3-6",
-            "L3 at high speed 17.4 us before a pulse: the deceleration starts from it",
-            &["timing", "hs-limit", "latency-probe"], hs_cruise_late),
-        Scenario::new("s3_6_hs_limit_accel_12us_not_before", "3-6",
-            "L3 while accelerating 11.7 us before a pulse: that pulse is still on the ramp up",
-            &["timing", "hs-limit", "latency-probe"], hs_accel_early),
-        Scenario::new("s3_6_hs_limit_accel_12us_not_after", "3-6",
-            "L3 while accelerating 12.3 us before a pulse: the ramp turns down from it",
-            &["timing", "hs-limit", "latency-probe"], hs_accel_late),
-        Scenario::new("s3_3_4_longest_triangle_first_pout", "3-3-4",
-            "22,000 steps with PA = 11,220: the longest triangles take nearly 1.1 ms to the first POUT",
-            &["timing", "accel", "triangle", "boundary"], longest_triangle),
+        s3_6_decel_stop_17us_not_before(),
+        s3_6_decel_stop_17us_not_after(),
+        s3_6_hs_limit_cruise_17us_not_before(),
+        s3_6_hs_limit_cruise_17us_not_after(),
+        s3_6_hs_limit_accel_12us_not_before(),
+        s3_6_hs_limit_accel_12us_not_after(),
+        s3_3_4_longest_triangle_first_pout(),
     ]
 }
 
@@ -67,39 +53,53 @@ fn l3(d: &mut Driver) -> Outcome {
     d.set(Input::L3, true).map(|_| ())
 }
 
-fn decel_early(d: &mut Driver) -> Outcome {
+/// a Decelerating Stop 16.6 us before a pulse: that pulse is still output at speed
+#[scenario(tags("timing", "decel-stop", "latency-probe"))]
+fn s3_6_decel_stop_17us_not_before(d: &mut Driver) -> Outcome {
     at_speed_probe(d, Duration::from_nanos(16_600), decel_stop, TimingId::DecelStopProcessing)?;
     // Pulse index 500 still at speed; 501 and 99 more decelerate.
     d.expect_pulses(501 + 100, Cw)
 }
 
-fn decel_late(d: &mut Driver) -> Outcome {
+/// a Decelerating Stop 17.4 us before a pulse: the deceleration starts from it
+#[scenario(tags("timing", "decel-stop", "latency-probe"))]
+fn s3_6_decel_stop_17us_not_after(d: &mut Driver) -> Outcome {
     at_speed_probe(d, Duration::from_nanos(17_400), decel_stop, TimingId::DecelStopProcessing)?;
     d.expect_pulses(500 + 100, Cw)
 }
 
-fn hs_cruise_early(d: &mut Driver) -> Outcome {
+/// L3 at high speed 16.6 us before a pulse: that pulse is still output at speed
+#[scenario(tags("timing", "hs-limit", "latency-probe"))]
+fn s3_6_hs_limit_cruise_17us_not_before(d: &mut Driver) -> Outcome {
     at_speed_probe(d, Duration::from_nanos(16_600), l3, TimingId::HighSpeedLimitCruise)?;
     d.expect_pulses(501 + 100, Cw)
 }
 
-fn hs_cruise_late(d: &mut Driver) -> Outcome {
+/// L3 at high speed 17.4 us before a pulse: the deceleration starts from it
+#[scenario(tags("timing", "hs-limit", "latency-probe"))]
+fn s3_6_hs_limit_cruise_17us_not_after(d: &mut Driver) -> Outcome {
     at_speed_probe(d, Duration::from_nanos(17_400), l3, TimingId::HighSpeedLimitCruise)?;
     d.expect_pulses(500 + 100, Cw)
 }
 
-fn hs_accel_early(d: &mut Driver) -> Outcome {
+/// L3 while accelerating 11.7 us before a pulse: that pulse is still on the ramp up
+#[scenario(tags("timing", "hs-limit", "latency-probe"))]
+fn s3_6_hs_limit_accel_12us_not_before(d: &mut Driver) -> Outcome {
     accel_probe(d, Duration::from_nanos(11_700))?;
     // Pulse index 11 still goes out on the way up; the ramp turns at 12.
     d.expect_pulses(24, Cw)
 }
 
-fn hs_accel_late(d: &mut Driver) -> Outcome {
+/// L3 while accelerating 12.3 us before a pulse: the ramp turns down from it
+#[scenario(tags("timing", "hs-limit", "latency-probe"))]
+fn s3_6_hs_limit_accel_12us_not_after(d: &mut Driver) -> Outcome {
     accel_probe(d, Duration::from_nanos(12_300))?;
     d.expect_pulses(22, Cw)
 }
 
-fn longest_triangle(d: &mut Driver) -> Outcome {
+/// 22,000 steps with PA = 11,220: the longest triangles take nearly 1.1 ms to the first POUT
+#[scenario(tags("timing", "accel", "triangle", "boundary"))]
+fn s3_3_4_longest_triangle_first_pout(d: &mut Driver) -> Outcome {
     d.init_and_wait(Init::four_phase().rates(200, 20).accel_pulses(11_220))?;
     d.run(Move::accel(Cw, 22_000))?;
     d.expect_pulses(22_000, Cw)?;

@@ -2,11 +2,12 @@
 //! table (the source of `docs/performance.md`). Timings live here and never
 //! in tests: the machines are shared and noisy.
 
+use crate::emu::ModelConfig;
+use crate::protocol::{InitData, PulseCount, Status, Straps};
+use crate::scenario::Scenario;
+use crate::target::{EmuTarget, Op, Reply, Target};
+use crate::time::Duration;
 use clap::Args;
-use ppmc::emu::ModelConfig;
-use ppmc::protocol::{InitData, PulseCount, Status, Straps};
-use ppmc::target::{EmuTarget, Op, Reply, Target};
-use ppmc::time::Duration;
 use std::process::ExitCode;
 use std::time::Instant as WallClock;
 
@@ -106,7 +107,7 @@ fn time_case(repeat: usize, f: impl Fn() -> Outcome) -> (f64, Outcome) {
     (median_ms(samples), outcome)
 }
 
-pub fn run(args: BenchArgs) -> ExitCode {
+pub fn run(args: BenchArgs, suite: &[Scenario]) -> ExitCode {
     let max_ramp = InitData {
         rl: 200,
         rh: 20,
@@ -170,25 +171,24 @@ pub fn run(args: BenchArgs) -> ExitCode {
         "| per-pulse expansion of the 16,777,216-step record | {ms:.3} ms | {pulses} | - | - |"
     );
     println!();
-    suite_over_bridge(args.repeat.clamp(1, 5))
+    suite_over_bridge(args.repeat.clamp(1, 5), suite)
 }
 
 /// The conformance suite in process and over a pseudo-terminal to the
 /// bridge simulator: wall time and round trips.
-fn suite_over_bridge(repeat: usize) -> ExitCode {
-    use ppmc::bridge::sim::{LinkFaults, PtyBridge};
-    use ppmc::runner::run_suite;
-    use ppmc::scenario::DriverOptions;
-    use ppmc::target::{SerialLink, SerialOptions, SerialTarget};
+fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> ExitCode {
+    use crate::bridge::sim::{LinkFaults, PtyBridge};
+    use crate::runner::run_suite;
+    use crate::scenario::DriverOptions;
+    use crate::target::{SerialLink, SerialOptions, SerialTarget};
 
-    let suite = ppmc::suite::all();
     let mut local = Vec::new();
     for _ in 0..repeat {
         let Ok(mut t) = EmuTarget::new(Straps::default(), ModelConfig::default()) else {
             return ExitCode::from(1);
         };
         let t0 = WallClock::now();
-        run_suite(&mut t, &suite, 1, DriverOptions::default(), |_| {});
+        run_suite(&mut t, suite, 1, DriverOptions::default(), |_| {});
         local.push(t0.elapsed().as_secs_f64() * 1e3);
     }
     let sim = EmuTarget::new(Straps::default(), ModelConfig::default())
@@ -212,7 +212,7 @@ fn suite_over_bridge(repeat: usize) -> ExitCode {
             return ExitCode::from(1);
         };
         let t0 = WallClock::now();
-        run_suite(&mut t, &suite, 1, DriverOptions::default(), |_| {});
+        run_suite(&mut t, suite, 1, DriverOptions::default(), |_| {});
         remote.push(t0.elapsed().as_secs_f64() * 1e3);
         trips = t.stats.round_trips;
     }

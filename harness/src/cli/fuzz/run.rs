@@ -1,10 +1,10 @@
 //! `ppmc fuzz [run] --target <t>`: a differential run against a target.
 
-use crate::TargetArgs;
+use crate::cli::args::TargetArgs;
+use crate::fuzzing::differential::{self, DiffSettings};
+use crate::target::{EmuTarget, Target};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use ppmc::fuzzing::differential::{self, DiffSettings};
-use ppmc::target::{EmuTarget, Target};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant as WallClock;
@@ -23,8 +23,8 @@ pub struct DiffArgs {
     ops: usize,
     /// Stop after this much wall time (e.g. 30s, 5m is 300s) even if
     /// --ops are not done.
-    #[arg(long, value_parser = crate::parse_duration)]
-    duration: Option<ppmc::time::Duration>,
+    #[arg(long, value_parser = crate::cli::args::parse_duration)]
+    duration: Option<crate::time::Duration>,
     /// Where to write the minimized reproducer (a console script).
     /// Default: fuzz-diff-<seed>.ppmc in the current directory.
     #[arg(short, long)]
@@ -41,19 +41,19 @@ pub struct DiffArgs {
 pub fn run(args: DiffArgs) -> ExitCode {
     let straps = match args.target.straps() {
         Ok(s) => s,
-        Err(e) => return crate::usage_error(e),
+        Err(e) => return crate::cli::usage_error(e),
     };
     let mut target: Box<dyn Target> = if args.target.name() == "emu" {
         let mut model = args.target.model();
-        if let Err(e) = ppmc::faults::apply_all(&args.chip_faults, &mut model) {
-            return crate::usage_error(format!("--chip-fault: {e}"));
+        if let Err(e) = crate::faults::apply_all(&args.chip_faults, &mut model) {
+            return crate::cli::usage_error(format!("--chip-fault: {e}"));
         }
         match EmuTarget::new(straps, model) {
             Ok(t) => Box::new(t),
-            Err(e) => return crate::usage_error(e),
+            Err(e) => return crate::cli::usage_error(e),
         }
     } else if !args.chip_faults.is_empty() {
-        return crate::usage_error(
+        return crate::cli::usage_error(
             "--chip-fault applies to --target emu; a bridge simulator takes it as `ppmc bridge-sim --chip-fault`",
         );
     } else {
@@ -135,7 +135,7 @@ pub fn run(args: DiffArgs) -> ExitCode {
         .output
         .unwrap_or_else(|| PathBuf::from(format!("fuzz-diff-{seed}.ppmc")));
     let text = differential::script(&acts_out, &d_out, seed, &name);
-    if let Err(e) = ppmc::golden::write_atomic(&out, text.as_bytes()) {
+    if let Err(e) = crate::golden::write_atomic(&out, text.as_bytes()) {
         eprintln!("ppmc fuzz: cannot write {}: {e}", out.display());
         return ExitCode::from(2);
     }

@@ -1,44 +1,26 @@
 //! Section 3-2: initialization, its boundary values, clocks, the frozen
 //! winding rule, the ramp, and the speed limit.
 
-use crate::scenario::prelude::*;
+use ppmc::scenario::prelude::*;
 
 pub fn scenarios() -> Vec<Scenario> {
     vec![
-        Scenario::new("s3_2_1_initialization_sets_the_phase_outputs", "3-2-1",
-            "the phase outputs are set 44 us after the final byte (Table 3-3)",
-            &["init", "timing", "phases"], outputs_set),
-        Scenario::new("s3_2_2_init_processing_with_pa_4", "3-2-2",
-            "initialization with the fewest acceleration pulses: 16.5 ms (Table 3-3 min)",
-            &["init", "timing", "boundary"], init_time_pa_4),
-        Scenario::new("s3_2_2_init_processing_with_pa_11220", "3-2-2",
-            "initialization with the most acceleration pulses: 162.8 ms (Table 3-3 max)",
-            &["init", "timing", "boundary"], init_time_pa_11220),
-        Scenario::new("s3_2_2_boundary_rates_are_accepted", "3-2-2",
-            "RL = 254, RH = 1 and RL = 21, RH = 20 are accepted",
-            &["init", "boundary"], boundary_rates),
-        Scenario::new("s3_2_1_winding_is_frozen_until_software_reset", "3-2-1",
-            "type, excitation and logic ignore re-initialization until a software reset",
-            &["init", "phases", "reset"], frozen_winding),
-        Scenario::new("s3_2_2_rates_change_by_reinitializing", "3-2-2",
-            "a new RH takes effect without a reset (Equation 3-1)",
-            &["init", "rates"], rates_change),
-        Scenario::new("s3_2_2_ramp_runs_from_rl_to_rh", "3-2-2",
-            "an accel/decel move spans the RL and RH periods and is symmetric",
-            &["init", "rates", "accel"], ramp_shape),
-        Scenario::new("s3_2_2_external_clock", "3-2-1",
-            "the external clock sets Tclock; with none fitted the chip never pulses",
-            &["init", "clock"], external_clock),
-        Scenario::new("s3_2_2_over_speed_locks_out_the_host", "3-2-2",
-            "above 27 kpps in phase mode the chip takes no host byte until it slows down",
-            &["init", "speed-limit"], over_speed),
-        Scenario::new("s3_2_2_pout_mode_allows_40_kpps", "3-2-2",
-            "the same 35.7 kpps is within the POUT-mode limit: commands are taken",
-            &["init", "speed-limit", "pout"], pout_speed_limit),
+        s3_2_1_initialization_sets_the_phase_outputs(),
+        s3_2_2_init_processing_with_pa_4(),
+        s3_2_2_init_processing_with_pa_11220(),
+        s3_2_2_boundary_rates_are_accepted(),
+        s3_2_1_winding_is_frozen_until_software_reset(),
+        s3_2_2_rates_change_by_reinitializing(),
+        s3_2_2_ramp_runs_from_rl_to_rh(),
+        s3_2_2_external_clock(),
+        s3_2_2_over_speed_locks_out_the_host(),
+        s3_2_2_pout_mode_allows_40_kpps(),
     ]
 }
 
-fn outputs_set(d: &mut Driver) -> Outcome {
+/// the phase outputs are set 44 us after the final byte (Table 3-3)
+#[scenario(tags("init", "timing", "phases"))]
+fn s3_2_1_initialization_sets_the_phase_outputs(d: &mut Driver) -> Outcome {
     d.expect_phases(0)?;
     d.init(Init::four_phase())?;
     d.wait(ms(1))?;
@@ -46,7 +28,9 @@ fn outputs_set(d: &mut Driver) -> Outcome {
     d.expect_phases(0b11000)
 }
 
-fn init_time_pa_4(d: &mut Driver) -> Outcome {
+/// initialization with the fewest acceleration pulses: 16.5 ms (Table 3-3 min)
+#[scenario(tags("init", "timing", "boundary"))]
+fn s3_2_2_init_processing_with_pa_4(d: &mut Driver) -> Outcome {
     d.init(Init::four_phase().accel_pulses(4))?;
     d.expect_no_error()?;
     d.expect_latency(TimingId::InitProcessing)?;
@@ -54,7 +38,9 @@ fn init_time_pa_4(d: &mut Driver) -> Outcome {
     d.expect_pulses(20, Cw)
 }
 
-fn init_time_pa_11220(d: &mut Driver) -> Outcome {
+/// initialization with the most acceleration pulses: 162.8 ms (Table 3-3 max)
+#[scenario(tags("init", "timing", "boundary"))]
+fn s3_2_2_init_processing_with_pa_11220(d: &mut Driver) -> Outcome {
     d.init(Init::four_phase().rates(200, 20).accel_pulses(11_220))?;
     d.expect_no_error()?;
     d.expect_latency(TimingId::InitProcessing)?;
@@ -62,7 +48,9 @@ fn init_time_pa_11220(d: &mut Driver) -> Outcome {
     d.expect_pulses(30, Cw)
 }
 
-fn boundary_rates(d: &mut Driver) -> Outcome {
+/// RL = 254, RH = 1 and RL = 21, RH = 20 are accepted
+#[scenario(tags("init", "boundary"))]
+fn s3_2_2_boundary_rates_are_accepted(d: &mut Driver) -> Outcome {
     d.init(Init::four_phase().rates(254, 1))?;
     d.expect_no_error()?;
     d.init(Init::four_phase().rates(21, 20))?;
@@ -72,7 +60,9 @@ fn boundary_rates(d: &mut Driver) -> Outcome {
     d.expect_intervals(lo, hi)
 }
 
-fn frozen_winding(d: &mut Driver) -> Outcome {
+/// type, excitation and logic ignore re-initialization until a software reset
+#[scenario(tags("init", "phases", "reset"))]
+fn s3_2_1_winding_is_frozen_until_software_reset(d: &mut Driver) -> Outcome {
     d.init(Init::four_phase())?;
     // Ask for 3-phase, 1-2 excitation, positive logic: ignored.
     d.init(Init::new(MotorType::ThreePhase).half_step().positive_logic())?;
@@ -88,7 +78,9 @@ fn frozen_winding(d: &mut Driver) -> Outcome {
     d.expect_output_status(0b1100_0000)
 }
 
-fn rates_change(d: &mut Driver) -> Outcome {
+/// a new RH takes effect without a reset (Equation 3-1)
+#[scenario(tags("init", "rates"))]
+fn s3_2_2_rates_change_by_reinitializing(d: &mut Driver) -> Outcome {
     d.init(Init::four_phase())?;
     d.run(Move::accel(Cw, 300))?;
     let (fast, slow) = (d.period(20), d.period(100));
@@ -99,7 +91,9 @@ fn rates_change(d: &mut Driver) -> Outcome {
     d.expect_intervals(fast, slow)
 }
 
-fn ramp_shape(d: &mut Driver) -> Outcome {
+/// an accel/decel move spans the RL and RH periods and is symmetric
+#[scenario(tags("init", "rates", "accel"))]
+fn s3_2_2_ramp_runs_from_rl_to_rh(d: &mut Driver) -> Outcome {
     d.init(Init::four_phase())?;
     d.run(Move::accel(Cw, 1_000))?;
     d.expect_pulses(1_000, Cw)?;
@@ -107,7 +101,9 @@ fn ramp_shape(d: &mut Driver) -> Outcome {
     d.expect_intervals(fast, slow)
 }
 
-fn external_clock(d: &mut Driver) -> Outcome {
+/// the external clock sets Tclock; with none fitted the chip never pulses
+#[scenario(section = "3-2-1", tags("init", "clock"))]
+fn s3_2_2_external_clock(d: &mut Driver) -> Outcome {
     d.init(Init::four_phase().external_clock())?;
     match d.straps().ext_clock_hz {
         Some(hz) => {
@@ -124,7 +120,9 @@ fn external_clock(d: &mut Driver) -> Outcome {
     }
 }
 
-fn over_speed(d: &mut Driver) -> Outcome {
+/// above 27 kpps in phase mode the chip takes no host byte until it slows down
+#[scenario(tags("init", "speed-limit"))]
+fn s3_2_2_over_speed_locks_out_the_host(d: &mut Driver) -> Outcome {
     // A high speed rate over the limit on this board (RH = 17 at 16 MHz).
     let Some(rh) = d.speed_limit_rates(false).1 else {
         return d.check("a rate over the speed limit exists on this board", true, false);
@@ -142,7 +140,9 @@ fn over_speed(d: &mut Driver) -> Outcome {
     d.expect_finish(0xC3)
 }
 
-fn pout_speed_limit(d: &mut Driver) -> Outcome {
+/// the same 35.7 kpps is within the POUT-mode limit: commands are taken
+#[scenario(tags("init", "speed-limit", "pout"))]
+fn s3_2_2_pout_mode_allows_40_kpps(d: &mut Driver) -> Outcome {
     // A rate over the phase-mode limit but within POUT mode's (13 at 16 MHz).
     let rh = match (d.speed_limit_rates(true).0, d.speed_limit_rates(false).1) {
         (Some(a), Some(b)) if a <= b => a,

@@ -93,9 +93,17 @@ fn minimize_then_to_scenario_on_an_injected_bug() {
     );
     let file = scen.join("fuzz_remaining_pulses_1.rs");
     let text = std::fs::read_to_string(&file).expect("scenario written");
-    assert!(text.contains("\"fuzz_remaining_pulses_1\""), "{text}");
-    assert!(text.contains("\"3-4-4\""), "{text}");
-    assert!(text.contains("d.replay_bus(OPS)"));
+    assert!(
+        text.contains("fn fuzz_remaining_pulses_1(d: &mut Driver)"),
+        "{text}"
+    );
+    assert!(text.contains("section = \"3-4-4\""), "{text}");
+    assert!(text.contains("regression(d, OPS)"));
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains("add `fuzz_remaining_pulses_1` to the suite!"),
+        "{said}"
+    );
     let again = ppmc(&args);
     assert_eq!(again.status.code(), Some(0));
     assert!(scen.join("fuzz_remaining_pulses_2.rs").exists());

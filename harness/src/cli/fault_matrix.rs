@@ -1,13 +1,14 @@
 //! `ppmc fault-matrix`: every catalogued board fault against the suite,
 //! the golden traces and a bounded differential fuzz, over the pty.
 
+use crate::bridge::sim::{LinkFaults, PtyBridge};
+use crate::emu::ModelConfig;
+use crate::fault_matrix::{self, FuzzBudget, Row};
+use crate::faults::{self, CATALOGUE};
+use crate::protocol::Straps;
+use crate::scenario::Scenario;
+use crate::target::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use clap::Args;
-use ppmc::bridge::sim::{LinkFaults, PtyBridge};
-use ppmc::emu::ModelConfig;
-use ppmc::fault_matrix::{self, FuzzBudget, Row};
-use ppmc::faults::{self, CATALOGUE};
-use ppmc::protocol::Straps;
-use ppmc::target::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -37,7 +38,7 @@ pub struct MatrixArgs {
     output: Option<PathBuf>,
 }
 
-pub fn run(args: MatrixArgs) -> ExitCode {
+pub fn run(args: MatrixArgs, suite: &[Scenario]) -> ExitCode {
     if args.list {
         println!("| fault | section | what the board does |\n|---|---|---|");
         for f in CATALOGUE {
@@ -46,7 +47,7 @@ pub fn run(args: MatrixArgs) -> ExitCode {
         return ExitCode::SUCCESS;
     }
     if !args.golden.is_dir() {
-        return crate::usage_error(format!(
+        return super::usage_error(format!(
             "{} is not a directory: run from the repository root or give --golden",
             args.golden.display()
         ));
@@ -58,11 +59,10 @@ pub fn run(args: MatrixArgs) -> ExitCode {
         }
     }
     if let Some(unknown) = args.only.iter().find(|n| faults::find(n).is_none()) {
-        return crate::usage_error(format!(
+        return super::usage_error(format!(
             "--fault {unknown}: not in the catalogue (see --list)"
         ));
     }
-    let suite = ppmc::suite::all();
     let budget = FuzzBudget {
         seeds: args.fuzz_seeds,
         actions: args.fuzz_actions,
@@ -71,7 +71,7 @@ pub fn run(args: MatrixArgs) -> ExitCode {
     let total = boards.len();
     for (i, (name, model)) in boards.into_iter().enumerate() {
         eprint!("[{}/{total}] {name} ... ", i + 1);
-        let row = match board_row(&name, model, args.in_process, &suite, &args.golden, budget) {
+        let row = match board_row(&name, model, args.in_process, suite, &args.golden, budget) {
             Ok(r) => r,
             Err(e) => {
                 eprintln!("infrastructure error");
@@ -102,8 +102,8 @@ pub fn run(args: MatrixArgs) -> ExitCode {
                 }
             }
         }
-        if let Err(e) = ppmc::golden::write_atomic(path, text.as_bytes()) {
-            return crate::usage_error(format!("cannot write {}: {e}", path.display()));
+        if let Err(e) = crate::golden::write_atomic(path, text.as_bytes()) {
+            return super::usage_error(format!("cannot write {}: {e}", path.display()));
         }
     }
     if fault_matrix::all_as_expected(&rows) {
@@ -119,7 +119,7 @@ fn board_row(
     name: &str,
     model: ModelConfig,
     in_process: bool,
-    suite: &[ppmc::scenario::Scenario],
+    suite: &[crate::scenario::Scenario],
     golden: &std::path::Path,
     budget: FuzzBudget,
 ) -> Result<Row, String> {

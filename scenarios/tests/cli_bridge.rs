@@ -99,7 +99,7 @@ fn a_disconnect_mid_run_writes_the_partial_junit_and_exits_1() {
     assert!(stdout.contains("NOT RUN "), "{stdout}");
     let xml = std::fs::read_to_string(&junit).expect("JUnit written");
     let report = quick_junit::Report::deserialize_from_str(&xml).expect("valid JUnit");
-    let n = ppmc::suite::all().len();
+    let n = ppmc_scenarios::all().len();
     assert_eq!(report.tests, n);
     assert!(report.errors >= 1);
     assert!(
@@ -124,7 +124,7 @@ fn a_missing_board_is_an_infrastructure_error_with_reports() {
     assert!(err.contains("infrastructure error"), "{err}");
     assert!(err.contains("no such serial port"), "{err}");
     let xml = std::fs::read_to_string(&junit).expect("JUnit written");
-    assert_eq!(xml.matches("<skipped").count(), ppmc::suite::all().len());
+    assert_eq!(xml.matches("<skipped").count(), ppmc_scenarios::all().len());
     let _ = std::fs::remove_file(junit);
     // A malformed target is bad usage.
     assert_eq!(ppmc(&["run", "--target", "serial:"]).status.code(), Some(2));

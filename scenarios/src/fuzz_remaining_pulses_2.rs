@@ -4,22 +4,23 @@
 //! It fails while the bug is there; once fixed, record its golden trace
 //! (`ppmc record --filter fuzz_remaining_pulses_2`).
 
-use crate::fuzzing::bus::BusOp::{self, *};
-use crate::scenario::prelude::*;
+use ppmc::fuzzing::bus::BusOp::{self, *};
+use ppmc::fuzzing::replay::regression;
+use ppmc::scenario::prelude::*;
 
 pub fn scenarios() -> Vec<Scenario> {
-    vec![Scenario::new(
-        "fuzz_remaining_pulses_2",
-        "3-4-4",
-        "fuzz finding: remaining-pulses must hold",
-        &["fuzz", "regression"],
-        replay,
-    )]
+    vec![fuzz_remaining_pulses_2()]
+}
+
+/// fuzz finding: remaining-pulses must hold
+#[scenario(section = "3-4-4", tags("fuzz", "regression"))]
+fn fuzz_remaining_pulses_2(d: &mut Driver) -> Outcome {
+    regression(d, OPS)
 }
 
 /// The minimized bus script, one op per line (console form in comments).
 const OPS: &[BusOp] = &[
-    BusOp::Input { input: crate::protocol::Input::L1, asserted: true }, // set l1 on
+    BusOp::Input { input: ppmc::protocol::Input::L1, asserted: true }, // set l1 on
     Command(0x06), // wc! 0x06
     Advance(Duration::from_nanos(6000)), // wait 6us
     Data(0x40), // wd! 0x40
@@ -42,7 +43,3 @@ const OPS: &[BusOp] = &[
     Advance(Duration::from_nanos(10000)), // wait 10us
     ReadData, // rd!
 ];
-
-fn replay(d: &mut Driver) -> Outcome {
-    d.replay_bus(OPS)
-}

@@ -1,0 +1,19 @@
+//! `board-suite`: ppmc's conformance suite plus this board's own
+//! scenarios, with every `ppmc` command (`run`, `list`, `record`,
+//! `compare`, `--target`, JUnit and JSON reports).
+//!
+//! ```sh
+//! cargo run -p board-suite -- list --tag board
+//! cargo run -p board-suite -- run --junit report.xml
+//! cargo run -p board-suite -- run --target serial:/dev/ttyACM0 --tag board
+//! ```
+
+mod x_axis;
+
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let mut suite = ppmc_scenarios::all();
+    suite.extend(x_axis::scenarios());
+    ppmc::cli::main(suite)
+}

@@ -1,0 +1,91 @@
+//! `ppmc compare`: a golden trace set against traces or a fresh run.
+
+use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
+use crate::compare::compare;
+use crate::golden::{self};
+use crate::scenario::Scenario;
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Which scenarios to take.
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The golden trace set.
+    golden: PathBuf,
+    /// A second trace set to compare (a board revision's recording). Without
+    /// it, the scenarios run on --target and are compared as they run.
+    #[arg(long, value_name = "DIR")]
+    traces: Option<PathBuf>,
+    #[command(flatten)]
+    select: SelectArgs,
+    #[command(flatten)]
+    target: TargetArgs,
+    #[command(flatten)]
+    tolerance: ToleranceArgs,
+}
+
+pub fn run(args: CompareArgs, suite: &[Scenario]) -> ExitCode {
+    let tol = match args.tolerance.tolerances() {
+        Ok(t) => t,
+        Err(e) => return super::usage_error(e),
+    };
+    if !args.golden.is_dir() {
+        return super::usage_error(format!(
+            "{}: golden directory not found",
+            args.golden.display()
+        ));
+    }
+    let scenarios = match args.select.scenarios(suite) {
+        Ok(s) => s,
+        Err(e) => return super::usage_error(e),
+    };
+    let Some(dir) = &args.traces else {
+        // Against a target: the run itself, with the golden check.
+        let run_args = super::run::RunArgs {
+            select: args.select,
+            target: args.target,
+            golden: Some(args.golden),
+            tolerance: args.tolerance,
+            junit: None,
+            json: None,
+            artifacts: None,
+            board_rev: None,
+            repeat: 1,
+            marginal: 0.25,
+        };
+        return super::run::run(run_args, suite);
+    };
+    if !dir.is_dir() {
+        return super::usage_error(format!("{}: trace directory not found", dir.display()));
+    }
+    let (mut ok, mut bad) = (0usize, 0usize);
+    for s in &scenarios {
+        let line = match (
+            golden::load(&args.golden, s.name),
+            golden::load(dir, s.name),
+        ) {
+            (Ok(g), Ok(t)) => match compare(&g, &t, &tol) {
+                Ok(()) => {
+                    ok += 1;
+                    format!("MATCH    {}", s.name)
+                }
+                Err(d) => {
+                    bad += 1;
+                    format!("DIVERGE  {}\n         first divergence {d}", s.name)
+                }
+            },
+            (Err(e), _) | (_, Err(e)) => {
+                bad += 1;
+                format!("BAD FILE {}\n         {e}", s.name)
+            }
+        };
+        println!("{line}");
+    }
+    println!("compare: {ok} passed, {bad} failed");
+    if bad == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}

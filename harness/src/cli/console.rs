@@ -1,0 +1,109 @@
+//! `ppmc console`: a bus script against a target, one line per result.
+
+use super::args::{parse_duration, TargetArgs};
+use super::usage_error;
+use crate::console::{self, ConsoleOptions, Line, ScriptError};
+use crate::target::Target;
+use crate::time::Duration;
+use clap::Args;
+use std::io::{self, BufRead, IsTerminal, Read, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, Args)]
+pub struct ConsoleArgs {
+    /// Script file; `-` or nothing reads standard input.
+    file: Option<PathBuf>,
+    /// Script text given on the command line (`;` separates operations).
+    #[arg(short = 'e', long = "exec", conflicts_with = "file")]
+    exec: Option<String>,
+    #[command(flatten)]
+    target: TargetArgs,
+    /// How long `wc` / `wd` wait for IBF = 0 before reporting a timeout.
+    #[arg(long, default_value = "1s", value_parser = parse_duration)]
+    ibf_timeout: Duration,
+    /// How long `rd` waits for OBF = 1 before reporting a timeout.
+    #[arg(long, default_value = "1s", value_parser = parse_duration)]
+    obf_timeout: Duration,
+    /// How long `await` waits when the script gives no timeout.
+    #[arg(long, default_value = "1s", value_parser = parse_duration)]
+    await_timeout: Duration,
+}
+
+pub fn run(args: ConsoleArgs) -> ExitCode {
+    let opts = ConsoleOptions {
+        ibf_timeout: args.ibf_timeout,
+        obf_timeout: args.obf_timeout,
+        await_timeout: args.await_timeout,
+    };
+    let mut target = match args.target.open() {
+        Ok(t) => t,
+        Err(e) => return e.exit(),
+    };
+    let from_stdin = args.exec.is_none() && args.file.as_ref().is_none_or(|f| f.as_os_str() == "-");
+    if from_stdin && io::stdin().is_terminal() {
+        return interactive(target.as_mut(), &opts);
+    }
+    let text = match (&args.exec, &args.file) {
+        (Some(e), _) => e.clone(),
+        (None, Some(f)) if f.as_os_str() != "-" => match std::fs::read_to_string(f) {
+            Ok(t) => t,
+            Err(e) => return usage_error(format!("cannot read {}: {e}", f.display())),
+        },
+        _ => {
+            let mut t = String::new();
+            if let Err(e) = io::stdin().read_to_string(&mut t) {
+                return usage_error(format!("cannot read standard input: {e}"));
+            }
+            t
+        }
+    };
+    let lines = match console::parse_script(&text) {
+        Ok(l) => l,
+        Err(e) => return script_error(&args.file, &e),
+    };
+    let stdout = io::stdout();
+    let mut out = stdout.lock();
+    match console::run(target.as_mut(), &lines, &opts, &mut out) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            let _ = out.flush();
+            eprintln!("ppmc: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn script_error(file: &Option<PathBuf>, e: &ScriptError) -> ExitCode {
+    match file {
+        Some(f) if f.as_os_str() != "-" => eprintln!("{}: {e}", f.display()),
+        _ => eprintln!("{e}"),
+    }
+    ExitCode::from(2)
+}
+
+/// Line by line at a terminal: a bad line is reported and skipped, so a
+/// typo at the bench does not end the session.
+fn interactive(target: &mut dyn Target, opts: &ConsoleOptions) -> ExitCode {
+    let stdin = io::stdin();
+    let stdout = io::stdout();
+    for (i, line) in stdin.lock().lines().enumerate() {
+        let line = match line {
+            Ok(l) => l,
+            Err(e) => return usage_error(format!("cannot read standard input: {e}")),
+        };
+        let parsed: Vec<Line> = match console::parse_line(&line, i + 1) {
+            Ok(p) => p,
+            Err(e) => {
+                eprintln!("{e}");
+                continue;
+            }
+        };
+        let mut out = stdout.lock();
+        if let Err(e) = console::run(target, &parsed, opts, &mut out) {
+            eprintln!("ppmc: {e}");
+            return ExitCode::from(1);
+        }
+    }
+    ExitCode::SUCCESS
+}

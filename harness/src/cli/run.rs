@@ -1,0 +1,241 @@
+//! `ppmc run`: the conformance suite on a target, graded, with reports.
+
+use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
+use super::progress::Progress;
+use crate::compare::{compare, Tolerances};
+use crate::golden::{self};
+use crate::report::{self, RunInfo, Tally};
+use crate::runner::run_suite;
+use crate::scenario::{DriverOptions, Failure, Grading, Scenario, ScenarioResult, Verdict};
+use crate::time::Duration;
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Which scenarios to take.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    #[command(flatten)]
+    pub(super) select: SelectArgs,
+    #[command(flatten)]
+    pub(super) target: TargetArgs,
+    /// Compare each scenario's trace with its golden trace in DIR as it runs.
+    #[arg(long, value_name = "DIR")]
+    pub(super) golden: Option<PathBuf>,
+    #[command(flatten)]
+    pub(super) tolerance: ToleranceArgs,
+    /// Write a JUnit XML report (one test case per scenario).
+    #[arg(long, value_name = "FILE")]
+    pub(super) junit: Option<PathBuf>,
+    /// Write a JSON run record (target, board, harness version, every
+    /// measurement with its limits).
+    #[arg(long, value_name = "FILE")]
+    pub(super) json: Option<PathBuf>,
+    /// Keep the trace and VCD of every scenario that did not pass here.
+    #[arg(long, value_name = "DIR")]
+    pub(super) artifacts: Option<PathBuf>,
+    /// Board revision label for the reports.
+    #[arg(long)]
+    pub(super) board_rev: Option<String>,
+    /// Run the selection this many times (soak runs).
+    #[arg(long, default_value_t = 1)]
+    pub(super) repeat: usize,
+    /// Width of the MARGINAL zone inside each Table 3-3 limit, in percent of
+    /// the limit.
+    #[arg(long, default_value_t = 0.25)]
+    pub(super) marginal: f64,
+}
+
+fn verdict_line(r: &ScenarioResult) -> String {
+    let tag = match r.verdict {
+        Verdict::Passed => "PASS",
+        Verdict::Marginal => "MARGINAL",
+        Verdict::Failed(_) => "FAIL",
+        Verdict::Error(_) => "ERROR",
+        Verdict::NotRun(_) => "NOT RUN",
+    };
+    let mut s = format!("{tag:<8} {} (section {})", r.name, r.section);
+    if let Some(d) = r.verdict.detail() {
+        s.push_str("\n         ");
+        s.push_str(&d);
+    }
+    s
+}
+
+/// Applies the golden comparison to a result: a divergence or an unusable
+/// golden file fails the scenario (never the process).
+fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) {
+    if !r.verdict.ok() {
+        return;
+    }
+    let Some(trace) = &r.trace else {
+        r.verdict = Verdict::Error("no capture to compare with the golden trace".into());
+        return;
+    };
+    let fail = |expectation: String, expected: String, got: String, at| {
+        Verdict::Failed(Failure {
+            expectation,
+            expected,
+            got,
+            at,
+        })
+    };
+    match golden::load(dir, r.name) {
+        Ok(g) => {
+            if let Err(d) = compare(&g, trace, tol) {
+                r.verdict = fail(
+                    format!("golden trace: first divergence in {}", d.quantity),
+                    format!("{} (allowed {})", d.golden, d.allowed),
+                    d.got,
+                    d.at,
+                );
+            }
+        }
+        Err(e) => {
+            r.verdict = fail(
+                "golden trace usable".into(),
+                "a valid golden file".into(),
+                e.to_string(),
+                crate::time::Instant::ZERO,
+            );
+        }
+    }
+}
+
+fn save_artifacts(dir: &Path, r: &ScenarioResult) -> Result<(), String> {
+    let Some(trace) = &r.trace else { return Ok(()) };
+    let text = trace.render();
+    let tpath = dir.join(format!("{}.trace", r.name));
+    golden::write_atomic(&tpath, text.as_bytes())
+        .map_err(|e| format!("{}: {e}", tpath.display()))?;
+    let vpath = dir.join(format!("{}.vcd", r.name));
+    let mut buf = Vec::new();
+    crate::vcd_export::export(trace, &mut buf).map_err(|e| format!("{}: {e}", vpath.display()))?;
+    golden::write_atomic(&vpath, &buf).map_err(|e| format!("{}: {e}", vpath.display()))
+}
+
+fn write_report(path: &Path, text: Result<String, String>) -> Result<(), String> {
+    let text = text.map_err(|e| format!("{}: {e}", path.display()))?;
+    golden::write_atomic(path, text.as_bytes()).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+fn summary_lines(t: &Tally, results: usize) {
+    println!(
+        "{results} scenarios: {} passed, {} marginal, {} failed, {} errors, {} not run",
+        t.passed, t.marginal, t.failed, t.errors, t.not_run
+    );
+    // The closing line CI log readers look for.
+    println!(
+        "suite: {} passed, {} failed",
+        t.passed + t.marginal,
+        t.failed + t.errors + t.not_run
+    );
+}
+
+impl RunArgs {
+    fn target_name(&self) -> String {
+        self.target.name().to_string()
+    }
+}
+
+pub fn run(args: RunArgs, suite: &[Scenario]) -> ExitCode {
+    let scenarios = match args.select.scenarios(suite) {
+        Ok(s) => s,
+        Err(e) => return super::usage_error(e),
+    };
+    let tol = match args.tolerance.tolerances() {
+        Ok(t) => t,
+        Err(e) => return super::usage_error(e),
+    };
+    if !(args.marginal.is_finite() && (0.0..=50.0).contains(&args.marginal)) {
+        return super::usage_error(format!(
+            "--marginal {}: give a percentage from 0 to 50",
+            args.marginal
+        ));
+    }
+    if let Some(dir) = &args.golden {
+        if !dir.is_dir() {
+            return super::usage_error(format!("{}: golden directory not found", dir.display()));
+        }
+    }
+    let mut target = match args.target.open() {
+        Ok(t) => t,
+        Err(e @ super::OpenError::Infrastructure(_)) => {
+            // Nothing ran: say so in the reports too, so CI shows an
+            // infrastructure problem rather than a bad board.
+            let why = e.to_string();
+            let results: Vec<ScenarioResult> = scenarios
+                .iter()
+                .map(|s| ScenarioResult {
+                    name: s.name,
+                    section: s.section,
+                    tags: s.tags,
+                    verdict: Verdict::NotRun(why.clone()),
+                    measurements: Vec::new(),
+                    trace: None,
+                    elapsed: Duration::ZERO,
+                })
+                .collect();
+            let info = RunInfo::new(
+                &crate::target::TargetInfo {
+                    name: args.target_name(),
+                    details: Vec::new(),
+                },
+                args.board_rev.clone(),
+            );
+            let _ = args
+                .junit
+                .as_ref()
+                .map(|p| write_report(p, report::junit(&info, &results)));
+            let _ = args
+                .json
+                .as_ref()
+                .map(|p| write_report(p, report::json(&info, &results)));
+            summary_lines(&Tally::of(&results), results.len());
+            return e.exit();
+        }
+        Err(e) => return e.exit(),
+    };
+    let info = RunInfo::new(&target.info(), args.board_rev.clone());
+    let opts = DriverOptions {
+        grading: Grading {
+            marginal_bp: (args.marginal * 100.0).round() as u64,
+        },
+        ..DriverOptions::default()
+    };
+    let progress = Progress::new(scenarios.len() * args.repeat.max(1));
+    let mut problems = Vec::new();
+    let results = run_suite(target.as_mut(), &scenarios, args.repeat, opts, |r| {
+        if let Some(dir) = &args.golden {
+            check_golden(r, dir, &tol);
+        }
+        progress.step(r.name);
+        progress.line(&verdict_line(r));
+        if let (Some(dir), false) = (&args.artifacts, r.verdict.ok()) {
+            if let Err(e) = save_artifacts(dir, r) {
+                problems.push(e);
+            }
+        }
+    });
+    progress.finish();
+    let tally = Tally::of(&results);
+    if let Some(p) = &args.junit {
+        if let Err(e) = write_report(p, report::junit(&info, &results)) {
+            problems.push(e);
+        }
+    }
+    if let Some(p) = &args.json {
+        if let Err(e) = write_report(p, report::json(&info, &results)) {
+            problems.push(e);
+        }
+    }
+    summary_lines(&tally, results.len());
+    for p in &problems {
+        eprintln!("ppmc: {p}");
+    }
+    if tally.ok() && problems.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    }
+}
