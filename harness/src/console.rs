@@ -6,9 +6,9 @@
 //! [`run`] executes statements on a [`Target`] and prints one line per
 //! result.
 
+use crate::backend::{Op, Reply, Target, TargetError};
 pub use crate::protocol::Flag;
 use crate::protocol::{Direction, Input, Status};
-use crate::target::{Op, Reply, Target, TargetError};
 use crate::time::Duration;
 use crate::trace::BusEvent;
 use std::fmt;
@@ -433,7 +433,7 @@ pub fn run(
             return Err(ConsoleError::Target {
                 line: chunk.first().map_or(0, |l| l.line),
                 source: TargetError {
-                    kind: crate::target::TargetErrorKind::Other,
+                    kind: crate::backend::TargetErrorKind::Other,
                     message: format!(
                         "target answered {} of {} operations",
                         replies.len(),

@@ -3,11 +3,11 @@
 //! golden trace comparison, and a bounded differential fuzz against the
 //! emulator. Which caught it, with what, after how much wall time.
 
+use crate::backend::{Target, TargetError};
 use crate::compare::{compare, Tolerances};
 use crate::fuzzing::differential::{self, DiffSettings};
 use crate::runner::run_suite;
 use crate::scenario::{DriverOptions, Scenario, Verdict};
-use crate::target::{Target, TargetError};
 use std::path::Path;
 use std::time::{Duration as WallDuration, Instant as WallClock};
 
@@ -103,7 +103,7 @@ pub fn check_board(
     });
     if let Some(message) = link_error {
         return Err(TargetError {
-            kind: crate::target::TargetErrorKind::Link,
+            kind: crate::backend::TargetErrorKind::Link,
             message,
         });
     }

@@ -1,11 +1,16 @@
 //! ppmc: a hardware-in-the-loop harness, reference emulator and protocol
 //! fuzzer for the PPMC-104BFP stepper-motor pulse controller.
 //!
-//! Layers, each depending only on the ones before it:
-//! [`protocol`] (pure wire types) ← [`emu`] (the chip model) ← [`target`]
-//! (one bus abstraction, many backends) ← [`console`] (bus scripts) ← the
-//! `ppmc` binary.
+//! The std half of ppmc: everything that needs an operating system, on top
+//! of the portable `ppmc-core` (re-exported here as [`time`], [`protocol`],
+//! [`emu`] and [`bus`]). Layers, each depending only on the ones before it:
+//! [`backend`] (one bus abstraction, many backends: the emulator, a serial
+//! bridge) and [`bridge::sim`] ← [`scenario`] (the scenario API) ←
+//! [`runner`], [`trace`], [`golden`], [`compare`], [`report`],
+//! [`console`] ← [`fuzzing`], [`fault_matrix`] ← [`cli`] (the command
+//! line). `ARCHITECTURE.md` at the repository root is the map.
 
+pub mod backend;
 pub mod bridge;
 pub mod cli;
 pub mod compare;
@@ -17,7 +22,6 @@ pub mod golden;
 pub mod report;
 pub mod runner;
 pub mod scenario;
-pub mod target;
 pub mod trace;
 pub mod vcd_export;
 

@@ -1,8 +1,8 @@
 //! Run reports: JUnit XML for CI systems, and a JSON run record with every
 //! measurement and its limits.
 
+use crate::backend::TargetInfo;
 use crate::scenario::{Grade, ScenarioResult, Verdict};
-use crate::target::TargetInfo;
 use quick_junit::{NonSuccessKind, Report, TestCase, TestCaseStatus, TestSuite};
 use serde::Serialize;
 

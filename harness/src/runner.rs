@@ -1,8 +1,8 @@
 //! Running a suite: choosing scenarios, running them one after another on
 //! a target, and keeping going when one fails or errors.
 
+use crate::backend::{Op, Target};
 use crate::scenario::{run_scenario, DriverOptions, Scenario, ScenarioResult, Verdict};
-use crate::target::{Op, Target};
 use crate::time::Duration;
 
 /// Which scenarios a run takes.
@@ -188,7 +188,7 @@ mod tests {
             Scenario::new("c_fails", "3-1", "", &[], fails),
             Scenario::new("d_passes", "3-1", "", &[], ok),
         ];
-        let mut t = crate::target::EmuTarget::new(Default::default(), Default::default())
+        let mut t = crate::backend::EmuTarget::new(Default::default(), Default::default())
             .expect("emulator");
         let r = run_suite(&mut t, &suite, 1, DriverOptions::default(), |_| {});
         let v: Vec<&str> = r.iter().map(|r| r.verdict.label()).collect();

@@ -3,12 +3,12 @@
 
 mod common;
 
+use ppmc::backend::{EmuTarget, SerialError, SerialLink, SerialOptions, SerialTarget};
 use ppmc::bridge::sim::{LinkFaults, PtyBridge};
 use ppmc::emu::{Faults, ModelConfig};
 use ppmc::protocol::Straps;
 use ppmc::runner::run_suite;
 use ppmc::scenario::{DriverOptions, ScenarioResult, Verdict};
-use ppmc::target::{EmuTarget, SerialError, SerialLink, SerialOptions, SerialTarget};
 use std::time::Duration as WallDuration;
 
 /// A bridge simulator serving on its own thread.
@@ -147,13 +147,13 @@ fn a_stalled_bridge_gives_a_timeout_naming_the_op() {
         ModelConfig::default(),
     );
     let mut t = sim.target(fast()).expect("healthy before the stall");
-    let err = ppmc::target::Target::execute(&mut t, &[ppmc::target::Op::ReadStatus])
+    let err = ppmc::backend::Target::execute(&mut t, &[ppmc::backend::Op::ReadStatus])
         .map(|_| ())
         .and_then(|_| {
-            ppmc::target::Target::execute(&mut t, &[ppmc::target::Op::ReadPins]).map(|_| ())
+            ppmc::backend::Target::execute(&mut t, &[ppmc::backend::Op::ReadPins]).map(|_| ())
         })
         .expect_err("no answer");
-    assert_eq!(err.kind, ppmc::target::TargetErrorKind::Link);
+    assert_eq!(err.kind, ppmc::backend::TargetErrorKind::Link);
     assert!(
         err.message.contains("no bridge answering"),
         "{}",
@@ -228,8 +228,8 @@ fn a_disconnect_mid_run_ends_with_the_rest_not_run() {
 
 #[test]
 fn a_realtime_bridge_takes_as_long_as_its_waits_and_the_host_waits_for_it() {
+    use ppmc::backend::{Op, Reply, Target};
     use ppmc::bridge::sim::BridgeOptions;
-    use ppmc::target::{Op, Reply, Target};
     use ppmc::time::Duration;
     let emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
     let bridge = BridgeOptions {

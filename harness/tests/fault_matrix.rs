@@ -2,11 +2,11 @@
 //! catalogue is caught by the conformance suite, the golden comparison or
 //! a bounded differential fuzz, and the clean board by none of them.
 
+use ppmc::backend::EmuTarget;
 use ppmc::emu::ModelConfig;
 use ppmc::fault_matrix::{all_as_expected, check_board, render, FuzzBudget};
 use ppmc::faults::CATALOGUE;
 use ppmc::protocol::Straps;
-use ppmc::target::EmuTarget;
 use std::path::Path;
 
 #[test]

@@ -37,11 +37,11 @@ fn frame_decoder_corpus_replays() {
 #[test]
 #[ignore]
 fn write_frame_decoder_seeds() {
+    use ppmc::backend::{EmuTarget, Op};
     use ppmc::bridge::frame::encode;
     use ppmc::bridge::sim::engine;
     use ppmc::bridge::wire::{fragment, Request, Timer};
     use ppmc::protocol::{Input, Straps};
-    use ppmc::target::{EmuTarget, Op};
     use ppmc::time::Duration;
 
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/frame_decoder");

@@ -3,12 +3,12 @@
 //! failed by at least one mutant (so no scenario is unable to fail), and
 //! every mutant must be caught.
 
+use ppmc::backend::EmuTarget;
 use ppmc::compare::{compare, Tolerances};
 use ppmc::emu::{Faults, ModelConfig};
 use ppmc::protocol::{ErrorCode, Straps};
 use ppmc::runner::run_suite;
 use ppmc::scenario::{DriverOptions, Failure, ScenarioResult, Verdict};
-use ppmc::target::EmuTarget;
 use ppmc::time::Duration;
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -1,10 +1,10 @@
 //! The whole conformance suite passes on the reference emulator.
 
+use ppmc::backend::EmuTarget;
 use ppmc::emu::ModelConfig;
 use ppmc::protocol::Straps;
 use ppmc::runner::{run_suite, validate_suite};
 use ppmc::scenario::DriverOptions;
-use ppmc::target::EmuTarget;
 
 #[test]
 fn every_scenario_passes_on_the_emulator() {

@@ -4,7 +4,6 @@
 
 use super::engine::BridgeEngine;
 use crate::bus::EmuBus;
-use crate::target::EmuTarget;
 use crate::time::{Duration, Instant};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -16,11 +15,12 @@ use std::time::{Duration as WallDuration, Instant as WallInstant};
 /// What `ppmc bridge-sim` runs: the bridge engine over the reference model.
 pub type SimEngine = BridgeEngine<EmuBus>;
 
-/// The simulator's engine in front of `emu`; `session` should differ
-/// between runs.
-pub fn engine(emu: EmuTarget, session: u32, virtual_time: bool) -> SimEngine {
+/// The simulator's engine in front of the emulated chip `emu` (an
+/// [`EmuBus`], or anything that becomes one, such as an `EmuTarget`);
+/// `session` should differ between runs.
+pub fn engine(emu: impl Into<EmuBus>, session: u32, virtual_time: bool) -> SimEngine {
     BridgeEngine::new(
-        emu.into_bus(),
+        emu.into(),
         session,
         virtual_time,
         format!("ppmc-bridge-sim {}", crate::VERSION),
@@ -201,18 +201,19 @@ pub struct PtyBridge {
 
 impl PtyBridge {
     /// Serves `emu` (in virtual time) with `faults` on the link.
-    pub fn start(emu: EmuTarget, faults: LinkFaults) -> io::Result<PtyBridge> {
+    pub fn start(emu: impl Into<EmuBus>, faults: LinkFaults) -> io::Result<PtyBridge> {
         Self::start_with(emu, faults, BridgeOptions::default())
     }
 
     /// Serves `emu` as a bridge set up by `bridge`, with `faults` on the
     /// link.
     pub fn start_with(
-        emu: EmuTarget,
+        emu: impl Into<EmuBus>,
         faults: LinkFaults,
         bridge: BridgeOptions,
     ) -> io::Result<PtyBridge> {
         use serialport::SerialPort;
+        let emu: EmuBus = emu.into();
         let (mut master, slave) = serialport::TTYPort::pair().map_err(io::Error::other)?;
         master
             .set_timeout(WallDuration::from_millis(20))

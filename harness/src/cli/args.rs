@@ -1,12 +1,12 @@
 //! The argument groups several commands share: the target and its straps,
 //! the scenario selection, the comparison tolerances.
 
+use crate::backend::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use crate::compare::Tolerances;
 use crate::emu::{AccelCurve, ModelConfig};
 use crate::protocol::Straps;
 use crate::runner::{parse_shard, validate_suite, Selection};
 use crate::scenario::Scenario;
-use crate::target::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use crate::time::Duration;
 use clap::{Args, ValueEnum};
 use std::process::ExitCode;
@@ -99,13 +99,13 @@ impl TargetArgs {
             return Ok(Box::new(t));
         }
         if self.target.starts_with("serial:") {
-            let (path, baud) = crate::target::parse_spec(&self.target).ok_or_else(|| {
+            let (path, baud) = crate::backend::parse_spec(&self.target).ok_or_else(|| {
                 OpenError::Usage(format!(
                     "bad target `{}`: write serial:<path>[,baud=N]",
                     self.target
                 ))
             })?;
-            let infra = |e: crate::target::SerialError| OpenError::Infrastructure(e.to_string());
+            let infra = |e: crate::backend::SerialError| OpenError::Infrastructure(e.to_string());
             let link = SerialLink::open(&path, baud).map_err(infra)?;
             let t = SerialTarget::open(link, SerialOptions::default()).map_err(infra)?;
             return Ok(Box::new(t));

@@ -2,10 +2,10 @@
 //! table (the source of `docs/performance.md`). Timings live here and never
 //! in tests: the machines are shared and noisy.
 
+use crate::backend::{EmuTarget, Op, Reply, Target};
 use crate::emu::ModelConfig;
 use crate::protocol::{InitData, PulseCount, Status, Straps};
 use crate::scenario::Scenario;
-use crate::target::{EmuTarget, Op, Reply, Target};
 use crate::time::Duration;
 use clap::Args;
 use std::process::ExitCode;
@@ -177,10 +177,10 @@ pub fn run(args: BenchArgs, suite: &[Scenario]) -> ExitCode {
 /// The conformance suite in process and over a pseudo-terminal to the
 /// bridge simulator: wall time and round trips.
 fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> ExitCode {
+    use crate::backend::{SerialLink, SerialOptions, SerialTarget};
     use crate::bridge::sim::{LinkFaults, PtyBridge};
     use crate::runner::run_suite;
     use crate::scenario::DriverOptions;
-    use crate::target::{SerialLink, SerialOptions, SerialTarget};
 
     let mut local = Vec::new();
     for _ in 0..repeat {

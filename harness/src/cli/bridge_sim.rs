@@ -3,7 +3,7 @@
 
 use super::args::TargetArgs;
 use super::usage_error;
-use crate::target::EmuTarget;
+use crate::backend::EmuTarget;
 use clap::Args;
 use std::io::{self, Write};
 use std::path::PathBuf;

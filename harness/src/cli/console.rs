@@ -2,8 +2,8 @@
 
 use super::args::{parse_duration, TargetArgs};
 use super::usage_error;
+use crate::backend::Target;
 use crate::console::{self, ConsoleOptions, Line, ScriptError};
-use crate::target::Target;
 use crate::time::Duration;
 use clap::Args;
 use std::io::{self, BufRead, IsTerminal, Read, Write};

@@ -1,13 +1,13 @@
 //! `ppmc fault-matrix`: every catalogued board fault against the suite,
 //! the golden traces and a bounded differential fuzz, over the pty.
 
+use crate::backend::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use crate::bridge::sim::{LinkFaults, PtyBridge};
 use crate::emu::ModelConfig;
 use crate::fault_matrix::{self, FuzzBudget, Row};
 use crate::faults::{self, CATALOGUE};
 use crate::protocol::Straps;
 use crate::scenario::Scenario;
-use crate::target::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -177,7 +177,7 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> ExitCode {
                 })
                 .collect();
             let info = RunInfo::new(
-                &crate::target::TargetInfo {
+                &crate::backend::TargetInfo {
                     name: args.target_name(),
                     details: Vec::new(),
                 },

@@ -5,11 +5,11 @@
 //! counts exactly). The seed alone replays a run.
 
 use super::actions::{self, Action};
+use crate::backend::{EmuTarget, Op, Reply, Target, TargetError, TargetErrorKind};
 use crate::compare::{compare, Divergence, Tolerances};
 use crate::console::{self, ConsoleOptions};
 use crate::emu::ModelConfig;
 use crate::protocol::{Record, Status, Straps};
-use crate::target::{EmuTarget, Op, Reply, Target, TargetError, TargetErrorKind};
 use crate::trace::{Event, EventKind, Trace};
 use rand::{Rng, SeedableRng};
 use std::fmt::Write as _;

@@ -235,10 +235,10 @@ pub fn reproducer_with(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::backend::EmuTarget;
     use crate::console;
     use crate::emu::Faults;
     use crate::protocol::Straps;
-    use crate::target::EmuTarget;
     use crate::time::Duration;
     use bus::BusOp::*;
 

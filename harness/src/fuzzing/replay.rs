@@ -6,9 +6,9 @@
 
 use super::bus::BusOp;
 use super::oracle::{self, Judge, Seen, Violation};
+use crate::backend::{Op, Reply, Target, TargetError};
 use crate::protocol::Record;
 use crate::scenario::{Driver, Failure, Outcome, Stop};
-use crate::target::{Op, Reply, Target, TargetError};
 use crate::trace::BusEvent;
 
 /// The body of a regression scenario written by `ppmc fuzz to-scenario`:
@@ -138,7 +138,7 @@ pub fn replay(target: &mut dyn Target, ops: &[BusOp]) -> Result<Option<Found>, T
     target.execute(&[Op::Reset])?;
     let (replies, capture) = target.execute_then_capture(&probed_ops(ops))?;
     judge(ops, &replies, &capture).map_err(|message| TargetError {
-        kind: crate::target::TargetErrorKind::Other,
+        kind: crate::backend::TargetErrorKind::Other,
         message,
     })
 }

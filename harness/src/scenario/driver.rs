@@ -4,11 +4,11 @@
 
 use super::grade::{Grade, Grading, Measurement};
 use super::{Failure, Move, Outcome, Stop};
+use crate::backend::{Op, Reply, Target};
 use crate::protocol::{
     ClockSource, Direction, ErrorCode, Excitation, Flag, InitCommand, InitData, Input, MotorType,
     OutputLogic, Pin, Pins, Record, Register, Status, StatusField, Straps, TimingId,
 };
-use crate::target::{Op, Reply, Target};
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, Event, EventKind};
 

@@ -14,8 +14,8 @@ pub use grade::{Grade, Grading, Measurement};
 /// Declares a scenario where it is written; see the `ppmc-macros` crate.
 pub use ppmc_macros::scenario;
 
+use crate::backend::Target;
 use crate::protocol::{Command, Direction, MoveCommand, MoveKind, PulseCount};
-use crate::target::Target;
 use crate::time::{Duration, Instant};
 use crate::trace::{Event, EventKind, Trace};
 use std::fmt;

@@ -5,11 +5,11 @@
 
 #![allow(dead_code)] // each test file uses a different part of the helper
 
+use ppmc::backend::{EmuTarget, Op, Reply, Target};
 use ppmc::emu::{Chip, ModelConfig};
 use ppmc::protocol::{
     Direction, ErrorCode, InitData, Input, MoveCommand, MoveKind, PulseCount, Status, Straps,
 };
-use ppmc::target::{EmuTarget, Op, Reply, Target};
 use ppmc::time::{Duration, Instant};
 
 pub const US: fn(u64) -> Duration = Duration::from_micros;

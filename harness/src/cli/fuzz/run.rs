@@ -1,8 +1,8 @@
 //! `ppmc fuzz [run] --target <t>`: a differential run against a target.
 
+use crate::backend::{EmuTarget, Target};
 use crate::cli::args::TargetArgs;
 use crate::fuzzing::differential::{self, DiffSettings};
-use crate::target::{EmuTarget, Target};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;

@@ -32,9 +32,11 @@ impl EmuTarget {
     pub fn bus(&self) -> &EmuBus {
         &self.bus
     }
+}
 
-    pub fn into_bus(self) -> EmuBus {
-        self.bus
+impl From<EmuTarget> for EmuBus {
+    fn from(t: EmuTarget) -> EmuBus {
+        t.bus
     }
 }
 

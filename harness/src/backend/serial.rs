@@ -9,13 +9,13 @@
 //! the run cannot go on safely and the error says so.
 
 use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
-use crate::bridge::frame::{self, FrameDecoder};
-use crate::bridge::wire::MAX_BATCH_OPS;
-use crate::bridge::wire::{
+use crate::protocol::Record;
+use ppmc_core::bridge::frame::{self, FrameDecoder};
+use ppmc_core::bridge::wire::MAX_BATCH_OPS;
+use ppmc_core::bridge::wire::{
     self, parse_fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer,
     PROTOCOL_VERSION,
 };
-use crate::protocol::Record;
 use std::fmt;
 use std::io::{self, Read, Write};
 use std::time::{Duration as WallDuration, Instant as WallInstant};
@@ -855,16 +855,16 @@ pub fn parse_spec(spec: &str) -> Option<(String, u32)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bridge::sim::{engine, SimEngine};
     use crate::emu::ModelConfig;
     use crate::protocol::Straps;
-    use crate::target::EmuTarget;
     use crate::time::Duration;
+    use ppmc_core::bridge::engine::BridgeEngine;
+    use ppmc_core::bus::EmuBus;
 
     /// A link straight into a bridge server, which fails on demand.
     #[derive(Debug)]
     struct MemLink {
-        server: SimEngine,
+        server: BridgeEngine<EmuBus>,
         pending: Vec<u8>,
         fail_sends: u32,
         fail_reopens: u32,
@@ -882,9 +882,9 @@ mod tests {
             }
         }
 
-        fn bridge(session: u32) -> SimEngine {
-            let emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emu");
-            engine(emu, session, true)
+        fn bridge(session: u32) -> BridgeEngine<EmuBus> {
+            let bus = EmuBus::new(Straps::default(), ModelConfig::default()).expect("emu");
+            BridgeEngine::new(bus, session, true, "test-bridge")
         }
     }
 
@@ -957,7 +957,8 @@ mod tests {
         // one before: no run-length saving at all).
         let steps: [fn(Duration) -> Duration; 2] = [|p| p, |p| p.scale(13, 10)];
         for step in steps {
-            let mut emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emu");
+            let mut emu = crate::backend::EmuTarget::new(Straps::default(), ModelConfig::default())
+                .expect("emu");
             let want = sample_a_move(&mut emu, step, 3_000);
             let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
             let before = t.stats.round_trips;
