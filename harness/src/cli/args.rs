@@ -1,6 +1,7 @@
 //! The argument groups several commands share: the target and its straps,
 //! the scenario selection, the comparison tolerances.
 
+use super::CliError;
 use crate::backend::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use crate::compare::Tolerances;
 use crate::emu::{AccelCurve, ModelConfig};
@@ -9,7 +10,6 @@ use crate::runner::{parse_shard, validate_suite, Selection};
 use crate::scenario::Scenario;
 use crate::time::Duration;
 use clap::{Args, ValueEnum};
-use std::process::ExitCode;
 
 /// Which chip to drive, and how its board is strapped.
 #[derive(Debug, Args)]
@@ -136,13 +136,11 @@ impl std::fmt::Display for OpenError {
     }
 }
 
-impl OpenError {
-    /// Reports the error and gives the exit status.
-    pub fn exit(&self) -> ExitCode {
-        eprintln!("ppmc: {self}");
-        match self {
-            OpenError::Usage(_) => ExitCode::from(2),
-            OpenError::Infrastructure(_) => ExitCode::from(1),
+impl From<OpenError> for CliError {
+    fn from(e: OpenError) -> CliError {
+        match e {
+            OpenError::Usage(m) => CliError::Usage(m),
+            OpenError::Infrastructure(m) => CliError::Infrastructure(m),
         }
     }
 }

@@ -3,12 +3,12 @@
 //! in tests: the machines are shared and noisy.
 
 use crate::backend::{EmuTarget, Op, Reply, Target};
+use crate::cli::CliError;
 use crate::emu::ModelConfig;
 use crate::protocol::{InitData, PulseCount, Status, Straps};
 use crate::scenario::Scenario;
 use crate::time::Duration;
 use clap::Args;
-use std::process::ExitCode;
 use std::time::Instant as WallClock;
 
 #[derive(Debug, Args)]
@@ -107,7 +107,7 @@ fn time_case(repeat: usize, f: impl Fn() -> Outcome) -> (f64, Outcome) {
     (median_ms(samples), outcome)
 }
 
-pub fn run(args: BenchArgs, suite: &[Scenario]) -> ExitCode {
+pub fn run(args: BenchArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let max_ramp = InitData {
         rl: 200,
         rh: 20,
@@ -158,7 +158,7 @@ pub fn run(args: BenchArgs, suite: &[Scenario]) -> ExitCode {
     // Per-pulse expansion of the longest record, on request.
     let Some((t, _)) = run_move(max_ramp, 0x43, &full) else {
         eprintln!("ppmc bench: the emulator could not be built");
-        return ExitCode::from(1);
+        return Err(CliError::Verdict);
     };
     let t0 = WallClock::now();
     let mut pulses = 0u64;
@@ -176,7 +176,7 @@ pub fn run(args: BenchArgs, suite: &[Scenario]) -> ExitCode {
 
 /// The conformance suite in process and over a pseudo-terminal to the
 /// bridge simulator: wall time and round trips.
-fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> ExitCode {
+fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> Result<(), CliError> {
     use crate::backend::{SerialLink, SerialOptions, SerialTarget};
     use crate::bridge::sim::{LinkFaults, PtyBridge};
     use crate::runner::run_suite;
@@ -185,7 +185,7 @@ fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> ExitCode {
     let mut local = Vec::new();
     for _ in 0..repeat {
         let Ok(mut t) = EmuTarget::new(Straps::default(), ModelConfig::default()) else {
-            return ExitCode::from(1);
+            return Err(CliError::Verdict);
         };
         let t0 = WallClock::now();
         run_suite(&mut t, suite, 1, DriverOptions::default(), |_| {});
@@ -198,7 +198,7 @@ fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> ExitCode {
         Ok(s) => s,
         Err(e) => {
             eprintln!("ppmc bench: no bridge simulator: {e}");
-            return ExitCode::from(1);
+            return Err(CliError::Verdict);
         }
     };
     let path = sim.path().to_string();
@@ -209,7 +209,7 @@ fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> ExitCode {
             .and_then(|l| SerialTarget::open(l, SerialOptions::default()));
         let Ok(mut t) = target else {
             eprintln!("ppmc bench: the bridge simulator did not answer");
-            return ExitCode::from(1);
+            return Err(CliError::Verdict);
         };
         let t0 = WallClock::now();
         run_suite(&mut t, suite, 1, DriverOptions::default(), |_| {});
@@ -226,5 +226,5 @@ fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> ExitCode {
         trips as f64 / suite.len() as f64
     );
     println!("\nover the pty / in process: {:.1}x", r / l.max(1e-9));
-    ExitCode::SUCCESS
+    Ok(())
 }

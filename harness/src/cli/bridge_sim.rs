@@ -2,12 +2,11 @@
 //! emulator behind it.
 
 use super::args::TargetArgs;
-use super::usage_error;
 use crate::backend::EmuTarget;
+use crate::cli::{usage, CliError};
 use clap::Args;
 use std::io::{self, Write};
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 #[derive(Debug, Args)]
 pub struct BridgeSimArgs {
@@ -48,7 +47,7 @@ pub struct BridgeSimArgs {
     chip_faults: Vec<String>,
 }
 
-pub fn run(args: BridgeSimArgs) -> ExitCode {
+pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     use crate::bridge::sim::engine;
     use crate::bridge::sim::{serve, LinkFaults, ServeEnd};
     use serialport::SerialPort;
@@ -60,41 +59,49 @@ pub fn run(args: BridgeSimArgs) -> ExitCode {
         ("--corrupt-rate", args.corrupt_rate),
     ] {
         if !(0.0..=1.0).contains(&rate) {
-            return usage_error(format!("{name} {rate}: give a probability from 0 to 1"));
+            return Err(usage(format!(
+                "{name} {rate}: give a probability from 0 to 1"
+            )));
         }
     }
     if args.target.name() != "emu" {
-        return usage_error("bridge-sim serves the emulator; --target must be emu");
+        return Err(usage(
+            "bridge-sim serves the emulator; --target must be emu",
+        ));
     }
     let straps = match args.target.straps() {
         Ok(s) => s,
-        Err(e) => return usage_error(e),
+        Err(e) => return Err(usage(e)),
     };
     let mut model = args.target.model();
     if let Err(e) = crate::faults::apply_all(&args.chip_faults, &mut model) {
-        return usage_error(format!("--chip-fault: {e}"));
+        return Err(usage(format!("--chip-fault: {e}")));
     }
     let emu = match EmuTarget::new(straps, model) {
         Ok(t) => t,
-        Err(e) => return usage_error(e),
+        Err(e) => return Err(usage(e)),
     };
     let (mut master, slave) = match serialport::TTYPort::pair() {
         Ok(p) => p,
         Err(e) => {
-            eprintln!("ppmc: cannot open a pseudo-terminal: {e}");
-            return ExitCode::from(1);
+            return Err(CliError::Failed(format!(
+                "cannot open a pseudo-terminal: {e}"
+            )));
         }
     };
     let _ = master.set_timeout(std::time::Duration::from_millis(50));
     let Some(path) = slave.name() else {
-        eprintln!("ppmc: the pseudo-terminal has no path");
-        return ExitCode::from(1);
+        return Err(CliError::Failed(
+            "the pseudo-terminal has no path".to_string(),
+        ));
     };
     if let Some(link) = &args.link {
         let _ = std::fs::remove_file(link);
         if let Err(e) = std::os::unix::fs::symlink(&path, link) {
-            eprintln!("ppmc: cannot link {} to {path}: {e}", link.display());
-            return ExitCode::from(1);
+            return Err(CliError::Failed(format!(
+                "cannot link {} to {path}: {e}",
+                link.display()
+            )));
         }
     }
     let session = std::time::SystemTime::now()
@@ -129,12 +136,9 @@ pub fn run(args: BridgeSimArgs) -> ExitCode {
                 "bridge-sim: disconnected after {} frames (fault)",
                 server.frames
             );
-            ExitCode::SUCCESS
+            Ok(())
         }
-        Ok(ServeEnd::Stopped) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("ppmc: bridge-sim: {e}");
-            ExitCode::from(1)
-        }
+        Ok(ServeEnd::Stopped) => Ok(()),
+        Err(e) => Err(CliError::Failed(format!("bridge-sim: {e}"))),
     }
 }

@@ -1,12 +1,12 @@
 //! `ppmc compare`: a golden trace set against traces or a fresh run.
 
 use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
+use crate::cli::{usage, CliError};
 use crate::compare::compare;
 use crate::golden::{self};
 use crate::scenario::Scenario;
 use clap::Args;
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 /// Which scenarios to take.
 #[derive(Debug, Args)]
@@ -25,20 +25,20 @@ pub struct CompareArgs {
     tolerance: ToleranceArgs,
 }
 
-pub fn run(args: CompareArgs, suite: &[Scenario]) -> ExitCode {
+pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let tol = match args.tolerance.tolerances() {
         Ok(t) => t,
-        Err(e) => return super::usage_error(e),
+        Err(e) => return Err(usage(e)),
     };
     if !args.golden.is_dir() {
-        return super::usage_error(format!(
+        return Err(usage(format!(
             "{}: golden directory not found",
             args.golden.display()
-        ));
+        )));
     }
     let scenarios = match args.select.scenarios(suite) {
         Ok(s) => s,
-        Err(e) => return super::usage_error(e),
+        Err(e) => return Err(usage(e)),
     };
     let Some(dir) = &args.traces else {
         // Against a target: the run itself, with the golden check.
@@ -57,7 +57,10 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> ExitCode {
         return super::run::run(run_args, suite);
     };
     if !dir.is_dir() {
-        return super::usage_error(format!("{}: trace directory not found", dir.display()));
+        return Err(usage(format!(
+            "{}: trace directory not found",
+            dir.display()
+        )));
     }
     let (mut ok, mut bad) = (0usize, 0usize);
     for s in &scenarios {
@@ -84,8 +87,8 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> ExitCode {
     }
     println!("compare: {ok} passed, {bad} failed");
     if bad == 0 {
-        ExitCode::SUCCESS
+        Ok(())
     } else {
-        ExitCode::from(1)
+        Err(CliError::Verdict)
     }
 }

@@ -1,14 +1,13 @@
 //! `ppmc console`: a bus script against a target, one line per result.
 
 use super::args::{parse_duration, TargetArgs};
-use super::usage_error;
 use crate::backend::Target;
+use crate::cli::{usage, CliError};
 use crate::console::{self, ConsoleOptions, Line, ScriptError};
 use crate::time::Duration;
 use clap::Args;
 use std::io::{self, BufRead, IsTerminal, Read, Write};
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 #[derive(Debug, Args)]
 pub struct ConsoleArgs {
@@ -30,16 +29,13 @@ pub struct ConsoleArgs {
     await_timeout: Duration,
 }
 
-pub fn run(args: ConsoleArgs) -> ExitCode {
+pub fn run(args: ConsoleArgs) -> Result<(), CliError> {
     let opts = ConsoleOptions {
         ibf_timeout: args.ibf_timeout,
         obf_timeout: args.obf_timeout,
         await_timeout: args.await_timeout,
     };
-    let mut target = match args.target.open() {
-        Ok(t) => t,
-        Err(e) => return e.exit(),
-    };
+    let mut target = args.target.open()?;
     let from_stdin = args.exec.is_none() && args.file.as_ref().is_none_or(|f| f.as_os_str() == "-");
     if from_stdin && io::stdin().is_terminal() {
         return interactive(target.as_mut(), &opts);
@@ -48,12 +44,12 @@ pub fn run(args: ConsoleArgs) -> ExitCode {
         (Some(e), _) => e.clone(),
         (None, Some(f)) if f.as_os_str() != "-" => match std::fs::read_to_string(f) {
             Ok(t) => t,
-            Err(e) => return usage_error(format!("cannot read {}: {e}", f.display())),
+            Err(e) => return Err(usage(format!("cannot read {}: {e}", f.display()))),
         },
         _ => {
             let mut t = String::new();
             if let Err(e) = io::stdin().read_to_string(&mut t) {
-                return usage_error(format!("cannot read standard input: {e}"));
+                return Err(usage(format!("cannot read standard input: {e}")));
             }
             t
         }
@@ -65,32 +61,30 @@ pub fn run(args: ConsoleArgs) -> ExitCode {
     let stdout = io::stdout();
     let mut out = stdout.lock();
     match console::run(target.as_mut(), &lines, &opts, &mut out) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) => Ok(()),
         Err(e) => {
             let _ = out.flush();
-            eprintln!("ppmc: {e}");
-            ExitCode::from(1)
+            Err(CliError::Failed(e.to_string()))
         }
     }
 }
 
-fn script_error(file: &Option<PathBuf>, e: &ScriptError) -> ExitCode {
-    match file {
-        Some(f) if f.as_os_str() != "-" => eprintln!("{}: {e}", f.display()),
-        _ => eprintln!("{e}"),
-    }
-    ExitCode::from(2)
+fn script_error(file: &Option<PathBuf>, e: &ScriptError) -> Result<(), CliError> {
+    Err(CliError::BadInput(match file {
+        Some(f) if f.as_os_str() != "-" => format!("{}: {e}", f.display()),
+        _ => e.to_string(),
+    }))
 }
 
 /// Line by line at a terminal: a bad line is reported and skipped, so a
 /// typo at the bench does not end the session.
-fn interactive(target: &mut dyn Target, opts: &ConsoleOptions) -> ExitCode {
+fn interactive(target: &mut dyn Target, opts: &ConsoleOptions) -> Result<(), CliError> {
     let stdin = io::stdin();
     let stdout = io::stdout();
     for (i, line) in stdin.lock().lines().enumerate() {
         let line = match line {
             Ok(l) => l,
-            Err(e) => return usage_error(format!("cannot read standard input: {e}")),
+            Err(e) => return Err(usage(format!("cannot read standard input: {e}"))),
         };
         let parsed: Vec<Line> = match console::parse_line(&line, i + 1) {
             Ok(p) => p,
@@ -101,9 +95,8 @@ fn interactive(target: &mut dyn Target, opts: &ConsoleOptions) -> ExitCode {
         };
         let mut out = stdout.lock();
         if let Err(e) = console::run(target, &parsed, opts, &mut out) {
-            eprintln!("ppmc: {e}");
-            return ExitCode::from(1);
+            return Err(CliError::Failed(e.to_string()));
         }
     }
-    ExitCode::SUCCESS
+    Ok(())
 }

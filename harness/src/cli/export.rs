@@ -1,10 +1,10 @@
 //! `ppmc export`: a trace as a VCD waveform.
 
+use crate::cli::{usage, CliError};
 use crate::golden::{self};
 use crate::trace::Trace;
 use clap::Args;
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 /// Which scenarios to take.
 #[derive(Debug, Args)]
@@ -16,20 +16,20 @@ pub struct ExportArgs {
     output: Option<PathBuf>,
 }
 
-pub fn run(args: ExportArgs) -> ExitCode {
+pub fn run(args: ExportArgs) -> Result<(), CliError> {
     let text = match std::fs::read_to_string(&args.trace) {
         Ok(t) => t,
-        Err(e) => return super::usage_error(format!("{}: {e}", args.trace.display())),
+        Err(e) => return Err(usage(format!("{}: {e}", args.trace.display()))),
     };
     let trace = match Trace::parse(&text) {
         Ok(t) => t,
         Err(e) => {
-            return super::usage_error(format!(
+            return Err(usage(format!(
                 "{}:{}: {}",
                 args.trace.display(),
                 e.line,
                 e.message
-            ))
+            )))
         }
     };
     let out = args
@@ -37,13 +37,11 @@ pub fn run(args: ExportArgs) -> ExitCode {
         .unwrap_or_else(|| args.trace.with_extension("vcd"));
     let mut buf = Vec::new();
     if let Err(e) = crate::vcd_export::export(&trace, &mut buf) {
-        eprintln!("ppmc: {}: {e}", out.display());
-        return ExitCode::from(1);
+        return Err(CliError::Failed(format!("{}: {e}", out.display())));
     }
     if let Err(e) = golden::write_atomic(&out, &buf) {
-        eprintln!("ppmc: {}: {e}", out.display());
-        return ExitCode::from(1);
+        return Err(CliError::Failed(format!("{}: {e}", out.display())));
     }
     println!("wrote {}", out.display());
-    ExitCode::SUCCESS
+    Ok(())
 }

@@ -3,6 +3,7 @@
 
 use crate::backend::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use crate::bridge::sim::{LinkFaults, PtyBridge};
+use crate::cli::{usage, CliError};
 use crate::emu::ModelConfig;
 use crate::fault_matrix::{self, FuzzBudget, Row};
 use crate::faults::{self, CATALOGUE};
@@ -10,7 +11,6 @@ use crate::protocol::Straps;
 use crate::scenario::Scenario;
 use clap::Args;
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 #[derive(Debug, Args)]
 pub struct MatrixArgs {
@@ -38,19 +38,19 @@ pub struct MatrixArgs {
     output: Option<PathBuf>,
 }
 
-pub fn run(args: MatrixArgs, suite: &[Scenario]) -> ExitCode {
+pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
     if args.list {
         println!("| fault | section | what the board does |\n|---|---|---|");
         for f in CATALOGUE {
             println!("| `{}` | {} | {} |", f.name, f.section, f.what);
         }
-        return ExitCode::SUCCESS;
+        return Ok(());
     }
     if !args.golden.is_dir() {
-        return super::usage_error(format!(
+        return Err(usage(format!(
             "{} is not a directory: run from the repository root or give --golden",
             args.golden.display()
-        ));
+        )));
     }
     let mut boards: Vec<(String, ModelConfig)> = vec![("clean".into(), ModelConfig::default())];
     for f in CATALOGUE {
@@ -59,9 +59,9 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> ExitCode {
         }
     }
     if let Some(unknown) = args.only.iter().find(|n| faults::find(n).is_none()) {
-        return super::usage_error(format!(
+        return Err(usage(format!(
             "--fault {unknown}: not in the catalogue (see --list)"
-        ));
+        )));
     }
     let budget = FuzzBudget {
         seeds: args.fuzz_seeds,
@@ -76,7 +76,7 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> ExitCode {
             Err(e) => {
                 eprintln!("infrastructure error");
                 eprintln!("ppmc fault-matrix: {name}: {e}");
-                return ExitCode::from(1);
+                return Err(CliError::Verdict);
             }
         };
         eprintln!("{}", if row.caught() { "caught" } else { "not caught" });
@@ -103,15 +103,15 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> ExitCode {
             }
         }
         if let Err(e) = crate::golden::write_atomic(path, text.as_bytes()) {
-            return super::usage_error(format!("cannot write {}: {e}", path.display()));
+            return Err(usage(format!("cannot write {}: {e}", path.display())));
         }
     }
     if fault_matrix::all_as_expected(&rows) {
         println!("\nevery fault caught, no false alarm on the clean board");
-        ExitCode::SUCCESS
+        Ok(())
     } else {
         println!("\nthe matrix is NOT as it must be (see MISSED / FALSE ALARM above)");
-        ExitCode::from(1)
+        Err(CliError::Verdict)
     }
 }
 

@@ -1,9 +1,9 @@
 //! `ppmc list`: the scenarios with their section, tags and summary.
 
 use super::args::SelectArgs;
+use crate::cli::{usage, CliError};
 use crate::scenario::Scenario;
 use clap::Args;
-use std::process::ExitCode;
 
 /// Which scenarios to take.
 #[derive(Debug, Args)]
@@ -12,10 +12,10 @@ pub struct ListArgs {
     select: SelectArgs,
 }
 
-pub fn run(args: ListArgs, suite: &[Scenario]) -> ExitCode {
+pub fn run(args: ListArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let scenarios = match args.select.scenarios(suite) {
         Ok(s) => s,
-        Err(e) => return super::usage_error(e),
+        Err(e) => return Err(usage(e)),
     };
     for s in &scenarios {
         println!(
@@ -27,5 +27,5 @@ pub fn run(args: ListArgs, suite: &[Scenario]) -> ExitCode {
         );
     }
     println!("{} scenarios", scenarios.len());
-    ExitCode::SUCCESS
+    Ok(())
 }

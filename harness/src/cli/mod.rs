@@ -88,7 +88,7 @@ enum Command {
 pub fn main(suite: Vec<Scenario>) -> ExitCode {
     let cli = Cli::parse();
     let suite = &suite;
-    match cli.command {
+    let done = match cli.command {
         Command::Run(args) => run::run(args, suite),
         Command::List(args) => list::run(args, suite),
         Command::Record(args) => record::run(args, suite),
@@ -99,11 +99,60 @@ pub fn main(suite: Vec<Scenario>) -> ExitCode {
         Command::BridgeSim(args) => bridge_sim::run(args),
         Command::Fuzz(args) => fuzz::run(args),
         Command::FaultMatrix(args) => fault_matrix::run(args, suite),
+    };
+    match done {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => e.exit(),
     }
 }
 
-/// Exit status 2: bad usage or bad input (the script, an option).
-pub(crate) fn usage_error(msg: impl std::fmt::Display) -> ExitCode {
-    eprintln!("ppmc: {msg}");
-    ExitCode::from(2)
+/// Why a command did not end in success. Every command returns it, and
+/// [`CliError::exit`] is the one place that turns it into the exit status:
+/// 2 for the user's input, 1 for everything else.
+#[derive(Debug)]
+pub(crate) enum CliError {
+    /// An option, or a file or script the user gave, is wrong (exit 2).
+    Usage(String),
+    /// Like [`CliError::Usage`], with a message that already says where
+    /// (`script.ppmc: line 3: ...`), printed as it is (exit 2).
+    BadInput(String),
+    /// The board, the bridge or the link is not there or not healthy: not
+    /// the device's fault, and not the user's typing either (exit 1).
+    Infrastructure(String),
+    /// The command could not do its work (exit 1).
+    Failed(String),
+    /// The command ran and its verdict is negative (a scenario failed, an
+    /// input breaks an invariant, a fault went undetected); it has said
+    /// why (exit 1).
+    Verdict,
+}
+
+impl CliError {
+    /// Reports the error on standard error and gives the exit status.
+    fn exit(self) -> ExitCode {
+        match self {
+            CliError::Usage(m) => {
+                eprintln!("ppmc: {m}");
+                ExitCode::from(2)
+            }
+            CliError::BadInput(m) => {
+                eprintln!("{m}");
+                ExitCode::from(2)
+            }
+            CliError::Infrastructure(m) => {
+                eprintln!("ppmc: infrastructure error: {m}");
+                ExitCode::from(1)
+            }
+            CliError::Failed(m) => {
+                eprintln!("ppmc: {m}");
+                ExitCode::from(1)
+            }
+            CliError::Verdict => ExitCode::from(1),
+        }
+    }
+}
+
+/// A usage error: an option or an input the user gave is wrong.
+pub(crate) fn usage(msg: impl std::fmt::Display) -> CliError {
+    CliError::Usage(msg.to_string())
 }

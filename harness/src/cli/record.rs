@@ -2,12 +2,12 @@
 
 use super::args::{SelectArgs, TargetArgs};
 use super::progress::Progress;
+use crate::cli::{usage, CliError};
 use crate::golden::{self, GoldenError, Written};
 use crate::runner::run_suite;
 use crate::scenario::{DriverOptions, Scenario};
 use clap::Args;
 use std::path::PathBuf;
-use std::process::ExitCode;
 
 /// Which scenarios to take.
 #[derive(Debug, Args)]
@@ -29,15 +29,12 @@ pub struct RecordArgs {
     allow_failures: bool,
 }
 
-pub fn run(args: RecordArgs, suite: &[Scenario]) -> ExitCode {
+pub fn run(args: RecordArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let scenarios = match args.select.scenarios(suite) {
         Ok(s) => s,
-        Err(e) => return super::usage_error(e),
+        Err(e) => return Err(usage(e)),
     };
-    let mut target = match args.target.open() {
-        Ok(t) => t,
-        Err(e) => return e.exit(),
-    };
+    let mut target = args.target.open()?;
     let progress = Progress::new(scenarios.len());
     let mut counts = [0usize; 4]; // created, replaced, unchanged, refused
     let mut failed = false;
@@ -87,8 +84,8 @@ pub fn run(args: RecordArgs, suite: &[Scenario]) -> ExitCode {
         counts[0], counts[1], counts[2], counts[3]
     );
     if failed {
-        ExitCode::from(1)
+        Err(CliError::Verdict)
     } else {
-        ExitCode::SUCCESS
+        Ok(())
     }
 }

@@ -2,6 +2,7 @@
 
 use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
 use super::progress::Progress;
+use crate::cli::{usage, CliError};
 use crate::compare::{compare, Tolerances};
 use crate::golden::{self};
 use crate::report::{self, RunInfo, Tally};
@@ -10,7 +11,6 @@ use crate::scenario::{DriverOptions, Failure, Grading, Scenario, ScenarioResult,
 use crate::time::Duration;
 use clap::Args;
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
 /// Which scenarios to take.
 #[derive(Debug, Args)]
@@ -138,24 +138,27 @@ impl RunArgs {
     }
 }
 
-pub fn run(args: RunArgs, suite: &[Scenario]) -> ExitCode {
+pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let scenarios = match args.select.scenarios(suite) {
         Ok(s) => s,
-        Err(e) => return super::usage_error(e),
+        Err(e) => return Err(usage(e)),
     };
     let tol = match args.tolerance.tolerances() {
         Ok(t) => t,
-        Err(e) => return super::usage_error(e),
+        Err(e) => return Err(usage(e)),
     };
     if !(args.marginal.is_finite() && (0.0..=50.0).contains(&args.marginal)) {
-        return super::usage_error(format!(
+        return Err(usage(format!(
             "--marginal {}: give a percentage from 0 to 50",
             args.marginal
-        ));
+        )));
     }
     if let Some(dir) = &args.golden {
         if !dir.is_dir() {
-            return super::usage_error(format!("{}: golden directory not found", dir.display()));
+            return Err(usage(format!(
+                "{}: golden directory not found",
+                dir.display()
+            )));
         }
     }
     let mut target = match args.target.open() {
@@ -192,9 +195,9 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> ExitCode {
                 .as_ref()
                 .map(|p| write_report(p, report::json(&info, &results)));
             summary_lines(&Tally::of(&results), results.len());
-            return e.exit();
+            return Err(e.into());
         }
-        Err(e) => return e.exit(),
+        Err(e) => return Err(e.into()),
     };
     let info = RunInfo::new(&target.info(), args.board_rev.clone());
     let opts = DriverOptions {
@@ -234,8 +237,8 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> ExitCode {
         eprintln!("ppmc: {p}");
     }
     if tally.ok() && problems.is_empty() {
-        ExitCode::SUCCESS
+        Ok(())
     } else {
-        ExitCode::from(1)
+        Err(CliError::Verdict)
     }
 }

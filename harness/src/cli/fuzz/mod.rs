@@ -1,13 +1,18 @@
 //! `ppmc fuzz`: turning fuzz findings into something people can read and
 //! keep, and differential runs against a target.
 
+mod coverage;
+mod minimize;
+mod reproduce;
 mod run;
+mod to_scenario;
+mod triage;
 
+use crate::cli::{usage, CliError};
 use crate::emu::ModelConfig;
 use crate::fuzzing::finding::{self, InputKind};
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
 #[derive(Debug, Args)]
 #[command(args_conflicts_with_subcommands = true)]
@@ -85,7 +90,7 @@ enum FuzzCommand {
 }
 
 #[derive(Debug, Args)]
-struct ModelArgs {
+pub(super) struct ModelArgs {
     /// Which fuzz target the inputs are for.
     #[arg(long, value_enum, default_value = "bus-bytes")]
     kind: InputKind,
@@ -96,27 +101,26 @@ struct ModelArgs {
 }
 
 impl ModelArgs {
-    fn model(&self) -> Result<ModelConfig, ExitCode> {
+    pub(super) fn model(&self) -> Result<ModelConfig, CliError> {
         let mut cfg = ModelConfig::default();
         crate::faults::apply_all(&self.chip_faults, &mut cfg)
-            .map_err(|e| crate::cli::usage_error(format!("--chip-fault: {e}")))?;
+            .map_err(|e| usage(format!("--chip-fault: {e}")))?;
         Ok(cfg)
     }
 }
 
 /// The inputs under `paths` (files, or the files of directories, sorted),
 /// as bus ops.
-fn load_inputs(
+pub(super) fn load_inputs(
     paths: &[PathBuf],
     kind: InputKind,
     cfg: &ModelConfig,
-) -> Result<Vec<(String, Vec<crate::fuzzing::bus::BusOp>)>, ExitCode> {
+) -> Result<Vec<(String, Vec<crate::fuzzing::bus::BusOp>)>, CliError> {
     let mut files = Vec::new();
     for p in paths {
         if p.is_dir() {
-            let rd = std::fs::read_dir(p).map_err(|e| {
-                crate::cli::usage_error(format!("cannot read {}: {e}", p.display()))
-            })?;
+            let rd = std::fs::read_dir(p)
+                .map_err(|e| usage(format!("cannot read {}: {e}", p.display())))?;
             let mut v: Vec<PathBuf> = rd
                 .filter_map(Result::ok)
                 .map(|e| e.path())
@@ -131,16 +135,15 @@ fn load_inputs(
     files
         .into_iter()
         .map(|f| {
-            let data = std::fs::read(&f).map_err(|e| {
-                crate::cli::usage_error(format!("cannot read {}: {e}", f.display()))
-            })?;
+            let data = std::fs::read(&f)
+                .map_err(|e| usage(format!("cannot read {}: {e}", f.display())))?;
             Ok((f.display().to_string(), finding::ops_of(&data, kind, cfg)))
         })
         .collect()
 }
 
 #[derive(Debug, Args)]
-struct InputArgs {
+pub(super) struct InputArgs {
     /// The input file.
     file: PathBuf,
     #[command(flatten)]
@@ -149,165 +152,28 @@ struct InputArgs {
 
 impl InputArgs {
     /// The model, the input's bytes and its bus ops.
-    fn load(&self) -> Result<(ModelConfig, Vec<crate::fuzzing::bus::BusOp>), ExitCode> {
+    pub(super) fn load(&self) -> Result<(ModelConfig, Vec<crate::fuzzing::bus::BusOp>), CliError> {
         let cfg = self.model.model()?;
-        let data = std::fs::read(&self.file).map_err(|e| {
-            crate::cli::usage_error(format!("cannot read {}: {e}", self.file.display()))
-        })?;
+        let data = std::fs::read(&self.file)
+            .map_err(|e| usage(format!("cannot read {}: {e}", self.file.display())))?;
         let ops = finding::ops_of(&data, self.model.kind, &cfg);
         Ok((cfg, ops))
     }
 }
 
-pub fn run(args: FuzzArgs) -> ExitCode {
+pub fn run(args: FuzzArgs) -> Result<(), CliError> {
     match args.command {
         None => run::run(args.run),
         Some(FuzzCommand::Run(a)) => run::run(a),
-        Some(FuzzCommand::Triage { paths, model }) => {
-            let cfg = match model.model() {
-                Ok(c) => c,
-                Err(code) => return code,
-            };
-            let inputs = match load_inputs(&paths, model.kind, &cfg) {
-                Ok(v) => v,
-                Err(code) => return code,
-            };
-            let (buckets, clean) = crate::fuzzing::campaign::triage(&inputs, &cfg);
-            println!("| invariant | inputs | shortest input | its ops | break |\n|---|---:|---|---:|---|");
-            for b in &buckets {
-                let (name, n, v) = &b.smallest;
-                println!(
-                    "| {} | {} | {name} | {n} | after op {}: {} |",
-                    b.invariant,
-                    b.inputs.len(),
-                    v.op,
-                    v.detail
-                );
-            }
-            println!(
-                "\n{} inputs: {} findings in {} buckets, {} break nothing",
-                inputs.len(),
-                inputs.len() - clean.len(),
-                buckets.len(),
-                clean.len()
-            );
-            if buckets.is_empty() {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::from(1)
-            }
-        }
-        Some(FuzzCommand::Coverage { paths, kind }) => {
-            let cfg = ModelConfig::default();
-            let inputs = match load_inputs(&paths, kind, &cfg) {
-                Ok(v) => v,
-                Err(code) => return code,
-            };
-            let ops: Vec<_> = inputs.into_iter().map(|(_, o)| o).collect();
-            print!("{}", crate::fuzzing::campaign::Coverage::of(&ops).render());
-            ExitCode::SUCCESS
-        }
-        Some(FuzzCommand::Reproduce { input }) => {
-            let (cfg, ops) = match input.load() {
-                Ok(x) => x,
-                Err(code) => return code,
-            };
-            let data = finding::to_bytes(&ops);
-            let source = input.file.display().to_string();
-            let (script, found) = crate::fuzzing::reproducer_with(&data, &source, cfg);
-            print!("{script}");
-            if found.is_some() {
-                ExitCode::from(1)
-            } else {
-                ExitCode::SUCCESS
-            }
-        }
-        Some(FuzzCommand::Minimize { input, output }) => {
-            let (cfg, ops) = match input.load() {
-                Ok(x) => x,
-                Err(code) => return code,
-            };
-            let Some(v) = finding::first_break(&ops, &cfg) else {
-                eprintln!(
-                    "ppmc fuzz minimize: {} breaks no invariant on this model; nothing to minimize",
-                    input.file.display()
-                );
-                return ExitCode::from(1);
-            };
-            let Some(m) = finding::minimize(&ops, &cfg, v.invariant) else {
-                eprintln!(
-                    "ppmc fuzz minimize: the break of {} is not reproducible",
-                    v.invariant
-                );
-                return ExitCode::from(1);
-            };
-            let out = output.unwrap_or_else(|| with_suffix(&input.file, "min"));
-            let bytes = finding::to_bytes(&m.ops);
-            if let Err(e) = crate::golden::write_atomic(&out, &bytes) {
-                return crate::cli::usage_error(format!("cannot write {}: {e}", out.display()));
-            }
-            eprintln!(
-                "ppmc fuzz minimize: {} ops -> {} ops ({} oracle runs), invariant {} still breaks; wrote {}",
-                ops.len(),
-                m.ops.len(),
-                m.tries,
-                m.violation.invariant,
-                out.display()
-            );
-            let (script, _) =
-                crate::fuzzing::reproducer_with(&bytes, &out.display().to_string(), cfg);
-            print!("{script}");
-            ExitCode::SUCCESS
-        }
-        Some(FuzzCommand::ToScenario { input, dir }) => {
-            let (cfg, ops) = match input.load() {
-                Ok(x) => x,
-                Err(code) => return code,
-            };
-            let Some(v) = finding::first_break(&ops, &cfg) else {
-                eprintln!(
-                    "ppmc fuzz to-scenario: {} breaks no invariant on this model; \
-                     a regression scenario would pass already",
-                    input.file.display()
-                );
-                return ExitCode::from(1);
-            };
-            if !dir.is_dir() {
-                return crate::cli::usage_error(format!(
-                    "{} is not a directory: run from the repository root or give --dir",
-                    dir.display()
-                ));
-            }
-            let (stem, path) = (1..)
-                .map(|n| {
-                    let stem = finding::scenario_stem(v.invariant, n);
-                    let path = dir.join(format!("{stem}.rs"));
-                    (stem, path)
-                })
-                .find(|(_, p)| !p.exists())
-                .unwrap_or_default();
-            let text = finding::scenario_file(
-                &stem,
-                &ops[..=v.op.min(ops.len().saturating_sub(1))],
-                &v,
-                &input.file.display().to_string(),
-            );
-            if let Err(e) = crate::golden::write_atomic(&path, text.as_bytes()) {
-                return crate::cli::usage_error(format!("cannot write {}: {e}", path.display()));
-            }
-            println!(
-                "wrote {} (scenario {stem}, invariant {}, {} ops); add `{stem}` to the \
-                 suite! list in scenarios/src/lib.rs, and `cargo test` runs it",
-                path.display(),
-                v.invariant,
-                v.op + 1
-            );
-            ExitCode::SUCCESS
-        }
+        Some(FuzzCommand::Triage { paths, model }) => triage::run(&paths, &model),
+        Some(FuzzCommand::Coverage { paths, kind }) => coverage::run(&paths, kind),
+        Some(FuzzCommand::Reproduce { input }) => reproduce::run(&input),
+        Some(FuzzCommand::Minimize { input, output }) => minimize::run(&input, output),
+        Some(FuzzCommand::ToScenario { input, dir }) => to_scenario::run(&input, &dir),
     }
 }
 
-fn with_suffix(p: &Path, suffix: &str) -> PathBuf {
+pub(super) fn with_suffix(p: &Path, suffix: &str) -> PathBuf {
     let mut s = p.as_os_str().to_owned();
     s.push(".");
     s.push(suffix);

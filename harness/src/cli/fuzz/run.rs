@@ -2,11 +2,11 @@
 
 use crate::backend::{EmuTarget, Target};
 use crate::cli::args::TargetArgs;
+use crate::cli::{usage, CliError};
 use crate::fuzzing::differential::{self, DiffSettings};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
-use std::process::ExitCode;
 use std::time::Instant as WallClock;
 
 #[derive(Debug, Args)]
@@ -38,29 +38,26 @@ pub struct DiffArgs {
     chip_faults: Vec<String>,
 }
 
-pub fn run(args: DiffArgs) -> ExitCode {
+pub fn run(args: DiffArgs) -> Result<(), CliError> {
     let straps = match args.target.straps() {
         Ok(s) => s,
-        Err(e) => return crate::cli::usage_error(e),
+        Err(e) => return Err(usage(e)),
     };
     let mut target: Box<dyn Target> = if args.target.name() == "emu" {
         let mut model = args.target.model();
         if let Err(e) = crate::faults::apply_all(&args.chip_faults, &mut model) {
-            return crate::cli::usage_error(format!("--chip-fault: {e}"));
+            return Err(usage(format!("--chip-fault: {e}")));
         }
         match EmuTarget::new(straps, model) {
             Ok(t) => Box::new(t),
-            Err(e) => return crate::cli::usage_error(e),
+            Err(e) => return Err(usage(e)),
         }
     } else if !args.chip_faults.is_empty() {
-        return crate::cli::usage_error(
+        return Err(usage(
             "--chip-fault applies to --target emu; a bridge simulator takes it as `ppmc bridge-sim --chip-fault`",
-        );
+        ));
     } else {
-        match args.target.open() {
-            Ok(t) => t,
-            Err(e) => return e.exit(),
-        }
+        args.target.open()?
     };
     let seed = args.seed.unwrap_or_else(|| {
         std::time::SystemTime::now()
@@ -98,7 +95,7 @@ pub fn run(args: DiffArgs) -> ExitCode {
         Ok(d) => d,
         Err(e) => {
             eprintln!("ppmc fuzz: infrastructure error after {done} actions: {e}");
-            return ExitCode::from(1);
+            return Err(CliError::Verdict);
         }
     };
     let Some(d) = departure else {
@@ -106,7 +103,7 @@ pub fn run(args: DiffArgs) -> ExitCode {
             "seed {seed}: {done} actions in {:.1} s, no departure from the emulator",
             t0.elapsed().as_secs_f64()
         );
-        return ExitCode::SUCCESS;
+        return Ok(());
     };
     println!("seed {seed}: {d}");
     let (small, small_d) = match differential::minimize(
@@ -118,7 +115,7 @@ pub fn run(args: DiffArgs) -> ExitCode {
         Ok(x) => x,
         Err(e) => {
             eprintln!("ppmc fuzz: infrastructure error while minimizing: {e}");
-            return ExitCode::from(1);
+            return Err(CliError::Verdict);
         }
     };
     let (acts_out, d_out) = match small_d {
@@ -136,13 +133,15 @@ pub fn run(args: DiffArgs) -> ExitCode {
         .unwrap_or_else(|| PathBuf::from(format!("fuzz-diff-{seed}.ppmc")));
     let text = differential::script(&acts_out, &d_out, seed, &name);
     if let Err(e) = crate::golden::write_atomic(&out, text.as_bytes()) {
-        eprintln!("ppmc fuzz: cannot write {}: {e}", out.display());
-        return ExitCode::from(2);
+        return Err(CliError::BadInput(format!(
+            "ppmc fuzz: cannot write {}: {e}",
+            out.display()
+        )));
     }
     println!(
         "minimized to {} actions; reproducer written to {}",
         acts_out.len(),
         out.display()
     );
-    ExitCode::from(1)
+    Err(CliError::Verdict)
 }

@@ -1,0 +1,37 @@
+//! `ppmc fuzz minimize`: a fuzz input shrunk while the same invariant breaks.
+
+use super::*;
+
+pub fn run(input: &InputArgs, output: Option<PathBuf>) -> Result<(), CliError> {
+    let (cfg, ops) = input.load()?;
+    let Some(v) = finding::first_break(&ops, &cfg) else {
+        eprintln!(
+            "ppmc fuzz minimize: {} breaks no invariant on this model; nothing to minimize",
+            input.file.display()
+        );
+        return Err(CliError::Verdict);
+    };
+    let Some(m) = finding::minimize(&ops, &cfg, v.invariant) else {
+        eprintln!(
+            "ppmc fuzz minimize: the break of {} is not reproducible",
+            v.invariant
+        );
+        return Err(CliError::Verdict);
+    };
+    let out = output.unwrap_or_else(|| super::with_suffix(&input.file, "min"));
+    let bytes = finding::to_bytes(&m.ops);
+    if let Err(e) = crate::golden::write_atomic(&out, &bytes) {
+        return Err(usage(format!("cannot write {}: {e}", out.display())));
+    }
+    eprintln!(
+            "ppmc fuzz minimize: {} ops -> {} ops ({} oracle runs), invariant {} still breaks; wrote {}",
+            ops.len(),
+            m.ops.len(),
+            m.tries,
+            m.violation.invariant,
+            out.display()
+        );
+    let (script, _) = crate::fuzzing::reproducer_with(&bytes, &out.display().to_string(), cfg);
+    print!("{script}");
+    Ok(())
+}

@@ -1,0 +1,16 @@
+//! `ppmc fuzz reproduce`: a fuzz input as a console script, with the invariant it breaks.
+
+use super::*;
+
+pub fn run(input: &InputArgs) -> Result<(), CliError> {
+    let (cfg, ops) = input.load()?;
+    let data = finding::to_bytes(&ops);
+    let source = input.file.display().to_string();
+    let (script, found) = crate::fuzzing::reproducer_with(&data, &source, cfg);
+    print!("{script}");
+    if found.is_some() {
+        Err(CliError::Verdict)
+    } else {
+        Ok(())
+    }
+}
