@@ -191,8 +191,7 @@ pub fn compare(golden: &Trace, got: &Trace, tol: &Tolerances) -> Result<(), Dive
     compare_moves(&g, &o, &mut first);
     compare_pulses(&g, &o, tol, &mut first);
     compare_pins(&g, &o, tol, &mut first);
-    let straps = Straps::from_details(&got.details);
-    compare_measures(&g, &o, tol, &straps, &mut first);
+    compare_measures(&g, &o, tol, &got.straps, &mut first);
     match first.0 {
         Some(d) => Err(d),
         None => Ok(()),
@@ -621,6 +620,10 @@ mod tests {
 scenario demo
 section 3-3-5
 target emu
+detail sysclk_hz 16000000
+detail csel high
+detail vsel high
+detail ext_clock_hz none
 events
 0.000us reset
 1000.000us wc 0x44 waited=0.000us

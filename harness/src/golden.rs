@@ -143,7 +143,7 @@ mod tests {
 
     fn trace(name: &str) -> Trace {
         Trace::parse(&format!(
-            "ppmc-trace 1\nscenario {name}\nsection 3-1\ntarget emu\nevents\n0.000us reset\nend\n"
+            "ppmc-trace 1\nscenario {name}\nsection 3-1\ntarget emu\ndetail sysclk_hz 16000000\ndetail csel high\ndetail vsel high\ndetail ext_clock_hz none\nevents\n0.000us reset\nend\n"
         ))
         .expect("valid")
     }
@@ -181,10 +181,10 @@ mod tests {
     fn bad_golden_files_name_path_and_line() {
         let d = tmpdir("bad");
         assert!(matches!(load(&d, "x"), Err(GoldenError::Missing { .. })));
-        fs::write(d.join("x.snap"), format!("{SNAPSHOT_HEADER}ppmc-trace 1\nscenario x\nsection 3\ntarget emu\nevents\n0.000us bogus\nend\n")).expect("write");
+        fs::write(d.join("x.snap"), format!("{SNAPSHOT_HEADER}ppmc-trace 1\nscenario x\nsection 3\ntarget emu\ndetail sysclk_hz 16000000\ndetail csel high\ndetail vsel high\ndetail ext_clock_hz none\nevents\n0.000us bogus\nend\n")).expect("write");
         let e = load(&d, "x").expect_err("corrupt");
         assert!(
-            e.to_string().ends_with("x.snap:9: unknown event `bogus`"),
+            e.to_string().ends_with("x.snap:13: unknown event `bogus`"),
             "{e}"
         );
         fs::write(d.join("y.snap"), trace("x").render()).expect("write");

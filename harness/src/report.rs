@@ -22,7 +22,7 @@ pub struct RunInfo {
 impl RunInfo {
     pub fn new(target: &TargetInfo, board_rev: Option<String>) -> RunInfo {
         let bridge_firmware = target
-            .details
+            .extra
             .iter()
             .find(|(k, _)| k == "bridge_firmware")
             .map(|(_, v)| v.clone());
@@ -30,9 +30,22 @@ impl RunInfo {
             harness_version: crate::VERSION.to_string(),
             git_revision: crate::GIT_REV.to_string(),
             target: target.name.clone(),
-            target_details: target.details.clone(),
+            target_details: target.details(),
             board_rev,
             bridge_firmware,
+        }
+    }
+
+    /// A run whose target could not be reached: nothing is known of it
+    /// but its name.
+    pub fn unreached(target: String, board_rev: Option<String>) -> RunInfo {
+        RunInfo {
+            harness_version: crate::VERSION.to_string(),
+            git_revision: crate::GIT_REV.to_string(),
+            target,
+            target_details: Vec::new(),
+            board_rev,
+            bridge_firmware: None,
         }
     }
 }

@@ -22,7 +22,9 @@
 //! golden file may start with insta's `---` front matter, which is skipped.
 //! [`Trace::parse`] reads back exactly what [`Trace::render`] writes.
 
-use crate::protocol::{Direction, Flag, Input, MoveKind, Pin, Record, Winding};
+use crate::protocol::{
+    Direction, Flag, Input, MoveKind, Pin, Record, StrapFieldError, Straps, Winding, STRAP_KEYS,
+};
 use crate::time::{Duration, Instant};
 use std::fmt::{self, Write as _};
 
@@ -35,7 +37,9 @@ pub struct Trace {
     pub scenario: String,
     pub section: String,
     pub target: String,
-    /// Straps and other target facts, `key value`.
+    /// How the target's chip was strapped (`detail` lines, first).
+    pub straps: Straps,
+    /// Other target facts, `key value` (`detail` lines after the straps).
     pub details: Vec<(String, String)>,
     pub events: Vec<Event>,
 }
@@ -129,18 +133,28 @@ pub struct TraceError {
 }
 
 impl Trace {
-    /// Builds a trace from the driver's bus events and the target's capture,
-    /// merged in time order. At one instant: pin changes and pulses, then
-    /// bus transactions, then move starts, then measurements.
-    pub fn assemble(
+    /// A trace with no events yet: what ran, where, at which straps.
+    pub fn new(
         scenario: &str,
         section: &str,
         target: &str,
+        straps: Straps,
         details: Vec<(String, String)>,
-        bus: Vec<Event>,
-        capture: &Record,
-        measures: Vec<Event>,
     ) -> Trace {
+        Trace {
+            scenario: scenario.to_string(),
+            section: section.to_string(),
+            target: target.to_string(),
+            straps,
+            details,
+            events: Vec::new(),
+        }
+    }
+
+    /// This trace with the driver's bus events and the target's capture,
+    /// merged in time order. At one instant: pin changes and pulses, then
+    /// bus transactions, then move starts, then measurements.
+    pub fn assemble(self, bus: Vec<Event>, capture: &Record, measures: Vec<Event>) -> Trace {
         let mut tagged: Vec<(Instant, u8, usize, EventKind)> = Vec::new();
         let mut seq = 0usize;
         let mut push = |at: Instant, rank: u8, kind: EventKind, v: &mut Vec<_>| {
@@ -193,14 +207,11 @@ impl Trace {
         }
         tagged.sort_by_key(|(at, rank, seq, _)| (*at, *rank, *seq));
         Trace {
-            scenario: scenario.to_string(),
-            section: section.to_string(),
-            target: target.to_string(),
-            details,
             events: tagged
                 .into_iter()
                 .map(|(at, _, _, kind)| Event { at, kind })
                 .collect(),
+            ..self
         }
     }
 
@@ -211,6 +222,9 @@ impl Trace {
         let _ = writeln!(s, "scenario {}", self.scenario);
         let _ = writeln!(s, "section {}", self.section);
         let _ = writeln!(s, "target {}", self.target);
+        for (k, v) in self.straps.fields() {
+            let _ = writeln!(s, "detail {k} {v}");
+        }
         for (k, v) in &self.details {
             let _ = writeln!(s, "detail {k} {v}");
         }
@@ -282,7 +296,9 @@ impl Trace {
         let scenario = field("scenario")?;
         let section = field("section")?;
         let target = field("target")?;
+        let mut straps = Vec::new();
         let mut details = Vec::new();
+        let mut parsed_straps = None;
         let mut events = Vec::new();
         let mut in_events = false;
         let mut ended = false;
@@ -296,11 +312,34 @@ impl Trace {
             if !in_events {
                 if l == "events" {
                     in_events = true;
+                    // The straps come before the events, every one of them;
+                    // an error names the strap's line (a missing one, this).
+                    parsed_straps = Some(
+                        Straps::from_fields(straps.iter().map(|&(k, v, _)| (k, v))).map_err(
+                            |e| {
+                                let key = match &e {
+                                    StrapFieldError::Repeated(k)
+                                    | StrapFieldError::BadValue { key: k, .. } => Some(*k),
+                                    _ => None,
+                                };
+                                let line = straps
+                                    .iter()
+                                    .rev()
+                                    .find(|(k, _, _)| Some(*k) == key)
+                                    .map_or(n, |&(_, _, at)| at);
+                                err(line, format!("{e} in the `detail` lines"))
+                            },
+                        )?,
+                    );
                 } else if let Some(rest) = l.strip_prefix("detail ") {
                     let (k, v) = rest
                         .split_once(' ')
                         .ok_or_else(|| err(n, "expected `detail <key> <value>`"))?;
-                    details.push((k.to_string(), v.to_string()));
+                    if STRAP_KEYS.contains(&k) {
+                        straps.push((k, v, n));
+                    } else {
+                        details.push((k.to_string(), v.to_string()));
+                    }
                 } else {
                     return Err(err(
                         n,
@@ -321,10 +360,14 @@ impl Trace {
                 "no `end` line: the trace is truncated",
             ));
         }
+        let Some(straps) = parsed_straps else {
+            return Err(err(text.lines().count(), "no `events` line"));
+        };
         Ok(Trace {
             scenario,
             section,
             target,
+            straps,
             details,
             events,
         })
@@ -614,6 +657,10 @@ scenario demo
 section 3-3-5
 target emu
 detail sysclk_hz 16000000
+detail csel low
+detail vsel high
+detail ext_clock_hz 250000
+detail bridge_firmware ppmc-bridge-sim 0.1.0
 events
 0.000us reset
 200000.000us wc 0x44 waited=0.000us
@@ -652,7 +699,7 @@ end
     fn errors_name_the_line() {
         let bad = SAMPLE.replace("pulses cw n=100", "pulses cw n=x");
         let e = Trace::parse(&bad).expect_err("bad count");
-        assert_eq!(e.line, 17);
+        assert_eq!(e.line, 21);
         assert!(e.message.contains("bad pulse count"), "{e}");
 
         let truncated = &SAMPLE[..SAMPLE.len() - 4];
@@ -663,6 +710,16 @@ end
         let e = Trace::parse(&other).expect_err("version");
         assert_eq!(e.line, 1);
         assert!(e.message.contains("version 7"), "{e}");
+
+        // A strap that does not read is an error at its line, never a
+        // default: a typo would otherwise judge the trace at other straps.
+        let typo = SAMPLE.replace("detail csel low", "detail csel lwo");
+        let e = Trace::parse(&typo).expect_err("bad strap");
+        assert_eq!(e.line, 6);
+        assert!(e.message.contains("strap `csel` cannot be `lwo`"), "{e}");
+        let missing = SAMPLE.replace("detail vsel high\n", "");
+        let e = Trace::parse(&missing).expect_err("missing strap");
+        assert!(e.message.contains("strap `vsel` is missing"), "{e}");
 
         let e = Trace::parse("hello\n").expect_err("not a trace");
         assert!(e.message.contains("not a ppmc trace"), "{e}");

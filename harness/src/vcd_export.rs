@@ -215,6 +215,10 @@ mod tests {
 scenario demo
 section 3-3-3
 target emu
+detail sysclk_hz 16000000
+detail csel high
+detail vsel high
+detail ext_clock_hz none
 events
 0.000us reset
 68.000us pin s 0b11000

@@ -213,29 +213,18 @@ impl<B: Bus> BridgeEngine<B> {
                 code: BridgeErrorCode::Version,
                 detail: format!("bridge speaks protocol {PROTOCOL_VERSION}, host {version}"),
             },
-            Request::Hello { .. } => {
-                let s = self.bus.straps();
-                let level = |high: bool| if high { "high" } else { "low" };
-                let straps = format!(
-                    "sysclk_hz={} csel={} vsel={} ext_clock_hz={}",
-                    s.sysclk_hz,
-                    level(s.csel_high),
-                    level(s.vsel_high),
-                    s.ext_clock_hz.map_or("none".to_string(), |h| h.to_string()),
-                );
-                Response::Hello(Hello {
-                    version: PROTOCOL_VERSION,
-                    session: self.session,
-                    timer_hz: self.timer.hz,
-                    max_batch_ops: MAX_BATCH_OPS,
-                    max_payload: frame::MAX_PAYLOAD as u16,
-                    capture_capacity: self.capture_capacity,
-                    inputs_wired: 0x3FF,
-                    virtual_time: self.virtual_time,
-                    firmware: self.firmware.clone(),
-                    straps,
-                })
-            }
+            Request::Hello { .. } => Response::Hello(Hello {
+                version: PROTOCOL_VERSION,
+                session: self.session,
+                timer_hz: self.timer.hz,
+                max_batch_ops: MAX_BATCH_OPS,
+                max_payload: frame::MAX_PAYLOAD as u16,
+                capture_capacity: self.capture_capacity,
+                inputs_wired: 0x3FF,
+                virtual_time: self.virtual_time,
+                firmware: self.firmware.clone(),
+                straps: self.bus.straps(),
+            }),
             Request::Batch(ops) => match self.run_ops(&ops) {
                 Ok(replies) => Response::Batch(replies),
                 Err(e) => e,
@@ -371,7 +360,7 @@ mod tests {
             (h.session, h.timer_hz, h.max_batch_ops),
             (42, 1_000_000_000, MAX_BATCH_OPS)
         );
-        assert!(h.straps.contains("sysclk_hz=16000000"));
+        assert_eq!(h.straps, Straps::default());
         let r = ask(&mut s, 2, &Request::Hello { version: 99 });
         assert!(matches!(
             r,

@@ -9,7 +9,8 @@
 use crate::bus::{Op, Reply};
 use crate::protocol::capture::MoveStart;
 use crate::protocol::{
-    Direction, Input, MoveKind, Pin, PinEvent, Pins, PulseRun, PulseSummary, Status, Winding,
+    Direction, Input, MoveKind, Pin, PinEvent, Pins, PulseRun, PulseSummary, Status, Straps,
+    Winding,
 };
 use crate::time::{Duration, Instant};
 use alloc::string::String;
@@ -17,7 +18,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 /// The protocol version this build speaks.
-pub const PROTOCOL_VERSION: u16 = 2;
+pub const PROTOCOL_VERSION: u16 = 3;
 
 /// Message kinds (the second payload byte).
 pub mod kind {
@@ -101,8 +102,8 @@ pub struct Hello {
     pub virtual_time: bool,
     /// Firmware name and version.
     pub firmware: String,
-    /// The chip's board straps, `key=value` separated by spaces.
-    pub straps: String,
+    /// How the chip is strapped on its board.
+    pub straps: Straps,
 }
 
 /// A host request.
@@ -433,6 +434,59 @@ impl<'a> R<'a> {
                 value: u64::from(i),
             })
     }
+}
+
+/// Strap flags in HELLO_REPLY.
+mod strap_flag {
+    pub const CSEL_HIGH: u8 = 0x01;
+    pub const VSEL_HIGH: u8 = 0x02;
+    pub const EXT_CLOCK: u8 = 0x04;
+}
+
+fn put_straps(w: &mut W, s: &Straps) {
+    w.u32(s.sysclk_hz);
+    let mut flags = 0;
+    if s.csel_high {
+        flags |= strap_flag::CSEL_HIGH;
+    }
+    if s.vsel_high {
+        flags |= strap_flag::VSEL_HIGH;
+    }
+    if s.ext_clock_hz.is_some() {
+        flags |= strap_flag::EXT_CLOCK;
+    }
+    w.u8(flags);
+    w.u32(s.ext_clock_hz.unwrap_or(0));
+}
+
+fn get_straps(r: &mut R) -> Result<Straps, WireError> {
+    let sysclk_hz = r.u32()?;
+    let at = r.at;
+    let flags = r.u8()?;
+    let all = strap_flag::CSEL_HIGH | strap_flag::VSEL_HIGH | strap_flag::EXT_CLOCK;
+    if flags & !all != 0 {
+        return Err(WireError::BadValue {
+            at,
+            field: "strap flags",
+            value: u64::from(flags),
+        });
+    }
+    let at = r.at;
+    let ext = r.u32()?;
+    let fitted = flags & strap_flag::EXT_CLOCK != 0;
+    if fitted != (ext != 0) {
+        return Err(WireError::BadValue {
+            at,
+            field: "external clock (0 exactly when not fitted)",
+            value: u64::from(ext),
+        });
+    }
+    Ok(Straps {
+        sysclk_hz,
+        csel_high: flags & strap_flag::CSEL_HIGH != 0,
+        vsel_high: flags & strap_flag::VSEL_HIGH != 0,
+        ext_clock_hz: fitted.then_some(ext),
+    })
 }
 
 fn pin_code(p: Pin) -> u8 {
@@ -1212,7 +1266,7 @@ impl Response {
                 w.u16(h.inputs_wired);
                 w.u8(u8::from(h.virtual_time));
                 w.str(&h.firmware);
-                w.str(&h.straps);
+                put_straps(&mut w, &h.straps);
             }
             Response::Batch(replies) => {
                 w.u8(kind::BATCH_REPLY);
@@ -1251,7 +1305,7 @@ impl Response {
                 inputs_wired: r.u16()?,
                 virtual_time: r.bool("virtual time flag")?,
                 firmware: r.str()?,
-                straps: r.str()?,
+                straps: get_straps(&mut r)?,
             }),
             kind::BATCH_REPLY => Response::Batch(get_replies(&mut r)?),
             kind::CAPTURE_REPLY => Response::Capture(get_capture(&mut r)?),
@@ -1475,7 +1529,12 @@ mod tests {
             inputs_wired: 0x3FF,
             virtual_time: true,
             firmware: "ppmc-bridge-sim 0.1.0".into(),
-            straps: "sysclk_hz=16000000 csel=high".into(),
+            straps: Straps {
+                sysclk_hz: 12_288_000,
+                csel_high: false,
+                vsel_high: true,
+                ext_clock_hz: Some(500_000),
+            },
         });
         assert_eq!(Response::decode(&hello.encode(1, T), T), Ok((1, hello)));
         let cap = Response::Capture(CaptureChunk {

@@ -16,7 +16,7 @@ pub use command::{
     MoveKind, OpFlags, OutputLogic, PulseCount, Register,
 };
 pub use phase::Winding;
-pub use rates::{Straps, StrapsError};
+pub use rates::{StrapFieldError, Straps, StrapsError, STRAP_KEYS};
 pub use registers::{
     AuxInputStatus, ErrorCode, FinishStatus, Flag, Input, InputSet, InputStatus, OutputStatus,
     Status, StatusField, StopCause,

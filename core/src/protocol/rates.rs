@@ -6,7 +6,7 @@
 
 use super::command::ClockSource;
 use crate::time::Duration;
-use alloc::string::String;
+use alloc::string::{String, ToString};
 
 /// The system clock the datasheet's timing figures were taken at (Diagram
 /// 3-5 "16MHz default"); firmware times scale with `16 MHz / SysClk`.
@@ -55,6 +55,27 @@ pub enum StrapsError {
     ExtClock { hz: u32, max: u32 },
 }
 
+/// The keys of [`Straps::fields`], in order.
+pub const STRAP_KEYS: [&str; 4] = ["sysclk_hz", "csel", "vsel", "ext_clock_hz"];
+
+/// Why `key value` fields do not describe straps.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum StrapFieldError {
+    /// A strap is not given.
+    #[error("strap `{0}` is missing")]
+    Missing(&'static str),
+    /// A strap is given twice.
+    #[error("strap `{0}` is given twice")]
+    Repeated(&'static str),
+    /// A key that is no strap.
+    #[error("`{0}` is not a strap (sysclk_hz, csel, vsel, ext_clock_hz)")]
+    UnknownKey(String),
+    /// A value the strap cannot take (`csel` is `high` or `low`, clocks are
+    /// whole hertz, `ext_clock_hz` may be `none`).
+    #[error("strap `{key}` cannot be `{value}`")]
+    BadValue { key: &'static str, value: String },
+}
+
 impl Straps {
     pub fn validate(&self) -> Result<(), StrapsError> {
         if !(1_000_000..=40_000_000).contains(&self.sysclk_hz) {
@@ -69,21 +90,61 @@ impl Straps {
         Ok(())
     }
 
-    /// Straps from a target's `key value` details (`sysclk_hz`, `csel`,
-    /// `vsel`, `ext_clock_hz`), as targets and traces carry them; defaults
-    /// where a key is missing or unreadable.
-    pub fn from_details(details: &[(String, String)]) -> Straps {
-        let mut s = Straps::default();
-        for (k, v) in details {
-            match k.as_str() {
-                "sysclk_hz" => s.sysclk_hz = v.parse().unwrap_or(s.sysclk_hz),
-                "csel" => s.csel_high = v != "low",
-                "vsel" => s.vsel_high = v != "low",
-                "ext_clock_hz" => s.ext_clock_hz = v.parse().ok(),
-                _ => {}
+    /// The straps as `key value` fields, in this order: how traces and
+    /// reports show them (`sysclk_hz 16000000`, `csel high`, `vsel high`,
+    /// `ext_clock_hz none`).
+    pub fn fields(&self) -> [(&'static str, String); 4] {
+        let level = |high: bool| String::from(if high { "high" } else { "low" });
+        [
+            (STRAP_KEYS[0], self.sysclk_hz.to_string()),
+            (STRAP_KEYS[1], level(self.csel_high)),
+            (STRAP_KEYS[2], level(self.vsel_high)),
+            (
+                STRAP_KEYS[3],
+                self.ext_clock_hz
+                    .map_or_else(|| String::from("none"), |h| h.to_string()),
+            ),
+        ]
+    }
+
+    /// Straps back from their [`Straps::fields`]: every key once, each with
+    /// a value it can take; anything else is refused, never defaulted.
+    pub fn from_fields<'a>(
+        fields: impl IntoIterator<Item = (&'a str, &'a str)>,
+    ) -> Result<Straps, StrapFieldError> {
+        let mut seen = [None::<&str>; 4];
+        for (k, v) in fields {
+            let i = STRAP_KEYS
+                .iter()
+                .position(|key| *key == k)
+                .ok_or_else(|| StrapFieldError::UnknownKey(k.into()))?;
+            if seen[i].replace(v).is_some() {
+                return Err(StrapFieldError::Repeated(STRAP_KEYS[i]));
             }
         }
-        s
+        let get = |i: usize| seen[i].ok_or(StrapFieldError::Missing(STRAP_KEYS[i]));
+        let bad = |i: usize, v: &str| StrapFieldError::BadValue {
+            key: STRAP_KEYS[i],
+            value: v.into(),
+        };
+        let level = |i: usize| -> Result<bool, StrapFieldError> {
+            match get(i)? {
+                "high" => Ok(true),
+                "low" => Ok(false),
+                v => Err(bad(i, v)),
+            }
+        };
+        let sysclk = get(0)?;
+        let ext = get(3)?;
+        Ok(Straps {
+            sysclk_hz: sysclk.parse().map_err(|_| bad(0, sysclk))?,
+            csel_high: level(1)?,
+            vsel_high: level(2)?,
+            ext_clock_hz: match ext {
+                "none" => None,
+                v => Some(v.parse().map_err(|_| bad(3, v))?),
+            },
+        })
     }
 
     /// Base clock period Tclock for a clock source, rounded to 1 ns (see
@@ -171,6 +232,57 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
     use rstest::rstest;
+
+    #[test]
+    fn strap_fields_round_trip_and_a_typo_is_refused_not_defaulted() {
+        let s = Straps {
+            sysclk_hz: 12_288_000,
+            csel_high: false,
+            vsel_high: true,
+            ext_clock_hz: Some(250_000),
+        };
+        let f = s.fields();
+        assert_eq!(
+            Straps::from_fields(f.iter().map(|(k, v)| (*k, v.as_str()))),
+            Ok(s)
+        );
+        let with = |k: &'static str, v: &'static str| {
+            Straps::default()
+                .fields()
+                .iter()
+                .map(|(key, val)| {
+                    if *key == k {
+                        (k, v.to_string())
+                    } else {
+                        (*key, val.clone())
+                    }
+                })
+                .collect::<alloc::vec::Vec<_>>()
+        };
+        let parse =
+            |f: &[(&str, String)]| Straps::from_fields(f.iter().map(|(k, v)| (*k, v.as_str())));
+        assert_eq!(
+            parse(&with("csel", "hgih")),
+            Err(StrapFieldError::BadValue {
+                key: "csel",
+                value: "hgih".into()
+            })
+        );
+        assert!(parse(&with("sysclk_hz", "16MHz")).is_err());
+        assert_eq!(parse(&with("ext_clock_hz", "none")), Ok(Straps::default()));
+        assert_eq!(
+            Straps::from_fields([
+                ("sysclk_hz", "16000000"),
+                ("csel", "high"),
+                ("vsel", "high")
+            ]),
+            Err(StrapFieldError::Missing("ext_clock_hz"))
+        );
+        assert_eq!(
+            Straps::from_fields([("sysclk_hz", "1"), ("sysclk_hz", "2")]),
+            Err(StrapFieldError::Repeated("sysclk_hz"))
+        );
+    }
 
     #[test]
     fn s3_2_1_internal_clock_is_500khz_or_125khz_at_16mhz() {

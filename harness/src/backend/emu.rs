@@ -42,25 +42,15 @@ impl From<EmuTarget> for EmuBus {
 
 impl Target for EmuTarget {
     fn info(&self) -> TargetInfo {
-        let s = self.bus.straps();
         TargetInfo {
             name: "emu".to_string(),
-            details: vec![
-                ("sysclk_hz".into(), s.sysclk_hz.to_string()),
-                (
-                    "csel".into(),
-                    if s.csel_high { "high" } else { "low" }.into(),
-                ),
-                (
-                    "vsel".into(),
-                    if s.vsel_high { "high" } else { "low" }.into(),
-                ),
-                (
-                    "ext_clock_hz".into(),
-                    s.ext_clock_hz.map_or("none".into(), |h| h.to_string()),
-                ),
-            ],
+            straps: self.bus.straps(),
+            extra: Vec::new(),
         }
+    }
+
+    fn straps(&self) -> Straps {
+        self.bus.straps()
     }
 
     fn capture(&mut self) -> Result<Record, TargetError> {

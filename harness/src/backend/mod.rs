@@ -18,7 +18,7 @@ pub use self::serial::{
 
 pub use ppmc_core::bus::{Op, Reply};
 
-use crate::protocol::Record;
+use crate::protocol::{Record, Straps};
 use std::fmt;
 
 /// What kind of failure a target error is, so that generic code can tell a
@@ -47,18 +47,40 @@ impl fmt::Display for TargetError {
     }
 }
 
-/// What a target says about itself, for reports.
+/// What a target says about itself, for traces and reports.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TargetInfo {
     /// `emu`, or `serial:/dev/ttyACM0`.
     pub name: String,
-    /// Free-form details: straps, model parameters, bridge firmware.
-    pub details: Vec<(String, String)>,
+    /// How the chip is strapped: the emulator's options, or what the
+    /// bridge reports of its board.
+    pub straps: Straps,
+    /// Other facts, `key value`: the bridge's firmware and protocol.
+    pub extra: Vec<(String, String)>,
+}
+
+impl TargetInfo {
+    /// The straps' fields, then the other facts: how traces and reports
+    /// list them.
+    pub fn details(&self) -> Vec<(String, String)> {
+        self.straps
+            .fields()
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .chain(self.extra.iter().cloned())
+            .collect()
+    }
 }
 
 /// A chip the harness can drive.
 pub trait Target: Send {
     fn info(&self) -> TargetInfo;
+
+    /// How the chip is strapped; scenarios derive rates, waits and timing
+    /// bands from it.
+    fn straps(&self) -> Straps {
+        self.info().straps
+    }
 
     /// Everything captured on the output side since the last reset: pulse
     /// runs with the target's timestamps, pin changes, move starts.

@@ -10,6 +10,7 @@
 
 use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
 use crate::protocol::Record;
+use crate::protocol::Straps;
 use ppmc_core::bridge::frame::{self, FrameDecoder};
 use ppmc_core::bridge::wire::MAX_BATCH_OPS;
 use ppmc_core::bridge::wire::{
@@ -340,7 +341,7 @@ impl<L: Link> SerialTarget<L> {
                 inputs_wired: 0,
                 virtual_time: false,
                 firmware: String::new(),
-                straps: String::new(),
+                straps: Straps::default(),
             },
             timer: Timer::NANOS,
             opts,
@@ -785,19 +786,18 @@ impl<L: Link> SerialTarget<L> {
 
 impl<L: Link> Target for SerialTarget<L> {
     fn info(&self) -> TargetInfo {
-        let mut details: Vec<(String, String)> = self
-            .hello
-            .straps
-            .split_whitespace()
-            .filter_map(|kv| kv.split_once('='))
-            .map(|(k, v)| (k.to_string(), v.to_string()))
-            .collect();
-        details.push(("bridge_firmware".into(), self.hello.firmware.clone()));
-        details.push(("bridge_protocol".into(), self.hello.version.to_string()));
         TargetInfo {
             name: self.link.name(),
-            details,
+            straps: self.hello.straps,
+            extra: vec![
+                ("bridge_firmware".into(), self.hello.firmware.clone()),
+                ("bridge_protocol".into(), self.hello.version.to_string()),
+            ],
         }
+    }
+
+    fn straps(&self) -> Straps {
+        self.hello.straps
     }
 
     /// Fetches what the bridge captured since the last fetch: new pin
@@ -1041,7 +1041,7 @@ mod tests {
                         inputs_wired: 0,
                         virtual_time: true,
                         firmware: "future".into(),
-                        straps: String::new(),
+                        straps: Straps::default(),
                     });
                     self.0
                         .extend(frame::encode(&hello.encode(seq, Timer::NANOS)));
@@ -1066,8 +1066,8 @@ mod tests {
             matches!(
                 e,
                 SerialError::Version {
-                    theirs: 3,
-                    ours: 2,
+                    theirs: 4,
+                    ours: 3,
                     ..
                 }
             ),

@@ -179,13 +179,7 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
                     elapsed: Duration::ZERO,
                 })
                 .collect();
-            let info = RunInfo::new(
-                &crate::backend::TargetInfo {
-                    name: args.target_name(),
-                    details: Vec::new(),
-                },
-                args.board_rev.clone(),
-            );
+            let info = RunInfo::unreached(args.target_name(), args.board_rev.clone());
             let _ = args
                 .junit
                 .as_ref()

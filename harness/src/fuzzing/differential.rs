@@ -93,11 +93,8 @@ impl Side<'_> {
     fn trace(&self, name: &str, with_capture: bool) -> Trace {
         let empty = Record::default();
         let capture = if with_capture { &self.capture } else { &empty };
-        Trace::assemble(
-            name,
-            "-",
-            self.target.info().name.as_str(),
-            Vec::new(),
+        let info = self.target.info();
+        Trace::new(name, "-", info.name.as_str(), info.straps, Vec::new()).assemble(
             self.bus.clone(),
             capture,
             Vec::new(),

@@ -410,7 +410,11 @@ fn record_breaks(rec: &Record) -> Option<String> {
 /// A trace's text parses back to the same trace and renders to the same
 /// bytes.
 fn trace_round_trip(rec: &Record) -> Option<String> {
-    let t = Trace::assemble("fuzz", "-", "emu", Vec::new(), Vec::new(), rec, Vec::new());
+    let t = Trace::new("fuzz", "-", "emu", Straps::default(), Vec::new()).assemble(
+        Vec::new(),
+        rec,
+        Vec::new(),
+    );
     let text = t.render();
     match Trace::parse(&text) {
         Ok(back) if back.render() == text => None,

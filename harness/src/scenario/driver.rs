@@ -257,7 +257,7 @@ fn fail(
 
 impl<'t> Driver<'t> {
     pub fn new(target: &'t mut dyn Target, opts: DriverOptions) -> Self {
-        let straps = Straps::from_details(&target.info().details);
+        let straps = target.straps();
         Driver {
             straps,
             target,

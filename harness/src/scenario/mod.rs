@@ -292,15 +292,14 @@ pub fn run_scenario(
         })
         .collect();
     let trace = capture.map(|c| {
-        Trace::assemble(
+        Trace::new(
             scenario.name,
             scenario.section,
             &info.name,
-            info.details.clone(),
-            bus,
-            &c,
-            measures,
+            info.straps,
+            info.extra.clone(),
         )
+        .assemble(bus, &c, measures)
     });
     ScenarioResult {
         name: scenario.name,
