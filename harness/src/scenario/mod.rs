@@ -6,16 +6,19 @@
 //! its [`ScenarioResult`]: the verdict, the graded measurements and the
 //! trace.
 
+mod builders;
 pub mod driver;
 pub mod grade;
+mod measure;
+mod queue;
 
-pub use driver::{Driver, DriverOptions, Init};
+pub use builders::{Init, Move};
+pub use driver::{Driver, DriverOptions};
 pub use grade::{Grade, Grading, Measurement};
 /// Declares a scenario where it is written; see the `ppmc-macros` crate.
 pub use ppmc_macros::scenario;
 
 use crate::backend::Target;
-use crate::protocol::{Command, Direction, MoveCommand, MoveKind, PulseCount};
 use crate::time::{Duration, Instant};
 use crate::trace::{Event, EventKind, Trace};
 use std::fmt;
@@ -104,81 +107,6 @@ impl Scenario {
 
     pub fn has_tag(&self, tag: &str) -> bool {
         self.tags.contains(&tag)
-    }
-}
-
-/// A move to issue: the command code and its data bytes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Move {
-    pub cmd: MoveCommand,
-    pub rate: Option<u8>,
-    pub steps: Option<PulseCount>,
-}
-
-impl Move {
-    fn new(kind: MoveKind, dir: Direction, rate: Option<u8>, steps: Option<u32>) -> Move {
-        Move {
-            cmd: MoveCommand::new(kind, dir, true),
-            rate,
-            // Out-of-range counts are a scenario bug; clamp into 1..=2^24.
-            steps: steps.map(|n| PulseCount::new(n.clamp(1, 1 << 24)).unwrap_or(PulseCount::MAX)),
-        }
-    }
-
-    /// Section 3-3-4: `steps` with the initialization's ramp.
-    pub fn accel(dir: Direction, steps: u32) -> Move {
-        Move::new(MoveKind::AccelDecel, dir, None, Some(steps))
-    }
-
-    /// Section 3-3-5: `steps` at pulse rate `rate`.
-    pub fn constant(dir: Direction, rate: u8, steps: u32) -> Move {
-        Move::new(MoveKind::Constant, dir, Some(rate), Some(steps))
-    }
-
-    /// Section 3-3-6: at `rate` until a limit.
-    pub fn continuous(dir: Direction, rate: u8) -> Move {
-        Move::new(MoveKind::ContinuousConstant, dir, Some(rate), None)
-    }
-
-    /// Section 3-3-7: ramp up and run at high speed until a limit.
-    pub fn high_speed(dir: Direction) -> Move {
-        Move::new(MoveKind::ContinuousHigh, dir, None, None)
-    }
-
-    /// Section 3-3-8: at `rate` until the origin signal.
-    pub fn origin(dir: Direction, rate: u8) -> Move {
-        Move::new(MoveKind::OriginSearch, dir, Some(rate), None)
-    }
-
-    /// Section 3-3-3: one step.
-    pub fn single_step(dir: Direction) -> Move {
-        Move::new(MoveKind::SingleStep, dir, None, None)
-    }
-
-    /// POUT mode (Sections 3-3-4, 3-3-7): pulses only, phases hold.
-    pub fn pout(mut self) -> Move {
-        self.cmd.pout = true;
-        self
-    }
-
-    /// Termination interrupt masked (bit 4 = 1).
-    pub fn masked(mut self) -> Move {
-        self.cmd.flags.interrupt = false;
-        self
-    }
-
-    pub fn code(&self) -> u8 {
-        Command::Move(self.cmd).encode()
-    }
-
-    /// The data bytes in flowchart order.
-    pub fn params(&self) -> Vec<u8> {
-        let mut v = Vec::new();
-        v.extend(self.rate);
-        if let Some(n) = self.steps {
-            v.extend(n.to_bytes());
-        }
-        v
     }
 }
 

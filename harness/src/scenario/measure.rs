@@ -1,0 +1,217 @@
+//! Table 3-3 measurements: each latency taken from the trace of the
+//! scenario so far, graded against its band at this board's straps.
+
+use super::driver::Driver;
+use super::grade::Grade;
+use super::queue::fail;
+use super::{Failure, Outcome, Stop};
+use crate::protocol::{Flag, Pin, Register, TimingId};
+use crate::time::{Duration, Instant};
+
+impl Driver<'_> {
+    fn record_measure(&mut self, id: TimingId, value: Duration, at: Instant) -> Outcome<Grade> {
+        let m = self.opts.grading.grade(id, &self.straps, value, at);
+        let grade = m.grade;
+        let (lo, hi) = (m.lo, m.hi);
+        self.measurements.push(m);
+        if grade == Grade::Fail {
+            return Err(Stop::Failed(Failure {
+                expectation: format!("{} (Table 3-3)", id.name()),
+                expected: format!("{lo}..={}", super::grade::fmt_hi(hi)),
+                got: value.to_string(),
+                at,
+            }));
+        }
+        Ok(grade)
+    }
+
+    fn pin_after(
+        &mut self,
+        pin: Pin,
+        value: Option<u8>,
+        from: Instant,
+    ) -> Outcome<Option<Instant>> {
+        Ok(self
+            .capture()?
+            .pins
+            .iter()
+            .find(|e| e.pin == pin && e.at >= from && value.is_none_or(|v| e.value == v))
+            .map(|e| e.at))
+    }
+
+    /// [`Driver::need`] of a time set by a queued step: flushes first.
+    fn flushed(&mut self, what: &str, t: fn(&Self) -> Option<Instant>) -> Outcome<Instant> {
+        self.flush()?;
+        self.need(what, t(self))
+    }
+
+    pub(super) fn need(&self, what: &str, t: Option<Instant>) -> Outcome<Instant> {
+        t.ok_or_else(|| {
+            Stop::Error(format!(
+                "scenario bug: measuring needs {what}, which this scenario has not done"
+            ))
+        })
+    }
+
+    fn last_move_pulse_times(&mut self) -> Outcome<(Instant, Instant)> {
+        let now = self.now;
+        let s = self.capture()?.last_move_pulses();
+        match (s.first, s.last) {
+            (Some(a), Some(b)) => Ok((a, b)),
+            _ => Err(fail("the move output pulses", "at least 1", 0, now)),
+        }
+    }
+
+    /// Measures the Table 3-3 quantity `id` from what has happened so far
+    /// and grades it. A FAIL stops the scenario; MARGINAL is recorded.
+    pub fn expect_latency(&mut self, id: TimingId) -> Outcome<Duration> {
+        let (from, to) = match id {
+            TimingId::BusyRise => {
+                let a = self.flushed("an operation command", |d| d.anchor)?;
+                (a, self.pin_after(Pin::Busy, Some(1), a)?)
+            }
+            TimingId::AccelFirstPout | TimingId::ConstantFirstPout => {
+                let a = self.flushed("an operation command", |d| d.anchor)?;
+                let (first, _) = self.last_move_pulse_times()?;
+                (a, Some(first))
+            }
+            TimingId::SingleStep => {
+                let a = self.flushed("an operation command", |d| d.anchor)?;
+                (a, self.pin_after(Pin::Busy, Some(0), a)?)
+            }
+            TimingId::InterruptOutput => {
+                let (_, last) = self.last_move_pulse_times()?;
+                (last, self.pin_after(Pin::Int, Some(1), last)?)
+            }
+            TimingId::HoldOn => {
+                let (_, last) = self.last_move_pulse_times()?;
+                (last, self.pin_after(Pin::Hold, Some(1), last)?)
+            }
+            TimingId::AbnormalTermination => {
+                let t = self.flushed("a stop or limit", |d| d.trigger)?;
+                (t, self.pin_after(Pin::Busy, Some(0), t)?)
+            }
+            TimingId::AuxOn => {
+                let t = self.flushed("an AUX ON command", |d| d.trigger)?;
+                (t, self.pin_after(Pin::Aux, Some(1), t)?)
+            }
+            TimingId::AuxOff => {
+                let t = self.flushed("an AUX OFF command", |d| d.trigger)?;
+                (t, self.pin_after(Pin::Aux, Some(0), t)?)
+            }
+            TimingId::ExcitationOff => {
+                let t = self.flushed("a software reset", |d| d.trigger)?;
+                (t, self.pin_after(Pin::Phases, Some(0), t)?)
+            }
+            TimingId::InitOutputsSet => {
+                let t = self.flushed("an initialization", |d| d.init_write)?;
+                (t, self.pin_after(Pin::Phases, None, t)?)
+            }
+            TimingId::InitProcessing => return self.measure_init_processing(),
+            TimingId::NextCommand => return self.measure_next_command(),
+            TimingId::DecelStopProcessing
+            | TimingId::HighSpeedLimitAccel
+            | TimingId::HighSpeedLimitCruise => return self.expect_decel_start(id),
+        };
+        let now = self.now;
+        let to = to.ok_or_else(|| {
+            fail(
+                format!("{} (Table 3-3): the event it ends with", id.name()),
+                "observed",
+                "never happened",
+                now,
+            )
+        })?;
+        let value = to.saturating_since(from);
+        self.record_measure(id, value, to)?;
+        Ok(value)
+    }
+
+    /// Initialization processing: from the final data byte until the chip
+    /// takes the next command (an input status read, harmless).
+    fn measure_init_processing(&mut self) -> Outcome<Duration> {
+        let timeout = self.opts.ibf_timeout;
+        self.expect_flag(Flag::Ibf, false, timeout)?;
+        self.raw_command(Register::InputSignals.code())?;
+        self.expect_flag(Flag::Ibf, false, timeout)?;
+        let t = self.flushed("an initialization", |d| d.init_write)?;
+        let value = self.now.saturating_since(t);
+        let at = self.now;
+        self.record_measure(TimingId::InitProcessing, value, at)?;
+        Ok(value)
+    }
+
+    /// Normal termination: the final POUT to the chip taking a command
+    /// written as soon as BUSY = 0.
+    fn measure_next_command(&mut self) -> Outcome<Duration> {
+        self.wait_idle()?;
+        self.raw_command(Register::InputSignals.code())?;
+        let timeout = self.opts.ibf_timeout;
+        self.expect_flag(Flag::Ibf, false, timeout)?;
+        // The move had ended before the command: its last pulse is in the
+        // capture fetched with the batch.
+        let (_, last) = self.last_move_pulse_times()?;
+        let value = self.now.saturating_since(last);
+        let at = self.now;
+        self.record_measure(TimingId::NextCommand, value, at)?;
+        Ok(value)
+    }
+
+    /// The deceleration latencies: after the move, the pulse count says from
+    /// which pulse the deceleration started; it must be the first pulse
+    /// after the trigger plus a latency inside the row's band. A pass/fail
+    /// check, not a graded measurement: one run only brackets the latency
+    /// between two pulses. Returns the time from the trigger to that pulse.
+    fn expect_decel_start(&mut self, id: TimingId) -> Outcome<Duration> {
+        let pa = self
+            .init
+            .map(|i| u64::from(i.data.pa))
+            .ok_or_else(|| Stop::Error("scenario bug: measuring needs an initialization".into()))?;
+        self.wait_idle()?;
+        let t = self.flushed("a decelerating stop or high-speed limit", |d| d.trigger)?;
+        let rec = self.capture()?;
+        let from = rec.moves.last().map_or(0, |m| m.first_run);
+        let times: Vec<Instant> = rec.runs[from..]
+            .iter()
+            .flat_map(|r| {
+                (0..r.count).map(move |i| r.start + r.interval.saturating_mul(u64::from(i)))
+            })
+            .collect();
+        let n = times.len() as u64;
+        // Pulse index the deceleration started from: at high speed it and
+        // PA - 1 more make the PA pulses of deceleration; during acceleration
+        // from index j the ramp down takes j (notes N16, N24).
+        let j1 = if id == TimingId::HighSpeedLimitAccel {
+            n / 2
+        } else {
+            n.saturating_sub(pa)
+        };
+        let (lo, hi) = id.row().band_for(&self.straps);
+        let first_after = |d: Duration| {
+            times
+                .iter()
+                .position(|p| *p > t + d)
+                .map_or(n, |i| i as u64)
+        };
+        let (j_lo, j_hi) = (first_after(lo), first_after(hi));
+        let start_time = times.get(j1 as usize).copied().unwrap_or(self.now);
+        if j1 < j_lo || j1 > j_hi {
+            return Err(Stop::Failed(Failure {
+                expectation: format!(
+                    "{} (Table 3-3): deceleration starts at the first pulse after the latency",
+                    id.name()
+                ),
+                expected: format!(
+                    "from pulse {j_lo}..={j_hi} (latency {lo}..={})",
+                    super::grade::fmt_hi(hi)
+                ),
+                got: format!("from pulse {j1}"),
+                at: start_time,
+            }));
+        }
+        // The latency itself lies between the pulse before j1 and j1; what is
+        // observable is how long after the trigger the first pulse of the
+        // deceleration came.
+        Ok(start_time.saturating_since(t))
+    }
+}
