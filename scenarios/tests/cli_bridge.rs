@@ -13,6 +13,11 @@ const EXAMPLE: &str = concat!(
 );
 
 /// A `ppmc bridge-sim` child process, killed when dropped.
+///
+/// The host reaches it through a link of its own (`--link`), as it reaches
+/// a board through a stable device path: a pseudo-terminal's number is
+/// reused as soon as it is free, so a host still reconnecting after its
+/// bridge went away could otherwise open another test's bridge.
 struct BridgeSim {
     child: Child,
     path: String,
@@ -21,8 +26,13 @@ struct BridgeSim {
 
 impl BridgeSim {
     fn start(args: &[&str]) -> BridgeSim {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        static N: AtomicUsize = AtomicUsize::new(0);
+        let link = tmp(&format!("pty-{}", N.fetch_add(1, Ordering::Relaxed)));
         let mut child = Command::new(env!("CARGO_BIN_EXE_ppmc"))
             .arg("bridge-sim")
+            .arg("--link")
+            .arg(&link)
             .args(args)
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
@@ -34,14 +44,13 @@ impl BridgeSim {
         reader
             .read_line(&mut first)
             .expect("bridge-sim prints its pty");
-        let path = first
-            .trim()
-            .strip_prefix("bridge-sim: serving on ")
-            .unwrap_or_else(|| panic!("unexpected first line `{first}`"))
-            .to_string();
+        assert!(
+            first.trim().starts_with("bridge-sim: serving on /dev/"),
+            "unexpected first line `{first}`"
+        );
         BridgeSim {
             child,
-            path,
+            path: link.to_str().expect("utf-8 path").to_string(),
             _stdout: reader,
         }
     }
@@ -55,6 +64,7 @@ impl Drop for BridgeSim {
     fn drop(&mut self) {
         let _ = self.child.kill();
         let _ = self.child.wait();
+        let _ = std::fs::remove_file(&self.path);
     }
 }
 
@@ -67,7 +77,13 @@ fn run_over_the_bridge_gives_the_same_verdicts_as_the_emulator() {
     let sim = BridgeSim::start(&[]);
     let over = ppmc(&["run", "--target", &sim.target()]);
     let local = ppmc(&["run"]);
-    assert_eq!(over.status.code(), Some(0), "{}", text(&over.stdout));
+    assert_eq!(
+        over.status.code(),
+        Some(0),
+        "{}{}",
+        text(&over.stdout),
+        text(&over.stderr)
+    );
     assert_eq!(text(&over.stdout), text(&local.stdout));
 }
 
@@ -93,8 +109,9 @@ fn a_disconnect_mid_run_writes_the_partial_junit_and_exits_1() {
         junit.to_str().expect("utf-8"),
     ]);
     let stdout = text(&out.stdout);
-    assert_eq!(out.status.code(), Some(1), "{stdout}");
-    assert!(stdout.contains("PASS "), "some ran: {stdout}");
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stdout}{stderr}");
+    assert!(stdout.contains("PASS "), "some ran: {stdout}{stderr}");
     assert!(stdout.contains("ERROR "), "{stdout}");
     assert!(stdout.contains("NOT RUN "), "{stdout}");
     let xml = std::fs::read_to_string(&junit).expect("JUnit written");

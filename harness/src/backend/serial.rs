@@ -69,7 +69,7 @@ impl SerialLink {
 fn open_error(path: &str, e: io::Error) -> SerialError {
     match e.kind() {
         io::ErrorKind::NotFound => SerialError::PortMissing { path: path.into() },
-        io::ErrorKind::PermissionDenied => SerialError::PortBusy {
+        io::ErrorKind::PermissionDenied | io::ErrorKind::ResourceBusy => SerialError::PortBusy {
             path: path.into(),
             detail: e.to_string(),
         },
@@ -112,7 +112,16 @@ impl Link for SerialLink {
         let port = serialport::new(&self.path, self.baud)
             .timeout(WallDuration::from_millis(100))
             .open()
-            .map_err(io::Error::from)?;
+            .map_err(|e| match e.kind {
+                // serialport reports EBUSY (another program holds the
+                // port's exclusive lock) as `NoDevice`, which its io::Error
+                // conversion turns into NotFound: keep it apart from a
+                // port that is not there.
+                serialport::ErrorKind::NoDevice => {
+                    io::Error::new(io::ErrorKind::ResourceBusy, e.description)
+                }
+                _ => io::Error::from(e),
+            })?;
         self.port = Some(port);
         Ok(())
     }
@@ -976,6 +985,7 @@ mod tests {
         // root passes the exclusive lock serialport takes on the port.)
         for e in [
             io::Error::from_raw_os_error(16), // EBUSY
+            io::Error::new(io::ErrorKind::ResourceBusy, "busy"),
             io::Error::new(io::ErrorKind::PermissionDenied, "denied"),
         ] {
             let msg = open_error("/dev/ttyACM0", e).to_string();

@@ -192,6 +192,12 @@ pub fn serve<P: Read + Write>(
 /// A bridge simulator serving an emulator on its own thread, on a fresh
 /// pseudo-terminal: what tests, `ppmc bench` and `ppmc fault-matrix` point
 /// a serial target at. Dropping it stops the thread.
+///
+/// Hosts reach it through a symbolic link of its own in the temporary
+/// directory ([`PtyBridge::path`]), removed when the bridge stops serving,
+/// as a board is reached through a stable device path: the kernel reuses a
+/// pseudo-terminal's number as soon as it is free, so a host reconnecting
+/// to a bridge that went away could otherwise open another one.
 #[derive(Debug)]
 pub struct PtyBridge {
     path: String,
@@ -218,16 +224,21 @@ impl PtyBridge {
         master
             .set_timeout(WallDuration::from_millis(20))
             .map_err(io::Error::other)?;
-        let path = slave
+        let pty = slave
             .name()
             .ok_or_else(|| io::Error::other("the pseudo-terminal has no path"))?;
+        let path = link_to(&pty)?;
         let stop = Arc::new(AtomicBool::new(false));
         let flag = Arc::clone(&stop);
+        let link = path.clone();
         let handle = std::thread::spawn(move || {
             let _keep_open = slave;
             let mut server = engine(emu, 0x5EED, !bridge.realtime)
                 .with_capture_capacity(bridge.capture_capacity);
-            serve(&mut master, &mut server, faults, bridge.realtime, &flag).ok()
+            let end = serve(&mut master, &mut server, faults, bridge.realtime, &flag).ok();
+            // Gone before the pty is: a host reconnecting now finds nothing.
+            let _ = std::fs::remove_file(&link);
+            end
         });
         Ok(PtyBridge {
             path,
@@ -236,7 +247,7 @@ impl PtyBridge {
         })
     }
 
-    /// The pty's path, for `serial:<path>`.
+    /// The bridge's path (a link to its pty), for `serial:<path>`.
     pub fn path(&self) -> &str {
         &self.path
     }
@@ -255,5 +266,28 @@ impl PtyBridge {
 impl Drop for PtyBridge {
     fn drop(&mut self) {
         self.halt();
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
+/// A new symbolic link to `pty` in the temporary directory, under a name
+/// no other bridge of this process has used.
+fn link_to(pty: &str) -> io::Result<String> {
+    use std::sync::atomic::AtomicUsize;
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    loop {
+        let n = NEXT.fetch_add(1, Ordering::Relaxed);
+        let link = std::env::temp_dir().join(format!("ppmc-pty-{}-{n}", std::process::id()));
+        match std::os::unix::fs::symlink(pty, &link) {
+            Ok(()) => {
+                return link
+                    .into_os_string()
+                    .into_string()
+                    .map_err(|_| io::Error::other("the temporary directory's path is not UTF-8"))
+            }
+            // Left by an earlier process with this id: take another name.
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        }
     }
 }
