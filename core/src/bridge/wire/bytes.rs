@@ -1,0 +1,215 @@
+//! Little-endian writing and checked reading of message fields, with
+//! times converted to and from the bridge timer's ticks.
+
+use super::*;
+
+/// Converts between nanoseconds and ticks of a timer running at `hz`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Timer {
+    pub hz: u64,
+}
+
+impl Timer {
+    /// The simulator's timer: one tick per nanosecond.
+    pub const NANOS: Timer = Timer { hz: 1_000_000_000 };
+
+    /// Nanoseconds to ticks, to the nearest tick: so that ticks turned into
+    /// nanoseconds ([`Timer::to_nanos`], which truncates) and back are the
+    /// same ticks for any timer up to 500 MHz.
+    pub fn to_ticks(self, ns: u64) -> u64 {
+        if self.hz == Self::NANOS.hz {
+            return ns;
+        }
+        let t = (u128::from(ns) * u128::from(self.hz) + 500_000_000) / 1_000_000_000;
+        u64::try_from(t).unwrap_or(u64::MAX)
+    }
+
+    pub fn to_nanos(self, ticks: u64) -> u64 {
+        if self.hz == Self::NANOS.hz {
+            return ticks;
+        }
+        if self.hz == 0 {
+            return u64::MAX;
+        }
+        let n = u128::from(ticks) * 1_000_000_000 / u128::from(self.hz);
+        u64::try_from(n).unwrap_or(u64::MAX)
+    }
+}
+
+#[derive(Debug)]
+pub(super) struct W(pub(super) Vec<u8>, pub(super) Timer);
+
+impl W {
+    pub(super) fn dur(&mut self, d: Duration) {
+        let t = self.1.to_ticks(d.as_nanos());
+        self.u64(t);
+    }
+    pub(super) fn time(&mut self, i: Instant) {
+        let t = self.1.to_ticks(i.as_nanos());
+        self.u64(t);
+    }
+    pub(super) fn opt_dur(&mut self, d: Option<Duration>) {
+        let v = d.map(|d| self.1.to_ticks(d.as_nanos()));
+        self.opt(v);
+    }
+    pub(super) fn opt_time(&mut self, i: Option<Instant>) {
+        let v = i.map(|i| self.1.to_ticks(i.as_nanos()));
+        self.opt(v);
+    }
+    pub(super) fn u8(&mut self, v: u8) {
+        self.0.push(v);
+    }
+    pub(super) fn u16(&mut self, v: u16) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    pub(super) fn u32(&mut self, v: u32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    pub(super) fn u64(&mut self, v: u64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+    pub(super) fn opt(&mut self, v: Option<u64>) {
+        match v {
+            Some(x) => {
+                self.u8(1);
+                self.u64(x);
+            }
+            None => self.u8(0),
+        }
+    }
+    pub(super) fn str(&mut self, s: &str) {
+        let b = s.as_bytes();
+        let n = b.len().min(255);
+        self.u8(n as u8);
+        self.0.extend_from_slice(&b[..n]);
+    }
+}
+
+pub(super) struct R<'a> {
+    pub(super) b: &'a [u8],
+    pub(super) at: usize,
+    pub(super) timer: Timer,
+}
+
+impl<'a> R<'a> {
+    pub(super) fn new(b: &'a [u8], timer: Timer) -> Self {
+        R { b, at: 0, timer }
+    }
+    pub(super) fn dur(&mut self) -> Result<Duration, WireError> {
+        let t = self.u64()?;
+        Ok(Duration::from_nanos(self.timer.to_nanos(t)))
+    }
+    pub(super) fn time(&mut self) -> Result<Instant, WireError> {
+        let t = self.u64()?;
+        Ok(Instant::from_nanos(self.timer.to_nanos(t)))
+    }
+    pub(super) fn opt_dur(&mut self) -> Result<Option<Duration>, WireError> {
+        let t = self.timer;
+        Ok(self.opt()?.map(|v| Duration::from_nanos(t.to_nanos(v))))
+    }
+    pub(super) fn opt_time(&mut self) -> Result<Option<Instant>, WireError> {
+        let t = self.timer;
+        Ok(self.opt()?.map(|v| Instant::from_nanos(t.to_nanos(v))))
+    }
+    pub(super) fn take(&mut self, n: usize) -> Result<&'a [u8], WireError> {
+        if self.b.len() - self.at < n {
+            return Err(WireError::Truncated {
+                at: self.at,
+                wanted: n - (self.b.len() - self.at),
+            });
+        }
+        let s = &self.b[self.at..self.at + n];
+        self.at += n;
+        Ok(s)
+    }
+    pub(super) fn u8(&mut self) -> Result<u8, WireError> {
+        Ok(self.take(1)?[0])
+    }
+    pub(super) fn u16(&mut self) -> Result<u16, WireError> {
+        let s = self.take(2)?;
+        Ok(u16::from_le_bytes([s[0], s[1]]))
+    }
+    pub(super) fn u32(&mut self) -> Result<u32, WireError> {
+        let s = self.take(4)?;
+        Ok(u32::from_le_bytes([s[0], s[1], s[2], s[3]]))
+    }
+    pub(super) fn u64(&mut self) -> Result<u64, WireError> {
+        let s = self.take(8)?;
+        let mut a = [0u8; 8];
+        a.copy_from_slice(s);
+        Ok(u64::from_le_bytes(a))
+    }
+    pub(super) fn bool(&mut self, field: &'static str) -> Result<bool, WireError> {
+        let at = self.at;
+        match self.u8()? {
+            0 => Ok(false),
+            1 => Ok(true),
+            v => Err(WireError::BadValue {
+                at,
+                field,
+                value: u64::from(v),
+            }),
+        }
+    }
+    pub(super) fn opt(&mut self) -> Result<Option<u64>, WireError> {
+        Ok(if self.bool("option flag")? {
+            Some(self.u64()?)
+        } else {
+            None
+        })
+    }
+    pub(super) fn str(&mut self) -> Result<String, WireError> {
+        let n = usize::from(self.u8()?);
+        Ok(String::from_utf8_lossy(self.take(n)?).into_owned())
+    }
+    pub(super) fn peek(&self) -> Option<u8> {
+        self.b.get(self.at).copied()
+    }
+    /// A sample count: 2..=MAX_SAMPLES.
+    pub(super) fn samples(&mut self) -> Result<usize, WireError> {
+        let at = self.at;
+        let n = usize::from(self.u16()?);
+        if !(2..=MAX_SAMPLES).contains(&n) {
+            return Err(WireError::BadValue {
+                at,
+                field: "sample count",
+                value: n as u64,
+            });
+        }
+        Ok(n)
+    }
+    pub(super) fn count(&mut self, max_item: usize) -> Result<usize, WireError> {
+        let at = self.at;
+        let n = usize::from(self.u16()?);
+        // A count cannot promise more items than bytes left.
+        if n.saturating_mul(max_item.max(1)) > (self.b.len() - self.at).saturating_mul(64) {
+            return Err(WireError::BadValue {
+                at,
+                field: "count",
+                value: n as u64,
+            });
+        }
+        Ok(n)
+    }
+    pub(super) fn end(&self) -> Result<(), WireError> {
+        match self.b.len() - self.at {
+            0 => Ok(()),
+            n => Err(WireError::Trailing(n)),
+        }
+    }
+    pub(super) fn dir(&mut self) -> Result<Direction, WireError> {
+        Ok(Direction::from_bit(self.bool("direction")?))
+    }
+    pub(super) fn input(&mut self) -> Result<Input, WireError> {
+        let at = self.at;
+        let i = self.u8()?;
+        Input::ALL
+            .get(usize::from(i))
+            .copied()
+            .ok_or(WireError::BadValue {
+                at,
+                field: "input",
+                value: u64::from(i),
+            })
+    }
+}
