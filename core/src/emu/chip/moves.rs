@@ -1,0 +1,426 @@
+//! Moves (Section 3-3): starting them, stops, inputs during a move, the
+//! pulse train, and the outputs that follow (INT*, HOLD, stop switching,
+//! the phase pattern).
+
+use super::*;
+
+impl Chip {
+    // ----- moves (Section 3-3) --------------------------------------------
+
+    pub(super) fn start_move(&mut self, cmd: MoveCommand, params: [u8; 4], base: Instant) {
+        let Some(setup) = self.setup.clone() else {
+            self.set_error(ErrorCode::NotInitialized);
+            return;
+        };
+        let kind = cmd.kind;
+        let total = match kind {
+            MoveKind::SingleStep => 1,
+            MoveKind::AccelDecel => {
+                PulseCount::from_bytes([params[0], params[1], params[2]]).steps()
+            }
+            MoveKind::Constant => PulseCount::from_bytes([params[1], params[2], params[3]]).steps(),
+            _ => PulseCount::MAX.steps(),
+        };
+        let tclock = self.straps.tclock(setup.clock);
+        let (profile, first_pout) = match (kind, &setup.ramp) {
+            (MoveKind::AccelDecel | MoveKind::ContinuousHigh, Some((table, cruise))) => {
+                let pa = u32::from(setup.data.pa);
+                let mut first = self.cfg.accel_first_pout;
+                if total < 2 * pa {
+                    // Triangular drive: the deceleration point takes longer to
+                    // find the more steps there are (Table 3-3, notes N17).
+                    let extra = self
+                        .cfg
+                        .accel_first_pout_triangle_max
+                        .saturating_sub(first)
+                        .scale(u64::from(total), 2 * u64::from(PA_MAX));
+                    first += extra;
+                }
+                (
+                    Profile::Ramped {
+                        table: Arc::clone(table),
+                        cruise: *cruise,
+                    },
+                    Some(first),
+                )
+            }
+            (MoveKind::SingleStep, _) => (
+                Profile::Constant {
+                    interval: Duration::ZERO,
+                },
+                tclock.map(|_| self.cfg.single_step_pout),
+            ),
+            (MoveKind::Constant | MoveKind::ContinuousConstant | MoveKind::OriginSearch, _) => {
+                let rate = params[0];
+                let interval =
+                    tclock.map_or(Duration::MAX, |t| self.straps.pulse_interval(rate, t));
+                (
+                    Profile::Constant { interval },
+                    tclock.map(|_| self.cfg.constant_first_pout),
+                )
+            }
+            // A ramped move without a clock never pulses.
+            _ => (
+                Profile::Constant {
+                    interval: Duration::MAX,
+                },
+                None,
+            ),
+        };
+        let first_pulse = first_pout.map_or(Instant::NEVER, |d| base + self.fw(d));
+        self.motion_seq += 1;
+        let id = self.motion_seq;
+        let motion = Motion::new(
+            id,
+            kind,
+            cmd.flags.direction,
+            cmd.pout,
+            cmd.flags.interrupt,
+            base,
+            total,
+            first_pulse,
+            profile,
+        );
+        self.record.moves.push(MoveStart {
+            at: base,
+            kind,
+            dir: cmd.flags.direction,
+            pout: cmd.pout,
+            steps: total,
+            first_run: self.record.runs.len(),
+            phase_index: self.phase_index,
+            winding: if cmd.pout { None } else { self.winding },
+        });
+        self.motion = Some(motion);
+        let rise = base + self.fw(self.cfg.busy_rise);
+        self.proc_free_at = self.proc_free_at.max(rise);
+        self.schedule(rise, Timer::BusyRise { id });
+    }
+
+    pub(super) fn stop_command_immediate(&mut self, base: Instant) {
+        self.halt(StopCause::StopCommand, base);
+    }
+
+    pub(super) fn stop_command_decel(&mut self, base: Instant) {
+        let Some(m) = self.motion.as_ref() else {
+            return;
+        };
+        if !m.kind.ramped() || self.cfg.faults.decel_stop_immediate {
+            // Constant-speed moves have no deceleration: stop at once (N13).
+            self.halt(StopCause::StopCommand, base);
+            return;
+        }
+        if m.decelerating() || m.decel_requested {
+            self.set_error(ErrorCode::DecelStopDuringDecel);
+            return;
+        }
+        let id = m.id;
+        if let Some(m) = self.motion.as_mut() {
+            m.decel_requested = true;
+        }
+        self.schedule(
+            base + self.fw(self.cfg.decel_stop),
+            Timer::DecelStart {
+                id,
+                cause: StopCause::StopCommand,
+            },
+        );
+    }
+
+    /// Reacts to an input that was just asserted while a move is under way.
+    /// Before the first pulse, inputs are sampled instead (see
+    /// [`Self::check_inputs_before_first_pulse`]).
+    pub(super) fn react_to_input(&mut self, input: Input) {
+        let Some(m) = self.motion.as_ref() else {
+            return;
+        };
+        if !m.pulses_left() || m.emitted == 0 {
+            return;
+        }
+        let now = self.now;
+        let (dir, kind, pout) = (m.dir, m.kind, m.pout);
+        let mut only = InputSet::default();
+        only.set(input, true);
+        let seen = self.seen_inputs(only, dir);
+        if seen.contains(Input::Alm) {
+            self.halt(StopCause::Alarm, now);
+        } else if seen.contains(Input::limit_for(dir)) {
+            self.halt(StopCause::Limit, now);
+        } else if seen.contains(Input::Cnp) && kind == MoveKind::OriginSearch {
+            self.halt(StopCause::Completed, now);
+        } else if input == Input::high_speed_limit_for(dir) && kind.ramped() {
+            self.high_speed_limit(pout);
+        }
+    }
+
+    /// L3/L4 for the direction of a ramped move: decelerate (Sections 3-3-4,
+    /// 3-3-7), except during acceleration in POUT mode.
+    pub(super) fn high_speed_limit(&mut self, pout: bool) {
+        let Some(m) = self.motion.as_ref() else {
+            return;
+        };
+        if m.decelerating() || m.decel_requested {
+            return;
+        }
+        let at_speed = m.at_high_speed();
+        if pout && !at_speed {
+            // Checked again on reaching high speed.
+            return;
+        }
+        let latency = if at_speed {
+            self.cfg.hs_limit_cruise
+        } else {
+            self.cfg.hs_limit_accel
+        };
+        let id = m.id;
+        if let Some(m) = self.motion.as_mut() {
+            m.decel_requested = true;
+        }
+        let at = self.now + self.fw(latency);
+        self.schedule(
+            at,
+            Timer::DecelStart {
+                id,
+                cause: StopCause::HighSpeedLimit,
+            },
+        );
+    }
+
+    /// Cuts pulse output now. `trigger` is when the cause arose (the stop
+    /// command write, or the input edge), from which Table 3-3's abnormal
+    /// termination time is counted.
+    pub(super) fn halt(&mut self, cause: StopCause, trigger: Instant) {
+        let now = self.now;
+        let Some(m) = self.motion.as_mut() else {
+            return;
+        };
+        if !m.pulses_left() {
+            // Already past its last pulse: the move completes normally.
+            return;
+        }
+        m.halted = true;
+        m.cause = cause;
+        let id = m.id;
+        let end = if m.kind == MoveKind::SingleStep {
+            m.base + self.straps.firmware_time(self.cfg.single_step_done)
+        } else if m.kind.ramped() && cause != StopCause::Completed {
+            trigger + self.straps.firmware_time(self.cfg.remaining_calc)
+        } else {
+            now + self.straps.firmware_time(self.cfg.interrupt_delay)
+        };
+        self.schedule(end.max(now), Timer::Terminate { id });
+    }
+
+    pub(super) fn check_inputs_before_first_pulse(&mut self) {
+        let Some(m) = self.motion.as_ref() else {
+            return;
+        };
+        let (dir, kind, pout) = (m.dir, m.kind, m.pout);
+        let now = self.now;
+        let inputs = self.seen_inputs(self.inputs, dir);
+        if inputs.contains(Input::Alm) {
+            self.halt(StopCause::Alarm, now);
+        } else if inputs.contains(Input::limit_for(dir)) {
+            self.halt(StopCause::Limit, now);
+        } else if kind == MoveKind::OriginSearch && inputs.contains(Input::Cnp) {
+            self.halt(StopCause::Completed, now);
+        } else if kind.ramped() && !pout && inputs.contains(Input::high_speed_limit_for(dir)) {
+            // Detected before the first pulse: decelerate from standstill,
+            // which leaves the one pulse already being timed.
+            if let Some(m) = self.motion.as_mut() {
+                if m.begin_decel() {
+                    m.cause = StopCause::HighSpeedLimit;
+                }
+            }
+        }
+    }
+
+    /// The inputs as the firmware sees them during a move in `dir`: all of
+    /// them, unless a board fault hides one.
+    pub(super) fn seen_inputs(&self, mut inputs: InputSet, dir: Direction) -> InputSet {
+        let f = &self.cfg.faults;
+        if f.alarm_ignored {
+            inputs.set(Input::Alm, false);
+        }
+        if f.origin_ignored {
+            inputs.set(Input::Cnp, false);
+        }
+        if f.limit_ignored == Some(dir) {
+            inputs.set(Input::limit_for(dir), false);
+        }
+        inputs
+    }
+
+    /// Whether the move is in POUT mode with its high-speed limit asserted
+    /// and not yet acted on: it looks at the limit after every pulse until
+    /// high speed is reached (Section 3-3-4, notes N26).
+    pub(super) fn pout_hs_check(m: &Motion, inputs: InputSet) -> bool {
+        m.pout
+            && m.kind.ramped()
+            && !m.decel_requested
+            && inputs.contains(Input::high_speed_limit_for(m.dir))
+    }
+
+    /// The pulses the move will output next without any decision in
+    /// between: `(first, interval, count)`. A whole constant-period stretch,
+    /// or one pulse where the model must look again after it (a ramp, the
+    /// first pulse, a pending POUT high-speed-limit check). Both [`Self::poll_at`] and
+    /// [`Self::emit_pulses`] use it, so waiting never skips a decision.
+    pub(super) fn next_stretch(&self) -> Option<(Instant, Duration, u32)> {
+        let m = self.motion.as_ref().filter(|m| m.pulses_left())?;
+        let (interval, count) = m.constant_stretch();
+        // The first pulse samples the inputs (notes N27).
+        let count = if m.emitted == 0 || Self::pout_hs_check(m, self.inputs) {
+            count.min(1)
+        } else {
+            count
+        };
+        Some((m.next_pulse, interval, count))
+    }
+
+    /// Emits the next pulses due at or before `horizon`: one ramp pulse, or a
+    /// whole constant-period stretch in one step.
+    pub(super) fn emit_pulses(&mut self, horizon: Instant) {
+        let Some(m) = self.motion.as_ref() else {
+            return;
+        };
+        if m.emitted == 0 {
+            self.check_inputs_before_first_pulse();
+        }
+        let Some(m) = self.motion.as_ref() else {
+            return;
+        };
+        let pout_hs_check = Self::pout_hs_check(m, self.inputs);
+        let Some((first, interval, stretch)) = self.next_stretch() else {
+            return;
+        };
+        let Some(m) = self.motion.as_mut() else {
+            return;
+        };
+        let fit = if stretch <= 1 || interval == Duration::ZERO {
+            stretch
+        } else {
+            let span = horizon.saturating_since(first).as_nanos() / interval.as_nanos();
+            u32::try_from(span.saturating_add(1))
+                .unwrap_or(u32::MAX)
+                .min(stretch)
+        };
+        let last = first + interval.saturating_mul(u64::from(fit - 1));
+        let new_move = m.emitted == 0;
+        let dir = m.dir;
+        let steps_phases = !m.pout;
+        m.emitted += fit;
+        m.last_pulse = Some(last);
+        if m.emitted < m.end {
+            m.next_pulse = last + m.interval_after(m.emitted - 1);
+        }
+        let done = m.emitted >= m.end;
+        let at_speed = m.at_high_speed();
+        let (id, kind, base) = (m.id, m.kind, m.base);
+        // Fault: the final pulse of the move never reaches the wire.
+        let on_wire = if done && self.cfg.faults.drop_last_pulse {
+            fit - 1
+        } else {
+            fit
+        };
+        self.record
+            .push_pulses(first, interval, on_wire, dir, new_move);
+        if steps_phases {
+            if let Some(w) = self.winding {
+                // Fault: the first step of each move never reaches the phases.
+                let skipped = u64::from(new_move && self.cfg.faults.phase_step_skipped);
+                let steps = u64::from(fit) - skipped;
+                self.phase_index = w.advance(self.phase_index, dir, steps);
+            }
+        }
+        self.now = last;
+        if pout_hs_check && at_speed && !done {
+            self.high_speed_limit(true);
+        }
+        if done {
+            let end = if kind == MoveKind::SingleStep {
+                base + self.fw(self.cfg.single_step_done)
+            } else {
+                last + self.fw(self.cfg.interrupt_delay)
+            };
+            self.schedule(end, Timer::Terminate { id });
+        }
+        if self.pick_starved && !self.starved() {
+            self.pick_starved = false;
+            let at = self.now.max(self.proc_free_at);
+            self.schedule_pick(at);
+        }
+    }
+
+    // ----- outputs --------------------------------------------------------
+
+    pub(super) fn set_int(&mut self, asserted: bool) {
+        if self.int != asserted {
+            self.int = asserted;
+            self.record.pin(self.now, Pin::Int, u8::from(asserted));
+        }
+    }
+
+    pub(super) fn set_hold(&mut self, on: bool) {
+        if on && self.cfg.faults.hold_stuck_off {
+            return;
+        }
+        if self.hold != on {
+            self.hold = on;
+            self.record.pin(self.now, Pin::Hold, u8::from(on));
+        }
+    }
+
+    pub(super) fn start_switching_if_enabled(&mut self) {
+        let enabled = self.setup.as_ref().is_some_and(|s| s.stop_switching);
+        if enabled && self.phases_on {
+            self.set_switching(Some(self.now));
+        }
+    }
+
+    pub(super) fn set_switching(&mut self, since: Option<Instant>) {
+        if self.switching_since.is_some() != since.is_some() {
+            self.record
+                .pin(self.now, Pin::Switching, u8::from(since.is_some()));
+        }
+        self.switching_since = since;
+    }
+
+    pub(super) fn record_phases(&mut self) {
+        let p = self.energized_pattern();
+        self.record.pin(self.now, Pin::Phases, p);
+    }
+
+    /// Energized phases ignoring stop switching.
+    pub(super) fn energized_pattern(&self) -> u8 {
+        match (self.phases_on, self.winding) {
+            (true, Some(w)) => w.pattern(self.phase_index),
+            _ => 0,
+        }
+    }
+
+    /// Energized phases at `t`, with stop switching chopping them.
+    pub(super) fn energized(&self, t: Instant) -> u8 {
+        let p = self.energized_pattern();
+        match self.switching_since {
+            Some(since) => {
+                let cycle = (self.switch_on + self.switch_off).as_nanos().max(1);
+                let phase = t.saturating_since(since).as_nanos() % cycle;
+                if phase < self.switch_on.as_nanos() {
+                    p
+                } else {
+                    0
+                }
+            }
+            None => p,
+        }
+    }
+
+    /// Pin levels of S1..S5 for an energized pattern (Section 3-2-1).
+    pub(super) fn levels(&self, energized: u8) -> u8 {
+        match self.logic {
+            OutputLogic::Positive => energized,
+            OutputLogic::Negative => !energized & 0x1F,
+        }
+    }
+}

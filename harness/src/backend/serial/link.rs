@@ -1,0 +1,133 @@
+//! The byte link to a bridge: the [`Link`] trait, a serial port behind it
+//! ([`SerialLink`]), and `serial:<path>[,baud=N]` target specs.
+
+use super::SerialError;
+use std::fmt;
+use std::io::{self, Read, Write};
+use std::time::Duration as WallDuration;
+
+/// A byte link to a bridge.
+pub trait Link: Send + fmt::Debug {
+    fn send(&mut self, bytes: &[u8]) -> io::Result<()>;
+    /// Reads what arrives within `timeout`; `Ok(0)` when nothing did.
+    fn recv(&mut self, buf: &mut [u8], timeout: WallDuration) -> io::Result<usize>;
+    /// Opens the link again after it failed.
+    fn reopen(&mut self) -> io::Result<()>;
+    /// What to call the link in messages: `serial:/dev/ttyACM0`.
+    fn name(&self) -> String;
+}
+
+/// A serial port (USB CDC, UART, or a pseudo-terminal) through `serialport`.
+pub struct SerialLink {
+    path: String,
+    baud: u32,
+    port: Option<Box<dyn serialport::SerialPort>>,
+}
+
+impl fmt::Debug for SerialLink {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("SerialLink")
+            .field("path", &self.path)
+            .field("baud", &self.baud)
+            .finish()
+    }
+}
+
+impl SerialLink {
+    pub fn open(path: &str, baud: u32) -> Result<SerialLink, SerialError> {
+        let mut link = SerialLink {
+            path: path.to_string(),
+            baud,
+            port: None,
+        };
+        link.reopen().map_err(|e| open_error(path, e))?;
+        Ok(link)
+    }
+
+    fn port(&mut self) -> io::Result<&mut Box<dyn serialport::SerialPort>> {
+        self.port
+            .as_mut()
+            .ok_or_else(|| io::Error::new(io::ErrorKind::NotConnected, "port closed"))
+    }
+}
+
+pub(super) fn open_error(path: &str, e: io::Error) -> SerialError {
+    match e.kind() {
+        io::ErrorKind::NotFound => SerialError::PortMissing { path: path.into() },
+        io::ErrorKind::PermissionDenied | io::ErrorKind::ResourceBusy => SerialError::PortBusy {
+            path: path.into(),
+            detail: e.to_string(),
+        },
+        _ if e.raw_os_error() == Some(16) => SerialError::PortBusy {
+            path: path.into(),
+            detail: e.to_string(),
+        },
+        _ => SerialError::Io {
+            path: path.into(),
+            source: e,
+        },
+    }
+}
+
+impl Link for SerialLink {
+    fn send(&mut self, bytes: &[u8]) -> io::Result<()> {
+        let port = self.port()?;
+        port.write_all(bytes)?;
+        port.flush()
+    }
+
+    fn recv(&mut self, buf: &mut [u8], timeout: WallDuration) -> io::Result<usize> {
+        let port = self.port()?;
+        port.set_timeout(timeout.max(WallDuration::from_millis(1)))
+            .map_err(io::Error::from)?;
+        match port.read(buf) {
+            Ok(0) => Err(io::Error::new(io::ErrorKind::UnexpectedEof, "link closed")),
+            Ok(n) => Ok(n),
+            Err(e)
+                if e.kind() == io::ErrorKind::TimedOut || e.kind() == io::ErrorKind::WouldBlock =>
+            {
+                Ok(0)
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    fn reopen(&mut self) -> io::Result<()> {
+        self.port = None;
+        let port = serialport::new(&self.path, self.baud)
+            .timeout(WallDuration::from_millis(100))
+            .open()
+            .map_err(|e| match e.kind {
+                // serialport reports EBUSY (another program holds the
+                // port's exclusive lock) as `NoDevice`, which its io::Error
+                // conversion turns into NotFound: keep it apart from a
+                // port that is not there.
+                serialport::ErrorKind::NoDevice => {
+                    io::Error::new(io::ErrorKind::ResourceBusy, e.description)
+                }
+                _ => io::Error::from(e),
+            })?;
+        self.port = Some(port);
+        Ok(())
+    }
+
+    fn name(&self) -> String {
+        format!("serial:{}", self.path)
+    }
+}
+
+/// Parses `serial:<path>[,baud=N]`.
+pub fn parse_spec(spec: &str) -> Option<(String, u32)> {
+    let rest = spec.strip_prefix("serial:")?;
+    let mut parts = rest.split(',');
+    let path = parts.next().filter(|p| !p.is_empty())?.to_string();
+    let mut baud = 115_200;
+    for p in parts {
+        let (k, v) = p.split_once('=')?;
+        match k {
+            "baud" => baud = v.parse().ok().filter(|b| *b > 0)?,
+            _ => return None,
+        }
+    }
+    Some((path, baud))
+}
