@@ -60,8 +60,19 @@ pub struct ScriptError {
 
 const OPS: &str = "wc, wc!, wd, wd!, rs, rd, rd!, wait, await, set, pins, pulses, now";
 
+/// Why a console argument is not a byte.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ByteError {
+    /// Not a number in any of the accepted forms.
+    #[error("`{0}` is not a byte (write 0xNN, decimal or 0bNNNNNNNN)")]
+    NotANumber(String),
+    /// A number above 255.
+    #[error("`{0}` is out of range for a byte (0..=255)")]
+    OutOfRange(String),
+}
+
 /// Parses a byte written as `0xNN`, decimal or `0bNNNNNNNN`.
-pub fn parse_byte(s: &str) -> Result<u8, String> {
+pub fn parse_byte(s: &str) -> Result<u8, ByteError> {
     let lower = s.to_ascii_lowercase();
     let (digits, radix) = if let Some(h) = lower.strip_prefix("0x") {
         (h, 16)
@@ -70,9 +81,8 @@ pub fn parse_byte(s: &str) -> Result<u8, String> {
     } else {
         (lower.as_str(), 10)
     };
-    let value = u32::from_str_radix(digits, radix)
-        .map_err(|_| format!("`{s}` is not a byte (write 0xNN, decimal or 0bNNNNNNNN)"))?;
-    u8::try_from(value).map_err(|_| format!("`{s}` is out of range for a byte (0..=255)"))
+    let value = u32::from_str_radix(digits, radix).map_err(|_| ByteError::NotANumber(s.into()))?;
+    u8::try_from(value).map_err(|_| ByteError::OutOfRange(s.into()))
 }
 
 fn parse_stmt(text: &str) -> Result<Stmt, String> {
@@ -88,7 +98,7 @@ fn parse_stmt(text: &str) -> Result<Stmt, String> {
     };
     let byte_arg = |usage: &str| -> Result<u8, String> {
         want(1, usage)?;
-        parse_byte(args[0])
+        parse_byte(args[0]).map_err(|e| e.to_string())
     };
     let stmt = match op.as_str() {
         "wc" | "wc!" => Stmt::WriteCommand {
@@ -432,14 +442,14 @@ pub fn run(
         if replies.len() != ops.len() {
             return Err(ConsoleError::Target {
                 line: chunk.first().map_or(0, |l| l.line),
-                source: TargetError {
-                    kind: crate::backend::TargetErrorKind::Other,
-                    message: format!(
+                source: TargetError::new(
+                    crate::backend::TargetErrorKind::Other,
+                    format!(
                         "target answered {} of {} operations",
                         replies.len(),
                         ops.len()
                     ),
-                },
+                ),
             });
         }
         for (l, reply) in chunk.iter().zip(&replies) {
@@ -477,7 +487,7 @@ mod tests {
     #[case("0x1G", "not a byte")]
     #[case("-1", "not a byte")]
     fn bad_bytes_say_why(#[case] text: &str, #[case] why: &str) {
-        let err = parse_byte(text).expect_err("bad byte");
+        let err = parse_byte(text).expect_err("bad byte").to_string();
         assert!(err.contains(why), "{err}");
     }
 

@@ -102,10 +102,10 @@ pub fn check_board(
         }
     });
     if let Some(message) = link_error {
-        return Err(TargetError {
-            kind: crate::backend::TargetErrorKind::Link,
+        return Err(TargetError::new(
+            crate::backend::TargetErrorKind::Link,
             message,
-        });
+        ));
     }
     let t1 = WallClock::now();
     let settings = DiffSettings::default();

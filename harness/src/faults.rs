@@ -227,10 +227,26 @@ pub fn find(name: &str) -> Option<&'static BoardFault> {
     CATALOGUE.iter().find(|f| f.name == name)
 }
 
+/// A fault name that is not in the catalogue nor one of its parameterized
+/// forms.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum FaultNameError {
+    #[error("fault `{0}`: write swap-error-A-B with A, B in 0..=7")]
+    BadSwap(String),
+    #[error("fault `{0}`: write status-stuck-0xNN")]
+    BadStuck(String),
+    #[error(
+        "unknown fault `{0}`: one of {known}, or swap-error-A-B, status-stuck-0xNN \
+         (`ppmc fault-matrix --list` describes them)",
+        known = CATALOGUE.iter().map(|f| f.name).collect::<Vec<_>>().join(", ")
+    )]
+    Unknown(String),
+}
+
 /// Puts the fault called `name` into `cfg`: a catalogue name, or one of the
 /// parameterized forms `swap-error-A-B` (A, B in 0..=7) and
 /// `status-stuck-0xNN`.
-pub fn apply_named(name: &str, cfg: &mut ModelConfig) -> Result<(), String> {
+pub fn apply_named(name: &str, cfg: &mut ModelConfig) -> Result<(), FaultNameError> {
     if let Some(f) = find(name) {
         f.apply(cfg);
         return Ok(());
@@ -240,29 +256,21 @@ pub fn apply_named(name: &str, cfg: &mut ModelConfig) -> Result<(), String> {
             .split_once('-')
             .and_then(|(a, b)| Some((a.parse::<u8>().ok()?, b.parse::<u8>().ok()?)))
             .filter(|(a, b)| *a < 8 && *b < 8)
-            .ok_or_else(|| format!("fault `{name}`: write swap-error-A-B with A, B in 0..=7"))?;
+            .ok_or_else(|| FaultNameError::BadSwap(name.into()))?;
         cfg.faults.swap_error = Some((ErrorCode::from_number(a), ErrorCode::from_number(b)));
         return Ok(());
     }
     if let Some(hex) = name.strip_prefix("status-stuck-0x") {
-        cfg.faults.status_stuck_high = u8::from_str_radix(hex, 16)
-            .map_err(|_| format!("fault `{name}`: write status-stuck-0xNN"))?;
+        cfg.faults.status_stuck_high =
+            u8::from_str_radix(hex, 16).map_err(|_| FaultNameError::BadStuck(name.into()))?;
         return Ok(());
     }
-    Err(format!(
-        "unknown fault `{name}`: one of {}, or swap-error-A-B, status-stuck-0xNN \
-         (`ppmc fault-matrix --list` describes them)",
-        CATALOGUE
-            .iter()
-            .map(|f| f.name)
-            .collect::<Vec<_>>()
-            .join(", ")
-    ))
+    Err(FaultNameError::Unknown(name.into()))
 }
 
 /// Puts every named fault into `cfg` ([`apply_named`] each, in order); the
 /// error names the first fault that is not known.
-pub fn apply_all<S: AsRef<str>>(names: &[S], cfg: &mut ModelConfig) -> Result<(), String> {
+pub fn apply_all<S: AsRef<str>>(names: &[S], cfg: &mut ModelConfig) -> Result<(), FaultNameError> {
     names.iter().try_for_each(|n| apply_named(n.as_ref(), cfg))
 }
 
@@ -300,7 +308,9 @@ mod tests {
         assert_eq!(c.faults.status_stuck_high, 0x40);
         apply_named("dir-inverted", &mut c).expect("catalogue");
         assert!(c.faults.dir_inverted);
-        let e = apply_named("no-such", &mut c).expect_err("unknown");
+        let e = apply_named("no-such", &mut c)
+            .expect_err("unknown")
+            .to_string();
         assert!(e.contains("unknown fault `no-such`") && e.contains("drop-last-pulse"));
         assert!(apply_named("swap-error-9-1", &mut c).is_err());
     }

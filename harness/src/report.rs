@@ -6,6 +6,15 @@ use crate::scenario::{Grade, ScenarioResult, Verdict};
 use quick_junit::{NonSuccessKind, Report, TestCase, TestCaseStatus, TestSuite};
 use serde::Serialize;
 
+/// A report that could not be rendered.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    #[error("cannot render the JUnit report: {0}")]
+    Junit(#[source] quick_junit::SerializeError),
+    #[error("cannot render the JSON run record: {0}")]
+    Json(#[source] serde_json::Error),
+}
+
 /// Facts about a run that every report carries.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct RunInfo {
@@ -83,7 +92,7 @@ impl Tally {
 
 /// JUnit XML: one test case per scenario (classname = datasheet section),
 /// the failure text = the first divergence; run facts as properties.
-pub fn junit(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, String> {
+pub fn junit(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, ReportError> {
     let mut report = Report::new("ppmc");
     let mut suite = TestSuite::new("ppmc-conformance");
     let props: Vec<(String, String)> = [
@@ -145,7 +154,7 @@ pub fn junit(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, Strin
         suite.add_test_case(case);
     }
     report.add_test_suite(suite);
-    report.to_string().map_err(|e| e.to_string())
+    report.to_string().map_err(ReportError::Junit)
 }
 
 #[derive(Serialize)]
@@ -184,7 +193,7 @@ fn finite(d: crate::time::Duration) -> Option<u64> {
 }
 
 /// The JSON run record.
-pub fn json(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, String> {
+pub fn json(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, ReportError> {
     let run = JsonRun {
         format: "ppmc-run-record/1",
         run: info,
@@ -215,5 +224,5 @@ pub fn json(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, String
             })
             .collect(),
     };
-    serde_json::to_string_pretty(&run).map_err(|e| e.to_string())
+    serde_json::to_string_pretty(&run).map_err(ReportError::Json)
 }

@@ -32,32 +32,51 @@ impl Selection {
     }
 }
 
+/// Why a `--shard` value does not read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ShardError {
+    #[error("shard `{0}` should be I/N, e.g. 2/4")]
+    NotIOverN(String),
+    #[error("shard index `{0}` is not a number")]
+    BadIndex(String),
+    #[error("shard count `{0}` is not a number")]
+    BadCount(String),
+    #[error("shard {i}/{n}: need 1 <= I <= N")]
+    OutOfRange { i: usize, n: usize },
+}
+
 /// Parses `I/N` (1 <= I <= N).
-pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+pub fn parse_shard(s: &str) -> Result<(usize, usize), ShardError> {
     let (i, n) = s
         .split_once('/')
-        .ok_or_else(|| format!("shard `{s}` should be I/N, e.g. 2/4"))?;
-    let i: usize = i
-        .parse()
-        .map_err(|_| format!("shard index `{i}` is not a number"))?;
-    let n: usize = n
-        .parse()
-        .map_err(|_| format!("shard count `{n}` is not a number"))?;
+        .ok_or_else(|| ShardError::NotIOverN(s.into()))?;
+    let i: usize = i.parse().map_err(|_| ShardError::BadIndex(i.into()))?;
+    let n: usize = n.parse().map_err(|_| ShardError::BadCount(n.into()))?;
     if n == 0 || i == 0 || i > n {
-        return Err(format!("shard {i}/{n}: need 1 <= I <= N"));
+        return Err(ShardError::OutOfRange { i, n });
     }
     Ok((i, n))
 }
 
+/// A suite that breaks the rules every suite keeps.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum SuiteError {
+    /// Names are the golden files' and the reports' keys.
+    #[error("two scenarios are named `{0}`")]
+    DuplicateName(&'static str),
+    #[error("scenario `{0}` names no datasheet section")]
+    NoSection(&'static str),
+}
+
 /// Checks the suite's invariants: unique names, a section on each.
-pub fn validate_suite(all: &[Scenario]) -> Result<(), String> {
-    let mut names: Vec<&str> = all.iter().map(|s| s.name).collect();
+pub fn validate_suite(all: &[Scenario]) -> Result<(), SuiteError> {
+    let mut names: Vec<&'static str> = all.iter().map(|s| s.name).collect();
     names.sort_unstable();
     if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
-        return Err(format!("two scenarios are named `{}`", w[0]));
+        return Err(SuiteError::DuplicateName(w[0]));
     }
     if let Some(s) = all.iter().find(|s| s.section.is_empty()) {
-        return Err(format!("scenario `{}` names no datasheet section", s.name));
+        return Err(SuiteError::NoSection(s.name));
     }
     Ok(())
 }
@@ -216,7 +235,7 @@ mod tests {
         all.push(Scenario::new("a_one", "3-1", "", &[], ok));
         assert_eq!(
             validate_suite(&all),
-            Err("two scenarios are named `a_one`".into())
+            Err(SuiteError::DuplicateName("a_one"))
         );
     }
 }

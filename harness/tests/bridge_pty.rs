@@ -155,14 +155,14 @@ fn a_stalled_bridge_gives_a_timeout_naming_the_op() {
         .expect_err("no answer");
     assert_eq!(err.kind, ppmc::backend::TargetErrorKind::Link);
     assert!(
-        err.message.contains("no bridge answering"),
+        err.to_string().contains("no bridge answering"),
         "{}",
-        err.message
+        err.to_string()
     );
     assert!(
-        err.message.contains("ReadPins") || err.message.contains("ReadStatus"),
+        err.to_string().contains("ReadPins") || err.to_string().contains("ReadStatus"),
         "{}",
-        err.message
+        err.to_string()
     );
 }
 

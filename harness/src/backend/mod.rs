@@ -34,16 +34,45 @@ pub enum TargetErrorKind {
     Other,
 }
 
-/// A failure to run a batch on a target.
-#[derive(Debug, thiserror::Error)]
+/// A failure to run a batch on a target: its [`TargetErrorKind`] for
+/// generic code, and the backend's own error, kept whole. As with
+/// `std::io::Error`, it displays as that error, [`TargetError::get_ref`]
+/// gives it back (to downcast to, say, a `SerialError`), and
+/// [`std::error::Error::source`] continues its chain.
+#[derive(Debug)]
 pub struct TargetError {
     pub kind: TargetErrorKind,
-    pub message: String,
+    inner: Box<dyn std::error::Error + Send + Sync>,
+}
+
+impl TargetError {
+    /// An error of `kind` caused by `inner` (a backend's error, or a
+    /// sentence: a `String` converts).
+    pub fn new(
+        kind: TargetErrorKind,
+        inner: impl Into<Box<dyn std::error::Error + Send + Sync>>,
+    ) -> TargetError {
+        TargetError {
+            kind,
+            inner: inner.into(),
+        }
+    }
+
+    /// The backend's error.
+    pub fn get_ref(&self) -> &(dyn std::error::Error + Send + Sync + 'static) {
+        &*self.inner
+    }
 }
 
 impl fmt::Display for TargetError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.message)
+        self.inner.fmt(f)
+    }
+}
+
+impl std::error::Error for TargetError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.inner.source()
     }
 }
 
@@ -99,9 +128,11 @@ pub trait Target: Send {
     /// Runs one op.
     fn execute_one(&mut self, op: Op) -> Result<Reply, TargetError> {
         let mut replies = self.execute(std::slice::from_ref(&op))?;
-        replies.pop().ok_or_else(|| TargetError {
-            kind: TargetErrorKind::Other,
-            message: format!("target returned no reply to {op:?}"),
+        replies.pop().ok_or_else(|| {
+            TargetError::new(
+                TargetErrorKind::Other,
+                format!("target returned no reply to {op:?}"),
+            )
         })
     }
 }

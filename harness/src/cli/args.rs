@@ -170,7 +170,7 @@ impl SelectArgs {
 
     /// The suite, validated, narrowed to the selection.
     pub fn scenarios(&self, suite: &[Scenario]) -> Result<Vec<Scenario>, String> {
-        validate_suite(suite)?;
+        validate_suite(suite).map_err(|e| e.to_string())?;
         let chosen = self.selection().select(suite);
         if chosen.is_empty() {
             return Err("no scenario matches the selection (see `ppmc list`)".into());

@@ -16,8 +16,6 @@ mod progress;
 mod record;
 mod run;
 
-pub use args::{OpenError, TargetArgs};
-
 use crate::scenario::Scenario;
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

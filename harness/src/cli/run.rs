@@ -114,7 +114,7 @@ fn save_artifacts(dir: &Path, r: &ScenarioResult) -> Result<(), String> {
     golden::write_atomic(&vpath, &buf).map_err(|e| format!("{}: {e}", vpath.display()))
 }
 
-fn write_report(path: &Path, text: Result<String, String>) -> Result<(), String> {
+fn write_report(path: &Path, text: Result<String, report::ReportError>) -> Result<(), String> {
     let text = text.map_err(|e| format!("{}: {e}", path.display()))?;
     golden::write_atomic(path, text.as_bytes()).map_err(|e| format!("{}: {e}", path.display()))
 }
@@ -163,7 +163,7 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     }
     let mut target = match args.target.open() {
         Ok(t) => t,
-        Err(e @ super::OpenError::Infrastructure(_)) => {
+        Err(e @ super::args::OpenError::Infrastructure(_)) => {
             // Nothing ran: say so in the reports too, so CI shows an
             // infrastructure problem rather than a bad board.
             let why = e.to_string();

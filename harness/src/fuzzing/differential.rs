@@ -63,14 +63,14 @@ impl Side<'_> {
     fn run(&mut self, stmts: &[console::Stmt], ops: &[Op]) -> Result<Status, TargetError> {
         let (replies, capture) = self.target.execute_then_capture(ops)?;
         if replies.len() != ops.len() {
-            return Err(TargetError {
-                kind: TargetErrorKind::Other,
-                message: format!(
+            return Err(TargetError::new(
+                TargetErrorKind::Other,
+                format!(
                     "target answered {} of {} operations",
                     replies.len(),
                     ops.len()
                 ),
-            });
+            ));
         }
         for (s, r) in stmts.iter().zip(&replies) {
             if let Some(kind) = console::bus_event(*s, r) {
@@ -83,10 +83,10 @@ impl Side<'_> {
         self.capture = capture;
         match replies.last() {
             Some(Reply::Status { status, .. }) => Ok(*status),
-            other => Err(TargetError {
-                kind: TargetErrorKind::Other,
-                message: format!("expected the closing status read, got {other:?}"),
-            }),
+            other => Err(TargetError::new(
+                TargetErrorKind::Other,
+                format!("expected the closing status read, got {other:?}"),
+            )),
         }
     }
 
@@ -122,9 +122,8 @@ pub fn run(
     s: &DiffSettings,
     mut progress: impl FnMut(usize) -> bool,
 ) -> Result<Option<Departure>, TargetError> {
-    let mut reference = EmuTarget::new(s.straps, s.reference.clone()).map_err(|e| TargetError {
-        kind: TargetErrorKind::Other,
-        message: format!("reference emulator: {e}"),
+    let mut reference = EmuTarget::new(s.straps, s.reference.clone()).map_err(|e| {
+        TargetError::new(TargetErrorKind::Other, format!("reference emulator: {e}"))
     })?;
     target.execute(&[Op::Reset])?;
     let mut got = Side {

@@ -137,8 +137,6 @@ pub fn judge(ops: &[BusOp], replies: &[Reply], capture: &Record) -> Result<Optio
 pub fn replay(target: &mut dyn Target, ops: &[BusOp]) -> Result<Option<Found>, TargetError> {
     target.execute(&[Op::Reset])?;
     let (replies, capture) = target.execute_then_capture(&probed_ops(ops))?;
-    judge(ops, &replies, &capture).map_err(|message| TargetError {
-        kind: crate::backend::TargetErrorKind::Other,
-        message,
-    })
+    judge(ops, &replies, &capture)
+        .map_err(|message| TargetError::new(crate::backend::TargetErrorKind::Other, message))
 }

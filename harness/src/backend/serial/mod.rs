@@ -92,10 +92,7 @@ impl SerialError {
 
 impl From<SerialError> for TargetError {
     fn from(e: SerialError) -> Self {
-        TargetError {
-            kind: e.kind(),
-            message: e.to_string(),
-        }
+        TargetError::new(e.kind(), e)
     }
 }
 
@@ -892,11 +889,15 @@ mod tests {
         let e = t.execute(&[Op::ReadStatus]).expect_err("gone");
         assert_eq!(e.kind, TargetErrorKind::Link);
         assert!(
-            e.message
+            e.to_string()
                 .contains("link lost and not back after 3 reopen attempts"),
-            "{}",
-            e.message
+            "{e}"
         );
+        // The serial backend's own error is kept, not flattened to text.
+        assert!(matches!(
+            e.get_ref().downcast_ref::<SerialError>(),
+            Some(SerialError::LinkLost { .. })
+        ));
     }
 
     #[test]
@@ -905,7 +906,11 @@ mod tests {
         t.link.fail_sends = 1;
         t.link.restart_on_reopen = true;
         let e = t.execute(&[Op::ReadStatus]).expect_err("restarted");
-        assert!(e.message.contains("the bridge restarted"), "{}", e.message);
+        assert!(
+            e.to_string().contains("the bridge restarted"),
+            "{}",
+            e.to_string()
+        );
     }
 
     #[test]
