@@ -22,8 +22,6 @@ pub struct Duration(u64);
 impl Instant {
     /// The moment the target came out of reset.
     pub const ZERO: Instant = Instant(0);
-    /// A time later than any run will reach; used as "never".
-    pub const NEVER: Instant = Instant(u64::MAX);
 
     pub const fn from_nanos(ns: u64) -> Self {
         Instant(ns)

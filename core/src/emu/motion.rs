@@ -89,8 +89,9 @@ pub(crate) struct Motion {
     pub emitted: u32,
     /// Pulses this move will output as now planned (`<= total`).
     pub end: u32,
-    /// Time of pulse number `emitted`, when `emitted < end`.
-    pub next_pulse: Instant,
+    /// Time of pulse number `emitted`, when `emitted < end`; `None` for a
+    /// move that never pulses (no base clock fitted).
+    pub next_pulse: Option<Instant>,
     pub last_pulse: Option<Instant>,
     pub profile: Profile,
     /// `(j0, c)`: deceleration from speed index `c` starting at pulse `j0`.
@@ -113,7 +114,7 @@ impl Motion {
         interrupt: bool,
         base: Instant,
         total: u32,
-        first_pulse: Instant,
+        first_pulse: Option<Instant>,
         profile: Profile,
     ) -> Self {
         Motion {
@@ -263,7 +264,7 @@ mod tests {
             true,
             Instant::ZERO,
             total,
-            Instant::ZERO,
+            Some(Instant::ZERO),
             Profile::Ramped {
                 table: table.into(),
                 cruise: Duration::from_micros(42),

@@ -312,12 +312,13 @@ impl Chip {
     /// when `n` lies beyond it. `None` when no further pulse is planned.
     pub fn predict_pulse(&self, n: u64) -> Option<Instant> {
         let m = self.motion.as_ref().filter(|m| m.pulses_left())?;
-        if m.next_pulse == Instant::NEVER || n <= u64::from(m.emitted) {
+        let next = m.next_pulse?;
+        if n <= u64::from(m.emitted) {
             return None;
         }
         let (interval, stretch) = m.constant_stretch();
         let k = (n - u64::from(m.emitted)).min(u64::from(stretch));
-        Some(m.next_pulse + interval.saturating_mul(k - 1))
+        Some(next + interval.saturating_mul(k - 1))
     }
 
     /// The next instant at which the status register, a pin or the
@@ -328,7 +329,6 @@ impl Chip {
         let timer = self.next_timer().map(|(at, _)| at);
         let pulse = self
             .next_stretch()
-            .filter(|(first, _, _)| *first != Instant::NEVER)
             .map(|(first, interval, count)| first + interval.saturating_mul(u64::from(count - 1)));
         match (timer, pulse) {
             (Some(a), Some(b)) => Some(a.min(b)),
@@ -344,16 +344,15 @@ impl Chip {
         }
         loop {
             let next_timer = self.next_timer();
-            let timer_at = next_timer.map_or(Instant::NEVER, |(at, _)| at);
-            let horizon = timer_at.min(until);
+            let horizon = next_timer.map_or(until, |(at, _)| at.min(until));
+            // A move without a base clock has no next pulse: it never
+            // comes, however far time is advanced.
             let pulse_at = self
                 .motion
                 .as_ref()
                 .filter(|m| m.pulses_left())
-                .map_or(Instant::NEVER, |m| m.next_pulse);
-            // A move without a base clock has its next pulse at NEVER: it
-            // never comes, however far time is advanced.
-            if pulse_at <= horizon && pulse_at != Instant::NEVER {
+                .and_then(|m| m.next_pulse);
+            if let Some(pulse_at) = pulse_at.filter(|at| *at <= horizon) {
                 self.now = self.now.max(pulse_at);
                 self.emit_pulses(horizon);
                 continue;

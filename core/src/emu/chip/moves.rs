@@ -67,7 +67,7 @@ impl Chip {
                 None,
             ),
         };
-        let first_pulse = first_pout.map_or(Instant::NEVER, |d| base + self.fw(d));
+        let first_pulse = first_pout.map(|d| base + self.fw(d));
         self.motion_seq += 1;
         let id = self.motion_seq;
         let motion = Motion::new(
@@ -275,7 +275,7 @@ impl Chip {
         } else {
             count
         };
-        Some((m.next_pulse, interval, count))
+        Some((m.next_pulse?, interval, count))
     }
 
     /// Emits the next pulses due at or before `horizon`: one ramp pulse, or a
@@ -312,7 +312,7 @@ impl Chip {
         m.emitted += fit;
         m.last_pulse = Some(last);
         if m.emitted < m.end {
-            m.next_pulse = last + m.interval_after(m.emitted - 1);
+            m.next_pulse = Some(last + m.interval_after(m.emitted - 1));
         }
         let done = m.emitted >= m.end;
         let at_speed = m.at_high_speed();
