@@ -145,6 +145,21 @@ impl fmt::Display for Duration {
     }
 }
 
+/// An upper limit for display: the duration, or `inf` for
+/// [`Duration::MAX`] (no limit), as timing bands print their top.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limit(pub Duration);
+
+impl fmt::Display for Limit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0 == Duration::MAX {
+            f.write_str("inf")
+        } else {
+            self.0.fmt(f)
+        }
+    }
+}
+
 /// Why a duration string did not parse.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ParseDurationError {
@@ -219,6 +234,12 @@ impl FromStr for Duration {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_limit_shows_inf_for_no_limit() {
+        assert_eq!(Limit(Duration::MAX).to_string(), "inf");
+        assert_eq!(Limit(Duration::from_micros(17)).to_string(), "17.000us");
+    }
     use rstest::rstest;
 
     #[rstest]

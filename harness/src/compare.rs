@@ -21,8 +21,7 @@
 //! and got, and the allowed band.
 
 use crate::protocol::{Pin, Straps, TimingId};
-use crate::scenario::grade::fmt_hi;
-use crate::time::{Duration, Instant};
+use crate::time::{Duration, Instant, Limit};
 use crate::trace::{BusEvent, EventKind, Trace};
 use std::collections::BTreeMap;
 use std::fmt;
@@ -178,7 +177,7 @@ fn within(got: Duration, (lo, hi): (Duration, Duration)) -> bool {
 }
 
 fn band_text((lo, hi): (Duration, Duration)) -> String {
-    format!("{lo}..={}", fmt_hi(hi))
+    format!("{lo}..={}", Limit(hi))
 }
 
 /// Compares `got` with `golden`; `Ok(())` when every quantity is within

@@ -8,7 +8,7 @@
 //! for a look, as OpenHTF's marginal limits do.
 
 use crate::protocol::{Straps, TimingId};
-use crate::time::{Duration, Instant};
+use crate::time::{Duration, Instant, Limit};
 use std::fmt;
 
 /// How a measurement compares with its limits.
@@ -117,17 +117,8 @@ impl fmt::Display for Measurement {
             self.name,
             self.value,
             self.lo,
-            fmt_hi(self.hi)
+            Limit(self.hi)
         )
-    }
-}
-
-/// An upper limit, `inf` when there is none.
-pub fn fmt_hi(hi: Duration) -> String {
-    if hi == Duration::MAX {
-        "inf".to_string()
-    } else {
-        hi.to_string()
     }
 }
 

@@ -6,7 +6,7 @@ use super::grade::Grade;
 use super::queue::fail;
 use super::{Failure, Outcome, Stop};
 use crate::protocol::{Flag, Pin, Register, TimingId};
-use crate::time::{Duration, Instant};
+use crate::time::{Duration, Instant, Limit};
 
 impl Driver<'_> {
     fn record_measure(&mut self, id: TimingId, value: Duration, at: Instant) -> Outcome<Grade> {
@@ -17,7 +17,7 @@ impl Driver<'_> {
         if grade == Grade::Fail {
             return Err(Stop::Failed(Failure {
                 expectation: format!("{} (Table 3-3)", id.name()),
-                expected: format!("{lo}..={}", super::grade::fmt_hi(hi)),
+                expected: format!("{lo}..={}", Limit(hi)),
                 got: value.to_string(),
                 at,
             }));
@@ -201,10 +201,7 @@ impl Driver<'_> {
                     "{} (Table 3-3): deceleration starts at the first pulse after the latency",
                     id.name()
                 ),
-                expected: format!(
-                    "from pulse {j_lo}..={j_hi} (latency {lo}..={})",
-                    super::grade::fmt_hi(hi)
-                ),
+                expected: format!("from pulse {j_lo}..={j_hi} (latency {lo}..={})", Limit(hi)),
                 got: format!("from pulse {j1}"),
                 at: start_time,
             }));
