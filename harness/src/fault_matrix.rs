@@ -68,7 +68,10 @@ pub fn check_board(
     let mut link_error: Option<String> = None;
     run_suite(target, suite, 1, DriverOptions::default(), |r| {
         match &r.verdict {
-            Verdict::Error(e) | Verdict::NotRun(e) if link_error.is_none() => {
+            Verdict::Error(e) if link_error.is_none() => {
+                link_error = Some(format!("{}: {e}", r.name));
+            }
+            Verdict::NotRun(e) if link_error.is_none() => {
                 link_error = Some(format!("{}: {e}", r.name));
             }
             v if !v.ok() && first_fail.is_none() => {

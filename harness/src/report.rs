@@ -129,7 +129,7 @@ pub fn junit(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, Repor
             }
             Verdict::Error(e) => {
                 let mut s = TestCaseStatus::non_success(NonSuccessKind::Error);
-                s.set_message(e.clone());
+                s.set_message(e.to_string());
                 s.set_type("harness");
                 s
             }

@@ -7,7 +7,9 @@ use crate::compare::{compare, Tolerances};
 use crate::golden::{self};
 use crate::report::{self, RunInfo, Tally};
 use crate::runner::run_suite;
-use crate::scenario::{DriverOptions, Failure, Grading, Scenario, ScenarioResult, Verdict};
+use crate::scenario::{
+    DriverOptions, Failure, Grading, HarnessError, Scenario, ScenarioResult, Verdict,
+};
 use crate::time::Duration;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -69,7 +71,9 @@ fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) {
         return;
     }
     let Some(trace) = &r.trace else {
-        r.verdict = Verdict::Error("no capture to compare with the golden trace".into());
+        r.verdict = Verdict::Error(HarnessError::Golden(
+            "no capture to compare with the golden trace".into(),
+        ));
         return;
     };
     let fail = |expectation: String, expected: String, got: String, at| {

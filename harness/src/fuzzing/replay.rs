@@ -8,7 +8,7 @@ use super::bus::BusOp;
 use super::oracle::{self, Judge, Seen, Violation};
 use crate::backend::{Op, Reply, Target, TargetError};
 use crate::protocol::Record;
-use crate::scenario::{Driver, Failure, Outcome, Stop};
+use crate::scenario::{Driver, Failure, HarnessError, Outcome, Stop};
 use crate::trace::BusEvent;
 
 /// The body of a regression scenario written by `ppmc fuzz to-scenario`:
@@ -37,7 +37,7 @@ pub fn regression(d: &mut Driver, ops: &[BusOp]) -> Outcome {
     }
     let capture = d.capture()?.clone();
     match judge(ops, &replies, &capture) {
-        Err(e) => Err(Stop::Error(e)),
+        Err(e) => Err(Stop::Error(HarnessError::Reply(e))),
         Ok(None) => Ok(()),
         Ok(Some(f)) => {
             let v = f.violation;

@@ -7,7 +7,7 @@
 
 use super::grade::{Grade, Grading, Measurement};
 use super::queue::{fail, Check, Done, Group, Role, Step};
-use super::{Init, Move, Outcome, Stop};
+use super::{HarnessError, Init, Move, Outcome, Stop};
 use crate::backend::{Op, Reply, Target};
 use crate::protocol::{
     ClockSource, Direction, ErrorCode, Flag, Input, Pins, Record, Register, Status, Straps,
@@ -195,7 +195,9 @@ impl<'t> Driver<'t> {
     pub fn status(&mut self) -> Outcome<Status> {
         match self.step(Step::Status)? {
             Done::Status(s) => Ok(s),
-            _ => Err(Stop::Error("status read answered otherwise".into())),
+            _ => Err(Stop::Error(HarnessError::Reply(
+                "status read answered otherwise".into(),
+            ))),
         }
     }
 
@@ -203,7 +205,9 @@ impl<'t> Driver<'t> {
     pub fn read_data(&mut self) -> Outcome<u8> {
         match self.step(Step::ReadData)? {
             Done::Byte(b) => Ok(b),
-            _ => Err(Stop::Error("data read answered otherwise".into())),
+            _ => Err(Stop::Error(HarnessError::Reply(
+                "data read answered otherwise".into(),
+            ))),
         }
     }
 
@@ -221,7 +225,9 @@ impl<'t> Driver<'t> {
             must: false,
         })? {
             Done::Waited(w) => Ok(w),
-            _ => Err(Stop::Error("await answered otherwise".into())),
+            _ => Err(Stop::Error(HarnessError::Reply(
+                "await answered otherwise".into(),
+            ))),
         }
     }
 
@@ -299,7 +305,9 @@ impl<'t> Driver<'t> {
     pub fn pins(&mut self) -> Outcome<Pins> {
         match self.step(Step::Pins)? {
             Done::Pins(p) => Ok(p),
-            _ => Err(Stop::Error("pins read answered otherwise".into())),
+            _ => Err(Stop::Error(HarnessError::Reply(
+                "pins read answered otherwise".into(),
+            ))),
         }
     }
 
@@ -382,12 +390,12 @@ impl<'t> Driver<'t> {
             let c = self
                 .target
                 .capture()
-                .map_err(|e| Stop::Error(format!("target capture: {e}")))?;
+                .map_err(|e| Stop::Error(HarnessError::Capture(format!("target capture: {e}"))))?;
             self.capture = Some(c);
         }
         self.capture
             .as_ref()
-            .ok_or_else(|| Stop::Error("capture unavailable".into()))
+            .ok_or_else(|| Stop::Error(HarnessError::Capture("capture unavailable".into())))
     }
 
     // ----- flowchart helpers ---------------------------------------------

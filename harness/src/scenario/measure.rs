@@ -4,7 +4,7 @@
 use super::driver::Driver;
 use super::grade::Grade;
 use super::queue::fail;
-use super::{Failure, Outcome, Stop};
+use super::{Failure, HarnessError, Outcome, Stop};
 use crate::protocol::{Flag, Pin, Register, TimingId};
 use crate::time::{Duration, Instant, Limit};
 
@@ -47,9 +47,9 @@ impl Driver<'_> {
 
     pub(super) fn need(&self, what: &str, t: Option<Instant>) -> Outcome<Instant> {
         t.ok_or_else(|| {
-            Stop::Error(format!(
+            Stop::Error(HarnessError::Scenario(format!(
                 "scenario bug: measuring needs {what}, which this scenario has not done"
-            ))
+            )))
         })
     }
 
@@ -163,10 +163,11 @@ impl Driver<'_> {
     /// check, not a graded measurement: one run only brackets the latency
     /// between two pulses. Returns the time from the trigger to that pulse.
     fn expect_decel_start(&mut self, id: TimingId) -> Outcome<Duration> {
-        let pa = self
-            .init
-            .map(|i| u64::from(i.data.pa))
-            .ok_or_else(|| Stop::Error("scenario bug: measuring needs an initialization".into()))?;
+        let pa = self.init.map(|i| u64::from(i.data.pa)).ok_or_else(|| {
+            Stop::Error(HarnessError::Scenario(
+                "scenario bug: measuring needs an initialization".into(),
+            ))
+        })?;
         self.wait_idle()?;
         let t = self.flushed("a decelerating stop or high-speed limit", |d| d.trigger)?;
         let rec = self.capture()?;

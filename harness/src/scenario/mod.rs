@@ -18,7 +18,7 @@ pub use grade::{Grade, Grading, Measurement};
 /// Declares a scenario where it is written; see the `ppmc-macros` crate.
 pub use ppmc_macros::scenario;
 
-use crate::backend::Target;
+use crate::backend::{Target, TargetError, TargetErrorKind};
 use crate::time::{Duration, Instant};
 use crate::trace::{Event, EventKind, Trace};
 use std::fmt;
@@ -32,9 +32,48 @@ pub type Outcome<T = ()> = Result<T, Stop>;
 pub enum Stop {
     /// The device did something the datasheet does not allow.
     Failed(Failure),
-    /// The harness or the link failed (a target error, a scenario bug, the
-    /// time budget): not the device's fault.
-    Error(String),
+    /// The harness or the link failed: not the device's fault.
+    Error(HarnessError),
+}
+
+/// Why a scenario could not be judged: never the device's fault. The kind
+/// says whose it is; the text is for people.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum HarnessError {
+    /// The target could not run a batch: the link, the bridge, the port.
+    #[error("target: {message}")]
+    Target {
+        kind: TargetErrorKind,
+        message: String,
+    },
+    /// The target's replies do not fit the ops sent (a backend or bridge
+    /// bug).
+    #[error("{0}")]
+    Reply(String),
+    /// The scenario used more virtual time than its budget.
+    #[error("scenario exceeded its time budget of {0} (virtual time)")]
+    Budget(Duration),
+    /// The capture did not come back, so the run cannot be judged, shown
+    /// or compared.
+    #[error("{0}")]
+    Capture(String),
+    /// The scenario's own code is wrong: it panicked, or asked for
+    /// something it had not set up.
+    #[error("{0}")]
+    Scenario(String),
+    /// A golden trace is missing, unreadable or could not be used.
+    #[error("{0}")]
+    Golden(String),
+}
+
+impl HarnessError {
+    /// A target failure, with its kind.
+    pub fn target(e: &TargetError) -> HarnessError {
+        HarnessError::Target {
+            kind: e.kind,
+            message: e.to_string(),
+        }
+    }
 }
 
 /// An expectation that did not hold.
@@ -119,7 +158,7 @@ pub enum Verdict {
     /// The device did something wrong.
     Failed(Failure),
     /// The harness or the link failed.
-    Error(String),
+    Error(HarnessError),
     /// Never started (the run stopped before it).
     NotRun(String),
 }
@@ -146,7 +185,8 @@ impl Verdict {
             Verdict::Passed => None,
             Verdict::Marginal => Some("a measurement is near its limit".into()),
             Verdict::Failed(f) => Some(f.to_string()),
-            Verdict::Error(e) | Verdict::NotRun(e) => Some(e.clone()),
+            Verdict::Error(e) => Some(e.to_string()),
+            Verdict::NotRun(e) => Some(e.clone()),
         }
     }
 }
@@ -193,7 +233,9 @@ pub fn run_scenario(
                 .map(|s| s.to_string())
                 .or_else(|| panic.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "panic".into());
-            Err(Stop::Error(format!("scenario panicked: {msg}")))
+            Err(Stop::Error(HarnessError::Scenario(format!(
+                "scenario panicked: {msg}"
+            ))))
         }
     };
     let elapsed = driver.clock().saturating_since(Instant::ZERO);

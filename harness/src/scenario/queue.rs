@@ -6,7 +6,7 @@
 //! or on the capture as it stood where they were queued.
 
 use super::driver::Driver;
-use super::{Failure, Outcome, Stop};
+use super::{Failure, HarnessError, Outcome, Stop};
 use crate::backend::{Op, Reply};
 use crate::protocol::{Direction, ErrorCode, Flag, Input, Pins, Record, Status, StatusField};
 use crate::time::{Duration, Instant};
@@ -133,30 +133,27 @@ impl Driver<'_> {
     /// after them (one round trip less on a board).
     pub(super) fn send_then(&mut self, ops: &[Op], capture: bool) -> Outcome<Vec<Reply>> {
         if self.now.as_nanos() > self.opts.budget.as_nanos() {
-            return Err(Stop::Error(format!(
-                "scenario exceeded its time budget of {} (virtual time)",
-                self.opts.budget
-            )));
+            return Err(Stop::Error(HarnessError::Budget(self.opts.budget)));
         }
         let (replies, record) = if capture {
             let (replies, record) = self
                 .target
                 .execute_then_capture(ops)
-                .map_err(|e| Stop::Error(format!("target: {e}")))?;
+                .map_err(|e| Stop::Error(HarnessError::target(&e)))?;
             (replies, Some(record))
         } else {
             let replies = self
                 .target
                 .execute(ops)
-                .map_err(|e| Stop::Error(format!("target: {e}")))?;
+                .map_err(|e| Stop::Error(HarnessError::target(&e)))?;
             (replies, None)
         };
         if replies.len() != ops.len() {
-            return Err(Stop::Error(format!(
+            return Err(Stop::Error(HarnessError::Reply(format!(
                 "target answered {} of {} operations",
                 replies.len(),
                 ops.len()
-            )));
+            ))));
         }
         if let Some(last) = replies.last() {
             self.now = last.at();
@@ -166,7 +163,9 @@ impl Driver<'_> {
     }
 
     pub(super) fn unexpected(&self, op: &str, reply: &Reply) -> Stop {
-        Stop::Error(format!("target answered {reply:?} to {op}"))
+        Stop::Error(HarnessError::Reply(format!(
+            "target answered {reply:?} to {op}"
+        )))
     }
 
     /// Queues steps (and a check of their replies) to go with the next
@@ -238,9 +237,11 @@ impl Driver<'_> {
         for g in groups {
             let mut done = Vec::with_capacity(g.steps.len());
             for (step, role) in g.steps {
-                let reply = replies
-                    .next()
-                    .ok_or_else(|| Stop::Error("target answered too few operations".into()))?;
+                let reply = replies.next().ok_or_else(|| {
+                    Stop::Error(HarnessError::Reply(
+                        "target answered too few operations".into(),
+                    ))
+                })?;
                 let at = reply.at();
                 done.push(self.judge(step, reply, began)?);
                 match role {
@@ -274,7 +275,8 @@ impl Driver<'_> {
 
     pub(super) fn step(&mut self, step: Step) -> Outcome<Done> {
         let mut v = self.steps(&[step])?;
-        v.pop().ok_or_else(|| Stop::Error("no reply".into()))
+        v.pop()
+            .ok_or_else(|| Stop::Error(HarnessError::Reply("no reply".into())))
     }
 
     /// The op a step sends.
@@ -458,7 +460,11 @@ impl Driver<'_> {
             let mut rec = self
                 .capture
                 .as_ref()
-                .ok_or_else(|| Stop::Error("the capture did not come back".into()))?
+                .ok_or_else(|| {
+                    Stop::Error(HarnessError::Capture(
+                        "the capture did not come back".into(),
+                    ))
+                })?
                 .until(at);
             // A move is recorded at the time of its final byte, and a write
             // takes no time: a move at the cut belongs before the check only
@@ -565,9 +571,9 @@ impl Driver<'_> {
                 }
             }
             (c, _, _) => {
-                return Err(Stop::Error(format!(
+                return Err(Stop::Error(HarnessError::Scenario(format!(
                     "scenario bug: check {c:?} has no reply to judge"
-                )))
+                ))))
             }
         }
         Ok(())
@@ -606,9 +612,9 @@ impl Driver<'_> {
                 no_pulses_after(rec, t + margin)?;
             }
             _ => {
-                return Err(Stop::Error(format!(
+                return Err(Stop::Error(HarnessError::Scenario(format!(
                     "scenario bug: check {c:?} is not one of the capture"
-                )))
+                ))))
             }
         }
         Ok(())
@@ -690,7 +696,7 @@ pub(super) fn opt(d: Option<Duration>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::backend::{EmuTarget, Target, TargetError, TargetInfo};
+    use crate::backend::{EmuTarget, Target, TargetError, TargetErrorKind, TargetInfo};
     use crate::emu::ModelConfig;
     use crate::protocol::Straps;
     use crate::scenario::{DriverOptions, Init, Move};
@@ -837,5 +843,55 @@ mod tests {
         d.flush().expect("runs");
         drop(d);
         assert_eq!(t.batches, vec![MAX_QUEUED, MAX_QUEUED, 1]);
+    }
+
+    /// A target whose cable is pulled.
+    #[derive(Debug)]
+    struct Unplugged;
+
+    impl Target for Unplugged {
+        fn info(&self) -> TargetInfo {
+            TargetInfo {
+                name: "unplugged".into(),
+                straps: Straps::default(),
+                extra: Vec::new(),
+            }
+        }
+        fn capture(&mut self) -> Result<Record, TargetError> {
+            Err(TargetError::new(TargetErrorKind::Link, "cable pulled"))
+        }
+        fn execute(&mut self, _: &[Op]) -> Result<Vec<Reply>, TargetError> {
+            Err(TargetError::new(TargetErrorKind::Link, "cable pulled"))
+        }
+    }
+
+    #[test]
+    fn a_target_failure_is_a_harness_error_that_keeps_its_kind() {
+        let mut t = Unplugged;
+        let mut d = Driver::new(&mut t, DriverOptions::default());
+        d.reset().expect("queued");
+        match d.flush() {
+            Err(Stop::Error(HarnessError::Target { kind, message })) => {
+                assert_eq!(kind, TargetErrorKind::Link);
+                assert_eq!(message, "cable pulled");
+            }
+            other => panic!("expected a link error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_scenario_past_its_budget_is_a_budget_error_not_a_failure() {
+        let opts = DriverOptions {
+            budget: Duration::from_millis(1),
+            ..DriverOptions::default()
+        };
+        let mut t = Counting::new();
+        let mut d = Driver::new(&mut t, opts);
+        d.wait(Duration::from_millis(2)).expect("queued");
+        d.flush().expect("the first batch runs");
+        assert_eq!(
+            d.status(),
+            Err(Stop::Error(HarnessError::Budget(Duration::from_millis(1))))
+        );
     }
 }
