@@ -192,6 +192,58 @@ fn summary(func: &ItemFn) -> syn::Result<String> {
 mod tests {
     use super::*;
 
+    fn error_of(args: proc_macro2::TokenStream, item: proc_macro2::TokenStream) -> String {
+        expand(args, item).expect_err("refused").to_string()
+    }
+
+    #[test]
+    fn a_scenario_becomes_a_constructor_named_after_it_with_its_doc_as_summary() {
+        let out = expand(
+            quote!(tags("operation", "accel")),
+            quote! {
+                /// one step
+                /// and no more
+                fn s3_3_4_accel_one(d: &mut Driver) -> Outcome { Ok(()) }
+            },
+        )
+        .expect("expands")
+        .to_string();
+        assert!(out.contains("fn s3_3_4_accel_one ()"), "{out}");
+        assert!(
+            out.contains(
+                r#"Scenario :: new ("s3_3_4_accel_one" , "3-3-4" , "one step and no more""#
+            ),
+            "{out}"
+        );
+        assert!(out.contains(r#"& ["operation" , "accel"]"#), "{out}");
+    }
+
+    #[test]
+    fn what_a_scenario_lacks_is_a_compile_error_that_says_so() {
+        let body = quote!(
+            fn s3_1_1_x(d: &mut Driver) -> Outcome {
+                Ok(())
+            }
+        );
+        assert!(error_of(quote!(tags("a")), body.clone()).contains("needs a doc comment"));
+        let documented = quote! {
+            /// x
+            fn s3_1_1_x(d: &mut Driver) -> Outcome { Ok(()) }
+        };
+        assert!(error_of(quote!(), documented.clone()).contains("needs `tags"));
+        assert!(error_of(quote!(tags()), documented.clone()).contains("at least one tag"));
+        assert!(
+            error_of(quote!(tags("a"), section = "3-1-1"), documented.clone())
+                .contains("already in the name")
+        );
+        assert!(error_of(quote!(tags("a"), colour = "red"), documented).contains("expected"));
+        let unnamed = quote! {
+            /// x
+            fn home_axis(d: &mut Driver) -> Outcome { Ok(()) }
+        };
+        assert!(error_of(quote!(tags("a")), unnamed).contains("give one"));
+    }
+
     #[test]
     fn the_section_comes_from_the_name_or_is_given_once_in_the_same_clause() {
         let sp = Span::call_site();
