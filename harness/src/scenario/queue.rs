@@ -785,18 +785,24 @@ mod tests {
         assert!(f.got.contains("error 3"), "{f}");
     }
 
-    #[test]
-    fn a_pulse_check_is_judged_on_the_capture_where_it_was_asked() {
-        // Section 3-3-5: a constant move of 100 steps. Checked after its
-        // tenth pulse, the move has 10 pulses, though the capture that
-        // comes back at the end holds all 100.
-        let mut t = Counting::new();
-        let mut d = Driver::new(&mut t, DriverOptions::default());
+    /// A driver right after the tenth pulse of a 100-step constant move
+    /// (Section 3-3-5).
+    fn ten_pulses_into_a_move(t: &mut Counting) -> Driver<'_> {
+        let mut d = Driver::new(t, DriverOptions::default());
         d.reset().expect("queued");
         d.init_and_wait(Init::four_phase()).expect("init");
         d.start(Move::constant(Direction::Cw, 50, 100))
             .expect("queued");
         d.after_pulses(10).expect("queued");
+        d
+    }
+
+    #[test]
+    fn a_pulse_check_is_judged_on_the_capture_where_it_was_asked() {
+        // Checked after its tenth pulse, the move has 10 pulses, though
+        // the capture that comes back at the end holds all 100.
+        let mut t = Counting::new();
+        let mut d = ten_pulses_into_a_move(&mut t);
         d.expect_pulses(10, Direction::Cw).expect("queued");
         d.wait_idle().expect("queued");
         d.expect_pulses(100, Direction::Cw).expect("queued");
@@ -804,12 +810,7 @@ mod tests {
         assert_eq!(d.capture().expect("capture").last_move_pulses().count, 100);
 
         let mut t = Counting::new();
-        let mut d = Driver::new(&mut t, DriverOptions::default());
-        d.reset().expect("queued");
-        d.init_and_wait(Init::four_phase()).expect("init");
-        d.start(Move::constant(Direction::Cw, 50, 100))
-            .expect("queued");
-        d.after_pulses(10).expect("queued");
+        let mut d = ten_pulses_into_a_move(&mut t);
         d.expect_pulses(100, Direction::Cw).expect("queued");
         let f = failure(d.finish());
         assert!(f.got.starts_with("10 "), "{f}");
