@@ -27,7 +27,7 @@ fn ready() -> Host {
 fn init_time(pa: u16) -> Duration {
     let mut h = Host::new();
     let t = h.send(
-        INIT_4PH,
+        init_4ph(),
         &InitData {
             rl: 200,
             rh: 20,
@@ -58,7 +58,7 @@ fn s3_6_initialization_time_grows_with_pa_within_16_5_to_162_8_ms() {
 #[test]
 fn s3_6_initialization_sets_the_outputs_44_us_after_the_final_byte() {
     let mut h = Host::new();
-    let t = h.send(INIT_4PH, &EXAMPLE_INIT.to_bytes());
+    let t = h.send(init_4ph(), &EXAMPLE_INIT.to_bytes());
     h.wait(MS(1));
     let set = h.pin_event(Pin::Phases, 0b11000, t).expect("phases set");
     assert_in_row(TimingId::InitOutputsSet, set.saturating_since(t));
@@ -91,7 +91,7 @@ fn s3_6_accel_first_pout_grows_with_the_triangle() {
     let first = |pa: u16, steps: u32| {
         let mut h = Host::new();
         h.init(
-            INIT_4PH,
+            init_4ph(),
             InitData {
                 rl: 200,
                 rh: 20,

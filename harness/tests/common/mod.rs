@@ -23,7 +23,9 @@ pub const EXAMPLE_INIT: InitData = InitData {
 };
 
 /// 4-phase motor, 2-phase excitation, negative logic, internal clock.
-pub const INIT_4PH: u8 = 0x02;
+pub fn init_4ph() -> u8 {
+    ppmc::scenario::Init::four_phase().code()
+}
 
 pub struct Host {
     pub t: EmuTarget,
@@ -152,7 +154,7 @@ impl Host {
 
     /// The console example's initialization: 4-phase, RL 100, RH 20, PA 100.
     pub fn init_example(&mut self) {
-        self.init(INIT_4PH, EXAMPLE_INIT);
+        self.init(init_4ph(), EXAMPLE_INIT);
     }
 
     /// Issues a move and returns the time of its final write.
