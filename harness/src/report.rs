@@ -135,7 +135,7 @@ pub fn junit(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, Repor
             }
             Verdict::NotRun(why) => {
                 let mut s = TestCaseStatus::skipped();
-                s.set_message(why.clone());
+                s.set_message(why.to_string());
                 s
             }
         };

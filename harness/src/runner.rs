@@ -2,7 +2,7 @@
 //! a target, and keeping going when one fails or errors.
 
 use crate::backend::{Op, Target};
-use crate::scenario::{run_scenario, DriverOptions, Scenario, ScenarioResult, Verdict};
+use crate::scenario::{run_scenario, DriverOptions, NotRun, Scenario, ScenarioResult, Verdict};
 use crate::time::Duration;
 
 /// Which scenarios a run takes.
@@ -101,7 +101,7 @@ pub fn run_suite(
                     name: s.name,
                     section: s.section,
                     tags: s.tags,
-                    verdict: Verdict::NotRun(format!("not run: {why}")),
+                    verdict: Verdict::NotRun(NotRun::TargetLost(why.clone())),
                     measurements: Vec::new(),
                     trace: None,
                     elapsed: Duration::ZERO,
@@ -110,7 +110,7 @@ pub fn run_suite(
                     let r = run_scenario(target, s, opts);
                     if matches!(r.verdict, Verdict::Error(_)) {
                         if let Err(e) = target.execute(&[Op::Reset]) {
-                            dead = Some(format!("the target stopped answering ({e})"));
+                            dead = Some(e.to_string());
                         }
                     }
                     r
@@ -126,7 +126,8 @@ pub fn run_suite(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scenario::{Driver, Outcome};
+    use crate::backend::{TargetError, TargetErrorKind};
+    use crate::scenario::{Driver, HarnessError, Outcome};
 
     fn ok(_: &mut Driver) -> Outcome {
         Ok(())
@@ -236,6 +237,54 @@ mod tests {
         assert_eq!(
             validate_suite(&all),
             Err(SuiteError::DuplicateName("a_one"))
+        );
+    }
+
+    /// A target whose cable was pulled before the run.
+    #[derive(Debug)]
+    struct Gone;
+
+    impl Target for Gone {
+        fn info(&self) -> crate::backend::TargetInfo {
+            crate::backend::TargetInfo {
+                name: "gone".into(),
+                straps: crate::protocol::Straps::default(),
+                extra: Vec::new(),
+            }
+        }
+        fn capture(&mut self) -> Result<crate::protocol::Record, TargetError> {
+            Err(TargetError::new(TargetErrorKind::Link, "cable pulled"))
+        }
+        fn execute(&mut self, _: &[Op]) -> Result<Vec<crate::backend::Reply>, TargetError> {
+            Err(TargetError::new(TargetErrorKind::Link, "cable pulled"))
+        }
+    }
+
+    #[test]
+    fn after_a_target_is_lost_the_rest_are_not_run_and_blame_the_target() {
+        let results = run_suite(&mut Gone, &suite(), 1, DriverOptions::default(), |_| {});
+        assert!(
+            matches!(
+                &results[0].verdict,
+                Verdict::Error(HarnessError::Target {
+                    kind: TargetErrorKind::Link,
+                    ..
+                })
+            ),
+            "{:?}",
+            results[0].verdict
+        );
+        for r in &results[1..] {
+            assert_eq!(
+                r.verdict,
+                Verdict::NotRun(NotRun::TargetLost("cable pulled".into())),
+                "{}",
+                r.name
+            );
+        }
+        assert_eq!(
+            results[1].verdict.detail().as_deref(),
+            Some("not run: the target stopped answering (cable pulled)")
         );
     }
 }

@@ -8,7 +8,7 @@ use crate::golden::{self};
 use crate::report::{self, RunInfo, Tally};
 use crate::runner::run_suite;
 use crate::scenario::{
-    DriverOptions, Failure, Grading, HarnessError, Scenario, ScenarioResult, Verdict,
+    DriverOptions, Failure, Grading, HarnessError, NotRun, Scenario, ScenarioResult, Verdict,
 };
 use crate::time::Duration;
 use clap::Args;
@@ -177,7 +177,7 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
                     name: s.name,
                     section: s.section,
                     tags: s.tags,
-                    verdict: Verdict::NotRun(why.clone()),
+                    verdict: Verdict::NotRun(NotRun::Unreachable(why.clone())),
                     measurements: Vec::new(),
                     trace: None,
                     elapsed: Duration::ZERO,

@@ -160,7 +160,20 @@ pub enum Verdict {
     /// The harness or the link failed.
     Error(HarnessError),
     /// Never started (the run stopped before it).
-    NotRun(String),
+    NotRun(NotRun),
+}
+
+/// Why a scenario was never started: the infrastructure, never the device.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum NotRun {
+    /// The target could not be reached or was not healthy before the run
+    /// began (the text says why).
+    #[error("{0}")]
+    Unreachable(String),
+    /// The target stopped answering during the run (after a harness error,
+    /// the health check failed too).
+    #[error("not run: the target stopped answering ({0})")]
+    TargetLost(String),
 }
 
 impl Verdict {
@@ -186,7 +199,7 @@ impl Verdict {
             Verdict::Marginal => Some("a measurement is near its limit".into()),
             Verdict::Failed(f) => Some(f.to_string()),
             Verdict::Error(e) => Some(e.to_string()),
-            Verdict::NotRun(e) => Some(e.clone()),
+            Verdict::NotRun(why) => Some(why.to_string()),
         }
     }
 }
