@@ -11,7 +11,7 @@
 //! chip bus plus its pins and a pulse capture. [`EmuBus`] is the reference
 //! model behind it; a bridge firmware implements it over the real chip.
 
-use crate::emu::{Chip, ChipError, ModelConfig};
+use crate::emu::{Board, Chip, ChipError, ModelConfig};
 use crate::protocol::{Flag, Input, Pins, PulseSummary, Record, Status, Straps};
 use crate::time::{Duration, Instant};
 
@@ -180,24 +180,32 @@ pub trait Bus {
 /// are resolved exactly by jumping from one model event to the next.
 #[derive(Debug, Clone)]
 pub struct EmuBus {
-    chip: Chip,
+    /// The model behind its board: status reads, here and in every wait,
+    /// pass the board's bus faults.
+    chip: Board,
     cfg: ModelConfig,
 }
 
 impl EmuBus {
     pub fn new(straps: Straps, cfg: ModelConfig) -> Result<Self, ChipError> {
         Ok(EmuBus {
-            chip: Chip::new(straps, cfg.clone())?,
+            chip: Board::new(straps, cfg.clone())?,
             cfg,
         })
     }
 
+    /// The model itself (its own status, without the board).
     pub fn chip(&self) -> &Chip {
-        &self.chip
+        self.chip.chip()
     }
 
     pub fn chip_mut(&mut self) -> &mut Chip {
-        &mut self.chip
+        self.chip.chip_mut()
+    }
+
+    /// The model on its board, as the bus sees it.
+    pub fn board(&self) -> &Board {
+        &self.chip
     }
 
     /// The model configuration the chip was built with (and is rebuilt
@@ -354,7 +362,7 @@ impl EmuBus {
             },
             Op::Reset => {
                 // Straps and config were validated when the target was built.
-                if let Ok(chip) = Chip::new(*self.chip.straps(), self.cfg.clone()) {
+                if let Ok(chip) = Board::new(*self.chip.straps(), self.cfg.clone()) {
                     self.chip = chip;
                 }
                 Reply::ResetDone {

@@ -130,19 +130,19 @@ pub const CATALOGUE: &[BoardFault] = &[
         "swap-error-2-3",
         "Table 3-2",
         "a move before initialization reports error 3, not 2",
-        |c| c.faults.swap_error = Some((ErrorCode::NotInitialized, ErrorCode::TooManyParameters))
+        |c| c.board.swap_error = Some((ErrorCode::NotInitialized, ErrorCode::TooManyParameters))
     ),
     fault!(
         "swap-error-1-6",
         "Table 3-2",
         "a command during BUSY reports error 6, not 1",
-        |c| c.faults.swap_error = Some((ErrorCode::NotAllowedWhileBusy, ErrorCode::DataWhileBusy))
+        |c| c.board.swap_error = Some((ErrorCode::NotAllowedWhileBusy, ErrorCode::DataWhileBusy))
     ),
     fault!(
         "status-bit3-stuck",
         "3-1-1",
         "status bit 3 (data line D3) stuck high",
-        |c| c.faults.status_stuck_high = 0x08
+        |c| c.board.status_stuck_high = 0x08
     ),
     fault!(
         "ccw-limit-ignored",
@@ -257,11 +257,11 @@ pub fn apply_named(name: &str, cfg: &mut ModelConfig) -> Result<(), FaultNameErr
             .and_then(|(a, b)| Some((a.parse::<u8>().ok()?, b.parse::<u8>().ok()?)))
             .filter(|(a, b)| *a < 8 && *b < 8)
             .ok_or_else(|| FaultNameError::BadSwap(name.into()))?;
-        cfg.faults.swap_error = Some((ErrorCode::from_number(a), ErrorCode::from_number(b)));
+        cfg.board.swap_error = Some((ErrorCode::from_number(a), ErrorCode::from_number(b)));
         return Ok(());
     }
     if let Some(hex) = name.strip_prefix("status-stuck-0x") {
-        cfg.faults.status_stuck_high =
+        cfg.board.status_stuck_high =
             u8::from_str_radix(hex, 16).map_err(|_| FaultNameError::BadStuck(name.into()))?;
         return Ok(());
     }
@@ -301,11 +301,11 @@ mod tests {
         let mut c = ModelConfig::default();
         apply_named("swap-error-3-4", &mut c).expect("parameterized");
         assert_eq!(
-            c.faults.swap_error,
+            c.board.swap_error,
             Some((ErrorCode::TooManyParameters, ErrorCode::AccelPulsesTooMany))
         );
         apply_named("status-stuck-0x40", &mut c).expect("stuck");
-        assert_eq!(c.faults.status_stuck_high, 0x40);
+        assert_eq!(c.board.status_stuck_high, 0x40);
         apply_named("dir-inverted", &mut c).expect("catalogue");
         assert!(c.faults.dir_inverted);
         let e = apply_named("no-such", &mut c)

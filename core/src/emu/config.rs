@@ -6,6 +6,7 @@
 //! it gives a range; `docs/datasheet-notes.md` says where each default comes
 //! from.
 
+use super::board::BusFaults;
 use super::hooks::Faults;
 use crate::time::Duration;
 
@@ -83,8 +84,11 @@ pub struct ModelConfig {
     pub switching_off: Duration,
     /// Shape of the acceleration ramp.
     pub accel_curve: AccelCurve,
-    /// Deliberate faults; none by default.
+    /// Deliberate faults inside the model; none by default.
     pub faults: Faults,
+    /// Deliberate faults on the board's data bus, applied around the model
+    /// by [`super::Board`]; none by default.
+    pub board: BusFaults,
 }
 
 impl Default for ModelConfig {
@@ -117,6 +121,7 @@ impl Default for ModelConfig {
             switching_off: Duration::from_nanos(108_750),
             accel_curve: AccelCurve::LinearSpeed,
             faults: Faults::default(),
+            board: BusFaults::default(),
         }
     }
 }

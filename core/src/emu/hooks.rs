@@ -3,7 +3,7 @@
 //! chip has none ([`Faults::default`]). The named catalogue that sets them
 //! lives in the harness (`ppmc::faults`).
 
-use crate::protocol::{Direction, ErrorCode};
+use crate::protocol::Direction;
 
 /// Behaviour switches the model consults. Timing faults need none: they
 /// are latencies moved out of their Table 3-3 band in [`ModelConfig`].
@@ -12,12 +12,6 @@ pub struct Faults {
     /// The last pulse of every move is lost on the POUT wire (the chip
     /// counts it as output).
     pub drop_last_pulse: bool,
-    /// The chip reports the second error number where the datasheet says
-    /// the first.
-    pub swap_error: Option<(ErrorCode, ErrorCode)>,
-    /// Status register bits that read 1 whatever the chip says (a data bus
-    /// line stuck high on the board).
-    pub status_stuck_high: u8,
     /// The remaining-pulses register reads N - output instead of one less.
     pub remaining_off_by_one: bool,
     /// The limit input for this direction (L1 for CW, L2 for CCW) is never

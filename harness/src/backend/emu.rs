@@ -28,6 +28,12 @@ impl EmuTarget {
         self.bus.chip_mut()
     }
 
+    /// The model on its board, as the bus sees it (status reads pass the
+    /// board's bus faults).
+    pub fn board(&self) -> &crate::emu::Board {
+        self.bus.board()
+    }
+
     /// The model as the bridge engine drives it.
     pub fn bus(&self) -> &EmuBus {
         &self.bus

@@ -3,7 +3,7 @@
 //! has a stable id; a finding is bucketed by it.
 
 use super::bus::BusOp;
-use crate::emu::{Chip, ChipError, ModelConfig};
+use crate::emu::{Board, ChipError, ModelConfig};
 use crate::protocol::capture::{Pin, Record};
 use crate::protocol::{Command, FinishStatus, Register, Status, StatusField, Straps};
 use crate::time::Instant;
@@ -256,20 +256,21 @@ fn pulses_until(r: &crate::protocol::PulseRun, t: Instant) -> u64 {
 /// judged as it goes; [`Checker::finish`] judges the whole record.
 #[derive(Debug)]
 pub struct Checker {
-    chip: Chip,
+    /// The model on its board: the oracle reads status as a host does.
+    chip: Board,
     judge: Judge,
 }
 
 impl Checker {
     pub fn new(cfg: ModelConfig) -> Result<Checker, ChipError> {
         Ok(Checker {
-            chip: Chip::new(Straps::default(), cfg)?,
+            chip: Board::new(Straps::default(), cfg)?,
             judge: Judge::default(),
         })
     }
 
-    /// The chip under test.
-    pub fn chip(&self) -> &Chip {
+    /// The chip under test, on its board.
+    pub fn chip(&self) -> &Board {
         &self.chip
     }
 
@@ -426,7 +427,7 @@ fn trace_round_trip(rec: &Record) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emu::Faults;
+    use crate::emu::{BusFaults, Chip};
     use crate::fuzzing::bus::BusOp::*;
     use crate::time::Duration;
 
@@ -481,9 +482,9 @@ mod tests {
     #[test]
     fn a_stuck_status_bit_is_caught() {
         let cfg = ModelConfig {
-            faults: Faults {
+            board: BusFaults {
                 status_stuck_high: 0x08,
-                ..Faults::default()
+                ..BusFaults::default()
             },
             ..ModelConfig::default()
         };
@@ -496,9 +497,9 @@ mod tests {
     #[test]
     fn parameter_counts_beyond_four_are_caught() {
         let cfg = ModelConfig {
-            faults: Faults {
+            board: BusFaults {
                 status_stuck_high: 0x50,
-                ..Faults::default()
+                ..BusFaults::default()
             },
             ..ModelConfig::default()
         };

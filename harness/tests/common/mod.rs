@@ -104,7 +104,7 @@ impl Host {
     }
 
     pub fn status(&self) -> Status {
-        self.t.chip().read_status()
+        self.t.board().read_status()
     }
 
     /// Waits for the byte in the input buffer to be taken, then returns the

@@ -56,10 +56,6 @@ impl Chip {
     }
 
     pub(super) fn set_error(&mut self, e: ErrorCode) {
-        let e = match self.cfg.faults.swap_error {
-            Some((from, to)) if from == e => to,
-            _ => e,
-        };
         self.field = StatusField::Error(e);
         self.expect = Expect::Command;
     }

@@ -255,8 +255,7 @@ impl Chip {
 
     /// Host read of the status register (A = H, RD low). No side effects.
     pub fn read_status(&self) -> Status {
-        let s = Status::new(self.obf, self.inbuf.is_some(), self.busy, self.field);
-        Status(s.0 | self.cfg.faults.status_stuck_high)
+        Status::new(self.obf, self.inbuf.is_some(), self.busy, self.field)
     }
 
     /// Host read of the data register (A = L, RD low). Reading with OBF = 0
