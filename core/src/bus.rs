@@ -182,30 +182,30 @@ pub trait Bus {
 pub struct EmuBus {
     /// The model behind its board: status reads, here and in every wait,
     /// pass the board's bus faults.
-    chip: Board,
+    board: Board,
     cfg: ModelConfig,
 }
 
 impl EmuBus {
     pub fn new(straps: Straps, cfg: ModelConfig) -> Result<Self, ChipError> {
         Ok(EmuBus {
-            chip: Board::new(straps, cfg.clone())?,
+            board: Board::new(straps, cfg.clone())?,
             cfg,
         })
     }
 
     /// The model itself (its own status, without the board).
     pub fn chip(&self) -> &Chip {
-        self.chip.chip()
+        self.board.chip()
     }
 
     pub fn chip_mut(&mut self) -> &mut Chip {
-        self.chip.chip_mut()
+        self.board.chip_mut()
     }
 
     /// The model on its board, as the bus sees it.
     pub fn board(&self) -> &Board {
-        &self.chip
+        &self.board
     }
 
     /// The model configuration the chip was built with (and is rebuilt
@@ -218,23 +218,23 @@ impl EmuBus {
     /// `Ok(waited)` or `Err(())` on timeout; the chip's clock stands at the
     /// moment the condition first held, or at the deadline.
     fn wait_for(&mut self, mask: u8, value: u8, timeout: Duration) -> Result<Duration, ()> {
-        let start = self.chip.now();
+        let start = self.board.now();
         let deadline = start + timeout;
         loop {
-            let now = self.chip.now();
-            if self.chip.read_status().0 & mask == value {
+            let now = self.board.now();
+            if self.board.read_status().0 & mask == value {
                 return Ok(now.saturating_since(start));
             }
-            match self.chip.poll_at() {
-                Some(t) if t > now && t <= deadline => self.chip.advance_to(t),
+            match self.board.poll_at() {
+                Some(t) if t > now && t <= deadline => self.board.advance_to(t),
                 // Due now: advancing to `now` has processed it already, so a
                 // second look cannot change anything before the next event.
                 Some(t) if t <= now => {
-                    self.chip.advance_to(now + Duration::from_nanos(1));
+                    self.board.advance_to(now + Duration::from_nanos(1));
                 }
                 _ => {
-                    self.chip.advance_to(deadline);
-                    let status = self.chip.read_status();
+                    self.board.advance_to(deadline);
+                    let status = self.board.read_status();
                     return if status.0 & mask == value {
                         Ok(timeout)
                     } else {
@@ -248,12 +248,12 @@ impl EmuBus {
     /// Waits until the move has output `count` pulses. Stops exactly at
     /// that pulse, even inside a constant-rate stretch.
     fn wait_pulses(&mut self, count: u64, timeout: Duration) -> Result<Instant, u64> {
-        let deadline = self.chip.now() + timeout;
+        let deadline = self.board.now() + timeout;
         loop {
-            if self.chip.move_pulses() >= count {
-                return Ok(self.chip.now());
+            if self.board.move_pulses() >= count {
+                return Ok(self.board.now());
             }
-            let next = match (self.chip.predict_pulse(count), self.chip.poll_at()) {
+            let next = match (self.board.predict_pulse(count), self.board.poll_at()) {
                 (Some(a), Some(b)) => a.min(b),
                 (a, b) => match a.or(b) {
                     Some(t) => t,
@@ -263,16 +263,16 @@ impl EmuBus {
             if next > deadline {
                 break;
             }
-            let now = self.chip.now();
-            self.chip
+            let now = self.board.now();
+            self.board
                 .advance_to(next.max(now + Duration::from_nanos(1)).min(deadline));
         }
-        self.chip.advance_to(deadline.max(self.chip.now()));
-        Err(self.chip.move_pulses())
+        self.board.advance_to(deadline.max(self.board.now()));
+        Err(self.board.move_pulses())
     }
 
     fn status_at(&self) -> (Instant, Status) {
-        (self.chip.now(), self.chip.read_status())
+        (self.board.now(), self.board.read_status())
     }
 
     fn run_op(&mut self, op: Op) -> Reply {
@@ -289,12 +289,12 @@ impl EmuBus {
                     }
                 }
                 if matches!(op, Op::WriteCommand { .. }) {
-                    self.chip.write_command(byte);
+                    self.board.write_command(byte);
                 } else {
-                    self.chip.write_data(byte);
+                    self.board.write_data(byte);
                 }
                 Reply::Written {
-                    at: self.chip.now(),
+                    at: self.board.now(),
                     waited,
                 }
             }
@@ -313,16 +313,16 @@ impl EmuBus {
                         }
                     }
                 }
-                let byte = self.chip.read_data();
+                let byte = self.board.read_data();
                 Reply::Data {
-                    at: self.chip.now(),
+                    at: self.board.now(),
                     byte,
                     waited,
                 }
             }
             Op::Delay(d) => {
-                let to = self.chip.now() + d;
-                self.chip.advance_to(to);
+                let to = self.board.now() + d;
+                self.board.advance_to(to);
                 Reply::Delayed { at: to }
             }
             Op::AwaitStatus {
@@ -340,33 +340,33 @@ impl EmuBus {
                 }
             },
             Op::SetInput { input, asserted } => {
-                self.chip.set_input(input, asserted);
+                self.board.set_input(input, asserted);
                 Reply::InputSet {
-                    at: self.chip.now(),
+                    at: self.board.now(),
                 }
             }
             Op::ReadPins => Reply::Pins {
-                at: self.chip.now(),
-                pins: self.chip.pins(),
+                at: self.board.now(),
+                pins: self.board.pins(),
             },
             Op::ReadPulses => Reply::Pulses {
-                at: self.chip.now(),
-                summary: self.chip.record().last_move_pulses(),
+                at: self.board.now(),
+                summary: self.board.record().last_move_pulses(),
             },
             Op::AwaitPulses { count, timeout } => match self.wait_pulses(count, timeout) {
                 Ok(at) => Reply::PulsesReached { at },
                 Err(count) => Reply::PulsesTimedOut {
-                    at: self.chip.now(),
+                    at: self.board.now(),
                     count,
                 },
             },
             Op::Reset => {
                 // Straps and config were validated when the target was built.
-                if let Ok(chip) = Board::new(*self.chip.straps(), self.cfg.clone()) {
-                    self.chip = chip;
+                if let Ok(board) = Board::new(*self.board.straps(), self.cfg.clone()) {
+                    self.board = board;
                 }
                 Reply::ResetDone {
-                    at: self.chip.now(),
+                    at: self.board.now(),
                 }
             }
         }
@@ -379,14 +379,14 @@ impl Bus for EmuBus {
     }
 
     fn record(&self) -> &Record {
-        self.chip.record()
+        self.board.record()
     }
 
     fn straps(&self) -> Straps {
-        *self.chip.straps()
+        *self.board.straps()
     }
 
     fn now(&self) -> Instant {
-        self.chip.now()
+        self.board.now()
     }
 }

@@ -257,21 +257,21 @@ fn pulses_until(r: &crate::protocol::PulseRun, t: Instant) -> u64 {
 #[derive(Debug)]
 pub struct Checker {
     /// The model on its board: the oracle reads status as a host does.
-    chip: Board,
+    board: Board,
     judge: Judge,
 }
 
 impl Checker {
     pub fn new(cfg: ModelConfig) -> Result<Checker, ChipError> {
         Ok(Checker {
-            chip: Board::new(Straps::default(), cfg)?,
+            board: Board::new(Straps::default(), cfg)?,
             judge: Judge::default(),
         })
     }
 
     /// The chip under test, on its board.
     pub fn chip(&self) -> &Board {
-        &self.chip
+        &self.board
     }
 
     /// Ops applied so far.
@@ -281,7 +281,7 @@ impl Checker {
 
     /// Applies one op and judges it.
     pub fn apply(&mut self, op: BusOp) -> Result<(), Violation> {
-        let chip = &mut self.chip;
+        let chip = &mut self.board;
         let before = chip.read_status();
         let value = match op {
             BusOp::Command(b) => {
@@ -314,7 +314,7 @@ impl Checker {
 
     /// The record's own invariants, checked once at the end.
     pub fn finish(&self) -> Result<(), Violation> {
-        self.judge.finish(self.chip.record())
+        self.judge.finish(self.board.record())
     }
 }
 
