@@ -68,11 +68,8 @@ pub fn check_board(
     let mut link_error: Option<String> = None;
     run_suite(target, suite, 1, DriverOptions::default(), |r| {
         match &r.verdict {
-            Verdict::Error(e) if link_error.is_none() => {
-                link_error = Some(format!("{}: {e}", r.name));
-            }
-            Verdict::NotRun(e) if link_error.is_none() => {
-                link_error = Some(format!("{}: {e}", r.name));
+            v @ (Verdict::Error(_) | Verdict::NotRun(_)) if link_error.is_none() => {
+                link_error = Some(format!("{}: {}", r.name, v.detail().unwrap_or_default()));
             }
             v if !v.ok() && first_fail.is_none() => {
                 first_fail = Some(Catch {

@@ -208,7 +208,7 @@ fn typed_seeds_move_the_motor() {
         for op in ops {
             c.apply(op).expect("no break");
         }
-        if c.chip().record().pulse_count() > 0 {
+        if c.board().record().pulse_count() > 0 {
             moving += 1;
         }
     }

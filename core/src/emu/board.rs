@@ -5,7 +5,7 @@
 //! ([`super::hooks`]).
 
 use super::{Chip, ChipError, ModelConfig};
-use crate::protocol::{ErrorCode, FinishStatus, Input, InputSet, Pins, Record, Status, Straps};
+use crate::protocol::{ErrorCode, Input, Pins, Record, Status, Straps};
 use crate::time::Instant;
 
 /// Faults on the board's data bus, seen in every status register read (by
@@ -91,18 +91,6 @@ impl Board {
 
     pub fn record(&self) -> &Record {
         self.chip.record()
-    }
-
-    pub fn inputs(&self) -> InputSet {
-        self.chip.inputs()
-    }
-
-    pub fn initialized(&self) -> bool {
-        self.chip.initialized()
-    }
-
-    pub fn finish_status(&self) -> FinishStatus {
-        self.chip.finish_status()
     }
 
     pub fn pins(&self) -> Pins {

@@ -126,10 +126,12 @@ impl Coverage {
         // Pin events already looked at: only new ones can be a move's end.
         let mut pins_seen = 0;
         for op in ops {
-            let chip = k.chip();
-            let state = if chip.read_status().busy() {
+            let board = k.board();
+            // The state as the host sees it (through the board), and the
+            // model's own view of whether it was initialized.
+            let state = if board.read_status().busy() {
                 ChipState::Moving
-            } else if chip.initialized() {
+            } else if board.chip().initialized() {
                 ChipState::Idle
             } else {
                 ChipState::Uninitialized
@@ -148,11 +150,11 @@ impl Coverage {
             }
             // Oracle breaks are the fuzz targets' business, not coverage's.
             let _ = k.apply(*op);
-            let chip = k.chip();
-            if let StatusField::Error(e) = chip.read_status().field() {
+            let board = k.board();
+            if let StatusField::Error(e) = board.read_status().field() {
                 *self.errors.entry(e.number()).or_default() += 1;
             }
-            let pins = &chip.record().pins;
+            let pins = &board.record().pins;
             let ended = pins
                 .get(pins_seen..)
                 .unwrap_or_default()
@@ -160,7 +162,7 @@ impl Coverage {
                 .any(|p| p.pin == crate::protocol::Pin::Busy && p.value == 0);
             pins_seen = pins.len();
             if ended {
-                let f = chip.finish_status();
+                let f = board.chip().finish_status();
                 let kind = MoveKind::ALL
                     .iter()
                     .find(|m| m.code() == f.op_code())

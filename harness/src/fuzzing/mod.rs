@@ -134,10 +134,10 @@ pub fn lower(
                 ready: &dyn Fn(Status) -> bool,
                 timeout: Duration|
      -> Result<(), oracle::Violation> {
-        let deadline = c.chip().now() + timeout;
-        while !ready(c.chip().read_status()) && c.chip().now() < deadline {
-            let now = c.chip().now();
-            let next = c.chip().poll_at().unwrap_or(deadline).min(deadline);
+        let deadline = c.board().now() + timeout;
+        while !ready(c.board().read_status()) && c.board().now() < deadline {
+            let now = c.board().now();
+            let next = c.board().poll_at().unwrap_or(deadline).min(deadline);
             let us = next.saturating_since(now).as_nanos().div_ceil(1_000).max(1);
             for op in bus::advances(Duration::from_micros(us)) {
                 ops.push(op);

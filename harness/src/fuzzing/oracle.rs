@@ -270,7 +270,7 @@ impl Checker {
     }
 
     /// The chip under test, on its board.
-    pub fn chip(&self) -> &Board {
+    pub fn board(&self) -> &Board {
         &self.board
     }
 
