@@ -7,7 +7,7 @@
 //! which check catches which.
 
 use crate::emu::ModelConfig;
-use crate::protocol::{Direction, ErrorCode};
+use crate::protocol::{ErrorCode, Input};
 use crate::time::Duration;
 
 /// One named fault of the catalogue.
@@ -148,17 +148,17 @@ pub const CATALOGUE: &[BoardFault] = &[
         "ccw-limit-ignored",
         "3-3-2",
         "L2 (CCW limit) is never seen: CCW moves run through it",
-        |c| c.faults.limit_ignored = Some(Direction::Ccw)
+        |c| c.board.inputs_cut.set(Input::L2, true)
     ),
     fault!("alarm-ignored", "3-3-2", "ALM is never seen", |c| c
-        .faults
-        .alarm_ignored =
-        true),
+        .board
+        .inputs_cut
+        .set(Input::Alm, true)),
     fault!(
         "origin-ignored",
         "3-3-8",
         "CNP is never seen: origin search runs on",
-        |c| c.faults.origin_ignored = true
+        |c| c.board.inputs_cut.set(Input::Cnp, true)
     ),
     fault!(
         "phase-step-skipped",
@@ -188,7 +188,7 @@ pub const CATALOGUE: &[BoardFault] = &[
         "dir-inverted",
         "3-3-1",
         "the DIR output shows the opposite direction",
-        |c| c.faults.dir_inverted = true
+        |c| c.board.dir_inverted = true
     ),
     fault!(
         "reset-quirk-missing",
@@ -200,13 +200,13 @@ pub const CATALOGUE: &[BoardFault] = &[
         "hold-stuck-off",
         "3-2-1",
         "the HOLD output never turns on",
-        |c| c.faults.hold_stuck_off = true
+        |c| c.board.hold_stuck_off = true
     ),
     fault!(
         "auxo-reversed",
         "3-5-5",
         "AUXO0..3 come out in reverse bit order",
-        |c| c.faults.auxo_reversed = true
+        |c| c.board.auxo_reversed = true
     ),
     fault!(
         "decel-stop-immediate",
@@ -307,7 +307,7 @@ mod tests {
         apply_named("status-stuck-0x40", &mut c).expect("stuck");
         assert_eq!(c.board.status_stuck_high, 0x40);
         apply_named("dir-inverted", &mut c).expect("catalogue");
-        assert!(c.faults.dir_inverted);
+        assert!(c.board.dir_inverted);
         let e = apply_named("no-such", &mut c)
             .expect_err("unknown")
             .to_string();

@@ -5,7 +5,7 @@ mod common;
 
 use ppmc::backend::{EmuTarget, SerialError, SerialLink, SerialOptions, SerialTarget};
 use ppmc::bridge::sim::{LinkFaults, PtyBridge};
-use ppmc::emu::{BusFaults, ModelConfig};
+use ppmc::emu::{BoardFaults, ModelConfig};
 use ppmc::protocol::Straps;
 use ppmc::runner::run_suite;
 use ppmc::scenario::{DriverOptions, ScenarioResult, Verdict};
@@ -171,9 +171,9 @@ fn an_unhealthy_board_is_refused_at_open() {
     let sim = Sim::start(
         LinkFaults::default(),
         ModelConfig {
-            board: BusFaults {
+            board: BoardFaults {
                 status_stuck_high: 0x08,
-                ..BusFaults::default()
+                ..BoardFaults::default()
             },
             ..ModelConfig::default()
         },

@@ -5,7 +5,7 @@
 
 use ppmc::backend::EmuTarget;
 use ppmc::compare::{compare, Tolerances};
-use ppmc::emu::{BusFaults, Faults, ModelConfig};
+use ppmc::emu::{BoardFaults, Faults, ModelConfig};
 use ppmc::protocol::{ErrorCode, Straps};
 use ppmc::runner::run_suite;
 use ppmc::scenario::{DriverOptions, Failure, ScenarioResult, Verdict};
@@ -102,9 +102,9 @@ fn mutants() -> Vec<(String, ModelConfig)> {
     v.push((
         "status bit 3 stuck high".into(),
         ModelConfig {
-            board: BusFaults {
+            board: BoardFaults {
                 status_stuck_high: 0x08,
-                ..BusFaults::default()
+                ..BoardFaults::default()
             },
             ..ModelConfig::default()
         },
@@ -114,9 +114,9 @@ fn mutants() -> Vec<(String, ModelConfig)> {
         v.push((
             format!("error {} reported as {}", e.number(), other.number()),
             ModelConfig {
-                board: BusFaults {
+                board: BoardFaults {
                     swap_error: Some((e, other)),
-                    ..BusFaults::default()
+                    ..BoardFaults::default()
                 },
                 ..ModelConfig::default()
             },
@@ -230,9 +230,9 @@ fn a_dropped_pulse_fails_with_the_pulse_count() {
 #[test]
 fn a_different_error_code_fails_with_expected_and_got() {
     let cfg = ModelConfig {
-        board: BusFaults {
+        board: BoardFaults {
             swap_error: Some((ErrorCode::TooManyParameters, ErrorCode::AccelPulsesTooMany)),
-            ..BusFaults::default()
+            ..BoardFaults::default()
         },
         ..ModelConfig::default()
     };

@@ -6,7 +6,7 @@
 //! it gives a range; `docs/datasheet-notes.md` says where each default comes
 //! from.
 
-use super::board::BusFaults;
+use super::board::BoardFaults;
 use super::hooks::Faults;
 use crate::time::Duration;
 
@@ -88,7 +88,7 @@ pub struct ModelConfig {
     pub faults: Faults,
     /// Deliberate faults on the board's data bus, applied around the model
     /// by [`super::Board`]; none by default.
-    pub board: BusFaults,
+    pub board: BoardFaults,
 }
 
 impl Default for ModelConfig {
@@ -121,7 +121,7 @@ impl Default for ModelConfig {
             switching_off: Duration::from_nanos(108_750),
             accel_curve: AccelCurve::LinearSpeed,
             faults: Faults::default(),
-            board: BusFaults::default(),
+            board: BoardFaults::default(),
         }
     }
 }

@@ -7,7 +7,7 @@ pub mod config;
 pub mod hooks;
 mod motion;
 
-pub use board::{Board, BusFaults};
+pub use board::{Board, BoardFaults};
 pub use chip::{Chip, ChipError, PA_MAX, PA_MIN};
 pub use config::{AccelCurve, ConfigError, ModelConfig};
 pub use hooks::Faults;

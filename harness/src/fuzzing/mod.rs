@@ -237,7 +237,7 @@ mod tests {
     use super::*;
     use crate::backend::EmuTarget;
     use crate::console;
-    use crate::emu::BusFaults;
+    use crate::emu::BoardFaults;
     use crate::protocol::Straps;
     use crate::time::Duration;
     use bus::BusOp::*;
@@ -288,9 +288,9 @@ mod tests {
     fn a_reproducer_names_the_break_and_marks_its_op() {
         let data = bus::encode(&sample());
         let cfg = ModelConfig {
-            board: BusFaults {
+            board: BoardFaults {
                 status_stuck_high: 0x08,
-                ..BusFaults::default()
+                ..BoardFaults::default()
             },
             ..ModelConfig::default()
         };

@@ -427,7 +427,7 @@ fn trace_round_trip(rec: &Record) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emu::{BusFaults, Chip};
+    use crate::emu::{BoardFaults, Chip};
     use crate::fuzzing::bus::BusOp::*;
     use crate::time::Duration;
 
@@ -482,9 +482,9 @@ mod tests {
     #[test]
     fn a_stuck_status_bit_is_caught() {
         let cfg = ModelConfig {
-            board: BusFaults {
+            board: BoardFaults {
                 status_stuck_high: 0x08,
-                ..BusFaults::default()
+                ..BoardFaults::default()
             },
             ..ModelConfig::default()
         };
@@ -497,9 +497,9 @@ mod tests {
     #[test]
     fn parameter_counts_beyond_four_are_caught() {
         let cfg = ModelConfig {
-            board: BusFaults {
+            board: BoardFaults {
                 status_stuck_high: 0x50,
-                ..BusFaults::default()
+                ..BoardFaults::default()
             },
             ..ModelConfig::default()
         };

@@ -155,11 +155,6 @@ impl Chip {
             }
             Command::AuxOutput => {
                 let bits = buf[0] & 0x0F;
-                let bits = if self.cfg.faults.auxo_reversed {
-                    bits.reverse_bits() >> 4
-                } else {
-                    bits
-                };
                 self.schedule(base + self.fw(self.cfg.aux_output), Timer::Auxo(bits));
             }
             _ => {}

@@ -412,12 +412,7 @@ impl Chip {
                 self.hold_epoch += 1;
                 self.set_hold(false);
                 self.set_switching(None);
-                let shown = |d: Direction| match (d, self.cfg.faults.dir_inverted) {
-                    (d, false) => d,
-                    (Direction::Cw, true) => Direction::Ccw,
-                    (Direction::Ccw, true) => Direction::Cw,
-                };
-                if let Some(dir) = self.motion.as_ref().map(|m| shown(m.dir)) {
+                if let Some(dir) = self.motion.as_ref().map(|m| m.dir) {
                     if dir != self.dir {
                         self.dir = dir;
                         self.record.pin(now, Pin::Dir, u8::from(dir.bit()));

@@ -139,14 +139,11 @@ impl Chip {
         }
         let now = self.now;
         let (dir, kind, pout) = (m.dir, m.kind, m.pout);
-        let mut only = InputSet::default();
-        only.set(input, true);
-        let seen = self.seen_inputs(only, dir);
-        if seen.contains(Input::Alm) {
+        if input == Input::Alm {
             self.halt(StopCause::Alarm, now);
-        } else if seen.contains(Input::limit_for(dir)) {
+        } else if input == Input::limit_for(dir) {
             self.halt(StopCause::Limit, now);
-        } else if seen.contains(Input::Cnp) && kind == MoveKind::OriginSearch {
+        } else if input == Input::Cnp && kind == MoveKind::OriginSearch {
             self.halt(StopCause::Completed, now);
         } else if input == Input::high_speed_limit_for(dir) && kind.ramped() {
             self.high_speed_limit(pout);
@@ -217,7 +214,7 @@ impl Chip {
         };
         let (dir, kind, pout) = (m.dir, m.kind, m.pout);
         let now = self.now;
-        let inputs = self.seen_inputs(self.inputs, dir);
+        let inputs = self.inputs;
         if inputs.contains(Input::Alm) {
             self.halt(StopCause::Alarm, now);
         } else if inputs.contains(Input::limit_for(dir)) {
@@ -233,22 +230,6 @@ impl Chip {
                 }
             }
         }
-    }
-
-    /// The inputs as the firmware sees them during a move in `dir`: all of
-    /// them, unless a board fault hides one.
-    pub(super) fn seen_inputs(&self, mut inputs: InputSet, dir: Direction) -> InputSet {
-        let f = &self.cfg.faults;
-        if f.alarm_ignored {
-            inputs.set(Input::Alm, false);
-        }
-        if f.origin_ignored {
-            inputs.set(Input::Cnp, false);
-        }
-        if f.limit_ignored == Some(dir) {
-            inputs.set(Input::limit_for(dir), false);
-        }
-        inputs
     }
 
     /// Whether the move is in POUT mode with its high-speed limit asserted
@@ -362,9 +343,6 @@ impl Chip {
     }
 
     pub(super) fn set_hold(&mut self, on: bool) {
-        if on && self.cfg.faults.hold_stuck_off {
-            return;
-        }
         if self.hold != on {
             self.hold = on;
             self.record.pin(self.now, Pin::Hold, u8::from(on));
