@@ -2,13 +2,12 @@
 //!
 //! The files are insta snapshots (so `cargo insta review` accepts a changed
 //! emulator trace), which is a short `---` header and the trace text.
-//! Nothing here overwrites a file unless asked, and every write goes to a
-//! temporary file first and is renamed into place, so an interrupted write
-//! never leaves half a golden file.
+//! Nothing here overwrites a file unless asked; reads and writes go through
+//! [`crate::files`], so an interrupted write never leaves half a golden
+//! file and a FIFO or a huge file is refused, not read.
 
+use crate::files::{self, FileError, MAX_TRACE_BYTES};
 use crate::trace::{Trace, TraceError};
-use std::fs;
-use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 /// The front matter insta writes for `harness/tests/golden.rs`; `ppmc
@@ -22,12 +21,8 @@ pub enum GoldenError {
     #[error("{path}: no golden trace for this scenario (record one with `ppmc record`)")]
     Missing { path: PathBuf },
     /// The file could not be read or written.
-    #[error("{path}: {source}")]
-    Io {
-        path: PathBuf,
-        #[source]
-        source: io::Error,
-    },
+    #[error(transparent)]
+    File(#[from] FileError),
     /// The file is not a valid trace (corrupt, truncated, another version).
     #[error("{path}:{line}: {message}")]
     Parse {
@@ -62,10 +57,10 @@ pub fn path_for(dir: &Path, scenario: &str) -> PathBuf {
 /// Reads and checks the golden trace of `scenario`.
 pub fn load(dir: &Path, scenario: &str) -> Result<Trace, GoldenError> {
     let path = path_for(dir, scenario);
-    let text = match fs::read_to_string(&path) {
+    let text = match files::read_text(&path, MAX_TRACE_BYTES) {
         Ok(t) => t,
-        Err(e) if e.kind() == io::ErrorKind::NotFound => return Err(GoldenError::Missing { path }),
-        Err(source) => return Err(GoldenError::Io { path, source }),
+        Err(e) if e.is_not_found() => return Err(GoldenError::Missing { path }),
+        Err(e) => return Err(e.into()),
     };
     let trace = Trace::parse(&text).map_err(|TraceError { line, message }| GoldenError::Parse {
         path: path.clone(),
@@ -95,10 +90,12 @@ pub enum Written {
 pub fn write(dir: &Path, trace: &Trace, bless: bool) -> Result<Written, GoldenError> {
     let path = dir.join(format!("{}.snap", trace.scenario));
     let text = format!("{SNAPSHOT_HEADER}{}", trace.render());
-    let existing = match fs::read_to_string(&path) {
+    // A symlink or a FIFO at the name is refused before it is read.
+    files::check_writable(&path)?;
+    let existing = match files::read_text(&path, MAX_TRACE_BYTES) {
         Ok(t) => Some(t),
-        Err(e) if e.kind() == io::ErrorKind::NotFound => None,
-        Err(source) => return Err(GoldenError::Io { path, source }),
+        Err(e) if e.is_not_found() => None,
+        Err(e) => return Err(e.into()),
     };
     let outcome = match existing {
         Some(t) if t == text => return Ok(Written::Unchanged),
@@ -106,39 +103,21 @@ pub fn write(dir: &Path, trace: &Trace, bless: bool) -> Result<Written, GoldenEr
         Some(_) => Written::Replaced,
         None => Written::Created,
     };
-    write_atomic(&path, text.as_bytes()).map_err(|source| GoldenError::Io { path, source })?;
+    files::write(&path, text.as_bytes())?;
     Ok(outcome)
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same folder
-/// and a rename, so readers see the old file or the new one, never half.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    fs::create_dir_all(dir)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    {
-        let mut f = fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-    }
-    fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = fs::remove_file(&tmp);
-    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::fs;
 
-    fn tmpdir(tag: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("ppmc-golden-{tag}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&d);
-        fs::create_dir_all(&d).expect("temp dir");
-        d
+    /// A scratch folder, removed when dropped (even by a failing test).
+    fn tmpdir() -> tempfile::TempDir {
+        tempfile::Builder::new()
+            .prefix("ppmc-golden-")
+            .tempdir()
+            .expect("temp dir")
     }
 
     fn trace(name: &str) -> Trace {
@@ -150,26 +129,24 @@ mod tests {
 
     #[test]
     fn write_never_overwrites_without_bless() {
-        let d = tmpdir("bless");
+        let scratch = tmpdir();
+        let d = scratch.path();
+        assert_eq!(write(d, &trace("a"), false).expect("new"), Written::Created);
         assert_eq!(
-            write(&d, &trace("a"), false).expect("new"),
-            Written::Created
-        );
-        assert_eq!(
-            write(&d, &trace("a"), false).expect("same"),
+            write(d, &trace("a"), false).expect("same"),
             Written::Unchanged
         );
         let mut other = trace("a");
         other.section = "3-2".into();
         let before = fs::read_to_string(d.join("a.snap")).expect("exists");
         assert!(matches!(
-            write(&d, &other, false),
+            write(d, &other, false),
             Err(GoldenError::Exists { .. })
         ));
         assert_eq!(fs::read_to_string(d.join("a.snap")).expect("kept"), before);
-        assert_eq!(write(&d, &other, true).expect("blessed"), Written::Replaced);
-        assert_eq!(load(&d, "a").expect("loads"), other);
-        let leftovers: Vec<_> = fs::read_dir(&d)
+        assert_eq!(write(d, &other, true).expect("blessed"), Written::Replaced);
+        assert_eq!(load(d, "a").expect("loads"), other);
+        let leftovers: Vec<_> = fs::read_dir(d)
             .expect("dir")
             .filter_map(Result::ok)
             .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
@@ -179,22 +156,23 @@ mod tests {
 
     #[test]
     fn bad_golden_files_name_path_and_line() {
-        let d = tmpdir("bad");
-        assert!(matches!(load(&d, "x"), Err(GoldenError::Missing { .. })));
+        let scratch = tmpdir();
+        let d = scratch.path();
+        assert!(matches!(load(d, "x"), Err(GoldenError::Missing { .. })));
         fs::write(d.join("x.snap"), format!("{SNAPSHOT_HEADER}ppmc-trace 1\nscenario x\nsection 3\ntarget emu\ndetail sysclk_hz 16000000\ndetail csel high\ndetail vsel high\ndetail ext_clock_hz none\nevents\n0.000us bogus\nend\n")).expect("write");
-        let e = load(&d, "x").expect_err("corrupt");
+        let e = load(d, "x").expect_err("corrupt");
         assert!(
             e.to_string().ends_with("x.snap:13: unknown event `bogus`"),
             "{e}"
         );
         fs::write(d.join("y.snap"), trace("x").render()).expect("write");
-        let e = load(&d, "y").expect_err("other scenario");
+        let e = load(d, "y").expect_err("other scenario");
         assert!(
             e.to_string().contains("trace of scenario `x`, not `y`"),
             "{e}"
         );
         fs::write(d.join("z.snap"), "ppmc-trace 1\nscenario z\n").expect("write");
-        assert!(load(&d, "z")
+        assert!(load(d, "z")
             .expect_err("truncated")
             .to_string()
             .contains("truncated"));

@@ -17,6 +17,7 @@ pub mod compare;
 pub mod console;
 pub mod fault_matrix;
 pub mod faults;
+pub mod files;
 pub mod fuzzing;
 pub mod golden;
 pub mod report;

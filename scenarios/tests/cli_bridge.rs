@@ -22,17 +22,24 @@ struct BridgeSim {
     child: Child,
     path: String,
     _stdout: BufReader<std::process::ChildStdout>,
+    _dir: Option<tempfile::TempDir>,
 }
 
 impl BridgeSim {
     fn start(args: &[&str]) -> BridgeSim {
-        use std::sync::atomic::{AtomicUsize, Ordering};
-        static N: AtomicUsize = AtomicUsize::new(0);
-        let link = tmp(&format!("pty-{}", N.fetch_add(1, Ordering::Relaxed)));
+        let dir = scratch();
+        let link = dir.path().join("pty");
+        let mut sim = BridgeSim::start_at(&link, args);
+        sim._dir = Some(dir);
+        sim
+    }
+
+    /// A bridge-sim whose link is `link`.
+    fn start_at(link: &std::path::Path, args: &[&str]) -> BridgeSim {
         let mut child = Command::new(env!("CARGO_BIN_EXE_ppmc"))
             .arg("bridge-sim")
             .arg("--link")
-            .arg(&link)
+            .arg(link)
             .args(args)
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
@@ -52,6 +59,7 @@ impl BridgeSim {
             child,
             path: link.to_str().expect("utf-8 path").to_string(),
             _stdout: reader,
+            _dir: None,
         }
     }
 
@@ -68,8 +76,12 @@ impl Drop for BridgeSim {
     }
 }
 
-fn tmp(name: &str) -> std::path::PathBuf {
-    std::env::temp_dir().join(format!("ppmc-clibridge-{}-{name}", std::process::id()))
+/// A scratch folder, removed when dropped, even by a failing test.
+fn scratch() -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix("ppmc-clibridge-")
+        .tempdir()
+        .expect("scratch dir")
 }
 
 #[test]
@@ -100,7 +112,8 @@ fn console_over_the_bridge_prints_what_the_emulator_prints() {
 #[test]
 fn a_disconnect_mid_run_writes_the_partial_junit_and_exits_1() {
     let sim = BridgeSim::start(&["--disconnect-after", "40"]);
-    let junit = tmp("partial.xml");
+    let dir = scratch();
+    let junit = dir.path().join("partial.xml");
     let out = ppmc(&[
         "run",
         "--target",
@@ -123,12 +136,12 @@ fn a_disconnect_mid_run_writes_the_partial_junit_and_exits_1() {
         xml.matches("<skipped").count() > 0,
         "the rest are marked not run"
     );
-    let _ = std::fs::remove_file(junit);
 }
 
 #[test]
 fn a_missing_board_is_an_infrastructure_error_with_reports() {
-    let junit = tmp("missing.xml");
+    let dir = scratch();
+    let junit = dir.path().join("missing.xml");
     let out = ppmc(&[
         "run",
         "--target",
@@ -142,7 +155,6 @@ fn a_missing_board_is_an_infrastructure_error_with_reports() {
     assert!(err.contains("no such serial port"), "{err}");
     let xml = std::fs::read_to_string(&junit).expect("JUnit written");
     assert_eq!(xml.matches("<skipped").count(), ppmc_scenarios::all().len());
-    let _ = std::fs::remove_file(junit);
     // A malformed target is bad usage.
     assert_eq!(ppmc(&["run", "--target", "serial:"]).status.code(), Some(2));
 }
@@ -182,7 +194,8 @@ fn differential_fuzz_over_the_pty() {
     );
 
     let bad = BridgeSim::start(&["--chip-fault", "dir-inverted"]);
-    let file = std::env::temp_dir().join(format!("ppmc-diff-pty-{}.ppmc", std::process::id()));
+    let dir = scratch();
+    let file = dir.path().join("diff-pty.ppmc");
     let out = ppmc(&[
         "fuzz",
         "--target",
@@ -203,4 +216,69 @@ fn differential_fuzz_over_the_pty() {
     let text = std::fs::read_to_string(&file).expect("reproducer written");
     assert!(text.contains(&format!("target {}", bad.target())), "{text}");
     let _ = std::fs::remove_file(&file);
+}
+
+#[test]
+fn bridge_sim_never_replaces_a_file_that_is_not_its_stale_link() {
+    let dir = scratch();
+    let file = dir.path().join("notes.txt");
+    std::fs::write(&file, "keep me").expect("file");
+    let out = Command::new(env!("CARGO_BIN_EXE_ppmc"))
+        .args(["bridge-sim", "--link"])
+        .arg(&file)
+        .output()
+        .expect("bridge-sim runs");
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("exists and is not a link"), "{err}");
+    assert_eq!(std::fs::read_to_string(&file).expect("kept"), "keep me");
+    // A link to a pseudo-terminal that is gone is an earlier bridge's.
+    let stale = dir.path().join("stale");
+    std::os::unix::fs::symlink("/dev/pts/999999", &stale).expect("stale link");
+    let other = dir.path().join("other");
+    std::os::unix::fs::symlink(&file, &other).expect("other link");
+    let out = Command::new(env!("CARGO_BIN_EXE_ppmc"))
+        .args(["bridge-sim", "--link"])
+        .arg(&other)
+        .output()
+        .expect("bridge-sim runs");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not a stale bridge-sim link"));
+    let sim = BridgeSim::start_at(&stale, &[]);
+    assert!(std::fs::read_link(&stale)
+        .expect("relinked")
+        .starts_with("/dev/pts/"));
+    drop(sim);
+}
+
+#[test]
+fn bridge_sim_removes_its_link_on_sigterm_and_sigint() {
+    for signal in ["-TERM", "-INT"] {
+        let dir = scratch();
+        let link = dir.path().join("pty");
+        let mut sim = BridgeSim::start_at(&link, &[]);
+        assert!(std::fs::symlink_metadata(&link).is_ok());
+        let sent = Command::new("kill")
+            .arg(signal)
+            .arg(sim.child.id().to_string())
+            .status()
+            .expect("kill runs");
+        assert!(sent.success());
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+        let status = loop {
+            if let Some(s) = sim.child.try_wait().expect("wait") {
+                break s;
+            }
+            assert!(
+                std::time::Instant::now() < deadline,
+                "bridge-sim did not stop on {signal}"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        };
+        assert!(status.success(), "{signal}: {status}");
+        assert!(
+            std::fs::symlink_metadata(&link).is_err(),
+            "{signal}: link left behind"
+        );
+    }
 }

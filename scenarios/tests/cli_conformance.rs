@@ -13,11 +13,12 @@ fn golden_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../golden")
 }
 
-fn tmpdir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ppmc-cli-{tag}-{}", std::process::id()));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).expect("temp dir");
-    d
+/// A scratch folder, removed when dropped, even by a failing test.
+fn tmpdir(tag: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("ppmc-cli-{tag}-"))
+        .tempdir()
+        .expect("temp dir")
 }
 
 fn s(p: &Path) -> &str {
@@ -26,7 +27,8 @@ fn s(p: &Path) -> &str {
 
 #[test]
 fn run_passes_on_the_emulator_and_writes_valid_junit_and_json() {
-    let d = tmpdir("run");
+    let d_dir = tmpdir("run");
+    let d = d_dir.path();
     let (junit, json) = (d.join("report.xml"), d.join("run.json"));
     let out = ppmc(&[
         "run",
@@ -79,8 +81,9 @@ fn run_compares_with_golden_as_it_runs() {
 }
 
 /// Writes a copy of the golden set with every time scaled by `num / den`.
-fn scaled_copy(tag: &str, num: u64, den: u64) -> PathBuf {
-    let d = tmpdir(tag);
+fn scaled_copy(tag: &str, num: u64, den: u64) -> tempfile::TempDir {
+    let d_dir = tmpdir(tag);
+    let d = d_dir.path();
     for e in fs::read_dir(golden_dir()).expect("golden dir") {
         let p = e.expect("entry").path();
         if p.extension().is_some_and(|x| x == "snap") {
@@ -89,18 +92,20 @@ fn scaled_copy(tag: &str, num: u64, den: u64) -> PathBuf {
             fs::write(d.join(p.file_name().expect("name")), scaled.render()).expect("write");
         }
     }
-    d
+    d_dir
 }
 
 #[test]
 fn compare_passes_half_a_percent_and_fails_three_percent() {
-    let half = scaled_copy("half", 1005, 1000);
-    let out = ppmc(&["compare", s(&golden_dir()), "--traces", s(&half)]);
+    let half_dir = scaled_copy("half", 1005, 1000);
+    let half = half_dir.path();
+    let out = ppmc(&["compare", s(&golden_dir()), "--traces", s(half)]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
     assert!(text(&out.stdout).contains(" 0 failed"));
 
-    let three = scaled_copy("three", 103, 100);
-    let out = ppmc(&["compare", s(&golden_dir()), "--traces", s(&three)]);
+    let three_dir = scaled_copy("three", 103, 100);
+    let three = three_dir.path();
+    let out = ppmc(&["compare", s(&golden_dir()), "--traces", s(three)]);
     assert_eq!(out.status.code(), Some(1));
     let stdout = text(&out.stdout);
     assert!(
@@ -114,7 +119,7 @@ fn compare_passes_half_a_percent_and_fails_three_percent() {
         "compare",
         s(&golden_dir()),
         "--traces",
-        s(&three),
+        s(three),
         "--latency-tol",
         "4",
         "--interval-tol",
@@ -127,7 +132,8 @@ fn compare_passes_half_a_percent_and_fails_three_percent() {
 
 #[test]
 fn export_writes_a_vcd_that_parses_back() {
-    let d = tmpdir("vcd");
+    let d_dir = tmpdir("vcd");
+    let d = d_dir.path();
     let vcd_path = d.join("out.vcd");
     let golden = golden_dir().join("s3_3_5_constant_speed_100_steps.snap");
     let out = ppmc(&["export", s(&golden), "-o", s(&vcd_path)]);
@@ -145,9 +151,10 @@ fn export_writes_a_vcd_that_parses_back() {
 
 #[test]
 fn record_never_overwrites_without_bless() {
-    let d = tmpdir("record");
+    let d_dir = tmpdir("record");
+    let d = d_dir.path();
     let args = |extra: &[&str]| {
-        let mut v = vec!["record", "--out", s(&d), "--filter", "e0_undefined"];
+        let mut v = vec!["record", "--out", s(d), "--filter", "e0_undefined"];
         v.extend_from_slice(extra);
         ppmc(&v)
     };
@@ -181,8 +188,9 @@ fn record_never_overwrites_without_bless() {
 }
 
 #[test]
-fn a_corrupt_golden_file_fails_its_scenario_alone_with_path_and_line() {
-    let g = tmpdir("corrupt");
+fn a_corrupt_golden_file_is_a_harness_error_of_its_scenario_alone_with_path_and_line() {
+    let g_dir = tmpdir("corrupt");
+    let g = g_dir.path();
     for name in ["e0_undefined_command_code", "e3_data_without_a_command"] {
         fs::copy(
             golden_dir().join(format!("{name}.snap")),
@@ -193,11 +201,12 @@ fn a_corrupt_golden_file_fails_its_scenario_alone_with_path_and_line() {
     let bad = g.join("e3_data_without_a_command.snap");
     let text_ = fs::read_to_string(&bad).expect("read");
     fs::write(&bad, text_.replacen(" wd ", " wq ", 1)).expect("corrupt");
-    let arts = tmpdir("artifacts");
+    let arts_dir = tmpdir("artifacts");
+    let arts = arts_dir.path();
     let out = ppmc(&[
         "run",
         "--golden",
-        s(&g),
+        s(g),
         "--filter",
         "e",
         "--tag",
@@ -205,7 +214,7 @@ fn a_corrupt_golden_file_fails_its_scenario_alone_with_path_and_line() {
         "--shard",
         "1/1",
         "--artifacts",
-        s(&arts),
+        s(arts),
     ]);
     let stdout = text(&out.stdout);
     assert_eq!(out.status.code(), Some(1), "{stdout}");
@@ -213,16 +222,18 @@ fn a_corrupt_golden_file_fails_its_scenario_alone_with_path_and_line() {
         stdout.contains("PASS     e0_undefined_command_code"),
         "{stdout}"
     );
+    // The golden file is at fault, not the device: an error, not a failure.
     assert!(
-        stdout.contains("FAIL     e3_data_without_a_command"),
+        stdout.contains("ERROR    e3_data_without_a_command"),
         "{stdout}"
     );
+    assert!(!stdout.contains("FAIL "), "{stdout}");
     assert!(
         stdout.contains("e3_data_without_a_command.snap:"),
         "{stdout}"
     );
     assert!(stdout.contains("unknown event `wq`"), "{stdout}");
-    // Scenarios with no golden file fail too, naming the missing file.
+    // Scenarios with no golden file are errors too, naming the missing file.
     assert!(
         stdout.contains("no golden trace for this scenario"),
         "{stdout}"
@@ -267,4 +278,75 @@ fn list_and_shards_cover_the_suite() {
             .expect("count line")
     };
     assert_eq!(count("1/3") + count("2/3") + count("3/3"), n);
+}
+
+/// Reports and golden files never follow a planted symlink, never replace a
+/// device, a FIFO or a directory, and never leave a temporary file behind.
+#[cfg(unix)]
+#[test]
+fn outputs_never_follow_a_symlink_or_replace_what_is_not_a_regular_file() {
+    let d_dir = tmpdir("planted");
+    let d = d_dir.path();
+    let outside = d.join("outside.txt");
+    fs::write(&outside, "keep me").expect("outside file");
+    let report = d.join("report.json");
+    std::os::unix::fs::symlink(&outside, &report).expect("symlink");
+    let out = ppmc(&["run", "--filter", "e0_undefined", "--json", s(&report)]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stdout));
+    let err = text(&out.stderr);
+    assert!(err.contains("report.json: is a symbolic link"), "{err}");
+    assert!(out.stdout.is_empty(), "refused before anything ran");
+    assert_eq!(fs::read_to_string(&outside).expect("kept"), "keep me");
+
+    let out = ppmc(&["run", "--filter", "e0_undefined", "--junit", "/dev/null"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("/dev/null: is a device"));
+
+    // A golden file planted as a symlink is refused too, and counted.
+    let golden = d.join("golden");
+    fs::create_dir(&golden).expect("golden dir");
+    std::os::unix::fs::symlink(&outside, golden.join("e0_undefined_command_code.snap"))
+        .expect("symlink");
+    let out = ppmc(&["record", "--filter", "e0_undefined", "--out", s(&golden)]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stdout));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("is a symbolic link"), "{stdout}");
+    assert!(stdout.contains("1 not written"), "{stdout}");
+    assert_eq!(fs::read_to_string(&outside).expect("kept"), "keep me");
+    let leftovers: Vec<_> = fs::read_dir(&golden)
+        .expect("dir")
+        .map(|e| e.expect("entry").file_name())
+        .filter(|n| n.to_string_lossy().ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+/// A golden path that is a FIFO or a device is refused, not read forever.
+#[cfg(unix)]
+#[test]
+fn a_golden_file_that_is_a_fifo_or_a_device_is_an_error_not_a_hang() {
+    let d_dir = tmpdir("fifo");
+    let d = d_dir.path();
+    let fifo = d.join("e0_undefined_command_code.snap");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo");
+    assert!(made.success());
+    std::os::unix::fs::symlink("/dev/zero", d.join("e0_motor_type_code_00.snap")).expect("symlink");
+    let out = ppmc(&["run", "--golden", s(d), "--filter", "e0_"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("e0_undefined_command_code.snap: is a FIFO"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("e0_motor_type_code_00.snap: is a device"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("ERROR    e0_undefined_command_code"),
+        "{stdout}"
+    );
 }

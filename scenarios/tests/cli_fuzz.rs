@@ -27,11 +27,12 @@ fn reproduce_of_a_missing_file_is_a_usage_error_naming_it() {
     assert!(err.contains("no/such/crash-file"), "{err}");
 }
 
-fn scratch(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("ppmc-cli-fuzz-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("scratch dir");
-    d
+/// A scratch folder, removed when dropped, even by a failing test.
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("ppmc-cli-fuzz-{name}-"))
+        .tempdir()
+        .expect("scratch dir")
 }
 
 const STOP_SEED: &str = "../fuzz/corpus/bus_bytes/s3_3_1_immediate_stop_and_resume.bin";
@@ -42,7 +43,8 @@ const STOP_SEED: &str = "../fuzz/corpus/bus_bytes/s3_3_1_immediate_stop_and_resu
 /// to-scenario never overwrites the first.
 #[test]
 fn minimize_then_to_scenario_on_an_injected_bug() {
-    let dir = scratch("loop");
+    let dir_dir = scratch("loop");
+    let dir = dir_dir.path();
     let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join(STOP_SEED);
     let input = dir.join("crash-1");
     std::fs::copy(&seed, &input).expect("copy");
@@ -122,7 +124,7 @@ fn minimize_then_to_scenario_on_an_injected_bug() {
         scen.to_str().expect("p"),
     ]);
     assert_eq!(none.status.code(), Some(1));
-    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(dir);
 }
 
 /// The structure-aware target's inputs go through the same loop.
@@ -153,7 +155,8 @@ fn a_differential_run_finds_a_faulty_emulator_and_writes_a_reproducer() {
     assert_eq!(out.status.code(), Some(0));
     assert!(String::from_utf8_lossy(&out.stdout).contains("no departure"));
 
-    let dir = scratch("diff");
+    let dir_dir = scratch("diff");
+    let dir = dir_dir.path();
     let repro = dir.join("r.ppmc");
     let run = |path: &Path| {
         ppmc(&[
@@ -185,7 +188,7 @@ fn a_differential_run_finds_a_faulty_emulator_and_writes_a_reproducer() {
         text,
         "the seed replays"
     );
-    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(dir);
 }
 
 /// A directory of findings of one bug is one bucket; the coverage report

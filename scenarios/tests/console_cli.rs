@@ -68,8 +68,11 @@ fn a_bad_line_stops_with_its_number_and_exit_2_before_anything_runs() {
 
 #[test]
 fn a_bad_line_in_a_file_names_the_file() {
-    let dir = std::env::temp_dir().join(format!("ppmc-console-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
+    let scratch = tempfile::Builder::new()
+        .prefix("ppmc-console-")
+        .tempdir()
+        .expect("temp dir");
+    let dir = scratch.path();
     let f = dir.join("bad.ppmc");
     std::fs::write(&f, "# ok\nfrobnicate\n").expect("script");
     let out = ppmc(&["console", f.to_str().expect("utf-8 path")], "");

@@ -6,13 +6,15 @@ use crate::backend::EmuTarget;
 use crate::cli::{usage, CliError};
 use clap::Args;
 use std::io::{self, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, Args)]
 pub struct BridgeSimArgs {
     #[command(flatten)]
     target: TargetArgs,
-    /// Also make PATH a symbolic link to the pty (removed on exit).
+    /// Also make PATH a symbolic link to the pty, removed on exit, SIGINT
+    /// and SIGTERM. An existing PATH is replaced only when it is a stale
+    /// link of an earlier bridge-sim (to a pseudo-terminal that is gone).
     #[arg(long, value_name = "PATH")]
     link: Option<PathBuf>,
     /// Pace replies to the wall clock instead of answering at once in
@@ -51,8 +53,6 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     use crate::bridge::sim::engine;
     use crate::bridge::sim::{serve, LinkFaults, ServeEnd};
     use serialport::SerialPort;
-    use std::sync::atomic::{AtomicBool, Ordering};
-    use std::sync::Arc;
 
     for (name, rate) in [
         ("--drop-rate", args.drop_rate),
@@ -96,13 +96,7 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
         ));
     };
     if let Some(link) = &args.link {
-        let _ = std::fs::remove_file(link);
-        if let Err(e) = std::os::unix::fs::symlink(&path, link) {
-            return Err(CliError::Failed(format!(
-                "cannot link {} to {path}: {e}",
-                link.display()
-            )));
-        }
+        place_link(link, &path)?;
     }
     let session = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -115,7 +109,8 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     let _ = writeln!(out, "bridge-sim: serving on {path}");
     let _ = writeln!(out, "bridge-sim: run   ppmc run --target serial:{path}");
     let _ = out.flush();
-    let stop = Arc::new(AtomicBool::new(false));
+    // SIGINT and SIGTERM end the serve loop, so the link is removed.
+    let stop = super::signals::stop_requested();
     let faults = LinkFaults {
         drop_rate: args.drop_rate,
         corrupt_rate: args.corrupt_rate,
@@ -125,10 +120,9 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     };
     let end = serve(&mut master, &mut server, faults, args.realtime, &stop);
     if let Some(link) = &args.link {
-        let _ = std::fs::remove_file(link);
+        remove_own_link(link, &path);
     }
     drop(slave);
-    let _ = stop.load(Ordering::Relaxed);
     match end {
         Ok(ServeEnd::Disconnected) => {
             let _ = writeln!(
@@ -140,5 +134,45 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
         }
         Ok(ServeEnd::Stopped) => Ok(()),
         Err(e) => Err(CliError::Failed(format!("bridge-sim: {e}"))),
+    }
+}
+
+/// Makes `link` a symbolic link to the pty at `pty`. Something already at
+/// `link` is replaced only when it is a stale link of a bridge-sim (a link
+/// to a pseudo-terminal that is gone); anything else is refused.
+fn place_link(link: &Path, pty: &str) -> Result<(), CliError> {
+    match std::fs::symlink_metadata(link) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+        Err(e) => return Err(CliError::Failed(format!("{}: {e}", link.display()))),
+        Ok(meta) if meta.file_type().is_symlink() => {
+            let to = std::fs::read_link(link).unwrap_or_default();
+            let stale_pty = to.starts_with("/dev/pts/") && !to.exists();
+            if !stale_pty {
+                return Err(usage(format!(
+                    "--link {}: is a link to {}, not a stale bridge-sim link; \
+                     remove it or choose another path",
+                    link.display(),
+                    to.display()
+                )));
+            }
+            std::fs::remove_file(link)
+                .map_err(|e| CliError::Failed(format!("{}: {e}", link.display())))?;
+        }
+        Ok(_) => {
+            return Err(usage(format!(
+                "--link {}: exists and is not a link; bridge-sim replaces only a \
+                 stale link of its own",
+                link.display()
+            )));
+        }
+    }
+    std::os::unix::fs::symlink(pty, link)
+        .map_err(|e| CliError::Failed(format!("cannot link {} to {pty}: {e}", link.display())))
+}
+
+/// Removes `link` if it is still this bridge's link to `pty`.
+fn remove_own_link(link: &Path, pty: &str) {
+    if std::fs::read_link(link).is_ok_and(|to| to == Path::new(pty)) {
+        let _ = std::fs::remove_file(link);
     }
 }

@@ -42,10 +42,9 @@ pub fn run(args: ConsoleArgs) -> Result<(), CliError> {
     }
     let text = match (&args.exec, &args.file) {
         (Some(e), _) => e.clone(),
-        (None, Some(f)) if f.as_os_str() != "-" => match std::fs::read_to_string(f) {
-            Ok(t) => t,
-            Err(e) => return Err(usage(format!("cannot read {}: {e}", f.display()))),
-        },
+        (None, Some(f)) if f.as_os_str() != "-" => {
+            crate::files::read_text(f, crate::files::MAX_INPUT_BYTES)?
+        }
         _ => {
             let mut t = String::new();
             if let Err(e) = io::stdin().read_to_string(&mut t) {

@@ -1,7 +1,7 @@
 //! `ppmc export`: a trace as a VCD waveform.
 
 use crate::cli::{usage, CliError};
-use crate::golden::{self};
+use crate::files;
 use crate::trace::Trace;
 use clap::Args;
 use std::path::PathBuf;
@@ -11,16 +11,14 @@ use std::path::PathBuf;
 pub struct ExportArgs {
     /// A trace or golden file.
     trace: PathBuf,
-    /// The VCD file to write (default: the trace's name with .vcd).
+    /// The VCD file to write (default: the trace's name with .vcd; `-` for
+    /// standard output).
     #[arg(short, long)]
     output: Option<PathBuf>,
 }
 
 pub fn run(args: ExportArgs) -> Result<(), CliError> {
-    let text = match std::fs::read_to_string(&args.trace) {
-        Ok(t) => t,
-        Err(e) => return Err(usage(format!("{}: {e}", args.trace.display()))),
-    };
+    let text = files::read_text(&args.trace, files::MAX_TRACE_BYTES)?;
     let trace = match Trace::parse(&text) {
         Ok(t) => t,
         Err(e) => {
@@ -35,13 +33,15 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
     let out = args
         .output
         .unwrap_or_else(|| args.trace.with_extension("vcd"));
-    let mut buf = Vec::new();
-    if let Err(e) = crate::vcd_export::export(&trace, &mut buf) {
-        return Err(CliError::Failed(format!("{}: {e}", out.display())));
+    // Streamed: a 16-million-pulse trace costs time, not memory.
+    if out.as_os_str() == "-" {
+        let stdout = std::io::stdout().lock();
+        if let Err(e) = crate::vcd_export::export(&trace, stdout) {
+            return Err(CliError::Failed(format!("standard output: {e}")));
+        }
+        return Ok(());
     }
-    if let Err(e) = golden::write_atomic(&out, &buf) {
-        return Err(CliError::Failed(format!("{}: {e}", out.display())));
-    }
+    files::write_with(&out, |w| crate::vcd_export::export(&trace, w))?;
     println!("wrote {}", out.display());
     Ok(())
 }

@@ -102,9 +102,7 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 }
             }
         }
-        if let Err(e) = crate::golden::write_atomic(path, text.as_bytes()) {
-            return Err(usage(format!("cannot write {}: {e}", path.display())));
-        }
+        crate::files::write_report(path, text.as_bytes())?;
     }
     if fault_matrix::all_as_expected(&rows) {
         println!("\nevery fault caught, no false alarm on the clean board");

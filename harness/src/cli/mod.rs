@@ -15,6 +15,7 @@ mod list;
 mod progress;
 mod record;
 mod run;
+mod signals;
 
 use crate::scenario::Scenario;
 use clap::{Parser, Subcommand};
@@ -119,6 +120,10 @@ pub(crate) enum CliError {
     Infrastructure(String),
     /// The command could not do its work (exit 1).
     Failed(String),
+    /// A file could not be read or written; the error names it and says
+    /// what failed (exit 2 when it is the user's file or path that is wrong,
+    /// 1 when the system failed a write).
+    File(crate::files::FileError),
     /// The command ran and its verdict is negative (a scenario failed, an
     /// input breaks an invariant, a fault went undetected); it has said
     /// why (exit 1).
@@ -145,8 +150,23 @@ impl CliError {
                 eprintln!("ppmc: {m}");
                 ExitCode::from(1)
             }
+            CliError::File(e) => {
+                use crate::files::{Action, FileError};
+                eprintln!("ppmc: {e}");
+                let users = match &e {
+                    FileError::Io { action, .. } => *action == Action::Reading,
+                    _ => true,
+                };
+                ExitCode::from(if users { 2 } else { 1 })
+            }
             CliError::Verdict => ExitCode::from(1),
         }
+    }
+}
+
+impl From<crate::files::FileError> for CliError {
+    fn from(e: crate::files::FileError) -> Self {
+        CliError::File(e)
     }
 }
 

@@ -5,7 +5,8 @@ use super::progress::Progress;
 use crate::cli::{usage, CliError};
 use crate::golden::{self, GoldenError, Written};
 use crate::runner::run_suite;
-use crate::scenario::{DriverOptions, Scenario};
+use crate::scenario::{DriverOptions, Scenario, ScenarioResult, Verdict};
+use crate::trace::Trace;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -23,8 +24,10 @@ pub struct RecordArgs {
     /// ever overwritten.
     #[arg(long)]
     bless: bool,
-    /// Record scenarios that did not pass too (normally refused, so that a
-    /// broken run never becomes the reference).
+    /// Record scenarios the device failed too (normally refused, so that a
+    /// broken board never becomes the reference). Scenarios that ended in a
+    /// harness or link error, or did not run, are never recorded: their
+    /// capture is incomplete.
     #[arg(long)]
     allow_failures: bool,
 }
@@ -36,8 +39,7 @@ pub fn run(args: RecordArgs, suite: &[Scenario]) -> Result<(), CliError> {
     };
     let mut target = args.target.open()?;
     let progress = Progress::new(scenarios.len());
-    let mut counts = [0usize; 4]; // created, replaced, unchanged, refused
-    let mut failed = false;
+    let mut tally = Tally::default();
     run_suite(
         target.as_mut(),
         &scenarios,
@@ -45,47 +47,146 @@ pub fn run(args: RecordArgs, suite: &[Scenario]) -> Result<(), CliError> {
         DriverOptions::default(),
         |r| {
             progress.step(r.name);
-            let outcome = match (&r.trace, r.verdict.ok() || args.allow_failures) {
-                (None, _) => Err(format!("{}: the target gave no capture", r.name)),
-                (Some(_), false) => Err(format!(
-                    "{}: not recorded, it did not pass ({}); fix it or pass --allow-failures",
-                    r.name,
-                    r.verdict.detail().unwrap_or_default()
-                )),
-                (Some(t), true) => golden::write(&args.out, t, args.bless).map_err(|e| match e {
-                    GoldenError::Exists { .. } => format!("{e} (it differs from this run)"),
-                    other => other.to_string(),
-                }),
-            };
-            match outcome {
-                Ok(w) => {
-                    let (i, word) = match w {
-                        Written::Created => (0, "created"),
-                        Written::Replaced => (1, "replaced"),
-                        Written::Unchanged => (2, "unchanged"),
-                    };
-                    counts[i] += 1;
-                    progress.line(&format!(
-                        "{word:<9} {}",
-                        golden::path_for(&args.out, r.name).display()
-                    ));
+            match admit(r, args.allow_failures) {
+                Err(why) => {
+                    tally.refused += 1;
+                    progress.line(&format!("refused   {}: {why}", r.name));
                 }
-                Err(e) => {
-                    counts[3] += 1;
-                    failed = true;
-                    progress.line(&format!("refused   {e}"));
-                }
+                Ok(t) => match golden::write(&args.out, t, args.bless) {
+                    Ok(w) => {
+                        let word = match w {
+                            Written::Created => "created",
+                            Written::Replaced => "replaced",
+                            Written::Unchanged => "unchanged",
+                        };
+                        tally.count(w);
+                        if matches!(r.verdict, Verdict::Failed(_)) {
+                            tally.device_failures += 1;
+                        }
+                        progress.line(&format!(
+                            "{word:<9} {}",
+                            golden::path_for(&args.out, r.name).display()
+                        ));
+                    }
+                    Err(GoldenError::Exists { path }) => {
+                        tally.refused += 1;
+                        progress.line(&format!(
+                            "refused   {}: exists and differs from this run; pass --bless to replace it",
+                            path.display()
+                        ));
+                    }
+                    Err(e) => {
+                        tally.write_errors += 1;
+                        progress.line(&format!("error     {e}"));
+                    }
+                },
             }
         },
     );
     progress.finish();
     println!(
-        "{} created, {} replaced, {} unchanged, {} refused",
-        counts[0], counts[1], counts[2], counts[3]
+        "{} created, {} replaced, {} unchanged, {} refused, {} not written (I/O errors)",
+        tally.created, tally.replaced, tally.unchanged, tally.refused, tally.write_errors
     );
-    if failed {
+    if tally.device_failures > 0 {
+        println!(
+            "{} of the golden traces are of scenarios the device failed (--allow-failures)",
+            tally.device_failures
+        );
+    }
+    if tally.refused + tally.write_errors > 0 {
         Err(CliError::Verdict)
     } else {
         Ok(())
+    }
+}
+
+#[derive(Debug, Default)]
+struct Tally {
+    created: usize,
+    replaced: usize,
+    unchanged: usize,
+    refused: usize,
+    write_errors: usize,
+    device_failures: usize,
+}
+
+impl Tally {
+    fn count(&mut self, w: Written) {
+        match w {
+            Written::Created => self.created += 1,
+            Written::Replaced => self.replaced += 1,
+            Written::Unchanged => self.unchanged += 1,
+        }
+    }
+}
+
+/// The trace to record from `r`, or why not. Only a complete run is ever a
+/// reference: a scenario that ended in a harness or link error, or never
+/// ran, has an incomplete capture whatever the flags; a device failure is
+/// admitted with `--allow-failures` only.
+fn admit(r: &ScenarioResult, allow_failures: bool) -> Result<&Trace, String> {
+    match (&r.verdict, &r.trace) {
+        (Verdict::Error(e), _) => Err(format!(
+            "not recorded: it ended in an error, so its capture is incomplete ({e})"
+        )),
+        (Verdict::NotRun(why), _) => Err(format!("not recorded: it did not run ({why})")),
+        (Verdict::Failed(_), Some(_)) if !allow_failures => Err(format!(
+            "not recorded: the device failed it ({}); fix it or pass --allow-failures",
+            r.verdict.detail().unwrap_or_default()
+        )),
+        (_, None) => Err("not recorded: the target gave no capture".into()),
+        (Verdict::Passed | Verdict::Marginal | Verdict::Failed(_), Some(t)) => Ok(t),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::backend::TargetErrorKind;
+    use crate::scenario::{Failure, HarnessError, NotRun};
+    use crate::time::{Duration, Instant};
+
+    fn result(verdict: Verdict, trace: bool) -> ScenarioResult {
+        let text = "ppmc-trace 1\nscenario x\nsection 3-1\ntarget emu\ndetail sysclk_hz 16000000\n\
+                    detail csel high\ndetail vsel high\ndetail ext_clock_hz none\nevents\n0.000us reset\nend\n";
+        ScenarioResult {
+            name: "x",
+            section: "3-1",
+            tags: &[],
+            verdict,
+            measurements: Vec::new(),
+            trace: trace.then(|| Trace::parse(text).expect("valid trace")),
+            elapsed: Duration::ZERO,
+        }
+    }
+
+    fn failed() -> Verdict {
+        Verdict::Failed(Failure {
+            expectation: "finish status".into(),
+            expected: "0x8E".into(),
+            got: "0x00".into(),
+            at: Instant::ZERO,
+        })
+    }
+
+    #[test]
+    fn only_complete_runs_become_golden_traces() {
+        let link = Verdict::Error(HarnessError::Target {
+            kind: TargetErrorKind::Link,
+            message: "no reply".into(),
+        });
+        for allow in [false, true] {
+            let e = admit(&result(link.clone(), true), allow).expect_err("error refused");
+            assert!(e.contains("capture is incomplete"), "{e}");
+            let lost = Verdict::NotRun(NotRun::TargetLost("gone".into()));
+            assert!(admit(&result(lost, true), allow).is_err());
+            assert!(admit(&result(Verdict::Passed, false), allow).is_err());
+            assert!(admit(&result(Verdict::Passed, true), allow).is_ok());
+            assert!(admit(&result(Verdict::Marginal, true), allow).is_ok());
+        }
+        let e = admit(&result(failed(), true), false).expect_err("failure refused");
+        assert!(e.contains("--allow-failures"), "{e}");
+        assert!(admit(&result(failed(), true), true).is_ok());
     }
 }

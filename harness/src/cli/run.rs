@@ -4,6 +4,7 @@ use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
 use super::progress::Progress;
 use crate::cli::{usage, CliError};
 use crate::compare::{compare, Tolerances};
+use crate::files;
 use crate::golden::{self};
 use crate::report::{self, RunInfo, Tally};
 use crate::runner::run_suite;
@@ -95,14 +96,9 @@ fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) {
                 );
             }
         }
-        Err(e) => {
-            r.verdict = fail(
-                "golden trace usable".into(),
-                "a valid golden file".into(),
-                e.to_string(),
-                crate::time::Instant::ZERO,
-            );
-        }
+        // A missing, corrupt or mismatched golden file is the harness's
+        // input at fault, never the device.
+        Err(e) => r.verdict = Verdict::Error(HarnessError::Golden(e.to_string())),
     }
 }
 
@@ -110,17 +106,14 @@ fn save_artifacts(dir: &Path, r: &ScenarioResult) -> Result<(), String> {
     let Some(trace) = &r.trace else { return Ok(()) };
     let text = trace.render();
     let tpath = dir.join(format!("{}.trace", r.name));
-    golden::write_atomic(&tpath, text.as_bytes())
-        .map_err(|e| format!("{}: {e}", tpath.display()))?;
+    files::write(&tpath, text.as_bytes()).map_err(|e| e.to_string())?;
     let vpath = dir.join(format!("{}.vcd", r.name));
-    let mut buf = Vec::new();
-    crate::vcd_export::export(trace, &mut buf).map_err(|e| format!("{}: {e}", vpath.display()))?;
-    golden::write_atomic(&vpath, &buf).map_err(|e| format!("{}: {e}", vpath.display()))
+    files::write_with(&vpath, |w| crate::vcd_export::export(trace, w)).map_err(|e| e.to_string())
 }
 
 fn write_report(path: &Path, text: Result<String, report::ReportError>) -> Result<(), String> {
     let text = text.map_err(|e| format!("{}: {e}", path.display()))?;
-    golden::write_atomic(path, text.as_bytes()).map_err(|e| format!("{}: {e}", path.display()))
+    files::write_report(path, text.as_bytes()).map_err(|e| e.to_string())
 }
 
 fn summary_lines(t: &Tally, results: usize) {
@@ -156,6 +149,9 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             "--marginal {}: give a percentage from 0 to 50",
             args.marginal
         )));
+    }
+    for report in [&args.junit, &args.json].into_iter().flatten() {
+        files::check_writable(report)?;
     }
     if let Some(dir) = &args.golden {
         if !dir.is_dir() {

@@ -171,6 +171,8 @@ pub fn scenario_stem(invariant: &str, n: usize) -> String {
 /// while `v` still breaks: the body of `ppmc fuzz to-scenario`.
 pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> String {
     let section = oracle::section(v.invariant);
+    let source = comment_safe(source);
+    let detail = comment_safe(&v.detail);
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -179,9 +181,7 @@ pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> 
          //! Written by `ppmc fuzz to-scenario` from {source}.\n\
          //! It fails while the bug is there; once fixed, record its golden trace\n\
          //! (`ppmc record --filter {stem}`).\n",
-        v.invariant,
-        v.op,
-        v.detail.replace('\n', " "),
+        v.invariant, v.op, detail,
     );
     s.push_str("use ppmc::fuzzing::bus::BusOp::{self, *};\n");
     s.push_str("use ppmc::fuzzing::replay::regression;\n");
@@ -218,6 +218,22 @@ pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> 
     }
     s.push_str("];\n");
     s
+}
+
+/// `text` as it may appear in a generated source comment: printable ASCII
+/// as it is, everything else (a newline, a control or bidirectional
+/// character from a file name) escaped, so no text from outside can add a
+/// line of code or hide one.
+fn comment_safe(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c == ' ' || c.is_ascii_graphic() {
+                c.to_string()
+            } else {
+                c.escape_unicode().to_string()
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -266,6 +282,29 @@ mod tests {
             minimize(&ops, &ModelConfig::default(), "remaining-pulses"),
             None
         );
+    }
+
+    #[test]
+    fn no_text_from_a_file_name_reaches_the_generated_code_unescaped() {
+        let v = Violation {
+            invariant: "remaining-pulses",
+            op: 0,
+            detail: "read 5\nfn evil() {}".into(),
+        };
+        let source = "crash\npub fn injected() {}\u{202E}";
+        let text = scenario_file("fuzz_x_1", &[BusOp::Command(0x83)], &v, source);
+        for line in text.lines() {
+            let code = line.trim_start();
+            assert!(
+                !code.starts_with("pub fn injected") && !code.starts_with("fn evil"),
+                "{text}"
+            );
+        }
+        assert!(
+            text.contains("crash\\u{a}pub fn injected() {}\\u{202e}"),
+            "{text}"
+        );
+        assert!(!text.contains('\u{202E}'));
     }
 
     #[test]

@@ -20,9 +20,7 @@ pub fn run(input: &InputArgs, output: Option<PathBuf>) -> Result<(), CliError> {
     };
     let out = output.unwrap_or_else(|| super::with_suffix(&input.file, "min"));
     let bytes = finding::to_bytes(&m.ops);
-    if let Err(e) = crate::golden::write_atomic(&out, &bytes) {
-        return Err(usage(format!("cannot write {}: {e}", out.display())));
-    }
+    crate::files::write(&out, &bytes)?;
     eprintln!(
             "ppmc fuzz minimize: {} ops -> {} ops ({} oracle runs), invariant {} still breaks; wrote {}",
             ops.len(),

@@ -135,8 +135,7 @@ pub(super) fn load_inputs(
     files
         .into_iter()
         .map(|f| {
-            let data = std::fs::read(&f)
-                .map_err(|e| usage(format!("cannot read {}: {e}", f.display())))?;
+            let data = crate::files::read(&f, crate::files::MAX_INPUT_BYTES)?;
             Ok((f.display().to_string(), finding::ops_of(&data, kind, cfg)))
         })
         .collect()
@@ -154,8 +153,7 @@ impl InputArgs {
     /// The model, the input's bytes and its bus ops.
     pub(super) fn load(&self) -> Result<(ModelConfig, Vec<crate::fuzzing::bus::BusOp>), CliError> {
         let cfg = self.model.model()?;
-        let data = std::fs::read(&self.file)
-            .map_err(|e| usage(format!("cannot read {}: {e}", self.file.display())))?;
+        let data = crate::files::read(&self.file, crate::files::MAX_INPUT_BYTES)?;
         let ops = finding::ops_of(&data, self.model.kind, &cfg);
         Ok((cfg, ops))
     }

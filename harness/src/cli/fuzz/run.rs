@@ -132,12 +132,7 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
         .output
         .unwrap_or_else(|| PathBuf::from(format!("fuzz-diff-{seed}.ppmc")));
     let text = differential::script(&acts_out, &d_out, seed, &name);
-    if let Err(e) = crate::golden::write_atomic(&out, text.as_bytes()) {
-        return Err(CliError::BadInput(format!(
-            "ppmc fuzz: cannot write {}: {e}",
-            out.display()
-        )));
-    }
+    crate::files::write(&out, text.as_bytes())?;
     println!(
         "minimized to {} actions; reproducer written to {}",
         acts_out.len(),

@@ -1,6 +1,7 @@
 //! `ppmc fuzz to-scenario`: a fuzz input as a regression scenario.
 
 use super::*;
+use crate::files;
 
 pub fn run(input: &InputArgs, dir: &Path) -> Result<(), CliError> {
     let (cfg, ops) = input.load()?;
@@ -18,23 +19,20 @@ pub fn run(input: &InputArgs, dir: &Path) -> Result<(), CliError> {
             dir.display()
         )));
     }
-    let (stem, path) = (1..)
-        .map(|n| {
-            let stem = finding::scenario_stem(v.invariant, n);
-            let path = dir.join(format!("{stem}.rs"));
-            (stem, path)
-        })
-        .find(|(_, p)| !p.exists())
-        .unwrap_or_default();
-    let text = finding::scenario_file(
-        &stem,
-        &ops[..=v.op.min(ops.len().saturating_sub(1))],
-        &v,
-        &input.file.display().to_string(),
-    );
-    if let Err(e) = crate::golden::write_atomic(&path, text.as_bytes()) {
-        return Err(usage(format!("cannot write {}: {e}", path.display())));
-    }
+    let ops = &ops[..=v.op.min(ops.len().saturating_sub(1))];
+    let source = input.file.display().to_string();
+    // The first free name; another process taking it first moves us on.
+    let mut n = 1;
+    let (stem, path) = loop {
+        let stem = finding::scenario_stem(v.invariant, n);
+        let path = dir.join(format!("{stem}.rs"));
+        let text = finding::scenario_file(&stem, ops, &v, &source);
+        match files::create_new(&path, text.as_bytes()) {
+            Ok(()) => break (stem, path),
+            Err(files::FileError::Exists { .. }) if n < 10_000 => n += 1,
+            Err(e) => return Err(e.into()),
+        }
+    };
     println!(
         "wrote {} (scenario {stem}, invariant {}, {} ops); add `{stem}` to the \
              suite! list in scenarios/src/lib.rs, and `cargo test` runs it",
