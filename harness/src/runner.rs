@@ -12,12 +12,24 @@ pub struct Selection {
     pub filter: Option<String>,
     /// Every listed tag must be present.
     pub tags: Vec<String>,
+    /// No listed tag may be present.
+    pub skip_tags: Vec<String>,
     /// `(i, n)`: the i-th (1-based) of n interleaved shards.
     pub shard: Option<(usize, usize)>,
 }
 
 impl Selection {
     pub fn select(&self, all: &[Scenario]) -> Vec<Scenario> {
+        self.matching(all)
+            .into_iter()
+            .enumerate()
+            .filter(|(i, _)| self.shard.is_none_or(|(k, n)| i % n == k - 1))
+            .map(|(_, s)| s)
+            .collect()
+    }
+
+    /// The scenarios the filter and tags take, before sharding.
+    pub fn matching(&self, all: &[Scenario]) -> Vec<Scenario> {
         all.iter()
             .filter(|s| {
                 self.filter
@@ -25,9 +37,8 @@ impl Selection {
                     .is_none_or(|f| s.name.contains(f.as_str()))
             })
             .filter(|s| self.tags.iter().all(|t| s.has_tag(t)))
-            .enumerate()
-            .filter(|(i, _)| self.shard.is_none_or(|(k, n)| i % n == k - 1))
-            .map(|(_, s)| *s)
+            .filter(|s| !self.skip_tags.iter().any(|t| s.has_tag(t)))
+            .copied()
             .collect()
     }
 }
@@ -90,22 +101,43 @@ pub fn run_suite(
     scenarios: &[Scenario],
     repeat: usize,
     opts: DriverOptions,
+    on_result: impl FnMut(&mut ScenarioResult),
+) -> Vec<ScenarioResult> {
+    run_suite_until(target, scenarios, repeat, opts, || false, on_result)
+}
+
+/// [`run_suite`] that asks `stop` before each scenario: once it says yes
+/// (SIGINT, a closed output), the scenarios left in this pass are reported
+/// as not run, interrupted, and no further pass starts.
+pub fn run_suite_until(
+    target: &mut dyn Target,
+    scenarios: &[Scenario],
+    repeat: usize,
+    opts: DriverOptions,
+    stop: impl Fn() -> bool,
     mut on_result: impl FnMut(&mut ScenarioResult),
 ) -> Vec<ScenarioResult> {
     let mut results = Vec::new();
     let mut dead: Option<String> = None;
+    let mut interrupted = false;
     for _ in 0..repeat.max(1) {
+        if interrupted {
+            break;
+        }
         for s in scenarios {
+            interrupted = interrupted || stop();
+            let not_run = |why| ScenarioResult {
+                name: s.name,
+                section: s.section,
+                tags: s.tags,
+                verdict: Verdict::NotRun(why),
+                measurements: Vec::new(),
+                trace: None,
+                elapsed: Duration::ZERO,
+            };
             let mut r = match &dead {
-                Some(why) => ScenarioResult {
-                    name: s.name,
-                    section: s.section,
-                    tags: s.tags,
-                    verdict: Verdict::NotRun(NotRun::TargetLost(why.clone())),
-                    measurements: Vec::new(),
-                    trace: None,
-                    elapsed: Duration::ZERO,
-                },
+                _ if interrupted => not_run(NotRun::Interrupted),
+                Some(why) => not_run(NotRun::TargetLost(why.clone())),
                 None => {
                     let r = run_scenario(target, s, opts);
                     if matches!(r.verdict, Verdict::Error(_)) {
@@ -152,6 +184,7 @@ mod tests {
         let sel = |f: Option<&str>, tags: &[&str], shard| Selection {
             filter: f.map(String::from),
             tags: tags.iter().map(|t| t.to_string()).collect(),
+            skip_tags: Vec::new(),
             shard,
         };
         assert_eq!(
@@ -166,6 +199,13 @@ mod tests {
             names(sel(None, &[], Some((1, 2))).select(&all)),
             vec!["a_one", "c_three"]
         );
+        let skip_y = Selection {
+            skip_tags: vec!["y".into()],
+            ..Selection::default()
+        };
+        assert_eq!(names(skip_y.select(&all)), vec!["a_one", "d_four"]);
+        // A shard past the end of a small suite is empty, not an error.
+        assert!(sel(None, &[], Some((7, 9))).select(&all).is_empty());
         assert_eq!(
             names(sel(None, &[], Some((2, 2))).select(&all)),
             vec!["b_two", "d_four"]

@@ -153,6 +153,10 @@ pub struct SelectArgs {
     /// Only scenarios with this tag (repeat for several; all must match).
     #[arg(long = "tag")]
     tags: Vec<String>,
+    /// Leave out scenarios with this tag (repeat for several), e.g.
+    /// `--skip-tag long` on a board.
+    #[arg(long = "skip-tag", value_name = "TAG")]
+    skip_tags: Vec<String>,
     /// Run the I-th of N interleaved parts of the suite, e.g. 2/4, to split
     /// it across CI jobs or boards.
     #[arg(long, value_parser = parse_shard)]
@@ -164,18 +168,21 @@ impl SelectArgs {
         Selection {
             filter: self.filter.clone(),
             tags: self.tags.clone(),
+            skip_tags: self.skip_tags.clone(),
             shard: self.shard,
         }
     }
 
-    /// The suite, validated, narrowed to the selection.
+    /// The suite, validated, narrowed to the selection. A filter or tags
+    /// that match nothing are an error (a typo); a shard past the end of a
+    /// small selection is simply empty (N CI jobs over fewer scenarios).
     pub fn scenarios(&self, suite: &[Scenario]) -> Result<Vec<Scenario>, String> {
         validate_suite(suite).map_err(|e| e.to_string())?;
-        let chosen = self.selection().select(suite);
-        if chosen.is_empty() {
+        let selection = self.selection();
+        if selection.matching(suite).is_empty() {
             return Err("no scenario matches the selection (see `ppmc list`)".into());
         }
-        Ok(chosen)
+        Ok(selection.select(suite))
     }
 }
 

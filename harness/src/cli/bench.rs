@@ -144,11 +144,11 @@ pub fn run(args: BenchArgs, suite: &[Scenario]) -> Result<(), CliError> {
             Box::new(move || one_move(short_ramp, 0x44, &[100, full[0], full[1], full[2]])),
         ),
     ];
-    println!("| case | median wall time | pulses | stored runs | virtual time |");
-    println!("|---|---:|---:|---:|---:|");
+    outln!("| case | median wall time | pulses | stored runs | virtual time |");
+    outln!("|---|---:|---:|---:|---:|");
     for (name, f) in &cases {
         let (ms, o) = time_case(args.repeat, f);
-        println!(
+        outln!(
             "| {name} | {ms:.3} ms | {} | {} | {:.3} s |",
             o.pulses,
             o.runs,
@@ -157,7 +157,7 @@ pub fn run(args: BenchArgs, suite: &[Scenario]) -> Result<(), CliError> {
     }
     // Per-pulse expansion of the longest record, on request.
     let Some((t, _)) = run_move(max_ramp, 0x43, &full) else {
-        eprintln!("ppmc bench: the emulator could not be built");
+        errln!("ppmc bench: the emulator could not be built");
         return Err(CliError::Verdict);
     };
     let t0 = WallClock::now();
@@ -167,10 +167,8 @@ pub fn run(args: BenchArgs, suite: &[Scenario]) -> Result<(), CliError> {
         pulses += 1;
     }
     let ms = t0.elapsed().as_secs_f64() * 1e3;
-    println!(
-        "| per-pulse expansion of the 16,777,216-step record | {ms:.3} ms | {pulses} | - | - |"
-    );
-    println!();
+    outln!("| per-pulse expansion of the 16,777,216-step record | {ms:.3} ms | {pulses} | - | - |");
+    outln!();
     suite_over_bridge(args.repeat.clamp(1, 5), suite)
 }
 
@@ -197,7 +195,7 @@ fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> Result<(), CliError> 
     let sim = match sim {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("ppmc bench: no bridge simulator: {e}");
+            errln!("ppmc bench: no bridge simulator: {e}");
             return Err(CliError::Verdict);
         }
     };
@@ -208,7 +206,7 @@ fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> Result<(), CliError> 
         let target = SerialLink::open(&path, 115_200)
             .and_then(|l| SerialTarget::open(l, SerialOptions::default()));
         let Ok(mut t) = target else {
-            eprintln!("ppmc bench: the bridge simulator did not answer");
+            errln!("ppmc bench: the bridge simulator did not answer");
             return Err(CliError::Verdict);
         };
         let t0 = WallClock::now();
@@ -218,13 +216,13 @@ fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> Result<(), CliError> 
     }
     sim.stop();
     let (l, r) = (median_ms(local), median_ms(remote));
-    println!("| conformance suite ({} scenarios) | median wall time | round trips | round trips per scenario |", suite.len());
-    println!("|---|---:|---:|---:|");
-    println!("| in process (emulator) | {l:.1} ms | 0 | 0 |");
-    println!(
+    outln!("| conformance suite ({} scenarios) | median wall time | round trips | round trips per scenario |", suite.len());
+    outln!("|---|---:|---:|---:|");
+    outln!("| in process (emulator) | {l:.1} ms | 0 | 0 |");
+    outln!(
         "| over a pty to `ppmc bridge-sim` | {r:.1} ms | {trips} | {:.1} |",
         trips as f64 / suite.len() as f64
     );
-    println!("\nover the pty / in process: {:.1}x", r / l.max(1e-9));
+    outln!("\nover the pty / in process: {:.1}x", r / l.max(1e-9));
     Ok(())
 }

@@ -83,9 +83,9 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 format!("BAD FILE {}\n         {e}", s.name)
             }
         };
-        println!("{line}");
+        outln!("{line}");
     }
-    println!("compare: {ok} passed, {bad} failed");
+    outln!("compare: {ok} passed, {bad} failed");
     if bad == 0 {
         Ok(())
     } else {

@@ -3,7 +3,7 @@
 use super::args::{parse_duration, TargetArgs};
 use crate::backend::Target;
 use crate::cli::{usage, CliError};
-use crate::console::{self, ConsoleOptions, Line, ScriptError};
+use crate::console::{self, ConsoleError, ConsoleOptions, Line, ScriptError};
 use crate::time::Duration;
 use clap::Args;
 use std::io::{self, BufRead, IsTerminal, Read, Write};
@@ -61,6 +61,8 @@ pub fn run(args: ConsoleArgs) -> Result<(), CliError> {
     let mut out = stdout.lock();
     match console::run(target.as_mut(), &lines, &opts, &mut out) {
         Ok(()) => Ok(()),
+        // Nobody reads the results any more (`ppmc console s.ppmc | head`).
+        Err(ConsoleError::Io(e)) if e.kind() == io::ErrorKind::BrokenPipe => Ok(()),
         Err(e) => {
             let _ = out.flush();
             Err(CliError::Failed(e.to_string()))
@@ -80,6 +82,13 @@ fn script_error(file: &Option<PathBuf>, e: &ScriptError) -> Result<(), CliError>
 fn interactive(target: &mut dyn Target, opts: &ConsoleOptions) -> Result<(), CliError> {
     let stdin = io::stdin();
     let stdout = io::stdout();
+    // The prompt goes to standard error, so results written to a file
+    // stay clean.
+    let prompt = || {
+        let mut err = io::stderr();
+        let _ = write!(err, "ppmc> ").and_then(|()| err.flush());
+    };
+    prompt();
     for (i, line) in stdin.lock().lines().enumerate() {
         let line = match line {
             Ok(l) => l,
@@ -88,14 +97,18 @@ fn interactive(target: &mut dyn Target, opts: &ConsoleOptions) -> Result<(), Cli
         let parsed: Vec<Line> = match console::parse_line(&line, i + 1) {
             Ok(p) => p,
             Err(e) => {
-                eprintln!("{e}");
+                errln!("{e}");
+                prompt();
                 continue;
             }
         };
         let mut out = stdout.lock();
-        if let Err(e) = console::run(target, &parsed, opts, &mut out) {
-            return Err(CliError::Failed(e.to_string()));
+        match console::run(target, &parsed, opts, &mut out) {
+            Ok(()) => {}
+            Err(ConsoleError::Io(e)) if e.kind() == io::ErrorKind::BrokenPipe => return Ok(()),
+            Err(e) => return Err(CliError::Failed(e.to_string())),
         }
+        prompt();
     }
     Ok(())
 }

@@ -42,6 +42,6 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
         return Ok(());
     }
     files::write_with(&out, |w| crate::vcd_export::export(&trace, w))?;
-    println!("wrote {}", out.display());
+    outln!("wrote {}", out.display());
     Ok(())
 }

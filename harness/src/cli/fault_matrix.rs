@@ -40,9 +40,9 @@ pub struct MatrixArgs {
 
 pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
     if args.list {
-        println!("| fault | section | what the board does |\n|---|---|---|");
+        outln!("| fault | section | what the board does |\n|---|---|---|");
         for f in CATALOGUE {
-            println!("| `{}` | {} | {} |", f.name, f.section, f.what);
+            outln!("| `{}` | {} | {} |", f.name, f.section, f.what);
         }
         return Ok(());
     }
@@ -70,20 +70,23 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let mut rows: Vec<Row> = Vec::new();
     let total = boards.len();
     for (i, (name, model)) in boards.into_iter().enumerate() {
-        eprint!("[{}/{total}] {name} ... ", i + 1);
+        {
+            use std::io::Write;
+            let _ = write!(std::io::stderr(), "[{}/{total}] {name} ... ", i + 1);
+        }
         let row = match board_row(&name, model, args.in_process, suite, &args.golden, budget) {
             Ok(r) => r,
             Err(e) => {
-                eprintln!("infrastructure error");
-                eprintln!("ppmc fault-matrix: {name}: {e}");
+                errln!("infrastructure error");
+                errln!("ppmc fault-matrix: {name}: {e}");
                 return Err(CliError::Verdict);
             }
         };
-        eprintln!("{}", if row.caught() { "caught" } else { "not caught" });
+        errln!("{}", if row.caught() { "caught" } else { "not caught" });
         rows.push(row);
     }
     let table = fault_matrix::render(&rows);
-    print!("{table}");
+    outln!("{}", table.trim_end_matches('\n'));
     if let Some(path) = &args.output {
         let mut text = table.clone();
         text.push_str("\nWhat each check saw first:\n\n");
@@ -105,10 +108,10 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
         crate::files::write_report(path, text.as_bytes())?;
     }
     if fault_matrix::all_as_expected(&rows) {
-        println!("\nevery fault caught, no false alarm on the clean board");
+        outln!("\nevery fault caught, no false alarm on the clean board");
         Ok(())
     } else {
-        println!("\nthe matrix is NOT as it must be (see MISSED / FALSE ALARM above)");
+        outln!("\nthe matrix is NOT as it must be (see MISSED / FALSE ALARM above)");
         Err(CliError::Verdict)
     }
 }

@@ -18,7 +18,7 @@ pub fn run(args: ListArgs, suite: &[Scenario]) -> Result<(), CliError> {
         Err(e) => return Err(usage(e)),
     };
     for s in &scenarios {
-        println!(
+        outln!(
             "{:<58} {:<7} [{}]  {}",
             s.name,
             s.section,
@@ -26,6 +26,6 @@ pub fn run(args: ListArgs, suite: &[Scenario]) -> Result<(), CliError> {
             s.summary
         );
     }
-    println!("{} scenarios", scenarios.len());
+    outln!("{} scenarios", scenarios.len());
     Ok(())
 }

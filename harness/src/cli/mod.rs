@@ -3,6 +3,8 @@
 //! (`run`, `list`, `record`, `compare`, `--target`, JUnit and JSON) by
 //! handing its suite to it.
 
+#[macro_use]
+pub(crate) mod out;
 pub(crate) mod args;
 mod bench;
 mod bridge_sim;
@@ -28,6 +30,10 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Colour the verdict words: on a terminal (`auto`, off when NO_COLOR
+    /// is set), `always` or `never`.
+    #[arg(long, global = true, value_enum, default_value_t = out::ColorChoice::Auto)]
+    color: out::ColorChoice,
 }
 
 #[derive(Debug, Subcommand)]
@@ -86,6 +92,7 @@ enum Command {
 /// ```
 pub fn main(suite: Vec<Scenario>) -> ExitCode {
     let cli = Cli::parse();
+    out::set_color(cli.color);
     let suite = &suite;
     let done = match cli.command {
         Command::Run(args) => run::run(args, suite),
@@ -124,6 +131,9 @@ pub(crate) enum CliError {
     /// what failed (exit 2 when it is the user's file or path that is wrong,
     /// 1 when the system failed a write).
     File(crate::files::FileError),
+    /// SIGINT or SIGTERM, or standard output closed, stopped the command
+    /// before its end; it has written what it had (exit 130).
+    Interrupted,
     /// The command ran and its verdict is negative (a scenario failed, an
     /// input breaks an invariant, a fault went undetected); it has said
     /// why (exit 1).
@@ -135,24 +145,24 @@ impl CliError {
     fn exit(self) -> ExitCode {
         match self {
             CliError::Usage(m) => {
-                eprintln!("ppmc: {m}");
+                errln!("ppmc: {m}");
                 ExitCode::from(2)
             }
             CliError::BadInput(m) => {
-                eprintln!("{m}");
+                errln!("{m}");
                 ExitCode::from(2)
             }
             CliError::Infrastructure(m) => {
-                eprintln!("ppmc: infrastructure error: {m}");
+                errln!("ppmc: infrastructure error: {m}");
                 ExitCode::from(1)
             }
             CliError::Failed(m) => {
-                eprintln!("ppmc: {m}");
+                errln!("ppmc: {m}");
                 ExitCode::from(1)
             }
             CliError::File(e) => {
                 use crate::files::{Action, FileError};
-                eprintln!("ppmc: {e}");
+                errln!("ppmc: {e}");
                 let users = match &e {
                     FileError::Io { action, .. } => *action == Action::Reading,
                     _ => true,
@@ -160,6 +170,7 @@ impl CliError {
                 ExitCode::from(if users { 2 } else { 1 })
             }
             CliError::Verdict => ExitCode::from(1),
+            CliError::Interrupted => ExitCode::from(130),
         }
     }
 }

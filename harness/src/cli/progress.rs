@@ -22,8 +22,10 @@ impl Progress {
 
     pub fn line(&self, text: &str) {
         match &self.bar {
-            Some(b) => b.println(text),
-            None => println!("{text}"),
+            // The bar is on standard error; the line goes to standard
+            // output, as without a terminal.
+            Some(b) => b.suspend(|| outln!("{text}")),
+            None => outln!("{text}"),
         }
     }
 

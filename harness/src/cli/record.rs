@@ -84,12 +84,16 @@ pub fn run(args: RecordArgs, suite: &[Scenario]) -> Result<(), CliError> {
         },
     );
     progress.finish();
-    println!(
+    outln!(
         "{} created, {} replaced, {} unchanged, {} refused, {} not written (I/O errors)",
-        tally.created, tally.replaced, tally.unchanged, tally.refused, tally.write_errors
+        tally.created,
+        tally.replaced,
+        tally.unchanged,
+        tally.refused,
+        tally.write_errors
     );
     if tally.device_failures > 0 {
-        println!(
+        outln!(
             "{} of the golden traces are of scenarios the device failed (--allow-failures)",
             tally.device_failures
         );

@@ -7,13 +7,14 @@ use crate::compare::{compare, Tolerances};
 use crate::files;
 use crate::golden::{self};
 use crate::report::{self, RunInfo, Tally};
-use crate::runner::run_suite;
+use crate::runner::run_suite_until;
 use crate::scenario::{
     DriverOptions, Failure, Grading, HarnessError, NotRun, Scenario, ScenarioResult, Verdict,
 };
 use crate::time::Duration;
 use clap::Args;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
 
 /// Which scenarios to take.
 #[derive(Debug, Args)]
@@ -40,9 +41,10 @@ pub struct RunArgs {
     /// Board revision label for the reports.
     #[arg(long)]
     pub(super) board_rev: Option<String>,
-    /// Run the selection this many times (soak runs).
-    #[arg(long, default_value_t = 1)]
-    pub(super) repeat: usize,
+    /// Run the selection this many times (soak runs). SIGINT or SIGTERM
+    /// stops after the scenario under way and still writes the reports.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    pub(super) repeat: u32,
     /// Width of the MARGINAL zone inside each Table 3-3 limit, in percent of
     /// the limit.
     #[arg(long, default_value_t = 0.25)]
@@ -57,7 +59,12 @@ fn verdict_line(r: &ScenarioResult) -> String {
         Verdict::Error(_) => "ERROR",
         Verdict::NotRun(_) => "NOT RUN",
     };
-    let mut s = format!("{tag:<8} {} (section {})", r.name, r.section);
+    let mut s = format!(
+        "{} {} (section {})",
+        super::out::verdict_word(tag, 8),
+        r.name,
+        r.section
+    );
     if let Some(d) = r.verdict.detail() {
         s.push_str("\n         ");
         s.push_str(&d);
@@ -117,12 +124,16 @@ fn write_report(path: &Path, text: Result<String, report::ReportError>) -> Resul
 }
 
 fn summary_lines(t: &Tally, results: usize) {
-    println!(
+    outln!(
         "{results} scenarios: {} passed, {} marginal, {} failed, {} errors, {} not run",
-        t.passed, t.marginal, t.failed, t.errors, t.not_run
+        t.passed,
+        t.marginal,
+        t.failed,
+        t.errors,
+        t.not_run
     );
     // The closing line CI log readers look for.
-    println!(
+    outln!(
         "suite: {} passed, {} failed",
         t.passed + t.marginal,
         t.failed + t.errors + t.not_run
@@ -200,21 +211,29 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         },
         ..DriverOptions::default()
     };
-    let progress = Progress::new(scenarios.len() * args.repeat.max(1));
+    let repeat = args.repeat as usize;
+    let progress = Progress::new(scenarios.len() * repeat);
     let mut problems = Vec::new();
-    let results = run_suite(target.as_mut(), &scenarios, args.repeat, opts, |r| {
+    let stop = super::signals::stop_requested();
+    let stopped = || stop.load(Ordering::Relaxed) || super::out::stdout_closed();
+    let results = run_suite_until(target.as_mut(), &scenarios, repeat, opts, stopped, |r| {
         if let Some(dir) = &args.golden {
             check_golden(r, dir, &tol);
         }
         progress.step(r.name);
-        progress.line(&verdict_line(r));
+        if !matches!(r.verdict, Verdict::NotRun(NotRun::Interrupted)) {
+            progress.line(&verdict_line(r));
+        }
         if let (Some(dir), false) = (&args.artifacts, r.verdict.ok()) {
             if let Err(e) = save_artifacts(dir, r) {
                 problems.push(e);
             }
         }
+        // Judged, compared and saved: a soak run need not keep it.
+        r.trace = None;
     });
     progress.finish();
+    let interrupted = stopped();
     let tally = Tally::of(&results);
     if let Some(p) = &args.junit {
         if let Err(e) = write_report(p, report::junit(&info, &results)) {
@@ -228,9 +247,11 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     }
     summary_lines(&tally, results.len());
     for p in &problems {
-        eprintln!("ppmc: {p}");
+        errln!("ppmc: {p}");
     }
-    if tally.ok() && problems.is_empty() {
+    if interrupted {
+        Err(CliError::Interrupted)
+    } else if tally.ok() && problems.is_empty() {
         Ok(())
     } else {
         Err(CliError::Verdict)

@@ -174,6 +174,10 @@ pub enum NotRun {
     /// the health check failed too).
     #[error("not run: the target stopped answering ({0})")]
     TargetLost(String),
+    /// The run was stopped before it (SIGINT, SIGTERM, or its output
+    /// closed).
+    #[error("not run: the run was interrupted")]
+    Interrupted,
 }
 
 impl Verdict {

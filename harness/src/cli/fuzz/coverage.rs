@@ -6,6 +6,11 @@ pub fn run(paths: &[PathBuf], kind: InputKind) -> Result<(), CliError> {
     let cfg = ModelConfig::default();
     let inputs = load_inputs(paths, kind, &cfg)?;
     let ops: Vec<_> = inputs.into_iter().map(|(_, o)| o).collect();
-    print!("{}", crate::fuzzing::campaign::Coverage::of(&ops).render());
+    outln!(
+        "{}",
+        crate::fuzzing::campaign::Coverage::of(&ops)
+            .render()
+            .trim_end_matches('\n')
+    );
     Ok(())
 }

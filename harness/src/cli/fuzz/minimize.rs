@@ -5,14 +5,14 @@ use super::*;
 pub fn run(input: &InputArgs, output: Option<PathBuf>) -> Result<(), CliError> {
     let (cfg, ops) = input.load()?;
     let Some(v) = finding::first_break(&ops, &cfg) else {
-        eprintln!(
+        errln!(
             "ppmc fuzz minimize: {} breaks no invariant on this model; nothing to minimize",
             input.file.display()
         );
         return Err(CliError::Verdict);
     };
     let Some(m) = finding::minimize(&ops, &cfg, v.invariant) else {
-        eprintln!(
+        errln!(
             "ppmc fuzz minimize: the break of {} is not reproducible",
             v.invariant
         );
@@ -21,7 +21,7 @@ pub fn run(input: &InputArgs, output: Option<PathBuf>) -> Result<(), CliError> {
     let out = output.unwrap_or_else(|| super::with_suffix(&input.file, "min"));
     let bytes = finding::to_bytes(&m.ops);
     crate::files::write(&out, &bytes)?;
-    eprintln!(
+    errln!(
             "ppmc fuzz minimize: {} ops -> {} ops ({} oracle runs), invariant {} still breaks; wrote {}",
             ops.len(),
             m.ops.len(),
@@ -30,6 +30,6 @@ pub fn run(input: &InputArgs, output: Option<PathBuf>) -> Result<(), CliError> {
             out.display()
         );
     let (script, _) = crate::fuzzing::reproducer_with(&bytes, &out.display().to_string(), cfg);
-    print!("{script}");
+    outln!("{}", script.trim_end_matches('\n'));
     Ok(())
 }

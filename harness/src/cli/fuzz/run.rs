@@ -70,7 +70,7 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
         ..DiffSettings::default()
     };
     let name = args.target.name().to_string();
-    eprintln!(
+    errln!(
         "ppmc fuzz: seed {seed}, {} actions against {name} (replay with --seed {seed})",
         args.ops
     );
@@ -94,18 +94,18 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
     let departure = match result {
         Ok(d) => d,
         Err(e) => {
-            eprintln!("ppmc fuzz: infrastructure error after {done} actions: {e}");
+            errln!("ppmc fuzz: infrastructure error after {done} actions: {e}");
             return Err(CliError::Verdict);
         }
     };
     let Some(d) = departure else {
-        println!(
+        outln!(
             "seed {seed}: {done} actions in {:.1} s, no departure from the emulator",
             t0.elapsed().as_secs_f64()
         );
         return Ok(());
     };
-    println!("seed {seed}: {d}");
+    outln!("seed {seed}: {d}");
     let (small, small_d) = match differential::minimize(
         target.as_mut(),
         &acts[..=d.action],
@@ -114,7 +114,7 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
     ) {
         Ok(x) => x,
         Err(e) => {
-            eprintln!("ppmc fuzz: infrastructure error while minimizing: {e}");
+            errln!("ppmc fuzz: infrastructure error while minimizing: {e}");
             return Err(CliError::Verdict);
         }
     };
@@ -122,9 +122,7 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
         Some(sd) => (small, sd),
         // Not reproducible from a reset (a flaky board): keep the whole run.
         None => {
-            eprintln!(
-                "ppmc fuzz: the departure did not repeat from a reset; keeping the whole run"
-            );
+            errln!("ppmc fuzz: the departure did not repeat from a reset; keeping the whole run");
             (acts[..=d.action].to_vec(), d.clone())
         }
     };
@@ -133,7 +131,7 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
         .unwrap_or_else(|| PathBuf::from(format!("fuzz-diff-{seed}.ppmc")));
     let text = differential::script(&acts_out, &d_out, seed, &name);
     crate::files::write(&out, text.as_bytes())?;
-    println!(
+    outln!(
         "minimized to {} actions; reproducer written to {}",
         acts_out.len(),
         out.display()

@@ -6,7 +6,7 @@ use crate::files;
 pub fn run(input: &InputArgs, dir: &Path) -> Result<(), CliError> {
     let (cfg, ops) = input.load()?;
     let Some(v) = finding::first_break(&ops, &cfg) else {
-        eprintln!(
+        errln!(
             "ppmc fuzz to-scenario: {} breaks no invariant on this model; \
                  a regression scenario would pass already",
             input.file.display()
@@ -33,7 +33,7 @@ pub fn run(input: &InputArgs, dir: &Path) -> Result<(), CliError> {
             Err(e) => return Err(e.into()),
         }
     };
-    println!(
+    outln!(
         "wrote {} (scenario {stem}, invariant {}, {} ops); add `{stem}` to the \
              suite! list in scenarios/src/lib.rs, and `cargo test` runs it",
         path.display(),

@@ -6,10 +6,10 @@ pub fn run(paths: &[PathBuf], model: &ModelArgs) -> Result<(), CliError> {
     let cfg = model.model()?;
     let inputs = load_inputs(paths, model.kind, &cfg)?;
     let (buckets, clean) = crate::fuzzing::campaign::triage(&inputs, &cfg);
-    println!("| invariant | inputs | shortest input | its ops | break |\n|---|---:|---|---:|---|");
+    outln!("| invariant | inputs | shortest input | its ops | break |\n|---|---:|---|---:|---|");
     for b in &buckets {
         let (name, n, v) = &b.smallest;
-        println!(
+        outln!(
             "| {} | {} | {name} | {n} | after op {}: {} |",
             b.invariant,
             b.inputs.len(),
@@ -17,7 +17,7 @@ pub fn run(paths: &[PathBuf], model: &ModelArgs) -> Result<(), CliError> {
             v.detail
         );
     }
-    println!(
+    outln!(
         "\n{} inputs: {} findings in {} buckets, {} break nothing",
         inputs.len(),
         inputs.len() - clean.len(),
