@@ -2,30 +2,56 @@
 //! measurement and its limits.
 
 use crate::backend::TargetInfo;
-use crate::scenario::{Grade, ScenarioResult, Verdict};
-use quick_junit::{NonSuccessKind, Report, TestCase, TestCaseStatus, TestSuite};
+use crate::scenario::{Grade, NotRun, ScenarioResult, Verdict};
 use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::time::SystemTime;
 
 /// A report that could not be rendered.
 #[derive(Debug, thiserror::Error)]
 pub enum ReportError {
-    #[error("cannot render the JUnit report: {0}")]
-    Junit(#[source] quick_junit::SerializeError),
     #[error("cannot render the JSON run record: {0}")]
     Json(#[source] serde_json::Error),
 }
 
+/// The selection and settings a run was made with, for the record.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct RunOptions {
+    pub filter: Option<String>,
+    pub tags: Vec<String>,
+    pub skip_tags: Vec<String>,
+    /// `I/N`, when the run is one shard of the suite.
+    pub shard: Option<String>,
+    pub repeat: u32,
+    /// The golden directory compared against, if any.
+    pub golden: Option<String>,
+    /// Width of the MARGINAL zone, percent of each limit.
+    pub marginal_pct: f64,
+    /// The golden comparison's tolerances.
+    pub latency_tol_pct: f64,
+    pub interval_tol_pct: f64,
+    pub time_floor_ns: u64,
+}
+
 /// Facts about a run that every report carries.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RunInfo {
     pub harness_version: String,
     pub git_revision: String,
     pub target: String,
-    pub target_details: Vec<(String, String)>,
+    pub target_details: BTreeMap<String, String>,
     /// The board revision label given with `--board-rev`.
     pub board_rev: Option<String>,
     /// The bus bridge's firmware version, when the target is a board.
     pub bridge_firmware: Option<String>,
+    /// When the run started, UTC, RFC 3339.
+    pub started: String,
+    /// Wall-clock duration of the whole run, seconds.
+    pub wall_s: f64,
+    /// The machine the harness ran on.
+    pub host: String,
+    pub options: RunOptions,
 }
 
 impl RunInfo {
@@ -36,12 +62,9 @@ impl RunInfo {
             .find(|(k, _)| k == "bridge_firmware")
             .map(|(_, v)| v.clone());
         RunInfo {
-            harness_version: crate::VERSION.to_string(),
-            git_revision: crate::GIT_REV.to_string(),
-            target: target.name.clone(),
-            target_details: target.details(),
-            board_rev,
+            target_details: target.details().into_iter().collect(),
             bridge_firmware,
+            ..RunInfo::unreached(target.name.clone(), board_rev)
         }
     }
 
@@ -52,11 +75,49 @@ impl RunInfo {
             harness_version: crate::VERSION.to_string(),
             git_revision: crate::GIT_REV.to_string(),
             target,
-            target_details: Vec::new(),
+            target_details: BTreeMap::new(),
             board_rev,
             bridge_firmware: None,
+            started: rfc3339(SystemTime::now()),
+            wall_s: 0.0,
+            host: hostname(),
+            options: RunOptions::default(),
         }
     }
+}
+
+/// The machine's name, as far as it can be learned without privileges.
+fn hostname() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|h| h.trim().to_string())
+        .filter(|h| !h.is_empty())
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// `t` as `YYYY-MM-DDTHH:MM:SSZ` (UTC).
+pub fn rfc3339(t: SystemTime) -> String {
+    let secs = t
+        .duration_since(SystemTime::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let (days, rem) = (secs / 86_400, secs % 86_400);
+    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
+    let z = days as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1_460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3_600,
+        rem % 3_600 / 60,
+        rem % 60
+    )
 }
 
 /// Counts of verdicts.
@@ -65,6 +126,8 @@ pub struct Tally {
     pub passed: usize,
     pub marginal: usize,
     pub failed: usize,
+    /// Spelled as the verdict is in the JSON record.
+    #[serde(rename = "error")]
     pub errors: usize,
     pub not_run: usize,
 }
@@ -90,71 +153,198 @@ impl Tally {
     }
 }
 
-/// JUnit XML: one test case per scenario (classname = datasheet section),
-/// the failure text = the first divergence; run facts as properties.
-pub fn junit(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, ReportError> {
-    let mut report = Report::new("ppmc");
-    let mut suite = TestSuite::new("ppmc-conformance");
-    let props: Vec<(String, String)> = [
-        ("harness_version".to_string(), info.harness_version.clone()),
-        ("git_revision".to_string(), info.git_revision.clone()),
-        ("target".to_string(), info.target.clone()),
+/// Files saved beside a scenario's result (`--artifacts`), for the
+/// reports to point at.
+pub type Attachments<'a> = &'a dyn Fn(&ScenarioResult) -> Vec<String>;
+
+/// JUnit XML for CI systems, valid under the Jenkins xunit schema
+/// (`junit-10.xsd`) and read by GitLab and junitparser: one test case per
+/// scenario run (classname = datasheet section; names made unique under
+/// `--repeat` with ` [pass K]`), `time` in wall seconds with the device's
+/// virtual time as a suite property per case; a failure or error carries
+/// its explanation in `message` and as its text; infrastructure problems
+/// (target unreachable or lost) are errors, an interrupted run's leftovers
+/// are skipped; saved traces are `[[ATTACHMENT|path]]` lines in
+/// `system-out`.
+pub fn junit(
+    info: &RunInfo,
+    results: &[ScenarioResult],
+    attachments: Attachments<'_>,
+) -> Result<String, ReportError> {
+    let tally = Tally::of(results);
+    let skipped = results
+        .iter()
+        .filter(|r| r.verdict == Verdict::NotRun(NotRun::Interrupted))
+        .count();
+    let errors = tally.errors + tally.not_run - skipped;
+    let wall: f64 = results.iter().map(|r| r.wall.as_secs_f64()).sum();
+    let suite_name = match &info.options.shard {
+        Some(shard) => format!("ppmc-conformance shard {shard}"),
+        None => "ppmc-conformance".to_string(),
+    };
+    let names = unique_names(results);
+    let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let _ = writeln!(
+        x,
+        "<testsuites name=\"ppmc\" tests=\"{}\" failures=\"{}\" errors=\"{errors}\" time=\"{:.6}\">",
+        results.len(),
+        tally.failed,
+        info.wall_s
+    );
+    let _ = writeln!(
+        x,
+        "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{errors}\" skipped=\"{skipped}\" \
+         time=\"{wall:.6}\" timestamp=\"{}\" hostname=\"{}\">",
+        esc(&suite_name),
+        results.len(),
+        tally.failed,
+        esc(&info.started),
+        esc(&info.host)
+    );
+    x.push_str("    <properties>\n");
+    let mut props: Vec<(String, String)> = vec![
+        ("harness_version".into(), info.harness_version.clone()),
+        ("git_revision".into(), info.git_revision.clone()),
+        ("target".into(), info.target.clone()),
         (
-            "board_rev".to_string(),
+            "board_rev".into(),
             info.board_rev.clone().unwrap_or_default(),
         ),
         (
-            "bridge_firmware".to_string(),
+            "bridge_firmware".into(),
             info.bridge_firmware.clone().unwrap_or_default(),
         ),
-    ]
-    .into_iter()
-    .chain(
+    ];
+    props.extend(
         info.target_details
             .iter()
             .map(|(k, v)| (format!("target.{k}"), v.clone())),
-    )
-    .collect();
+    );
+    props.extend(results.iter().zip(&names).map(|(r, n)| {
+        (
+            format!("device_time.{n}"),
+            format!("{:.9}", r.elapsed.as_nanos() as f64 / 1e9),
+        )
+    }));
     for (k, v) in props {
-        suite.add_property((k, v));
+        let _ = writeln!(
+            x,
+            "      <property name=\"{}\" value=\"{}\"/>",
+            esc(&k),
+            esc(&v)
+        );
     }
-    for r in results {
-        let status = match &r.verdict {
-            Verdict::Passed | Verdict::Marginal => TestCaseStatus::success(),
-            Verdict::Failed(f) => {
-                let mut s = TestCaseStatus::non_success(NonSuccessKind::Failure);
-                s.set_message(f.to_string());
-                s.set_type("device");
-                s
-            }
-            Verdict::Error(e) => {
-                let mut s = TestCaseStatus::non_success(NonSuccessKind::Error);
-                s.set_message(e.to_string());
-                s.set_type("harness");
-                s
-            }
-            Verdict::NotRun(why) => {
-                let mut s = TestCaseStatus::skipped();
-                s.set_message(why.to_string());
-                s
-            }
+    x.push_str("    </properties>\n");
+    for (r, name) in results.iter().zip(&names) {
+        let _ = write!(
+            x,
+            "    <testcase name=\"{}\" classname=\"section {}\" time=\"{:.6}\"",
+            esc(name),
+            esc(r.section),
+            r.wall.as_secs_f64()
+        );
+        let mut body = String::new();
+        let mut element = |tag: &str, kind: &str, message: &str| {
+            let _ = writeln!(
+                body,
+                "      <{tag} type=\"{kind}\" message=\"{}\">{}</{tag}>",
+                esc(message),
+                esc_text(message)
+            );
         };
-        let mut case = TestCase::new(r.name, status);
-        case.set_classname(format!("section {}", r.section));
-        case.set_time(std::time::Duration::from_nanos(r.elapsed.as_nanos()));
+        match &r.verdict {
+            Verdict::Passed | Verdict::Marginal => {}
+            Verdict::Failed(f) => element("failure", "device", &f.to_string()),
+            Verdict::Error(e) => element("error", "harness", &e.to_string()),
+            Verdict::NotRun(NotRun::Interrupted) => {
+                element("skipped", "interrupted", &NotRun::Interrupted.to_string())
+            }
+            Verdict::NotRun(why) => element("error", "infrastructure", &why.to_string()),
+        }
+        let mut out: Vec<String> = Vec::new();
         if r.verdict == Verdict::Marginal {
-            let names: Vec<String> = r
+            let near: Vec<String> = r
                 .measurements
                 .iter()
                 .filter(|m| m.grade == Grade::Marginal)
                 .map(|m| m.to_string())
                 .collect();
-            case.set_system_out(format!("MARGINAL: {}", names.join("; ")));
+            out.push(format!("MARGINAL: {}", near.join("; ")));
         }
-        suite.add_test_case(case);
+        out.extend(
+            attachments(r)
+                .into_iter()
+                .map(|p| format!("[[ATTACHMENT|{p}]]")),
+        );
+        if !out.is_empty() {
+            let _ = writeln!(
+                body,
+                "      <system-out>{}</system-out>",
+                esc_text(&out.join("\n"))
+            );
+        }
+        if body.is_empty() {
+            x.push_str("/>\n");
+        } else {
+            x.push_str(">\n");
+            x.push_str(&body);
+            x.push_str("    </testcase>\n");
+        }
     }
-    report.add_test_suite(suite);
-    report.to_string().map_err(ReportError::Junit)
+    x.push_str("  </testsuite>\n</testsuites>\n");
+    Ok(x)
+}
+
+/// Test case names, with ` [pass K]` when a scenario ran more than once.
+fn unique_names(results: &[ScenarioResult]) -> Vec<String> {
+    let mut runs: BTreeMap<&str, usize> = BTreeMap::new();
+    for r in results {
+        *runs.entry(r.name).or_default() += 1;
+    }
+    let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
+    results
+        .iter()
+        .map(|r| {
+            let k = seen.entry(r.name).or_default();
+            *k += 1;
+            if runs[r.name] > 1 {
+                format!("{} [pass {k}]", r.name)
+            } else {
+                r.name.to_string()
+            }
+        })
+        .collect()
+}
+
+/// Text as an XML attribute value (a newline kept as `&#10;`).
+fn esc(s: &str) -> String {
+    escape(s, true)
+}
+
+/// Text as XML element content (newlines as they are).
+fn esc_text(s: &str) -> String {
+    escape(s, false)
+}
+
+/// Characters XML 1.0 cannot carry at all (most control characters)
+/// become `?`.
+fn escape(s: &str, attribute: bool) -> String {
+    let mut o = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '\n' if !attribute => o.push('\n'),
+            '&' => o.push_str("&amp;"),
+            '<' => o.push_str("&lt;"),
+            '>' => o.push_str("&gt;"),
+            '"' => o.push_str("&quot;"),
+            '\'' => o.push_str("&apos;"),
+            '\n' => o.push_str("&#10;"),
+            '\t' | '\r' => o.push(' '),
+            c if (c as u32) < 0x20 || c == '\u{FFFE}' || c == '\u{FFFF}' => o.push('?'),
+            c => o.push(c),
+        }
+    }
+    o
 }
 
 #[derive(Serialize)]
@@ -169,15 +359,49 @@ struct JsonMeasurement<'a> {
     at_ns: u64,
 }
 
+/// What the device did wrong, as fields.
+#[derive(Serialize)]
+struct JsonFailure<'a> {
+    expectation: &'a str,
+    expected: &'a str,
+    got: &'a str,
+    at_ns: u64,
+}
+
+/// Why the harness could not judge, as fields.
+#[derive(Serialize)]
+struct JsonError {
+    /// `harness`, `infrastructure` (target unreachable or lost) or
+    /// `interrupted`.
+    kind: &'static str,
+    message: String,
+}
+
 #[derive(Serialize)]
 struct JsonScenario<'a> {
     name: &'a str,
     section: &'a str,
     tags: &'a [&'a str],
+    /// `passed`, `marginal`, `failed`, `error` or `not_run`: the keys of
+    /// `summary`.
     verdict: &'static str,
     detail: Option<String>,
+    failure: Option<JsonFailure<'a>>,
+    error: Option<JsonError>,
     elapsed_ns: u64,
+    wall_s: f64,
     measurements: Vec<JsonMeasurement<'a>>,
+}
+
+/// The verdict's one spelling in the JSON record.
+fn json_verdict(v: &Verdict) -> &'static str {
+    match v {
+        Verdict::Passed => "passed",
+        Verdict::Marginal => "marginal",
+        Verdict::Failed(_) => "failed",
+        Verdict::Error(_) => "error",
+        Verdict::NotRun(_) => "not_run",
+    }
 }
 
 #[derive(Serialize)]
@@ -195,7 +419,7 @@ fn finite(d: crate::time::Duration) -> Option<u64> {
 /// The JSON run record.
 pub fn json(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, ReportError> {
     let run = JsonRun {
-        format: "ppmc-run-record/1",
+        format: "ppmc-run-record/2",
         run: info,
         summary: Tally::of(results),
         scenarios: results
@@ -204,9 +428,34 @@ pub fn json(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, Report
                 name: r.name,
                 section: r.section,
                 tags: r.tags,
-                verdict: r.verdict.label(),
+                verdict: json_verdict(&r.verdict),
                 detail: r.verdict.detail(),
+                failure: match &r.verdict {
+                    Verdict::Failed(f) => Some(JsonFailure {
+                        expectation: &f.expectation,
+                        expected: &f.expected,
+                        got: &f.got,
+                        at_ns: f.at.as_nanos(),
+                    }),
+                    _ => None,
+                },
+                error: match &r.verdict {
+                    Verdict::Error(e) => Some(JsonError {
+                        kind: "harness",
+                        message: e.to_string(),
+                    }),
+                    Verdict::NotRun(NotRun::Interrupted) => Some(JsonError {
+                        kind: "interrupted",
+                        message: NotRun::Interrupted.to_string(),
+                    }),
+                    Verdict::NotRun(why) => Some(JsonError {
+                        kind: "infrastructure",
+                        message: why.to_string(),
+                    }),
+                    _ => None,
+                },
                 elapsed_ns: r.elapsed.as_nanos(),
+                wall_s: r.wall.as_secs_f64(),
                 measurements: r
                     .measurements
                     .iter()

@@ -134,6 +134,7 @@ pub fn run_suite_until(
                 measurements: Vec::new(),
                 trace: None,
                 elapsed: Duration::ZERO,
+                wall: std::time::Duration::ZERO,
             };
             let mut r = match &dead {
                 _ if interrupted => not_run(NotRun::Interrupted),

@@ -132,10 +132,13 @@ fn a_disconnect_mid_run_writes_the_partial_junit_and_exits_1() {
     let n = ppmc_scenarios::all().len();
     assert_eq!(report.tests, n);
     assert!(report.errors >= 1);
+    // The rest were not run because the target was lost: infrastructure
+    // errors, never skips a dashboard would show green.
     assert!(
-        xml.matches("<skipped").count() > 0,
-        "the rest are marked not run"
+        xml.matches("<error type=\"infrastructure\"").count() > 0,
+        "the rest are marked not run: {xml}"
     );
+    assert!(!xml.contains("<skipped"), "{xml}");
 }
 
 #[test]
@@ -154,7 +157,21 @@ fn a_missing_board_is_an_infrastructure_error_with_reports() {
     assert!(err.contains("infrastructure error"), "{err}");
     assert!(err.contains("no such serial port"), "{err}");
     let xml = std::fs::read_to_string(&junit).expect("JUnit written");
-    assert_eq!(xml.matches("<skipped").count(), ppmc_scenarios::all().len());
+    // Errors, so CI turns red: nothing was skipped on purpose.
+    let n = ppmc_scenarios::all().len();
+    assert_eq!(
+        xml.matches("<error type=\"infrastructure\"").count(),
+        n,
+        "{xml}"
+    );
+    assert!(xml.contains(&format!("errors=\"{n}\"")), "{xml}");
+    assert!(!xml.contains("<skipped"), "{xml}");
+    // The two summary lines agree.
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains(&format!("suite: 0 passed, 0 failed, 0 errors, {n} not run")),
+        "{stdout}"
+    );
     // A malformed target is bad usage.
     assert_eq!(ppmc(&["run", "--target", "serial:"]).status.code(), Some(2));
 }

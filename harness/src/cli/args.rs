@@ -173,6 +173,14 @@ impl SelectArgs {
         }
     }
 
+    /// The selection, for the run record.
+    pub fn describe(&self, opts: &mut crate::report::RunOptions) {
+        opts.filter = self.filter.clone();
+        opts.tags = self.tags.clone();
+        opts.skip_tags = self.skip_tags.clone();
+        opts.shard = self.shard.map(|(i, n)| format!("{i}/{n}"));
+    }
+
     /// The suite, validated, narrowed to the selection. A filter or tags
     /// that match nothing are an error (a typo); a shard past the end of a
     /// small selection is simply empty (N CI jobs over fewer scenarios).

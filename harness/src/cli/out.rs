@@ -10,6 +10,13 @@ use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 
 static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
 static COLOR: AtomicU8 = AtomicU8::new(0);
+static TO_STDERR: AtomicBool = AtomicBool::new(false);
+
+/// Sends the lines meant for people to standard error, because standard
+/// output carries a report (`--junit -`).
+pub fn people_to_stderr() {
+    TO_STDERR.store(true, Ordering::Relaxed);
+}
 
 /// When to colour the verdict words.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -35,6 +42,9 @@ pub fn set_color(choice: ColorChoice) {
 
 /// Writes one line to standard output; nothing once it has closed.
 pub fn line(args: fmt::Arguments<'_>) {
+    if TO_STDERR.load(Ordering::Relaxed) {
+        return error_line(args);
+    }
     if STDOUT_CLOSED.load(Ordering::Relaxed) {
         return;
     }

@@ -162,6 +162,7 @@ mod tests {
             measurements: Vec::new(),
             trace: trace.then(|| Trace::parse(text).expect("valid trace")),
             elapsed: Duration::ZERO,
+            wall: std::time::Duration::ZERO,
         }
     }
 

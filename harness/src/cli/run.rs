@@ -6,7 +6,7 @@ use crate::cli::{usage, CliError};
 use crate::compare::{compare, Tolerances};
 use crate::files;
 use crate::golden::{self};
-use crate::report::{self, RunInfo, Tally};
+use crate::report::{self, RunInfo, RunOptions, Tally};
 use crate::runner::run_suite_until;
 use crate::scenario::{
     DriverOptions, Failure, Grading, HarnessError, NotRun, Scenario, ScenarioResult, Verdict,
@@ -28,11 +28,13 @@ pub struct RunArgs {
     pub(super) golden: Option<PathBuf>,
     #[command(flatten)]
     pub(super) tolerance: ToleranceArgs,
-    /// Write a JUnit XML report (one test case per scenario).
+    /// Write a JUnit XML report (one test case per scenario); `-` for
+    /// standard output (the verdict lines then go to standard error).
     #[arg(long, value_name = "FILE")]
     pub(super) junit: Option<PathBuf>,
-    /// Write a JSON run record (target, board, harness version, every
-    /// measurement with its limits).
+    /// Write a JSON run record (docs/run-record.schema.json: target, board,
+    /// options, every verdict and measurement with its limits); `-` for
+    /// standard output.
     #[arg(long, value_name = "FILE")]
     pub(super) json: Option<PathBuf>,
     /// Keep the trace and VCD of every scenario that did not pass here.
@@ -132,17 +134,47 @@ fn summary_lines(t: &Tally, results: usize) {
         t.errors,
         t.not_run
     );
-    // The closing line CI log readers look for.
+    // The closing line CI log readers look for; the same counts.
     outln!(
-        "suite: {} passed, {} failed",
+        "suite: {} passed, {} failed, {} errors, {} not run",
         t.passed + t.marginal,
-        t.failed + t.errors + t.not_run
+        t.failed,
+        t.errors,
+        t.not_run
     );
 }
 
 impl RunArgs {
     fn target_name(&self) -> String {
         self.target.name().to_string()
+    }
+
+    /// The options in force, for the run record.
+    fn options(&self, tol: &Tolerances) -> RunOptions {
+        let mut o = RunOptions {
+            repeat: self.repeat,
+            golden: self.golden.as_ref().map(|g| g.display().to_string()),
+            marginal_pct: self.marginal,
+            latency_tol_pct: tol.latency_bp as f64 / 100.0,
+            interval_tol_pct: tol.interval_bp as f64 / 100.0,
+            time_floor_ns: tol.floor.as_nanos(),
+            ..RunOptions::default()
+        };
+        self.select.describe(&mut o);
+        o
+    }
+
+    /// The files `--artifacts` saved for `r`.
+    fn attachments(&self, r: &ScenarioResult) -> Vec<String> {
+        match (&self.artifacts, r.verdict.ok()) {
+            (Some(dir), false) => ["trace", "vcd"]
+                .iter()
+                .map(|ext| dir.join(format!("{}.{ext}", r.name)))
+                .filter(|p| p.is_file())
+                .map(|p| p.display().to_string())
+                .collect(),
+            _ => Vec::new(),
+        }
     }
 }
 
@@ -161,8 +193,19 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             args.marginal
         )));
     }
-    for report in [&args.junit, &args.json].into_iter().flatten() {
+    let reports: Vec<&PathBuf> = [&args.junit, &args.json].into_iter().flatten().collect();
+    for report in &reports {
         files::check_writable(report)?;
+    }
+    match reports.iter().filter(|p| p.as_os_str() == "-").count() {
+        0 => {}
+        // Standard output carries the report: the verdicts go to stderr.
+        1 => super::out::people_to_stderr(),
+        _ => {
+            return Err(usage(
+                "--junit - and --json - cannot both take standard output",
+            ))
+        }
     }
     if let Some(dir) = &args.golden {
         if !dir.is_dir() {
@@ -188,13 +231,15 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
                     measurements: Vec::new(),
                     trace: None,
                     elapsed: Duration::ZERO,
+                    wall: std::time::Duration::ZERO,
                 })
                 .collect();
-            let info = RunInfo::unreached(args.target_name(), args.board_rev.clone());
+            let mut info = RunInfo::unreached(args.target_name(), args.board_rev.clone());
+            info.options = args.options(&tol);
             let _ = args
                 .junit
                 .as_ref()
-                .map(|p| write_report(p, report::junit(&info, &results)));
+                .map(|p| write_report(p, report::junit(&info, &results, &|_| Vec::new())));
             let _ = args
                 .json
                 .as_ref()
@@ -204,7 +249,9 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         }
         Err(e) => return Err(e.into()),
     };
-    let info = RunInfo::new(&target.info(), args.board_rev.clone());
+    let started = std::time::Instant::now();
+    let mut info = RunInfo::new(&target.info(), args.board_rev.clone());
+    info.options = args.options(&tol);
     let opts = DriverOptions {
         grading: Grading {
             marginal_bp: (args.marginal * 100.0).round() as u64,
@@ -234,9 +281,11 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     });
     progress.finish();
     let interrupted = stopped();
+    info.wall_s = started.elapsed().as_secs_f64();
     let tally = Tally::of(&results);
     if let Some(p) = &args.junit {
-        if let Err(e) = write_report(p, report::junit(&info, &results)) {
+        let attachments = |r: &ScenarioResult| args.attachments(r);
+        if let Err(e) = write_report(p, report::junit(&info, &results, &attachments)) {
             problems.push(e);
         }
     }

@@ -220,6 +220,8 @@ pub struct ScenarioResult {
     pub trace: Option<Trace>,
     /// Virtual time the scenario took on the target.
     pub elapsed: Duration,
+    /// Wall-clock time the harness spent on it.
+    pub wall: std::time::Duration,
 }
 
 /// Runs one scenario from a hardware reset. A panic in the scenario body
@@ -233,6 +235,7 @@ pub fn run_scenario(
         budget: scenario.budget,
         ..opts
     };
+    let started = std::time::Instant::now();
     let info = target.info();
     let mut driver = Driver::new(target, opts);
     let outcome = catch_unwind(AssertUnwindSafe(|| {
@@ -296,6 +299,7 @@ pub fn run_scenario(
         measurements,
         trace,
         elapsed,
+        wall: started.elapsed(),
     }
 }
 

@@ -1,0 +1,191 @@
+//! The reports as their consumers read them: the JSON record against its
+//! schema (`docs/run-record.schema.json`), and the JUnit file against the
+//! rules of the Jenkins xunit schema (`junit-10.xsd`) that GitLab and
+//! junitparser also accept. CI feeds the same files to junitparser.
+
+mod common;
+
+use common::{ppmc, text};
+use std::path::Path;
+
+fn scratch() -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix("ppmc-reports-")
+        .tempdir()
+        .expect("scratch dir")
+}
+
+fn schema() -> jsonschema::Validator {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/run-record.schema.json");
+    let schema: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).expect("schema")).expect("JSON");
+    jsonschema::validator_for(&schema).expect("a valid schema")
+}
+
+fn check(validator: &jsonschema::Validator, record: &serde_json::Value) {
+    let errors: Vec<String> = validator
+        .iter_errors(record)
+        .map(|e| format!("{} at {}", e, e.instance_path))
+        .collect();
+    assert!(errors.is_empty(), "{errors:#?}");
+}
+
+/// Real records of every verdict kind: passed and marginal (the emulator),
+/// failed and error (a board fault, a corrupt golden file behind the
+/// bridge-less emulator), not run (an unreachable target).
+#[test]
+fn real_run_records_match_the_schema_and_spell_each_verdict_once() {
+    let validator = schema();
+    let dir = scratch();
+    let json = dir.path().join("run.json");
+    let j = json.to_str().expect("utf-8");
+    let out = ppmc(&["run", "--json", j, "--shard", "1/3", "--skip-tag", "long"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("written")).expect("JSON");
+    check(&validator, &record);
+    assert_eq!(record["run"]["options"]["shard"], "1/3");
+    assert_eq!(record["run"]["options"]["skip_tags"][0], "long");
+
+    // A failure with expected and got as fields.
+    let golden = dir.path().join("golden");
+    std::fs::create_dir(&golden).expect("dir");
+    let out = ppmc(&[
+        "run",
+        "--json",
+        j,
+        "--filter",
+        "e0_undefined",
+        "--golden",
+        golden.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("written")).expect("JSON");
+    check(&validator, &record);
+    assert_eq!(record["scenarios"][0]["verdict"], "error");
+    assert_eq!(record["scenarios"][0]["error"]["kind"], "harness");
+    assert_eq!(record["summary"]["error"], 1);
+
+    let out = ppmc(&[
+        "run",
+        "--json",
+        j,
+        "--filter",
+        "e0_undefined",
+        "--target",
+        "serial:/dev/ppmc-no-such-port",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("written")).expect("JSON");
+    check(&validator, &record);
+    assert_eq!(record["scenarios"][0]["verdict"], "not_run");
+    assert_eq!(record["summary"]["not_run"], 1);
+    assert_eq!(record["scenarios"][0]["error"]["kind"], "infrastructure");
+}
+
+/// A golden trace 3 % slower than the emulator: a divergence the device is
+/// blamed for, with expected and got as fields.
+#[test]
+fn a_device_failure_carries_expected_and_got_as_fields() {
+    let validator = schema();
+    let dir = scratch();
+    let golden = dir.path().join("golden");
+    std::fs::create_dir(&golden).expect("dir");
+    let name = "s3_3_5_constant_speed_100_steps";
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../golden/{name}.snap"));
+    let trace =
+        ppmc::trace::Trace::parse(&std::fs::read_to_string(src).expect("golden")).expect("parses");
+    let slower = ppmc::compare::scale_times(&trace, 103, 100);
+    std::fs::write(golden.join(format!("{name}.snap")), slower.render()).expect("write");
+    let json = dir.path().join("run.json");
+    let out = ppmc(&[
+        "run",
+        "--json",
+        json.to_str().expect("utf-8"),
+        "--filter",
+        name,
+        "--golden",
+        golden.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stdout));
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("written")).expect("JSON");
+    check(&validator, &record);
+    let s = &record["scenarios"][0];
+    assert_eq!(s["verdict"], "failed");
+    assert_eq!(record["summary"]["failed"], 1);
+    assert!(s["failure"]["expected"].is_string(), "{s}");
+    assert!(s["failure"]["got"].is_string(), "{s}");
+    assert!(s["error"].is_null(), "{s}");
+}
+
+/// The attributes and children `junit-10.xsd` allows, checked on a real
+/// report with a failure, an error, repeats, a shard and attachments.
+#[test]
+fn the_junit_report_keeps_the_jenkins_schema_rules() {
+    let dir = scratch();
+    let junit = dir.path().join("r.xml");
+    let arts = dir.path().join("arts");
+    let golden = dir.path().join("golden");
+    std::fs::create_dir(&golden).expect("dir");
+    let out = ppmc(&[
+        "run",
+        "--junit",
+        junit.to_str().expect("utf-8"),
+        "--filter",
+        "e0_undefined",
+        "--repeat",
+        "2",
+        "--shard",
+        "1/1",
+        "--golden",
+        golden.to_str().expect("utf-8"),
+        "--artifacts",
+        arts.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let xml = std::fs::read_to_string(&junit).expect("written");
+    let report = quick_junit::Report::deserialize_from_str(&xml).expect("parses");
+    assert_eq!(report.tests, 2);
+    assert_eq!(report.errors, 2);
+    let suite = &report.test_suites[0];
+    assert_eq!(suite.name.as_str(), "ppmc-conformance shard 1/1");
+    assert!(suite.timestamp.is_some(), "{xml}");
+    let names: Vec<&str> = suite.test_cases.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "e0_undefined_command_code [pass 1]",
+            "e0_undefined_command_code [pass 2]"
+        ]
+    );
+    // junit-10.xsd: no `skipped` on testsuites; testsuite has time,
+    // timestamp, hostname; the explanation is the element's text too.
+    let root = xml
+        .lines()
+        .find(|l| l.starts_with("<testsuites"))
+        .expect("root");
+    assert!(!root.contains("skipped="), "{root}");
+    let suite_line = xml
+        .lines()
+        .find(|l| l.trim_start().starts_with("<testsuite "))
+        .expect("suite");
+    for attr in [
+        "time=",
+        "timestamp=",
+        "hostname=",
+        "tests=",
+        "failures=",
+        "errors=",
+    ] {
+        assert!(suite_line.contains(attr), "{attr} in {suite_line}");
+    }
+    assert!(
+        xml.contains("no golden trace for this scenario (record one with `ppmc record`)</error>"),
+        "{xml}"
+    );
+    assert!(xml.contains("[[ATTACHMENT|"), "{xml}");
+    assert!(xml.contains("property name=\"device_time.e0_undefined_command_code [pass 1]\""));
+}
