@@ -236,16 +236,15 @@ fn temporary_beside(path: &Path) -> Result<tempfile::NamedTempFile, FileError> {
         .map_err(FileError::io(path, Action::CreatingTemporary))
 }
 
-/// Fills a temporary file beside `path` through `fill`, then moves it into
-/// place over nothing or over a regular file. On any error nothing is left
-/// behind and the old file, if any, is untouched.
-pub fn write_with(
+/// A temporary file beside `path` filled through `fill`, with the
+/// permissions the new file will have (`old`'s, or 0644), flushed to disk.
+/// Dropped on any error, so nothing is left behind.
+fn filled_beside(
     path: &Path,
+    old: Option<fs::Permissions>,
     fill: impl FnOnce(&mut dyn Write) -> io::Result<()>,
-) -> Result<(), FileError> {
-    let old = check_destination(path)?;
-    let tmp = temporary_beside(path)?;
-    let mut out = BufWriter::new(tmp);
+) -> Result<tempfile::NamedTempFile, FileError> {
+    let mut out = BufWriter::new(temporary_beside(path)?);
     fill(&mut out).map_err(FileError::io(path, Action::Writing))?;
     let tmp = out
         .into_inner()
@@ -254,6 +253,18 @@ pub fn write_with(
     tmp.as_file()
         .sync_all()
         .map_err(FileError::io(path, Action::Syncing))?;
+    Ok(tmp)
+}
+
+/// Fills a temporary file beside `path` through `fill`, then moves it into
+/// place over nothing or over a regular file. On any error nothing is left
+/// behind and the old file, if any, is untouched.
+pub fn write_with(
+    path: &Path,
+    fill: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> Result<(), FileError> {
+    let old = check_destination(path)?;
+    let tmp = filled_beside(path, old, fill)?;
     // Between the check and the rename, another process could put something
     // else there; the check is for mistakes, not for an attacker with write
     // access to the folder.
@@ -287,13 +298,7 @@ pub fn create_new(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
             path: path.to_path_buf(),
         });
     }
-    let mut tmp = temporary_beside(path)?;
-    tmp.write_all(bytes)
-        .map_err(FileError::io(path, Action::Writing))?;
-    set_permissions(&tmp, None)?;
-    tmp.as_file()
-        .sync_all()
-        .map_err(FileError::io(path, Action::Syncing))?;
+    let tmp = filled_beside(path, None, |w| w.write_all(bytes))?;
     // A hard link fails if anything, even a dangling symlink, has the name.
     tmp.persist_noclobber(path).map_err(|e| {
         if e.error.kind() == io::ErrorKind::AlreadyExists {
@@ -330,16 +335,19 @@ fn set_permissions(
         .map_err(FileError::io(tmp.path(), Action::Writing))
 }
 
+/// A scratch folder for a unit test, removed when dropped (even by a
+/// failing test).
+#[cfg(test)]
+pub(crate) fn scratch(tag: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("ppmc-{tag}-"))
+        .tempdir()
+        .expect("scratch dir")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn scratch() -> tempfile::TempDir {
-        tempfile::Builder::new()
-            .prefix("ppmc-files-")
-            .tempdir()
-            .expect("scratch dir")
-    }
 
     fn leftovers(dir: &Path) -> Vec<String> {
         fs::read_dir(dir)
@@ -351,7 +359,7 @@ mod tests {
 
     #[test]
     fn write_replaces_a_regular_file_and_leaves_nothing_behind() {
-        let d = scratch();
+        let d = scratch("files");
         let p = d.path().join("a.txt");
         write(&p, b"one").expect("create");
         write(&p, b"two").expect("replace");
@@ -362,7 +370,7 @@ mod tests {
     #[cfg(unix)]
     #[test]
     fn write_refuses_a_symlink_fifo_or_directory_at_the_destination() {
-        let d = scratch();
+        let d = scratch("files");
         let outside = d.path().join("outside.txt");
         fs::write(&outside, b"keep").expect("outside");
         let link = d.path().join("link.txt");
@@ -379,7 +387,7 @@ mod tests {
 
     #[test]
     fn a_failed_fill_leaves_the_old_file_and_no_temporary() {
-        let d = scratch();
+        let d = scratch("files");
         let p = d.path().join("r.json");
         write(&p, b"old").expect("create");
         let e = write_with(&p, |w| {
@@ -395,7 +403,7 @@ mod tests {
     #[cfg(unix)]
     #[test]
     fn create_new_never_replaces_even_a_dangling_symlink() {
-        let d = scratch();
+        let d = scratch("files");
         let p = d.path().join("s.rs");
         std::os::unix::fs::symlink(d.path().join("nowhere"), &p).expect("symlink");
         let e = create_new(&p, b"x").expect_err("refused");
@@ -416,7 +424,7 @@ mod tests {
     fn read_refuses_devices_and_big_files_and_missing_is_not_found() {
         let e = read(Path::new("/dev/zero"), 1024).expect_err("device");
         assert!(e.to_string().contains("a device"), "{e}");
-        let d = scratch();
+        let d = scratch("files");
         let p = d.path().join("big");
         fs::write(&p, vec![b'x'; 100]).expect("write");
         assert!(matches!(read(&p, 99), Err(FileError::TooLarge { .. })));
@@ -430,7 +438,7 @@ mod tests {
     #[cfg(unix)]
     #[test]
     fn read_refuses_a_fifo_without_blocking() {
-        let d = scratch();
+        let d = scratch("files");
         let p = d.path().join("fifo");
         let made = std::process::Command::new("mkfifo")
             .arg(&p)

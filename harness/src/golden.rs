@@ -112,13 +112,7 @@ mod tests {
     use super::*;
     use std::fs;
 
-    /// A scratch folder, removed when dropped (even by a failing test).
-    fn tmpdir() -> tempfile::TempDir {
-        tempfile::Builder::new()
-            .prefix("ppmc-golden-")
-            .tempdir()
-            .expect("temp dir")
-    }
+    use crate::files::scratch;
 
     fn trace(name: &str) -> Trace {
         Trace::parse(&format!(
@@ -129,8 +123,8 @@ mod tests {
 
     #[test]
     fn write_never_overwrites_without_bless() {
-        let scratch = tmpdir();
-        let d = scratch.path();
+        let dir = scratch("golden");
+        let d = dir.path();
         assert_eq!(write(d, &trace("a"), false).expect("new"), Written::Created);
         assert_eq!(
             write(d, &trace("a"), false).expect("same"),
@@ -156,8 +150,8 @@ mod tests {
 
     #[test]
     fn bad_golden_files_name_path_and_line() {
-        let scratch = tmpdir();
-        let d = scratch.path();
+        let dir = scratch("golden");
+        let d = dir.path();
         assert!(matches!(load(d, "x"), Err(GoldenError::Missing { .. })));
         fs::write(d.join("x.snap"), format!("{SNAPSHOT_HEADER}ppmc-trace 1\nscenario x\nsection 3\ntarget emu\ndetail sysclk_hz 16000000\ndetail csel high\ndetail vsel high\ndetail ext_clock_hz none\nevents\n0.000us bogus\nend\n")).expect("write");
         let e = load(d, "x").expect_err("corrupt");

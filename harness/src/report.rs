@@ -153,10 +153,6 @@ impl Tally {
     }
 }
 
-/// Files saved beside a scenario's result (`--artifacts`), for the
-/// reports to point at.
-pub type Attachments<'a> = &'a dyn Fn(&ScenarioResult) -> Vec<String>;
-
 /// JUnit XML for CI systems, valid under the Jenkins xunit schema
 /// (`junit-10.xsd`) and read by GitLab and junitparser: one test case per
 /// scenario run (classname = datasheet section; names made unique under
@@ -164,12 +160,13 @@ pub type Attachments<'a> = &'a dyn Fn(&ScenarioResult) -> Vec<String>;
 /// virtual time as a suite property per case; a failure or error carries
 /// its explanation in `message` and as its text; infrastructure problems
 /// (target unreachable or lost) are errors, an interrupted run's leftovers
-/// are skipped; saved traces are `[[ATTACHMENT|path]]` lines in
-/// `system-out`.
+/// are skipped; the files saved for each result (`attachments`, in the
+/// results' order; missing entries mean none) are `[[ATTACHMENT|path]]`
+/// lines in `system-out`.
 pub fn junit(
     info: &RunInfo,
     results: &[ScenarioResult],
-    attachments: Attachments<'_>,
+    attachments: &[Vec<String>],
 ) -> Result<String, ReportError> {
     let tally = Tally::of(results);
     let skipped = results
@@ -235,7 +232,7 @@ pub fn junit(
         );
     }
     x.push_str("    </properties>\n");
-    for (r, name) in results.iter().zip(&names) {
+    for (i, (r, name)) in results.iter().zip(&names).enumerate() {
         let _ = write!(
             x,
             "    <testcase name=\"{}\" classname=\"section {}\" time=\"{:.6}\"",
@@ -272,8 +269,10 @@ pub fn junit(
             out.push(format!("MARGINAL: {}", near.join("; ")));
         }
         out.extend(
-            attachments(r)
+            attachments
+                .get(i)
                 .into_iter()
+                .flatten()
                 .map(|p| format!("[[ATTACHMENT|{p}]]")),
         );
         if !out.is_empty() {

@@ -3,33 +3,10 @@
 
 mod common;
 
-use common::{ppmc, text};
+use common::{ppmc, scratch, text, wait_bounded};
 use std::io::Read;
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
-
-fn scratch() -> tempfile::TempDir {
-    tempfile::Builder::new()
-        .prefix("ppmc-behaves-")
-        .tempdir()
-        .expect("scratch dir")
-}
-
-/// Waits for `child` at most `limit`; kills it and fails past that.
-fn wait_bounded(child: &mut std::process::Child, limit: Duration) -> std::process::ExitStatus {
-    let deadline = Instant::now() + limit;
-    loop {
-        if let Some(s) = child.try_wait().expect("wait") {
-            return s;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("ppmc did not stop within {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
+use std::time::Duration;
 
 /// `ppmc ARGS | head -0`: standard output closed before anything is read.
 fn with_closed_stdout(args: &[&str]) -> (std::process::ExitStatus, String) {
@@ -53,7 +30,7 @@ fn a_closed_pipe_ends_list_and_run_quietly_and_run_still_writes_its_reports() {
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(status.code(), Some(0), "{err}");
 
-    let dir = scratch();
+    let dir = scratch("behaves");
     let junit = dir.path().join("r.xml");
     let (status, err) = with_closed_stdout(&[
         "run",
@@ -71,7 +48,7 @@ fn a_closed_pipe_ends_list_and_run_quietly_and_run_still_writes_its_reports() {
 
 #[test]
 fn sigint_in_a_soak_run_writes_both_reports_and_exits_non_zero() {
-    let dir = scratch();
+    let dir = scratch("behaves");
     let (junit, json) = (dir.path().join("s.xml"), dir.path().join("s.json"));
     let mut child = Command::new(env!("CARGO_BIN_EXE_ppmc"))
         .args([

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{ppmc, text};
+use common::{ppmc, scratch, text, wait_bounded};
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 
@@ -27,7 +27,7 @@ struct BridgeSim {
 
 impl BridgeSim {
     fn start(args: &[&str]) -> BridgeSim {
-        let dir = scratch();
+        let dir = scratch("clibridge");
         let link = dir.path().join("pty");
         let mut sim = BridgeSim::start_at(&link, args);
         sim._dir = Some(dir);
@@ -76,14 +76,6 @@ impl Drop for BridgeSim {
     }
 }
 
-/// A scratch folder, removed when dropped, even by a failing test.
-fn scratch() -> tempfile::TempDir {
-    tempfile::Builder::new()
-        .prefix("ppmc-clibridge-")
-        .tempdir()
-        .expect("scratch dir")
-}
-
 #[test]
 fn run_over_the_bridge_gives_the_same_verdicts_as_the_emulator() {
     let sim = BridgeSim::start(&[]);
@@ -112,7 +104,7 @@ fn console_over_the_bridge_prints_what_the_emulator_prints() {
 #[test]
 fn a_disconnect_mid_run_writes_the_partial_junit_and_exits_1() {
     let sim = BridgeSim::start(&["--disconnect-after", "40"]);
-    let dir = scratch();
+    let dir = scratch("clibridge");
     let junit = dir.path().join("partial.xml");
     let out = ppmc(&[
         "run",
@@ -143,7 +135,7 @@ fn a_disconnect_mid_run_writes_the_partial_junit_and_exits_1() {
 
 #[test]
 fn a_missing_board_is_an_infrastructure_error_with_reports() {
-    let dir = scratch();
+    let dir = scratch("clibridge");
     let junit = dir.path().join("missing.xml");
     let out = ppmc(&[
         "run",
@@ -211,7 +203,7 @@ fn differential_fuzz_over_the_pty() {
     );
 
     let bad = BridgeSim::start(&["--chip-fault", "dir-inverted"]);
-    let dir = scratch();
+    let dir = scratch("clibridge");
     let file = dir.path().join("diff-pty.ppmc");
     let out = ppmc(&[
         "fuzz",
@@ -237,7 +229,7 @@ fn differential_fuzz_over_the_pty() {
 
 #[test]
 fn bridge_sim_never_replaces_a_file_that_is_not_its_stale_link() {
-    let dir = scratch();
+    let dir = scratch("clibridge");
     let file = dir.path().join("notes.txt");
     std::fs::write(&file, "keep me").expect("file");
     let out = Command::new(env!("CARGO_BIN_EXE_ppmc"))
@@ -271,7 +263,7 @@ fn bridge_sim_never_replaces_a_file_that_is_not_its_stale_link() {
 #[test]
 fn bridge_sim_removes_its_link_on_sigterm_and_sigint() {
     for signal in ["-TERM", "-INT"] {
-        let dir = scratch();
+        let dir = scratch("clibridge");
         let link = dir.path().join("pty");
         let mut sim = BridgeSim::start_at(&link, &[]);
         assert!(std::fs::symlink_metadata(&link).is_ok());
@@ -281,17 +273,8 @@ fn bridge_sim_removes_its_link_on_sigterm_and_sigint() {
             .status()
             .expect("kill runs");
         assert!(sent.success());
-        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
-        let status = loop {
-            if let Some(s) = sim.child.try_wait().expect("wait") {
-                break s;
-            }
-            assert!(
-                std::time::Instant::now() < deadline,
-                "bridge-sim did not stop on {signal}"
-            );
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        };
+        // Fails the test if bridge-sim does not stop on the signal.
+        let status = wait_bounded(&mut sim.child, std::time::Duration::from_secs(10));
         assert!(status.success(), "{signal}: {status}");
         assert!(
             std::fs::symlink_metadata(&link).is_err(),

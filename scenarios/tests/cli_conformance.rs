@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{ppmc, text};
+use common::{ppmc, scratch, text};
 
 use ppmc::compare::scale_times;
 use ppmc::trace::Trace;
@@ -13,21 +13,13 @@ fn golden_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../golden")
 }
 
-/// A scratch folder, removed when dropped, even by a failing test.
-fn tmpdir(tag: &str) -> tempfile::TempDir {
-    tempfile::Builder::new()
-        .prefix(&format!("ppmc-cli-{tag}-"))
-        .tempdir()
-        .expect("temp dir")
-}
-
 fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")
 }
 
 #[test]
 fn run_passes_on_the_emulator_and_writes_valid_junit_and_json() {
-    let d_dir = tmpdir("run");
+    let d_dir = scratch("run");
     let d = d_dir.path();
     let (junit, json) = (d.join("report.xml"), d.join("run.json"));
     let out = ppmc(&[
@@ -82,7 +74,7 @@ fn run_compares_with_golden_as_it_runs() {
 
 /// Writes a copy of the golden set with every time scaled by `num / den`.
 fn scaled_copy(tag: &str, num: u64, den: u64) -> tempfile::TempDir {
-    let d_dir = tmpdir(tag);
+    let d_dir = scratch(tag);
     let d = d_dir.path();
     for e in fs::read_dir(golden_dir()).expect("golden dir") {
         let p = e.expect("entry").path();
@@ -132,7 +124,7 @@ fn compare_passes_half_a_percent_and_fails_three_percent() {
 
 #[test]
 fn export_writes_a_vcd_that_parses_back() {
-    let d_dir = tmpdir("vcd");
+    let d_dir = scratch("vcd");
     let d = d_dir.path();
     let vcd_path = d.join("out.vcd");
     let golden = golden_dir().join("s3_3_5_constant_speed_100_steps.snap");
@@ -151,7 +143,7 @@ fn export_writes_a_vcd_that_parses_back() {
 
 #[test]
 fn record_never_overwrites_without_bless() {
-    let d_dir = tmpdir("record");
+    let d_dir = scratch("record");
     let d = d_dir.path();
     let args = |extra: &[&str]| {
         let mut v = vec!["record", "--out", s(d), "--filter", "e0_undefined"];
@@ -189,7 +181,7 @@ fn record_never_overwrites_without_bless() {
 
 #[test]
 fn a_corrupt_golden_file_is_a_harness_error_of_its_scenario_alone_with_path_and_line() {
-    let g_dir = tmpdir("corrupt");
+    let g_dir = scratch("corrupt");
     let g = g_dir.path();
     for name in ["e0_undefined_command_code", "e3_data_without_a_command"] {
         fs::copy(
@@ -201,7 +193,7 @@ fn a_corrupt_golden_file_is_a_harness_error_of_its_scenario_alone_with_path_and_
     let bad = g.join("e3_data_without_a_command.snap");
     let text_ = fs::read_to_string(&bad).expect("read");
     fs::write(&bad, text_.replacen(" wd ", " wq ", 1)).expect("corrupt");
-    let arts_dir = tmpdir("artifacts");
+    let arts_dir = scratch("artifacts");
     let arts = arts_dir.path();
     let out = ppmc(&[
         "run",
@@ -285,7 +277,7 @@ fn list_and_shards_cover_the_suite() {
 #[cfg(unix)]
 #[test]
 fn outputs_never_follow_a_symlink_or_replace_what_is_not_a_regular_file() {
-    let d_dir = tmpdir("planted");
+    let d_dir = scratch("planted");
     let d = d_dir.path();
     let outside = d.join("outside.txt");
     fs::write(&outside, "keep me").expect("outside file");
@@ -325,7 +317,7 @@ fn outputs_never_follow_a_symlink_or_replace_what_is_not_a_regular_file() {
 #[cfg(unix)]
 #[test]
 fn a_golden_file_that_is_a_fifo_or_a_device_is_an_error_not_a_hang() {
-    let d_dir = tmpdir("fifo");
+    let d_dir = scratch("fifo");
     let d = d_dir.path();
     let fifo = d.join("e0_undefined_command_code.snap");
     let made = std::process::Command::new("mkfifo")

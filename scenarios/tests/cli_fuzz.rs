@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::ppmc;
+use common::{ppmc, scratch};
 use std::path::Path;
 
 #[test]
@@ -27,14 +27,6 @@ fn reproduce_of_a_missing_file_is_a_usage_error_naming_it() {
     assert!(err.contains("no/such/crash-file"), "{err}");
 }
 
-/// A scratch folder, removed when dropped, even by a failing test.
-fn scratch(name: &str) -> tempfile::TempDir {
-    tempfile::Builder::new()
-        .prefix(&format!("ppmc-cli-fuzz-{name}-"))
-        .tempdir()
-        .expect("scratch dir")
-}
-
 const STOP_SEED: &str = "../fuzz/corpus/bus_bytes/s3_3_1_immediate_stop_and_resume.bin";
 
 /// The finding loop of the README on an injected bug (the board fault
@@ -43,7 +35,7 @@ const STOP_SEED: &str = "../fuzz/corpus/bus_bytes/s3_3_1_immediate_stop_and_resu
 /// to-scenario never overwrites the first.
 #[test]
 fn minimize_then_to_scenario_on_an_injected_bug() {
-    let dir_dir = scratch("loop");
+    let dir_dir = scratch("fuzz-loop");
     let dir = dir_dir.path();
     let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join(STOP_SEED);
     let input = dir.join("crash-1");
@@ -155,7 +147,7 @@ fn a_differential_run_finds_a_faulty_emulator_and_writes_a_reproducer() {
     assert_eq!(out.status.code(), Some(0));
     assert!(String::from_utf8_lossy(&out.stdout).contains("no departure"));
 
-    let dir_dir = scratch("diff");
+    let dir_dir = scratch("fuzz-diff");
     let dir = dir_dir.path();
     let repro = dir.join("r.ppmc");
     let run = |path: &Path| {

@@ -68,10 +68,7 @@ fn a_bad_line_stops_with_its_number_and_exit_2_before_anything_runs() {
 
 #[test]
 fn a_bad_line_in_a_file_names_the_file() {
-    let scratch = tempfile::Builder::new()
-        .prefix("ppmc-console-")
-        .tempdir()
-        .expect("temp dir");
+    let scratch = common::scratch("console");
     let dir = scratch.path();
     let f = dir.join("bad.ppmc");
     std::fs::write(&f, "# ok\nfrobnicate\n").expect("script");

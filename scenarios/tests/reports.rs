@@ -5,15 +5,8 @@
 
 mod common;
 
-use common::{ppmc, text};
+use common::{ppmc, scratch, text};
 use std::path::Path;
-
-fn scratch() -> tempfile::TempDir {
-    tempfile::Builder::new()
-        .prefix("ppmc-reports-")
-        .tempdir()
-        .expect("scratch dir")
-}
 
 fn schema() -> jsonschema::Validator {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/run-record.schema.json");
@@ -36,7 +29,7 @@ fn check(validator: &jsonschema::Validator, record: &serde_json::Value) {
 #[test]
 fn real_run_records_match_the_schema_and_spell_each_verdict_once() {
     let validator = schema();
-    let dir = scratch();
+    let dir = scratch("reports");
     let json = dir.path().join("run.json");
     let j = json.to_str().expect("utf-8");
     let out = ppmc(&["run", "--json", j, "--shard", "1/3", "--skip-tag", "long"]);
@@ -90,7 +83,7 @@ fn real_run_records_match_the_schema_and_spell_each_verdict_once() {
 #[test]
 fn a_device_failure_carries_expected_and_got_as_fields() {
     let validator = schema();
-    let dir = scratch();
+    let dir = scratch("reports");
     let golden = dir.path().join("golden");
     std::fs::create_dir(&golden).expect("dir");
     let name = "s3_3_5_constant_speed_100_steps";
@@ -125,7 +118,7 @@ fn a_device_failure_carries_expected_and_got_as_fields() {
 /// report with a failure, an error, repeats, a shard and attachments.
 #[test]
 fn the_junit_report_keeps_the_jenkins_schema_rules() {
-    let dir = scratch();
+    let dir = scratch("reports");
     let junit = dir.path().join("r.xml");
     let arts = dir.path().join("arts");
     let golden = dir.path().join("golden");

@@ -6,10 +6,10 @@
 
 use std::fmt;
 use std::io::{self, IsTerminal, Write};
-use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
-static COLOR: AtomicU8 = AtomicU8::new(0);
+static COLOR: AtomicBool = AtomicBool::new(false);
 static TO_STDERR: AtomicBool = AtomicBool::new(false);
 
 /// Sends the lines meant for people to standard error, because standard
@@ -37,7 +37,7 @@ pub fn set_color(choice: ColorChoice) {
             io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty())
         }
     };
-    COLOR.store(u8::from(on), Ordering::Relaxed);
+    COLOR.store(on, Ordering::Relaxed);
 }
 
 /// Writes one line to standard output; nothing once it has closed.
@@ -73,7 +73,7 @@ pub fn stdout_closed() -> bool {
 /// A verdict word, padded to `width`, coloured when colour is on.
 pub fn verdict_word(word: &str, width: usize) -> String {
     let padded = format!("{word:<width$}");
-    if COLOR.load(Ordering::Relaxed) == 0 {
+    if !COLOR.load(Ordering::Relaxed) {
         return padded;
     }
     let code = match word {

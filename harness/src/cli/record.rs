@@ -54,12 +54,7 @@ pub fn run(args: RecordArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 }
                 Ok(t) => match golden::write(&args.out, t, args.bless) {
                     Ok(w) => {
-                        let word = match w {
-                            Written::Created => "created",
-                            Written::Replaced => "replaced",
-                            Written::Unchanged => "unchanged",
-                        };
-                        tally.count(w);
+                        let word = tally.count(w);
                         if matches!(r.verdict, Verdict::Failed(_)) {
                             tally.device_failures += 1;
                         }
@@ -116,12 +111,15 @@ struct Tally {
 }
 
 impl Tally {
-    fn count(&mut self, w: Written) {
-        match w {
-            Written::Created => self.created += 1,
-            Written::Replaced => self.replaced += 1,
-            Written::Unchanged => self.unchanged += 1,
-        }
+    /// Counts a file written; the word for its line.
+    fn count(&mut self, w: Written) -> &'static str {
+        let (n, word) = match w {
+            Written::Created => (&mut self.created, "created"),
+            Written::Replaced => (&mut self.replaced, "replaced"),
+            Written::Unchanged => (&mut self.unchanged, "unchanged"),
+        };
+        *n += 1;
+        word
     }
 }
 

@@ -111,13 +111,19 @@ fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) {
     }
 }
 
-fn save_artifacts(dir: &Path, r: &ScenarioResult) -> Result<(), String> {
+/// Saves `r`'s trace and VCD in `dir`, adding each file written to `saved`
+/// (for the reports to point at).
+fn save_artifacts(dir: &Path, r: &ScenarioResult, saved: &mut Vec<String>) -> Result<(), String> {
     let Some(trace) = &r.trace else { return Ok(()) };
     let text = trace.render();
     let tpath = dir.join(format!("{}.trace", r.name));
     files::write(&tpath, text.as_bytes()).map_err(|e| e.to_string())?;
+    saved.push(tpath.display().to_string());
     let vpath = dir.join(format!("{}.vcd", r.name));
-    files::write_with(&vpath, |w| crate::vcd_export::export(trace, w)).map_err(|e| e.to_string())
+    files::write_with(&vpath, |w| crate::vcd_export::export(trace, w))
+        .map_err(|e| e.to_string())?;
+    saved.push(vpath.display().to_string());
+    Ok(())
 }
 
 fn write_report(path: &Path, text: Result<String, report::ReportError>) -> Result<(), String> {
@@ -162,19 +168,6 @@ impl RunArgs {
         };
         self.select.describe(&mut o);
         o
-    }
-
-    /// The files `--artifacts` saved for `r`.
-    fn attachments(&self, r: &ScenarioResult) -> Vec<String> {
-        match (&self.artifacts, r.verdict.ok()) {
-            (Some(dir), false) => ["trace", "vcd"]
-                .iter()
-                .map(|ext| dir.join(format!("{}.{ext}", r.name)))
-                .filter(|p| p.is_file())
-                .map(|p| p.display().to_string())
-                .collect(),
-            _ => Vec::new(),
-        }
     }
 }
 
@@ -239,7 +232,7 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             let _ = args
                 .junit
                 .as_ref()
-                .map(|p| write_report(p, report::junit(&info, &results, &|_| Vec::new())));
+                .map(|p| write_report(p, report::junit(&info, &results, &[])));
             let _ = args
                 .json
                 .as_ref()
@@ -261,6 +254,8 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let repeat = args.repeat as usize;
     let progress = Progress::new(scenarios.len() * repeat);
     let mut problems = Vec::new();
+    // The files saved for each result, in the results' order.
+    let mut attachments: Vec<Vec<String>> = Vec::new();
     let stop = super::signals::stop_requested();
     let stopped = || stop.load(Ordering::Relaxed) || super::out::stdout_closed();
     let results = run_suite_until(target.as_mut(), &scenarios, repeat, opts, stopped, |r| {
@@ -271,11 +266,13 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         if !matches!(r.verdict, Verdict::NotRun(NotRun::Interrupted)) {
             progress.line(&verdict_line(r));
         }
+        let mut saved = Vec::new();
         if let (Some(dir), false) = (&args.artifacts, r.verdict.ok()) {
-            if let Err(e) = save_artifacts(dir, r) {
+            if let Err(e) = save_artifacts(dir, r, &mut saved) {
                 problems.push(e);
             }
         }
+        attachments.push(saved);
         // Judged, compared and saved: a soak run need not keep it.
         r.trace = None;
     });
@@ -284,7 +281,6 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     info.wall_s = started.elapsed().as_secs_f64();
     let tally = Tally::of(&results);
     if let Some(p) = &args.junit {
-        let attachments = |r: &ScenarioResult| args.attachments(r);
         if let Err(e) = write_report(p, report::junit(&info, &results, &attachments)) {
             problems.push(e);
         }
