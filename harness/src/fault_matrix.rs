@@ -111,8 +111,8 @@ pub fn check_board(
     let settings = DiffSettings::default();
     let mut fuzz = None;
     for seed in 0..budget.seeds {
-        let acts = differential::program(seed, budget.actions);
-        if let Some(d) = differential::run(target, &acts, &settings, |_| true)? {
+        let acts = differential::program(seed).take(budget.actions);
+        if let Some(d) = differential::run(target, acts, &settings, |_| true)? {
             let dv = d.divergence;
             fuzz = Some(Catch {
                 first: format!(

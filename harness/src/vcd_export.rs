@@ -1,12 +1,16 @@
-//! Exporting a trace as a VCD waveform for GTKWave or PulseView.
+//! Exporting a trace as a VCD waveform for GTKWave, PulseView and
+//! sigrok-cli.
 //!
-//! One wire per signal: `pout`, `dir`, `s1`..`s5` (energized phases, as the
-//! trace records them, independent of the output logic level), `int`,
-//! `hold`, `aux` (1 = asserted), `busy`, `switching` (stop switching active;
-//! the chopping itself is not expanded), and `auxo` as a 4-bit vector.
-//! Timescale 1 ns, the trace's own resolution. POUT is drawn as a pulse of
-//! 1 us, or half the period when pulses come faster. The file is written as
-//! a stream, so a 16-million-pulse trace costs time but not memory.
+//! One 1-bit wire per signal: `pout`, `dir`, `s1`..`s5` (energized phases,
+//! as the trace records them, independent of the output logic level),
+//! `int`, `hold`, `aux` (1 = asserted), `busy`, `switching` (stop switching
+//! active; the chopping itself is not expanded), and `auxo0`..`auxo3`.
+//! There are no vectors (libsigrok's VCD reader loads a file with a vector
+//! as zero samples, without a word), and a value is written only when it
+//! changes, with a timestamp only where something changes. Timescale 1 ns,
+//! the trace's own resolution. POUT is drawn as a pulse of 1 us, or half
+//! the period when pulses come faster. The file is written as a stream, so
+//! a 16-million-pulse trace costs time but not memory.
 
 use crate::protocol::{Direction, Pin, Winding};
 use crate::time::{Duration, Instant};
@@ -15,7 +19,7 @@ use std::io::{self, Write};
 use vcd::{IdCode, TimescaleUnit, Value};
 
 /// The wires of the export, in declaration order.
-pub const SIGNALS: [&str; 13] = [
+pub const SIGNALS: [&str; 16] = [
     "pout",
     "dir",
     "s1",
@@ -28,29 +32,21 @@ pub const SIGNALS: [&str; 13] = [
     "aux",
     "busy",
     "switching",
-    "auxo",
+    "auxo0",
+    "auxo1",
+    "auxo2",
+    "auxo3",
 ];
 
-/// A change to emit at a time.
-#[derive(Debug, Clone, Copy)]
-enum Change {
-    Pout(bool),
-    Dir(bool),
-    Phases(u8),
-    Wire(usize, bool),
-    Auxo(u8),
-}
-
-struct Ids {
-    wires: Vec<IdCode>,
-}
-
-impl Ids {
-    fn get(&self, name: &str) -> IdCode {
-        let i = SIGNALS.iter().position(|s| *s == name).unwrap_or(0);
-        self.wires[i]
-    }
-}
+const POUT: usize = 0;
+const DIR: usize = 1;
+const S1: usize = 2;
+const INT: usize = 7;
+const HOLD: usize = 8;
+const AUX: usize = 9;
+const BUSY: usize = 10;
+const SWITCHING: usize = 11;
+const AUXO0: usize = 12;
 
 fn bit(b: bool) -> Value {
     if b {
@@ -69,32 +65,26 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
     ))?;
     w.timescale(1, TimescaleUnit::NS)?;
     w.add_module("ppmc")?;
-    let mut wires = Vec::new();
+    let mut ids = Vec::with_capacity(SIGNALS.len());
     for name in SIGNALS {
-        let width = if name == "auxo" { 4 } else { 1 };
-        wires.push(w.add_wire(width, name)?);
+        ids.push(w.add_wire(1, name)?);
     }
-    let ids = Ids { wires };
     w.upscope()?;
     w.enddefinitions()?;
     w.begin(vcd::SimulationCommand::Dumpvars)?;
-    for name in SIGNALS {
-        if name == "auxo" {
-            w.change_vector(ids.get(name), [Value::V0; 4])?;
-        } else {
-            w.change_scalar(ids.get(name), Value::V0)?;
-        }
+    for id in &ids {
+        w.change_scalar(*id, Value::V0)?;
     }
     w.end()?;
 
     let mut state = Emitter {
         w,
         ids,
-        last_time: None,
+        values: [false; SIGNALS.len()],
+        last_time: 0,
     };
     let mut winding: Option<Winding> = None;
     let mut phase: u32 = 0;
-    let mut dir_bit = false;
     // Falling edge of the last POUT, not yet written.
     let mut pending_fall: Option<Instant> = None;
     for e in &trace.events {
@@ -108,11 +98,7 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
                 state.flush_before(&mut pending_fall, e.at)?;
                 winding = *wd;
                 phase = *p;
-                let b = *dir == Direction::Ccw;
-                if b != dir_bit {
-                    dir_bit = b;
-                    state.emit(e.at, Change::Dir(b))?;
-                }
+                state.set(e.at, DIR, *dir == Direction::Ccw)?;
             }
             EventKind::Pulses {
                 dir,
@@ -127,10 +113,10 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
                 for i in 0..*count {
                     let t = e.at + interval.saturating_mul(u64::from(i));
                     state.flush_before(&mut pending_fall, t)?;
-                    state.emit(t, Change::Pout(true))?;
+                    state.set(t, POUT, true)?;
                     if let Some(wd) = winding {
                         phase = wd.advance(phase, *dir, 1);
-                        state.emit(t, Change::Phases(wd.pattern(phase)))?;
+                        state.set_bits(t, S1, 5, wd.pattern(phase))?;
                     }
                     pending_fall = Some(t + width.max(Duration::from_nanos(1)));
                 }
@@ -138,34 +124,38 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
             EventKind::Pin { pin, value } => {
                 state.flush_before(&mut pending_fall, e.at)?;
                 let v = *value != 0;
-                let change = match pin {
-                    Pin::Busy => Change::Wire(10, v),
-                    Pin::Int => Change::Wire(7, v),
-                    Pin::Hold => Change::Wire(8, v),
-                    Pin::Aux => Change::Wire(9, v),
-                    Pin::Switching => Change::Wire(11, v),
-                    Pin::Dir => {
-                        dir_bit = v;
-                        Change::Dir(v)
+                match pin {
+                    Pin::Busy => state.set(e.at, BUSY, v)?,
+                    Pin::Int => state.set(e.at, INT, v)?,
+                    Pin::Hold => state.set(e.at, HOLD, v)?,
+                    Pin::Aux => state.set(e.at, AUX, v)?,
+                    Pin::Switching => state.set(e.at, SWITCHING, v)?,
+                    Pin::Dir => state.set(e.at, DIR, v)?,
+                    Pin::Phases => state.set_bits(e.at, S1, 5, *value)?,
+                    // auxo0 is bit 0.
+                    Pin::Auxo => {
+                        for k in 0..4 {
+                            state.set(e.at, AUXO0 + k, value & (1 << k) != 0)?;
+                        }
                     }
-                    Pin::Phases => Change::Phases(*value),
-                    Pin::Auxo => Change::Auxo(*value),
-                };
-                state.emit(e.at, change)?;
+                }
             }
             EventKind::Bus(_) | EventKind::Measure { .. } => {}
         }
     }
     if let Some(f) = pending_fall.take() {
-        state.emit(f, Change::Pout(false))?;
+        state.set(f, POUT, false)?;
     }
     state.w.flush()
 }
 
 struct Emitter<W: Write> {
     w: vcd::Writer<W>,
-    ids: Ids,
-    last_time: Option<u64>,
+    ids: Vec<IdCode>,
+    /// Every wire's value as last written.
+    values: [bool; SIGNALS.len()],
+    /// The last timestamp written (0 is the `$dumpvars` block's).
+    last_time: u64,
 }
 
 impl<W: Write> Emitter<W> {
@@ -174,34 +164,33 @@ impl<W: Write> Emitter<W> {
         if let Some(f) = *pending {
             if f <= t {
                 *pending = None;
-                self.emit(f, Change::Pout(false))?;
+                self.set(f, POUT, false)?;
             }
         }
         Ok(())
     }
 
-    fn emit(&mut self, at: Instant, c: Change) -> io::Result<()> {
+    /// Sets wire `i` at `at`: writes nothing unless its value changes.
+    fn set(&mut self, at: Instant, i: usize, v: bool) -> io::Result<()> {
+        if self.values[i] == v {
+            return Ok(());
+        }
         let t = at.as_nanos();
-        if self.last_time.is_none_or(|l| t > l) {
+        if t > self.last_time {
             self.w.timestamp(t)?;
-            self.last_time = Some(t);
+            self.last_time = t;
         }
-        match c {
-            Change::Pout(b) => self.w.change_scalar(self.ids.get("pout"), bit(b)),
-            Change::Dir(b) => self.w.change_scalar(self.ids.get("dir"), bit(b)),
-            Change::Wire(i, b) => self.w.change_scalar(self.ids.wires[i], bit(b)),
-            Change::Phases(p) => {
-                for (k, name) in ["s1", "s2", "s3", "s4", "s5"].iter().enumerate() {
-                    let on = p & (0b1_0000 >> k) != 0;
-                    self.w.change_scalar(self.ids.get(name), bit(on))?;
-                }
-                Ok(())
-            }
-            Change::Auxo(v) => {
-                let bits = (0..4).rev().map(|k| bit(v & (1 << k) != 0));
-                self.w.change_vector(self.ids.get("auxo"), bits)
-            }
+        self.values[i] = v;
+        self.w.change_scalar(self.ids[i], bit(v))
+    }
+
+    /// Sets the `n` wires from `first` to a pattern whose most significant
+    /// of `n` bits is the first wire (the phases: bit 4 is S1).
+    fn set_bits(&mut self, at: Instant, first: usize, n: usize, pattern: u8) -> io::Result<()> {
+        for k in 0..n {
+            self.set(at, first + k, pattern & (1 << (n - 1 - k)) != 0)?;
         }
+        Ok(())
     }
 }
 
@@ -239,29 +228,43 @@ end
         let mut parser = Parser::new(&buf[..]);
         let header = parser.parse_header().expect("VCD header parses");
         let id = |name: &str| header.find_var(&["ppmc", name]).expect("declared").code;
-        let (pout, busy, s1, s4, dir, auxo) = (
-            id("pout"),
-            id("busy"),
-            id("s1"),
-            id("s4"),
-            id("dir"),
-            id("auxo"),
-        );
+        let (pout, busy, s1, s4, dir) = (id("pout"), id("busy"), id("s1"), id("s4"), id("dir"));
+        let auxo: Vec<IdCode> = (0..4).map(|k| id(&format!("auxo{k}"))).collect();
         let mut now = 0u64;
         let mut rises = Vec::new();
         let mut busy_changes = Vec::new();
         let mut last_s = (0, 0);
         let mut dir_high = false;
-        let mut auxo_seen = None;
+        let mut auxo_seen = [false; 4];
+        // Every value written is a change, and every timestamp has one.
+        let mut values = std::collections::HashMap::new();
+        let mut changes_since_timestamp = 1;
         for cmd in parser {
-            match cmd.expect("VCD body parses") {
-                Command::Timestamp(t) => now = t,
+            let cmd = cmd.expect("VCD body parses");
+            match cmd {
+                Command::Timestamp(t) => {
+                    assert!(changes_since_timestamp > 0, "an empty timestamp before #{t}");
+                    changes_since_timestamp = 0;
+                    now = t;
+                }
+                Command::ChangeScalar(i, v) => {
+                    changes_since_timestamp += 1;
+                    assert_ne!(values.insert(i, v), Some(v), "{i} rewritten unchanged at {now}");
+                }
+                Command::ChangeVector(..) => panic!("a vector in the export"),
+                _ => {}
+            }
+            match cmd {
                 Command::ChangeScalar(i, Value::V1) if i == pout => rises.push(now),
                 Command::ChangeScalar(i, v) if i == busy => busy_changes.push((now, v)),
                 Command::ChangeScalar(i, v) if i == s1 => last_s.0 = u8::from(v == Value::V1),
                 Command::ChangeScalar(i, v) if i == s4 => last_s.1 = u8::from(v == Value::V1),
                 Command::ChangeScalar(i, Value::V1) if i == dir => dir_high = true,
-                Command::ChangeVector(i, v) if i == auxo => auxo_seen = Some(v.to_string()),
+                Command::ChangeScalar(i, v) => {
+                    if let Some(k) = auxo.iter().position(|a| *a == i) {
+                        auxo_seen[k] = v == Value::V1;
+                    }
+                }
                 _ => {}
             }
         }
@@ -273,6 +276,7 @@ end
         // Three CCW steps from S1S2 end at S2S3... index 1: S2 S3, so S1 = 0, S4 = 0.
         assert_eq!(last_s, (0, 0));
         assert!(dir_high, "DIR shows CCW");
-        assert_eq!(auxo_seen.as_deref(), Some("0101"));
+        // 0b0101: AUXO0 and AUXO2.
+        assert_eq!(auxo_seen, [true, false, true, false]);
     }
 }

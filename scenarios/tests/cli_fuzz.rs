@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{ppmc, scratch};
+use common::{ppmc, scratch, text};
 use std::path::Path;
 
 #[test]
@@ -181,6 +181,25 @@ fn a_differential_run_finds_a_faulty_emulator_and_writes_a_reproducer() {
         "the seed replays"
     );
     let _ = std::fs::remove_dir_all(dir);
+}
+
+/// Actions are generated as they run: a billion of them stopped by
+/// `--duration` cost no more memory than a few (generating them up front
+/// would ask for gigabytes and abort), and the run says how far it got.
+#[test]
+fn a_differential_run_of_a_billion_actions_generates_them_as_it_goes() {
+    let out = ppmc(&[
+        "fuzz",
+        "--seed",
+        "5",
+        "--ops",
+        "1000000000",
+        "--duration",
+        "1s",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let said = text(&out.stdout);
+    assert!(said.contains("no departure from the emulator"), "{said}");
 }
 
 /// A directory of findings of one bug is one bucket; the coverage report

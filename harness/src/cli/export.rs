@@ -36,10 +36,13 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
     // Streamed: a 16-million-pulse trace costs time, not memory.
     if out.as_os_str() == "-" {
         let stdout = std::io::stdout().lock();
-        if let Err(e) = crate::vcd_export::export(&trace, stdout) {
-            return Err(CliError::Failed(format!("standard output: {e}")));
-        }
-        return Ok(());
+        return match crate::vcd_export::export(&trace, stdout) {
+            // A reader that stops early (`| head`) is not an error.
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                Err(CliError::Failed(format!("standard output: {e}")))
+            }
+            _ => Ok(()),
+        };
     }
     files::write_with(&out, |w| crate::vcd_export::export(&trace, w))?;
     outln!("wrote {}", out.display());

@@ -14,17 +14,34 @@ use crate::trace::{Event, EventKind, Trace};
 use rand::{Rng, SeedableRng};
 use std::fmt::Write as _;
 
-/// The actions of run `seed`: a valid initialization, then `n - 1` actions
-/// decoded from the seed's random bytes.
-pub fn program(seed: u64, n: usize) -> Vec<Action> {
-    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-    let mut acts = vec![Action::default_init()];
-    while acts.len() < n {
-        let bytes: Vec<u8> = (0..256).map(|_| rng.random()).collect();
-        acts.extend(actions::decode(&bytes));
+/// The actions of run `seed`, generated as they are taken: a valid
+/// initialization, then actions decoded from the seed's random bytes, for
+/// ever. `program(seed).take(n)` is the run of `n` actions; memory does not
+/// grow with `n`.
+pub fn program(seed: u64) -> Program {
+    Program {
+        rng: rand::rngs::StdRng::seed_from_u64(seed),
+        pending: std::collections::VecDeque::from([Action::default_init()]),
     }
-    acts.truncate(n.max(1));
-    acts
+}
+
+/// The endless action stream of one seed (see [`program`]).
+#[derive(Debug, Clone)]
+pub struct Program {
+    rng: rand::rngs::StdRng,
+    pending: std::collections::VecDeque<Action>,
+}
+
+impl Iterator for Program {
+    type Item = Action;
+
+    fn next(&mut self) -> Option<Action> {
+        while self.pending.is_empty() {
+            let bytes: Vec<u8> = (0..256).map(|_| self.rng.random()).collect();
+            self.pending.extend(actions::decode(&bytes));
+        }
+        self.pending.pop_front()
+    }
 }
 
 /// Where a run first departed from the emulator.
@@ -118,7 +135,7 @@ pub struct DiffSettings {
 /// stop the run early by returning false.
 pub fn run(
     target: &mut dyn Target,
-    acts: &[Action],
+    acts: impl IntoIterator<Item = Action>,
     s: &DiffSettings,
     mut progress: impl FnMut(usize) -> bool,
 ) -> Result<Option<Departure>, TargetError> {
@@ -136,7 +153,9 @@ pub fn run(
         bus: Vec::new(),
         capture: Record::default(),
     };
-    for (i, a) in acts.iter().enumerate() {
+    let mut last = 0;
+    for (i, a) in acts.into_iter().enumerate() {
+        last = i;
         let mut stmts = a.stmts();
         // Every action ends with a status read: what the host sees, and
         // whether the chip is idle so that the pulses can be compared.
@@ -170,7 +189,7 @@ pub fn run(
         &s.tolerances,
     ) {
         return Ok(Some(Departure {
-            action: acts.len().saturating_sub(1),
+            action: last,
             divergence,
         }));
     }
@@ -187,7 +206,9 @@ pub fn minimize(
     budget: usize,
 ) -> Result<(Vec<Action>, Option<Departure>), TargetError> {
     let mut tries = 1;
-    let departs = |target: &mut dyn Target, acts: &[Action]| run(target, acts, s, |_| true);
+    let departs = |target: &mut dyn Target, acts: &[Action]| {
+        run(target, acts.iter().cloned(), s, |_| true)
+    };
     let Some(mut d) = departs(target, acts)? else {
         return Ok((acts.to_vec(), None));
     };
@@ -254,10 +275,14 @@ mod tests {
 
     #[test]
     fn a_seed_gives_one_program() {
-        assert_eq!(program(7, 50), program(7, 50));
-        assert_ne!(program(7, 50), program(8, 50));
-        assert_eq!(program(7, 50)[0], Action::default_init());
-        assert_eq!(program(7, 50).len(), 50);
+        let take = |seed, n| program(seed).take(n).collect::<Vec<_>>();
+        assert_eq!(take(7, 50), take(7, 50));
+        assert_ne!(take(7, 50), take(8, 50));
+        assert_eq!(take(7, 50)[0], Action::default_init());
+        assert_eq!(take(7, 50).len(), 50);
+        // A longer run starts with the shorter one: the seed alone replays
+        // the prefix that departed.
+        assert_eq!(take(7, 500)[..50], take(7, 50)[..]);
     }
 
     #[test]
@@ -266,7 +291,7 @@ mod tests {
         for seed in 0..4 {
             let d = run(
                 &mut t,
-                &program(seed, 120),
+                program(seed).take(120),
                 &DiffSettings::default(),
                 |_| true,
             );
@@ -283,8 +308,8 @@ mod tests {
         let mut t = emu(cfg);
         let s = DiffSettings::default();
         let found = (0..40).find_map(|seed| {
-            let acts = program(seed, 300);
-            run(&mut t, &acts, &s, |_| true)
+            let acts: Vec<Action> = program(seed).take(300).collect();
+            run(&mut t, acts.iter().cloned(), &s, |_| true)
                 .expect("runs")
                 .map(|d| (seed, acts, d))
         });

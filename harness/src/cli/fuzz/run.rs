@@ -74,8 +74,9 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
         "ppmc fuzz: seed {seed}, {} actions against {name} (replay with --seed {seed})",
         args.ops
     );
-    let acts = differential::program(seed, args.ops);
-    let bar = ProgressBar::new(acts.len() as u64);
+    // Generated as they run: a billion actions cost no more memory than ten.
+    let n = args.ops.max(1);
+    let bar = ProgressBar::new(n as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} actions {elapsed} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -85,7 +86,8 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
         .duration
         .map(|d| std::time::Duration::from_nanos(d.as_nanos()));
     let mut done = 0;
-    let result = differential::run(target.as_mut(), &acts, &settings, |n| {
+    let acts = differential::program(seed).take(n);
+    let result = differential::run(target.as_mut(), acts, &settings, |n| {
         done = n;
         bar.set_position(n as u64);
         limit.is_none_or(|l| t0.elapsed() < l)
@@ -106,9 +108,11 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
         return Ok(());
     };
     outln!("seed {seed}: {d}");
+    // The seed replays the run up to the departure.
+    let acts: Vec<_> = differential::program(seed).take(d.action + 1).collect();
     let (small, small_d) = match differential::minimize(
         target.as_mut(),
-        &acts[..=d.action],
+        &acts,
         &settings,
         args.minimize_budget,
     ) {
@@ -123,7 +127,7 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
         // Not reproducible from a reset (a flaky board): keep the whole run.
         None => {
             errln!("ppmc fuzz: the departure did not repeat from a reset; keeping the whole run");
-            (acts[..=d.action].to_vec(), d.clone())
+            (acts, d.clone())
         }
     };
     let out = args
