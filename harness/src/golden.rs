@@ -7,6 +7,7 @@
 //! file and a FIFO or a huge file is refused, not read.
 
 use crate::files::{self, FileError, MAX_TRACE_BYTES};
+use crate::protocol::Straps;
 use crate::trace::{Trace, TraceError};
 use std::path::{Path, PathBuf};
 
@@ -36,6 +37,14 @@ pub enum GoldenError {
         path: PathBuf,
         expected: String,
         found: String,
+    },
+    /// The file was recorded on a chip strapped otherwise than the one it
+    /// would judge: every time in it would be off for that reason alone.
+    #[error("{path}: recorded at {recorded}, but the target is strapped {target}; record golden traces at these straps (`ppmc record`) or judge a board strapped as they were")]
+    OtherStraps {
+        path: PathBuf,
+        recorded: Straps,
+        target: Straps,
     },
     /// Writing would replace an existing golden file.
     #[error("{path}: exists; pass --bless to replace golden files")]
@@ -72,6 +81,20 @@ pub fn load(dir: &Path, scenario: &str) -> Result<Trace, GoldenError> {
             path,
             expected: scenario.to_string(),
             found: trace.scenario,
+        });
+    }
+    Ok(trace)
+}
+
+/// Reads the golden trace of `scenario` to judge a target strapped
+/// `straps`: one recorded at other straps is refused by name.
+pub fn load_for(dir: &Path, scenario: &str, straps: &Straps) -> Result<Trace, GoldenError> {
+    let trace = load(dir, scenario)?;
+    if trace.straps != *straps {
+        return Err(GoldenError::OtherStraps {
+            path: path_for(dir, scenario),
+            recorded: trace.straps,
+            target: *straps,
         });
     }
     Ok(trace)
@@ -165,6 +188,19 @@ mod tests {
             e.to_string().contains("trace of scenario `x`, not `y`"),
             "{e}"
         );
+        let at12 = Straps {
+            sysclk_hz: 12_000_000,
+            ..Straps::default()
+        };
+        write(d, &trace("w"), false).expect("new");
+        let e = load_for(d, "w", &at12).expect_err("other straps");
+        assert!(
+            e.to_string().contains(
+                "w.snap: recorded at SysClk 16 MHz, CSEL high, VSEL high, no external clock, but the target is strapped SysClk 12 MHz"
+            ),
+            "{e}"
+        );
+        assert!(load_for(d, "w", &Straps::default()).is_ok());
         fs::write(d.join("z.snap"), "ppmc-trace 1\nscenario z\n").expect("write");
         assert!(load(d, "z")
             .expect_err("truncated")

@@ -243,13 +243,20 @@ end
             let cmd = cmd.expect("VCD body parses");
             match cmd {
                 Command::Timestamp(t) => {
-                    assert!(changes_since_timestamp > 0, "an empty timestamp before #{t}");
+                    assert!(
+                        changes_since_timestamp > 0,
+                        "an empty timestamp before #{t}"
+                    );
                     changes_since_timestamp = 0;
                     now = t;
                 }
                 Command::ChangeScalar(i, v) => {
                     changes_since_timestamp += 1;
-                    assert_ne!(values.insert(i, v), Some(v), "{i} rewritten unchanged at {now}");
+                    assert_ne!(
+                        values.insert(i, v),
+                        Some(v),
+                        "{i} rewritten unchanged at {now}"
+                    );
                 }
                 Command::ChangeVector(..) => panic!("a vector in the export"),
                 _ => {}

@@ -105,10 +105,11 @@ fn s3_2_2_ramp_runs_from_rl_to_rh(d: &mut Driver) -> Outcome {
 #[scenario(section = "3-2-1", tags("init", "clock"))]
 fn s3_2_2_external_clock(d: &mut Driver) -> Outcome {
     d.init(Init::four_phase().external_clock())?;
-    match d.straps().ext_clock_hz {
-        Some(hz) => {
+    // Tclock = 1 / the CLOCK pin's frequency: (99 + 1) x Tclock, plus
+    // VSEL low's term (Equations 3-1, 3-3).
+    match d.period_on(ClockSource::External, 99) {
+        Some(period) => {
             d.run(Move::constant(Cw, 99, 10))?;
-            let period = Duration::from_nanos((100 * 1_000_000_000 + u64::from(hz) / 2) / u64::from(hz));
             d.expect_intervals(period, period)
         }
         None => {

@@ -44,7 +44,8 @@ fn s3_5_1_default_switching_chops_the_phases(d: &mut Driver) -> Outcome {
     let (on, off) = (d.fw(us(65)), d.fw(Duration::from_nanos(108_750)));
     d.expect_chopping(on, off, Duration::from_nanos(250))?;
     d.run(Move::accel(Cw, 20))?;
-    let (offs, _) = count_chops(d, us(5), ms(2))?;
+    // HOLD comes on 3.4 ms after the last pulse at 16 MHz (Table 3-3).
+    let (offs, _) = count_chops(d, us(5), d.fw(ms(3)))?;
     d.check("no chopping until HOLD", 0, offs)
 }
 
@@ -74,12 +75,12 @@ fn s3_5_1_switching_parameters_while_busy(d: &mut Driver) -> Outcome {
 fn s3_5_2_aux_on_off_before_initialization(d: &mut Driver) -> Outcome {
     d.expect_pins(None, None, Some(false), Some(0))?;
     d.trigger_command(0xC1)?;
-    d.wait(us(50))?;
+    d.wait(d.fw(us(50)))?;
     d.expect_latency(TimingId::AuxOn)?;
     d.expect_no_error()?;
     d.expect_pins(None, None, Some(true), None)?;
     d.trigger_command(0xC2)?;
-    d.wait(us(50))?;
+    d.wait(d.fw(us(50)))?;
     d.expect_latency(TimingId::AuxOff)?;
     d.expect_pins(None, None, Some(false), None)
 }
@@ -90,7 +91,7 @@ fn s3_5_2_aux_on_while_busy(d: &mut Driver) -> Outcome {
     d.init_and_wait(Init::four_phase())?;
     d.start(Move::accel(Cw, 500))?;
     d.trigger_command(0xC1)?;
-    d.wait(us(50))?;
+    d.wait(d.fw(us(50)))?;
     d.expect_no_error()?;
     d.expect_latency(TimingId::AuxOn)?;
     d.wait_idle()?;
@@ -103,13 +104,13 @@ fn s3_5_2_aux_on_while_busy(d: &mut Driver) -> Outcome {
 fn s3_5_3_aux_output_drives_auxo(d: &mut Driver) -> Outcome {
     d.command(0x86)?;
     d.data(0b0101)?;
-    d.wait(us(50))?;
+    d.wait(d.fw(us(50)))?;
     d.expect_pins(None, None, None, Some(0b0101))?;
     d.init_and_wait(Init::four_phase())?;
     d.start(Move::accel(Cw, 500))?;
     d.command(0x86)?;
     d.data(0xFA)?;
-    d.wait(us(50))?;
+    d.wait(d.fw(us(50)))?;
     d.expect_no_error()?;
     d.expect_pins(None, None, None, Some(0b1010))?;
     d.wait_idle()?;
@@ -122,7 +123,7 @@ fn s3_5_4_software_reset_frees_the_motor(d: &mut Driver) -> Outcome {
     d.init_and_wait(Init::four_phase())?;
     d.expect_phases(0b11000)?;
     d.trigger_command(0xC0)?;
-    d.wait(us(50))?;
+    d.wait(d.fw(us(50)))?;
     d.expect_latency(TimingId::ExcitationOff)?;
     d.expect_phases(0)?;
     d.command(Move::single_step(Cw).code())?;

@@ -168,6 +168,67 @@ fn a_missing_board_is_an_infrastructure_error_with_reports() {
     assert_eq!(ppmc(&["run", "--target", "serial:"]).status.code(), Some(2));
 }
 
+/// The bridge says how its chip is strapped. Straps on the command line
+/// that contradict it stop the run before any scenario (an infrastructure
+/// error naming both); without them the bridge's are used, and a golden
+/// trace recorded at other straps says so by name instead of failing the
+/// board on every time.
+#[test]
+fn straps_come_from_the_bridge_and_a_contradiction_stops_the_run() {
+    let sim = BridgeSim::start(&["--clock-mhz", "12"]);
+    let one = "s3_3_4_accel_1000_steps_cw";
+    let out = ppmc(&[
+        "run",
+        "--target",
+        &sim.target(),
+        "--clock-mhz",
+        "16",
+        "--filter",
+        one,
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(err.contains("infrastructure error"), "{err}");
+    assert!(
+        err.contains("--clock-mhz: the bridge reports 12, given 16"),
+        "{err}"
+    );
+    assert!(
+        text(&out.stdout).contains("1 not run"),
+        "{}",
+        text(&out.stdout)
+    );
+
+    // Agreeing straps, or none, run; the bridge's straps are the trace's.
+    let golden = concat!(env!("CARGO_MANIFEST_DIR"), "/../golden");
+    let out = ppmc(&[
+        "run",
+        "--target",
+        &sim.target(),
+        "--filter",
+        one,
+        "--golden",
+        golden,
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains(&format!("ERROR    {one}")), "{stdout}");
+    assert!(
+        stdout.contains("recorded at SysClk 16 MHz, CSEL high, VSEL high, no external clock, but the target is strapped SysClk 12 MHz"),
+        "{stdout}"
+    );
+    let out = ppmc(&[
+        "run",
+        "--target",
+        &sim.target(),
+        "--clock-mhz",
+        "12",
+        "--filter",
+        one,
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+}
+
 #[test]
 fn a_chip_fault_behind_the_bridge_is_caught() {
     let sim = BridgeSim::start(&["--chip-fault", "swap-error-3-4"]);

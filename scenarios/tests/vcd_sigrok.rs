@@ -62,7 +62,7 @@ fn rising_edges(vcd: &Path, wire: &str) -> u64 {
     text(&out.stdout)
         .lines()
         .filter_map(|l| l.rsplit(':').next()?.trim().parse::<u64>().ok())
-        .last()
+        .next_back()
         .unwrap_or(0)
 }
 
@@ -107,7 +107,11 @@ fn sigrok_counts_every_pulse_of_an_exported_trace() {
         assert!(samples > 0, "{name}: sigrok loads no samples:\n{show}");
         let trace = std::fs::read_to_string(&src).expect("golden");
         let want = pulses_in(&trace);
-        assert_eq!(rising_edges(&vcd, "pout"), want, "{name}: POUT rising edges");
+        assert_eq!(
+            rising_edges(&vcd, "pout"),
+            want,
+            "{name}: POUT rising edges"
+        );
     }
     // AUXO is four wires sigrok reads: the scenario drives some of them high.
     let auxo = dir.path().join("s3_5_3_aux_output_drives_auxo.vcd");

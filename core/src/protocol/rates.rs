@@ -43,6 +43,25 @@ impl Default for Straps {
     }
 }
 
+impl core::fmt::Display for Straps {
+    /// `SysClk 16 MHz, CSEL high, VSEL high, no external clock`: how a
+    /// person names a board's straps.
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let level = |high| if high { "high" } else { "low" };
+        write!(
+            f,
+            "SysClk {} MHz, CSEL {}, VSEL {}, ",
+            f64::from(self.sysclk_hz) / 1e6,
+            level(self.csel_high),
+            level(self.vsel_high)
+        )?;
+        match self.ext_clock_hz {
+            Some(hz) => write!(f, "external clock {} kHz", f64::from(hz) / 1e3),
+            None => f.write_str("no external clock"),
+        }
+    }
+}
+
 /// Why a set of straps cannot describe a working board.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum StrapsError {
@@ -214,6 +233,23 @@ impl Straps {
         at_16mhz.scale(u64::from(REFERENCE_SYSCLK_HZ), u64::from(self.sysclk_hz))
     }
 
+    /// A time limit given for the reference board (16 MHz, CSEL high, no
+    /// external clock), stretched for this one: by as many times as its
+    /// firmware (16 MHz / SysClk) or its slowest pulse clock (Tclock over
+    /// the reference 2 us, internal or external) is slower, never
+    /// shortened. Timeouts and budgets written for the reference board
+    /// hold on every board the straps allow.
+    pub fn stretch(&self, at_reference: Duration) -> Duration {
+        let reference_tclock = 2_000u64;
+        let mut out = at_reference.max(self.firmware_time(at_reference));
+        for source in [ClockSource::Internal, ClockSource::External] {
+            if let Some(t) = self.tclock(source) {
+                out = out.max(at_reference.scale(t.as_nanos(), reference_tclock));
+            }
+        }
+        out
+    }
+
     /// Switching ON time (Equations 3-5 and 3-7).
     pub fn switching_on_time(&self, pon: u8) -> Duration {
         let base = if self.vsel_high { 27_000 } else { 25_000 };
@@ -232,6 +268,54 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
     use rstest::rstest;
+
+    #[test]
+    fn a_reference_time_limit_stretches_for_a_slower_board_and_never_shrinks() {
+        let second = Duration::from_secs(1);
+        assert_eq!(Straps::default().stretch(second), second);
+        let fast = Straps {
+            sysclk_hz: 40_000_000,
+            ..Straps::default()
+        };
+        assert_eq!(fast.stretch(second), second);
+        // 1 MHz: firmware 16 times slower, Tclock 32 us (16 times).
+        let slow = Straps {
+            sysclk_hz: 1_000_000,
+            ..Straps::default()
+        };
+        assert_eq!(slow.stretch(second), Duration::from_secs(16));
+        // CSEL low at 1 MHz: Tclock 128 us, 64 times the reference.
+        let slowest = Straps {
+            csel_high: false,
+            ..slow
+        };
+        assert_eq!(slowest.stretch(second), Duration::from_secs(64));
+        // A 1 kHz external clock: Tclock 1 ms, 500 times.
+        let ext = Straps {
+            ext_clock_hz: Some(1_000),
+            ..Straps::default()
+        };
+        assert_eq!(ext.stretch(second), Duration::from_secs(500));
+    }
+
+    #[test]
+    fn straps_read_as_a_person_names_them() {
+        use alloc::format;
+        assert_eq!(
+            format!("{}", Straps::default()),
+            "SysClk 16 MHz, CSEL high, VSEL high, no external clock"
+        );
+        let s = Straps {
+            sysclk_hz: 12_288_000,
+            csel_high: false,
+            vsel_high: false,
+            ext_clock_hz: Some(250_000),
+        };
+        assert_eq!(
+            format!("{s}"),
+            "SysClk 12.288 MHz, CSEL low, VSEL low, external clock 250 kHz"
+        );
+    }
 
     #[test]
     fn strap_fields_round_trip_and_a_typo_is_refused_not_defaulted() {

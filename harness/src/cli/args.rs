@@ -18,18 +18,23 @@ pub struct TargetArgs {
     /// or `ppmc bridge-sim`, behind the serial bus bridge).
     #[arg(long, default_value = "emu")]
     target: String,
-    /// System clock in MHz (fractions allowed, e.g. 12.288).
-    #[arg(long, default_value_t = 16.0)]
-    clock_mhz: f64,
-    /// CSEL strap: high = internal clock SysClk/32 (500 kHz at 16 MHz), low = SysClk/128.
-    #[arg(long, value_enum, default_value_t = Level::High)]
-    csel: Level,
-    /// VSEL strap: high = Equations 3-1/3-2, low = 3-3/3-4 (+7.5 us per pulse).
-    #[arg(long, value_enum, default_value_t = Level::High)]
-    vsel: Level,
+    /// System clock in MHz, 1 to 40 (fractions allowed, e.g. 12.288).
+    /// Default: 16 on the emulator; on a board, what its bridge reports
+    /// (given, it must agree).
+    #[arg(long, value_name = "MHZ")]
+    clock_mhz: Option<f64>,
+    /// CSEL strap: high = internal clock SysClk/32 (500 kHz at 16 MHz), low =
+    /// SysClk/128. Default: high on the emulator; on a board, the bridge's.
+    #[arg(long, value_enum)]
+    csel: Option<Level>,
+    /// VSEL strap: high = Equations 3-1/3-2, low = 3-3/3-4 (+7.5 us per
+    /// pulse). Default: high on the emulator; on a board, the bridge's.
+    #[arg(long, value_enum)]
+    vsel: Option<Level>,
     /// Frequency on the CLOCK pin in kHz, if the board has one (used when the
-    /// initialization selects the external clock).
-    #[arg(long)]
+    /// initialization selects the external clock). Default: none on the
+    /// emulator; on a board, the bridge's.
+    #[arg(long, value_name = "KHZ")]
     ext_clock_khz: Option<f64>,
     /// Shape of the acceleration ramp (the datasheet's chapter 1 is not available).
     #[arg(long, value_enum, default_value_t = Curve::LinearSpeed)]
@@ -48,31 +53,78 @@ enum Curve {
     LinearRate,
 }
 
+/// `value` Hz (the flag's `shown` value) as a whole number of hertz.
+fn hz(value: f64, flag: &str, shown: f64) -> Result<u32, String> {
+    let v = value.round();
+    if v.is_finite() && v >= 1.0 && v <= f64::from(u32::MAX) {
+        Ok(v as u32)
+    } else {
+        Err(format!("{flag} {shown} is not a usable frequency"))
+    }
+}
+
 pub fn parse_duration(s: &str) -> Result<Duration, String> {
     s.parse::<Duration>().map_err(|e| e.to_string())
 }
 
 impl TargetArgs {
+    /// The straps: those given, the emulator's defaults for the rest.
     pub fn straps(&self) -> Result<Straps, String> {
-        let hz = |mhz: f64, what: &str| -> Result<u32, String> {
-            let v = (mhz * 1e6).round();
-            if v.is_finite() && v >= 1.0 && v <= f64::from(u32::MAX) {
-                Ok(v as u32)
-            } else {
-                Err(format!("{what} {mhz} is not a usable frequency"))
-            }
-        };
+        let d = Straps::default();
         let straps = Straps {
-            sysclk_hz: hz(self.clock_mhz, "--clock-mhz")?,
-            csel_high: self.csel == Level::High,
-            vsel_high: self.vsel == Level::High,
+            sysclk_hz: match self.clock_mhz {
+                Some(mhz) => hz(mhz * 1e6, "--clock-mhz", mhz)?,
+                None => d.sysclk_hz,
+            },
+            csel_high: self.csel.map_or(d.csel_high, |l| l == Level::High),
+            vsel_high: self.vsel.map_or(d.vsel_high, |l| l == Level::High),
             ext_clock_hz: self
                 .ext_clock_khz
-                .map(|k| hz(k / 1e3, "--ext-clock-khz"))
+                .map(|k| hz(k * 1e3, "--ext-clock-khz", k))
                 .transpose()?,
         };
         straps.validate().map_err(|e| e.to_string())?;
         Ok(straps)
+    }
+
+    /// The straps given on the command line that disagree with `reported`
+    /// (what a bridge says its chip is strapped to), each as
+    /// `--flag: bridge X, given Y`.
+    pub fn disagreements(&self, reported: &Straps) -> Result<Vec<String>, String> {
+        let given = self.straps()?;
+        let level = |high| if high { "high" } else { "low" };
+        let mut out = Vec::new();
+        if self.clock_mhz.is_some() && given.sysclk_hz != reported.sysclk_hz {
+            out.push(format!(
+                "--clock-mhz: the bridge reports {}, given {}",
+                f64::from(reported.sysclk_hz) / 1e6,
+                f64::from(given.sysclk_hz) / 1e6
+            ));
+        }
+        if self.csel.is_some() && given.csel_high != reported.csel_high {
+            out.push(format!(
+                "--csel: the bridge reports {}, given {}",
+                level(reported.csel_high),
+                level(given.csel_high)
+            ));
+        }
+        if self.vsel.is_some() && given.vsel_high != reported.vsel_high {
+            out.push(format!(
+                "--vsel: the bridge reports {}, given {}",
+                level(reported.vsel_high),
+                level(given.vsel_high)
+            ));
+        }
+        if self.ext_clock_khz.is_some() && given.ext_clock_hz != reported.ext_clock_hz {
+            let khz =
+                |h: Option<u32>| h.map_or("none".to_string(), |h| (f64::from(h) / 1e3).to_string());
+            out.push(format!(
+                "--ext-clock-khz: the bridge reports {}, given {}",
+                khz(reported.ext_clock_hz),
+                khz(given.ext_clock_hz)
+            ));
+        }
+        Ok(out)
     }
 
     /// The `--target` text.
@@ -108,6 +160,17 @@ impl TargetArgs {
             let infra = |e: crate::backend::SerialError| OpenError::Infrastructure(e.to_string());
             let link = SerialLink::open(&path, baud).map_err(infra)?;
             let t = SerialTarget::open(link, SerialOptions::default()).map_err(infra)?;
+            // The bridge knows how its chip is strapped; the command line
+            // may only confirm it. A board at 12 MHz judged as one at 16
+            // would fail for the wrong reason.
+            let reported = t.straps();
+            let differ = self.disagreements(&reported).map_err(OpenError::Usage)?;
+            if !differ.is_empty() {
+                return Err(OpenError::Infrastructure(format!(
+                    "{path}: the bridge reports its chip strapped {reported}, which the command line contradicts ({}); fix the options or the board, or leave the strap options out to use the bridge's",
+                    differ.join("; ")
+                )));
+            }
             return Ok(Box::new(t));
         }
         Err(OpenError::Usage(format!(

@@ -94,7 +94,7 @@ fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) {
             at,
         })
     };
-    match golden::load(dir, r.name) {
+    match golden::load_for(dir, r.name, &trace.straps) {
         Ok(g) => {
             if let Err(d) = compare(&g, trace, tol) {
                 r.verdict = fail(

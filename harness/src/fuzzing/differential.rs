@@ -206,9 +206,8 @@ pub fn minimize(
     budget: usize,
 ) -> Result<(Vec<Action>, Option<Departure>), TargetError> {
     let mut tries = 1;
-    let departs = |target: &mut dyn Target, acts: &[Action]| {
-        run(target, acts.iter().cloned(), s, |_| true)
-    };
+    let departs =
+        |target: &mut dyn Target, acts: &[Action]| run(target, acts.iter().cloned(), s, |_| true);
     let Some(mut d) = departs(target, acts)? else {
         return Ok((acts.to_vec(), None));
     };

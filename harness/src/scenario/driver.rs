@@ -16,7 +16,10 @@ use crate::protocol::{
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, Event, EventKind};
 
-/// Timeouts and limits of a [`Driver`].
+/// Timeouts and limits of a [`Driver`], given for the reference board
+/// (16 MHz, CSEL high): the driver stretches each for a slower board
+/// ([`Straps::stretch`]), so a scenario's limits hold at every clock the
+/// straps allow.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DriverOptions {
     /// Flowchart writes wait at most this long for IBF = 0.
@@ -77,6 +80,14 @@ impl std::fmt::Debug for Driver<'_> {
 impl<'t> Driver<'t> {
     pub fn new(target: &'t mut dyn Target, opts: DriverOptions) -> Self {
         let straps = target.straps();
+        let opts = DriverOptions {
+            ibf_timeout: straps.stretch(opts.ibf_timeout),
+            obf_timeout: straps.stretch(opts.obf_timeout),
+            busy_timeout: straps.stretch(opts.busy_timeout),
+            idle_timeout: straps.stretch(opts.idle_timeout),
+            budget: straps.stretch(opts.budget),
+            ..opts
+        };
         Driver {
             straps,
             target,
@@ -110,11 +121,15 @@ impl<'t> Driver<'t> {
     /// The pulse period of rate value `rate` on this board's internal clock
     /// (Equations 3-1..3-4).
     pub fn period(&self, rate: u8) -> Duration {
-        let t = self
-            .straps
-            .tclock(ClockSource::Internal)
-            .unwrap_or(Duration::from_micros(2));
-        self.straps.pulse_interval(rate, t)
+        self.period_on(ClockSource::Internal, rate)
+            .unwrap_or(Duration::from_micros(2))
+    }
+
+    /// The pulse period of rate value `rate` on `clock` (Equations 3-1..3-4,
+    /// VSEL included); `None` on an external clock the board lacks.
+    pub fn period_on(&self, clock: ClockSource, rate: u8) -> Option<Duration> {
+        let t = self.straps.tclock(clock)?;
+        Some(self.straps.pulse_interval(rate, t))
     }
 
     /// A firmware time given at the datasheet's 16 MHz, on this board's

@@ -307,7 +307,9 @@ pub fn run_scenario(
 pub mod prelude {
     pub use super::{scenario, Driver, Init, Move, Outcome, Scenario};
     pub use crate::protocol::Direction::{Ccw, Cw};
-    pub use crate::protocol::{Direction, ErrorCode, Flag, Input, MotorType, Register, TimingId};
+    pub use crate::protocol::{
+        ClockSource, Direction, ErrorCode, Flag, Input, MotorType, Register, TimingId,
+    };
     pub use crate::time::Duration;
 
     /// Microseconds.

@@ -15,6 +15,7 @@ pub use self::link::{parse_spec, Link, SerialLink};
 use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
 use crate::protocol::Record;
 use crate::protocol::Straps;
+use crate::time::Instant;
 use ppmc_core::bridge::frame::{self, FrameDecoder};
 use ppmc_core::bridge::wire::MAX_BATCH_OPS;
 use ppmc_core::bridge::wire::{
@@ -72,6 +73,15 @@ pub enum SerialError {
     },
     #[error("{link}: the bridge restarted (session {old:08x} -> {new:08x}); the chip's state is unknown")]
     Restarted { link: String, old: u32, new: u32 },
+    /// A reply came back timed before an earlier one, with no chip reset
+    /// in between: the bridge restarted behind the open port (a watchdog,
+    /// a brown-out) and the chip's state was lost with it.
+    #[error("{link}: the bridge's clock went back from {was} to {now} without a chip reset: the bridge restarted behind the open port and the chip's state is unknown")]
+    ClockWentBack {
+        link: String,
+        was: Instant,
+        now: Instant,
+    },
     #[error("{link}: health check failed: {detail}")]
     Unhealthy { link: String, detail: String },
     /// A request of `len` bytes kept arriving garbled; the bridge has not
@@ -216,6 +226,9 @@ pub struct SerialTarget<L: Link> {
     /// the rest of it back, and the bridge's chip has not moved on since
     /// (it runs in virtual time, so nothing happens between requests).
     captured_current: bool,
+    /// The latest bridge time seen since the last chip reset: a reply
+    /// timed before it means the bridge restarted.
+    clock: Instant,
     /// The request size in force: halved when a request needed asking
     /// again, doubled back after clean ones.
     request_size: usize,
@@ -246,6 +259,7 @@ impl<L: Link> SerialTarget<L> {
             opts,
             captured: Record::default(),
             captured_current: false,
+            clock: Instant::ZERO,
             request_size: MAX_REQUEST,
             stats: LinkStats::default(),
         };
@@ -614,6 +628,26 @@ impl<L: Link> SerialTarget<L> {
         n
     }
 
+    /// Follows the bridge's clock through the replies to `ops`: it restarts
+    /// at a chip reset and otherwise never goes back.
+    fn check_clock(&mut self, ops: &[Op], replies: &[Reply]) -> Result<(), SerialError> {
+        for (op, r) in ops.iter().zip(replies) {
+            let at = r.at();
+            if *op == Op::Reset {
+                self.clock = at;
+            } else if at < self.clock {
+                return Err(SerialError::ClockWentBack {
+                    link: self.link.name(),
+                    was: self.clock,
+                    now: at,
+                });
+            } else {
+                self.clock = at;
+            }
+        }
+        Ok(())
+    }
+
     /// Runs `ops` in requests of the size in force. On a clean link the last
     /// request also brings back the capture since the last fetch (what the
     /// bridge has not sent yet, up to one chunk), so that reading the
@@ -670,8 +704,12 @@ impl<L: Link> SerialTarget<L> {
                 (self.request_size * 2).min(MAX_REQUEST)
             };
             match reply {
-                Response::Batch(r) if r.len() == chunk.len() => out.extend(r),
+                Response::Batch(r) if r.len() == chunk.len() => {
+                    self.check_clock(chunk, &r)?;
+                    out.extend(r);
+                }
                 Response::BatchCapture { replies, capture } if replies.len() == chunk.len() => {
+                    self.check_clock(chunk, &replies)?;
                     out.extend(replies);
                     let more = self.absorb(capture);
                     self.captured_current = !more && self.hello.virtual_time;
@@ -910,6 +948,29 @@ mod tests {
             e.to_string().contains("the bridge restarted"),
             "{}",
             e.to_string()
+        );
+    }
+
+    /// A bridge that reboots while the port stays open (a UART bridge, a
+    /// network link) keeps answering, but its clock starts again at 0: the
+    /// run ends as a link error, never as a device failure on a reset chip.
+    #[test]
+    fn a_bridge_that_restarts_behind_an_open_port_is_caught_by_its_clock() {
+        let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+        let ms = |n| Op::Delay(crate::time::Duration::from_millis(n));
+        t.execute(&[ms(5), Op::ReadStatus]).expect("runs");
+        // A reset of the host's own moves the clock back, rightly.
+        t.execute(&[Op::Reset, Op::ReadStatus])
+            .expect("a reset is fine");
+        t.execute(&[ms(5)]).expect("runs");
+        t.link.server = MemLink::bridge(1);
+        let e = t.execute(&[Op::ReadStatus]).expect_err("restarted");
+        assert_eq!(e.kind, TargetErrorKind::Link);
+        assert!(
+            e.to_string().contains(
+                "the bridge's clock went back from 5000.000us to 0.000us without a chip reset"
+            ),
+            "{e}"
         );
     }
 

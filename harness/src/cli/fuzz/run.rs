@@ -64,6 +64,8 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
             .duration_since(std::time::UNIX_EPOCH)
             .map_or(1, |d| d.as_nanos() as u64)
     });
+    // On a board, its bridge's straps (the emulator's are those given).
+    let straps = target.straps();
     let settings = DiffSettings {
         straps,
         reference: args.target.model(),
@@ -110,18 +112,14 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
     outln!("seed {seed}: {d}");
     // The seed replays the run up to the departure.
     let acts: Vec<_> = differential::program(seed).take(d.action + 1).collect();
-    let (small, small_d) = match differential::minimize(
-        target.as_mut(),
-        &acts,
-        &settings,
-        args.minimize_budget,
-    ) {
-        Ok(x) => x,
-        Err(e) => {
-            errln!("ppmc fuzz: infrastructure error while minimizing: {e}");
-            return Err(CliError::Verdict);
-        }
-    };
+    let (small, small_d) =
+        match differential::minimize(target.as_mut(), &acts, &settings, args.minimize_budget) {
+            Ok(x) => x,
+            Err(e) => {
+                errln!("ppmc fuzz: infrastructure error while minimizing: {e}");
+                return Err(CliError::Verdict);
+            }
+        };
     let (acts_out, d_out) = match small_d {
         Some(sd) => (small, sd),
         // Not reproducible from a reset (a flaky board): keep the whole run.
