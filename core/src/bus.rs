@@ -70,6 +70,53 @@ impl Op {
     }
 }
 
+impl core::fmt::Display for Op {
+    /// What the op does, in words: `write command 0x02 (waiting up to
+    /// 1000000.000us for IBF = 0)`.
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let wait = |f: &mut core::fmt::Formatter<'_>, w: Option<Duration>, flag: &str| match w {
+            Some(t) => write!(f, " (waiting up to {t} for {flag})"),
+            None => Ok(()),
+        };
+        match *self {
+            Op::WriteCommand { byte, wait_ibf } => {
+                write!(f, "write command 0x{byte:02X}")?;
+                wait(f, wait_ibf, "IBF = 0")
+            }
+            Op::WriteData { byte, wait_ibf } => {
+                write!(f, "write data 0x{byte:02X}")?;
+                wait(f, wait_ibf, "IBF = 0")
+            }
+            Op::ReadStatus => f.write_str("read status"),
+            Op::ReadData { wait_obf } => {
+                f.write_str("read data")?;
+                wait(f, wait_obf, "OBF = 1")
+            }
+            Op::Delay(d) => write!(f, "wait {d}"),
+            Op::AwaitStatus {
+                mask,
+                value,
+                timeout,
+            } => write!(
+                f,
+                "wait up to {timeout} for status & 0x{mask:02X} = 0x{value:02X}"
+            ),
+            Op::SetInput { input, asserted } => write!(
+                f,
+                "{} {}",
+                if asserted { "assert" } else { "release" },
+                input.name()
+            ),
+            Op::ReadPins => f.write_str("sample the pins"),
+            Op::ReadPulses => f.write_str("count the pulses"),
+            Op::AwaitPulses { count, timeout } => {
+                write!(f, "wait up to {timeout} for pulse {count}")
+            }
+            Op::Reset => f.write_str("chip reset"),
+        }
+    }
+}
+
 /// The outcome of one [`Op`], stamped with the target's time when it ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Reply {
@@ -156,6 +203,37 @@ impl Reply {
             | Reply::PulsesTimedOut { at, .. }
             | Reply::ResetDone { at } => at,
         }
+    }
+}
+
+impl core::fmt::Display for Reply {
+    /// What came back, in words: `status 0x8E at 120.000us`.
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Reply::Written { .. } => f.write_str("written")?,
+            Reply::WriteTimedOut { status, .. } => {
+                write!(f, "write skipped, IBF stayed 1 (status 0x{:02X})", status.0)?
+            }
+            Reply::Status { status, .. } => write!(f, "status 0x{:02X}", status.0)?,
+            Reply::Data { byte, .. } => write!(f, "data 0x{byte:02X}")?,
+            Reply::ReadTimedOut { status, .. } => {
+                write!(f, "read skipped, OBF stayed 0 (status 0x{:02X})", status.0)?
+            }
+            Reply::Delayed { .. } => f.write_str("waited")?,
+            Reply::Awaited { status, .. } => {
+                write!(f, "condition met (status 0x{:02X})", status.0)?
+            }
+            Reply::AwaitTimedOut { status, .. } => {
+                write!(f, "timed out (status 0x{:02X})", status.0)?
+            }
+            Reply::InputSet { .. } => f.write_str("input set")?,
+            Reply::Pins { .. } => f.write_str("pins")?,
+            Reply::Pulses { summary, .. } => write!(f, "{} pulses", summary.count)?,
+            Reply::PulsesReached { .. } => f.write_str("pulse count reached")?,
+            Reply::PulsesTimedOut { count, .. } => write!(f, "timed out after {count} pulses")?,
+            Reply::ResetDone { .. } => f.write_str("reset done")?,
+        }
+        write!(f, " at {}", self.at())
     }
 }
 

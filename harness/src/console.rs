@@ -416,7 +416,7 @@ pub fn format_reply(stmt: Stmt, reply: &Reply) -> Option<String> {
         (Stmt::WriteCommand { .. } | Stmt::WriteData { .. }, Reply::Written { .. })
         | (Stmt::Wait(_), Reply::Delayed { .. })
         | (Stmt::Set { .. }, Reply::InputSet { .. }) => None,
-        _ => Some(format!("?? unexpected reply {reply:?}")),
+        _ => Some(format!("?? unexpected reply: {reply}")),
     }
 }
 
@@ -458,7 +458,7 @@ pub fn run(
                     return Err(ConsoleError::Protocol {
                         line: l.line,
                         stmt: l.stmt,
-                        reply: format!("{reply:?}"),
+                        reply: reply.to_string(),
                     });
                 }
                 writeln!(out, "{text}")?;

@@ -32,6 +32,7 @@ impl Sim {
 fn fast() -> SerialOptions {
     SerialOptions {
         reply_timeout: WallDuration::from_millis(60),
+        min_reply_timeout: WallDuration::from_millis(5),
         retries: 8,
         reopen_attempts: 3,
         backoff: WallDuration::from_millis(20),
@@ -67,10 +68,17 @@ fn the_whole_suite_over_the_pty_equals_the_in_process_run() {
         assert_eq!(ta.events, tb.events, "{}: same trace over the pty", a.name);
         assert_eq!(ta.target, format!("serial:{}", sim.0.path()), "{}", a.name);
     }
-    assert_eq!(t.stats.retransmissions, 0);
+    // A clean line garbles nothing. (A reply later than the measured
+    // round trip allows, on a loaded machine, may be asked for again; that
+    // costs a round trip, never a result.)
+    assert_eq!(t.stats.corrupt_frames, 0);
     assert!(t.stats.round_trips > 0);
 }
 
+/// With the host's default link settings, a cable that corrupts 1 % of
+/// its bytes costs time, not results: at least 95 of the 96 scenarios
+/// complete, and whatever completes saw exactly what the chip did (the
+/// rest end as link errors, never as a wrong verdict).
 #[test]
 fn corrupted_bytes_never_turn_into_wrong_values() {
     let faults = LinkFaults {
@@ -80,7 +88,7 @@ fn corrupted_bytes_never_turn_into_wrong_values() {
     };
     let sim = Sim::start(faults, ModelConfig::default());
     let mut t = sim
-        .target(fast())
+        .target(SerialOptions::default())
         .expect("bridge answers through the noise");
     let noisy = run_suite(
         &mut t,
@@ -121,17 +129,12 @@ fn corrupted_bytes_never_turn_into_wrong_values() {
         t.stats.retransmissions > 0,
         "and repaired by retransmission"
     );
-    for r in &noisy {
-        if let Verdict::Error(e) = &r.verdict {
-            eprintln!("link error in {}: {e}", r.name);
-        }
-    }
     let first_error = noisy.iter().find_map(|r| match &r.verdict {
         Verdict::Error(e) => Some(format!("{}: {e}", r.name)),
         _ => None,
     });
     assert!(
-        passed * 10 >= noisy.len() * 9,
+        passed + 1 >= noisy.len(),
         "{passed} of {} completed; first error {first_error:?}",
         noisy.len()
     );
@@ -160,7 +163,8 @@ fn a_stalled_bridge_gives_a_timeout_naming_the_op() {
         err.to_string()
     );
     assert!(
-        err.to_string().contains("ReadPins") || err.to_string().contains("ReadStatus"),
+        err.to_string().contains("starting with `sample the pins`")
+            || err.to_string().contains("starting with `read status`"),
         "{}",
         err.to_string()
     );
@@ -182,7 +186,13 @@ fn an_unhealthy_board_is_refused_at_open() {
         .target(fast())
         .expect_err("status is not 0x00 after reset");
     assert!(matches!(err, SerialError::Unhealthy { .. }), "{err}");
-    assert!(err.to_string().contains("health check failed"), "{err}");
+    // A sentence a person reads, not Rust's debug output.
+    assert!(
+        err.to_string().ends_with(
+            "health check failed: after a chip reset the status register reads 0x08, not 0x00"
+        ),
+        "{err}"
+    );
 }
 
 #[test]

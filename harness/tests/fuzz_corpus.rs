@@ -98,6 +98,7 @@ fn write_frame_decoder_seeds() {
         Request::Resend {
             fragments: vec![0, 2],
         },
+        Request::Link { fragment: 12 },
     ];
     let mut server = engine(
         EmuTarget::new(Straps::default(), Default::default()).expect("emu"),
@@ -117,7 +118,10 @@ fn write_frame_decoder_seeds() {
         put(&format!("response-{i}"), &answer);
     }
     let big: Vec<u8> = (0..300u16).map(|x| x as u8).collect();
-    let frags: Vec<u8> = fragment(&big).iter().flat_map(|f| encode(f)).collect();
+    let frags: Vec<u8> = fragment(&big, ppmc::bridge::wire::FRAGMENT_DATA)
+        .iter()
+        .flat_map(|f| encode(f))
+        .collect();
     put("fragments", &frags);
     let mut bad = encode(&Request::Hello { version: 1 }.encode(9, t));
     bad[2] ^= 0x10;

@@ -42,6 +42,8 @@ pub struct BridgeEngine<B> {
     capture_capacity: u32,
     /// The last request payload and the frames sent for it.
     last: Option<(Vec<u8>, Vec<Vec<u8>>)>,
+    /// Data bytes per reply fragment, as the host last asked (LINK).
+    fragment: usize,
     /// Frames handled so far (for fault injection by the caller).
     pub frames: u64,
 }
@@ -60,6 +62,7 @@ impl<B: Bus> BridgeEngine<B> {
             virtual_time,
             capture_capacity: u32::MAX,
             last: None,
+            fragment: wire::FRAGMENT_DATA,
             frames: 0,
         }
     }
@@ -164,7 +167,7 @@ impl<B: Bus> BridgeEngine<B> {
             }
             .encode(seq, self.timer);
         }
-        let frames = fragment(&reply);
+        let frames = fragment(&reply, self.fragment);
         self.last = Some((payload.to_vec(), frames.clone()));
         frames
     }
@@ -246,6 +249,13 @@ impl<B: Bus> BridgeEngine<B> {
                 code: BridgeErrorCode::Malformed,
                 detail: "batch-capture handled before dispatch".into(),
             },
+            Request::Link { fragment } => {
+                self.fragment =
+                    usize::from(fragment).clamp(wire::MIN_FRAGMENT_DATA, wire::FRAGMENT_DATA);
+                Response::Link {
+                    fragment: self.fragment as u8,
+                }
+            }
         }
     }
 

@@ -131,7 +131,7 @@ pub trait Target: Send {
         replies.pop().ok_or_else(|| {
             TargetError::new(
                 TargetErrorKind::Other,
-                format!("target returned no reply to {op:?}"),
+                format!("target returned no reply to `{op}`"),
             )
         })
     }

@@ -34,6 +34,11 @@ pub struct LinkFaults {
     pub drop_rate: f64,
     /// Probability that a byte (either direction) has a bit flipped.
     pub corrupt_rate: f64,
+    /// Probability that a byte (either direction) arrives twice.
+    pub dup_rate: f64,
+    /// Probability that a byte (either direction) swaps places with the
+    /// byte after it.
+    pub reorder_rate: f64,
     /// After this many frames the bridge stops answering (it keeps reading).
     pub stall_after: Option<u64>,
     /// After this many frames the bridge closes the link and ends.
@@ -47,6 +52,8 @@ impl Default for LinkFaults {
         LinkFaults {
             drop_rate: 0.0,
             corrupt_rate: 0.0,
+            dup_rate: 0.0,
+            reorder_rate: 0.0,
             stall_after: None,
             disconnect_after: None,
             seed: 1,
@@ -89,21 +96,39 @@ struct Faulty {
 }
 
 impl Faulty {
+    /// `bytes` as they come out of the faulty line. Each byte draws its
+    /// faults in a fixed order (drop, corrupt, duplicate, reorder), so a
+    /// seed replays the same line.
     fn apply(&mut self, bytes: &[u8]) -> Vec<u8> {
-        if self.f.drop_rate == 0.0 && self.f.corrupt_rate == 0.0 {
+        let f = self.f;
+        if f.drop_rate == 0.0 && f.corrupt_rate == 0.0 && f.dup_rate == 0.0 && f.reorder_rate == 0.0
+        {
             return bytes.to_vec();
         }
-        let mut out = Vec::with_capacity(bytes.len());
+        let mut out = Vec::with_capacity(bytes.len() + 8);
+        // A byte held back to come after the next one.
+        let mut held: Option<u8> = None;
         for &b in bytes {
-            if self.rng.random::<f64>() < self.f.drop_rate {
+            if self.rng.random::<f64>() < f.drop_rate {
                 continue;
             }
-            if self.rng.random::<f64>() < self.f.corrupt_rate {
-                out.push(b ^ (1 << self.rng.random_range(0..8)));
+            let b = if self.rng.random::<f64>() < f.corrupt_rate {
+                b ^ (1 << self.rng.random_range(0..8))
             } else {
+                b
+            };
+            let twice = self.rng.random::<f64>() < f.dup_rate;
+            if held.is_none() && self.rng.random::<f64>() < f.reorder_rate {
+                held = Some(b);
+                continue;
+            }
+            out.push(b);
+            if twice {
                 out.push(b);
             }
+            out.extend(held.take());
         }
+        out.extend(held);
         out
     }
 }

@@ -36,6 +36,16 @@ pub struct TargetArgs {
     /// emulator; on a board, the bridge's.
     #[arg(long, value_name = "KHZ")]
     ext_clock_khz: Option<f64>,
+    /// On a board: how long to wait at most for a reply (beyond the time
+    /// the batch's own waits take), e.g. 1s, 250ms. The host waits less on
+    /// a link it has measured to be fast, and backs off up to this.
+    #[arg(long, value_name = "DURATION", default_value = "1s", value_parser = parse_duration)]
+    link_timeout: Duration,
+    /// On a board: attempts in a row that hear nothing before a request is
+    /// given up as a link error (ten times as many that hear only garbage:
+    /// a noisy line is alive).
+    #[arg(long, value_name = "N", default_value_t = 10)]
+    link_retries: u32,
     /// Shape of the acceleration ramp (the datasheet's chapter 1 is not available).
     #[arg(long, value_enum, default_value_t = Curve::LinearSpeed)]
     accel_curve: Curve,
@@ -159,7 +169,12 @@ impl TargetArgs {
             })?;
             let infra = |e: crate::backend::SerialError| OpenError::Infrastructure(e.to_string());
             let link = SerialLink::open(&path, baud).map_err(infra)?;
-            let t = SerialTarget::open(link, SerialOptions::default()).map_err(infra)?;
+            let opts = SerialOptions {
+                reply_timeout: std::time::Duration::from_nanos(self.link_timeout.as_nanos()),
+                retries: self.link_retries,
+                ..SerialOptions::default()
+            };
+            let t = SerialTarget::open(link, opts).map_err(infra)?;
             // The bridge knows how its chip is strapped; the command line
             // may only confirm it. A board at 12 MHz judged as one at 16
             // would fail for the wrong reason.

@@ -16,6 +16,18 @@ pub struct BenchArgs {
     /// Repetitions of each case; the median is reported.
     #[arg(long, default_value_t = 15)]
     repeat: usize,
+    /// Instead: the suite over a noisy link to the bridge simulator, with
+    /// the host's default link settings, for each kind and rate of line
+    /// fault (the table in docs/performance.md).
+    #[arg(long)]
+    noisy_link: bool,
+    /// With --noisy-link: the fault seeds to run each row with.
+    #[arg(long, default_value_t = 3)]
+    seeds: u64,
+    /// With --noisy-link: only these rows, each KIND:PERCENT with KIND one
+    /// of corrupt, drop, duplicate, reorder, mixed (e.g. corrupt:2).
+    #[arg(long = "fault", value_name = "KIND:PERCENT", value_parser = parse_fault_row)]
+    faults: Vec<(String, f64)>,
 }
 
 /// A named benchmark case.
@@ -108,6 +120,9 @@ fn time_case(repeat: usize, f: impl Fn() -> Outcome) -> (f64, Outcome) {
 }
 
 pub fn run(args: BenchArgs, suite: &[Scenario]) -> Result<(), CliError> {
+    if args.noisy_link {
+        return noisy_link(args.seeds.max(1), &args.faults, suite);
+    }
     let max_ramp = InitData {
         rl: 200,
         rh: 20,
@@ -224,5 +239,148 @@ fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> Result<(), CliError> 
         trips as f64 / suite.len() as f64
     );
     outln!("\nover the pty / in process: {:.1}x", r / l.max(1e-9));
+    Ok(())
+}
+
+/// The suite over a noisy pty to the bridge simulator, with the shipped
+/// link settings: per fault kind and rate, how many scenarios completed
+/// with the verdict and trace of the clean in-process run (the rest ended
+/// as link errors), and whether any got a wrong verdict.
+fn parse_fault_row(s: &str) -> Result<(String, f64), String> {
+    let (kind, pct) = s
+        .split_once(':')
+        .ok_or("write KIND:PERCENT, e.g. corrupt:1")?;
+    if !["corrupt", "drop", "duplicate", "reorder", "mixed"].contains(&kind) {
+        return Err(format!(
+            "`{kind}`: the kinds are corrupt, drop, duplicate, reorder and mixed"
+        ));
+    }
+    let pct: f64 = pct
+        .parse()
+        .map_err(|_| format!("`{pct}` is not a percentage"))?;
+    if !(0.0..=100.0).contains(&pct) {
+        return Err(format!("{pct}% is not a percentage"));
+    }
+    Ok((kind.to_string(), pct / 100.0))
+}
+
+fn noisy_link(seeds: u64, only: &[(String, f64)], suite: &[Scenario]) -> Result<(), CliError> {
+    use crate::backend::{SerialLink, SerialOptions, SerialTarget};
+    use crate::bridge::sim::{LinkFaults, PtyBridge};
+    use crate::runner::run_suite;
+    use crate::scenario::{DriverOptions, Verdict};
+
+    let Ok(mut t) = EmuTarget::new(Straps::default(), ModelConfig::default()) else {
+        return Err(CliError::Verdict);
+    };
+    let clean = run_suite(&mut t, suite, 1, DriverOptions::default(), |_| {});
+    let row = |name: &str, rate: f64| -> LinkFaults {
+        let mut f = LinkFaults::default();
+        match name {
+            "corrupt" => f.corrupt_rate = rate,
+            "drop" => f.drop_rate = rate,
+            "duplicate" => f.dup_rate = rate,
+            "reorder" => f.reorder_rate = rate,
+            _ => {
+                f.corrupt_rate = rate;
+                f.drop_rate = rate;
+                f.dup_rate = rate;
+                f.reorder_rate = rate;
+            }
+        }
+        f
+    };
+    let mut rows = Vec::new();
+    for kind in ["corrupt", "drop", "duplicate"] {
+        for rate in [0.001, 0.005, 0.01, 0.02] {
+            rows.push((kind, rate));
+        }
+    }
+    rows.push(("duplicate", 0.05));
+    rows.push(("reorder", 0.005));
+    rows.push(("mixed", 0.005));
+    if !only.is_empty() {
+        rows = only.iter().map(|(k, r)| (k.as_str(), *r)).collect();
+    }
+    outln!(
+        "| line fault (each byte, both ways) | scenarios complete of {} | wrong verdicts | wall time (median) | round trips (median) |",
+        suite.len()
+    );
+    outln!("|---|---:|---:|---:|---:|");
+    let mut any_wrong = false;
+    for (kind, rate) in rows {
+        let what = if kind == "mixed" {
+            format!(
+                "{}% each of corrupt, drop, duplicate, reorder",
+                rate * 100.0
+            )
+        } else {
+            format!("{}% {kind}", rate * 100.0)
+        };
+        let (mut done, mut wrong, mut walls, mut trips) = (Vec::new(), 0, Vec::new(), Vec::new());
+        for seed in 1..=seeds {
+            let faults = LinkFaults {
+                seed,
+                ..row(kind, rate)
+            };
+            let emu = EmuTarget::new(Straps::default(), ModelConfig::default())
+                .map_err(|e| CliError::Failed(e.to_string()))?;
+            let sim = PtyBridge::start(emu, faults)
+                .map_err(|e| CliError::Failed(format!("no bridge simulator: {e}")))?;
+            let t0 = WallClock::now();
+            let opened = SerialLink::open(sim.path(), 115_200)
+                .and_then(|l| SerialTarget::open(l, SerialOptions::default()));
+            let (ok, rt) = match opened {
+                Ok(mut t) => {
+                    let got = run_suite(&mut t, suite, 1, DriverOptions::default(), |_| {});
+                    let mut ok = 0;
+                    for (g, c) in got.iter().zip(&clean) {
+                        match &g.verdict {
+                            Verdict::Error(e) => {
+                                errln!("{what} seed {seed}: {}: {e}", g.name);
+                            }
+                            Verdict::NotRun(_) => {}
+                            v if *v == c.verdict
+                                && g.trace.as_ref().map(|t| &t.events)
+                                    == c.trace.as_ref().map(|t| &t.events) =>
+                            {
+                                ok += 1
+                            }
+                            _ => wrong += 1,
+                        }
+                    }
+                    (ok, t.stats.round_trips)
+                }
+                Err(e) => {
+                    errln!("{what} seed {seed}: {e}");
+                    (0, 0)
+                }
+            };
+            walls.push(t0.elapsed().as_secs_f64() * 1e3);
+            sim.stop();
+            done.push(ok);
+            trips.push(rt as f64);
+        }
+        any_wrong |= wrong > 0;
+        let (lo, hi) = (
+            done.iter().min().copied().unwrap_or(0),
+            done.iter().max().copied().unwrap_or(0),
+        );
+        let span = if lo == hi {
+            lo.to_string()
+        } else {
+            format!("{lo}-{hi}")
+        };
+        outln!(
+            "| {what} | {span} | {wrong} | {:.2} s | {:.0} |",
+            median_ms(walls) / 1e3,
+            median_ms(trips)
+        );
+    }
+    outln!("\n{seeds} seeds per row (1..={seeds}); `ppmc bench --noisy-link --seeds {seeds}`");
+    if any_wrong {
+        errln!("ppmc bench: a noisy link produced a wrong verdict");
+        return Err(CliError::Verdict);
+    }
     Ok(())
 }

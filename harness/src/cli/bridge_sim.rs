@@ -33,6 +33,12 @@ pub struct BridgeSimArgs {
     /// Probability of flipping a bit in each byte on the link.
     #[arg(long, default_value_t = 0.0)]
     corrupt_rate: f64,
+    /// Probability of each byte on the link arriving twice.
+    #[arg(long, default_value_t = 0.0)]
+    dup_rate: f64,
+    /// Probability of each byte on the link swapping places with the next.
+    #[arg(long, default_value_t = 0.0)]
+    reorder_rate: f64,
     /// Stop answering after N frames (a hung bridge).
     #[arg(long, value_name = "N")]
     stall_after: Option<u64>,
@@ -57,6 +63,8 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     for (name, rate) in [
         ("--drop-rate", args.drop_rate),
         ("--corrupt-rate", args.corrupt_rate),
+        ("--dup-rate", args.dup_rate),
+        ("--reorder-rate", args.reorder_rate),
     ] {
         if !(0.0..=1.0).contains(&rate) {
             return Err(usage(format!(
@@ -114,6 +122,8 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     let faults = LinkFaults {
         drop_rate: args.drop_rate,
         corrupt_rate: args.corrupt_rate,
+        dup_rate: args.dup_rate,
+        reorder_rate: args.reorder_rate,
         stall_after: args.stall_after,
         disconnect_after: args.disconnect_after,
         seed: args.seed,

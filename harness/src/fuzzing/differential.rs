@@ -102,7 +102,10 @@ impl Side<'_> {
             Some(Reply::Status { status, .. }) => Ok(*status),
             other => Err(TargetError::new(
                 TargetErrorKind::Other,
-                format!("expected the closing status read, got {other:?}"),
+                match other {
+                    Some(r) => format!("expected the closing status read, got `{r}`"),
+                    None => "no reply to the closing status read".into(),
+                },
             )),
         }
     }

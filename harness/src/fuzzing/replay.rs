@@ -100,7 +100,7 @@ pub fn judge(ops: &[BusOp], replies: &[Reply], capture: &Record) -> Result<Optio
     }
     let status = |r: &Reply| match *r {
         Reply::Status { status, .. } => Ok(status),
-        other => Err(format!("expected a status reply, got {other:?}")),
+        other => Err(format!("expected a status reply, got {other}")),
     };
     let mut judge = Judge::default();
     let mut last_at = crate::time::Instant::ZERO;
@@ -109,7 +109,7 @@ pub fn judge(ops: &[BusOp], replies: &[Reply], capture: &Record) -> Result<Optio
             (BusOp::ReadStatus, Reply::Status { status, .. }) => Some(status.0),
             (BusOp::ReadData, Reply::Data { byte, .. }) => Some(*byte),
             (BusOp::ReadStatus | BusOp::ReadData, other) => {
-                return Err(format!("expected a read reply to {op}, got {other:?}"))
+                return Err(format!("expected a read reply to {op}, got {other}"))
             }
             _ => None,
         };

@@ -16,6 +16,39 @@ use crate::protocol::{
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, Event, EventKind};
 
+/// A value [`Driver::check`] compares, as a failure report shows it to a
+/// person: `true`, `42`, `0x3F` for a register byte, `120.000us`, `none`.
+pub trait Shown {
+    fn shown(&self) -> String;
+}
+
+macro_rules! shown_as_text {
+    ($($t:ty),*) => {$(
+        impl Shown for $t {
+            fn shown(&self) -> String {
+                self.to_string()
+            }
+        }
+    )*};
+}
+
+shown_as_text!(bool, u16, u32, u64, usize, i32, i64, Instant, Duration, String, &str);
+
+impl Shown for u8 {
+    fn shown(&self) -> String {
+        format!("0x{self:02X}")
+    }
+}
+
+impl<T: Shown> Shown for Option<T> {
+    fn shown(&self) -> String {
+        match self {
+            Some(v) => v.shown(),
+            None => "none".into(),
+        }
+    }
+}
+
 /// Timeouts and limits of a [`Driver`], given for the reference board
 /// (16 MHz, CSEL high): the driver stretches each for a slower board
 /// ([`Straps::stretch`]), so a scenario's limits hold at every clock the
@@ -552,20 +585,10 @@ impl<'t> Driver<'t> {
     /// A scenario's own check: fails with `what`, expected vs got, now.
     /// Everything queued is judged first, so an earlier failure is the one
     /// reported.
-    pub fn check<T: PartialEq + std::fmt::Debug>(
-        &mut self,
-        what: &str,
-        expected: T,
-        got: T,
-    ) -> Outcome {
+    pub fn check<T: PartialEq + Shown>(&mut self, what: &str, expected: T, got: T) -> Outcome {
         self.flush()?;
         if expected != got {
-            return Err(fail(
-                what,
-                format!("{expected:?}"),
-                format!("{got:?}"),
-                self.now,
-            ));
+            return Err(fail(what, expected.shown(), got.shown(), self.now));
         }
         Ok(())
     }

@@ -164,7 +164,7 @@ impl Driver<'_> {
 
     pub(super) fn unexpected(&self, op: &str, reply: &Reply) -> Stop {
         Stop::Error(HarnessError::Reply(format!(
-            "target answered {reply:?} to {op}"
+            "target answered `{reply}` to {op}"
         )))
     }
 
@@ -449,7 +449,7 @@ impl Driver<'_> {
                 Ok(Done::At)
             }
             (Step::Pins, Reply::Pins { pins, .. }) => Ok(Done::Pins(pins)),
-            (step, other) => Err(self.unexpected(&format!("{step:?}"), &other)),
+            (step, other) => Err(self.unexpected(&format!("`{}`", self.step_op(step)), &other)),
         }
     }
 

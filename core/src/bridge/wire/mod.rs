@@ -18,7 +18,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 /// The protocol version this build speaks.
-pub const PROTOCOL_VERSION: u16 = 3;
+pub const PROTOCOL_VERSION: u16 = 4;
 
 /// Message kinds (the second payload byte).
 pub mod kind {
@@ -27,11 +27,13 @@ pub mod kind {
     pub const CAPTURE: u8 = 0x03;
     pub const RESEND: u8 = 0x04;
     pub const BATCH_CAPTURE: u8 = 0x05;
+    pub const LINK: u8 = 0x06;
     pub const HELLO_REPLY: u8 = 0x81;
     pub const BATCH_REPLY: u8 = 0x82;
     pub const CAPTURE_REPLY: u8 = 0x83;
     pub const FRAGMENT: u8 = 0x84;
     pub const BATCH_CAPTURE_REPLY: u8 = 0x85;
+    pub const LINK_REPLY: u8 = 0x86;
     pub const ERROR: u8 = 0xFF;
 }
 
@@ -76,6 +78,21 @@ impl BridgeErrorCode {
             5 => BridgeErrorCode::Malformed,
             6 => BridgeErrorCode::Version,
             other => BridgeErrorCode::Unknown(other),
+        }
+    }
+}
+
+impl core::fmt::Display for BridgeErrorCode {
+    /// The name the protocol document gives the code: `BAD_FRAME`.
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            BridgeErrorCode::BadFrame => f.write_str("BAD_FRAME"),
+            BridgeErrorCode::UnknownOp => f.write_str("UNKNOWN_OP"),
+            BridgeErrorCode::Overflow => f.write_str("OVERFLOW"),
+            BridgeErrorCode::CaptureOverrun => f.write_str("CAPTURE_OVERRUN"),
+            BridgeErrorCode::Malformed => f.write_str("MALFORMED"),
+            BridgeErrorCode::Version => f.write_str("VERSION"),
+            BridgeErrorCode::Unknown(c) => write!(f, "error code {c}"),
         }
     }
 }
@@ -134,24 +151,38 @@ pub enum Request {
         moves: u32,
         max: u16,
     },
+    /// From the next response on, send fragments of at most this many
+    /// data bytes ([`MIN_FRAGMENT_DATA`]..=[`FRAGMENT_DATA`]): smaller
+    /// frames for a noisier line.
+    Link {
+        fragment: u8,
+    },
 }
 
 /// Largest response payload sent as one frame; longer ones go as
 /// fragments of this many bytes, so that a noisy link loses little.
 pub const FRAGMENT_DATA: usize = 48;
 
+/// The smallest fragment a host may ask for (LINK).
+pub const MIN_FRAGMENT_DATA: usize = 8;
+
 /// The longest response payload: 255 fragments.
 pub const MAX_REPLY: usize = 255 * FRAGMENT_DATA;
 
-/// Splits a response payload into frame payloads: itself if short, else
-/// `seq, FRAGMENT, index, count, data`. A payload over [`MAX_REPLY`] loses
-/// its tail; the bridge never sends one (it answers OVERFLOW instead).
-pub fn fragment(payload: &[u8]) -> Vec<Vec<u8>> {
-    if payload.len() <= FRAGMENT_DATA {
+/// Splits a response payload into frame payloads: itself if it fits one
+/// fragment of `size` data bytes, else `seq, FRAGMENT, index, count, data`
+/// pieces of `size` bytes (more, if 255 of `size` would not hold it). A
+/// payload over [`MAX_REPLY`] loses its tail; the bridge never sends one
+/// (it answers OVERFLOW instead).
+pub fn fragment(payload: &[u8], size: usize) -> Vec<Vec<u8>> {
+    let size = size
+        .clamp(MIN_FRAGMENT_DATA, FRAGMENT_DATA)
+        .max(payload.len().div_ceil(255));
+    if payload.len() <= size {
         return vec![payload.to_vec()];
     }
     let seq = payload.first().copied().unwrap_or(0);
-    let chunks: Vec<&[u8]> = payload.chunks(FRAGMENT_DATA).collect();
+    let chunks: Vec<&[u8]> = payload.chunks(size).collect();
     let count = chunks.len().min(255) as u8;
     chunks
         .iter()
@@ -202,6 +233,24 @@ pub enum Response {
         code: BridgeErrorCode,
         detail: String,
     },
+    /// The fragment size now in force.
+    Link {
+        fragment: u8,
+    },
+}
+
+impl Response {
+    /// The message's name in the protocol document: `BATCH_REPLY`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Response::Hello(_) => "HELLO_REPLY",
+            Response::Batch(_) => "BATCH_REPLY",
+            Response::Capture(_) => "CAPTURE_REPLY",
+            Response::BatchCapture { .. } => "BATCH_CAPTURE_REPLY",
+            Response::Error { .. } => "ERROR",
+            Response::Link { .. } => "LINK_REPLY",
+        }
+    }
 }
 
 /// Why a message does not decode.
@@ -332,6 +381,10 @@ impl Request {
                 put_ops(&mut w, ops);
                 put_capture_from(&mut w, *runs, *pins, *moves, *max);
             }
+            Request::Link { fragment } => {
+                w.u8(kind::LINK);
+                w.u8(*fragment);
+            }
             Request::Resend { fragments } => {
                 w.u8(kind::RESEND);
                 w.u8(fragments.len().min(255) as u8);
@@ -366,6 +419,7 @@ impl Request {
                     max: r.u16()?,
                 }
             }
+            kind::LINK => Request::Link { fragment: r.u8()? },
             kind::RESEND => {
                 let n = usize::from(r.u8()?);
                 Request::Resend {
@@ -417,6 +471,10 @@ impl Response {
                 w.u8(code.code());
                 w.str(detail);
             }
+            Response::Link { fragment } => {
+                w.u8(kind::LINK_REPLY);
+                w.u8(*fragment);
+            }
         }
         w.0
     }
@@ -451,6 +509,7 @@ impl Response {
                 code: BridgeErrorCode::from_code(r.u8()?),
                 detail: r.str()?,
             },
+            kind::LINK_REPLY => Response::Link { fragment: r.u8()? },
             k => return Err(WireError::UnknownKind(k)),
         };
         r.end()?;
@@ -706,7 +765,7 @@ mod tests {
     #[test]
     fn long_replies_fragment_and_reassemble() {
         let payload: Vec<u8> = (0..130u16).map(|i| i as u8).collect();
-        let frags = fragment(&payload);
+        let frags = fragment(&payload, FRAGMENT_DATA);
         assert_eq!(frags.len(), 3);
         let mut whole = Vec::new();
         for (i, f) in frags.iter().enumerate() {
@@ -715,7 +774,22 @@ mod tests {
             whole.extend_from_slice(data);
         }
         assert_eq!(whole, payload);
-        assert_eq!(fragment(&[5, 1, 2]), vec![vec![5, 1, 2]]);
+        assert_eq!(fragment(&[5, 1, 2], FRAGMENT_DATA), vec![vec![5, 1, 2]]);
+        // Smaller fragments for a noisy line; never below the minimum, and
+        // never more than 255 of them.
+        let small = fragment(&payload, 10);
+        assert_eq!(small.len(), 13);
+        assert!(small.iter().all(|f| f.len() <= 4 + 10));
+        assert_eq!(
+            fragment(&payload, 1).len(),
+            130_usize.div_ceil(MIN_FRAGMENT_DATA)
+        );
+        let long = vec![7u8; MAX_REPLY];
+        assert_eq!(fragment(&long, MIN_FRAGMENT_DATA).len(), 255);
+        let link = Request::Link { fragment: 12 };
+        assert_eq!(Request::decode(&link.encode(6, T), T), Ok((6, link)));
+        let set = Response::Link { fragment: 12 };
+        assert_eq!(Response::decode(&set.encode(6, T), T), Ok((6, set)));
         let r = Request::Resend {
             fragments: vec![0, 2],
         };

@@ -20,7 +20,7 @@ use ppmc_core::bridge::frame::{self, FrameDecoder};
 use ppmc_core::bridge::wire::MAX_BATCH_OPS;
 use ppmc_core::bridge::wire::{
     self, parse_fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer,
-    PROTOCOL_VERSION,
+    FRAGMENT_DATA, MIN_FRAGMENT_DATA, PROTOCOL_VERSION,
 };
 use std::io;
 use std::time::{Duration as WallDuration, Instant as WallInstant};
@@ -50,7 +50,7 @@ pub enum SerialError {
         ours: u16,
         theirs: u16,
     },
-    #[error("{link}: bridge reported {code:?} for {what}: {detail}")]
+    #[error("{link}: the bridge answered {code} to {what}: {detail}")]
     Bridge {
         link: String,
         what: String,
@@ -107,18 +107,34 @@ impl From<SerialError> for TargetError {
 }
 
 /// Retry and timeout policy.
+///
+/// The host learns the link's round-trip time from clean exchanges and
+/// waits for a reply a few times that (never less than `min_reply_timeout`,
+/// never more than `reply_timeout`), plus the time the batch's own waits
+/// take on a real-time bridge. Each attempt in a row that brings nothing
+/// new doubles the pause before the next try, and one that heard nothing at
+/// all also doubles the wait (exponential backoff, as TCP's retransmission
+/// timer does). `retries` silent attempts in a row end the request as a
+/// link error; a line that answers, however garbled, is alive and gets ten
+/// times as many.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SerialOptions {
-    /// How long to wait for a reply beyond the time the batch itself needs.
+    /// The longest wait for a reply beyond the time the batch itself needs
+    /// (the first waits, before the round-trip time is known, and the cap
+    /// of the backoff).
     pub reply_timeout: WallDuration,
-    /// Retransmissions of one request before giving up.
+    /// The shortest wait for a reply, however fast the link has been.
+    pub min_reply_timeout: WallDuration,
+    /// Silent attempts in a row before a request is given up (after the
+    /// first try); ten times as many that heard only garbage.
     pub retries: u32,
     /// Reopen attempts after the link vanished, with doubling backoff.
     pub reopen_attempts: u32,
-    /// The first backoff.
+    /// The first reopen backoff.
     pub backoff: WallDuration,
     /// After a corrupted frame, how long the line must stay silent before
-    /// the host asks again (rather than waiting out `reply_timeout`).
+    /// the host asks again (rather than waiting out the reply timeout); at
+    /// most this, and less on a link that answers faster.
     pub quiet: WallDuration,
 }
 
@@ -126,10 +142,50 @@ impl Default for SerialOptions {
     fn default() -> Self {
         SerialOptions {
             reply_timeout: WallDuration::from_millis(1000),
-            retries: 4,
+            min_reply_timeout: WallDuration::from_millis(20),
+            retries: 10,
             reopen_attempts: 5,
             backoff: WallDuration::from_millis(100),
             quiet: WallDuration::from_millis(30),
+        }
+    }
+}
+
+/// The pause before the first retry after a fruitless attempt; it doubles
+/// with each one in a row, up to [`MAX_RETRY_PAUSE`].
+const FIRST_RETRY_PAUSE: WallDuration = WallDuration::from_millis(1);
+const MAX_RETRY_PAUSE: WallDuration = WallDuration::from_millis(16);
+
+/// The link's round-trip time, smoothed as TCP does (RFC 6298): from
+/// exchanges answered at the first try whose batch had no waits of its own.
+#[derive(Debug, Clone, Copy, Default)]
+struct RoundTrip {
+    srtt: Option<WallDuration>,
+    rttvar: WallDuration,
+}
+
+impl RoundTrip {
+    fn sample(&mut self, rtt: WallDuration) {
+        match self.srtt {
+            None => {
+                self.srtt = Some(rtt);
+                self.rttvar = rtt / 2;
+            }
+            Some(s) => {
+                let err = s.abs_diff(rtt);
+                self.rttvar = (self.rttvar * 3 + err) / 4;
+                self.srtt = Some((s * 7 + rtt) / 8);
+            }
+        }
+    }
+
+    /// How long to wait for a reply: `srtt + 4 rttvar`, within the bounds.
+    fn timeout(&self, opts: &SerialOptions) -> WallDuration {
+        match self.srtt {
+            None => opts.reply_timeout,
+            Some(s) => (s + self.rttvar * 4)
+                .max(opts.min_reply_timeout)
+                .min(opts.reply_timeout),
         }
     }
 }
@@ -138,7 +194,19 @@ impl Default for SerialOptions {
 /// (fewer round trips), small on a noisy one (small frames survive it). A
 /// batch split over several requests runs the same.
 const MAX_REQUEST: usize = 2048;
-const MIN_REQUEST: usize = 48;
+const MIN_REQUEST: usize = 16;
+
+/// A line that answers, however garbled, is alive: a request gets this
+/// many times `retries` attempts that bring nothing new before it is given
+/// up, where a silent one gets `retries`.
+const NOISY_RETRIES: u32 = 10;
+
+/// Most fragments one RESEND asks for.
+const MAX_RESEND: usize = 8;
+
+/// After this many requests in a row that needed no second try, the host
+/// asks for reply fragments twice as large again (up to the largest).
+const CLEAN_TO_GROW: u32 = 8;
 
 /// The most bytes the reply entries to one request may take, at worst:
 /// with the capture chunk the bridge adds (which it shrinks to fit), a
@@ -189,6 +257,9 @@ impl Fragments {
                 .enumerate()
                 .filter(|(_, p)| p.is_none())
                 .map(|(i, _)| i as u8)
+                // A short RESEND survives a noisy line; the rest are asked
+                // for next time.
+                .take(MAX_RESEND)
                 .collect()
         })
     }
@@ -226,6 +297,20 @@ pub struct SerialTarget<L: Link> {
     /// the rest of it back, and the bridge's chip has not moved on since
     /// (it runs in virtual time, so nothing happens between requests).
     captured_current: bool,
+    /// The link's measured round-trip time.
+    rtt: RoundTrip,
+    /// Whether the last [`Self::await_reply`] received any byte at all.
+    heard: bool,
+    /// Data bytes per reply fragment in force on the bridge (LINK), and
+    /// the size wanted: halved after a request whose reply needed asking
+    /// again, doubled back after [`CLEAN_TO_GROW`] clean ones.
+    fragment: u8,
+    want_fragment: u8,
+    /// Clean requests in a row.
+    clean: u32,
+    /// The bridge answers LINK (one that refuses it keeps 48-byte
+    /// fragments, and is not asked again).
+    link_ok: bool,
     /// The latest bridge time seen since the last chip reset: a reply
     /// timed before it means the bridge restarted.
     clock: Instant,
@@ -260,6 +345,12 @@ impl<L: Link> SerialTarget<L> {
             captured: Record::default(),
             captured_current: false,
             clock: Instant::ZERO,
+            rtt: RoundTrip::default(),
+            heard: false,
+            fragment: FRAGMENT_DATA as u8,
+            want_fragment: FRAGMENT_DATA as u8,
+            clean: 0,
+            link_ok: true,
             request_size: MAX_REQUEST,
             stats: LinkStats::default(),
         };
@@ -275,9 +366,19 @@ impl<L: Link> SerialTarget<L> {
                 })?;
         match replies.get(1) {
             Some(Reply::Status { status, .. }) if status.0 == 0 => Ok(t),
+            Some(Reply::Status { status, .. }) => Err(SerialError::Unhealthy {
+                link: t.link.name(),
+                detail: format!(
+                    "after a chip reset the status register reads 0x{:02X}, not 0x00",
+                    status.0
+                ),
+            }),
             other => Err(SerialError::Unhealthy {
                 link: t.link.name(),
-                detail: format!("status after chip reset is {other:?}, expected 0x00"),
+                detail: match other {
+                    Some(r) => format!("the status read after a chip reset got `{r}`"),
+                    None => "no reply to the status read after a chip reset".into(),
+                },
             }),
         }
     }
@@ -287,13 +388,19 @@ impl<L: Link> SerialTarget<L> {
     }
 
     fn say_hello(&mut self) -> Result<Hello, SerialError> {
-        match self.request(
-            &Request::Hello {
-                version: PROTOCOL_VERSION,
-            },
-            "hello",
-            WallDuration::ZERO,
-        )? {
+        let hello = Request::Hello {
+            version: PROTOCOL_VERSION,
+        };
+        let reply = match self.request(&hello, "hello", WallDuration::ZERO) {
+            // A line too noisy for the hello reply's 48-byte fragments:
+            // ask for the smallest and say hello again.
+            Err(SerialError::NoAnswer { .. }) if self.link_ok => {
+                self.want_fragment = MIN_FRAGMENT_DATA as u8;
+                self.request(&hello, "hello", WallDuration::ZERO)?
+            }
+            other => other?,
+        };
+        match reply {
             Response::Hello(h) if h.version == PROTOCOL_VERSION => Ok(h),
             Response::Hello(h) => Err(SerialError::Version {
                 link: self.link.name(),
@@ -333,7 +440,7 @@ impl<L: Link> SerialTarget<L> {
             other => SerialError::Protocol {
                 link: self.link.name(),
                 what: what.into(),
-                detail: format!("{other:?}"),
+                detail: format!("a {} message", other.name()),
             },
         }
     }
@@ -348,6 +455,55 @@ impl<L: Link> SerialTarget<L> {
         what: &str,
         extra: WallDuration,
     ) -> Result<Response, SerialError> {
+        if self.want_fragment != self.fragment && self.link_ok {
+            self.set_fragment(self.want_fragment)?;
+        }
+        let retransmitted = self.stats.retransmissions;
+        let r = self.exchange(req, what, extra);
+        if !matches!(req, Request::Link { .. }) {
+            if self.stats.retransmissions > retransmitted {
+                self.clean = 0;
+                self.want_fragment = (self.fragment / 2).max(MIN_FRAGMENT_DATA as u8);
+            } else {
+                self.clean += 1;
+                if self.clean >= CLEAN_TO_GROW {
+                    self.clean = 0;
+                    self.want_fragment = self.fragment.saturating_mul(2).min(FRAGMENT_DATA as u8);
+                }
+            }
+        }
+        r
+    }
+
+    /// Asks the bridge for reply fragments of `size` data bytes. A bridge
+    /// that does not know LINK (UNKNOWN_OP) keeps its own, and is not
+    /// asked again.
+    fn set_fragment(&mut self, size: u8) -> Result<(), SerialError> {
+        match self.exchange(
+            &Request::Link { fragment: size },
+            "link",
+            WallDuration::ZERO,
+        )? {
+            Response::Link { fragment } => {
+                self.fragment = fragment;
+                self.want_fragment = fragment;
+            }
+            Response::Error {
+                code: BridgeErrorCode::UnknownOp,
+                ..
+            } => self.link_ok = false,
+            other => return Err(self.unexpected("link", &other)),
+        }
+        Ok(())
+    }
+
+    /// One request and its reply, asked again as the line needs.
+    fn exchange(
+        &mut self,
+        req: &Request,
+        what: &str,
+        extra: WallDuration,
+    ) -> Result<Response, SerialError> {
         self.seq = self.seq.wrapping_add(1);
         let seq = self.seq;
         let payload = req.encode(seq, self.timer);
@@ -355,24 +511,34 @@ impl<L: Link> SerialTarget<L> {
         let full = frame::encode(&payload);
         let mut frags = Fragments::default();
         let mut next = full.clone();
+        // Attempts in a row that brought nothing new: `silent` ones heard
+        // nothing at all (a dead link: `retries` of them end the request),
+        // `fruitless` ones at most heard garbage (a live, noisy line: it
+        // gets ten times as many).
         let mut fruitless = 0;
+        let mut silent = 0;
         let mut garbled = 0;
-        let mut first = true;
-        while fruitless <= self.opts.retries {
-            if !first {
+        let mut attempts = 0u32;
+        let mut wait = self.rtt.timeout(&self.opts);
+        let mut pause = WallDuration::ZERO;
+        while silent <= self.opts.retries && fruitless <= self.opts.retries * NOISY_RETRIES {
+            if attempts > 0 {
                 self.stats.retransmissions += 1;
+                std::thread::sleep(pause);
             }
-            first = false;
+            attempts += 1;
             if let Err(e) = self.link.send(&next) {
                 self.recover(e)?;
                 frags = Fragments::default();
                 next = full.clone();
                 fruitless += 1;
+                silent += 1;
                 continue;
             }
+            let sent = WallInstant::now();
             self.stats.round_trips += 1;
             let had = frags.received();
-            match self.await_reply(seq, self.opts.reply_timeout + extra, &mut frags) {
+            match self.await_reply(seq, wait + extra, &mut frags) {
                 Ok(Some(Response::Error {
                     code: BridgeErrorCode::BadFrame,
                     ..
@@ -401,7 +567,14 @@ impl<L: Link> SerialTarget<L> {
                         }
                     }
                 }
-                Ok(Some(r)) => return Ok(r),
+                Ok(Some(r)) => {
+                    // Karn's rule: only an exchange that was not repeated
+                    // times the link, and only one with no waits of its own.
+                    if attempts == 1 && extra.is_zero() {
+                        self.rtt.sample(sent.elapsed());
+                    }
+                    return Ok(r);
+                }
                 Ok(None) => {
                     next = match frags.missing() {
                         Some(m) => {
@@ -418,14 +591,33 @@ impl<L: Link> SerialTarget<L> {
             }
             if frags.received() > had {
                 fruitless = 0;
+                silent = 0;
+                pause = WallDuration::ZERO;
             } else {
                 fruitless += 1;
+                if self.heard {
+                    silent = 0;
+                } else {
+                    silent += 1;
+                }
+                // Back off: after silence, wait longer for the reply (a
+                // slow or busy bridge; a garbled reply was heard, so its
+                // wait was long enough); and pause longer before asking
+                // again (a burst of noise).
+                if !self.heard {
+                    wait = (wait * 2).min(self.opts.reply_timeout);
+                }
+                pause = if pause.is_zero() {
+                    FIRST_RETRY_PAUSE
+                } else {
+                    (pause * 2).min(MAX_RETRY_PAUSE)
+                };
             }
         }
         Err(SerialError::NoAnswer {
             link: self.link.name(),
             what: what.into(),
-            tries: self.opts.retries + 1,
+            tries: attempts,
         })
     }
 
@@ -442,7 +634,7 @@ impl<L: Link> SerialTarget<L> {
             }
             self.stats.round_trips += 1;
             let before = frags.received();
-            match self.await_reply(seq, self.opts.reply_timeout, frags) {
+            match self.await_reply(seq, self.rtt.timeout(&self.opts), frags) {
                 Ok(Some(Response::Error {
                     code: BridgeErrorCode::Malformed,
                     detail,
@@ -471,7 +663,13 @@ impl<L: Link> SerialTarget<L> {
         timeout: WallDuration,
         frags: &mut Fragments,
     ) -> io::Result<Option<Response>> {
-        let deadline = WallInstant::now() + timeout;
+        let start = WallInstant::now();
+        let mut deadline = start + timeout;
+        // A reply still arriving is waited for, as long as bytes keep
+        // coming (a slow line, a long reply), but not for ever.
+        let latest = start + timeout.max(self.opts.reply_timeout) * 4;
+        let quiet = self.opts.quiet.min(self.rtt.timeout(&self.opts));
+        self.heard = false;
         // After a corrupted frame, stop waiting once the line is quiet.
         let mut quiet_by: Option<WallInstant> = None;
         let mut buf = [0u8; 4096];
@@ -508,7 +706,7 @@ impl<L: Link> SerialTarget<L> {
                     Ok(None) => break,
                     Err(_) => {
                         self.stats.corrupt_frames += 1;
-                        quiet_by = Some(WallInstant::now() + self.opts.quiet);
+                        quiet_by = Some(WallInstant::now() + quiet);
                     }
                 }
             }
@@ -518,8 +716,13 @@ impl<L: Link> SerialTarget<L> {
                 return Ok(None);
             }
             let n = self.link.recv(&mut buf, until - now)?;
+            if n > 0 {
+                self.heard = true;
+                let gap = self.rtt.timeout(&self.opts);
+                deadline = deadline.max((WallInstant::now() + gap).min(latest));
+            }
             if n > 0 && quiet_by.is_some() {
-                quiet_by = Some(WallInstant::now() + self.opts.quiet);
+                quiet_by = Some(WallInstant::now() + quiet);
             }
             self.decoder.extend(&buf[..n]);
         }
@@ -662,12 +865,13 @@ impl<L: Link> SerialTarget<L> {
         let mut out = Vec::with_capacity(ops.len());
         let max_ops = usize::from(self.hello.max_batch_ops.clamp(1, MAX_BATCH_OPS.max(1)));
         let mut rest = ops;
+        let mut garbled_rounds = 0;
         while !rest.is_empty() {
             let n = self.next_request_len(rest, max_ops);
             let (chunk, tail) = rest.split_at(n);
             rest = tail;
             let what = format!(
-                "a batch of {} ops starting with {:?}",
+                "a batch of {} ops starting with `{}`",
                 chunk.len(),
                 chunk[0]
             );
@@ -688,13 +892,22 @@ impl<L: Link> SerialTarget<L> {
                 Request::Batch(chunk.to_vec())
             };
             let reply = match self.request(&req, &what, extra) {
-                Err(SerialError::Garbled { .. }) if self.request_size > MIN_REQUEST => {
-                    // Not run: send the same ops again in smaller requests.
+                Err(e @ SerialError::Garbled { .. }) => {
+                    // Not run: send the same ops again, in smaller requests
+                    // while they can shrink; a line that garbles even the
+                    // smallest this often is given up.
+                    garbled_rounds += 1;
+                    if self.request_size <= MIN_REQUEST && garbled_rounds > self.opts.retries {
+                        return Err(e);
+                    }
                     self.request_size = (self.request_size / 2).max(MIN_REQUEST);
                     rest = ops_from(ops, out.len());
                     continue;
                 }
-                other => other?,
+                other => {
+                    garbled_rounds = 0;
+                    other?
+                }
             };
             // Noisy line: smaller requests (and so smaller replies); clean:
             // back up towards the largest.
@@ -848,6 +1061,7 @@ mod tests {
     fn quick() -> SerialOptions {
         SerialOptions {
             reply_timeout: WallDuration::from_millis(20),
+            min_reply_timeout: WallDuration::from_millis(1),
             retries: 2,
             reopen_attempts: 3,
             backoff: WallDuration::from_millis(1),
@@ -1019,11 +1233,8 @@ mod tests {
         assert!(
             matches!(
                 e,
-                SerialError::Version {
-                    theirs: 4,
-                    ours: 3,
-                    ..
-                }
+                SerialError::Version { theirs, ours, .. }
+                    if theirs == PROTOCOL_VERSION + 1 && ours == PROTOCOL_VERSION
             ),
             "{e}"
         );
