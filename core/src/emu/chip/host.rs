@@ -211,6 +211,7 @@ impl Chip {
             });
             self.logic = cmd.logic;
             self.phase_index = 0;
+            self.out_winding = self.winding;
         }
         let ramp = self.straps.tclock(cmd.clock).map(|tclock| {
             let table = accel_table(

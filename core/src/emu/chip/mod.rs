@@ -135,6 +135,11 @@ pub struct Chip {
 
     // Initialization (Section 3-2).
     winding: Option<Winding>,
+    /// The winding the phase outputs follow. It is `winding` except after
+    /// a software reset: the reset cancels the initialization when it is
+    /// taken, but the phases stay energized until Table 3-3's excitation
+    /// OFF time has passed (note N36).
+    out_winding: Option<Winding>,
     logic: OutputLogic,
     setup: Option<Setup>,
     switch_on: Duration,
@@ -187,6 +192,7 @@ impl Chip {
             obf: false,
             out_latch: 0,
             winding: None,
+            out_winding: None,
             logic: OutputLogic::Negative,
             setup: None,
             config_epoch: 0,
@@ -441,6 +447,7 @@ impl Chip {
             }
             Timer::ExcitationOff { epoch } if epoch == self.config_epoch => {
                 self.phases_on = false;
+                self.out_winding = None;
                 self.phase_index = 0;
                 self.set_switching(None);
                 self.hold_epoch += 1;

@@ -371,7 +371,7 @@ impl Chip {
 
     /// Energized phases ignoring stop switching.
     pub(super) fn energized_pattern(&self) -> u8 {
-        match (self.phases_on, self.winding) {
+        match (self.phases_on, self.out_winding) {
             (true, Some(w)) => w.pattern(self.phase_index),
             _ => 0,
         }
