@@ -260,6 +260,8 @@ impl<'t> Driver<'t> {
     }
 
     /// Waits until `flag` has `value`; `Some(waited)` or `None` on timeout.
+    /// `timeout` is taken as given: a scenario that expects `None` (the
+    /// flag must not come within it) chooses it from the straps itself.
     pub fn await_flag(
         &mut self,
         flag: Flag,
@@ -279,8 +281,11 @@ impl<'t> Driver<'t> {
         }
     }
 
-    /// Waits for a flag and fails the scenario if it does not come.
+    /// Waits for a flag and fails the scenario if it does not come within
+    /// `timeout` (given for the reference board, stretched for a slower
+    /// one).
     pub fn expect_flag(&mut self, flag: Flag, value: bool, timeout: Duration) -> Outcome {
+        let timeout = self.straps.stretch(timeout);
         self.enqueue(
             Self::plain([Step::Await {
                 flag,
@@ -693,8 +698,11 @@ impl<'t> Driver<'t> {
     }
 
     /// Expects no pulse of the most recent move later than `margin` after
-    /// the last trigger (a stop write or an input edge).
+    /// the last trigger (a stop write or an input edge); `margin` is a
+    /// firmware time at 16 MHz, longer on a slower clock.
     pub fn expect_no_pulses_after_trigger(&mut self, margin: Duration) -> Outcome {
+        // The chip's reaction is a firmware time: longer on a slower clock.
+        let margin = self.fw(margin).max(margin);
         self.enqueue(Vec::new(), Some(Check::NoPulsesAfterTrigger(margin)))
     }
 
