@@ -243,6 +243,22 @@ fn bad_usage_exits_2() {
         &["run", "--golden", "/no/such/dir"],
         &["compare", "/no/such/dir", "--traces", "."],
         &["export", "/no/such/file"],
+        // Options are checked before a port is touched.
+        &[
+            "run",
+            "--target",
+            "serial:/dev/ppmc-none",
+            "--link-timeout",
+            "0s",
+        ],
+        &[
+            "run",
+            "--target",
+            "serial:/dev/ppmc-none",
+            "--clock-mhz",
+            "0.5",
+        ],
+        &["run", "--clock-mhz", "41"],
     ] {
         let out = ppmc(args);
         assert_eq!(
@@ -253,6 +269,12 @@ fn bad_usage_exits_2() {
         );
         assert!(!text(&out.stderr).is_empty());
     }
+    let out = ppmc(&["run", "--clock-mhz", "0.5"]);
+    assert!(
+        text(&out.stderr).contains("--clock-mhz 0.5: the system clock must be 1 to 40 MHz"),
+        "{}",
+        text(&out.stderr)
+    );
 }
 
 #[test]

@@ -93,7 +93,17 @@ impl TargetArgs {
                 .map(|k| hz(k * 1e3, "--ext-clock-khz", k))
                 .transpose()?,
         };
-        straps.validate().map_err(|e| e.to_string())?;
+        straps.validate().map_err(|e| match e {
+            crate::protocol::StrapsError::SysClk(_) => format!(
+                "--clock-mhz {}: the system clock must be 1 to 40 MHz",
+                self.clock_mhz.unwrap_or(16.0)
+            ),
+            crate::protocol::StrapsError::ExtClock { max, .. } => format!(
+                "--ext-clock-khz {}: the external clock must be 1 kHz to SysClk/16 ({} kHz here)",
+                self.ext_clock_khz.unwrap_or(0.0),
+                f64::from(max) / 1e3
+            ),
+        })?;
         Ok(straps)
     }
 
@@ -167,6 +177,14 @@ impl TargetArgs {
                     self.target
                 ))
             })?;
+            // Bad options are the user's, before any port is touched.
+            if self.link_timeout.as_nanos() < 1_000_000 {
+                return Err(OpenError::Usage(format!(
+                    "--link-timeout {}: give at least 1ms",
+                    self.link_timeout
+                )));
+            }
+            self.straps().map_err(OpenError::Usage)?;
             let infra = |e: crate::backend::SerialError| OpenError::Infrastructure(e.to_string());
             let link = SerialLink::open(&path, baud).map_err(infra)?;
             let opts = SerialOptions {
