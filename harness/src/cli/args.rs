@@ -112,39 +112,45 @@ impl TargetArgs {
     /// `--flag: bridge X, given Y`.
     pub fn disagreements(&self, reported: &Straps) -> Result<Vec<String>, String> {
         let given = self.straps()?;
-        let level = |high| if high { "high" } else { "low" };
-        let mut out = Vec::new();
-        if self.clock_mhz.is_some() && given.sysclk_hz != reported.sysclk_hz {
-            out.push(format!(
-                "--clock-mhz: the bridge reports {}, given {}",
-                f64::from(reported.sysclk_hz) / 1e6,
-                f64::from(given.sysclk_hz) / 1e6
-            ));
-        }
-        if self.csel.is_some() && given.csel_high != reported.csel_high {
-            out.push(format!(
-                "--csel: the bridge reports {}, given {}",
+        let mhz = |hz: u32| (f64::from(hz) / 1e6).to_string();
+        let level = |high| if high { "high" } else { "low" }.to_string();
+        let khz =
+            |h: Option<u32>| h.map_or("none".to_string(), |h| (f64::from(h) / 1e3).to_string());
+        // Each strap the command line gave: its flag, the bridge's value
+        // and the given one, as the user writes them.
+        let straps = [
+            (
+                self.clock_mhz.is_some(),
+                "--clock-mhz",
+                mhz(reported.sysclk_hz),
+                mhz(given.sysclk_hz),
+            ),
+            (
+                self.csel.is_some(),
+                "--csel",
                 level(reported.csel_high),
-                level(given.csel_high)
-            ));
-        }
-        if self.vsel.is_some() && given.vsel_high != reported.vsel_high {
-            out.push(format!(
-                "--vsel: the bridge reports {}, given {}",
+                level(given.csel_high),
+            ),
+            (
+                self.vsel.is_some(),
+                "--vsel",
                 level(reported.vsel_high),
-                level(given.vsel_high)
-            ));
-        }
-        if self.ext_clock_khz.is_some() && given.ext_clock_hz != reported.ext_clock_hz {
-            let khz =
-                |h: Option<u32>| h.map_or("none".to_string(), |h| (f64::from(h) / 1e3).to_string());
-            out.push(format!(
-                "--ext-clock-khz: the bridge reports {}, given {}",
+                level(given.vsel_high),
+            ),
+            (
+                self.ext_clock_khz.is_some(),
+                "--ext-clock-khz",
                 khz(reported.ext_clock_hz),
-                khz(given.ext_clock_hz)
-            ));
-        }
-        Ok(out)
+                khz(given.ext_clock_hz),
+            ),
+        ];
+        Ok(straps
+            .into_iter()
+            .filter(|(set, _, bridge, cli)| *set && bridge != cli)
+            .map(|(_, flag, bridge, cli)| {
+                format!("{flag}: the bridge reports {bridge}, given {cli}")
+            })
+            .collect())
     }
 
     /// The `--target` text.

@@ -595,16 +595,14 @@ impl<L: Link> SerialTarget<L> {
                 pause = WallDuration::ZERO;
             } else {
                 fruitless += 1;
-                if self.heard {
-                    silent = 0;
-                } else {
-                    silent += 1;
-                }
                 // Back off: after silence, wait longer for the reply (a
                 // slow or busy bridge; a garbled reply was heard, so its
                 // wait was long enough); and pause longer before asking
                 // again (a burst of noise).
-                if !self.heard {
+                if self.heard {
+                    silent = 0;
+                } else {
+                    silent += 1;
                     wait = (wait * 2).min(self.opts.reply_timeout);
                 }
                 pause = if pause.is_zero() {
@@ -668,7 +666,11 @@ impl<L: Link> SerialTarget<L> {
         // A reply still arriving is waited for, as long as bytes keep
         // coming (a slow line, a long reply), but not for ever.
         let latest = start + timeout.max(self.opts.reply_timeout) * 4;
-        let quiet = self.opts.quiet.min(self.rtt.timeout(&self.opts));
+        // The round trip does not change while waiting: the gap allowed
+        // between bytes of a reply still arriving, and the quiet after a
+        // corrupted frame, are fixed for this wait.
+        let gap = self.rtt.timeout(&self.opts);
+        let quiet = self.opts.quiet.min(gap);
         self.heard = false;
         // After a corrupted frame, stop waiting once the line is quiet.
         let mut quiet_by: Option<WallInstant> = None;
@@ -718,7 +720,6 @@ impl<L: Link> SerialTarget<L> {
             let n = self.link.recv(&mut buf, until - now)?;
             if n > 0 {
                 self.heard = true;
-                let gap = self.rtt.timeout(&self.opts);
                 deadline = deadline.max((WallInstant::now() + gap).min(latest));
             }
             if n > 0 && quiet_by.is_some() {
@@ -836,17 +837,14 @@ impl<L: Link> SerialTarget<L> {
     fn check_clock(&mut self, ops: &[Op], replies: &[Reply]) -> Result<(), SerialError> {
         for (op, r) in ops.iter().zip(replies) {
             let at = r.at();
-            if *op == Op::Reset {
-                self.clock = at;
-            } else if at < self.clock {
+            if *op != Op::Reset && at < self.clock {
                 return Err(SerialError::ClockWentBack {
                     link: self.link.name(),
                     was: self.clock,
                     now: at,
                 });
-            } else {
-                self.clock = at;
             }
+            self.clock = at;
         }
         Ok(())
     }
