@@ -20,7 +20,7 @@
 //! The report is the first divergence in time, with the quantity, golden
 //! and got, and the allowed band.
 
-use crate::protocol::{Pin, Straps, TimingId};
+use crate::protocol::{Pin, PulseRun, Straps, TimingId};
 use crate::time::{Duration, Instant, Limit};
 use crate::trace::{BusEvent, EventKind, Trace};
 use std::collections::BTreeMap;
@@ -51,7 +51,13 @@ impl Default for Tolerances {
 
 impl Tolerances {
     fn band(&self, golden: Duration, bp: u64) -> (Duration, Duration) {
-        let slack = golden.scale(bp, 10_000) + self.floor;
+        self.band_widened(golden, bp, Duration::ZERO)
+    }
+
+    /// The band, widened by what the capture itself cannot tell apart (the
+    /// jitter bounds of the pulse runs on either side).
+    fn band_widened(&self, golden: Duration, bp: u64, capture: Duration) -> (Duration, Duration) {
+        let slack = golden.scale(bp, 10_000) + self.floor + capture;
         (golden.saturating_sub(slack), golden + slack)
     }
 }
@@ -83,8 +89,7 @@ impl fmt::Display for Divergence {
 /// A run of pulses, with the anchor its move is timed from.
 #[derive(Debug, Clone, Copy)]
 struct Run {
-    start: Instant,
-    interval: Duration,
+    run: PulseRun,
     count: u32,
     dir: crate::protocol::Direction,
     /// Time of the move's start.
@@ -95,7 +100,23 @@ struct Run {
 
 impl Run {
     fn at(&self, i: u32) -> Instant {
-        self.start + self.interval.saturating_mul(u64::from(i))
+        self.run.at(i)
+    }
+
+    /// How far the time of any one pulse may be from [`Run::at`].
+    fn jitter(&self) -> Duration {
+        self.run.jitter
+    }
+
+    /// How far any one interval of the run may be from the run's mean
+    /// interval: twice the jitter, plus the nanosecond the mean is rounded
+    /// by; nothing for an exact run.
+    fn spread(&self) -> Duration {
+        if self.run.is_exact() {
+            Duration::ZERO
+        } else {
+            self.run.jitter.saturating_mul(2) + Duration::from_nanos(1)
+        }
     }
 }
 
@@ -126,19 +147,16 @@ fn streams(t: &Trace) -> Streams {
                 pending_first = true;
                 s.moves.push((e.at, k.clone()));
             }
-            EventKind::Pulses {
-                dir,
-                count,
-                interval,
-            } => {
-                s.pulses.push(Run {
-                    start: e.at,
-                    interval: *interval,
-                    count: *count,
-                    dir: *dir,
-                    anchor,
-                    first_of_move: pending_first,
-                });
+            EventKind::Pulses { dir, count, .. } => {
+                if let Some(run) = e.pulse_run() {
+                    s.pulses.push(Run {
+                        run,
+                        count: *count,
+                        dir: *dir,
+                        anchor,
+                        first_of_move: pending_first,
+                    });
+                }
                 pending_first = false;
             }
             EventKind::Pin { pin, value } => {
@@ -371,7 +389,8 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First)
     let total = |runs: &[Run]| runs.iter().map(|r| u64::from(r.count)).sum::<u64>();
     let (mut gc, mut oc) = (Cursor::default(), Cursor::default());
     let mut n: u64 = 0; // pulses compared so far
-    let mut prev: Option<(Instant, Instant)> = None; // previous (golden, got) pulse
+                        // The previous (golden, got) pulse and how far each may be off.
+    let mut prev: Option<(Instant, Instant, Duration)> = None;
     while gc.run < g.pulses.len() && oc.run < o.pulses.len() {
         let (gr, or) = (g.pulses[gc.run], o.pulses[oc.run]);
         let (gt, ot) = (gr.at(gc.pos), or.at(oc.pos));
@@ -417,21 +436,24 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First)
             ));
             return;
         }
-        let (what, gd, od, bp) = match prev {
-            Some((gp, op)) if !g_first => (
+        let here = gr.jitter() + or.jitter();
+        let (what, gd, od, bp, capture) = match prev {
+            Some((gp, op, off)) if !g_first => (
                 "interval",
                 gt.saturating_since(gp),
                 ot.saturating_since(op),
                 tol.interval_bp,
+                off + here,
             ),
             _ => (
                 "delay from the move's start",
                 gt.saturating_since(gr.anchor),
                 ot.saturating_since(or.anchor),
                 tol.latency_bp,
+                here,
             ),
         };
-        let band = tol.band(gd, bp);
+        let band = tol.band_widened(gd, bp, capture);
         if !within(od, band) {
             first.offer(diverge(
                 format!("pulse {k} {what}"),
@@ -444,13 +466,14 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First)
         // The rest of the stretch both runs share: one period each.
         let rest = (gr.count - gc.pos - 1).min(or.count - oc.pos - 1);
         if rest > 0 {
-            let band = tol.band(gr.interval, tol.interval_bp);
-            if !within(or.interval, band) {
+            let (gi, oi) = (gr.run.interval(), or.run.interval());
+            let band = tol.band_widened(gi, tol.interval_bp, gr.spread() + or.spread());
+            if !within(oi, band) {
                 first.offer(Divergence {
                     at: or.at(oc.pos + 1),
                     quantity: format!("pulse {} interval", k + 1),
-                    golden: gr.interval.to_string(),
-                    got: or.interval.to_string(),
+                    golden: gi.to_string(),
+                    got: oi.to_string(),
                     allowed: band_text(band),
                 });
                 return;
@@ -459,7 +482,7 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First)
         gc.pos += rest;
         oc.pos += rest;
         n += u64::from(rest) + 1;
-        prev = Some((gr.at(gc.pos), or.at(oc.pos)));
+        prev = Some((gr.at(gc.pos), or.at(oc.pos), here));
         for (c, runs) in [(&mut gc, &g.pulses), (&mut oc, &o.pulses)] {
             c.pos += 1;
             if c.pos >= runs[c.run].count {
@@ -589,7 +612,10 @@ pub fn scale_times(t: &Trace, num: u64, den: u64) -> Trace {
                 .as_nanos(),
         );
         match &mut e.kind {
-            EventKind::Pulses { interval, .. } => *interval = interval.scale(num, den),
+            EventKind::Pulses { span, jitter, .. } => {
+                *span = span.scale(num, den);
+                *jitter = jitter.scale(num, den);
+            }
             EventKind::Measure { value, .. } => *value = value.scale(num, den),
             EventKind::Bus(
                 BusEvent::Await {
@@ -693,11 +719,12 @@ end
             let mut events = Vec::new();
             for e in &t.events {
                 match &e.kind {
-                    EventKind::Pulses { dir, count, interval } => {
+                    EventKind::Pulses { dir, count, .. } => {
+                        let run = e.pulse_run().expect("a pulses event");
                         for i in 0..*count {
                             events.push(crate::trace::Event {
-                                at: e.at + interval.saturating_mul(u64::from(i)),
-                                kind: EventKind::Pulses { dir: *dir, count: 1, interval: Duration::ZERO },
+                                at: run.at(i),
+                                kind: EventKind::Pulses { dir: *dir, count: 1, span: Duration::ZERO, jitter: Duration::ZERO },
                             });
                         }
                     }

@@ -18,12 +18,16 @@
 //!
 //! One event per line, each stamped with the target's clock. Constant-rate
 //! pulse runs are one `pulses` line; acceleration ramps are one line per
-//! change of period. The `end` line makes a truncated file detectable. A
+//! change of period. A run captured by a bridge whose timer is not locked to
+//! the chip's clock is `pulses cw n=100 span=10098.031us jitter=0.016us`:
+//! the last pulse `span` after the first, every pulse within `jitter` of the
+//! straight line between them. The `end` line makes a truncated file detectable. A
 //! golden file may start with insta's `---` front matter, which is skipped.
 //! [`Trace::parse`] reads back exactly what [`Trace::render`] writes.
 
 use crate::protocol::{
-    Direction, Flag, Input, MoveKind, Pin, Record, StrapFieldError, Straps, Winding, STRAP_KEYS,
+    Direction, Flag, Input, MoveKind, Pin, PulseRun, Record, StrapFieldError, Straps, Winding,
+    STRAP_KEYS,
 };
 use crate::time::{Duration, Instant};
 use std::fmt::{self, Write as _};
@@ -51,6 +55,27 @@ pub struct Event {
     pub kind: EventKind,
 }
 
+impl Event {
+    /// The pulse run of a `pulses` event.
+    pub fn pulse_run(&self) -> Option<PulseRun> {
+        match self.kind {
+            EventKind::Pulses {
+                dir,
+                count,
+                span,
+                jitter,
+            } => Some(PulseRun {
+                start: self.at,
+                count,
+                dir,
+                span,
+                jitter,
+            }),
+            _ => None,
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum EventKind {
     Bus(BusEvent),
@@ -63,11 +88,14 @@ pub enum EventKind {
         winding: Option<Winding>,
         phase: u32,
     },
-    /// `count` pulses in `dir`, the first at `at`, `interval` apart.
+    /// `count` pulses in `dir`, the first at `at`, the last `span` later,
+    /// each within `jitter` of its place on the line between them (zero
+    /// for equally spaced pulses): a [`PulseRun`].
     Pulses {
         dir: Direction,
         count: u32,
-        interval: Duration,
+        span: Duration,
+        jitter: Duration,
     },
     Pin {
         pin: Pin,
@@ -179,7 +207,8 @@ impl Trace {
                 EventKind::Pulses {
                     dir: r.dir,
                     count: r.count,
-                    interval: r.interval,
+                    span: r.span,
+                    jitter: r.jitter,
                 },
                 &mut tagged,
             );
@@ -523,11 +552,27 @@ fn parse_event(line: &str) -> Result<Event, String> {
             if count == 0 {
                 return Err("a pulse run has at least one pulse".into());
             }
-            let interval = parse_time(kv(w.next(), "dt")?)?;
+            // `dt=` for equally spaced pulses, `span= jitter=` otherwise.
+            let (key, value) = w
+                .next()
+                .and_then(|t| t.split_once('='))
+                .ok_or("expected `dt=` or `span=`")?;
+            let (span, jitter) = match key {
+                "dt" => {
+                    let dt = parse_time(value)?;
+                    (dt.saturating_mul(u64::from(count - 1)), Duration::ZERO)
+                }
+                "span" => (parse_time(value)?, parse_time(kv(w.next(), "jitter")?)?),
+                _ => return Err(format!("expected `dt=` or `span=`, found `{key}=`")),
+            };
+            if count == 1 && span != Duration::ZERO {
+                return Err("a single pulse spans no time".into());
+            }
             EventKind::Pulses {
                 dir,
                 count,
-                interval,
+                span,
+                jitter,
             }
         }
         "pin" => {
@@ -577,8 +622,26 @@ impl fmt::Display for EventKind {
             EventKind::Pulses {
                 dir,
                 count,
-                interval,
-            } => write!(f, "pulses {} n={count} dt={interval}", dir.name()),
+                span,
+                jitter,
+            } => {
+                let run = PulseRun {
+                    start: Instant::ZERO,
+                    count: *count,
+                    dir: *dir,
+                    span: *span,
+                    jitter: *jitter,
+                };
+                if run.is_exact() {
+                    write!(f, "pulses {} n={count} dt={}", dir.name(), run.interval())
+                } else {
+                    write!(
+                        f,
+                        "pulses {} n={count} span={span} jitter={jitter}",
+                        dir.name()
+                    )
+                }
+            }
             EventKind::Pin { pin, value } => match pin {
                 Pin::Phases => write!(f, "pin {} 0b{value:05b}", pin.name()),
                 Pin::Auxo => write!(f, "pin {} 0b{value:04b}", pin.name()),

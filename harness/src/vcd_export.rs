@@ -100,18 +100,16 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
                 phase = *p;
                 state.set(e.at, DIR, *dir == Direction::Ccw)?;
             }
-            EventKind::Pulses {
-                dir,
-                count,
-                interval,
-            } => {
+            EventKind::Pulses { dir, count, .. } => {
+                let Some(run) = e.pulse_run() else { continue };
                 let width = if *count > 1 {
-                    Duration::from_micros(1).min(Duration::from_nanos(interval.as_nanos() / 2))
+                    Duration::from_micros(1)
+                        .min(Duration::from_nanos(run.interval().as_nanos() / 2))
                 } else {
                     Duration::from_micros(1)
                 };
                 for i in 0..*count {
-                    let t = e.at + interval.saturating_mul(u64::from(i));
+                    let t = run.at(i);
                     state.flush_before(&mut pending_fall, t)?;
                     state.set(t, POUT, true)?;
                     if let Some(wd) = winding {

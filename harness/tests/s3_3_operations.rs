@@ -29,7 +29,7 @@ fn pulses_after(h: &Host, t: Instant) -> usize {
     let from = h.chip().record().moves.last().map_or(0, |m| m.first_run);
     h.chip().record().runs[from..]
         .iter()
-        .flat_map(|r| (0..r.count).map(move |i| r.start + r.interval.saturating_mul(u64::from(i))))
+        .flat_map(|r| (0..r.count).map(move |i| r.at(i)))
         .filter(|p| *p > t)
         .count()
 }

@@ -12,23 +12,97 @@ use super::phase::Winding;
 use crate::time::{Duration, Instant};
 use alloc::vec::Vec;
 
-/// `count` pulses in `dir`, the first at `start`, each `interval` after the
-/// previous one (`interval` is zero when `count` is 1).
+/// `count` pulses in `dir`: the first at `start`, the last `span` later,
+/// the others on the straight line between them, each within `jitter` of
+/// its place on that line.
+///
+/// A run from the emulator, or from a bridge whose timer is locked to the
+/// chip's clock, is exact: `jitter` is zero and the pulses are equally
+/// spaced, `span / (count - 1)` apart. A bridge whose timer is not locked to
+/// the chip sees each edge up to a tick late, so its intervals wobble by a
+/// tick; it merges pulses into one run as long as every pulse stays within
+/// its tolerance of the line, and says so in `jitter`
+/// ([`EdgeRuns`], `docs/bridge-protocol.md` section 7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PulseRun {
     pub start: Instant,
-    pub interval: Duration,
     pub count: u32,
     pub dir: Direction,
+    /// From the first pulse to the last (zero for a single pulse).
+    pub span: Duration,
+    /// Bound on how far any pulse of the run lies from its place on the
+    /// line from the first pulse to the last.
+    pub jitter: Duration,
 }
 
 impl PulseRun {
+    /// `count` pulses exactly `interval` apart.
+    pub fn exact(start: Instant, interval: Duration, count: u32, dir: Direction) -> PulseRun {
+        PulseRun {
+            start,
+            count,
+            dir,
+            span: interval.saturating_mul(u64::from(count.saturating_sub(1))),
+            jitter: Duration::ZERO,
+        }
+    }
+
     /// Time of the last pulse in the run.
     pub fn last(&self) -> Instant {
-        self.start
-            + self
-                .interval
-                .saturating_mul(u64::from(self.count.saturating_sub(1)))
+        self.start + self.span
+    }
+
+    /// The interval between consecutive pulses: exact for an exact run, the
+    /// mean (to the nanosecond below) otherwise; zero for a single pulse.
+    pub fn interval(&self) -> Duration {
+        match self.count {
+            0 | 1 => Duration::ZERO,
+            n => Duration::from_nanos(self.span.as_nanos() / u64::from(n - 1)),
+        }
+    }
+
+    /// Whether the pulses are equally spaced to the nanosecond.
+    pub fn is_exact(&self) -> bool {
+        self.jitter == Duration::ZERO
+            && (self.count < 2 || self.span.as_nanos() % u64::from(self.count - 1) == 0)
+    }
+
+    /// Where pulse `k` (from 0) lies on the line from the first pulse to
+    /// the last: its time for an exact run, within `jitter` of it
+    /// otherwise.
+    pub fn at(&self, k: u32) -> Instant {
+        match self.count {
+            0 | 1 => self.start,
+            n => {
+                let off = u128::from(self.span.as_nanos()) * u128::from(k) / u128::from(n - 1);
+                self.start + Duration::from_nanos(u64::try_from(off).unwrap_or(u64::MAX))
+            }
+        }
+    }
+
+    /// How many pulses of the run lie at or before `t` on the line from the
+    /// first pulse to the last.
+    pub fn count_until(&self, t: Instant) -> u32 {
+        if self.start > t {
+            return 0;
+        }
+        if self.count < 2 || self.span == Duration::ZERO {
+            return self.count;
+        }
+        let since = u128::from(t.saturating_since(self.start).as_nanos());
+        let k = since * u128::from(self.count - 1) / u128::from(self.span.as_nanos()) + 1;
+        u32::try_from(k).map_or(self.count, |k| k.min(self.count))
+    }
+
+    /// The first `n` pulses of the run (`n` at least 1, at most `count`).
+    pub fn first(&self, n: u32) -> PulseRun {
+        let n = n.clamp(1, self.count.max(1));
+        PulseRun {
+            count: n,
+            span: self.at(n - 1).saturating_since(self.start),
+            jitter: if n > 1 { self.jitter } else { Duration::ZERO },
+            ..*self
+        }
     }
 }
 
@@ -162,7 +236,9 @@ impl PulseSummary {
             self.add_interval(run.start.saturating_since(prev));
         }
         if run.count > 1 {
-            self.add_interval(run.interval);
+            // On a run with jitter, the intervals' spread is not known:
+            // its mean stands for them.
+            self.add_interval(run.interval());
         }
         self.first.get_or_insert(run.start);
         self.last = Some(run.last());
@@ -186,8 +262,9 @@ pub struct Record {
 }
 
 impl Record {
-    /// Appends `count` pulses spaced `interval` apart starting at `start`,
-    /// merging with the previous run when the spacing continues it.
+    /// Appends `count` pulses spaced exactly `interval` apart starting at
+    /// `start`, merging with the previous run when the spacing continues
+    /// it.
     pub fn push_pulses(
         &mut self,
         start: Instant,
@@ -199,29 +276,22 @@ impl Record {
         if count == 0 {
             return;
         }
-        let interval = if count == 1 { Duration::ZERO } else { interval };
+        let run = PulseRun::exact(start, interval, count, dir);
         if !new_move {
             if let Some(last) = self.runs.last_mut() {
-                if last.dir == dir {
+                if last.dir == dir && last.is_exact() {
                     let gap = start.saturating_since(last.last());
-                    let spacing_matches = last.count == 1 || last.interval == gap;
+                    let spacing_matches = last.count == 1 || last.interval() == gap;
                     let continues = count == 1 || interval == gap;
                     if spacing_matches && continues && gap > Duration::ZERO {
-                        if last.count == 1 {
-                            last.interval = gap;
-                        }
                         last.count += count;
+                        last.span = run.last().saturating_since(last.start);
                         return;
                     }
                 }
             }
         }
-        self.runs.push(PulseRun {
-            start,
-            interval,
-            count,
-            dir,
-        });
+        self.runs.push(run);
     }
 
     pub fn pin(&mut self, at: Instant, pin: Pin, value: u8) {
@@ -251,19 +321,7 @@ impl Record {
             .runs
             .iter()
             .filter(|r| r.start <= t)
-            .map(|r| {
-                let mut r = *r;
-                if r.last() > t {
-                    // `last` is after `start`, so the interval is not zero.
-                    let on_time =
-                        t.saturating_since(r.start).as_nanos() / r.interval.as_nanos().max(1) + 1;
-                    r.count = u32::try_from(on_time).unwrap_or(r.count).min(r.count);
-                    if r.count == 1 {
-                        r.interval = Duration::ZERO;
-                    }
-                }
-                r
-            })
+            .map(|r| r.first(r.count_until(t)))
             .collect();
         Record {
             runs,
@@ -280,8 +338,112 @@ impl Record {
 
     /// Every pulse, one by one: `(time, direction)`.
     pub fn pulses(&self) -> impl Iterator<Item = (Instant, Direction)> + '_ {
-        self.runs.iter().flat_map(|r| {
-            (0..r.count).map(move |i| (r.start + r.interval.saturating_mul(u64::from(i)), r.dir))
+        self.runs
+            .iter()
+            .flat_map(|r| (0..r.count).map(move |i| (r.at(i), r.dir)))
+    }
+}
+
+/// Builds pulse runs from edges timestamped one at a time by a timer that
+/// is not locked to the chip's clock, as a bridge does.
+///
+/// Such a timer sees a train of equally spaced pulses with intervals that
+/// wobble by a tick, so runs cannot merge on equal intervals. Instead a
+/// pulse joins the current run when every pulse of the run stays within
+/// `tolerance` of the straight line from the run's first pulse to the new
+/// one; the run's `jitter` is then `tolerance` (zero while the pulses are
+/// equally spaced to the nanosecond). A constant-rate train of any length
+/// stays one run when `tolerance` covers the timer's resolution; each step
+/// of an acceleration ramp starts a new run, as it does on the emulator.
+///
+/// Each pulse costs O(1): the run keeps the range of slopes, as fractions,
+/// that the line may still take (the slopes that keep every pulse so far
+/// within `tolerance`), and the new pulse joins when the line to it has a
+/// slope in that range.
+#[derive(Debug, Clone)]
+pub struct EdgeRuns {
+    tolerance: Duration,
+    /// Lowest slope, nanoseconds per pulse as `(num, den)`.
+    lo: (u64, u64),
+    /// Highest slope; `den` 0 when there is no bound yet.
+    hi: (u64, u64),
+    /// Whether the record's last run is this builder's to extend.
+    open: bool,
+}
+
+impl EdgeRuns {
+    pub fn new(tolerance: Duration) -> EdgeRuns {
+        EdgeRuns {
+            tolerance,
+            lo: (0, 1),
+            hi: (0, 0),
+            open: false,
+        }
+    }
+
+    pub fn tolerance(&self) -> Duration {
+        self.tolerance
+    }
+
+    /// The next pulse starts a new run (after a chip reset, or when the
+    /// record was started over).
+    pub fn reset(&mut self) {
+        self.open = false;
+    }
+
+    /// Records a pulse at `at` in `dir` into `rec`; `new_move` when it is
+    /// the first pulse of a move (a run holds one move's pulses only).
+    pub fn push(&mut self, rec: &mut Record, at: Instant, dir: Direction, new_move: bool) {
+        if !new_move && self.open {
+            if let Some(last) = rec.runs.last_mut() {
+                if last.dir == dir && at > last.last() && last.count < u32::MAX {
+                    if let Some(joined) = self.join(last, at) {
+                        *last = joined;
+                        return;
+                    }
+                }
+            }
+        }
+        rec.runs.push(PulseRun::exact(at, Duration::ZERO, 1, dir));
+        self.lo = (0, 1);
+        self.hi = (0, 0);
+        self.open = true;
+    }
+
+    /// `run` with a pulse at `at` added, if the pulse keeps the run within
+    /// the tolerance.
+    fn join(&mut self, run: &PulseRun, at: Instant) -> Option<PulseRun> {
+        let n = u64::from(run.count); // the new pulse's index in the run
+        let d = at.saturating_since(run.start).as_nanos(); // the line's slope: d / n
+        let (wide_d, wide_n) = (u128::from(d), u128::from(n));
+        let above_lo = u128::from(self.lo.0) * wide_n <= wide_d * u128::from(self.lo.1);
+        let below_hi =
+            self.hi.1 == 0 || wide_d * u128::from(self.hi.1) <= u128::from(self.hi.0) * wide_n;
+        if !(above_lo && below_hi) {
+            return None;
+        }
+        let e = self.tolerance.as_nanos();
+        let lo = (d.saturating_sub(e), n);
+        if u128::from(lo.0) * u128::from(self.lo.1) > u128::from(self.lo.0) * u128::from(lo.1) {
+            self.lo = lo;
+        }
+        let hi = (d.saturating_add(e), n);
+        if self.hi.1 == 0
+            || u128::from(hi.0) * u128::from(self.hi.1) < u128::from(self.hi.0) * u128::from(hi.1)
+        {
+            self.hi = hi;
+        }
+        let exact =
+            run.is_exact() && (run.count == 1 || at.saturating_since(run.last()) == run.interval());
+        Some(PulseRun {
+            count: run.count + 1,
+            span: Duration::from_nanos(d),
+            jitter: if exact {
+                Duration::ZERO
+            } else {
+                self.tolerance
+            },
+            ..*run
         })
     }
 }
@@ -332,7 +494,7 @@ mod tests {
         // one-pulse run.
         let cut = r.until(t(2005));
         assert_eq!(cut.runs[1].count, 1);
-        assert_eq!(cut.runs[1].interval, Duration::ZERO);
+        assert_eq!(cut.runs[1].span, Duration::ZERO);
         assert_eq!(r.until(t(10_000)), r);
     }
 
@@ -348,5 +510,130 @@ mod tests {
         assert_eq!(s.last, Some(t(160)));
         assert_eq!(s.min_interval, Some(Duration::from_micros(30)));
         assert_eq!(s.max_interval, Some(Duration::from_micros(50)));
+    }
+
+    /// Each of `times` within its run's jitter of its place on the run's
+    /// line, in order, and none lost.
+    fn assert_within_jitter(r: &Record, times: &[u64]) {
+        assert_eq!(r.pulse_count(), times.len() as u64);
+        let mut k = 0;
+        for run in &r.runs {
+            for i in 0..run.count {
+                let got = times[k];
+                let line = run.at(i).as_nanos();
+                assert!(
+                    got.abs_diff(line) <= run.jitter.as_nanos(),
+                    "pulse {k} at {got} ns, {line} ns on its run's line, jitter {}",
+                    run.jitter
+                );
+                k += 1;
+            }
+            assert_eq!(
+                run.last().as_nanos(),
+                times[k - 1],
+                "a run ends on its last pulse"
+            );
+        }
+    }
+
+    /// Pulses at `times`, all one move, through an `EdgeRuns`.
+    fn edge_record(times: &[u64], tolerance: u64) -> Record {
+        let mut r = Record::default();
+        let mut e = EdgeRuns::new(Duration::from_nanos(tolerance));
+        for (i, t) in times.iter().enumerate() {
+            e.push(&mut r, Instant::from_nanos(*t), Direction::Cw, i == 0);
+        }
+        r
+    }
+
+    /// Times of a pulse train every `interval_ps` picoseconds, seen by a
+    /// timer of `hz` (each edge at the nearest tick, in whole nanoseconds).
+    fn seen_by(hz: u64, interval_ps: u64, count: u64) -> Vec<u64> {
+        (0..count)
+            .map(|k| {
+                let ps = 1_000_000 + k * interval_ps;
+                let tick = (u128::from(ps) * u128::from(hz) + 500_000_000_000) / 1_000_000_000_000;
+                (tick * 1_000_000_000 / u128::from(hz)) as u64
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_constant_rate_seen_by_an_unlocked_timer_is_one_run() {
+        // 10.0003 us between pulses, a 150 MHz timer: the intervals wobble
+        // by a tick, and a tick plus a nanosecond of tolerance keeps them
+        // one run, every pulse within the bound.
+        let times = seen_by(150_000_000, 10_000_300, 200_000);
+        let r = edge_record(&times, 6_667 / 1_000 + 2);
+        assert_eq!(r.runs.len(), 1, "{:?}", &r.runs[..r.runs.len().min(3)]);
+        assert_eq!(r.runs[0].jitter, Duration::from_nanos(8));
+        assert_within_jitter(&r, &times);
+        // Equal intervals would have needed a run per wobble.
+        let mut exact = Record::default();
+        for (i, w) in times.windows(2).enumerate() {
+            exact.push_pulses(
+                Instant::from_nanos(w[0]),
+                Duration::from_nanos(w[1] - w[0]),
+                1,
+                Direction::Cw,
+                i == 0,
+            );
+        }
+        assert!(exact.runs.len() > 1_000, "{} runs", exact.runs.len());
+    }
+
+    #[test]
+    fn equally_spaced_edges_stay_exact_and_a_new_rate_starts_a_run() {
+        let mut times: Vec<u64> = (0..50).map(|k| 1_000 + k * 2_500).collect();
+        let end = *times.last().unwrap_or(&0);
+        times.extend((1..30).map(|k| end + k * 2_000));
+        let r = edge_record(&times, 10);
+        assert_eq!(r.runs.len(), 2);
+        assert!(r.runs.iter().all(PulseRun::is_exact));
+        assert_eq!(
+            (r.runs[0].interval(), r.runs[1].interval()),
+            (Duration::from_nanos(2_500), Duration::from_nanos(2_000))
+        );
+        assert_eq!((r.runs[0].count, r.runs[1].count), (50, 29));
+        assert_within_jitter(&r, &times);
+    }
+
+    #[test]
+    fn wobbling_edges_never_leave_their_bound() {
+        // Pulses with random wobble of up to `w` ns around a steady rate,
+        // merged with tolerances below, at and above the wobble: whatever
+        // the runs, every pulse is within its run's jitter of the line.
+        let mut seed: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        for w in [0u64, 1, 3, 20] {
+            for tolerance in [0u64, 1, 2, 5, 40] {
+                let times: Vec<u64> = (0..5_000u64)
+                    .map(|k| 10_000 + k * 997 + next() % (w + 1))
+                    .collect();
+                let r = edge_record(&times, tolerance);
+                assert_within_jitter(&r, &times);
+                if tolerance >= 2 * w {
+                    assert_eq!(r.runs.len(), 1, "wobble {w}, tolerance {tolerance}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_run_cut_short_keeps_its_line() {
+        let times = seen_by(150_000_000, 3_333_300, 1_000);
+        let r = edge_record(&times, 8);
+        let run = r.runs[0];
+        let t = Instant::from_nanos(times[500]);
+        assert_eq!(run.count_until(t), 501);
+        let cut = run.first(501);
+        assert_eq!((cut.count, cut.jitter), (501, run.jitter));
+        assert_eq!(cut.at(250), run.at(250));
+        assert_eq!(run.first(1).jitter, Duration::ZERO);
     }
 }

@@ -201,7 +201,7 @@ impl Judge {
                 let runs_end = rec.moves.get(k + 1).map_or(rec.runs.len(), |n| n.first_run);
                 let out: u64 = rec.runs[m.first_run.min(runs_end)..runs_end]
                     .iter()
-                    .map(|r| pulses_until(r, at))
+                    .map(|r| u64::from(r.count_until(at)))
                     .sum();
                 let steps = u64::from(m.steps);
                 let want = if out >= steps { 0 } else { steps - out - 1 };
@@ -238,18 +238,6 @@ impl Judge {
             _ => None,
         }
     }
-}
-
-/// Pulses of a run at or before `t`.
-fn pulses_until(r: &crate::protocol::PulseRun, t: Instant) -> u64 {
-    if r.start > t {
-        return 0;
-    }
-    let n = match r.interval.as_nanos() {
-        0 => u64::from(r.count),
-        i => t.saturating_since(r.start).as_nanos() / i + 1,
-    };
-    n.min(u64::from(r.count))
 }
 
 /// The oracle on the emulator: a fresh chip, fed one op at a time, each

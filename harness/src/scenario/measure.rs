@@ -174,9 +174,7 @@ impl Driver<'_> {
         let from = rec.moves.last().map_or(0, |m| m.first_run);
         let times: Vec<Instant> = rec.runs[from..]
             .iter()
-            .flat_map(|r| {
-                (0..r.count).map(move |i| r.start + r.interval.saturating_mul(u64::from(i)))
-            })
+            .flat_map(|r| (0..r.count).map(move |i| r.at(i)))
             .collect();
         let n = times.len() as u64;
         // Pulse index the deceleration started from: at high speed it and

@@ -655,16 +655,10 @@ pub(super) fn no_pulses_after(rec: &Record, t: Instant) -> Outcome {
     for r in rec.runs.get(from..).unwrap_or_default() {
         let count = u64::from(r.count);
         // Pulses of the run at or before `t`.
-        let on_time = if r.start > t {
-            0
-        } else if r.interval == Duration::ZERO {
-            count
-        } else {
-            (t.saturating_since(r.start).as_nanos() / r.interval.as_nanos() + 1).min(count)
-        };
-        if on_time < count {
-            first.get_or_insert(r.start + r.interval.saturating_mul(on_time));
-            late += count - on_time;
+        let on_time = r.count_until(t);
+        if on_time < r.count {
+            first.get_or_insert(r.at(on_time));
+            late += count - u64::from(on_time);
         }
     }
     match first {

@@ -24,6 +24,34 @@ impl Timer {
         u64::try_from(t).unwrap_or(u64::MAX)
     }
 
+    /// Nanoseconds to ticks, rounded up: for a bound, which must not
+    /// shrink on the way.
+    pub fn to_ticks_up(self, ns: u64) -> u64 {
+        if self.hz == Self::NANOS.hz {
+            return ns;
+        }
+        let t = (u128::from(ns) * u128::from(self.hz)).div_ceil(1_000_000_000);
+        u64::try_from(t).unwrap_or(u64::MAX)
+    }
+
+    /// Ticks to nanoseconds, rounded up (for a bound).
+    pub fn to_nanos_up(self, ticks: u64) -> u64 {
+        if self.hz == Self::NANOS.hz {
+            return ticks;
+        }
+        if self.hz == 0 {
+            return u64::MAX;
+        }
+        let n = (u128::from(ticks) * 1_000_000_000).div_ceil(u128::from(self.hz));
+        u64::try_from(n).unwrap_or(u64::MAX)
+    }
+
+    /// Whether a tick is a whole number of nanoseconds, so that times
+    /// converted to nanoseconds keep their exact spacing.
+    pub fn whole_nanos(self) -> bool {
+        self.hz != 0 && 1_000_000_000 % self.hz == 0
+    }
+
     pub fn to_nanos(self, ticks: u64) -> u64 {
         if self.hz == Self::NANOS.hz {
             return ticks;
@@ -47,6 +75,11 @@ impl W {
     pub(super) fn time(&mut self, i: Instant) {
         let t = self.1.to_ticks(i.as_nanos());
         self.u64(t);
+    }
+    /// A bound, as `u32` ticks rounded up (saturating).
+    pub(super) fn bound(&mut self, d: Duration) {
+        let t = self.1.to_ticks_up(d.as_nanos());
+        self.u32(u32::try_from(t).unwrap_or(u32::MAX));
     }
     pub(super) fn opt_dur(&mut self, d: Option<Duration>) {
         let v = d.map(|d| self.1.to_ticks(d.as_nanos()));
@@ -98,6 +131,11 @@ impl<'a> R<'a> {
     pub(super) fn dur(&mut self) -> Result<Duration, WireError> {
         let t = self.u64()?;
         Ok(Duration::from_nanos(self.timer.to_nanos(t)))
+    }
+    /// A bound written by [`W::bound`], in nanoseconds rounded up.
+    pub(super) fn bound(&mut self) -> Result<Duration, WireError> {
+        let t = self.u32()?;
+        Ok(Duration::from_nanos(self.timer.to_nanos_up(u64::from(t))))
     }
     pub(super) fn time(&mut self) -> Result<Instant, WireError> {
         let t = self.u64()?;

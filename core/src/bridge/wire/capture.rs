@@ -31,13 +31,17 @@ pub(super) fn move_kind_from(at: usize, c: u8) -> Result<MoveKind, WireError> {
         })
 }
 
+/// Bytes of one pulse run on the wire.
+pub(super) const RUN_BYTES: usize = 8 + 8 + 4 + 1 + 4;
+
 pub(super) fn put_capture(w: &mut W, c: &CaptureChunk) {
     w.u16(c.runs.len() as u16);
     for run in &c.runs {
-        w.u64(run.start.as_nanos());
-        w.dur(run.interval);
+        w.time(run.start);
+        w.dur(run.span);
         w.u32(run.count);
         w.u8(u8::from(run.dir.bit()));
+        w.bound(run.jitter);
     }
     w.u16(c.pins.len() as u16);
     for p in &c.pins {
@@ -62,17 +66,37 @@ pub(super) fn put_capture(w: &mut W, c: &CaptureChunk) {
 
 pub(super) fn get_capture(r: &mut R) -> Result<CaptureChunk, WireError> {
     let mut c = CaptureChunk::default();
-    let n = r.count(21)?;
+    let n = r.count(RUN_BYTES)?;
     for _ in 0..n {
         let start = r.time()?;
-        let interval = r.dur()?;
+        let span = r.dur()?;
+        let cat = r.at;
         let count = r.u32()?;
         let dir = r.dir()?;
+        let mut jitter = r.bound()?;
+        if count == 0 || (count == 1 && span != Duration::ZERO) {
+            return Err(WireError::BadValue {
+                at: cat,
+                field: if count == 0 {
+                    "pulse count"
+                } else {
+                    "span of a one-pulse run"
+                },
+                value: if count == 0 { 0 } else { span.as_nanos() },
+            });
+        }
+        // Start and span each lose up to a nanosecond on the way from
+        // ticks, so the pulses between them may sit up to two nanoseconds
+        // further from the line.
+        if count > 2 && !r.timer.whole_nanos() {
+            jitter += Duration::from_nanos(2);
+        }
         c.runs.push(PulseRun {
             start,
-            interval,
             count,
             dir,
+            span,
+            jitter,
         });
     }
     let n = r.count(10)?;

@@ -18,7 +18,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 /// The protocol version this build speaks.
-pub const PROTOCOL_VERSION: u16 = 4;
+pub const PROTOCOL_VERSION: u16 = 5;
 
 /// Message kinds (the second payload byte).
 pub mod kind {
@@ -730,12 +730,21 @@ mod tests {
         });
         assert_eq!(Response::decode(&hello.encode(1, T), T), Ok((1, hello)));
         let cap = Response::Capture(CaptureChunk {
-            runs: vec![PulseRun {
-                start: Instant::from_nanos(5),
-                interval: Duration::from_nanos(42_000),
-                count: 1_000,
-                dir: Direction::Cw,
-            }],
+            runs: vec![
+                PulseRun::exact(
+                    Instant::from_nanos(5),
+                    Duration::from_nanos(42_000),
+                    1_000,
+                    Direction::Cw,
+                ),
+                PulseRun {
+                    start: Instant::from_nanos(50_000_000),
+                    count: 16_777_216,
+                    dir: Direction::Ccw,
+                    span: Duration::from_nanos(167_772_151_234),
+                    jitter: Duration::from_nanos(13),
+                },
+            ],
             pins: vec![PinEvent {
                 at: Instant::from_nanos(9),
                 pin: Pin::Switching,
