@@ -91,6 +91,11 @@ impl Duration {
     pub fn saturating_sub(self, other: Duration) -> Duration {
         Duration(self.0.saturating_sub(other.0))
     }
+
+    /// How far apart two durations are.
+    pub fn abs_diff(self, other: Duration) -> Duration {
+        Duration(self.0.abs_diff(other.0))
+    }
 }
 
 impl Add<Duration> for Instant {

@@ -674,6 +674,42 @@ end
         );
     }
 
+    /// A run captured by a bridge whose timer is not locked to the chip
+    /// carries a jitter bound (bridge protocol section 7): its mean
+    /// interval may be off the golden one by the tolerance plus what the
+    /// bound leaves open (twice the jitter and a nanosecond), never more.
+    #[test]
+    fn a_run_with_jitter_is_judged_with_its_bound() {
+        let with = |line: &str| {
+            let t = GOLDEN.replace("1218.000us pulses cw n=4 dt=102.000us", line);
+            compare(
+                &golden(),
+                &Trace::parse(&t).expect("parses"),
+                &Tolerances::default(),
+            )
+        };
+        // The band is 102 us +- (1 % + 0.1 us): up to 103.12 us. A mean of
+        // 103.2 us is outside it, but within 0.401 us more.
+        assert_eq!(
+            with("1218.000us pulses cw n=4 span=309.600us jitter=0.200us"),
+            Ok(())
+        );
+        let exact = with("1218.000us pulses cw n=4 dt=103.200us").expect_err("exact: outside");
+        assert_eq!(exact.quantity, "pulse 2 interval");
+        let far = with("1218.000us pulses cw n=4 span=310.800us jitter=0.200us")
+            .expect_err("103.6 us is outside even with the bound");
+        assert_eq!(far.quantity, "pulse 2 interval");
+        assert_eq!(far.allowed, "100.479us..=103.521us");
+        // The same pulses, exact in the golden and within their bound in
+        // the other, whichever way round.
+        let golden_jittered = GOLDEN.replace(
+            "1218.000us pulses cw n=4 dt=102.000us",
+            "1218.000us pulses cw n=4 span=306.003us jitter=0.002us",
+        );
+        let g = Trace::parse(&golden_jittered).expect("parses");
+        assert_eq!(compare(&g, &golden(), &Tolerances::default()), Ok(()));
+    }
+
     #[test]
     fn jitter_inside_the_tolerance_passes() {
         let jittered = GOLDEN

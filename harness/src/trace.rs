@@ -745,6 +745,31 @@ events
 end
 ";
 
+    /// A run with a jitter bound (a bridge timer not locked to the chip)
+    /// reads back as written; an exact one keeps its `dt=` form.
+    #[test]
+    fn pulse_runs_with_a_jitter_bound_round_trip() {
+        let line = "1218.000us pulses ccw n=16777216 span=637533448.001us jitter=0.018us";
+        let e = parse_event(line).expect("parses");
+        let run = e.pulse_run().expect("a run");
+        assert_eq!(run.count, 16_777_216);
+        assert_eq!(run.span, Duration::from_nanos(637_533_448_001));
+        assert_eq!(run.jitter, Duration::from_nanos(18));
+        assert_eq!(format!("{} {}", e.at, e.kind), line);
+        // Equally spaced pulses are written with `dt=` whichever way they
+        // were read.
+        let exact =
+            parse_event("5.000us pulses cw n=3 span=4.000us jitter=0.000us").expect("parses");
+        assert_eq!(exact.kind.to_string(), "pulses cw n=3 dt=2.000us");
+        for bad in [
+            "5.000us pulses cw n=3 span=4.000us",
+            "5.000us pulses cw n=1 span=4.000us jitter=0.000us",
+            "5.000us pulses cw n=3 width=4.000us jitter=0.000us",
+        ] {
+            assert!(parse_event(bad).is_err(), "{bad}");
+        }
+    }
+
     #[test]
     fn sample_round_trips_exactly() {
         let t = Trace::parse(SAMPLE).expect("parses");

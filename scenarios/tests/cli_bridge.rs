@@ -229,6 +229,72 @@ fn straps_come_from_the_bridge_and_a_contradiction_stops_the_run() {
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
 }
 
+/// A bridge whose timer is not locked to the chip (133.33 MHz: a 2 us
+/// step of the chip's pulse timing is 266.67 ticks, so the intervals it
+/// sees wobble by a tick): every time on the wire is in its ticks, pulse
+/// runs carry a jitter bound, and the whole suite still passes against the
+/// golden traces, whose runs are exact (bridge protocol section 7). A
+/// 16,777,216-pulse move stays one run; a fault of the chip is still
+/// caught.
+#[test]
+fn a_bridge_timer_not_locked_to_the_chip_passes_the_suite_on_its_bounds() {
+    let golden = concat!(env!("CARGO_MANIFEST_DIR"), "/../golden");
+    let sim = BridgeSim::start(&["--timer-hz", "133333333"]);
+    let out = ppmc(&["run", "--target", &sim.target(), "--golden", golden]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{}", text(&out.stderr));
+    assert!(
+        stdout.contains("suite: 96 passed, 0 failed, 0 errors, 0 not run"),
+        "{stdout}"
+    );
+    let dir = scratch("timed");
+    let rec = ppmc(&[
+        "record",
+        "--target",
+        &sim.target(),
+        "--out",
+        dir.path().to_str().expect("utf-8"),
+        "--filter",
+        "s3_3_4_accel_ffffff_is_16777216_steps",
+    ]);
+    assert!(rec.status.success(), "{}", text(&rec.stderr));
+    let name = "s3_3_4_accel_ffffff_is_16777216_steps.snap";
+    let trace = std::fs::read_to_string(dir.path().join(name)).expect("recorded");
+    let exact = std::fs::read_to_string(std::path::Path::new(golden).join(name)).expect("golden");
+    let runs = |t: &str| t.lines().filter(|l| l.contains(" pulses ")).count();
+    // As many runs as the exact capture: a tick of wobble splits none.
+    assert_eq!(runs(&trace), runs(&exact), "{trace}");
+    assert!(
+        exact.contains(" pulses cw n=16777198 dt=38.000us"),
+        "{exact}"
+    );
+    // The cruise is one run with a jitter bound (the pulse where the ramp
+    // meets it may fall on either side).
+    let cruise = |l: &&str| {
+        l.split_once(" n=")
+            .and_then(|(_, rest)| rest.split_once(' '))
+            .and_then(|(n, _)| n.parse::<u32>().ok())
+            .is_some_and(|n| n >= 16_777_190)
+    };
+    let long: Vec<&str> = trace.lines().filter(cruise).collect();
+    assert_eq!(long.len(), 1, "{trace}");
+    assert!(
+        long[0].contains(" span=") && long[0].contains(" jitter="),
+        "{}",
+        long[0]
+    );
+    assert!(
+        trace.contains("detail bridge_firmware ppmc-bridge-sim"),
+        "{trace}"
+    );
+    drop(sim);
+
+    let faulty = BridgeSim::start(&["--timer-hz", "133333333", "--chip-fault", "first-pout-slow"]);
+    let out = ppmc(&["run", "--target", &faulty.target(), "--golden", golden]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stdout));
+    assert!(text(&out.stdout).contains("FAIL "), "{}", text(&out.stdout));
+}
+
 #[test]
 fn a_chip_fault_behind_the_bridge_is_caught() {
     let sim = BridgeSim::start(&["--chip-fault", "swap-error-3-4"]);

@@ -75,6 +75,13 @@ impl<B: Bus> BridgeEngine<B> {
         self
     }
 
+    /// A bridge whose timer runs at `timer.hz`: every time and duration on
+    /// the wire is in its ticks, and HELLO_REPLY says so.
+    pub fn with_timer(mut self, timer: Timer) -> Self {
+        self.timer = timer;
+        self
+    }
+
     pub fn bus(&self) -> &B {
         &self.bus
     }

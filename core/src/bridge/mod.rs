@@ -5,8 +5,10 @@
 //!
 //! [`frame`] turns payloads into self-delimiting frames and back, [`wire`]
 //! turns requests and responses into payloads and back, and [`engine`] is
-//! the bridge's request executor over any [`crate::bus::Bus`].
+//! the bridge's request executor over any [`crate::bus::Bus`]; [`timed`]
+//! captures a bus's outputs again with a bridge timer's resolution.
 
 pub mod engine;
 pub mod frame;
+pub mod timed;
 pub mod wire;

@@ -219,6 +219,11 @@ pub struct PulseSummary {
     /// Shortest and longest interval between consecutive pulses.
     pub min_interval: Option<Duration>,
     pub max_interval: Option<Duration>,
+    /// How far the true shortest and longest interval may be from
+    /// `min_interval` and `max_interval`: zero when every run is exact; for
+    /// a run with jitter, whose mean interval stands for its intervals,
+    /// twice its jitter plus the nanosecond the mean is rounded by.
+    pub interval_bound: Duration,
 }
 
 impl PulseSummary {
@@ -237,8 +242,12 @@ impl PulseSummary {
         }
         if run.count > 1 {
             // On a run with jitter, the intervals' spread is not known:
-            // its mean stands for them.
+            // its mean stands for them, within the bound.
             self.add_interval(run.interval());
+            if !run.is_exact() {
+                let spread = run.jitter.saturating_mul(2) + Duration::from_nanos(1);
+                self.interval_bound = self.interval_bound.max(spread);
+            }
         }
         self.first.get_or_insert(run.start);
         self.last = Some(run.last());

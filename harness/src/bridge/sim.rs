@@ -3,7 +3,10 @@
 //! pseudo-terminal), with optional line faults and pacing to the wall clock.
 
 use super::engine::BridgeEngine;
-use crate::bus::EmuBus;
+use super::timed::Timed;
+use super::wire::Timer;
+use crate::bus::{Bus, EmuBus, Op, Reply};
+use crate::protocol::{Record, Straps};
 use crate::time::{Duration, Instant};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -13,18 +16,74 @@ use std::sync::Arc;
 use std::time::{Duration as WallDuration, Instant as WallInstant};
 
 /// What `ppmc bridge-sim` runs: the bridge engine over the reference model.
-pub type SimEngine = BridgeEngine<EmuBus>;
+pub type SimEngine = BridgeEngine<SimBus>;
+
+/// The reference model as the simulated bridge sees it: exactly, to the
+/// nanosecond, or through a timer of its own ([`Timed`]), as a bridge
+/// whose timer is not locked to the chip sees a board.
+#[derive(Debug, Clone)]
+pub enum SimBus {
+    Exact(EmuBus),
+    Timed(Timed<EmuBus>),
+}
+
+impl Bus for SimBus {
+    fn run(&mut self, op: Op) -> Reply {
+        match self {
+            SimBus::Exact(b) => b.run(op),
+            SimBus::Timed(b) => b.run(op),
+        }
+    }
+    fn record(&self) -> &Record {
+        match self {
+            SimBus::Exact(b) => b.record(),
+            SimBus::Timed(b) => b.record(),
+        }
+    }
+    fn straps(&self) -> Straps {
+        match self {
+            SimBus::Exact(b) => b.straps(),
+            SimBus::Timed(b) => b.straps(),
+        }
+    }
+    fn now(&self) -> Instant {
+        match self {
+            SimBus::Exact(b) => b.now(),
+            SimBus::Timed(b) => b.now(),
+        }
+    }
+}
 
 /// The simulator's engine in front of the emulated chip `emu` (an
 /// [`EmuBus`], or anything that becomes one, such as an `EmuTarget`);
-/// `session` should differ between runs.
+/// `session` should differ between runs. The bridge's timer counts
+/// nanoseconds, in step with the chip.
 pub fn engine(emu: impl Into<EmuBus>, session: u32, virtual_time: bool) -> SimEngine {
     BridgeEngine::new(
-        emu.into(),
+        SimBus::Exact(emu.into()),
         session,
         virtual_time,
         format!("ppmc-bridge-sim {}", crate::VERSION),
     )
+}
+
+/// The simulator's engine with a timer of `timer_hz` that is not locked to
+/// the chip's clock: every time on the wire is in its ticks, and pulses
+/// are captured edge by edge at its resolution.
+pub fn timed_engine(
+    emu: impl Into<EmuBus>,
+    session: u32,
+    virtual_time: bool,
+    timer_hz: u64,
+) -> SimEngine {
+    let timer = Timer { hz: timer_hz };
+    BridgeEngine::new(
+        SimBus::Timed(Timed::new(emu.into(), timer)),
+        session,
+        virtual_time,
+        format!("ppmc-bridge-sim {} (timer {timer_hz} Hz)", crate::VERSION),
+    )
+    .with_timer(timer)
 }
 
 /// How the simulated link or board misbehaves.
@@ -70,6 +129,9 @@ pub struct BridgeOptions {
     /// Pulse runs plus pin changes the capture buffer holds (see
     /// [`BridgeEngine::with_capture_capacity`]).
     pub capture_capacity: u32,
+    /// A bridge timer of this rate, not locked to the chip's clock (see
+    /// [`timed_engine`]); `None`: a nanosecond timer in step with the chip.
+    pub timer_hz: Option<u64>,
 }
 
 impl Default for BridgeOptions {
@@ -77,6 +139,7 @@ impl Default for BridgeOptions {
         BridgeOptions {
             realtime: false,
             capture_capacity: u32::MAX,
+            timer_hz: None,
         }
     }
 }
@@ -258,8 +321,11 @@ impl PtyBridge {
         let link = path.clone();
         let handle = std::thread::spawn(move || {
             let _keep_open = slave;
-            let mut server = engine(emu, 0x5EED, !bridge.realtime)
-                .with_capture_capacity(bridge.capture_capacity);
+            let server = match bridge.timer_hz {
+                Some(hz) => timed_engine(emu, 0x5EED, !bridge.realtime, hz),
+                None => engine(emu, 0x5EED, !bridge.realtime),
+            };
+            let mut server = server.with_capture_capacity(bridge.capture_capacity);
             let end = serve(&mut master, &mut server, faults, bridge.realtime, &flag).ok();
             // Gone before the pty is: a host reconnecting now finds nothing.
             let _ = std::fs::remove_file(&link);

@@ -27,6 +27,14 @@ pub struct BridgeSimArgs {
     /// unlimited.
     #[arg(long, value_name = "N", default_value_t = u32::MAX, hide_default_value = true)]
     capture_capacity: u32,
+    /// Give the bridge a timer of HZ that is not locked to the chip's clock,
+    /// as a real bridge's is: every time on the wire is in its ticks, each
+    /// output edge is stamped at the nearest tick, and pulse runs carry the
+    /// jitter bound a tick of wobble needs (docs/bridge-protocol.md
+    /// section 7), e.g. 150000000 for an RP2350 at 150 MHz. From 1000 to
+    /// 500000000. Default: a nanosecond timer in step with the chip.
+    #[arg(long, value_name = "HZ")]
+    timer_hz: Option<u64>,
     /// Probability of losing each byte on the link, e.g. 0.01.
     #[arg(long, default_value_t = 0.0)]
     drop_rate: f64,
@@ -56,7 +64,7 @@ pub struct BridgeSimArgs {
 }
 
 pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
-    use crate::bridge::sim::engine;
+    use crate::bridge::sim::{engine, timed_engine};
     use crate::bridge::sim::{serve, LinkFaults, ServeEnd};
     use serialport::SerialPort;
 
@@ -69,6 +77,13 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
         if !(0.0..=1.0).contains(&rate) {
             return Err(usage(format!(
                 "{name} {rate}: give a probability from 0 to 1"
+            )));
+        }
+    }
+    if let Some(hz) = args.timer_hz {
+        if !(1_000..=500_000_000).contains(&hz) {
+            return Err(usage(format!(
+                "--timer-hz {hz}: give a rate from 1000 to 500000000 Hz"
             )));
         }
     }
@@ -109,8 +124,11 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     let session = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(1, |d| d.subsec_nanos() ^ (d.as_secs() as u32));
-    let mut server =
-        engine(emu, session, !args.realtime).with_capture_capacity(args.capture_capacity);
+    let server = match args.timer_hz {
+        Some(hz) => timed_engine(emu, session, !args.realtime, hz),
+        None => engine(emu, session, !args.realtime),
+    };
+    let mut server = server.with_capture_capacity(args.capture_capacity);
     // Nobody may be reading stdout (a closed pipe): never let that stop
     // the bridge.
     let mut out = io::stdout();

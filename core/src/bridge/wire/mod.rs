@@ -588,6 +588,57 @@ mod tests {
         ]
     }
 
+    /// Section 7: a run's jitter is a bound, so it is rounded up on the
+    /// way to ticks and back, and grows by the two nanoseconds that start
+    /// and span may each lose when a tick is not a whole number of them;
+    /// a run of no pulses, or a single pulse that spans time, is refused.
+    #[test]
+    fn run_bounds_survive_a_timer_that_is_not_in_nanoseconds() {
+        let t = Timer { hz: 133_333_333 }; // 7.5 ns a tick
+        let run = PulseRun {
+            start: Instant::from_nanos(t.to_nanos(1_000)),
+            count: 1_000,
+            dir: Direction::Cw,
+            span: Duration::from_nanos(t.to_nanos(266_667)),
+            jitter: Duration::from_nanos(8),
+        };
+        let two = PulseRun::exact(
+            run.start,
+            Duration::from_nanos(t.to_nanos(267)),
+            2,
+            Direction::Ccw,
+        );
+        let cap = Response::Capture(CaptureChunk {
+            runs: vec![run, two],
+            ..CaptureChunk::default()
+        });
+        let Ok((_, Response::Capture(back))) = Response::decode(&cap.encode(1, t), t) else {
+            panic!("decodes");
+        };
+        assert_eq!(
+            (back.runs[0].start, back.runs[0].span),
+            (run.start, run.span)
+        );
+        // 8 ns is 1.07 ticks: 2 ticks up, 15.0000004 ns: 16 ns up, and 2 ns
+        // for the conversion.
+        assert_eq!(back.runs[0].jitter, Duration::from_nanos(18));
+        // Two pulses are both measured: nothing between them to be off.
+        assert_eq!(back.runs[1], two);
+        for bad in [PulseRun { count: 0, ..two }, PulseRun { count: 1, ..two }] {
+            let cap = Response::Capture(CaptureChunk {
+                runs: vec![bad],
+                ..CaptureChunk::default()
+            });
+            assert!(
+                matches!(
+                    Response::decode(&cap.encode(1, t), t),
+                    Err(WireError::BadValue { .. })
+                ),
+                "{bad:?}"
+            );
+        }
+    }
+
     #[test]
     fn every_op_round_trips() {
         let req = Request::Batch(sample_ops());
@@ -655,6 +706,7 @@ mod tests {
                     last: None,
                     min_interval: Some(Duration::from_micros(42)),
                     max_interval: None,
+                    interval_bound: Duration::from_nanos(37),
                 },
             },
             Reply::PulsesReached { at },

@@ -44,7 +44,7 @@ pub(super) mod rep {
 pub const MAX_SAMPLES: usize = 512;
 
 /// The largest reply entry of a plain op on the wire (PULSES).
-pub const MAX_REPLY_ENTRY: usize = 69;
+pub const MAX_REPLY_ENTRY: usize = 73;
 
 /// Most ops one batch may carry: the largest reply (128 x
 /// [`MAX_REPLY_ENTRY`] bytes) then stays within 255 fragments. A bridge
@@ -469,6 +469,7 @@ pub(super) fn put_reply(w: &mut W, rp: &Reply) {
             w.opt_time(summary.last);
             w.opt_dur(summary.min_interval);
             w.opt_dur(summary.max_interval);
+            w.bound(summary.interval_bound);
         }
         Reply::PulsesReached { at } => {
             w.u8(rep::PULSES_REACHED);
@@ -537,6 +538,7 @@ pub(super) fn get_reply(r: &mut R) -> Result<Reply, WireError> {
                 last: r.opt_time()?,
                 min_interval: r.opt_dur()?,
                 max_interval: r.opt_dur()?,
+                interval_bound: r.bound()?,
             },
         },
         rep::PULSES_REACHED => Reply::PulsesReached { at },
