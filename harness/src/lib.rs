@@ -16,7 +16,6 @@ pub mod cli;
 pub mod compare;
 pub mod console;
 pub mod fault_matrix;
-pub mod faults;
 pub mod files;
 pub mod fuzzing;
 pub mod golden;
@@ -26,6 +25,7 @@ pub mod scenario;
 pub mod trace;
 pub mod vcd_export;
 
+pub use ppmc_core::emu::faults;
 pub use ppmc_core::{bus, emu, protocol, time};
 
 /// The harness's version and git revision, for run records.

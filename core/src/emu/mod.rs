@@ -4,6 +4,7 @@
 pub mod board;
 mod chip;
 pub mod config;
+pub mod faults;
 pub mod hooks;
 mod motion;
 

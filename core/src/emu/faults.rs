@@ -3,12 +3,15 @@
 //! fuzzers catch a bad board. A clean chip has none.
 //!
 //! The [`CATALOGUE`] names each fault once; `ppmc bridge-sim --chip-fault
-//! NAME` and `ppmc fault-matrix` use those names. `docs/detection.md` shows
+//! NAME`, `ppmc fault-matrix` and the QEMU bridge firmware's virtual chip
+//! (`firmware/run-qemu --chip-fault NAME`) use those names. `docs/detection.md` shows
 //! which check catches which.
 
 use crate::emu::ModelConfig;
 use crate::protocol::{ErrorCode, Input};
 use crate::time::Duration;
+use alloc::string::String;
+use alloc::vec::Vec;
 
 /// One named fault of the catalogue.
 #[derive(Debug, Clone, Copy)]
@@ -277,6 +280,7 @@ pub fn apply_all<S: AsRef<str>>(names: &[S], cfg: &mut ModelConfig) -> Result<()
 #[cfg(test)]
 mod tests {
     use super::*;
+    use alloc::string::ToString;
 
     #[test]
     fn the_catalogue_has_twenty_distinct_faults_each_changing_the_model() {
