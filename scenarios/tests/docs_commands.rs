@@ -21,8 +21,9 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 /// The files whose commands run.
-const FILES: [&str; 9] = [
+const FILES: [&str; 10] = [
     "README.md",
+    "firmware/README.md",
     "docs/conformance.md",
     "docs/console.md",
     "docs/detection.md",
@@ -35,8 +36,17 @@ const FILES: [&str; 9] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 9] = [
+const ELSEWHERE: [(&str, &str); 12] = [
     ("cargo test", "in .ci/run (the test step)"),
+    (
+        "firmware/build qemu",
+        "in harness/tests/firmware_qemu.rs (firmware/run-qemu builds the image so)",
+    ),
+    ("firmware/build", "in .ci/run (the firmware step)"),
+    (
+        "firmware/run-qemu",
+        "in harness/tests/firmware_qemu.rs (started, the whole suite run through it, stopped)",
+    ),
     (
         "cargo run -p board-suite",
         "in .ci/run (a board team's own suite)",

@@ -57,6 +57,8 @@ fn main() -> ! {
     };
     let mut engine = BridgeEngine::new(bus, config.session, true, FIRMWARE);
     let mut uart = uart::Uart::take();
+    // `run-qemu` announces the board once it says this (QEMU's stdout).
+    cortex_m_semihosting::hprintln!("ppmc-bridge-qemu: ready, session {}", config.session);
     let mut incoming = alloc::vec::Vec::with_capacity(4096);
     loop {
         incoming.clear();
