@@ -118,6 +118,10 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
             "the pseudo-terminal has no path".to_string(),
         ));
     };
+    // SIGINT and SIGTERM end the serve loop, so the link is removed: the
+    // handlers are in place before the link is, and before anyone learns
+    // where the bridge serves.
+    let stop = super::signals::stop_requested();
     if let Some(link) = &args.link {
         place_link(link, &path)?;
     }
@@ -135,8 +139,6 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     let _ = writeln!(out, "bridge-sim: serving on {path}");
     let _ = writeln!(out, "bridge-sim: run   ppmc run --target serial:{path}");
     let _ = out.flush();
-    // SIGINT and SIGTERM end the serve loop, so the link is removed.
-    let stop = super::signals::stop_requested();
     let faults = LinkFaults {
         drop_rate: args.drop_rate,
         corrupt_rate: args.corrupt_rate,
