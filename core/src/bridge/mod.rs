@@ -6,9 +6,12 @@
 //! [`frame`] turns payloads into self-delimiting frames and back, [`wire`]
 //! turns requests and responses into payloads and back, and [`engine`] is
 //! the bridge's request executor over any [`crate::bus::Bus`]; [`timed`]
-//! captures a bus's outputs again with a bridge timer's resolution.
+//! captures a bus's outputs again with a bridge timer's resolution;
+//! [`moves`] keeps a capture's move records from the bus traffic, as a
+//! bridge firmware must.
 
 pub mod engine;
 pub mod frame;
+pub mod moves;
 pub mod timed;
 pub mod wire;

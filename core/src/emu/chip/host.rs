@@ -12,7 +12,11 @@ impl Chip {
         if self.inbuf.is_some() {
             self.record.overwritten_bytes += 1;
         }
-        self.inbuf = Some(InByte { byte, kind });
+        self.inbuf = Some(InByte {
+            byte,
+            kind,
+            written: self.now,
+        });
         if !self.pick_starved {
             let at = (self.now + self.fw(self.cfg.byte_pickup)).max(self.proc_free_at);
             self.schedule_pick(at);
@@ -48,6 +52,7 @@ impl Chip {
             return;
         }
         self.inbuf = None;
+        self.taken_written = inb.written;
         let base = self.now - self.fw(self.cfg.byte_pickup);
         match inb.kind {
             ByteKind::Command => self.on_command(Command::decode(inb.byte), base),

@@ -55,6 +55,8 @@ enum ByteKind {
 struct InByte {
     byte: u8,
     kind: ByteKind,
+    /// When the host wrote it.
+    written: Instant,
 }
 
 /// What the command parser is waiting for.
@@ -126,6 +128,9 @@ pub struct Chip {
     inbuf: Option<InByte>,
     pick_timer: Option<u64>,
     pick_starved: bool,
+    /// When the host wrote the byte the firmware is working on: a move
+    /// record's time (note N47).
+    taken_written: Instant,
     proc_free_at: Instant,
     field: StatusField,
     expect: Expect,
@@ -185,6 +190,7 @@ impl Chip {
             inbuf: None,
             pick_timer: None,
             pick_starved: false,
+            taken_written: Instant::ZERO,
             proc_free_at: Instant::ZERO,
             field: StatusField::ParamsRemaining(0),
             expect: Expect::Command,

@@ -82,7 +82,9 @@ impl Chip {
             profile,
         );
         self.record.moves.push(MoveStart {
-            at: base,
+            // The final byte's write, which a bridge sees (N47); the move
+            // itself runs from `base`, when the firmware took the byte.
+            at: self.taken_written,
             kind,
             dir: cmd.flags.direction,
             pout: cmd.pout,

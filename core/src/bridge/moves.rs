@@ -1,0 +1,275 @@
+//! The move records of a bridge's capture (`docs/bridge-protocol.md`
+//! section 7), kept by watching the bus: which command bytes the bridge
+//! wrote, what the status register said after them, and which phase
+//! pattern the chip was showing. This is what a bridge firmware does; the
+//! reference model writes its own records from the inside, and
+//! [`Tracked`] checks that the two agree, on the whole suite.
+//!
+//! - A move record is written at the final byte of a move command (its
+//!   `at`: that byte's write), with the kind, direction, POUT mode and step
+//!   count from the command and its parameters (Sections 3-3-3 to 3-3-8).
+//! - The first status read after it settles it: the error flag means the
+//!   chip refused the command (Table 3-2: during BUSY, before an
+//!   initialization) and the record is withdrawn.
+//! - The winding is that of the first initialization since reset whose
+//!   data the chip accepts (Section 3-2, Table 3-2 errors 4 and 5), settled
+//!   the same way; a software reset that is not the AUX ON quirk
+//!   (3-5-4: sent during BUSY) forgets it.
+//! - The phase is read, not modelled: the step of the winding's sequence
+//!   whose pattern the chip's S1..S5 show at the final byte (0 while the
+//!   phases are off).
+
+use crate::bus::{Bus, Op, Reply};
+use crate::emu::{PA_MAX, PA_MIN};
+use crate::protocol::{
+    Command, InitData, MoveCommand, MoveKind, MoveStart, OutputLogic, PulseCount, Record, Status,
+    Straps, Winding,
+};
+use crate::time::Instant;
+
+/// What a tentative record was, to undo it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Tentative {
+    /// A move record, the last of the record's moves.
+    Move,
+    /// An initialization, with the winding and logic before it.
+    Init {
+        before: Option<(Winding, OutputLogic)>,
+        was_initialized: bool,
+    },
+}
+
+/// Keeps a record's move records from the bus traffic a bridge sees.
+#[derive(Debug, Clone, Default)]
+pub struct MoveTracker {
+    /// The command whose parameter bytes are coming, and those so far.
+    params: Option<(Command, [u8; 4], u8)>,
+    /// The winding and output logic of the first accepted initialization
+    /// since reset.
+    winding: Option<(Winding, OutputLogic)>,
+    /// An initialization the chip accepted since reset or software reset.
+    initialized: bool,
+    /// BUSY as the last status read showed it.
+    busy: bool,
+    tentative: Option<Tentative>,
+}
+
+impl MoveTracker {
+    pub fn new() -> MoveTracker {
+        MoveTracker::default()
+    }
+
+    /// The output logic of the phases (how to read S1..S5's levels as an
+    /// energized pattern), once an initialization has set it.
+    pub fn logic(&self) -> Option<OutputLogic> {
+        self.winding.map(|(_, l)| l)
+    }
+
+    /// A chip reset: nothing is known any more.
+    pub fn reset(&mut self) {
+        *self = MoveTracker::default();
+    }
+
+    /// The bridge wrote `byte` to the command register (`command`) or the
+    /// data register at `at`; `phases` is the energized S1..S5 pattern the
+    /// chip shows then (S1 in bit 4).
+    pub fn on_write(&mut self, rec: &mut Record, command: bool, byte: u8, at: Instant, phases: u8) {
+        let (cmd, params) = if command {
+            let cmd = Command::decode(byte);
+            self.params = None;
+            match cmd {
+                Command::SoftwareReset(_) if !self.busy => {
+                    self.winding = None;
+                    self.initialized = false;
+                    return;
+                }
+                Command::Init(_)
+                | Command::Move(_)
+                | Command::SwitchingParams
+                | Command::AuxOutput
+                    if cmd.param_count() > 0 =>
+                {
+                    self.params = Some((cmd, [0; 4], 0));
+                    return;
+                }
+                Command::Move(_) => (cmd, [0; 4]),
+                _ => return,
+            }
+        } else {
+            let Some((cmd, mut buf, got)) = self.params.take() else {
+                return;
+            };
+            buf[usize::from(got)] = byte;
+            if got + 1 < cmd.param_count() {
+                self.params = Some((cmd, buf, got + 1));
+                return;
+            }
+            (cmd, buf)
+        };
+        match cmd {
+            Command::Move(m) => self.start(rec, m, params, at, phases),
+            Command::Init(c) => {
+                let data = InitData::from_bytes(params);
+                let ok = 0 < data.rh
+                    && data.rh < data.rl
+                    && data.rl < 255
+                    && (PA_MIN..=PA_MAX).contains(&data.pa);
+                if ok && !self.busy {
+                    self.tentative = Some(Tentative::Init {
+                        before: self.winding,
+                        was_initialized: self.initialized,
+                    });
+                    if self.winding.is_none() {
+                        let w = Winding {
+                            motor: c.motor,
+                            excitation: c.excitation,
+                        };
+                        self.winding = Some((w, c.logic));
+                    }
+                    self.initialized = true;
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn start(&mut self, rec: &mut Record, m: MoveCommand, p: [u8; 4], at: Instant, phases: u8) {
+        if !self.initialized {
+            return; // error 2: the chip starts nothing
+        }
+        let steps = match m.kind {
+            MoveKind::SingleStep => 1,
+            MoveKind::AccelDecel => PulseCount::from_bytes([p[0], p[1], p[2]]).steps(),
+            MoveKind::Constant => PulseCount::from_bytes([p[1], p[2], p[3]]).steps(),
+            _ => PulseCount::MAX.steps(),
+        };
+        let winding = self.winding.map(|(w, _)| w);
+        let phase_index = winding
+            .and_then(|w| (0..w.steps_per_cycle()).find(|&i| w.pattern(i) == phases))
+            .unwrap_or(0);
+        rec.moves.push(MoveStart {
+            at,
+            kind: m.kind,
+            dir: m.flags.direction,
+            pout: m.pout,
+            steps,
+            first_run: rec.runs.len(),
+            phase_index,
+            winding: if m.pout { None } else { winding },
+        });
+        self.tentative = Some(Tentative::Move);
+    }
+
+    /// The bridge read the status register.
+    pub fn on_status(&mut self, rec: &mut Record, status: Status) {
+        self.busy = status.busy();
+        let Some(t) = self.tentative.take() else {
+            return;
+        };
+        if !status.error_flag() {
+            return; // settled: the chip took it
+        }
+        match t {
+            Tentative::Move => {
+                rec.moves.pop();
+            }
+            Tentative::Init {
+                before,
+                was_initialized,
+            } => {
+                self.winding = before;
+                self.initialized = was_initialized;
+            }
+        }
+    }
+}
+
+/// A [`Bus`] whose move records are kept by a [`MoveTracker`] from the
+/// bus traffic, as a bridge firmware keeps them, instead of by the chip
+/// behind it: `ppmc bridge-sim --track-moves`, and the test that the
+/// tracker agrees with the reference model on the whole suite.
+#[derive(Debug, Clone)]
+pub struct Tracked<B> {
+    inner: B,
+    tracker: MoveTracker,
+    record: Record,
+}
+
+impl<B: Bus> Tracked<B> {
+    pub fn new(inner: B) -> Tracked<B> {
+        let mut record = inner.record().clone();
+        record.moves.clear();
+        Tracked {
+            inner,
+            tracker: MoveTracker::new(),
+            record,
+        }
+    }
+
+    pub fn inner(&self) -> &B {
+        &self.inner
+    }
+
+    /// The energized S1..S5 pattern the chip shows now.
+    fn phases(&mut self) -> u8 {
+        match self.inner.run(Op::ReadPins) {
+            Reply::Pins { pins, .. } => pins.phases,
+            _ => 0,
+        }
+    }
+}
+
+impl<B: Bus> Bus for Tracked<B> {
+    fn run(&mut self, op: Op) -> Reply {
+        // The pattern at the write: sampled just before it, which on the
+        // reference model is the same instant.
+        let phases = match op {
+            Op::WriteCommand { .. } | Op::WriteData { .. } => self.phases(),
+            _ => 0,
+        };
+        let reply = self.inner.run(op);
+        if op == Op::Reset {
+            self.tracker.reset();
+            self.record.moves.clear();
+        }
+        // Everything but the moves from the chip's own record, before the
+        // tracker looks at it: a write that waited for IBF may have let
+        // pulses of the move before out.
+        let inner = self.inner.record();
+        self.record.runs.clone_from(&inner.runs);
+        self.record.pins.clone_from(&inner.pins);
+        self.record.overwritten_bytes = inner.overwritten_bytes;
+        match (op, reply) {
+            (Op::WriteCommand { byte, .. }, Reply::Written { at, .. }) => {
+                self.tracker
+                    .on_write(&mut self.record, true, byte, at, phases)
+            }
+            (Op::WriteData { byte, .. }, Reply::Written { at, .. }) => {
+                self.tracker
+                    .on_write(&mut self.record, false, byte, at, phases)
+            }
+            (
+                _,
+                Reply::Status { status, .. }
+                | Reply::Awaited { status, .. }
+                | Reply::AwaitTimedOut { status, .. }
+                | Reply::WriteTimedOut { status, .. }
+                | Reply::ReadTimedOut { status, .. },
+            ) => self.tracker.on_status(&mut self.record, status),
+            _ => {}
+        }
+        reply
+    }
+
+    fn record(&self) -> &Record {
+        &self.record
+    }
+
+    fn straps(&self) -> Straps {
+        self.inner.straps()
+    }
+
+    fn now(&self) -> Instant {
+        self.inner.now()
+    }
+}
