@@ -252,6 +252,13 @@ pub trait Bus {
 
     /// The bus's clock: time since the last reset.
     fn now(&self) -> Instant;
+
+    /// Whether the capture lost anything since the last reset (a buffer
+    /// that filled faster than it was drained): the bridge then answers
+    /// CAPTURE_OVERRUN, never a capture with a hole in it.
+    fn capture_lost(&self) -> bool {
+        false
+    }
 }
 
 /// The reference model as a [`Bus`]: ops run in virtual time, and waits

@@ -284,17 +284,28 @@ impl<B: Bus> BridgeEngine<B> {
     fn overrun(&self) -> Option<usize> {
         let rec = self.bus.record();
         let held = rec.runs.len() + rec.pins.len();
-        (held > self.capture_capacity as usize).then_some(held)
+        (held > self.capture_capacity as usize || self.bus.capture_lost()).then_some(held)
     }
 
     fn overrun_error(&self, held: usize) -> Response {
-        Response::Error {
-            code: BridgeErrorCode::CaptureOverrun,
-            detail: format!(
+        let detail = if self.bus.capture_lost() {
+            "edges came faster than the capture was drained; some were lost".into()
+        } else {
+            format!(
                 "{held} records captured since the last reset; the buffer holds {}",
                 self.capture_capacity
-            ),
+            )
+        };
+        Response::Error {
+            code: BridgeErrorCode::CaptureOverrun,
+            detail,
         }
+    }
+
+    /// The bus, to let it work between requests (a bridge draining its
+    /// capture while it waits for the host).
+    pub fn bus_mut(&mut self) -> &mut B {
+        &mut self.bus
     }
 
     /// Up to `max` capture records of each kind from these positions on.

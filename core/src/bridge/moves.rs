@@ -272,4 +272,8 @@ impl<B: Bus> Bus for Tracked<B> {
     fn now(&self) -> Instant {
         self.inner.now()
     }
+
+    fn capture_lost(&self) -> bool {
+        self.inner.capture_lost()
+    }
 }

@@ -147,4 +147,8 @@ impl<B: Bus> Bus for Timed<B> {
     fn now(&self) -> Instant {
         self.inner.now()
     }
+
+    fn capture_lost(&self) -> bool {
+        self.inner.capture_lost()
+    }
 }

@@ -52,6 +52,12 @@ impl Bus for SimBus {
             SimBus::Timed(b) => b.now(),
         }
     }
+    fn capture_lost(&self) -> bool {
+        match self {
+            SimBus::Exact(b) => b.capture_lost(),
+            SimBus::Timed(b) => b.capture_lost(),
+        }
+    }
 }
 
 /// The simulator's engine in front of the emulated chip `emu` (an

@@ -1,0 +1,490 @@
+//! The chip on the bridge's pins, as the bridge engine's [`Bus`]: bus
+//! cycles through the PIO step player, inputs on GPIO outputs, outputs
+//! captured by the PIO edge counters and by sampling, the capture kept as
+//! the protocol's record (pulse runs through `EdgeRuns`, move records
+//! through `MoveTracker`). The pin map is docs/bridge-hardware.md's.
+
+use alloc::vec::Vec;
+use embassy_rp::gpio::{Input, Level, Output};
+use embassy_rp::peripherals::{PIO0, PIO1};
+use embassy_rp::pio::StateMachine;
+use ppmc_bridge_fw::bus::{BusTiming, Cycle};
+use ppmc_bridge_fw::timebase::{self, Edge};
+use ppmc_core::bridge::moves::MoveTracker;
+use ppmc_core::bridge::wire::Timer;
+use ppmc_core::bus::{Bus, Op, Reply};
+use ppmc_core::protocol::{
+    Direction, EdgeRuns, Input as ChipInput, OutputLogic, Pin, Pins, Record, Status, Straps,
+};
+use ppmc_core::time::{Duration, Instant};
+
+use crate::clock::Clock;
+
+/// The chip's input pins, in [`ChipInput::ALL`]'s order: L1*..L4*, ALM*,
+/// CNP*, AUXI0..3, each active low at the chip.
+pub type InputPins = [Output<'static>; 10];
+
+/// Outputs of the chip the CPU samples: S1..S5 and AUXO0..3 (DIR, which
+/// the POUT counter also reads, through the SIO input register).
+pub struct Sampled {
+    pub s: [Input<'static>; 5],
+    pub auxo: [Input<'static>; 4],
+}
+
+/// DIR's GPIO (33), read by the CPU without taking it from the PIO.
+fn dir_level() -> bool {
+    embassy_rp::pac::SIO.gpio_in(1).read() >> (33 - 32) & 1 == 1
+}
+
+/// The PIO state machines: the bus player, and the edge counters of POUT
+/// (with DIR), INT*, HOLD and AUX*, started together.
+pub struct Machines {
+    pub bus: StateMachine<'static, PIO0, 0>,
+    pub pout: StateMachine<'static, PIO1, 0>,
+    pub int: StateMachine<'static, PIO1, 1>,
+    pub hold: StateMachine<'static, PIO1, 2>,
+    pub aux: StateMachine<'static, PIO1, 3>,
+    /// Bridge ticks when the edge counters started.
+    pub started: u64,
+}
+
+impl core::fmt::Debug for Machines {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Machines")
+            .field("started", &self.started)
+            .finish_non_exhaustive()
+    }
+}
+
+pub struct BoardBus {
+    clock: Clock,
+    sysclk_hz: u32,
+    timer: Timer,
+    timing: BusTiming,
+    straps: Straps,
+    sm: Machines,
+    inputs: InputPins,
+    reset: Output<'static>,
+    sampled: Sampled,
+    /// Bridge ticks at the last chip reset: time zero of the record.
+    epoch: u64,
+    record: Record,
+    edges: EdgeRuns,
+    tracker: MoveTracker,
+    /// Last sampled S1..S5 levels, AUXO levels and DIR, for changes.
+    last_s: u8,
+    last_auxo: u8,
+    last_dir: bool,
+    busy: bool,
+    lost: bool,
+}
+
+impl core::fmt::Debug for BoardBus {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("BoardBus")
+            .field("timer", &self.timer)
+            .field("straps", &self.straps)
+            .field("epoch", &self.epoch)
+            .field("busy", &self.busy)
+            .field("lost", &self.lost)
+            .finish_non_exhaustive()
+    }
+}
+
+fn level(asserted: bool) -> Level {
+    // The chip's inputs are active low.
+    if asserted {
+        Level::Low
+    } else {
+        Level::High
+    }
+}
+
+impl BoardBus {
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        clock: Clock,
+        sysclk_hz: u32,
+        straps: Straps,
+        sm: Machines,
+        inputs: InputPins,
+        reset: Output<'static>,
+        sampled: Sampled,
+    ) -> BoardBus {
+        let timer = Timer {
+            hz: timebase::timer_hz(sysclk_hz),
+        };
+        // A tick of wobble plus the nanosecond lost converting ticks.
+        let tolerance = Duration::from_nanos(timer.to_nanos_up(1) + 1);
+        let epoch = clock.ticks();
+        let mut bus = BoardBus {
+            clock,
+            sysclk_hz,
+            timer,
+            timing: BusTiming::default(),
+            straps,
+            sm,
+            inputs,
+            reset,
+            sampled,
+            epoch,
+            record: Record::default(),
+            edges: EdgeRuns::new(tolerance),
+            tracker: MoveTracker::new(),
+            last_s: 0,
+            last_auxo: 0,
+            last_dir: false,
+            busy: false,
+            lost: false,
+        };
+        bus.sample();
+        bus
+    }
+
+    /// The timer HELLO_REPLY announces.
+    pub fn timer(&self) -> Timer {
+        self.timer
+    }
+
+    /// Ticks to the record's time.
+    fn at(&self, ticks: u64) -> Instant {
+        Instant::from_nanos(self.timer.to_nanos(ticks.saturating_sub(self.epoch)))
+    }
+
+    fn now_ticks(&self) -> u64 {
+        self.clock.ticks()
+    }
+
+    fn deadline(&self, d: Duration) -> u64 {
+        self.now_ticks() + self.timer.to_ticks(d.as_nanos())
+    }
+
+    /// Takes what the capture holds: edge words from the PIO counters and
+    /// changes of the sampled outputs. Called between ops, in every wait,
+    /// and while the bridge waits for the host.
+    pub fn poll(&mut self) {
+        let now = self.now_ticks().saturating_sub(self.sm.started);
+        let started = self.sm.started;
+        while let Some(w) = self.sm.pout.rx().try_pull() {
+            let e = timebase::place(w, now);
+            let dir = Direction::from_bit(e.bit);
+            let at = self.at(started + e.at);
+            let new_move = self
+                .record
+                .moves
+                .last()
+                .is_some_and(|m| m.first_run == self.record.runs.len());
+            self.edges.push(&mut self.record, at, dir, new_move);
+        }
+        for (pin, words) in [
+            (Pin::Int, drain(self.sm.int.rx())),
+            (Pin::Hold, drain(self.sm.hold.rx())),
+            (Pin::Aux, drain(self.sm.aux.rx())),
+        ] {
+            for w in words {
+                let Edge { bit, at } = timebase::place(w, now);
+                // INT* and AUX* are active low: asserted is the low level.
+                let value = match pin {
+                    Pin::Hold => u8::from(bit),
+                    _ => u8::from(!bit),
+                };
+                let at = self.at(started + at);
+                self.record.pin(at, pin, value);
+            }
+        }
+        self.lost |= self.sm.pout.rx().stalled()
+            | self.sm.int.rx().stalled()
+            | self.sm.hold.rx().stalled()
+            | self.sm.aux.rx().stalled();
+        self.sample();
+    }
+
+    /// Records changes of the outputs the CPU samples.
+    fn sample(&mut self) {
+        let s = self
+            .sampled
+            .s
+            .iter()
+            .fold(0u8, |v, p| v << 1 | u8::from(p.is_high()));
+        let auxo = self
+            .sampled
+            .auxo
+            .iter()
+            .enumerate()
+            .fold(0u8, |v, (i, p)| v | u8::from(p.is_low()) << i);
+        let dir = dir_level();
+        let at = self.at(self.now_ticks());
+        if s != self.last_s {
+            self.last_s = s;
+            let energized = self.energized(s);
+            self.record.pin(at, Pin::Phases, energized);
+        }
+        if auxo != self.last_auxo {
+            self.last_auxo = auxo;
+            self.record.pin(at, Pin::Auxo, auxo);
+        }
+        if dir != self.last_dir {
+            self.last_dir = dir;
+            self.record.pin(at, Pin::Dir, u8::from(dir));
+        }
+    }
+
+    /// S1..S5 levels as the energized pattern, by the logic the
+    /// initialization chose (negative until one did).
+    fn energized(&self, levels: u8) -> u8 {
+        match self.tracker.logic() {
+            Some(OutputLogic::Positive) => levels,
+            _ => !levels & 0x1F,
+        }
+    }
+
+    /// One bus cycle; the byte read, if a read.
+    fn cycle(&mut self, c: Cycle) -> (u64, Option<u8>) {
+        let steps = match self.timing.steps(c, self.sysclk_hz) {
+            Ok(s) => s,
+            // The default timing fits; a board's own is checked at start.
+            Err(_) => return (self.now_ticks(), None),
+        };
+        cortex_m::interrupt::free(|_| {
+            for w in steps.words() {
+                self.sm.bus.tx().push(*w);
+            }
+        });
+        let byte = match c {
+            Cycle::Read { .. } => loop {
+                if let Some(w) = self.sm.bus.rx().try_pull() {
+                    break Some(w as u8);
+                }
+            },
+            Cycle::Write { .. } => {
+                while !self.sm.bus.tx().empty() {}
+                None
+            }
+        };
+        (self.now_ticks(), byte)
+    }
+
+    fn read_status(&mut self) -> (u64, Status) {
+        let (t, b) = self.cycle(Cycle::Read { a0: true });
+        let status = Status(b.unwrap_or(0));
+        self.tracker.on_status(&mut self.record, status);
+        if status.busy() != self.busy {
+            self.busy = status.busy();
+            let at = self.at(t);
+            self.record.pin(at, Pin::Busy, u8::from(self.busy));
+        }
+        (t, status)
+    }
+
+    /// Polls the status register until `status & mask == value`, at most
+    /// until `deadline`; the ticks waited, or the last status.
+    fn wait_status(
+        &mut self,
+        mask: u8,
+        value: u8,
+        deadline: u64,
+    ) -> Result<(u64, Status), (u64, Status)> {
+        let start = self.now_ticks();
+        loop {
+            let (t, s) = self.read_status();
+            if s.0 & mask == value {
+                return Ok((t - start.min(t), s));
+            }
+            if t >= deadline {
+                return Err((t, s));
+            }
+            self.poll();
+        }
+    }
+
+    fn write(&mut self, command: bool, byte: u8, wait: Option<Duration>) -> Reply {
+        let mut waited = Duration::ZERO;
+        if let Some(d) = wait {
+            let deadline = self.deadline(d);
+            match self.wait_status(Status::IBF, 0, deadline) {
+                Ok((w, _)) => waited = Duration::from_nanos(self.timer.to_nanos(w)),
+                Err((t, status)) => {
+                    return Reply::WriteTimedOut {
+                        at: self.at(t),
+                        status,
+                    }
+                }
+            }
+        }
+        let phases = self.energized(self.last_s);
+        let (t, _) = self.cycle(Cycle::Write { a0: command, byte });
+        let at = self.at(t);
+        self.poll();
+        self.tracker
+            .on_write(&mut self.record, command, byte, at, phases);
+        Reply::Written { at, waited }
+    }
+
+    fn pins(&mut self) -> Pins {
+        self.poll();
+        let phases = self.energized(self.last_s);
+        Pins {
+            int: self.sm_level(Pin::Int),
+            hold: self.sm_level(Pin::Hold),
+            aux: self.sm_level(Pin::Aux),
+            auxo: self.last_auxo,
+            phases,
+            phase_levels: self.last_s,
+            dir: Direction::from_bit(self.last_dir),
+            busy: self.busy,
+        }
+    }
+
+    /// The level of a PIO-captured pin: its last recorded change.
+    fn sm_level(&self, pin: Pin) -> bool {
+        self.record
+            .pins
+            .iter()
+            .rev()
+            .find(|p| p.pin == pin)
+            .is_some_and(|p| p.value == 1)
+    }
+
+    fn reset_chip(&mut self) -> Reply {
+        self.reset.set_low();
+        // RESET held low for 100 us, well beyond any chip's minimum.
+        let until = self.deadline(Duration::from_micros(100));
+        while self.now_ticks() < until {}
+        self.reset.set_high();
+        self.poll();
+        self.epoch = self.now_ticks();
+        self.record = Record::default();
+        self.edges.reset();
+        self.tracker.reset();
+        self.lost = false;
+        self.busy = false;
+        Reply::ResetDone {
+            at: self.at(self.epoch),
+        }
+    }
+}
+
+fn drain<const SM: usize>(rx: &mut embassy_rp::pio::StateMachineRx<'static, PIO1, SM>) -> Vec<u32> {
+    let mut v = Vec::new();
+    while let Some(w) = rx.try_pull() {
+        v.push(w);
+    }
+    v
+}
+
+impl Bus for BoardBus {
+    fn run(&mut self, op: Op) -> Reply {
+        self.poll();
+        let reply = match op {
+            Op::WriteCommand { byte, wait_ibf } => self.write(true, byte, wait_ibf),
+            Op::WriteData { byte, wait_ibf } => self.write(false, byte, wait_ibf),
+            Op::ReadStatus => {
+                let (t, status) = self.read_status();
+                Reply::Status {
+                    at: self.at(t),
+                    status,
+                }
+            }
+            Op::ReadData { wait_obf } => {
+                let mut waited = Duration::ZERO;
+                if let Some(d) = wait_obf {
+                    let deadline = self.deadline(d);
+                    match self.wait_status(Status::OBF, Status::OBF, deadline) {
+                        Ok((w, _)) => waited = Duration::from_nanos(self.timer.to_nanos(w)),
+                        Err((t, status)) => {
+                            return Reply::ReadTimedOut {
+                                at: self.at(t),
+                                status,
+                            }
+                        }
+                    }
+                }
+                let (t, b) = self.cycle(Cycle::Read { a0: false });
+                Reply::Data {
+                    at: self.at(t),
+                    byte: b.unwrap_or(0),
+                    waited,
+                }
+            }
+            Op::Delay(d) => {
+                let until = self.deadline(d);
+                while self.now_ticks() < until {
+                    self.poll();
+                }
+                Reply::Delayed { at: self.at(until) }
+            }
+            Op::AwaitStatus {
+                mask,
+                value,
+                timeout,
+            } => {
+                let deadline = self.deadline(timeout);
+                match self.wait_status(mask, value & mask, deadline) {
+                    Ok((w, status)) => Reply::Awaited {
+                        at: self.at(self.now_ticks()),
+                        waited: Duration::from_nanos(self.timer.to_nanos(w)),
+                        status,
+                    },
+                    Err((t, status)) => Reply::AwaitTimedOut {
+                        at: self.at(t),
+                        status,
+                    },
+                }
+            }
+            Op::SetInput { input, asserted } => {
+                let i = ChipInput::ALL.iter().position(|x| *x == input).unwrap_or(0);
+                self.inputs[i].set_level(level(asserted));
+                Reply::InputSet {
+                    at: self.at(self.now_ticks()),
+                }
+            }
+            Op::ReadPins => {
+                let pins = self.pins();
+                Reply::Pins {
+                    at: self.at(self.now_ticks()),
+                    pins,
+                }
+            }
+            Op::ReadPulses => Reply::Pulses {
+                at: self.at(self.now_ticks()),
+                summary: self.record.last_move_pulses(),
+            },
+            Op::AwaitPulses { count, timeout } => {
+                let deadline = self.deadline(timeout);
+                loop {
+                    self.poll();
+                    let n = self.record.last_move_pulses().count;
+                    let t = self.now_ticks();
+                    if n >= count {
+                        break Reply::PulsesReached { at: self.at(t) };
+                    }
+                    if t >= deadline {
+                        break Reply::PulsesTimedOut {
+                            at: self.at(t),
+                            count: n,
+                        };
+                    }
+                }
+            }
+            Op::Reset => self.reset_chip(),
+        };
+        self.poll();
+        reply
+    }
+
+    fn record(&self) -> &Record {
+        &self.record
+    }
+
+    fn straps(&self) -> Straps {
+        self.straps
+    }
+
+    fn now(&self) -> Instant {
+        self.at(self.now_ticks())
+    }
+
+    fn capture_lost(&self) -> bool {
+        self.lost
+    }
+}
