@@ -21,9 +21,10 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 /// The files whose commands run.
-const FILES: [&str; 10] = [
+const FILES: [&str; 11] = [
     "README.md",
     "firmware/README.md",
+    "docs/bridge-hardware.md",
     "docs/conformance.md",
     "docs/console.md",
     "docs/detection.md",
@@ -36,11 +37,19 @@ const FILES: [&str; 10] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 12] = [
+const ELSEWHERE: [(&str, &str); 14] = [
+    (
+        "PPMC_BOARD=",
+        "needs a board; .ci/run runs the same test group against the QEMU board",
+    ),
     ("cargo test", "in .ci/run (the test step)"),
     (
         "firmware/build qemu",
         "in harness/tests/firmware_qemu.rs (firmware/run-qemu builds the image so)",
+    ),
+    (
+        "firmware/build board",
+        "a part of `firmware/build`, which runs in .ci/run (the firmware step)",
     ),
     ("firmware/build", "in .ci/run (the firmware step)"),
     (

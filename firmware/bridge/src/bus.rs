@@ -56,14 +56,27 @@ pub struct BusTiming {
     pub recovery_ns: u32,
 }
 
+impl BusTiming {
+    /// The defaults: 100 ns setup, 400 ns strobe, 100 ns hold, 200 ns
+    /// between cycles.
+    pub const DEFAULT: BusTiming = BusTiming {
+        setup_ns: 100,
+        strobe_ns: 400,
+        hold_ns: 100,
+        recovery_ns: 200,
+    };
+
+    /// Whether every cycle fits the player at `sysclk_hz`.
+    pub fn fits(&self, sysclk_hz: u32) -> bool {
+        [Cycle::Write { a0: true, byte: 0 }, Cycle::Read { a0: true }]
+            .into_iter()
+            .all(|c| self.steps(c, sysclk_hz).is_ok())
+    }
+}
+
 impl Default for BusTiming {
     fn default() -> Self {
-        BusTiming {
-            setup_ns: 100,
-            strobe_ns: 400,
-            hold_ns: 100,
-            recovery_ns: 200,
-        }
+        BusTiming::DEFAULT
     }
 }
 

@@ -105,6 +105,7 @@ impl BoardBus {
     pub fn new(
         clock: Clock,
         sysclk_hz: u32,
+        timing: BusTiming,
         straps: Straps,
         sm: Machines,
         inputs: InputPins,
@@ -121,7 +122,7 @@ impl BoardBus {
             clock,
             sysclk_hz,
             timer,
-            timing: BusTiming::default(),
+            timing,
             straps,
             sm,
             inputs,

@@ -37,6 +37,7 @@ use embassy_rp::usb::{Driver, InterruptHandler as UsbIrq};
 use embassy_time::Timer as Delay;
 use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
 use embedded_alloc::LlffHeap as Heap;
+use ppmc_bridge_fw::bus::BusTiming;
 use ppmc_bridge_fw::programs;
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::protocol::Straps;
@@ -67,6 +68,11 @@ const FIRMWARE: &str = concat!(
     env!("CARGO_PKG_VERSION"),
     " (PGA2350, PIO capture)"
 );
+const FIRMWARE_DEFAULT_TIMING: &str = concat!(
+    "ppmc-bridge-rp2350 ",
+    env!("CARGO_PKG_VERSION"),
+    " (PGA2350, PIO capture; the built bus timing does not fit a step, defaults used)"
+);
 
 /// A decimal number given at build time, or `default`.
 const fn build_number(v: Option<&str>, default: u32) -> u32 {
@@ -84,6 +90,23 @@ const fn build_number(v: Option<&str>, default: u32) -> u32 {
 
 const CHIP_SYSCLK_HZ: u32 = build_number(option_env!("PPMC_SYSCLK_HZ"), 16_000_000);
 const EXT_CLOCK_HZ: u32 = build_number(option_env!("PPMC_EXT_CLOCK_HZ"), 0);
+
+/// The bus timing, from the build's environment where given (in ns).
+const BUS_TIMING: BusTiming = BusTiming {
+    setup_ns: build_number(
+        option_env!("PPMC_BUS_SETUP_NS"),
+        BusTiming::DEFAULT.setup_ns,
+    ),
+    strobe_ns: build_number(
+        option_env!("PPMC_BUS_STROBE_NS"),
+        BusTiming::DEFAULT.strobe_ns,
+    ),
+    hold_ns: build_number(option_env!("PPMC_BUS_HOLD_NS"), BusTiming::DEFAULT.hold_ns),
+    recovery_ns: build_number(
+        option_env!("PPMC_BUS_RECOVERY_NS"),
+        BusTiming::DEFAULT.recovery_ns,
+    ),
+};
 
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
@@ -239,10 +262,19 @@ async fn main(_spawner: Spawner) {
         aux: aux_sm,
         started,
     };
-    let board = BoardBus::new(clock, SYSCLK_HZ, straps, machines, inputs, reset, sampled);
+    // A step holds 6.9 us at most: a longer time given at build cannot be
+    // played, and the board says so in its name instead of starting.
+    let (timing, firmware) = if BUS_TIMING.fits(SYSCLK_HZ) {
+        (BUS_TIMING, FIRMWARE)
+    } else {
+        (BusTiming::DEFAULT, FIRMWARE_DEFAULT_TIMING)
+    };
+    let board = BoardBus::new(
+        clock, SYSCLK_HZ, timing, straps, machines, inputs, reset, sampled,
+    );
     let timer = board.timer();
     let session = embassy_rp::clocks::RoscRng.next_u32();
-    let mut engine = BridgeEngine::new(board, session, false, FIRMWARE).with_timer(timer);
+    let mut engine = BridgeEngine::new(board, session, false, firmware).with_timer(timer);
 
     // USB CDC ACM.
     let driver = Driver::new(p.USB, Irqs);
