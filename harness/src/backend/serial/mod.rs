@@ -1094,7 +1094,14 @@ mod tests {
             let mut emu = crate::backend::EmuTarget::new(Straps::default(), ModelConfig::default())
                 .expect("emu");
             let want = sample_a_move(&mut emu, step, 3_000);
-            let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+            // Counting round trips: waits long enough that a loaded
+            // machine never makes a reply late and asked for again.
+            let patient = SerialOptions {
+                reply_timeout: WallDuration::from_secs(5),
+                min_reply_timeout: WallDuration::from_secs(2),
+                ..quick()
+            };
+            let mut t = SerialTarget::open(MemLink::new(), patient).expect("healthy");
             let before = t.stats.round_trips;
             let got = sample_a_move(&mut t, step, 3_000);
             assert_eq!(got, want);
