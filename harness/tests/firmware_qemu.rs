@@ -136,6 +136,7 @@ fn the_whole_suite_through_the_firmware_equals_the_in_process_run() {
         hello.firmware
     );
     assert!(hello.virtual_time);
+    assert_eq!(hello.capture_capacity, 50_000, "what the heap holds");
     let over = run_suite(
         &mut t,
         &ppmc_scenarios::all(),

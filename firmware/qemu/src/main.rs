@@ -35,6 +35,11 @@ static HEAP: Heap = Heap::empty();
 /// board's 4 MiB of data RAM.
 const HEAP_SIZE: usize = 3 * 1024 * 1024;
 
+/// Pulse runs plus pin changes the capture holds between chip resets: what
+/// the heap holds with room to spare (about 40 bytes each); past it the
+/// board answers CAPTURE_OVERRUN instead of running out of memory.
+const CAPTURE_RECORDS: u32 = 50_000;
+
 /// What HELLO_REPLY says this bridge runs.
 const FIRMWARE: &str = concat!(
     "ppmc-bridge-qemu ",
@@ -55,7 +60,8 @@ fn main() -> ! {
         Ok(bus) => bus,
         Err(e) => config::halt(format_args!("the virtual chip cannot start: {e}")),
     };
-    let mut engine = BridgeEngine::new(bus, config.session, true, FIRMWARE);
+    let mut engine = BridgeEngine::new(bus, config.session, true, FIRMWARE)
+        .with_capture_capacity(CAPTURE_RECORDS);
     let mut uart = uart::Uart::take();
     // `run-qemu` announces the board once it says this (QEMU's stdout).
     cortex_m_semihosting::hprintln!("ppmc-bridge-qemu: ready, session {}", config.session);

@@ -77,7 +77,17 @@ pub struct BoardBus {
     last_dir: bool,
     busy: bool,
     lost: bool,
+    /// Pulses in the record when the outputs were last sampled.
+    sampled_pulses: u64,
+    /// Stop switching seen: the phases chopping on and off while stopped.
+    switching: bool,
+    /// When S1..S5 last went all off or came back from it (ticks).
+    last_toggle: u64,
 }
+
+/// Phases that go off and on again within this (ticks at 75 MHz: 1 ms)
+/// are being chopped (stop switching), not switched.
+const CHOP_TICKS: u64 = 75_000;
 
 impl core::fmt::Debug for BoardBus {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -137,6 +147,9 @@ impl BoardBus {
             last_dir: false,
             busy: false,
             lost: false,
+            sampled_pulses: 0,
+            switching: false,
+            last_toggle: 0,
         };
         bus.sample();
         bus
@@ -201,6 +214,14 @@ impl BoardBus {
     }
 
     /// Records changes of the outputs the CPU samples.
+    ///
+    /// S1..S5 change with every step of a move; the protocol records their
+    /// pattern only when it changes otherwise (initialization, excitation
+    /// off), so a change with pulses since the last sample is a step and
+    /// is not recorded. Stop switching chops the phases off and on while
+    /// stopped: toggles closer than 1 ms are recorded as SWITCHING on, and
+    /// a millisecond without one as SWITCHING off. (A heuristic of the
+    /// firmware, not yet checked on hardware: docs/bridge-hardware.md.)
     fn sample(&mut self) {
         let s = self
             .sampled
@@ -214,11 +235,30 @@ impl BoardBus {
             .enumerate()
             .fold(0u8, |v, (i, p)| v | u8::from(p.is_low()) << i);
         let dir = dir_level();
-        let at = self.at(self.now_ticks());
+        let now = self.now_ticks();
+        let at = self.at(now);
+        let pulses = self.record.pulse_count();
+        let stepped = pulses != self.sampled_pulses;
+        self.sampled_pulses = pulses;
         if s != self.last_s {
+            let (was, is) = (self.energized(self.last_s), self.energized(s));
+            let toggle = was == 0 || is == 0;
+            let chopping = toggle && now.saturating_sub(self.last_toggle) < CHOP_TICKS;
+            if toggle {
+                self.last_toggle = now;
+            }
             self.last_s = s;
-            let energized = self.energized(s);
-            self.record.pin(at, Pin::Phases, energized);
+            if chopping {
+                if !self.switching {
+                    self.switching = true;
+                    self.record.pin(at, Pin::Switching, 1);
+                }
+            } else if !stepped {
+                self.record.pin(at, Pin::Phases, is);
+            }
+        } else if self.switching && now.saturating_sub(self.last_toggle) >= CHOP_TICKS {
+            self.switching = false;
+            self.record.pin(at, Pin::Switching, 0);
         }
         if auxo != self.last_auxo {
             self.last_auxo = auxo;
@@ -359,6 +399,8 @@ impl BoardBus {
         self.tracker.reset();
         self.lost = false;
         self.busy = false;
+        self.sampled_pulses = 0;
+        self.switching = false;
         Reply::ResetDone {
             at: self.at(self.epoch),
         }

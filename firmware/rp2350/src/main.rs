@@ -60,6 +60,10 @@ const HEAP_SIZE: usize = 256 * 1024;
 /// The system clock embassy-rp sets up by default.
 const SYSCLK_HZ: u32 = 150_000_000;
 
+/// Pulse runs plus pin changes the capture holds between chip resets, in
+/// the heap (about 40 bytes each); the suite's busiest scenario needs 367.
+const CAPTURE_RECORDS: u32 = 4096;
+
 /// The loop-back test signal's rate: 10 us between rising edges.
 const SELF_TEST_HZ: u32 = 100_000;
 
@@ -274,7 +278,9 @@ async fn main(_spawner: Spawner) {
     );
     let timer = board.timer();
     let session = embassy_rp::clocks::RoscRng.next_u32();
-    let mut engine = BridgeEngine::new(board, session, false, firmware).with_timer(timer);
+    let mut engine = BridgeEngine::new(board, session, false, firmware)
+        .with_timer(timer)
+        .with_capture_capacity(CAPTURE_RECORDS);
 
     // USB CDC ACM.
     let driver = Driver::new(p.USB, Irqs);
