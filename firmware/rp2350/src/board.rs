@@ -56,16 +56,21 @@ impl core::fmt::Debug for Machines {
     }
 }
 
+/// What the bridge is wired to: the state machines and the GPIOs.
+pub struct Wiring {
+    pub sm: Machines,
+    pub inputs: InputPins,
+    pub reset: Output<'static>,
+    pub sampled: Sampled,
+}
+
 pub struct BoardBus {
     clock: Clock,
     sysclk_hz: u32,
     timer: Timer,
     timing: BusTiming,
     straps: Straps,
-    sm: Machines,
-    inputs: InputPins,
-    reset: Output<'static>,
-    sampled: Sampled,
+    hw: Wiring,
     /// Bridge ticks at the last chip reset: time zero of the record.
     epoch: u64,
     record: Record,
@@ -111,16 +116,12 @@ fn level(asserted: bool) -> Level {
 }
 
 impl BoardBus {
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         clock: Clock,
         sysclk_hz: u32,
         timing: BusTiming,
         straps: Straps,
-        sm: Machines,
-        inputs: InputPins,
-        reset: Output<'static>,
-        sampled: Sampled,
+        hw: Wiring,
     ) -> BoardBus {
         let timer = Timer {
             hz: timebase::timer_hz(sysclk_hz),
@@ -134,10 +135,7 @@ impl BoardBus {
             timer,
             timing,
             straps,
-            sm,
-            inputs,
-            reset,
-            sampled,
+            hw,
             epoch,
             record: Record::default(),
             edges: EdgeRuns::new(tolerance),
@@ -177,9 +175,9 @@ impl BoardBus {
     /// changes of the sampled outputs. Called between ops, in every wait,
     /// and while the bridge waits for the host.
     pub fn poll(&mut self) {
-        let now = self.now_ticks().saturating_sub(self.sm.started);
-        let started = self.sm.started;
-        while let Some(w) = self.sm.pout.rx().try_pull() {
+        let now = self.now_ticks().saturating_sub(self.hw.sm.started);
+        let started = self.hw.sm.started;
+        while let Some(w) = self.hw.sm.pout.rx().try_pull() {
             let e = timebase::place(w, now);
             let dir = Direction::from_bit(e.bit);
             let at = self.at(started + e.at);
@@ -191,9 +189,9 @@ impl BoardBus {
             self.edges.push(&mut self.record, at, dir, new_move);
         }
         for (pin, words) in [
-            (Pin::Int, drain(self.sm.int.rx())),
-            (Pin::Hold, drain(self.sm.hold.rx())),
-            (Pin::Aux, drain(self.sm.aux.rx())),
+            (Pin::Int, drain(self.hw.sm.int.rx())),
+            (Pin::Hold, drain(self.hw.sm.hold.rx())),
+            (Pin::Aux, drain(self.hw.sm.aux.rx())),
         ] {
             for w in words {
                 let Edge { bit, at } = timebase::place(w, now);
@@ -206,10 +204,10 @@ impl BoardBus {
                 self.record.pin(at, pin, value);
             }
         }
-        self.lost |= self.sm.pout.rx().stalled()
-            | self.sm.int.rx().stalled()
-            | self.sm.hold.rx().stalled()
-            | self.sm.aux.rx().stalled();
+        self.lost |= self.hw.sm.pout.rx().stalled()
+            | self.hw.sm.int.rx().stalled()
+            | self.hw.sm.hold.rx().stalled()
+            | self.hw.sm.aux.rx().stalled();
         self.sample();
     }
 
@@ -224,11 +222,13 @@ impl BoardBus {
     /// firmware, not yet checked on hardware: docs/bridge-hardware.md.)
     fn sample(&mut self) {
         let s = self
+            .hw
             .sampled
             .s
             .iter()
             .fold(0u8, |v, p| v << 1 | u8::from(p.is_high()));
         let auxo = self
+            .hw
             .sampled
             .auxo
             .iter()
@@ -288,17 +288,17 @@ impl BoardBus {
         };
         cortex_m::interrupt::free(|_| {
             for w in steps.words() {
-                self.sm.bus.tx().push(*w);
+                self.hw.sm.bus.tx().push(*w);
             }
         });
         let byte = match c {
             Cycle::Read { .. } => loop {
-                if let Some(w) = self.sm.bus.rx().try_pull() {
+                if let Some(w) = self.hw.sm.bus.rx().try_pull() {
                     break Some(w as u8);
                 }
             },
             Cycle::Write { .. } => {
-                while !self.sm.bus.tx().empty() {}
+                while !self.hw.sm.bus.tx().empty() {}
                 None
             }
         };
@@ -387,11 +387,11 @@ impl BoardBus {
     }
 
     fn reset_chip(&mut self) -> Reply {
-        self.reset.set_low();
+        self.hw.reset.set_low();
         // RESET held low for 100 us, well beyond any chip's minimum.
         let until = self.deadline(Duration::from_micros(100));
         while self.now_ticks() < until {}
-        self.reset.set_high();
+        self.hw.reset.set_high();
         self.poll();
         self.epoch = self.now_ticks();
         self.record = Record::default();
@@ -476,7 +476,7 @@ impl Bus for BoardBus {
             }
             Op::SetInput { input, asserted } => {
                 let i = ChipInput::ALL.iter().position(|x| *x == input).unwrap_or(0);
-                self.inputs[i].set_level(level(asserted));
+                self.hw.inputs[i].set_level(level(asserted));
                 Reply::InputSet {
                     at: self.at(self.now_ticks()),
                 }

@@ -23,7 +23,7 @@ extern crate alloc;
 mod board;
 mod clock;
 
-use board::{BoardBus, Machines, Sampled};
+use board::{BoardBus, Machines, Sampled, Wiring};
 use core::mem::MaybeUninit;
 use embassy_executor::Spawner;
 use embassy_futures::join::join;
@@ -273,9 +273,13 @@ async fn main(_spawner: Spawner) {
     } else {
         (BusTiming::DEFAULT, FIRMWARE_DEFAULT_TIMING)
     };
-    let board = BoardBus::new(
-        clock, SYSCLK_HZ, timing, straps, machines, inputs, reset, sampled,
-    );
+    let wiring = Wiring {
+        sm: machines,
+        inputs,
+        reset,
+        sampled,
+    };
+    let board = BoardBus::new(clock, SYSCLK_HZ, timing, straps, wiring);
     let timer = board.timer();
     let session = embassy_rp::clocks::RoscRng.next_u32();
     let mut engine = BridgeEngine::new(board, session, false, firmware)
