@@ -13,7 +13,8 @@ mod serial;
 
 pub use self::emu::EmuTarget;
 pub use self::serial::{
-    parse_spec, Link, LinkStats, SerialError, SerialLink, SerialOptions, SerialTarget,
+    parse_spec, parse_tcp, Link, LinkStats, SerialError, SerialLink, SerialOptions, SerialTarget,
+    TcpLink,
 };
 
 pub use ppmc_core::bus::{Op, Reply};

@@ -2,7 +2,7 @@
 //! the scenario selection, the comparison tolerances.
 
 use super::CliError;
-use crate::backend::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
+use crate::backend::{EmuTarget, Link, SerialLink, SerialOptions, SerialTarget, Target, TcpLink};
 use crate::compare::Tolerances;
 use crate::emu::{AccelCurve, ModelConfig};
 use crate::protocol::Straps;
@@ -14,8 +14,10 @@ use clap::{Args, ValueEnum};
 /// Which chip to drive, and how its board is strapped.
 #[derive(Debug, Args)]
 pub struct TargetArgs {
-    /// `emu` (the reference emulator) or `serial:<path>[,baud=N]` (a board,
-    /// or `ppmc bridge-sim`, behind the serial bus bridge).
+    /// `emu` (the reference emulator), `serial:<path>[,baud=N]` (a board,
+    /// or `ppmc bridge-sim`, behind the serial bus bridge) or
+    /// `tcp://<host>:<port>` (a bridge's serial port served on the network
+    /// in raw mode, as ser2net or socat serve it).
     #[arg(long, default_value = "emu")]
     target: String,
     /// System clock in MHz, 1 to 40 (fractions allowed, e.g. 12.288).
@@ -183,40 +185,70 @@ impl TargetArgs {
                     self.target
                 ))
             })?;
-            // Bad options are the user's, before any port is touched.
-            if self.link_timeout.as_nanos() < 1_000_000 {
-                return Err(OpenError::Usage(format!(
-                    "--link-timeout {}: give at least 1ms",
-                    self.link_timeout
-                )));
-            }
-            self.straps().map_err(OpenError::Usage)?;
-            let infra = |e: crate::backend::SerialError| OpenError::Infrastructure(e.to_string());
+            self.check_link_options()?;
             let link = SerialLink::open(&path, baud).map_err(infra)?;
-            let opts = SerialOptions {
-                reply_timeout: std::time::Duration::from_nanos(self.link_timeout.as_nanos()),
-                retries: self.link_retries,
-                ..SerialOptions::default()
-            };
-            let t = SerialTarget::open(link, opts).map_err(infra)?;
-            // The bridge knows how its chip is strapped; the command line
-            // may only confirm it. A board at 12 MHz judged as one at 16
-            // would fail for the wrong reason.
-            let reported = t.straps();
-            let differ = self.disagreements(&reported).map_err(OpenError::Usage)?;
-            if !differ.is_empty() {
-                return Err(OpenError::Infrastructure(format!(
-                    "{path}: the bridge reports its chip strapped {reported}, which the command line contradicts ({}); fix the options or the board, or leave the strap options out to use the bridge's",
-                    differ.join("; ")
-                )));
-            }
-            return Ok(Box::new(t));
+            return self.open_bridge(link, &path);
+        }
+        if self.target.starts_with("tcp://") {
+            let addr = crate::backend::parse_tcp(&self.target).ok_or_else(|| {
+                OpenError::Usage(format!(
+                    "bad target `{}`: write tcp://<host>:<port>",
+                    self.target
+                ))
+            })?;
+            self.check_link_options()?;
+            let link = TcpLink::open(&addr).map_err(infra)?;
+            return self.open_bridge(link, &self.target);
         }
         Err(OpenError::Usage(format!(
-            "unknown target `{}`: use `emu` or `serial:<path>[,baud=N]`",
+            "unknown target `{}`: use `emu`, `serial:<path>[,baud=N]` or `tcp://<host>:<port>`",
             self.target
         )))
     }
+
+    /// Bad options are the user's, before any port is touched.
+    fn check_link_options(&self) -> Result<(), OpenError> {
+        if self.link_timeout.as_nanos() < 1_000_000 {
+            return Err(OpenError::Usage(format!(
+                "--link-timeout {}: give at least 1ms",
+                self.link_timeout
+            )));
+        }
+        self.straps().map_err(OpenError::Usage)?;
+        Ok(())
+    }
+
+    /// A bridge behind `link`: opened, health checked, and its straps
+    /// reconciled with the command line's.
+    fn open_bridge<L: Link + 'static>(
+        &self,
+        link: L,
+        name: &str,
+    ) -> Result<Box<dyn Target>, OpenError> {
+        let opts = SerialOptions {
+            reply_timeout: std::time::Duration::from_nanos(self.link_timeout.as_nanos()),
+            retries: self.link_retries,
+            ..SerialOptions::default()
+        };
+        let t = SerialTarget::open(link, opts).map_err(infra)?;
+        // The bridge knows how its chip is strapped; the command line may
+        // only confirm it. A board at 12 MHz judged as one at 16 would fail
+        // for the wrong reason.
+        let reported = t.straps();
+        let differ = self.disagreements(&reported).map_err(OpenError::Usage)?;
+        if !differ.is_empty() {
+            return Err(OpenError::Infrastructure(format!(
+                "{name}: the bridge reports its chip strapped {reported}, which the command line contradicts ({}); fix the options or the board, or leave the strap options out to use the bridge's",
+                differ.join("; ")
+            )));
+        }
+        Ok(Box::new(t))
+    }
+}
+
+/// A link that fails is the infrastructure's, never the board's.
+fn infra(e: crate::backend::SerialError) -> OpenError {
+    OpenError::Infrastructure(e.to_string())
 }
 
 /// Why a target could not be opened.

@@ -9,8 +9,10 @@
 //! the run cannot go on safely and the error says so.
 
 mod link;
+mod tcp;
 
 pub use self::link::{parse_spec, Link, SerialLink};
+pub use self::tcp::{parse_tcp, TcpLink};
 
 use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
 use crate::protocol::Record;

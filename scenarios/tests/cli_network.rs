@@ -1,0 +1,156 @@
+//! Boards on the network: a bridge's serial port served by ser2net (the
+//! Debian package, with its default settings), reached as
+//! `--target tcp://127.0.0.1:PORT`. ser2net listens on 127.0.0.1 only, in
+//! front of a `ppmc bridge-sim`; every process is stopped at the end.
+//!
+//! Without ser2net the tests say so and pass, except in CI (`CI` set),
+//! where `.ci/run` installs it and its absence fails.
+
+mod common;
+
+use common::{ppmc, scratch, text};
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn have_ser2net() -> bool {
+    let found = Command::new("ser2net")
+        .arg("-v")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok();
+    if !found {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI must test the network targets with ser2net (apt install ser2net)"
+        );
+        eprintln!("ser2net is not installed: the tcp:// target is not tested");
+    }
+    found
+}
+
+/// A child process killed when dropped.
+struct Killed(Child);
+
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// A bridge simulator and ser2net in front of its pty, on 127.0.0.1.
+struct Served {
+    port: u16,
+    _ser2net: Killed,
+    _bridge: Killed,
+    _dir: tempfile::TempDir,
+}
+
+fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .map(|a| a.port())
+        .expect("a free port")
+}
+
+impl Served {
+    fn start(ser2net_options: &str) -> Served {
+        let dir = scratch("ser2net");
+        let mut bridge = Command::new(env!("CARGO_BIN_EXE_ppmc"))
+            .args(["bridge-sim", "--link"])
+            .arg(dir.path().join("pty"))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("bridge-sim starts");
+        let mut first = String::new();
+        BufReader::new(bridge.stdout.take().expect("piped"))
+            .read_line(&mut first)
+            .expect("bridge-sim says where");
+        let pty = first
+            .trim()
+            .strip_prefix("bridge-sim: serving on ")
+            .expect("a pty")
+            .to_string();
+        let bridge = Killed(bridge);
+        let port = free_port();
+        let config = dir.path().join("ser2net.yaml");
+        std::fs::write(
+            &config,
+            format!(
+                "%YAML 1.1\n---\nconnection: &bridge\n    accepter: tcp,127.0.0.1,{port}\n    connector: serialdev,{pty},115200n81,local\n{ser2net_options}"
+            ),
+        )
+        .expect("config written");
+        let ser2net = Killed(
+            Command::new("ser2net")
+                .arg("-n")
+                .arg("-c")
+                .arg(&config)
+                .arg("-P")
+                .arg(dir.path().join("ser2net.pid"))
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .expect("ser2net starts"),
+        );
+        // Until it listens (bounded).
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+            assert!(
+                Instant::now() < deadline,
+                "ser2net did not listen on {port}"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        // That probe connection is closed; give ser2net a moment to free
+        // the port for the next client.
+        std::thread::sleep(Duration::from_millis(100));
+        Served {
+            port,
+            _ser2net: ser2net,
+            _bridge: bridge,
+            _dir: dir,
+        }
+    }
+
+    fn target(&self) -> String {
+        format!("tcp://127.0.0.1:{}", self.port)
+    }
+}
+
+#[test]
+fn the_suite_passes_through_ser2net_with_its_defaults() {
+    if !have_ser2net() {
+        return;
+    }
+    let served = Served::start("");
+    let out = ppmc(&["run", "--target", &served.target()]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{}", text(&out.stderr));
+    assert!(
+        stdout.contains("suite: 96 passed, 0 failed, 0 errors, 0 not run"),
+        "{stdout}"
+    );
+    // The same verdicts as the emulator's.
+    let local = ppmc(&["run"]);
+    assert_eq!(stdout, text(&local.stdout));
+}
+
+#[test]
+fn a_server_that_is_not_there_is_an_infrastructure_error() {
+    let port = free_port();
+    let out = ppmc(&["run", "--target", &format!("tcp://127.0.0.1:{port}")]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("infrastructure error"), "{stderr}");
+    assert!(
+        stderr.contains(&format!("tcp://127.0.0.1:{port}")),
+        "{stderr}"
+    );
+    let bad = ppmc(&["run", "--target", "tcp://127.0.0.1"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(text(&bad.stderr).contains("tcp://<host>:<port>"));
+}
