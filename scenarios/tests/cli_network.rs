@@ -1,6 +1,7 @@
 //! Boards on the network: a bridge's serial port served by ser2net (the
 //! Debian package, with its default settings), reached as
-//! `--target tcp://127.0.0.1:PORT`. ser2net listens on 127.0.0.1 only, in
+//! `--target tcp://127.0.0.1:PORT` (raw) and `rfc2217://127.0.0.1:PORT`
+//! (telnet with RFC 2217). ser2net listens on 127.0.0.1 only, in
 //! front of a `ppmc bridge-sim`; every process is stopped at the end.
 //!
 //! Without ser2net the tests say so and pass, except in CI (`CI` set),
@@ -56,7 +57,9 @@ fn free_port() -> u16 {
 }
 
 impl Served {
-    fn start(ser2net_options: &str) -> Served {
+    /// ser2net with `accepter` (`tcp` for raw, `telnet(rfc2217),tcp` for
+    /// RFC 2217) on a free port of 127.0.0.1.
+    fn start(accepter: &str) -> Served {
         let dir = scratch("ser2net");
         let mut bridge = Command::new(env!("CARGO_BIN_EXE_ppmc"))
             .args(["bridge-sim", "--link"])
@@ -80,7 +83,7 @@ impl Served {
         std::fs::write(
             &config,
             format!(
-                "%YAML 1.1\n---\nconnection: &bridge\n    accepter: tcp,127.0.0.1,{port}\n    connector: serialdev,{pty},115200n81,local\n{ser2net_options}"
+                "%YAML 1.1\n---\nconnection: &bridge\n    accepter: {accepter},127.0.0.1,{port}\n    connector: serialdev,{pty},115200n81,local\n"
             ),
         )
         .expect("config written");
@@ -116,8 +119,8 @@ impl Served {
         }
     }
 
-    fn target(&self) -> String {
-        format!("tcp://127.0.0.1:{}", self.port)
+    fn target(&self, scheme: &str) -> String {
+        format!("{scheme}://127.0.0.1:{}", self.port)
     }
 }
 
@@ -126,8 +129,8 @@ fn the_suite_passes_through_ser2net_with_its_defaults() {
     if !have_ser2net() {
         return;
     }
-    let served = Served::start("");
-    let out = ppmc(&["run", "--target", &served.target()]);
+    let served = Served::start("tcp");
+    let out = ppmc(&["run", "--target", &served.target("tcp")]);
     let stdout = text(&out.stdout);
     assert_eq!(out.status.code(), Some(0), "{stdout}{}", text(&out.stderr));
     assert!(
@@ -137,6 +140,20 @@ fn the_suite_passes_through_ser2net_with_its_defaults() {
     // The same verdicts as the emulator's.
     let local = ppmc(&["run"]);
     assert_eq!(stdout, text(&local.stdout));
+}
+
+/// RFC 2217 is telnet: bridge frames are full of 0xFF, which must be
+/// escaped both ways, and the server negotiates options first.
+#[test]
+fn the_suite_passes_through_ser2net_in_rfc2217_mode() {
+    if !have_ser2net() {
+        return;
+    }
+    let served = Served::start("telnet(rfc2217),tcp");
+    let out = ppmc(&["run", "--target", &served.target("rfc2217")]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{}", text(&out.stderr));
+    assert_eq!(stdout, text(&ppmc(&["run"]).stdout));
 }
 
 #[test]

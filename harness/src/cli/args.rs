@@ -2,7 +2,9 @@
 //! the scenario selection, the comparison tolerances.
 
 use super::CliError;
-use crate::backend::{EmuTarget, Link, SerialLink, SerialOptions, SerialTarget, Target, TcpLink};
+use crate::backend::{
+    EmuTarget, Link, Rfc2217Link, SerialLink, SerialOptions, SerialTarget, Target, TcpLink,
+};
 use crate::compare::Tolerances;
 use crate::emu::{AccelCurve, ModelConfig};
 use crate::protocol::Straps;
@@ -17,7 +19,9 @@ pub struct TargetArgs {
     /// `emu` (the reference emulator), `serial:<path>[,baud=N]` (a board,
     /// or `ppmc bridge-sim`, behind the serial bus bridge) or
     /// `tcp://<host>:<port>` (a bridge's serial port served on the network
-    /// in raw mode, as ser2net or socat serve it).
+    /// in raw mode, as ser2net or socat serve it) or
+    /// `rfc2217://<host>:<port>[,baud=N]` (served over telnet with RFC 2217,
+    /// as ser2net's telnet(rfc2217) mode and labgrid's exporter serve it).
     #[arg(long, default_value = "emu")]
     target: String,
     /// System clock in MHz, 1 to 40 (fractions allowed, e.g. 12.288).
@@ -200,8 +204,19 @@ impl TargetArgs {
             let link = TcpLink::open(&addr).map_err(infra)?;
             return self.open_bridge(link, &self.target);
         }
+        if self.target.starts_with("rfc2217://") {
+            let (addr, baud) = crate::backend::parse_rfc2217(&self.target).ok_or_else(|| {
+                OpenError::Usage(format!(
+                    "bad target `{}`: write rfc2217://<host>:<port>[,baud=N]",
+                    self.target
+                ))
+            })?;
+            self.check_link_options()?;
+            let link = Rfc2217Link::open(&addr, baud).map_err(infra)?;
+            return self.open_bridge(link, &self.target);
+        }
         Err(OpenError::Usage(format!(
-            "unknown target `{}`: use `emu`, `serial:<path>[,baud=N]` or `tcp://<host>:<port>`",
+            "unknown target `{}`: use `emu`, `serial:<path>[,baud=N]`, `tcp://<host>:<port>` or `rfc2217://<host>:<port>[,baud=N]`",
             self.target
         )))
     }

@@ -9,9 +9,11 @@
 //! the run cannot go on safely and the error says so.
 
 mod link;
+mod rfc2217;
 mod tcp;
 
 pub use self::link::{parse_spec, Link, SerialLink};
+pub use self::rfc2217::{parse_rfc2217, Rfc2217Link};
 pub use self::tcp::{parse_tcp, TcpLink};
 
 use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
