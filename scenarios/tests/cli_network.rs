@@ -44,7 +44,7 @@ impl Drop for Killed {
 /// A bridge simulator and ser2net in front of its pty, on 127.0.0.1.
 struct Served {
     port: u16,
-    _ser2net: Killed,
+    ser2net: Killed,
     _bridge: Killed,
     _dir: tempfile::TempDir,
 }
@@ -113,7 +113,7 @@ impl Served {
         std::thread::sleep(Duration::from_millis(100));
         Served {
             port,
-            _ser2net: ser2net,
+            ser2net,
             _bridge: bridge,
             _dir: dir,
         }
@@ -170,4 +170,65 @@ fn a_server_that_is_not_there_is_an_infrastructure_error() {
     let bad = ppmc(&["run", "--target", "tcp://127.0.0.1"]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(text(&bad.stderr).contains("tcp://<host>:<port>"));
+}
+
+/// The server goes away mid-run: the scenarios left are not run, blamed on
+/// the infrastructure, never on the board, and the reports are written.
+#[test]
+fn a_connection_cut_mid_run_ends_it_as_an_infrastructure_error() {
+    if !have_ser2net() {
+        return;
+    }
+    let mut served = Served::start("tcp");
+    let dir = scratch("cut");
+    let junit = dir.path().join("report.xml");
+    let mut run = Command::new(env!("CARGO_BIN_EXE_ppmc"))
+        .args([
+            "run",
+            "--repeat",
+            "1000",
+            "--link-timeout",
+            "200ms",
+            "--target",
+        ])
+        .arg(served.target("tcp"))
+        .arg("--junit")
+        .arg(&junit)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("ppmc runs");
+    // Read both pipes while it runs: a thousand passes print a lot.
+    let pipe = |mut r: Box<dyn std::io::Read + Send>| {
+        std::thread::spawn(move || {
+            let mut s = String::new();
+            let _ = r.read_to_string(&mut s);
+            s
+        })
+    };
+    let out_t = pipe(Box::new(run.stdout.take().expect("piped")));
+    let err_t = pipe(Box::new(run.stderr.take().expect("piped")));
+    // Let it get going, then pull the plug.
+    std::thread::sleep(Duration::from_millis(800));
+    let _ = served.ser2net.0.kill();
+    let _ = served.ser2net.0.wait();
+    let status = common::wait_bounded(&mut run, Duration::from_secs(120));
+    let stdout = out_t.join().unwrap_or_default();
+    let stderr = err_t.join().unwrap_or_default();
+    assert_eq!(status.code(), Some(1), "{stdout}{stderr}");
+    let last = stdout.lines().last().unwrap_or_default();
+    assert!(
+        last.contains(" 0 failed,"),
+        "nothing blamed on the board: {last}"
+    );
+    assert!(!last.contains(" 0 not run"), "the rest is not run: {last}");
+    // The scenario under way is an error of the target, the rest not run:
+    // both say the link went away.
+    assert!(
+        stdout.contains("not run: the target stopped answering")
+            && stdout.contains("link lost and not back"),
+        "{}",
+        &stdout[stdout.len().saturating_sub(2000)..]
+    );
+    assert!(std::fs::read_to_string(&junit).is_ok_and(|x| x.contains("<testcase")));
 }
