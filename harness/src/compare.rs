@@ -90,8 +90,6 @@ impl fmt::Display for Divergence {
 #[derive(Debug, Clone, Copy)]
 struct Run {
     run: PulseRun,
-    count: u32,
-    dir: crate::protocol::Direction,
     /// Time of the move's start.
     anchor: Instant,
     /// Whether the run's first pulse is the first of its move.
@@ -147,12 +145,10 @@ fn streams(t: &Trace) -> Streams {
                 pending_first = true;
                 s.moves.push((e.at, k.clone()));
             }
-            EventKind::Pulses { dir, count, .. } => {
+            EventKind::Pulses { .. } => {
                 if let Some(run) = e.pulse_run() {
                     s.pulses.push(Run {
                         run,
-                        count: *count,
-                        dir: *dir,
                         anchor,
                         first_of_move: pending_first,
                     });
@@ -386,7 +382,7 @@ struct Cursor {
 /// one period costs one check, so a 16-million-pulse move compares in
 /// O(runs).
 fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
-    let total = |runs: &[Run]| runs.iter().map(|r| u64::from(r.count)).sum::<u64>();
+    let total = |runs: &[Run]| runs.iter().map(|r| u64::from(r.run.count)).sum::<u64>();
     let (mut gc, mut oc) = (Cursor::default(), Cursor::default());
     let mut n: u64 = 0; // pulses compared so far
                         // The previous (golden, got) pulse and how far each may be off.
@@ -406,11 +402,11 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First)
             allowed,
         };
         // The pulse at the cursors, on its own.
-        if gr.dir != or.dir {
+        if gr.run.dir != or.run.dir {
             first.offer(diverge(
                 format!("pulse {k} direction"),
-                gr.dir.name().into(),
-                or.dir.name().into(),
+                gr.run.dir.name().into(),
+                or.run.dir.name().into(),
                 "equal".into(),
             ));
             return;
@@ -464,7 +460,7 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First)
             return;
         }
         // The rest of the stretch both runs share: one period each.
-        let rest = (gr.count - gc.pos - 1).min(or.count - oc.pos - 1);
+        let rest = (gr.run.count - gc.pos - 1).min(or.run.count - oc.pos - 1);
         if rest > 0 {
             let (gi, oi) = (gr.run.interval(), or.run.interval());
             let band = tol.band_widened(gi, tol.interval_bp, gr.spread() + or.spread());
@@ -485,7 +481,7 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First)
         prev = Some((gr.at(gc.pos), or.at(oc.pos), here));
         for (c, runs) in [(&mut gc, &g.pulses), (&mut oc, &o.pulses)] {
             c.pos += 1;
-            if c.pos >= runs[c.run].count {
+            if c.pos >= runs[c.run].run.count {
                 c.run += 1;
                 c.pos = 0;
             }

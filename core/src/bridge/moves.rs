@@ -230,14 +230,22 @@ impl<B: Bus> Bus for Tracked<B> {
         let reply = self.inner.run(op);
         if op == Op::Reset {
             self.tracker.reset();
-            self.record.moves.clear();
+            self.record = Record::default();
         }
         // Everything but the moves from the chip's own record, before the
         // tracker looks at it: a write that waited for IBF may have let
-        // pulses of the move before out.
+        // pulses of the move before out. Pin changes are only appended, and
+        // only the last pulse run may have grown.
         let inner = self.inner.record();
-        self.record.runs.clone_from(&inner.runs);
-        self.record.pins.clone_from(&inner.pins);
+        let keep = self.record.runs.len().saturating_sub(1);
+        self.record.runs.truncate(keep);
+        self.record
+            .runs
+            .extend_from_slice(inner.runs.get(keep..).unwrap_or_default());
+        let had = self.record.pins.len();
+        self.record
+            .pins
+            .extend_from_slice(inner.pins.get(had..).unwrap_or_default());
         self.record.overwritten_bytes = inner.overwritten_bytes;
         match (op, reply) {
             (Op::WriteCommand { byte, .. }, Reply::Written { at, .. }) => {

@@ -11,7 +11,7 @@
 use super::wire::Timer;
 use crate::bus::{Bus, Op, Reply};
 use crate::protocol::{EdgeRuns, MoveStart, PinEvent, Record, Straps};
-use crate::time::{Duration, Instant};
+use crate::time::Instant;
 
 /// A [`Bus`] whose capture is taken edge by edge with a timer of
 /// `timer.hz`: pulse and pin times fall on the timer's ticks, and pulse
@@ -33,15 +33,12 @@ pub struct Timed<B> {
 
 impl<B: Bus> Timed<B> {
     /// `inner` seen through a timer of `timer.hz`, merging pulses into runs
-    /// within one tick plus the nanosecond lost converting ticks to
-    /// nanoseconds.
+    /// within [`Timer::edge_tolerance`].
     pub fn new(inner: B, timer: Timer) -> Timed<B> {
-        let tick = timer.to_nanos_up(1);
-        let slack = if timer.whole_nanos() { 0 } else { 1 };
         let mut t = Timed {
             inner,
             timer,
-            edges: EdgeRuns::new(Duration::from_nanos(tick + slack)),
+            edges: EdgeRuns::new(timer.edge_tolerance()),
             record: Record::default(),
             runs_taken: (0, 0),
             pins_taken: 0,

@@ -4,12 +4,11 @@
 //! the protocol's record (pulse runs through `EdgeRuns`, move records
 //! through `MoveTracker`). The pin map is docs/bridge-hardware.md's.
 
-use alloc::vec::Vec;
 use embassy_rp::gpio::{Input, Level, Output};
 use embassy_rp::peripherals::{PIO0, PIO1};
-use embassy_rp::pio::StateMachine;
+use embassy_rp::pio::{StateMachine, StateMachineRx};
 use ppmc_bridge_fw::bus::{BusTiming, Cycle};
-use ppmc_bridge_fw::timebase::{self, Edge};
+use ppmc_bridge_fw::timebase;
 use ppmc_core::bridge::moves::MoveTracker;
 use ppmc_core::bridge::wire::Timer;
 use ppmc_core::bus::{Bus, Op, Reply};
@@ -82,8 +81,6 @@ pub struct BoardBus {
     last_dir: bool,
     busy: bool,
     lost: bool,
-    /// Pulses in the record when the outputs were last sampled.
-    sampled_pulses: u64,
     /// Stop switching seen: the phases chopping on and off while stopped.
     switching: bool,
     /// When S1..S5 last went all off or came back from it (ticks).
@@ -126,8 +123,6 @@ impl BoardBus {
         let timer = Timer {
             hz: timebase::timer_hz(sysclk_hz),
         };
-        // A tick of wobble plus the nanosecond lost converting ticks.
-        let tolerance = Duration::from_nanos(timer.to_nanos_up(1) + 1);
         let epoch = clock.ticks();
         let mut bus = BoardBus {
             clock,
@@ -138,18 +133,17 @@ impl BoardBus {
             hw,
             epoch,
             record: Record::default(),
-            edges: EdgeRuns::new(tolerance),
+            edges: EdgeRuns::new(timer.edge_tolerance()),
             tracker: MoveTracker::new(),
             last_s: 0,
             last_auxo: 0,
             last_dir: false,
             busy: false,
             lost: false,
-            sampled_pulses: 0,
             switching: false,
             last_toggle: 0,
         };
-        bus.sample();
+        bus.sample(false);
         bus
     }
 
@@ -160,7 +154,7 @@ impl BoardBus {
 
     /// Ticks to the record's time.
     fn at(&self, ticks: u64) -> Instant {
-        Instant::from_nanos(self.timer.to_nanos(ticks.saturating_sub(self.epoch)))
+        record_time(self.timer, self.epoch, ticks)
     }
 
     fn now_ticks(&self) -> u64 {
@@ -176,39 +170,32 @@ impl BoardBus {
     /// and while the bridge waits for the host.
     pub fn poll(&mut self) {
         let now = self.now_ticks().saturating_sub(self.hw.sm.started);
-        let started = self.hw.sm.started;
-        while let Some(w) = self.hw.sm.pout.rx().try_pull() {
+        let (started, timer, epoch) = (self.hw.sm.started, self.timer, self.epoch);
+        // A pushed word's time in the record.
+        let place = |w: u32| {
             let e = timebase::place(w, now);
-            let dir = Direction::from_bit(e.bit);
-            let at = self.at(started + e.at);
+            (e.bit, record_time(timer, epoch, started + e.at))
+        };
+        let mut stepped = false;
+        while let Some(w) = self.hw.sm.pout.rx().try_pull() {
+            stepped = true;
+            let (bit, at) = place(w);
             let new_move = self
                 .record
                 .moves
                 .last()
                 .is_some_and(|m| m.first_run == self.record.runs.len());
-            self.edges.push(&mut self.record, at, dir, new_move);
+            self.edges
+                .push(&mut self.record, at, Direction::from_bit(bit), new_move);
         }
-        for (pin, words) in [
-            (Pin::Int, drain(self.hw.sm.int.rx())),
-            (Pin::Hold, drain(self.hw.sm.hold.rx())),
-            (Pin::Aux, drain(self.hw.sm.aux.rx())),
-        ] {
-            for w in words {
-                let Edge { bit, at } = timebase::place(w, now);
-                // INT* and AUX* are active low: asserted is the low level.
-                let value = match pin {
-                    Pin::Hold => u8::from(bit),
-                    _ => u8::from(!bit),
-                };
-                let at = self.at(started + at);
-                self.record.pin(at, pin, value);
-            }
-        }
+        take_edges(self.hw.sm.int.rx(), Pin::Int, &mut self.record, place);
+        take_edges(self.hw.sm.hold.rx(), Pin::Hold, &mut self.record, place);
+        take_edges(self.hw.sm.aux.rx(), Pin::Aux, &mut self.record, place);
         self.lost |= self.hw.sm.pout.rx().stalled()
             | self.hw.sm.int.rx().stalled()
             | self.hw.sm.hold.rx().stalled()
             | self.hw.sm.aux.rx().stalled();
-        self.sample();
+        self.sample(stepped);
     }
 
     /// Records changes of the outputs the CPU samples.
@@ -216,11 +203,12 @@ impl BoardBus {
     /// S1..S5 change with every step of a move; the protocol records their
     /// pattern only when it changes otherwise (initialization, excitation
     /// off), so a change with pulses since the last sample is a step and
-    /// is not recorded. Stop switching chops the phases off and on while
+    /// is not recorded (`stepped`: the capture took pulses since the last
+    /// sample). Stop switching chops the phases off and on while
     /// stopped: toggles closer than 1 ms are recorded as SWITCHING on, and
     /// a millisecond without one as SWITCHING off. (A heuristic of the
     /// firmware, not yet checked on hardware: docs/bridge-hardware.md.)
-    fn sample(&mut self) {
+    fn sample(&mut self, stepped: bool) {
         let s = self
             .hw
             .sampled
@@ -237,9 +225,6 @@ impl BoardBus {
         let dir = dir_level();
         let now = self.now_ticks();
         let at = self.at(now);
-        let pulses = self.record.pulse_count();
-        let stepped = pulses != self.sampled_pulses;
-        self.sampled_pulses = pulses;
         if s != self.last_s {
             let (was, is) = (self.energized(self.last_s), self.energized(s));
             let toggle = was == 0 || is == 0;
@@ -399,7 +384,6 @@ impl BoardBus {
         self.tracker.reset();
         self.lost = false;
         self.busy = false;
-        self.sampled_pulses = 0;
         self.switching = false;
         Reply::ResetDone {
             at: self.at(self.epoch),
@@ -407,12 +391,27 @@ impl BoardBus {
     }
 }
 
-fn drain<const SM: usize>(rx: &mut embassy_rp::pio::StateMachineRx<'static, PIO1, SM>) -> Vec<u32> {
-    let mut v = Vec::new();
+/// Bridge ticks as the record's time: since `epoch`, the last chip reset.
+fn record_time(timer: Timer, epoch: u64, ticks: u64) -> Instant {
+    Instant::from_nanos(timer.to_nanos(ticks.saturating_sub(epoch)))
+}
+
+/// Records the edges an INT*, HOLD or AUX* counter pushed: HOLD's level as
+/// it is, INT*'s and AUX*'s (active low) asserted when low.
+fn take_edges<const SM: usize>(
+    rx: &mut StateMachineRx<'static, PIO1, SM>,
+    pin: Pin,
+    record: &mut Record,
+    place: impl Fn(u32) -> (bool, Instant),
+) {
     while let Some(w) = rx.try_pull() {
-        v.push(w);
+        let (high, at) = place(w);
+        let value = match pin {
+            Pin::Hold => high,
+            _ => !high,
+        };
+        record.pin(at, pin, u8::from(value));
     }
-    v
 }
 
 impl Bus for BoardBus {

@@ -52,6 +52,15 @@ impl Timer {
         self.hz != 0 && 1_000_000_000 % self.hz == 0
     }
 
+    /// How far pulses timestamped by this timer may stray from a straight
+    /// line when the timer is not locked to the chip: a tick, plus the
+    /// nanosecond lost turning ticks into nanoseconds when a tick is not a
+    /// whole number of them. What a bridge gives [`crate::protocol::EdgeRuns`].
+    pub fn edge_tolerance(self) -> Duration {
+        let slack = if self.whole_nanos() { 0 } else { 1 };
+        Duration::from_nanos(self.to_nanos_up(1) + slack)
+    }
+
     pub fn to_nanos(self, ticks: u64) -> u64 {
         if self.hz == Self::NANOS.hz {
             return ticks;
