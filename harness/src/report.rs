@@ -34,17 +34,64 @@ pub struct RunOptions {
     pub time_floor_ns: u64,
 }
 
+/// A board of a run: what the reports call it and what is known of it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BoardInfo {
+    /// The board's label: the `--target` given, or its `name=`.
+    pub name: String,
+    /// The target as reached: `serial:/dev/ttyACM0`, or
+    /// `labgrid:rig1 (rfc2217://lab:2001)`.
+    pub target: String,
+    pub target_details: BTreeMap<String, String>,
+    /// The board revision label (`rev=` or `--board-rev`).
+    pub board_rev: Option<String>,
+    /// The bus bridge's firmware version, when the target is a board.
+    pub bridge_firmware: Option<String>,
+    /// Why the board took no part in the run, or left it early.
+    pub error: Option<String>,
+}
+
+impl BoardInfo {
+    pub fn new(name: String, target: &TargetInfo, board_rev: Option<String>) -> BoardInfo {
+        let bridge_firmware = target
+            .extra
+            .iter()
+            .find(|(k, _)| k == "bridge_firmware")
+            .map(|(_, v)| v.clone());
+        BoardInfo {
+            name,
+            target: target.name.clone(),
+            target_details: target.details().into_iter().collect(),
+            board_rev,
+            bridge_firmware,
+            error: None,
+        }
+    }
+
+    /// A board that could not be reached: nothing is known of it but its
+    /// name and why.
+    pub fn unreached(name: String, board_rev: Option<String>, why: String) -> BoardInfo {
+        BoardInfo {
+            target: name.clone(),
+            name,
+            target_details: BTreeMap::new(),
+            board_rev,
+            bridge_firmware: None,
+            error: Some(why),
+        }
+    }
+}
+
 /// Facts about a run that every report carries.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RunInfo {
     pub harness_version: String,
     pub git_revision: String,
-    pub target: String,
-    pub target_details: BTreeMap<String, String>,
-    /// The board revision label given with `--board-rev`.
-    pub board_rev: Option<String>,
-    /// The bus bridge's firmware version, when the target is a board.
-    pub bridge_firmware: Option<String>,
+    /// The boards, in the order of `--target`; results name them by index.
+    pub boards: Vec<BoardInfo>,
+    /// `one` (a single board), `share` (each scenario on one of several
+    /// boards) or `each` (every scenario on every board).
+    pub spread: &'static str,
     /// When the run started, UTC, RFC 3339.
     pub started: String,
     /// Wall-clock duration of the whole run, seconds.
@@ -55,34 +102,23 @@ pub struct RunInfo {
 }
 
 impl RunInfo {
-    pub fn new(target: &TargetInfo, board_rev: Option<String>) -> RunInfo {
-        let bridge_firmware = target
-            .extra
-            .iter()
-            .find(|(k, _)| k == "bridge_firmware")
-            .map(|(_, v)| v.clone());
-        RunInfo {
-            target_details: target.details().into_iter().collect(),
-            bridge_firmware,
-            ..RunInfo::unreached(target.name.clone(), board_rev)
-        }
-    }
-
-    /// A run whose target could not be reached: nothing is known of it
-    /// but its name.
-    pub fn unreached(target: String, board_rev: Option<String>) -> RunInfo {
+    pub fn new(boards: Vec<BoardInfo>, spread: &'static str) -> RunInfo {
         RunInfo {
             harness_version: crate::VERSION.to_string(),
             git_revision: crate::GIT_REV.to_string(),
-            target,
-            target_details: BTreeMap::new(),
-            board_rev,
-            bridge_firmware: None,
+            boards,
+            spread,
             started: rfc3339(SystemTime::now()),
             wall_s: 0.0,
             host: hostname(),
             options: RunOptions::default(),
         }
+    }
+
+    /// The label of board `b`, or `(none)` for a result no board took.
+    pub fn board_name(&self, b: Option<usize>) -> &str {
+        b.and_then(|b| self.boards.get(b))
+            .map_or("(none)", |b| b.name.as_str())
     }
 }
 
@@ -134,6 +170,11 @@ pub struct Tally {
 
 impl Tally {
     pub fn of(results: &[ScenarioResult]) -> Tally {
+        Tally::of_refs(&results.iter().collect::<Vec<_>>())
+    }
+
+    /// [`Tally::of`] some of a run's results.
+    pub fn of_refs(results: &[&ScenarioResult]) -> Tally {
         let mut t = Tally::default();
         for r in results {
             match r.verdict {
@@ -163,23 +204,42 @@ impl Tally {
 /// are skipped; the files saved for each result (`attachments`, in the
 /// results' order; missing entries mean none) are `[[ATTACHMENT|path]]`
 /// lines in `system-out`.
+///
+/// `boards` gives each result's board (an index into `info.boards`). A run
+/// on one board is one test suite with the board's facts as properties
+/// (`target`, `board_rev`, `target.*`). A run shared by several boards is
+/// one test suite too: each board's facts are `board.<name>.*` properties,
+/// and each test case names its board in a `board_of.<case>` property and a
+/// `board:` line of its `system-out`. A run with `--each` is one test suite
+/// per board, named after it.
 pub fn junit(
     info: &RunInfo,
     results: &[ScenarioResult],
     attachments: &[Vec<String>],
+    boards: &[Option<usize>],
 ) -> Result<String, ReportError> {
     let tally = Tally::of(results);
-    let skipped = results
-        .iter()
-        .filter(|r| r.verdict == Verdict::NotRun(NotRun::Interrupted))
-        .count();
-    let errors = tally.errors + tally.not_run - skipped;
-    let wall: f64 = results.iter().map(|r| r.wall.as_secs_f64()).sum();
-    let suite_name = match &info.options.shard {
-        Some(shard) => format!("ppmc-conformance shard {shard}"),
-        None => "ppmc-conformance".to_string(),
+    let skipped = |rs: &[&ScenarioResult]| {
+        rs.iter()
+            .filter(|r| r.verdict == Verdict::NotRun(NotRun::Interrupted))
+            .count()
     };
-    let names = unique_names(results);
+    let all: Vec<&ScenarioResult> = results.iter().collect();
+    let errors = tally.errors + tally.not_run - skipped(&all);
+    let board_of = |i: usize| boards.get(i).copied().flatten();
+    // The suites: their board (when they have one) and their results.
+    let groups: Vec<(Option<usize>, Vec<usize>)> = if info.spread == "each" {
+        (0..info.boards.len())
+            .map(|b| {
+                let cases = (0..results.len()).filter(|&i| board_of(i) == Some(b));
+                (Some(b), cases.collect())
+            })
+            .collect()
+    } else if info.boards.len() == 1 {
+        vec![(Some(0), (0..results.len()).collect())]
+    } else {
+        vec![(None, (0..results.len()).collect())]
+    };
     let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = writeln!(
         x,
@@ -188,114 +248,168 @@ pub fn junit(
         tally.failed,
         info.wall_s
     );
-    let _ = writeln!(
-        x,
-        "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{errors}\" skipped=\"{skipped}\" \
-         time=\"{wall:.6}\" timestamp=\"{}\" hostname=\"{}\">",
-        esc(&suite_name),
-        results.len(),
-        tally.failed,
-        esc(&info.started),
-        esc(&info.host)
-    );
-    x.push_str("    <properties>\n");
-    let mut props: Vec<(String, String)> = vec![
-        ("harness_version".into(), info.harness_version.clone()),
-        ("git_revision".into(), info.git_revision.clone()),
-        ("target".into(), info.target.clone()),
-        (
-            "board_rev".into(),
-            info.board_rev.clone().unwrap_or_default(),
-        ),
-        (
-            "bridge_firmware".into(),
-            info.bridge_firmware.clone().unwrap_or_default(),
-        ),
-    ];
-    props.extend(
-        info.target_details
-            .iter()
-            .map(|(k, v)| (format!("target.{k}"), v.clone())),
-    );
-    props.extend(results.iter().zip(&names).map(|(r, n)| {
-        (
-            format!("device_time.{n}"),
-            format!("{:.9}", r.elapsed.as_nanos() as f64 / 1e9),
-        )
-    }));
-    for (k, v) in props {
+    for (board, cases) in groups {
+        let rs: Vec<&ScenarioResult> = cases.iter().map(|&i| &results[i]).collect();
+        let t = Tally::of_refs(&rs);
+        let suite_skipped = skipped(&rs);
+        let suite_errors = t.errors + t.not_run - suite_skipped;
+        let wall: f64 = rs.iter().map(|r| r.wall.as_secs_f64()).sum();
+        let mut suite_name = "ppmc-conformance".to_string();
+        if let Some(shard) = &info.options.shard {
+            suite_name.push_str(&format!(" shard {shard}"));
+        }
+        if info.spread == "each" {
+            suite_name.push_str(&format!(" on {}", info.board_name(board)));
+        }
+        let names = unique_names(&rs);
         let _ = writeln!(
             x,
-            "      <property name=\"{}\" value=\"{}\"/>",
-            esc(&k),
-            esc(&v)
+            "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{suite_errors}\" skipped=\"{suite_skipped}\" \
+             time=\"{wall:.6}\" timestamp=\"{}\" hostname=\"{}\">",
+            esc(&suite_name),
+            rs.len(),
+            t.failed,
+            esc(&info.started),
+            esc(&info.host)
         );
-    }
-    x.push_str("    </properties>\n");
-    for (i, (r, name)) in results.iter().zip(&names).enumerate() {
-        let _ = write!(
-            x,
-            "    <testcase name=\"{}\" classname=\"section {}\" time=\"{:.6}\"",
-            esc(name),
-            esc(r.section),
-            r.wall.as_secs_f64()
-        );
-        let mut body = String::new();
-        let mut element = |tag: &str, kind: &str, message: &str| {
-            let _ = writeln!(
-                body,
-                "      <{tag} type=\"{kind}\" message=\"{}\">{}</{tag}>",
-                esc(message),
-                esc_text(message)
-            );
-        };
-        match &r.verdict {
-            Verdict::Passed | Verdict::Marginal => {}
-            Verdict::Failed(f) => element("failure", "device", &f.to_string()),
-            Verdict::Error(e) => element("error", "harness", &e.to_string()),
-            Verdict::NotRun(NotRun::Interrupted) => {
-                element("skipped", "interrupted", &NotRun::Interrupted.to_string())
+        x.push_str("    <properties>\n");
+        let mut props: Vec<(String, String)> = vec![
+            ("harness_version".into(), info.harness_version.clone()),
+            ("git_revision".into(), info.git_revision.clone()),
+        ];
+        match board {
+            Some(b) => props.extend(board_props("", &info.boards[b])),
+            None => {
+                for b in &info.boards {
+                    props.extend(board_props(&format!("board.{}.", b.name), b));
+                }
+                props.extend(cases.iter().zip(&names).map(|(&i, n)| {
+                    (
+                        format!("board_of.{n}"),
+                        info.board_name(board_of(i)).to_string(),
+                    )
+                }));
             }
-            Verdict::NotRun(why) => element("error", "infrastructure", &why.to_string()),
         }
-        let mut out: Vec<String> = Vec::new();
-        if r.verdict == Verdict::Marginal {
-            let near: Vec<String> = r
-                .measurements
-                .iter()
-                .filter(|m| m.grade == Grade::Marginal)
-                .map(|m| m.to_string())
-                .collect();
-            out.push(format!("MARGINAL: {}", near.join("; ")));
-        }
-        out.extend(
-            attachments
-                .get(i)
-                .into_iter()
-                .flatten()
-                .map(|p| format!("[[ATTACHMENT|{p}]]")),
-        );
-        if !out.is_empty() {
+        props.extend(rs.iter().zip(&names).map(|(r, n)| {
+            (
+                format!("device_time.{n}"),
+                format!("{:.9}", r.elapsed.as_nanos() as f64 / 1e9),
+            )
+        }));
+        for (k, v) in props {
             let _ = writeln!(
-                body,
-                "      <system-out>{}</system-out>",
-                esc_text(&out.join("\n"))
+                x,
+                "      <property name=\"{}\" value=\"{}\"/>",
+                esc(&k),
+                esc(&v)
             );
         }
-        if body.is_empty() {
-            x.push_str("/>\n");
-        } else {
-            x.push_str(">\n");
-            x.push_str(&body);
-            x.push_str("    </testcase>\n");
+        x.push_str("    </properties>\n");
+        for (&i, name) in cases.iter().zip(&names) {
+            let shared = board.is_none().then(|| info.board_name(board_of(i)));
+            testcase(&mut x, &results[i], name, attachments.get(i), shared);
         }
+        x.push_str("  </testsuite>\n");
     }
-    x.push_str("  </testsuite>\n</testsuites>\n");
+    x.push_str("</testsuites>\n");
     Ok(x)
 }
 
+/// A board's facts as suite properties, their names prefixed by `prefix`.
+fn board_props(prefix: &str, b: &BoardInfo) -> Vec<(String, String)> {
+    let mut props = vec![
+        (format!("{prefix}target"), b.target.clone()),
+        (
+            format!("{prefix}board_rev"),
+            b.board_rev.clone().unwrap_or_default(),
+        ),
+        (
+            format!("{prefix}bridge_firmware"),
+            b.bridge_firmware.clone().unwrap_or_default(),
+        ),
+    ];
+    if let Some(e) = &b.error {
+        props.push((format!("{prefix}error"), e.clone()));
+    }
+    props.extend(
+        b.target_details
+            .iter()
+            .map(|(k, v)| (format!("{prefix}target.{k}"), v.clone())),
+    );
+    props
+}
+
+/// One `<testcase>`; `board` names the board when the suite is shared.
+fn testcase(
+    x: &mut String,
+    r: &ScenarioResult,
+    name: &str,
+    attachments: Option<&Vec<String>>,
+    board: Option<&str>,
+) {
+    let _ = write!(
+        x,
+        "    <testcase name=\"{}\" classname=\"section {}\" time=\"{:.6}\"",
+        esc(name),
+        esc(r.section),
+        r.wall.as_secs_f64()
+    );
+    let mut body = String::new();
+    let mut element = |tag: &str, kind: &str, message: &str| {
+        let _ = writeln!(
+            body,
+            "      <{tag} type=\"{kind}\" message=\"{}\">{}</{tag}>",
+            esc(message),
+            esc_text(message)
+        );
+    };
+    match &r.verdict {
+        Verdict::Passed | Verdict::Marginal => {}
+        Verdict::Failed(f) => element("failure", "device", &f.to_string()),
+        Verdict::Error(e) => element("error", "harness", &e.to_string()),
+        Verdict::NotRun(NotRun::Interrupted) => {
+            element("skipped", "interrupted", &NotRun::Interrupted.to_string())
+        }
+        Verdict::NotRun(why) => element("error", "infrastructure", &why.to_string()),
+    }
+    let mut out: Vec<String> = Vec::new();
+    if let Some(b) = board {
+        out.push(format!("board: {b}"));
+    }
+    if r.verdict == Verdict::Marginal {
+        let near: Vec<String> = r
+            .measurements
+            .iter()
+            .filter(|m| m.grade == Grade::Marginal)
+            .map(|m| m.to_string())
+            .collect();
+        out.push(format!("MARGINAL: {}", near.join("; ")));
+    }
+    out.extend(
+        attachments
+            .into_iter()
+            .flatten()
+            .map(|p| format!("[[ATTACHMENT|{p}]]")),
+    );
+    if !out.is_empty() {
+        let _ = writeln!(
+            body,
+            "      <system-out>{}</system-out>",
+            esc_text(&out.join("\n"))
+        );
+    }
+    if body.is_empty() {
+        x.push_str("/>\n");
+    } else {
+        x.push_str(">\n");
+        x.push_str(&body);
+        x.push_str("    </testcase>\n");
+    }
+}
+
 /// Test case names, with ` [pass K]` when a scenario ran more than once.
-fn unique_names(results: &[ScenarioResult]) -> Vec<String> {
+fn unique_names(results: &[&ScenarioResult]) -> Vec<String> {
     let mut runs: BTreeMap<&str, usize> = BTreeMap::new();
     for r in results {
         *runs.entry(r.name).or_default() += 1;
@@ -379,6 +493,8 @@ struct JsonError {
 #[derive(Serialize)]
 struct JsonScenario<'a> {
     name: &'a str,
+    /// The board it ran on (`run.boards[].name`); null if none took it.
+    board: Option<&'a str>,
     section: &'a str,
     tags: &'a [&'a str],
     /// `passed`, `marginal`, `failed`, `error` or `not_run`: the keys of
@@ -415,16 +531,28 @@ fn finite(d: crate::time::Duration) -> Option<u64> {
     (d != crate::time::Duration::MAX).then_some(d.as_nanos())
 }
 
-/// The JSON run record.
-pub fn json(info: &RunInfo, results: &[ScenarioResult]) -> Result<String, ReportError> {
+/// The JSON run record; `boards` gives each result's board (an index into
+/// `info.boards`).
+pub fn json(
+    info: &RunInfo,
+    results: &[ScenarioResult],
+    boards: &[Option<usize>],
+) -> Result<String, ReportError> {
     let run = JsonRun {
-        format: "ppmc-run-record/2",
+        format: "ppmc-run-record/3",
         run: info,
         summary: Tally::of(results),
         scenarios: results
             .iter()
-            .map(|r| JsonScenario {
+            .enumerate()
+            .map(|(i, r)| JsonScenario {
                 name: r.name,
+                board: boards
+                    .get(i)
+                    .copied()
+                    .flatten()
+                    .and_then(|b| info.boards.get(b))
+                    .map(|b| b.name.as_str()),
                 section: r.section,
                 tags: r.tags,
                 verdict: json_verdict(&r.verdict),

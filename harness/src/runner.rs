@@ -126,16 +126,7 @@ pub fn run_suite_until(
         }
         for s in scenarios {
             interrupted = interrupted || stop();
-            let not_run = |why| ScenarioResult {
-                name: s.name,
-                section: s.section,
-                tags: s.tags,
-                verdict: Verdict::NotRun(why),
-                measurements: Vec::new(),
-                trace: None,
-                elapsed: Duration::ZERO,
-                wall: std::time::Duration::ZERO,
-            };
+            let not_run = |why| not_run(s, why);
             let mut r = match &dead {
                 _ if interrupted => not_run(NotRun::Interrupted),
                 Some(why) => not_run(NotRun::TargetLost(why.clone())),
@@ -154,6 +145,181 @@ pub fn run_suite_until(
         }
     }
     results
+}
+
+/// The result of a scenario that did not run, and why.
+pub fn not_run(s: &Scenario, why: NotRun) -> ScenarioResult {
+    ScenarioResult {
+        name: s.name,
+        section: s.section,
+        tags: s.tags,
+        verdict: Verdict::NotRun(why),
+        measurements: Vec::new(),
+        trace: None,
+        elapsed: Duration::ZERO,
+        wall: std::time::Duration::ZERO,
+    }
+}
+
+/// How a run on several boards uses them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Spread {
+    /// Each scenario runs once, on whichever board is free first: the
+    /// suite in a fraction of the time.
+    Share,
+    /// Every scenario runs on every board: to compare boards.
+    Each,
+}
+
+/// A result of a run on several boards, and the board (its index) it ran
+/// on; `None` when no board took it.
+#[derive(Debug)]
+pub struct BoardResult {
+    pub board: Option<usize>,
+    /// Its place in the run: the index `on_result` was given.
+    pub slot: usize,
+    pub result: ScenarioResult,
+}
+
+/// What a board's worker reports to the run: a result, and whether the
+/// board stopped answering with it (it then takes no more scenarios).
+struct Report {
+    slot: usize,
+    board: usize,
+    result: ScenarioResult,
+    lost: Option<String>,
+}
+
+/// Runs `scenarios` `repeat` times on `boards` in parallel, one thread per
+/// board, as `spread` says. `on_result` sees each result as it arrives, on
+/// the calling thread, in the order they finish, with its slot (its place
+/// in the run) and its board.
+///
+/// A board that stops answering (a harness error, then a failed reset)
+/// takes no more scenarios: with [`Spread::Share`] the others take what is
+/// left; the scenarios no board could take, and with [`Spread::Each`] the
+/// lost board's own, are not run, blamed on the target. Once `stop` says
+/// yes no board starts another scenario; what is left of the pass under
+/// way is not run, interrupted, and no further pass starts.
+///
+/// The results come back in a fixed order whatever the timing: with
+/// `Share`, the suite's order (pass by pass); with `Each`, board by board.
+pub fn run_on_boards(
+    boards: &mut [Box<dyn Target>],
+    scenarios: &[Scenario],
+    repeat: usize,
+    opts: DriverOptions,
+    spread: Spread,
+    stop: impl Fn() -> bool + Sync,
+    mut on_result: impl FnMut(usize, Option<usize>, &mut ScenarioResult),
+) -> Vec<BoardResult> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::mpsc;
+
+    // A queue hands out the slots `q * per_queue ..` one by one: one queue
+    // shared by every board, or one per board. Nothing is allocated per
+    // slot before it runs, so a soak run of a million passes costs what
+    // it has run.
+    let per_queue = scenarios.len() * repeat.max(1);
+    let queues: Vec<AtomicUsize> = match spread {
+        Spread::Share => vec![AtomicUsize::new(0)],
+        Spread::Each => (0..boards.len()).map(|_| AtomicUsize::new(0)).collect(),
+    };
+    let scenario_of = |slot: usize| &scenarios[slot % per_queue % scenarios.len()];
+    let mut done: Vec<BoardResult> = Vec::new();
+    let mut lost: Vec<Option<String>> = vec![None; boards.len()];
+    let stop = &stop;
+    let queues = &queues;
+    std::thread::scope(|scope| {
+        let (tx, rx) = mpsc::channel();
+        for (board, target) in boards.iter_mut().enumerate() {
+            let tx = tx.clone();
+            let q = board.min(queues.len() - 1);
+            scope.spawn(move || loop {
+                if stop() {
+                    return;
+                }
+                let taken = queues[q].fetch_add(1, Ordering::SeqCst);
+                if taken >= per_queue {
+                    queues[q].store(per_queue, Ordering::SeqCst);
+                    return;
+                }
+                let slot = q * per_queue + taken;
+                let result = run_scenario(target.as_mut(), scenario_of(slot), opts);
+                let mut lost = None;
+                if matches!(result.verdict, Verdict::Error(_)) {
+                    if let Err(e) = target.execute(&[Op::Reset]) {
+                        lost = Some(e.to_string());
+                    }
+                }
+                let gone = lost.is_some();
+                let _ = tx.send(Report {
+                    slot,
+                    board,
+                    result,
+                    lost,
+                });
+                if gone {
+                    return;
+                }
+            });
+        }
+        drop(tx);
+        for mut r in rx {
+            on_result(r.slot, Some(r.board), &mut r.result);
+            if r.lost.is_some() {
+                lost[r.board] = r.lost;
+            }
+            done.push(BoardResult {
+                board: Some(r.board),
+                slot: r.slot,
+                result: r.result,
+            });
+        }
+    });
+    // What no board took: the rest of the pass under way when stopped, or
+    // everything left by lost boards.
+    let interrupted = stop();
+    let every_loss = lost
+        .iter()
+        .enumerate()
+        .filter_map(|(b, why)| why.as_ref().map(|w| format!("board {}: {w}", b + 1)))
+        .collect::<Vec<_>>()
+        .join("; ");
+    done.sort_by_key(|r| r.slot);
+    let mut all = Vec::with_capacity(done.len());
+    let mut done = done.into_iter().peekable();
+    for (q, queue) in queues.iter().enumerate() {
+        let taken = queue.load(Ordering::SeqCst).min(per_queue);
+        let end = match interrupted {
+            true if scenarios.is_empty() => 0,
+            true => taken.div_ceil(scenarios.len()).max(1) * scenarios.len(),
+            false => per_queue,
+        };
+        let board = match spread {
+            Spread::Share => None,
+            Spread::Each => Some(q),
+        };
+        for slot in q * per_queue..q * per_queue + end.min(per_queue) {
+            if let Some(r) = done.next_if(|r| r.slot == slot) {
+                all.push(r);
+                continue;
+            }
+            let why = match (interrupted, board) {
+                (true, _) => NotRun::Interrupted,
+                (false, Some(b)) => NotRun::TargetLost(lost[b].clone().unwrap_or_default()),
+                (false, None) => NotRun::TargetLost(every_loss.clone()),
+            };
+            let mut result = not_run(scenario_of(slot), why);
+            on_result(slot, board, &mut result);
+            all.push(BoardResult {
+                board,
+                slot,
+                result,
+            });
+        }
+    }
+    all
 }
 
 #[cfg(test)]
@@ -327,5 +493,196 @@ mod tests {
             results[1].verdict.detail().as_deref(),
             Some("not run: the target stopped answering (cable pulled)")
         );
+    }
+
+    fn emu() -> Box<dyn Target> {
+        Box::new(
+            crate::backend::EmuTarget::new(Default::default(), Default::default())
+                .expect("emulator"),
+        )
+    }
+
+    /// A board that answers once `lost` is set: so that the board that
+    /// loses its cable has surely taken a scenario first.
+    struct After(
+        Box<dyn Target>,
+        std::sync::Arc<std::sync::atomic::AtomicBool>,
+    );
+
+    impl Target for After {
+        fn info(&self) -> crate::backend::TargetInfo {
+            self.0.info()
+        }
+        fn capture(&mut self) -> Result<crate::protocol::Record, TargetError> {
+            self.0.capture()
+        }
+        fn execute(&mut self, ops: &[Op]) -> Result<Vec<crate::backend::Reply>, TargetError> {
+            let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+            while !self.1.load(std::sync::atomic::Ordering::SeqCst) {
+                assert!(
+                    std::time::Instant::now() < deadline,
+                    "the lost board never ran"
+                );
+                std::thread::yield_now();
+            }
+            self.0.execute(ops)
+        }
+    }
+
+    /// [`Gone`], saying so when it is first used.
+    struct GoneSays(std::sync::Arc<std::sync::atomic::AtomicBool>);
+
+    impl Target for GoneSays {
+        fn info(&self) -> crate::backend::TargetInfo {
+            Gone.info()
+        }
+        fn capture(&mut self) -> Result<crate::protocol::Record, TargetError> {
+            Gone.capture()
+        }
+        fn execute(&mut self, ops: &[Op]) -> Result<Vec<crate::backend::Reply>, TargetError> {
+            let r = Gone.execute(ops);
+            self.0.store(true, std::sync::atomic::Ordering::SeqCst);
+            r
+        }
+    }
+
+    fn run(boards: &mut [Box<dyn Target>], spread: Spread, repeat: usize) -> Vec<BoardResult> {
+        let mut seen = 0;
+        let r = run_on_boards(
+            boards,
+            &suite(),
+            repeat,
+            DriverOptions::default(),
+            spread,
+            || false,
+            |_, _, _| seen += 1,
+        );
+        assert_eq!(seen, r.len(), "on_result sees every result once");
+        r
+    }
+
+    #[test]
+    fn shared_boards_run_each_scenario_once_in_the_suites_order() {
+        let mut boards = vec![emu(), emu(), emu()];
+        let r = run(&mut boards, Spread::Share, 2);
+        let got: Vec<&str> = r.iter().map(|r| r.result.name).collect();
+        let once = names(suite());
+        assert_eq!(got, [once.clone(), once].concat());
+        assert!(r.iter().all(|r| r.result.verdict == Verdict::Passed));
+        assert!(r.iter().all(|r| r.board.is_some_and(|b| b < 3)));
+    }
+
+    #[test]
+    fn each_board_runs_the_whole_suite_and_results_come_board_by_board() {
+        let mut boards = vec![emu(), emu()];
+        let r = run(&mut boards, Spread::Each, 1);
+        let boards: Vec<Option<usize>> = r.iter().map(|r| r.board).collect();
+        assert_eq!(boards, [[Some(0); 4], [Some(1); 4]].concat());
+        let got: Vec<&str> = r.iter().map(|r| r.result.name).collect();
+        assert_eq!(got, [names(suite()), names(suite())].concat());
+    }
+
+    #[test]
+    fn a_board_that_drops_out_hands_the_rest_to_the_others() {
+        let lost = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let mut boards: Vec<Box<dyn Target>> = vec![
+            Box::new(After(emu(), lost.clone())),
+            Box::new(GoneSays(lost)),
+        ];
+        let r = run(&mut boards, Spread::Share, 1);
+        assert_eq!(r.len(), 4);
+        // The scenario under way on the lost board is an error of the
+        // target, on that board; every other one ran on the good board.
+        let errors: Vec<&BoardResult> = r
+            .iter()
+            .filter(|r| matches!(r.result.verdict, Verdict::Error(_)))
+            .collect();
+        assert_eq!(errors.len(), 1, "{r:?}");
+        assert_eq!(errors[0].board, Some(1));
+        assert!(matches!(
+            &errors[0].result.verdict,
+            Verdict::Error(HarnessError::Target {
+                kind: TargetErrorKind::Link,
+                ..
+            })
+        ));
+        for ok in r.iter().filter(|r| r.result.verdict == Verdict::Passed) {
+            assert_eq!(ok.board, Some(0), "{}", ok.result.name);
+        }
+        assert_eq!(
+            r.iter()
+                .filter(|r| r.result.verdict == Verdict::Passed)
+                .count(),
+            3
+        );
+    }
+
+    #[test]
+    fn when_every_board_is_lost_the_rest_are_not_run_naming_each_board() {
+        let mut boards: Vec<Box<dyn Target>> = vec![Box::new(Gone), Box::new(Gone)];
+        let r = run(&mut boards, Spread::Share, 1);
+        let errors = r
+            .iter()
+            .filter(|r| matches!(r.result.verdict, Verdict::Error(_)))
+            .count();
+        assert_eq!(errors, 2, "one scenario under way on each board: {r:?}");
+        for left in r.iter().filter(|r| r.board.is_none()) {
+            assert_eq!(
+                left.result.verdict,
+                Verdict::NotRun(NotRun::TargetLost(
+                    "board 1: cable pulled; board 2: cable pulled".into()
+                ))
+            );
+        }
+        assert_eq!(r.iter().filter(|r| r.board.is_none()).count(), 2);
+    }
+
+    #[test]
+    fn with_each_a_lost_board_leaves_its_own_scenarios_not_run() {
+        let mut boards: Vec<Box<dyn Target>> = vec![emu(), Box::new(Gone)];
+        let r = run(&mut boards, Spread::Each, 1);
+        let verdicts: Vec<&str> = r.iter().map(|r| r.result.verdict.label()).collect();
+        assert_eq!(
+            verdicts,
+            ["passed", "passed", "passed", "passed", "error", "not run", "not run", "not run"]
+        );
+        assert!(r[5..].iter().all(|r| r.board == Some(1)
+            && r.result.verdict == Verdict::NotRun(NotRun::TargetLost("cable pulled".into()))));
+    }
+
+    #[test]
+    fn a_stop_leaves_the_rest_of_the_pass_interrupted_and_starts_no_other() {
+        let mut boards = vec![emu(), emu()];
+        let r = run_on_boards(
+            &mut boards,
+            &suite(),
+            3,
+            DriverOptions::default(),
+            Spread::Share,
+            || true,
+            |_, _, _| {},
+        );
+        assert_eq!(r.len(), 4, "one pass");
+        assert!(
+            r.iter()
+                .all(|r| r.board.is_none()
+                    && r.result.verdict == Verdict::NotRun(NotRun::Interrupted))
+        );
+
+        // Stopped after two scenarios of a million passes: two ran, the
+        // two left of that pass did not, and nothing more is reported.
+        let asked = std::sync::atomic::AtomicUsize::new(0);
+        let mut one = vec![emu()];
+        let r = run_on_boards(
+            &mut one,
+            &suite(),
+            1_000_000,
+            DriverOptions::default(),
+            Spread::Share,
+            || asked.fetch_add(1, std::sync::atomic::Ordering::SeqCst) >= 2,
+            |_, _, _| {},
+        );
+        let verdicts: Vec<&str> = r.iter().map(|r| r.result.verdict.label()).collect();
+        assert_eq!(verdicts, ["passed", "passed", "not run", "not run"]);
     }
 }

@@ -51,7 +51,9 @@ fn run_passes_on_the_emulator_and_writes_valid_junit_and_json() {
         serde_json::from_str(&fs::read_to_string(&json).expect("json written"))
             .expect("valid JSON");
     assert_eq!(record["summary"]["passed"], n);
-    assert_eq!(record["run"]["board_rev"], "B2");
+    assert_eq!(record["run"]["boards"][0]["board_rev"], "B2");
+    assert_eq!(record["run"]["spread"], "one");
+    assert_eq!(record["scenarios"][0]["board"], "emu");
     let with_measures = record["scenarios"]
         .as_array()
         .expect("scenarios")

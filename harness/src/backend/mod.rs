@@ -13,8 +13,8 @@ mod serial;
 
 pub use self::emu::EmuTarget;
 pub use self::serial::{
-    parse_rfc2217, parse_spec, parse_tcp, Link, LinkStats, Rfc2217Link, SerialError, SerialLink,
-    SerialOptions, SerialTarget, TcpLink,
+    parse_labgrid, parse_rfc2217, parse_spec, parse_tcp, LabgridLink, Link, LinkStats, Place,
+    Rfc2217Link, SerialError, SerialLink, SerialOptions, SerialTarget, TcpLink,
 };
 
 pub use ppmc_core::bus::{Op, Reply};

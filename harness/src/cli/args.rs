@@ -3,7 +3,8 @@
 
 use super::CliError;
 use crate::backend::{
-    EmuTarget, Link, Rfc2217Link, SerialLink, SerialOptions, SerialTarget, Target, TcpLink,
+    EmuTarget, LabgridLink, Link, Rfc2217Link, SerialLink, SerialOptions, SerialTarget, Target,
+    TcpLink,
 };
 use crate::compare::Tolerances;
 use crate::emu::{AccelCurve, ModelConfig};
@@ -17,13 +18,19 @@ use clap::{Args, ValueEnum};
 #[derive(Debug, Args)]
 pub struct TargetArgs {
     /// `emu` (the reference emulator), `serial:<path>[,baud=N]` (a board,
-    /// or `ppmc bridge-sim`, behind the serial bus bridge) or
+    /// or `ppmc bridge-sim`, behind the serial bus bridge),
     /// `tcp://<host>:<port>` (a bridge's serial port served on the network
-    /// in raw mode, as ser2net or socat serve it) or
+    /// in raw mode, as ser2net or socat serve it),
     /// `rfc2217://<host>:<port>[,baud=N]` (served over telnet with RFC 2217,
-    /// as ser2net's telnet(rfc2217) mode and labgrid's exporter serve it).
-    #[arg(long, default_value = "emu")]
-    target: String,
+    /// as ser2net's telnet(rfc2217) mode and labgrid's exporter serve it) or
+    /// `labgrid:<place>` (the serial port of a labgrid place you have
+    /// acquired). Any of them may end in options of that board alone:
+    /// `,name=LABEL`, `,rev=LABEL` and the straps `,clock-mhz=`, `,csel=`,
+    /// `,vsel=`, `,ext-clock-khz=` (they override the flags below).
+    /// `ppmc run` takes several, one per board, and spreads the suite over
+    /// them.
+    #[arg(long = "target", value_name = "TARGET", default_value = "emu")]
+    targets: Vec<String>,
     /// System clock in MHz, 1 to 40 (fractions allowed, e.g. 12.288).
     /// Default: 16 on the emulator; on a board, what its bridge reports
     /// (given, it must agree).
@@ -83,9 +90,28 @@ pub fn parse_duration(s: &str) -> Result<Duration, String> {
     s.parse::<Duration>().map_err(|e| e.to_string())
 }
 
-impl TargetArgs {
+/// The strap options given, on the command line or in a target's spec.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct StrapFlags {
+    clock_mhz: Option<f64>,
+    csel: Option<Level>,
+    vsel: Option<Level>,
+    ext_clock_khz: Option<f64>,
+}
+
+impl StrapFlags {
+    /// These flags, with `under`'s where these give none.
+    fn over(self, under: StrapFlags) -> StrapFlags {
+        StrapFlags {
+            clock_mhz: self.clock_mhz.or(under.clock_mhz),
+            csel: self.csel.or(under.csel),
+            vsel: self.vsel.or(under.vsel),
+            ext_clock_khz: self.ext_clock_khz.or(under.ext_clock_khz),
+        }
+    }
+
     /// The straps: those given, the emulator's defaults for the rest.
-    pub fn straps(&self) -> Result<Straps, String> {
+    fn straps(&self) -> Result<Straps, String> {
         let d = Straps::default();
         let straps = Straps {
             sysclk_hz: match self.clock_mhz {
@@ -113,17 +139,16 @@ impl TargetArgs {
         Ok(straps)
     }
 
-    /// The straps given on the command line that disagree with `reported`
-    /// (what a bridge says its chip is strapped to), each as
-    /// `--flag: bridge X, given Y`.
-    pub fn disagreements(&self, reported: &Straps) -> Result<Vec<String>, String> {
+    /// The straps given that disagree with `reported` (what a bridge says
+    /// its chip is strapped to), each as `--flag: bridge X, given Y`.
+    fn disagreements(&self, reported: &Straps) -> Result<Vec<String>, String> {
         let given = self.straps()?;
         let mhz = |hz: u32| (f64::from(hz) / 1e6).to_string();
         let level = |high| if high { "high" } else { "low" }.to_string();
         let khz =
             |h: Option<u32>| h.map_or("none".to_string(), |h| (f64::from(h) / 1e3).to_string());
-        // Each strap the command line gave: its flag, the bridge's value
-        // and the given one, as the user writes them.
+        // Each strap given: its flag, the bridge's value and the given
+        // one, as the user writes them.
         let straps = [
             (
                 self.clock_mhz.is_some(),
@@ -158,10 +183,140 @@ impl TargetArgs {
             })
             .collect())
     }
+}
 
-    /// The `--target` text.
-    pub fn name(&self) -> &str {
-        &self.target
+/// One `--target`: where its chip is, and the options of that board alone.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TargetSpec {
+    /// The target as its backend takes it, board options removed:
+    /// `serial:/dev/ttyACM0,baud=115200`.
+    pub address: String,
+    /// What the reports call the board (`name=`); default: the address.
+    pub name: Option<String>,
+    /// The board revision label (`rev=`); default: `--board-rev`.
+    pub rev: Option<String>,
+    straps: StrapFlags,
+}
+
+impl TargetSpec {
+    /// Splits `spec` into its address and the board's own options
+    /// (`name=`, `rev=`, `clock-mhz=`, `csel=`, `vsel=`, `ext-clock-khz=`);
+    /// other `key=value` parts (`baud=`) stay with the address.
+    pub fn parse(spec: &str) -> Result<TargetSpec, String> {
+        let mut parts = spec.split(',');
+        let mut address = parts.next().unwrap_or_default().to_string();
+        let mut t = TargetSpec {
+            address: String::new(),
+            name: None,
+            rev: None,
+            straps: StrapFlags::default(),
+        };
+        let bad = |what: &str| format!("--target `{spec}`: {what}");
+        let number = |k: &str, v: &str| {
+            v.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| bad(&format!("{k}={v} is not a number")))
+        };
+        let level = |k: &str, v: &str| match v {
+            "high" => Ok(Level::High),
+            "low" => Ok(Level::Low),
+            _ => Err(bad(&format!("{k}={v}: write high or low"))),
+        };
+        let text = |k: &str, v: &str| {
+            if v.is_empty() {
+                Err(bad(&format!("{k}= needs a value")))
+            } else {
+                Ok(v.to_string())
+            }
+        };
+        for part in parts {
+            let (k, v) = part.split_once('=').unwrap_or((part, ""));
+            match k {
+                "name" => t.name = Some(text(k, v)?),
+                "rev" => t.rev = Some(text(k, v)?),
+                "clock-mhz" => t.straps.clock_mhz = Some(number(k, v)?),
+                "ext-clock-khz" => t.straps.ext_clock_khz = Some(number(k, v)?),
+                "csel" => t.straps.csel = Some(level(k, v)?),
+                "vsel" => t.straps.vsel = Some(level(k, v)?),
+                _ => {
+                    address.push(',');
+                    address.push_str(part);
+                }
+            }
+        }
+        t.address = address;
+        Ok(t)
+    }
+
+    /// What the reports call this board.
+    pub fn label(&self) -> &str {
+        self.name.as_deref().unwrap_or(&self.address)
+    }
+
+    pub fn is_emu(&self) -> bool {
+        self.address == "emu"
+    }
+}
+
+impl TargetArgs {
+    /// Every `--target`, parsed, with unique labels (a second `emu`
+    /// becomes `emu#2`).
+    pub fn specs(&self) -> Result<Vec<TargetSpec>, String> {
+        let mut specs = Vec::with_capacity(self.targets.len());
+        for t in &self.targets {
+            let mut spec = TargetSpec::parse(t)?;
+            let mut n = 1;
+            let base = spec.label().to_string();
+            while specs.iter().any(|s: &TargetSpec| s.label() == spec.label()) {
+                n += 1;
+                spec.name = Some(format!("{base}#{n}"));
+            }
+            specs.push(spec);
+        }
+        Ok(specs)
+    }
+
+    /// The one target of a command that drives one board.
+    pub fn single(&self) -> Result<TargetSpec, String> {
+        let mut specs = self.specs()?;
+        if specs.len() != 1 {
+            return Err(format!(
+                "--target given {} times: only `ppmc run` drives several boards",
+                specs.len()
+            ));
+        }
+        Ok(specs.remove(0))
+    }
+
+    fn flags(&self) -> StrapFlags {
+        StrapFlags {
+            clock_mhz: self.clock_mhz,
+            csel: self.csel,
+            vsel: self.vsel,
+            ext_clock_khz: self.ext_clock_khz,
+        }
+    }
+
+    /// The straps of the single target: those given (on the command line
+    /// or in its spec), the emulator's defaults for the rest.
+    pub fn straps(&self) -> Result<Straps, String> {
+        self.straps_of(&self.single()?)
+    }
+
+    /// The straps given for `spec` (its own, then the flags'), the
+    /// emulator's defaults for the rest.
+    pub fn straps_of(&self, spec: &TargetSpec) -> Result<Straps, String> {
+        spec.straps.over(self.flags()).straps()
+    }
+
+    /// The single target's address (`emu`, `serial:...`); the first one's
+    /// when several were given.
+    pub fn name(&self) -> String {
+        self.specs()
+            .ok()
+            .and_then(|s| s.into_iter().next())
+            .map_or_else(|| self.targets.join(" "), |s| s.address)
     }
 
     pub fn model(&self) -> ModelConfig {
@@ -174,71 +329,94 @@ impl TargetArgs {
         }
     }
 
-    /// Opens the target named by `--target`. A board target is health
-    /// checked on the way (hello, chip reset, status 0x00).
+    /// Opens the single target. A board target is health checked on the
+    /// way (hello, chip reset, status 0x00).
     pub fn open(&self) -> Result<Box<dyn Target>, OpenError> {
-        if self.target == "emu" {
-            let t = EmuTarget::new(self.straps().map_err(OpenError::Usage)?, self.model())
-                .map_err(|e| OpenError::Usage(e.to_string()))?;
-            return Ok(Box::new(t));
-        }
-        if self.target.starts_with("serial:") {
-            let (path, baud) = crate::backend::parse_spec(&self.target).ok_or_else(|| {
-                OpenError::Usage(format!(
-                    "bad target `{}`: write serial:<path>[,baud=N]",
-                    self.target
-                ))
-            })?;
-            self.check_link_options()?;
-            let link = SerialLink::open(&path, baud).map_err(infra)?;
-            return self.open_bridge(link, &path);
-        }
-        if self.target.starts_with("tcp://") {
-            let addr = crate::backend::parse_tcp(&self.target).ok_or_else(|| {
-                OpenError::Usage(format!(
-                    "bad target `{}`: write tcp://<host>:<port>",
-                    self.target
-                ))
-            })?;
-            self.check_link_options()?;
-            let link = TcpLink::open(&addr).map_err(infra)?;
-            return self.open_bridge(link, &self.target);
-        }
-        if self.target.starts_with("rfc2217://") {
-            let (addr, baud) = crate::backend::parse_rfc2217(&self.target).ok_or_else(|| {
-                OpenError::Usage(format!(
-                    "bad target `{}`: write rfc2217://<host>:<port>[,baud=N]",
-                    self.target
-                ))
-            })?;
-            self.check_link_options()?;
-            let link = Rfc2217Link::open(&addr, baud).map_err(infra)?;
-            return self.open_bridge(link, &self.target);
-        }
-        Err(OpenError::Usage(format!(
-            "unknown target `{}`: use `emu`, `serial:<path>[,baud=N]`, `tcp://<host>:<port>` or `rfc2217://<host>:<port>[,baud=N]`",
-            self.target
-        )))
+        let spec = self.single().map_err(OpenError::Usage)?;
+        self.check(&spec)?;
+        self.open_spec(&spec)
     }
 
-    /// Bad options are the user's, before any port is touched.
-    fn check_link_options(&self) -> Result<(), OpenError> {
+    /// The options of `spec` that can be checked without touching a port:
+    /// a bad one is the user's, before any board is opened.
+    pub fn check(&self, spec: &TargetSpec) -> Result<(), OpenError> {
+        self.straps_of(spec).map_err(OpenError::Usage)?;
+        if spec.is_emu() {
+            return Ok(());
+        }
+        let known = ["serial:", "tcp://", "rfc2217://", "labgrid:"];
+        if !known.iter().any(|k| spec.address.starts_with(k)) {
+            return Err(OpenError::Usage(format!(
+                "unknown target `{}`: use `emu`, `serial:<path>[,baud=N]`, `tcp://<host>:<port>`, `rfc2217://<host>:<port>[,baud=N]` or `labgrid:<place>`",
+                spec.address
+            )));
+        }
+        let shape_ok = if spec.address.starts_with("serial:") {
+            crate::backend::parse_spec(&spec.address).is_some()
+        } else if spec.address.starts_with("tcp://") {
+            crate::backend::parse_tcp(&spec.address).is_some()
+        } else if spec.address.starts_with("rfc2217://") {
+            crate::backend::parse_rfc2217(&spec.address).is_some()
+        } else {
+            crate::backend::parse_labgrid(&spec.address).is_some()
+        };
+        if !shape_ok {
+            let form = match spec.address.split(':').next() {
+                Some("serial") => "serial:<path>[,baud=N]",
+                Some("tcp") => "tcp://<host>:<port>",
+                Some("rfc2217") => "rfc2217://<host>:<port>[,baud=N]",
+                _ => "labgrid:<place>",
+            };
+            return Err(OpenError::Usage(format!(
+                "bad target `{}`: write {form}",
+                spec.address
+            )));
+        }
         if self.link_timeout.as_nanos() < 1_000_000 {
             return Err(OpenError::Usage(format!(
                 "--link-timeout {}: give at least 1ms",
                 self.link_timeout
             )));
         }
-        self.straps().map_err(OpenError::Usage)?;
         Ok(())
     }
 
+    /// Opens `spec`, already [`checked`](Self::check).
+    pub fn open_spec(&self, spec: &TargetSpec) -> Result<Box<dyn Target>, OpenError> {
+        let a = &spec.address;
+        if spec.is_emu() {
+            let straps = self.straps_of(spec).map_err(OpenError::Usage)?;
+            let t = EmuTarget::new(straps, self.model())
+                .map_err(|e| OpenError::Usage(e.to_string()))?;
+            return Ok(Box::new(t));
+        }
+        let usage = || OpenError::Usage(format!("bad target `{a}`"));
+        if a.starts_with("serial:") {
+            let (path, baud) = crate::backend::parse_spec(a).ok_or_else(usage)?;
+            let link = SerialLink::open(&path, baud).map_err(infra)?;
+            return self.open_bridge(link, spec);
+        }
+        if a.starts_with("tcp://") {
+            let addr = crate::backend::parse_tcp(a).ok_or_else(usage)?;
+            let link = TcpLink::open(&addr).map_err(infra)?;
+            return self.open_bridge(link, spec);
+        }
+        if a.starts_with("rfc2217://") {
+            let (addr, baud) = crate::backend::parse_rfc2217(a).ok_or_else(usage)?;
+            let link = Rfc2217Link::open(&addr, baud).map_err(infra)?;
+            return self.open_bridge(link, spec);
+        }
+        let place = crate::backend::parse_labgrid(a).ok_or_else(usage)?;
+        let link = LabgridLink::open(place).map_err(OpenError::Infrastructure)?;
+        self.open_bridge(link, spec)
+    }
+
     /// A bridge behind `link`: opened, health checked, and its straps
-    /// reconciled with the command line's.
+    /// reconciled with those given.
     fn open_bridge<L: Link + 'static>(
         &self,
         link: L,
-        name: &str,
+        spec: &TargetSpec,
     ) -> Result<Box<dyn Target>, OpenError> {
         let opts = SerialOptions {
             reply_timeout: std::time::Duration::from_nanos(self.link_timeout.as_nanos()),
@@ -250,10 +428,15 @@ impl TargetArgs {
         // only confirm it. A board at 12 MHz judged as one at 16 would fail
         // for the wrong reason.
         let reported = t.straps();
-        let differ = self.disagreements(&reported).map_err(OpenError::Usage)?;
+        let differ = spec
+            .straps
+            .over(self.flags())
+            .disagreements(&reported)
+            .map_err(OpenError::Usage)?;
         if !differ.is_empty() {
             return Err(OpenError::Infrastructure(format!(
-                "{name}: the bridge reports its chip strapped {reported}, which the command line contradicts ({}); fix the options or the board, or leave the strap options out to use the bridge's",
+                "{}: the bridge reports its chip strapped {reported}, which the command line contradicts ({}); fix the options or the board, or leave the strap options out to use the bridge's",
+                spec.address,
                 differ.join("; ")
             )));
         }

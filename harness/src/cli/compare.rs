@@ -51,6 +51,7 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             json: None,
             artifacts: None,
             board_rev: None,
+            each: false,
             repeat: 1,
             marginal: 0.25,
         };

@@ -1,18 +1,19 @@
 //! `ppmc run`: the conformance suite on a target, graded, with reports.
 
-use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
+use super::args::{OpenError, SelectArgs, TargetArgs, ToleranceArgs};
 use super::progress::Progress;
+use crate::backend::Target;
 use crate::cli::{usage, CliError};
 use crate::compare::{compare, Tolerances};
 use crate::files;
 use crate::golden::{self};
-use crate::report::{self, RunInfo, RunOptions, Tally};
-use crate::runner::run_suite_until;
+use crate::report::{self, BoardInfo, RunInfo, RunOptions, Tally};
+use crate::runner::{run_on_boards, Spread};
 use crate::scenario::{
     DriverOptions, Failure, Grading, HarnessError, NotRun, Scenario, ScenarioResult, Verdict,
 };
-use crate::time::Duration;
 use clap::Args;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
@@ -40,9 +41,14 @@ pub struct RunArgs {
     /// Keep the trace and VCD of every scenario that did not pass here.
     #[arg(long, value_name = "DIR")]
     pub(super) artifacts: Option<PathBuf>,
-    /// Board revision label for the reports.
+    /// Board revision label for the reports (a target's own `,rev=`
+    /// overrides it).
     #[arg(long)]
     pub(super) board_rev: Option<String>,
+    /// With several `--target`s: run the whole selection on every board
+    /// (to compare boards), instead of spreading it over them.
+    #[arg(long)]
+    pub(super) each: bool,
     /// Run the selection this many times (soak runs). SIGINT or SIGTERM
     /// stops after the scenario under way and still writes the reports.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
@@ -53,7 +59,7 @@ pub struct RunArgs {
     pub(super) marginal: f64,
 }
 
-fn verdict_line(r: &ScenarioResult) -> String {
+fn verdict_line(r: &ScenarioResult, board: Option<&str>) -> String {
     let tag = match r.verdict {
         Verdict::Passed => "PASS",
         Verdict::Marginal => "MARGINAL",
@@ -67,6 +73,10 @@ fn verdict_line(r: &ScenarioResult) -> String {
         r.name,
         r.section
     );
+    if let Some(b) = board {
+        s.push_str(" on ");
+        s.push_str(b);
+    }
     if let Some(d) = r.verdict.detail() {
         s.push_str("\n         ");
         s.push_str(&d);
@@ -151,10 +161,6 @@ fn summary_lines(t: &Tally, results: usize) {
 }
 
 impl RunArgs {
-    fn target_name(&self) -> String {
-        self.target.name().to_string()
-    }
-
     /// The options in force, for the run record.
     fn options(&self, tol: &Tolerances) -> RunOptions {
         let mut o = RunOptions {
@@ -208,43 +214,104 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             )));
         }
     }
-    let mut target = match args.target.open() {
-        Ok(t) => t,
-        Err(e @ super::args::OpenError::Infrastructure(_)) => {
-            // Nothing ran: say so in the reports too, so CI shows an
-            // infrastructure problem rather than a bad board.
-            let why = e.to_string();
-            let results: Vec<ScenarioResult> = scenarios
-                .iter()
-                .map(|s| ScenarioResult {
-                    name: s.name,
-                    section: s.section,
-                    tags: s.tags,
-                    verdict: Verdict::NotRun(NotRun::Unreachable(why.clone())),
-                    measurements: Vec::new(),
-                    trace: None,
-                    elapsed: Duration::ZERO,
-                    wall: std::time::Duration::ZERO,
-                })
-                .collect();
-            let mut info = RunInfo::unreached(args.target_name(), args.board_rev.clone());
-            info.options = args.options(&tol);
-            let _ = args
-                .junit
-                .as_ref()
-                .map(|p| write_report(p, report::junit(&info, &results, &[])));
-            let _ = args
-                .json
-                .as_ref()
-                .map(|p| write_report(p, report::json(&info, &results)));
-            summary_lines(&Tally::of(&results), results.len());
-            return Err(e.into());
-        }
-        Err(e) => return Err(e.into()),
+    let specs = args.target.specs().map_err(usage)?;
+    for spec in &specs {
+        args.target.check(spec)?;
+    }
+    let spread = match (specs.len(), args.each) {
+        (1, _) => "one",
+        (_, false) => "share",
+        (_, true) => "each",
     };
-    let started = std::time::Instant::now();
-    let mut info = RunInfo::new(&target.info(), args.board_rev.clone());
+    // Every board at once: a farm's boards each take a while to answer.
+    let opened: Vec<Result<Box<dyn Target>, OpenError>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = specs
+            .iter()
+            .map(|spec| scope.spawn(|| args.target.open_spec(spec)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| {
+                h.join().unwrap_or_else(|_| {
+                    Err(OpenError::Infrastructure(
+                        "opening the target panicked".into(),
+                    ))
+                })
+            })
+            .collect()
+    });
+    let mut boards = Vec::new();
+    let mut targets: Vec<Box<dyn Target>> = Vec::new();
+    // For each target opened, its board.
+    let mut reached = Vec::new();
+    let mut unreached = Vec::new();
+    for (b, (spec, opened)) in specs.iter().zip(opened).enumerate() {
+        let rev = spec.rev.clone().or_else(|| args.board_rev.clone());
+        let name = spec.label().to_string();
+        match opened {
+            Ok(t) => {
+                boards.push(BoardInfo::new(name, &t.info(), rev));
+                targets.push(t);
+                reached.push(b);
+            }
+            Err(OpenError::Usage(m)) => return Err(usage(m)),
+            Err(e @ OpenError::Infrastructure(_)) => {
+                boards.push(BoardInfo::unreached(name, rev, e.to_string()));
+                unreached.push((b, e));
+            }
+        }
+    }
+    let mut info = RunInfo::new(boards, spread);
     info.options = args.options(&tol);
+    let not_reached =
+        |s: &Scenario, why: &str| crate::runner::not_run(s, NotRun::Unreachable(why.to_string()));
+    if targets.is_empty() {
+        // Nothing ran: say so in the reports too, so CI shows an
+        // infrastructure problem rather than a bad board.
+        let why = match unreached.as_slice() {
+            [(_, e)] => e.to_string(),
+            all => format!(
+                "infrastructure error: no board could be reached: {}",
+                all.iter()
+                    .map(|(b, e)| format!("{}: {e}", info.boards[*b].name))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        };
+        let mut results = Vec::new();
+        let mut on = Vec::new();
+        let each_board: Vec<Option<usize>> = match spread {
+            "each" => (0..specs.len()).map(Some).collect(),
+            _ => vec![(specs.len() == 1).then_some(0)],
+        };
+        for board in each_board {
+            for s in &scenarios {
+                results.push(not_reached(s, &why));
+                on.push(board);
+            }
+        }
+        let _ = args
+            .junit
+            .as_ref()
+            .map(|p| write_report(p, report::junit(&info, &results, &[], &on)));
+        let _ = args
+            .json
+            .as_ref()
+            .map(|p| write_report(p, report::json(&info, &results, &on)));
+        summary_lines(&Tally::of(&results), results.len());
+        return Err(CliError::Infrastructure(
+            why.strip_prefix("infrastructure error: ")
+                .unwrap_or(&why)
+                .to_string(),
+        ));
+    }
+    for (b, e) in &unreached {
+        errln!(
+            "ppmc: board {} takes no part in the run: {e}",
+            info.boards[*b].name
+        );
+    }
+    let started = std::time::Instant::now();
     let opts = DriverOptions {
         grading: Grading {
             marginal_bp: (args.marginal * 100.0).round() as u64,
@@ -252,45 +319,90 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         ..DriverOptions::default()
     };
     let repeat = args.repeat as usize;
-    let progress = Progress::new(scenarios.len() * repeat);
+    let runs = match spread {
+        "each" => targets.len(),
+        _ => 1,
+    };
+    let progress = Progress::new(scenarios.len() * repeat * runs);
     let mut problems = Vec::new();
-    // The files saved for each result, in the results' order.
-    let mut attachments: Vec<Vec<String>> = Vec::new();
+    // The files saved for each result, by its slot.
+    let mut saved: BTreeMap<usize, Vec<String>> = BTreeMap::new();
     let stop = super::signals::stop_requested();
     let stopped = || stop.load(Ordering::Relaxed) || super::out::stdout_closed();
-    let results = run_suite_until(target.as_mut(), &scenarios, repeat, opts, stopped, |r| {
-        if let Some(dir) = &args.golden {
-            check_golden(r, dir, &tol);
-        }
-        progress.step(r.name);
-        if !matches!(r.verdict, Verdict::NotRun(NotRun::Interrupted)) {
-            progress.line(&verdict_line(r));
-        }
-        let mut saved = Vec::new();
-        if let (Some(dir), false) = (&args.artifacts, r.verdict.ok()) {
-            if let Err(e) = save_artifacts(dir, r, &mut saved) {
-                problems.push(e);
+    let several = info.boards.len() > 1;
+    let board_dirs = spread == "each";
+    let board_name = |t: Option<usize>| info.board_name(t.map(|t| reached[t])).to_string();
+    let results = run_on_boards(
+        &mut targets,
+        &scenarios,
+        repeat,
+        opts,
+        if spread == "each" {
+            Spread::Each
+        } else {
+            Spread::Share
+        },
+        stopped,
+        |slot, t, r| {
+            if let Some(dir) = &args.golden {
+                check_golden(r, dir, &tol);
             }
-        }
-        attachments.push(saved);
-        // Judged, compared and saved: a soak run need not keep it.
-        r.trace = None;
-    });
+            progress.step(r.name);
+            let name = board_name(t);
+            if !matches!(r.verdict, Verdict::NotRun(NotRun::Interrupted)) {
+                progress.line(&verdict_line(r, several.then_some(name.as_str())));
+            }
+            if let (Some(dir), false) = (&args.artifacts, r.verdict.ok()) {
+                let dir = match board_dirs {
+                    true => dir.join(file_name(&name)),
+                    false => dir.clone(),
+                };
+                if let Err(e) = save_artifacts(&dir, r, saved.entry(slot).or_default()) {
+                    problems.push(e);
+                }
+            }
+            // Judged, compared and saved: a soak run need not keep it.
+            r.trace = None;
+        },
+    );
     progress.finish();
     let interrupted = stopped();
     info.wall_s = started.elapsed().as_secs_f64();
+    let mut on: Vec<Option<usize>> = results
+        .iter()
+        .map(|r| r.board.map(|t| reached[t]))
+        .collect();
+    let attachments: Vec<Vec<String>> = results
+        .iter()
+        .map(|r| saved.remove(&r.slot).unwrap_or_default())
+        .collect();
+    let mut results: Vec<ScenarioResult> = results.into_iter().map(|r| r.result).collect();
+    // With --each, a board that could not be reached runs nothing.
+    if spread == "each" {
+        for (b, e) in &unreached {
+            for _ in 0..repeat {
+                for s in &scenarios {
+                    results.push(not_reached(s, &e.to_string()));
+                    on.push(Some(*b));
+                }
+            }
+        }
+    }
     let tally = Tally::of(&results);
     if let Some(p) = &args.junit {
-        if let Err(e) = write_report(p, report::junit(&info, &results, &attachments)) {
+        if let Err(e) = write_report(p, report::junit(&info, &results, &attachments, &on)) {
             problems.push(e);
         }
     }
     if let Some(p) = &args.json {
-        if let Err(e) = write_report(p, report::json(&info, &results)) {
+        if let Err(e) = write_report(p, report::json(&info, &results, &on)) {
             problems.push(e);
         }
     }
     summary_lines(&tally, results.len());
+    if several {
+        board_lines(&info, &results, &on);
+    }
     for p in &problems {
         errln!("ppmc: {p}");
     }
@@ -300,5 +412,43 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         Ok(())
     } else {
         Err(CliError::Verdict)
+    }
+}
+
+/// A board's label as a folder name: `serial:/dev/ttyACM0` becomes
+/// `serial__dev_ttyACM0`.
+fn file_name(label: &str) -> String {
+    label
+        .chars()
+        .map(|c| match c {
+            'a'..='z' | 'A'..='Z' | '0'..='9' | '-' | '.' | '#' => c,
+            _ => '_',
+        })
+        .collect()
+}
+
+/// One line per board: how many scenarios it ran and how they went.
+fn board_lines(info: &RunInfo, results: &[ScenarioResult], on: &[Option<usize>]) {
+    for (b, board) in info.boards.iter().enumerate() {
+        let mine: Vec<&ScenarioResult> = results
+            .iter()
+            .zip(on)
+            .filter(|(_, o)| **o == Some(b))
+            .map(|(r, _)| r)
+            .collect();
+        let t = Tally::of_refs(&mine);
+        let state = match &board.error {
+            Some(_) => " (not reached)",
+            None => "",
+        };
+        outln!(
+            "board {}{state}: {} scenarios, {} passed, {} failed, {} errors, {} not run",
+            board.name,
+            mine.len(),
+            t.passed + t.marginal,
+            t.failed,
+            t.errors,
+            t.not_run
+        );
     }
 }

@@ -8,10 +8,12 @@
 //! times; if the bridge comes back as a different session (it restarted)
 //! the run cannot go on safely and the error says so.
 
+mod labgrid;
 mod link;
 mod rfc2217;
 mod tcp;
 
+pub use self::labgrid::{parse_labgrid, LabgridLink, Place};
 pub use self::link::{parse_spec, Link, SerialLink};
 pub use self::rfc2217::{parse_rfc2217, Rfc2217Link};
 pub use self::tcp::{parse_tcp, TcpLink};
