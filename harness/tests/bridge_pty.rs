@@ -37,6 +37,7 @@ fn fast() -> SerialOptions {
         reopen_attempts: 3,
         backoff: WallDuration::from_millis(20),
         quiet: WallDuration::from_millis(4),
+        pad: 0,
     }
 }
 

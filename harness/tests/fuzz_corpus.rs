@@ -98,7 +98,10 @@ fn write_frame_decoder_seeds() {
         Request::Resend {
             fragments: vec![0, 2],
         },
-        Request::Link { fragment: 12 },
+        Request::Link {
+            fragment: 12,
+            pad: 64,
+        },
     ];
     let mut server = engine(
         EmuTarget::new(Straps::default(), Default::default()).expect("emu"),

@@ -139,4 +139,29 @@ fn the_suite_passes_on_a_labgrid_place_and_an_unacquired_place_is_refused() {
     );
     // The labgrid-client ppmc started to learn the port is gone.
     assert_eq!(mark(&out, "exports-left"), "0", "{}", text(err.as_bytes()));
+
+    // Two places in one run: the suite spread over both, each test case
+    // naming its place.
+    let two = read(dir.path(), "two/run.out");
+    assert_eq!(
+        mark(&out, "two-exit"),
+        "0",
+        "{two}\n{}",
+        read(dir.path(), "two/run.err")
+    );
+    assert!(
+        two.contains("suite: 95 passed, 0 failed, 0 errors, 0 not run\n"),
+        "{two}"
+    );
+    assert!(
+        two.contains("\nboard labgrid:rig1: ") && two.contains("\nboard labgrid:rig2: "),
+        "{two}"
+    );
+    let junit = read(dir.path(), "two/report.xml");
+    assert!(
+        junit.contains("name=\"board.labgrid:rig2.board_rev\" value=\"C1\""),
+        "{junit}"
+    );
+    assert_eq!(junit.matches("name=\"board_of.").count(), 95);
+    assert_eq!(mark(&out, "exports-left-two"), "0");
 }

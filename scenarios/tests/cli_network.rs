@@ -230,3 +230,44 @@ fn a_connection_cut_mid_run_ends_it_as_an_infrastructure_error() {
     );
     assert!(std::fs::read_to_string(&junit).is_ok_and(|x| x.contains("<testcase")));
 }
+
+/// `scripts/network-figures`, which makes the figures of
+/// `docs/performance.md`, runs every row once (the debug build): each row
+/// is a whole suite that passes, through ser2net and on several boards.
+#[test]
+fn the_figures_script_runs_every_row() {
+    if !have_ser2net() {
+        return;
+    }
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/network-figures");
+    let mut child = Command::new(script)
+        .args(["--runs", "1", "--ppmc", env!("CARGO_BIN_EXE_ppmc")])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the script runs");
+    let (so, se) = (child.stdout.take(), child.stderr.take());
+    let read = |p: Option<Box<dyn std::io::Read + Send>>| {
+        std::thread::spawn(move || p.map(|p| std::io::read_to_string(p).unwrap_or_default()))
+    };
+    let out = read(so.map(|p| Box::new(p) as Box<dyn std::io::Read + Send>));
+    let err = read(se.map(|p| Box::new(p) as Box<dyn std::io::Read + Send>));
+    let status = common::wait_bounded(&mut child, Duration::from_secs(600));
+    let out = out.join().expect("stdout").unwrap_or_default();
+    let err = err.join().expect("stderr").unwrap_or_default();
+    assert!(status.success(), "{status}\n{out}\n{err}");
+    for row in [
+        "| the pty, direct",
+        "| ser2net raw, its defaults (",
+        "replies not padded",
+        "| ser2net telnet(rfc2217), its defaults",
+        "| 3 boards, ser2net raw defaults |",
+        "| 3 boards |",
+    ] {
+        let line = out
+            .lines()
+            .find(|l| l.starts_with(row) || l.contains(row))
+            .unwrap_or_else(|| panic!("no row `{row}`:\n{out}"));
+        assert!(line.ends_with("x |") && line.contains(" s |"), "{line}");
+    }
+}

@@ -21,8 +21,9 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 /// The files whose commands run.
-const FILES: [&str; 11] = [
+const FILES: [&str; 12] = [
     "README.md",
+    "docs/board-farm.md",
     "firmware/README.md",
     "docs/bridge-hardware.md",
     "docs/conformance.md",
@@ -37,7 +38,19 @@ const FILES: [&str; 11] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 14] = [
+const ELSEWHERE: [(&str, &str); 17] = [
+    (
+        "scripts/network-figures",
+        "in scenarios/tests/cli_network.rs (every row once, the debug build)",
+    ),
+    (
+        "labgrid-client",
+        "in scenarios/tests/labgrid/place.sh (against a local coordinator)",
+    ),
+    (
+        "labgrid-exporter",
+        "started by scenarios/tests/labgrid/place.sh, with --hostname 127.0.0.1 in a network namespace",
+    ),
     (
         "PPMC_BOARD=",
         "needs a board; .ci/run runs the same test group against the QEMU board",
@@ -86,6 +99,21 @@ const ELSEWHERE: [(&str, &str); 14] = [
         "a measurement; the command after it runs here",
     ),
 ];
+
+/// `ppmc` commands whose targets are a lab's, run elsewhere against a
+/// local stand-in: `(text in the command, where)`. Those "in
+/// scenarios/tests/labgrid/place.sh" must appear in that script as written
+/// (with `"$ppmc"` for `ppmc`).
+const PPMC_ELSEWHERE: [(&str, &str); 2] = [
+    (
+        "bench1.lab:4321",
+        "in scenarios/tests/cli_network.rs (the suite through ser2net on 127.0.0.1, both modes)",
+    ),
+    ("--target labgrid:", "in scenarios/tests/labgrid/place.sh"),
+];
+
+/// The script that runs the labgrid commands of the docs.
+const LABGRID_SCRIPT: &str = "scenarios/tests/labgrid/place.sh";
 
 /// Measurement commands and how they are shrunk here: `(text to find,
 /// replacement)`, applied to the command before it runs.
@@ -304,7 +332,7 @@ fn workspace(tag: &str) -> tempfile::TempDir {
 }
 
 /// Runs one documented `ppmc` command in `dir`; `Err` says what is wrong.
-fn run(doc: &Doc, args: &str, dir: &Path, board: &mut Option<Bridge>) -> Result<(), String> {
+fn run(doc: &Doc, args: &str, dir: &Path, boards: &mut [Option<Bridge>; 2]) -> Result<(), String> {
     let mut args = args.to_string();
     for (from, to) in SHRINK {
         args = args.replace(from, to);
@@ -315,16 +343,27 @@ fn run(doc: &Doc, args: &str, dir: &Path, board: &mut Option<Bridge>) -> Result<
         Bridge::start(dir, "doc-bridge", &argv[1..])?;
         return Ok(());
     }
-    // The documented board ports: a clean bridge simulator.
+    // The documented board ports (with a board's options after them): a
+    // clean bridge simulator for each.
     for a in &mut argv {
-        for port in ["serial:/dev/ttyACM0", "serial:/dev/pts/3"] {
-            if a == port {
-                if board.is_none() {
-                    *board = Some(Bridge::start(dir, "board", &[])?);
-                }
-                let link = &board.as_ref().expect("started").link;
-                *a = format!("serial:{}", link.display());
+        // ttyACM0 and pts/3 are the one board of the single-board docs.
+        for (slot, port) in [
+            (0, "serial:/dev/ttyACM0"),
+            (0, "serial:/dev/pts/3"),
+            (1, "serial:/dev/ttyACM1"),
+        ] {
+            let Some(options) = a.strip_prefix(port) else {
+                continue;
+            };
+            if !(options.is_empty() || options.starts_with(',')) {
+                continue;
             }
+            if boards[slot].is_none() {
+                boards[slot] = Some(Bridge::start(dir, &format!("board{slot}"), &[])?);
+            }
+            let link = &boards[slot].as_ref().expect("started").link;
+            *a = format!("serial:{}{options}", link.display());
+            break;
         }
     }
     let mut child = Command::new(env!("CARGO_BIN_EXE_ppmc"))
@@ -387,11 +426,12 @@ fn every_documented_command_runs_as_shown() {
     let ci = std::fs::read_to_string(root().join(".ci/run"))
         .expect(".ci/run")
         .replace(" -q ", " ");
+    let labgrid = std::fs::read_to_string(root().join(LABGRID_SCRIPT)).expect("the labgrid script");
     let mut bad = Vec::new();
     let mut ran = 0;
     for file in FILES {
         let dir = workspace("docs");
-        let mut board = None;
+        let mut boards = [None, None];
         for doc in commands(file) {
             if doc.command.contains('<') && !doc.command.contains(" < ") {
                 // A template (`crash-<hash>`): the loop it shows runs in
@@ -399,13 +439,25 @@ fn every_documented_command_runs_as_shown() {
                 continue;
             }
             if let Some(args) = ppmc_args(&doc.command) {
+                if let Some((_, where_)) = PPMC_ELSEWHERE.iter().find(|(t, _)| args.contains(t)) {
+                    let shown = doc.command.replacen("ppmc ", "\"$ppmc\" ", 1);
+                    if where_.contains(LABGRID_SCRIPT) && !labgrid.contains(&shown) {
+                        bad.push(format!("{doc}: said to run {where_}, but it does not"));
+                    }
+                    continue;
+                }
                 ran += 1;
-                if let Err(e) = run(&doc, &args, dir.path(), &mut board) {
+                if let Err(e) = run(&doc, &args, dir.path(), &mut boards) {
                     bad.push(format!("{doc}: {e}"));
                 }
                 continue;
             }
             match ELSEWHERE.iter().find(|(p, _)| doc.command.starts_with(p)) {
+                Some((_, where_)) if where_.starts_with(&format!("in {LABGRID_SCRIPT}")) => {
+                    if !labgrid.contains(&doc.command) {
+                        bad.push(format!("{doc}: said to run {where_}, but it does not"));
+                    }
+                }
                 Some((_, where_)) if where_.starts_with("in .ci/run") => {
                     let shown = doc.command.trim_start_matches("cd ");
                     let in_ci = ci.contains(shown)
@@ -467,7 +519,7 @@ fn the_extraction_reads_commands_as_a_shell_would() {
         &doc,
         "export out/nothing.trace -o wave.vcd",
         dir.path(),
-        &mut None,
+        &mut [None, None],
     )
     .expect_err("a file a clean checkout lacks");
     assert!(e.contains("exit status Some(2)"), "{e}");

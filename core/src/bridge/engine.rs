@@ -44,6 +44,9 @@ pub struct BridgeEngine<B> {
     last: Option<(Vec<u8>, Vec<Vec<u8>>)>,
     /// Data bytes per reply fragment, as the host last asked (LINK).
     fragment: usize,
+    /// Every reply is padded with 0x00 to a multiple of this (LINK; 0:
+    /// not padded).
+    pad: usize,
     /// Frames handled so far (for fault injection by the caller).
     pub frames: u64,
 }
@@ -63,6 +66,7 @@ impl<B: Bus> BridgeEngine<B> {
             capture_capacity: u32::MAX,
             last: None,
             fragment: wire::FRAGMENT_DATA,
+            pad: 0,
             frames: 0,
         }
     }
@@ -112,6 +116,11 @@ impl<B: Bus> BridgeEngine<B> {
                     out.extend(frame::encode(&resp.encode(0, self.timer)));
                 }
             }
+        }
+        // Empty frames (back-to-back delimiters) are skipped by every
+        // decoder; they only fill a server's buffer so that it sends.
+        if self.pad > 0 && out.len() % self.pad != 0 {
+            out.resize(out.len().next_multiple_of(self.pad), 0);
         }
         out
     }
@@ -256,11 +265,13 @@ impl<B: Bus> BridgeEngine<B> {
                 code: BridgeErrorCode::Malformed,
                 detail: "batch-capture handled before dispatch".into(),
             },
-            Request::Link { fragment } => {
+            Request::Link { fragment, pad } => {
                 self.fragment =
                     usize::from(fragment).clamp(wire::MIN_FRAGMENT_DATA, wire::FRAGMENT_DATA);
+                self.pad = usize::from(pad.min(wire::MAX_PAD));
                 Response::Link {
                     fragment: self.fragment as u8,
+                    pad: self.pad as u16,
                 }
             }
         }
@@ -397,6 +408,72 @@ mod tests {
                 ..
             }
         ));
+    }
+
+    #[test]
+    fn link_pads_every_reply_to_the_asked_multiple_and_the_replies_still_decode() {
+        let mut s = server();
+        let hello = Request::Hello {
+            version: PROTOCOL_VERSION,
+        };
+        let plain = s.on_bytes(&frame::encode(&hello.encode(1, Timer::NANOS)));
+        assert_ne!(plain.len() % 64, 0, "unpadded by default");
+        let set = ask(
+            &mut s,
+            2,
+            &Request::Link {
+                fragment: 48,
+                pad: 64,
+            },
+        );
+        assert_eq!(
+            set,
+            Response::Link {
+                fragment: 48,
+                pad: 64
+            }
+        );
+        for (seq, req) in [
+            (3, hello.clone()),
+            (4, Request::Batch(vec![Op::Delay(Duration::from_millis(1))])),
+        ] {
+            let out = s.on_bytes(&frame::encode(&req.encode(seq, Timer::NANOS)));
+            assert_eq!(out.len() % 64, 0, "{req:?}: {} bytes", out.len());
+            assert!(out.ends_with(&[0, 0]), "padded with delimiters");
+        }
+        // The padded reply is the unpadded one plus empty frames.
+        let padded = s.on_bytes(&frame::encode(&hello.encode(5, Timer::NANOS)));
+        let mut d = FrameDecoder::new();
+        d.extend(&padded);
+        let first = d.decode().expect("valid").expect("a frame");
+        assert_eq!(d.decode(), Ok(None), "nothing but padding after it");
+        assert!(Response::decode(&first, Timer::NANOS).is_ok());
+        // Padding is bounded, and 0 turns it off.
+        let capped = ask(
+            &mut s,
+            6,
+            &Request::Link {
+                fragment: 48,
+                pad: 60_000,
+            },
+        );
+        assert_eq!(
+            capped,
+            Response::Link {
+                fragment: 48,
+                pad: wire::MAX_PAD
+            }
+        );
+        ask(
+            &mut s,
+            7,
+            &Request::Link {
+                fragment: 48,
+                pad: 0,
+            },
+        );
+        let again = s.on_bytes(&frame::encode(&hello.encode(8, Timer::NANOS)));
+        assert_eq!(again.len(), plain.len());
     }
 
     #[test]

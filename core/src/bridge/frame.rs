@@ -233,7 +233,7 @@ mod cross_check {
             version: PROTOCOL_VERSION,
         }
         .encode(1, Timer::NANOS);
-        assert_eq!(hello, [0x01, 0x01, 0x05, 0x00]);
+        assert_eq!(hello, [0x01, 0x01, 0x06, 0x00]);
         assert_eq!(super::encode(&hello), HELLO);
         let rs = Request::Batch(vec![Op::ReadStatus]).encode(2, Timer::NANOS);
         assert_eq!(super::encode(&rs), BATCH_RS);
@@ -246,7 +246,7 @@ mod cross_check {
         assert_eq!(super::encode(&samples), BATCH_SAMPLE);
     }
 
-    const HELLO: &[u8] = &[0x04, 0x01, 0x01, 0x05, 0x05, 0xAA, 0x8A, 0x4B, 0x6D, 0x00];
+    const HELLO: &[u8] = &[0x04, 0x01, 0x01, 0x06, 0x05, 0x33, 0x22, 0xAC, 0x59, 0x00];
     const BATCH_RS: &[u8] = &[
         0x04, 0x02, 0x02, 0x01, 0x06, 0x12, 0x0A, 0xAF, 0x13, 0xDE, 0x00,
     ];

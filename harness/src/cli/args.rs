@@ -25,7 +25,8 @@ pub struct TargetArgs {
     /// as ser2net's telnet(rfc2217) mode and labgrid's exporter serve it) or
     /// `labgrid:<place>` (the serial port of a labgrid place you have
     /// acquired). Any of them may end in options of that board alone:
-    /// `,name=LABEL`, `,rev=LABEL` and the straps `,clock-mhz=`, `,csel=`,
+    /// `,name=LABEL`, `,rev=LABEL`, `,pad=BYTES` (reply padding, default 64
+    /// on a network target, 0 on a serial port) and the straps `,clock-mhz=`, `,csel=`,
     /// `,vsel=`, `,ext-clock-khz=` (they override the flags below).
     /// `ppmc run` takes several, one per board, and spreads the suite over
     /// them.
@@ -195,12 +196,16 @@ pub struct TargetSpec {
     pub name: Option<String>,
     /// The board revision label (`rev=`); default: `--board-rev`.
     pub rev: Option<String>,
+    /// Reply padding to ask the bridge for (`pad=`); default: 64 on a
+    /// network target, none on a serial port.
+    pub pad: Option<u16>,
     straps: StrapFlags,
 }
 
 impl TargetSpec {
     /// Splits `spec` into its address and the board's own options
-    /// (`name=`, `rev=`, `clock-mhz=`, `csel=`, `vsel=`, `ext-clock-khz=`);
+    /// (`name=`, `rev=`, `pad=`, `clock-mhz=`, `csel=`, `vsel=`,
+    /// `ext-clock-khz=`);
     /// other `key=value` parts (`baud=`) stay with the address.
     pub fn parse(spec: &str) -> Result<TargetSpec, String> {
         let mut parts = spec.split(',');
@@ -209,6 +214,7 @@ impl TargetSpec {
             address: String::new(),
             name: None,
             rev: None,
+            pad: None,
             straps: StrapFlags::default(),
         };
         let bad = |what: &str| format!("--target `{spec}`: {what}");
@@ -235,6 +241,14 @@ impl TargetSpec {
             match k {
                 "name" => t.name = Some(text(k, v)?),
                 "rev" => t.rev = Some(text(k, v)?),
+                "pad" => {
+                    t.pad = Some(
+                        v.parse::<u16>()
+                            .ok()
+                            .filter(|p| *p <= ppmc_core::bridge::wire::MAX_PAD)
+                            .ok_or_else(|| bad(&format!("pad={v}: give 0 to 512 bytes")))?,
+                    )
+                }
                 "clock-mhz" => t.straps.clock_mhz = Some(number(k, v)?),
                 "ext-clock-khz" => t.straps.ext_clock_khz = Some(number(k, v)?),
                 "csel" => t.straps.csel = Some(level(k, v)?),
@@ -418,9 +432,14 @@ impl TargetArgs {
         link: L,
         spec: &TargetSpec,
     ) -> Result<Box<dyn Target>, OpenError> {
+        // A serial server on the way (ser2net, labgrid's exporter) holds a
+        // partly filled 64-byte buffer for a millisecond or more; a reply
+        // padded to fill it goes at once (docs/bridge-protocol.md, LINK).
+        let network = !spec.address.starts_with("serial:");
         let opts = SerialOptions {
             reply_timeout: std::time::Duration::from_nanos(self.link_timeout.as_nanos()),
             retries: self.link_retries,
+            pad: spec.pad.unwrap_or(if network { 64 } else { 0 }),
             ..SerialOptions::default()
         };
         let t = SerialTarget::open(link, opts).map_err(infra)?;

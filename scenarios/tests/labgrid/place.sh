@@ -28,13 +28,19 @@ ip addr add 10.254.0.1/32 dev lo
 
 "$ppmc" bridge-sim --link "$dir/pty" > "$dir/bridge-sim.log" 2>&1 &
 pids+=($!)
+"$ppmc" bridge-sim --link "$dir/pty2" > "$dir/bridge-sim2.log" 2>&1 &
+pids+=($!)
 labgrid-coordinator -l 127.0.0.1:20408 > "$dir/coordinator.log" 2>&1 &
 pids+=($!)
-for _ in $(seq 100); do [ -L "$dir/pty" ] && break; sleep 0.1; done
+for _ in $(seq 100); do [ -L "$dir/pty" ] && [ -L "$dir/pty2" ] && break; sleep 0.1; done
 cat > "$dir/exporter.yaml" <<YAML
 bridge:
   RawSerialPort:
     port: $(readlink "$dir/pty")
+    speed: 115200
+bridge2:
+  RawSerialPort:
+    port: $(readlink "$dir/pty2")
     speed: 115200
 YAML
 # The exporter gives up on a coordinator that is not listening yet.
@@ -46,7 +52,7 @@ labgrid-exporter -c 127.0.0.1:20408 --hostname 127.0.0.1 -n bench1 "$dir/exporte
     > "$dir/exporter.log" 2>&1 &
 pids+=($!)
 for _ in $(seq 150); do
-    labgrid-client resources 2>/dev/null | grep -q '^bench1/bridge/' && break
+    [ "$(labgrid-client resources 2>/dev/null | grep -c '^bench1/bridge2\?/')" = 2 ] && break
     sleep 0.2
 done
 resources=$(labgrid-client resources 2>&1 | tr '\n' ' ')
@@ -70,4 +76,15 @@ labgrid-client -p rig1 acquire
 echo "MARK run-exit $?"
 # ppmc stopped the labgrid-client it started to learn the port.
 echo "MARK exports-left $(pgrep -fc 'labgrid-client -c .* export' || true)"
+
+# Two places in one run (docs/board-farm.md, several boards).
+labgrid-client -p rig2 create
+labgrid-client -p rig2 add-match 'bench1/bridge2/*'
+labgrid-client -p rig2 acquire
+mkdir two && cd two
+"$ppmc" run --target labgrid:rig1,rev=B2 --target labgrid:rig2,rev=C1 --skip-tag long --junit report.xml > run.out 2> run.err
+echo "MARK two-exit $?"
+cd ..
+echo "MARK exports-left-two $(pgrep -fc 'labgrid-client -c .* export' || true)"
+labgrid-client -p rig2 release
 labgrid-client -p rig1 release

@@ -18,7 +18,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 /// The protocol version this build speaks.
-pub const PROTOCOL_VERSION: u16 = 5;
+pub const PROTOCOL_VERSION: u16 = 6;
 
 /// Message kinds (the second payload byte).
 pub mod kind {
@@ -153,9 +153,13 @@ pub enum Request {
     },
     /// From the next response on, send fragments of at most this many
     /// data bytes ([`MIN_FRAGMENT_DATA`]..=[`FRAGMENT_DATA`]): smaller
-    /// frames for a noisier line.
+    /// frames for a noisier line; and end every reply with 0x00 bytes up
+    /// to a multiple of `pad` bytes (0: no padding; at most [`MAX_PAD`]),
+    /// so that a serial server in between that holds a partial buffer
+    /// (ser2net's `chardelay`) sends each reply at once.
     Link {
         fragment: u8,
+        pad: u16,
     },
 }
 
@@ -165,6 +169,9 @@ pub const FRAGMENT_DATA: usize = 48;
 
 /// The smallest fragment a host may ask for (LINK).
 pub const MIN_FRAGMENT_DATA: usize = 8;
+
+/// The largest reply padding a host may ask for (LINK).
+pub const MAX_PAD: u16 = 512;
 
 /// The longest response payload: 255 fragments.
 pub const MAX_REPLY: usize = 255 * FRAGMENT_DATA;
@@ -233,9 +240,10 @@ pub enum Response {
         code: BridgeErrorCode,
         detail: String,
     },
-    /// The fragment size now in force.
+    /// The fragment size and padding now in force.
     Link {
         fragment: u8,
+        pad: u16,
     },
 }
 
@@ -381,9 +389,10 @@ impl Request {
                 put_ops(&mut w, ops);
                 put_capture_from(&mut w, *runs, *pins, *moves, *max);
             }
-            Request::Link { fragment } => {
+            Request::Link { fragment, pad } => {
                 w.u8(kind::LINK);
                 w.u8(*fragment);
+                w.u16(*pad);
             }
             Request::Resend { fragments } => {
                 w.u8(kind::RESEND);
@@ -419,7 +428,10 @@ impl Request {
                     max: r.u16()?,
                 }
             }
-            kind::LINK => Request::Link { fragment: r.u8()? },
+            kind::LINK => Request::Link {
+                fragment: r.u8()?,
+                pad: r.u16()?,
+            },
             kind::RESEND => {
                 let n = usize::from(r.u8()?);
                 Request::Resend {
@@ -471,9 +483,10 @@ impl Response {
                 w.u8(code.code());
                 w.str(detail);
             }
-            Response::Link { fragment } => {
+            Response::Link { fragment, pad } => {
                 w.u8(kind::LINK_REPLY);
                 w.u8(*fragment);
+                w.u16(*pad);
             }
         }
         w.0
@@ -509,7 +522,10 @@ impl Response {
                 code: BridgeErrorCode::from_code(r.u8()?),
                 detail: r.str()?,
             },
-            kind::LINK_REPLY => Response::Link { fragment: r.u8()? },
+            kind::LINK_REPLY => Response::Link {
+                fragment: r.u8()?,
+                pad: r.u16()?,
+            },
             k => return Err(WireError::UnknownKind(k)),
         };
         r.end()?;
@@ -847,9 +863,15 @@ mod tests {
         );
         let long = vec![7u8; MAX_REPLY];
         assert_eq!(fragment(&long, MIN_FRAGMENT_DATA).len(), 255);
-        let link = Request::Link { fragment: 12 };
+        let link = Request::Link {
+            fragment: 12,
+            pad: 64,
+        };
         assert_eq!(Request::decode(&link.encode(6, T), T), Ok((6, link)));
-        let set = Response::Link { fragment: 12 };
+        let set = Response::Link {
+            fragment: 12,
+            pad: 64,
+        };
         assert_eq!(Response::decode(&set.encode(6, T), T), Ok((6, set)));
         let r = Request::Resend {
             fragments: vec![0, 2],

@@ -142,6 +142,11 @@ pub struct SerialOptions {
     /// the host asks again (rather than waiting out the reply timeout); at
     /// most this, and less on a link that answers faster.
     pub quiet: WallDuration,
+    /// Ask the bridge to pad every reply with empty frames to a multiple of
+    /// this many bytes (LINK), so that a serial server in between that
+    /// holds a partly filled buffer (ser2net's 64 bytes) sends it at once;
+    /// 0 for none.
+    pub pad: u16,
 }
 
 impl Default for SerialOptions {
@@ -153,6 +158,7 @@ impl Default for SerialOptions {
             reopen_attempts: 5,
             backoff: WallDuration::from_millis(100),
             quiet: WallDuration::from_millis(30),
+            pad: 0,
         }
     }
 }
@@ -312,6 +318,8 @@ pub struct SerialTarget<L: Link> {
     /// again, doubled back after [`CLEAN_TO_GROW`] clean ones.
     fragment: u8,
     want_fragment: u8,
+    /// The reply padding in force on the bridge (LINK).
+    pad: u16,
     /// Clean requests in a row.
     clean: u32,
     /// The bridge answers LINK (one that refuses it keeps 48-byte
@@ -355,6 +363,7 @@ impl<L: Link> SerialTarget<L> {
             heard: false,
             fragment: FRAGMENT_DATA as u8,
             want_fragment: FRAGMENT_DATA as u8,
+            pad: 0,
             clean: 0,
             link_ok: true,
             request_size: MAX_REQUEST,
@@ -364,6 +373,11 @@ impl<L: Link> SerialTarget<L> {
         t.timer = Timer {
             hz: t.hello.timer_hz,
         };
+        // Always: a bridge keeps its LINK settings across hosts, and the
+        // last one may have asked for padding this link does not want.
+        if t.link_ok {
+            t.set_link(t.fragment, t.opts.pad)?;
+        }
         let replies =
             t.run_batch(&[Op::Reset, Op::ReadStatus])
                 .map_err(|e| SerialError::Unhealthy {
@@ -485,14 +499,16 @@ impl<L: Link> SerialTarget<L> {
     /// that does not know LINK (UNKNOWN_OP) keeps its own, and is not
     /// asked again.
     fn set_fragment(&mut self, size: u8) -> Result<(), SerialError> {
-        match self.exchange(
-            &Request::Link { fragment: size },
-            "link",
-            WallDuration::ZERO,
-        )? {
-            Response::Link { fragment } => {
+        self.set_link(size, self.pad)
+    }
+
+    /// Sets the reply fragment size and padding (LINK).
+    fn set_link(&mut self, fragment: u8, pad: u16) -> Result<(), SerialError> {
+        match self.exchange(&Request::Link { fragment, pad }, "link", WallDuration::ZERO)? {
+            Response::Link { fragment, pad } => {
                 self.fragment = fragment;
                 self.want_fragment = fragment;
+                self.pad = pad;
             }
             Response::Error {
                 code: BridgeErrorCode::UnknownOp,
@@ -1008,6 +1024,8 @@ mod tests {
         fail_sends: u32,
         fail_reopens: u32,
         restart_on_reopen: bool,
+        /// How many bytes the bridge sent for each request.
+        sent: Vec<usize>,
     }
 
     impl MemLink {
@@ -1018,6 +1036,7 @@ mod tests {
                 fail_sends: 0,
                 fail_reopens: 0,
                 restart_on_reopen: false,
+                sent: Vec::new(),
             }
         }
 
@@ -1034,6 +1053,7 @@ mod tests {
                 return Err(io::Error::new(io::ErrorKind::BrokenPipe, "unplugged"));
             }
             let out = self.server.on_bytes(bytes);
+            self.sent.push(out.len());
             self.pending.extend(out);
             Ok(())
         }
@@ -1070,7 +1090,30 @@ mod tests {
             reopen_attempts: 3,
             backoff: WallDuration::from_millis(1),
             quiet: WallDuration::from_millis(1),
+            pad: 0,
         }
+    }
+
+    #[test]
+    fn asked_to_pad_the_bridge_sends_whole_multiples_of_the_padding() {
+        let opts = SerialOptions { pad: 64, ..quick() };
+        let mut t = SerialTarget::open(MemLink::new(), opts).expect("opens");
+        let replies = t.execute(&[Op::Reset, Op::ReadStatus]).expect("runs");
+        assert_eq!(replies.len(), 2);
+        let sent = &t.link.sent;
+        // The hello reply (before LINK) is not padded; from LINK's own
+        // reply on, every reply fills whole 64-byte buffers.
+        assert_ne!(sent[0] % 64, 0, "{sent:?}");
+        assert!(sent.len() >= 3, "{sent:?}");
+        assert!(sent[1..].iter().all(|n| n % 64 == 0), "{sent:?}");
+        // Unasked, nothing is padded.
+        let mut plain = SerialTarget::open(MemLink::new(), quick()).expect("opens");
+        plain.execute(&[Op::ReadStatus]).expect("runs");
+        assert!(
+            plain.link.sent.iter().all(|n| n % 64 != 0),
+            "{:?}",
+            plain.link.sent
+        );
     }
 
     /// Pin samples of a phase-stepping move (Section 3-3-5), `n` of them
