@@ -6,45 +6,15 @@
 
 mod common;
 
-use common::{ppmc, scratch, text, wait_bounded};
+use common::{ppmc, scratch, text, wait_bounded, BridgeSim};
 use std::collections::BTreeSet;
-use std::io::{BufRead, BufReader, Read};
-use std::process::{Child, Command, Stdio};
+use std::io::Read;
+use std::process::{Command, Stdio};
 use std::time::Duration;
 
-/// A `ppmc bridge-sim` on a pty, killed when dropped.
-struct Sim {
-    child: Child,
-    target: String,
-}
-
-impl Sim {
-    fn start(dir: &std::path::Path, n: usize) -> Sim {
-        let link = dir.join(format!("board{n}"));
-        let mut child = Command::new(env!("CARGO_BIN_EXE_ppmc"))
-            .args(["bridge-sim", "--link"])
-            .arg(&link)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("bridge-sim starts");
-        let mut first = String::new();
-        BufReader::new(child.stdout.take().expect("piped"))
-            .read_line(&mut first)
-            .expect("bridge-sim says where");
-        assert!(first.starts_with("bridge-sim: serving on "), "{first}");
-        Sim {
-            child,
-            target: format!("serial:{}", link.display()),
-        }
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
+/// The `n`th board of a test: a bridge simulator linked at `dir/board<n>`.
+fn sim(dir: &std::path::Path, n: usize) -> BridgeSim {
+    BridgeSim::start_at(&dir.join(format!("board{n}")), &[])
 }
 
 fn json(path: &std::path::Path) -> serde_json::Value {
@@ -62,12 +32,12 @@ fn schema() -> jsonschema::Validator {
 /// Runs the suite shared by `n` bridge-sims; checks the merged reports.
 fn shared_by(n: usize) {
     let dir = scratch("boards");
-    let sims: Vec<Sim> = (1..=n).map(|i| Sim::start(dir.path(), i)).collect();
+    let sims: Vec<BridgeSim> = (1..=n).map(|i| sim(dir.path(), i)).collect();
     let (junit, record) = (dir.path().join("r.xml"), dir.path().join("r.json"));
     let mut args = vec!["run".to_string()];
     for (i, s) in sims.iter().enumerate() {
         args.push("--target".into());
-        args.push(format!("{},name=b{},rev=R{}", s.target, i + 1, i + 1));
+        args.push(format!("{},name=b{},rev=R{}", s.target(), i + 1, i + 1));
     }
     args.extend(["--golden", "../golden", "--junit"].map(String::from));
     args.push(junit.display().to_string());
@@ -161,15 +131,15 @@ fn three_boards_share_the_suite_with_one_report_naming_each_cases_board() {
 #[test]
 fn each_runs_the_suite_on_every_board_one_junit_suite_per_board() {
     let dir = scratch("boards");
-    let sims: Vec<Sim> = (1..=2).map(|i| Sim::start(dir.path(), i)).collect();
+    let sims: Vec<BridgeSim> = (1..=2).map(|i| sim(dir.path(), i)).collect();
     let junit = dir.path().join("r.xml");
     let out = ppmc(&[
         "run",
         "--each",
         "--target",
-        &sims[0].target,
+        &sims[0].target(),
         "--target",
-        &format!("{},name=second", sims[1].target),
+        &format!("{},name=second", sims[1].target()),
         "--skip-tag",
         "long",
         "--junit",
@@ -186,7 +156,7 @@ fn each_runs_the_suite_on_every_board_one_junit_suite_per_board() {
     let second = &report.test_suites[1];
     assert_eq!(
         first.name.as_str(),
-        format!("ppmc-conformance on {}", sims[0].target)
+        format!("ppmc-conformance on {}", sims[0].target())
     );
     assert_eq!(second.name.as_str(), "ppmc-conformance on second");
     assert_eq!(first.test_cases.len(), second.test_cases.len());
@@ -196,19 +166,19 @@ fn each_runs_the_suite_on_every_board_one_junit_suite_per_board() {
     assert!(second
         .properties
         .iter()
-        .any(|p| p.name.as_str() == "target" && p.value.as_str() == sims[1].target));
+        .any(|p| p.name.as_str() == "target" && p.value.as_str() == sims[1].target()));
 }
 
 #[test]
 fn a_board_that_drops_out_hands_its_scenarios_to_the_others() {
     let dir = scratch("boards");
-    let sims: Vec<Sim> = (1..=3).map(|i| Sim::start(dir.path(), i)).collect();
+    let sims: Vec<BridgeSim> = (1..=3).map(|i| sim(dir.path(), i)).collect();
     let record = dir.path().join("r.json");
     let mut child = Command::new(env!("CARGO_BIN_EXE_ppmc"))
         .args(["run", "--repeat", "30", "--skip-tag", "long"])
-        .args(["--target", &format!("{},name=b1", sims[0].target)])
-        .args(["--target", &format!("{},name=b2", sims[1].target)])
-        .args(["--target", &format!("{},name=b3", sims[2].target)])
+        .args(["--target", &format!("{},name=b1", sims[0].target())])
+        .args(["--target", &format!("{},name=b2", sims[1].target())])
+        .args(["--target", &format!("{},name=b3", sims[2].target())])
         .args(["--link-timeout", "100ms", "--link-retries", "3", "--json"])
         .arg(&record)
         .stdout(Stdio::piped())

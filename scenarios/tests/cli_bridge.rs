@@ -3,78 +3,13 @@
 
 mod common;
 
-use common::{ppmc, scratch, text, wait_bounded};
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Stdio};
+use common::{ppmc, scratch, text, wait_bounded, BridgeSim};
+use std::process::Command;
 
 const EXAMPLE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../docs/examples/accel-1000-steps.ppmc"
 );
-
-/// A `ppmc bridge-sim` child process, killed when dropped.
-///
-/// The host reaches it through a link of its own (`--link`), as it reaches
-/// a board through a stable device path: a pseudo-terminal's number is
-/// reused as soon as it is free, so a host still reconnecting after its
-/// bridge went away could otherwise open another test's bridge.
-struct BridgeSim {
-    child: Child,
-    path: String,
-    _stdout: BufReader<std::process::ChildStdout>,
-    _dir: Option<tempfile::TempDir>,
-}
-
-impl BridgeSim {
-    fn start(args: &[&str]) -> BridgeSim {
-        let dir = scratch("clibridge");
-        let link = dir.path().join("pty");
-        let mut sim = BridgeSim::start_at(&link, args);
-        sim._dir = Some(dir);
-        sim
-    }
-
-    /// A bridge-sim whose link is `link`.
-    fn start_at(link: &std::path::Path, args: &[&str]) -> BridgeSim {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_ppmc"))
-            .arg("bridge-sim")
-            .arg("--link")
-            .arg(link)
-            .args(args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("bridge-sim starts");
-        let stdout = child.stdout.take().expect("stdout piped");
-        let mut reader = BufReader::new(stdout);
-        let mut first = String::new();
-        reader
-            .read_line(&mut first)
-            .expect("bridge-sim prints its pty");
-        assert!(
-            first.trim().starts_with("bridge-sim: serving on /dev/"),
-            "unexpected first line `{first}`"
-        );
-        BridgeSim {
-            child,
-            path: link.to_str().expect("utf-8 path").to_string(),
-            _stdout: reader,
-            _dir: None,
-        }
-    }
-
-    fn target(&self) -> String {
-        format!("serial:{}", self.path)
-    }
-}
-
-impl Drop for BridgeSim {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-        let _ = std::fs::remove_file(&self.path);
-    }
-}
 
 #[test]
 fn run_over_the_bridge_gives_the_same_verdicts_as_the_emulator() {

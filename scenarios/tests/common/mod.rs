@@ -42,3 +42,65 @@ pub fn wait_bounded(
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
 }
+
+/// A `ppmc bridge-sim` child process, killed when dropped.
+///
+/// The host reaches it through a link of its own (`--link`), as it reaches
+/// a board through a stable device path: a pseudo-terminal's number is
+/// reused as soon as it is free, so a host still reconnecting after its
+/// bridge went away could otherwise open another test's bridge.
+pub struct BridgeSim {
+    pub child: std::process::Child,
+    path: String,
+    _stdout: std::io::BufReader<std::process::ChildStdout>,
+    _dir: Option<tempfile::TempDir>,
+}
+
+impl BridgeSim {
+    pub fn start(args: &[&str]) -> BridgeSim {
+        let dir = scratch("clibridge");
+        let link = dir.path().join("pty");
+        let mut sim = BridgeSim::start_at(&link, args);
+        sim._dir = Some(dir);
+        sim
+    }
+
+    /// A bridge-sim whose link is `link`.
+    pub fn start_at(link: &std::path::Path, args: &[&str]) -> BridgeSim {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_ppmc"))
+            .arg("bridge-sim")
+            .arg("--link")
+            .arg(link)
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("bridge-sim starts");
+        let stdout = child.stdout.take().expect("stdout piped");
+        let mut reader = std::io::BufReader::new(stdout);
+        let mut first = String::new();
+        std::io::BufRead::read_line(&mut reader, &mut first).expect("bridge-sim prints its pty");
+        assert!(
+            first.trim().starts_with("bridge-sim: serving on /dev/"),
+            "unexpected first line `{first}`"
+        );
+        BridgeSim {
+            child,
+            path: link.to_str().expect("utf-8 path").to_string(),
+            _stdout: reader,
+            _dir: None,
+        }
+    }
+
+    pub fn target(&self) -> String {
+        format!("serial:{}", self.path)
+    }
+}
+
+impl Drop for BridgeSim {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
