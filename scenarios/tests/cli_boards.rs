@@ -273,3 +273,45 @@ fn only_run_takes_several_targets_and_a_bad_board_option_is_refused() {
     assert_eq!(boards[1]["name"], "emu#2");
     assert_eq!(boards[1]["target_details"]["sysclk_hz"], "16000000");
 }
+
+/// With `--each`, the files of what did not pass go to a folder per board:
+/// here the 12 MHz emulator's, whose golden traces were recorded at 16 MHz
+/// (an error of the golden file, on that board alone).
+#[test]
+fn each_keeps_every_boards_artifacts_apart() {
+    let dir = scratch("boards");
+    let arts = dir.path().join("arts");
+    let golden = concat!(env!("CARGO_MANIFEST_DIR"), "/../golden");
+    let out = ppmc(&[
+        "run",
+        "--each",
+        "--target",
+        "emu",
+        "--target",
+        "emu,clock-mhz=12",
+        "--golden",
+        golden,
+        "--filter",
+        "s3_1_1_status_is_idle_after_reset",
+        "--artifacts",
+        arts.to_str().expect("utf-8"),
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("board emu: 1 scenarios, 1 passed"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("board emu#2: 1 scenarios, 0 passed, 0 failed, 1 errors"),
+        "{stdout}"
+    );
+    let saved: Vec<String> = std::fs::read_dir(&arts)
+        .expect("artifacts written")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(saved, ["emu#2"]);
+    assert!(arts
+        .join("emu#2/s3_1_1_status_is_idle_after_reset.trace")
+        .is_file());
+}
