@@ -22,6 +22,8 @@ pub const INVARIANTS: &[(&str, &str)] = &[
     ("remaining-pulses", "3-4-4"),
     ("finish-flag-once", "3-4-1"),
     ("busy-covers-pulses", "3-1-1"),
+    ("int-mask", "3-3-1"),
+    ("int-release", "3-4-1"),
     ("time-monotonic", "model"),
     ("record-ordered", "model"),
     ("trace-round-trip", "trace format"),
@@ -98,6 +100,11 @@ pub struct Judge {
     reading: Option<Reading>,
     /// Moves ended (BUSY falls) when the finish status was last read.
     stops_at_finish_read: usize,
+    /// Each operation command written: when, and whether it asks for the
+    /// termination interrupt (bit 4 = 0).
+    operations: Vec<(Instant, bool)>,
+    /// When each finish status read command (0x80) was written.
+    finish_reads: Vec<Instant>,
 }
 
 impl Judge {
@@ -119,6 +126,11 @@ impl Judge {
         }
         match (op, seen.value) {
             (BusOp::Command(b), _) => {
+                match Command::decode(b) {
+                    Command::Move(m) => self.operations.push((seen.at, m.flags.interrupt)),
+                    Command::Read(Register::FinishStatus) => self.finish_reads.push(seen.at),
+                    _ => {}
+                }
                 self.reading = Some(Reading {
                     command: b,
                     taken: false,
@@ -181,10 +193,74 @@ impl Judge {
         if let Some(d) = record_breaks(rec) {
             return Err(at_end("record-ordered", d));
         }
+        if let Some((invariant, d)) = self.int_breaks(rec) {
+            return Err(at_end(invariant, d));
+        }
         if let Some(d) = trace_round_trip(rec) {
             return Err(at_end("trace-round-trip", d));
         }
         Ok(())
+    }
+
+    /// INT* (Section 3-3, the operation commands' bit 4; 3-4-1): it is
+    /// asserted only at the end of a move whose operation command asked for
+    /// the termination interrupt (a stop command's own bit has no effect,
+    /// 3-3-1, 3-3-2: the original command's counts), and released only
+    /// by a finish status read: one written since the last release (it may
+    /// come before INT* rises, taken after). One-sided as the finish flag
+    /// is: a read command the chip lost cannot release it, so "still
+    /// asserted after a read" is not claimed.
+    fn int_breaks(&self, rec: &Record) -> Option<(&'static str, String)> {
+        let mut asserted_at = None;
+        let mut released_at = Instant::ZERO;
+        for p in rec.pins.iter().filter(|p| p.pin == Pin::Int) {
+            if p.value != 0 {
+                asserted_at = Some(p.at);
+                // The move that ended, and the operation command that
+                // started it: the last one written by its final byte.
+                let Some(m) = rec.moves.iter().rev().find(|m| m.at <= p.at) else {
+                    continue;
+                };
+                let Some(&(_, interrupt)) = self.operations.iter().rev().find(|(t, _)| *t <= m.at)
+                else {
+                    continue;
+                };
+                if !interrupt {
+                    return Some((
+                        "int-mask",
+                        format!(
+                            "INT* asserted at {} at the end of a {} move whose command masks the termination interrupt (bit 4 = 1)",
+                            p.at,
+                            m.kind.name()
+                        ),
+                    ));
+                }
+            } else if let Some(from) = asserted_at.take() {
+                // The read may have been written before INT* rose (during
+                // the move) and taken after: any read since the last
+                // release counts, but each release needs one of its own.
+                let read = self
+                    .finish_reads
+                    .iter()
+                    .any(|t| *t >= released_at && *t <= p.at);
+                if !read {
+                    return Some((
+                        "int-release",
+                        format!(
+                            "INT* (asserted at {from}) released at {} without a finish status read written since {}",
+                            p.at,
+                            if released_at == Instant::ZERO {
+                                "the start".to_string()
+                            } else {
+                                format!("the last release at {released_at}")
+                            }
+                        ),
+                    ));
+                }
+                released_at = p.at;
+            }
+        }
+        None
     }
 
     /// Checks a register read once all its bytes are in: the remaining
@@ -495,6 +571,71 @@ mod tests {
             .expect("chip")
             .expect("a break");
         assert_eq!(v.invariant, "status-params");
+    }
+
+    /// `init_and_step` with the step's termination interrupt masked
+    /// (0x5A: bit 4 = 1, Section 3-3-8).
+    fn init_and_masked_step() -> Vec<BusOp> {
+        init_and_step()
+            .into_iter()
+            .map(|op| {
+                if op == Command(0x4A) {
+                    Command(0x5A)
+                } else {
+                    op
+                }
+            })
+            .collect()
+    }
+
+    /// Section 3-3 (bit 4 of an operation command): a board that asserts
+    /// INT* at the end of a masked move breaks `int-mask`; the clean model
+    /// keeps it, masked or not.
+    #[test]
+    fn int_asserted_despite_the_mask_is_caught() {
+        assert_eq!(
+            check(&init_and_masked_step(), ModelConfig::default()).expect("chip"),
+            None
+        );
+        let v = check(&init_and_masked_step(), faulty("int-ignores-mask"))
+            .expect("chip")
+            .expect("a break");
+        assert_eq!(v.invariant, "int-mask", "{v}");
+        assert!(v.detail.contains("masks the termination interrupt"), "{v}");
+        // Unmasked, the same board asserts INT* rightly.
+        assert_eq!(
+            check(&init_and_step(), faulty("int-ignores-mask")).expect("chip"),
+            None
+        );
+    }
+
+    /// Section 3-4-1: the finish status read releases INT*; a release with
+    /// no such read since INT* was asserted breaks `int-release`.
+    #[test]
+    fn int_released_only_by_a_finish_status_read() {
+        let read = then_read(0x80, 1);
+        assert_eq!(check(&read, ModelConfig::default()).expect("chip"), None);
+        let mut rec = Record::default();
+        rec.pin(Instant::from_nanos(1_000), Pin::Int, 1);
+        rec.pin(Instant::from_nanos(5_000), Pin::Int, 0);
+        let v = Judge::default().finish(&rec).expect_err("a break");
+        assert_eq!(v.invariant, "int-release", "{v}");
+        // Released after a finish status read written since the start
+        // (here before INT* rose, taken after): kept.
+        let judge = Judge {
+            finish_reads: vec![Instant::from_nanos(500)],
+            ..Judge::default()
+        };
+        assert_eq!(judge.finish(&rec), Ok(()));
+        // A second release needs a read of its own.
+        rec.pin(Instant::from_nanos(7_000), Pin::Int, 1);
+        rec.pin(Instant::from_nanos(9_000), Pin::Int, 0);
+        let v = judge.finish(&rec).expect_err("a break");
+        assert_eq!(v.invariant, "int-release", "{v}");
+        assert!(
+            v.detail.contains("since the last release at 5.000us"),
+            "{v}"
+        );
     }
 
     /// `init_and_step`, then a register read: command, wait, its bytes.
