@@ -100,9 +100,12 @@ pub struct Judge {
     reading: Option<Reading>,
     /// Moves ended (BUSY falls) when the finish status was last read.
     stops_at_finish_read: usize,
-    /// Each operation command written: when, and whether it asks for the
-    /// termination interrupt (bit 4 = 0).
+    /// Each operation command the chip took: when it was written, and
+    /// whether it asks for the termination interrupt (bit 4 = 0).
     operations: Vec<(Instant, bool)>,
+    /// The last operation command written, until the chip takes it (IBF
+    /// seen at 0) or a later write replaces it.
+    pending_operation: Option<(Instant, bool)>,
     /// When each finish status read command (0x80) was written.
     finish_reads: Vec<Instant>,
 }
@@ -123,11 +126,13 @@ impl Judge {
             if self.reading.as_ref().is_some_and(|r| !r.taken) {
                 self.reading = None;
             }
+            // So may an operation command.
+            self.pending_operation = None;
         }
         match (op, seen.value) {
             (BusOp::Command(b), _) => {
                 match Command::decode(b) {
-                    Command::Move(m) => self.operations.push((seen.at, m.flags.interrupt)),
+                    Command::Move(m) => self.pending_operation = Some((seen.at, m.flags.interrupt)),
                     Command::Read(Register::FinishStatus) => self.finish_reads.push(seen.at),
                     _ => {}
                 }
@@ -168,6 +173,9 @@ impl Judge {
         }
         if let Some(r) = self.reading.as_mut() {
             r.taken |= !seen.after.ibf();
+        }
+        if !seen.after.ibf() {
+            self.operations.extend(self.pending_operation.take());
         }
         if seen.at < self.last_at {
             return Err(fail(
@@ -216,11 +224,23 @@ impl Judge {
         for p in rec.pins.iter().filter(|p| p.pin == Pin::Int) {
             if p.value != 0 {
                 asserted_at = Some(p.at);
-                // The move that ended, and the operation command that
-                // started it: the last one written by its final byte.
-                let Some(m) = rec.moves.iter().rev().find(|m| m.at <= p.at) else {
+                // The move that ended: the last one written by then, if it
+                // had pulsed by then. A move's command may be written while
+                // the one before still runs (its `at` is the write), so a
+                // last move with no pulse yet may not have begun: no claim.
+                let Some(k) = rec.moves.iter().rposition(|m| m.at <= p.at) else {
                     continue;
                 };
+                let m = &rec.moves[k];
+                let runs_end = rec.moves.get(k + 1).map_or(rec.runs.len(), |n| n.first_run);
+                let pulsed = rec.runs[m.first_run.min(runs_end)..runs_end]
+                    .first()
+                    .is_some_and(|r| r.start <= p.at);
+                if !pulsed {
+                    continue;
+                }
+                // The operation command that started it: the last one
+                // written by its final byte.
                 let Some(&(_, interrupt)) = self.operations.iter().rev().find(|(t, _)| *t <= m.at)
                 else {
                     continue;
