@@ -131,12 +131,8 @@ pub fn run_suite_until(
                 _ if interrupted => not_run(NotRun::Interrupted),
                 Some(why) => not_run(NotRun::TargetLost(why.clone())),
                 None => {
-                    let r = run_scenario(target, s, opts);
-                    if matches!(r.verdict, Verdict::Error(_)) {
-                        if let Err(e) = target.execute(&[Op::Reset]) {
-                            dead = Some(e.to_string());
-                        }
-                    }
+                    let (r, lost) = run_checked(target, s, opts);
+                    dead = lost;
                     r
                 }
             };
@@ -145,6 +141,24 @@ pub fn run_suite_until(
         }
     }
     results
+}
+
+/// Runs `s`, and after a harness error gives the target a health check (a
+/// chip reset): `Some(why)` when that fails too and the target is taken
+/// as lost.
+fn run_checked(
+    target: &mut dyn Target,
+    s: &Scenario,
+    opts: DriverOptions,
+) -> (ScenarioResult, Option<String>) {
+    let r = run_scenario(target, s, opts);
+    let mut lost = None;
+    if matches!(r.verdict, Verdict::Error(_)) {
+        if let Err(e) = target.execute(&[Op::Reset]) {
+            lost = Some(e.to_string());
+        }
+    }
+    (r, lost)
 }
 
 /// The result of a scenario that did not run, and why.
@@ -169,6 +183,18 @@ pub enum Spread {
     Share,
     /// Every scenario runs on every board: to compare boards.
     Each,
+}
+
+impl Spread {
+    /// How the run record names a run on `boards` boards spread so:
+    /// `one`, `share` or `each`.
+    pub fn name(self, boards: usize) -> &'static str {
+        match (boards, self) {
+            (1, _) => "one",
+            (_, Spread::Share) => "share",
+            (_, Spread::Each) => "each",
+        }
+    }
 }
 
 /// A result of a run on several boards, and the board (its index) it ran
@@ -239,19 +265,13 @@ pub fn run_on_boards(
                 if stop() {
                     return;
                 }
+                // Past the end, the counter is read as `per_queue`.
                 let taken = queues[q].fetch_add(1, Ordering::SeqCst);
                 if taken >= per_queue {
-                    queues[q].store(per_queue, Ordering::SeqCst);
                     return;
                 }
                 let slot = q * per_queue + taken;
-                let result = run_scenario(target.as_mut(), scenario_of(slot), opts);
-                let mut lost = None;
-                if matches!(result.verdict, Verdict::Error(_)) {
-                    if let Err(e) = target.execute(&[Op::Reset]) {
-                        lost = Some(e.to_string());
-                    }
-                }
+                let (result, lost) = run_checked(target.as_mut(), scenario_of(slot), opts);
                 let gone = lost.is_some();
                 let _ = tx.send(Report {
                     slot,

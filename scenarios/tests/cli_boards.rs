@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{ppmc, scratch, text, wait_bounded, BridgeSim};
+use common::{check_record, ppmc, run_record_schema, scratch, text, wait_bounded, BridgeSim};
 use std::collections::BTreeSet;
 use std::io::Read;
 use std::process::{Command, Stdio};
@@ -19,14 +19,6 @@ fn sim(dir: &std::path::Path, n: usize) -> BridgeSim {
 
 fn json(path: &std::path::Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).expect("JSON written")).expect("JSON")
-}
-
-fn schema() -> jsonschema::Validator {
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/run-record.schema.json");
-    let schema: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(path).expect("schema")).expect("JSON");
-    jsonschema::validator_for(&schema).expect("a valid schema")
 }
 
 /// Runs the suite shared by `n` bridge-sims; checks the merged reports.
@@ -86,7 +78,7 @@ fn shared_by(n: usize) {
 
     // JSON: the boards, and the board of every scenario.
     let v = json(&record);
-    assert!(schema().is_valid(&v), "the record matches its schema");
+    check_record(&run_record_schema(), &v);
     assert_eq!(v["run"]["spread"], "share");
     let boards: Vec<&str> = v["run"]["boards"]
         .as_array()

@@ -5,23 +5,8 @@
 
 mod common;
 
-use common::{ppmc, scratch, text};
+use common::{check_record as check, ppmc, run_record_schema as schema, scratch, text};
 use std::path::Path;
-
-fn schema() -> jsonschema::Validator {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/run-record.schema.json");
-    let schema: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(path).expect("schema")).expect("JSON");
-    jsonschema::validator_for(&schema).expect("a valid schema")
-}
-
-fn check(validator: &jsonschema::Validator, record: &serde_json::Value) {
-    let errors: Vec<String> = validator
-        .iter_errors(record)
-        .map(|e| format!("{} at {}", e, e.instance_path))
-        .collect();
-    assert!(errors.is_empty(), "{errors:#?}");
-}
 
 /// Real records of every verdict kind: passed and marginal (the emulator),
 /// failed and error (a board fault, a corrupt golden file behind the

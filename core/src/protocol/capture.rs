@@ -307,6 +307,18 @@ impl Record {
         self.pins.push(PinEvent { at, pin, value });
     }
 
+    /// The last move whose final command byte was written by `at`, with
+    /// its pulse runs (up to the next move's first).
+    pub fn move_written_by(&self, at: Instant) -> Option<(&MoveStart, &[PulseRun])> {
+        let k = self.moves.iter().rposition(|m| m.at <= at)?;
+        let m = &self.moves[k];
+        let end = self
+            .moves
+            .get(k + 1)
+            .map_or(self.runs.len(), |n| n.first_run);
+        Some((m, &self.runs[m.first_run.min(end)..end]))
+    }
+
     /// Summary of the pulses of the most recent move (all pulses if no move
     /// has started).
     pub fn last_move_pulses(&self) -> PulseSummary {

@@ -268,9 +268,44 @@ impl TargetSpec {
         self.name.as_deref().unwrap_or(&self.address)
     }
 
-    pub fn is_emu(&self) -> bool {
-        self.address == "emu"
+    /// The address read as its backend takes it; a usage message naming
+    /// the form to write when it does not read.
+    fn parsed(&self) -> Result<Address, String> {
+        let a = self.address.as_str();
+        let bad = |form: &str| format!("bad target `{a}`: write {form}");
+        if a == "emu" {
+            Ok(Address::Emu)
+        } else if a.starts_with("serial:") {
+            let (path, baud) =
+                crate::backend::parse_spec(a).ok_or_else(|| bad("serial:<path>[,baud=N]"))?;
+            Ok(Address::Serial { path, baud })
+        } else if a.starts_with("tcp://") {
+            crate::backend::parse_tcp(a)
+                .map(Address::Tcp)
+                .ok_or_else(|| bad("tcp://<host>:<port>"))
+        } else if a.starts_with("rfc2217://") {
+            let (addr, baud) = crate::backend::parse_rfc2217(a)
+                .ok_or_else(|| bad("rfc2217://<host>:<port>[,baud=N]"))?;
+            Ok(Address::Rfc2217 { addr, baud })
+        } else if a.starts_with("labgrid:") {
+            crate::backend::parse_labgrid(a)
+                .map(Address::Labgrid)
+                .ok_or_else(|| bad("labgrid:<place>"))
+        } else {
+            Err(format!(
+                "unknown target `{a}`: use `emu`, `serial:<path>[,baud=N]`, `tcp://<host>:<port>`, `rfc2217://<host>:<port>[,baud=N]` or `labgrid:<place>`"
+            ))
+        }
     }
+}
+
+/// Where a target's chip is, as its backend takes it.
+enum Address {
+    Emu,
+    Serial { path: String, baud: u32 },
+    Tcp(String),
+    Rfc2217 { addr: String, baud: u32 },
+    Labgrid(crate::backend::Place),
 }
 
 impl TargetArgs {
@@ -355,36 +390,8 @@ impl TargetArgs {
     /// a bad one is the user's, before any board is opened.
     pub fn check(&self, spec: &TargetSpec) -> Result<(), OpenError> {
         self.straps_of(spec).map_err(OpenError::Usage)?;
-        if spec.is_emu() {
+        if let Address::Emu = spec.parsed().map_err(OpenError::Usage)? {
             return Ok(());
-        }
-        let known = ["serial:", "tcp://", "rfc2217://", "labgrid:"];
-        if !known.iter().any(|k| spec.address.starts_with(k)) {
-            return Err(OpenError::Usage(format!(
-                "unknown target `{}`: use `emu`, `serial:<path>[,baud=N]`, `tcp://<host>:<port>`, `rfc2217://<host>:<port>[,baud=N]` or `labgrid:<place>`",
-                spec.address
-            )));
-        }
-        let shape_ok = if spec.address.starts_with("serial:") {
-            crate::backend::parse_spec(&spec.address).is_some()
-        } else if spec.address.starts_with("tcp://") {
-            crate::backend::parse_tcp(&spec.address).is_some()
-        } else if spec.address.starts_with("rfc2217://") {
-            crate::backend::parse_rfc2217(&spec.address).is_some()
-        } else {
-            crate::backend::parse_labgrid(&spec.address).is_some()
-        };
-        if !shape_ok {
-            let form = match spec.address.split(':').next() {
-                Some("serial") => "serial:<path>[,baud=N]",
-                Some("tcp") => "tcp://<host>:<port>",
-                Some("rfc2217") => "rfc2217://<host>:<port>[,baud=N]",
-                _ => "labgrid:<place>",
-            };
-            return Err(OpenError::Usage(format!(
-                "bad target `{}`: write {form}",
-                spec.address
-            )));
         }
         if self.link_timeout.as_nanos() < 1_000_000 {
             return Err(OpenError::Usage(format!(
@@ -397,49 +404,50 @@ impl TargetArgs {
 
     /// Opens `spec`, already [`checked`](Self::check).
     pub fn open_spec(&self, spec: &TargetSpec) -> Result<Box<dyn Target>, OpenError> {
-        let a = &spec.address;
-        if spec.is_emu() {
-            let straps = self.straps_of(spec).map_err(OpenError::Usage)?;
-            let t = EmuTarget::new(straps, self.model())
-                .map_err(|e| OpenError::Usage(e.to_string()))?;
-            return Ok(Box::new(t));
+        // A serial server on the way (ser2net, labgrid's exporter) holds a
+        // partly filled 64-byte buffer for a millisecond or more; a reply
+        // padded to fill it goes at once (docs/bridge-protocol.md, LINK).
+        // On a serial port the padding would only cost time.
+        const NETWORK_PAD: u16 = 64;
+        match spec.parsed().map_err(OpenError::Usage)? {
+            Address::Emu => {
+                let straps = self.straps_of(spec).map_err(OpenError::Usage)?;
+                let t = EmuTarget::new(straps, self.model())
+                    .map_err(|e| OpenError::Usage(e.to_string()))?;
+                Ok(Box::new(t))
+            }
+            Address::Serial { path, baud } => {
+                let link = SerialLink::open(&path, baud).map_err(infra)?;
+                self.open_bridge(link, spec, 0)
+            }
+            Address::Tcp(addr) => {
+                let link = TcpLink::open(&addr).map_err(infra)?;
+                self.open_bridge(link, spec, NETWORK_PAD)
+            }
+            Address::Rfc2217 { addr, baud } => {
+                let link = Rfc2217Link::open(&addr, baud).map_err(infra)?;
+                self.open_bridge(link, spec, NETWORK_PAD)
+            }
+            Address::Labgrid(place) => {
+                let link = LabgridLink::open(place).map_err(OpenError::Infrastructure)?;
+                self.open_bridge(link, spec, NETWORK_PAD)
+            }
         }
-        let usage = || OpenError::Usage(format!("bad target `{a}`"));
-        if a.starts_with("serial:") {
-            let (path, baud) = crate::backend::parse_spec(a).ok_or_else(usage)?;
-            let link = SerialLink::open(&path, baud).map_err(infra)?;
-            return self.open_bridge(link, spec);
-        }
-        if a.starts_with("tcp://") {
-            let addr = crate::backend::parse_tcp(a).ok_or_else(usage)?;
-            let link = TcpLink::open(&addr).map_err(infra)?;
-            return self.open_bridge(link, spec);
-        }
-        if a.starts_with("rfc2217://") {
-            let (addr, baud) = crate::backend::parse_rfc2217(a).ok_or_else(usage)?;
-            let link = Rfc2217Link::open(&addr, baud).map_err(infra)?;
-            return self.open_bridge(link, spec);
-        }
-        let place = crate::backend::parse_labgrid(a).ok_or_else(usage)?;
-        let link = LabgridLink::open(place).map_err(OpenError::Infrastructure)?;
-        self.open_bridge(link, spec)
     }
 
     /// A bridge behind `link`: opened, health checked, and its straps
-    /// reconciled with those given.
+    /// reconciled with those given; `pad` is the reply padding unless the
+    /// spec gives its own.
     fn open_bridge<L: Link + 'static>(
         &self,
         link: L,
         spec: &TargetSpec,
+        pad: u16,
     ) -> Result<Box<dyn Target>, OpenError> {
-        // A serial server on the way (ser2net, labgrid's exporter) holds a
-        // partly filled 64-byte buffer for a millisecond or more; a reply
-        // padded to fill it goes at once (docs/bridge-protocol.md, LINK).
-        let network = !spec.address.starts_with("serial:");
         let opts = SerialOptions {
             reply_timeout: std::time::Duration::from_nanos(self.link_timeout.as_nanos()),
             retries: self.link_retries,
-            pad: spec.pad.unwrap_or(if network { 64 } else { 0 }),
+            pad: spec.pad.unwrap_or(pad),
             ..SerialOptions::default()
         };
         let t = SerialTarget::open(link, opts).map_err(infra)?;

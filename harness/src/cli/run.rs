@@ -218,10 +218,9 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     for spec in &specs {
         args.target.check(spec)?;
     }
-    let spread = match (specs.len(), args.each) {
-        (1, _) => "one",
-        (_, false) => "share",
-        (_, true) => "each",
+    let spread = match args.each && specs.len() > 1 {
+        true => Spread::Each,
+        false => Spread::Share,
     };
     // Every board at once: a farm's boards each take a while to answer.
     let opened: Vec<Result<Box<dyn Target>, OpenError>> = std::thread::scope(|scope| {
@@ -261,7 +260,7 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             }
         }
     }
-    let mut info = RunInfo::new(boards, spread);
+    let mut info = RunInfo::new(boards, spread.name(specs.len()));
     info.options = args.options(&tol);
     let not_reached =
         |s: &Scenario, why: &str| crate::runner::not_run(s, NotRun::Unreachable(why.to_string()));
@@ -281,8 +280,8 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         let mut results = Vec::new();
         let mut on = Vec::new();
         let each_board: Vec<Option<usize>> = match spread {
-            "each" => (0..specs.len()).map(Some).collect(),
-            _ => vec![(specs.len() == 1).then_some(0)],
+            Spread::Each => (0..specs.len()).map(Some).collect(),
+            Spread::Share => vec![(specs.len() == 1).then_some(0)],
         };
         for board in each_board {
             for s in &scenarios {
@@ -320,8 +319,8 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     };
     let repeat = args.repeat as usize;
     let runs = match spread {
-        "each" => targets.len(),
-        _ => 1,
+        Spread::Each => targets.len(),
+        Spread::Share => 1,
     };
     let progress = Progress::new(scenarios.len() * repeat * runs);
     let mut problems = Vec::new();
@@ -330,18 +329,13 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let stop = super::signals::stop_requested();
     let stopped = || stop.load(Ordering::Relaxed) || super::out::stdout_closed();
     let several = info.boards.len() > 1;
-    let board_dirs = spread == "each";
     let board_name = |t: Option<usize>| info.board_name(t.map(|t| reached[t])).to_string();
     let results = run_on_boards(
         &mut targets,
         &scenarios,
         repeat,
         opts,
-        if spread == "each" {
-            Spread::Each
-        } else {
-            Spread::Share
-        },
+        spread,
         stopped,
         |slot, t, r| {
             if let Some(dir) = &args.golden {
@@ -353,9 +347,9 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 progress.line(&verdict_line(r, several.then_some(name.as_str())));
             }
             if let (Some(dir), false) = (&args.artifacts, r.verdict.ok()) {
-                let dir = match board_dirs {
-                    true => dir.join(file_name(&name)),
-                    false => dir.clone(),
+                let dir = match spread {
+                    Spread::Each => dir.join(file_name(&name)),
+                    Spread::Share => dir.clone(),
                 };
                 if let Err(e) = save_artifacts(&dir, r, saved.entry(slot).or_default()) {
                     problems.push(e);
@@ -378,7 +372,7 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         .collect();
     let mut results: Vec<ScenarioResult> = results.into_iter().map(|r| r.result).collect();
     // With --each, a board that could not be reached runs nothing.
-    if spread == "each" {
+    if spread == Spread::Each {
         for (b, e) in &unreached {
             for _ in 0..repeat {
                 for s in &scenarios {

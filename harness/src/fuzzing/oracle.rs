@@ -228,14 +228,10 @@ impl Judge {
                 // had pulsed by then. A move's command may be written while
                 // the one before still runs (its `at` is the write), so a
                 // last move with no pulse yet may not have begun: no claim.
-                let Some(k) = rec.moves.iter().rposition(|m| m.at <= p.at) else {
+                let Some((m, runs)) = rec.move_written_by(p.at) else {
                     continue;
                 };
-                let m = &rec.moves[k];
-                let runs_end = rec.moves.get(k + 1).map_or(rec.runs.len(), |n| n.first_run);
-                let pulsed = rec.runs[m.first_run.min(runs_end)..runs_end]
-                    .first()
-                    .is_some_and(|r| r.start <= p.at);
+                let pulsed = runs.first().is_some_and(|r| r.start <= p.at);
                 if !pulsed {
                     continue;
                 }
@@ -292,13 +288,8 @@ impl Judge {
         match Command::decode(*command) {
             Command::Read(Register::RemainingPulses) if bytes.len() == 3 => {
                 let read = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], 0]);
-                let k = rec.moves.iter().rposition(|m| m.at <= at)?;
-                let m = &rec.moves[k];
-                let runs_end = rec.moves.get(k + 1).map_or(rec.runs.len(), |n| n.first_run);
-                let out: u64 = rec.runs[m.first_run.min(runs_end)..runs_end]
-                    .iter()
-                    .map(|r| u64::from(r.count_until(at)))
-                    .sum();
+                let (m, runs) = rec.move_written_by(at)?;
+                let out: u64 = runs.iter().map(|r| u64::from(r.count_until(at))).sum();
                 let steps = u64::from(m.steps);
                 let want = if out >= steps { 0 } else { steps - out - 1 };
                 (u64::from(read) != want).then(|| {

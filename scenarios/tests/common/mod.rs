@@ -104,3 +104,21 @@ impl Drop for BridgeSim {
         let _ = std::fs::remove_file(&self.path);
     }
 }
+
+/// The JSON Schema of the run record, `docs/run-record.schema.json`.
+pub fn run_record_schema() -> jsonschema::Validator {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/run-record.schema.json");
+    let schema: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).expect("schema")).expect("JSON");
+    jsonschema::validator_for(&schema).expect("a valid schema")
+}
+
+/// Fails with every schema error of `record`, each with where it is.
+pub fn check_record(validator: &jsonschema::Validator, record: &serde_json::Value) {
+    let errors: Vec<String> = validator
+        .iter_errors(record)
+        .map(|e| format!("{} at {}", e, e.instance_path))
+        .collect();
+    assert!(errors.is_empty(), "{errors:#?}");
+}
