@@ -1,11 +1,14 @@
 //! The fault matrix: each board fault of the catalogue (and the clean
-//! board) against the three checks a user has: the conformance suite, the
-//! golden trace comparison, and a bounded differential fuzz against the
-//! emulator. Which caught it, with what, after how much wall time.
+//! board) against the four checks a user has: the conformance suite, the
+//! golden trace comparison, a bounded differential fuzz against the
+//! emulator, and the fuzz oracle's invariants judged on the board's own
+//! replies. Which caught it, with what, after how much wall time.
 
 use crate::backend::{Target, TargetError};
 use crate::compare::{compare, Tolerances};
+use crate::emu::ModelConfig;
 use crate::fuzzing::differential::{self, DiffSettings};
+use crate::fuzzing::{lower, replay};
 use crate::runner::run_suite;
 use crate::scenario::{DriverOptions, Scenario, Verdict};
 use std::path::Path;
@@ -27,15 +30,22 @@ pub struct Row {
     pub suite: Option<Catch>,
     pub golden: Option<Catch>,
     pub fuzz: Option<Catch>,
+    pub oracle: Option<Catch>,
 }
 
 impl Row {
     pub fn caught(&self) -> bool {
-        self.suite.is_some() || self.golden.is_some() || self.fuzz.is_some()
+        self.suite.is_some()
+            || self.golden.is_some()
+            || self.fuzz.is_some()
+            || self.oracle.is_some()
     }
 }
 
-/// How much differential fuzzing a row gets.
+/// How much fuzzing a row gets: the differential fuzz runs `seeds`
+/// programs of `actions` actions against the emulator; the oracle replays
+/// the same programs as bus ops (as they ran on the clean emulator, waits
+/// included) and judges the board's replies by the invariants.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FuzzBudget {
     /// Seeds tried, from 0.
@@ -53,7 +63,7 @@ impl Default for FuzzBudget {
     }
 }
 
-/// Runs the three checks on `target`. A target failure (the link) is an
+/// Runs the four checks on `target`. A target failure (the link) is an
 /// error, not a catch.
 pub fn check_board(
     board: &str,
@@ -127,11 +137,25 @@ pub fn check_board(
             break;
         }
     }
+    let t2 = WallClock::now();
+    let mut oracle = None;
+    for seed in 0..budget.seeds {
+        let acts: Vec<_> = differential::program(seed).take(budget.actions).collect();
+        let (ops, _) = lower(&acts, ModelConfig::default());
+        if let Some(f) = replay::replay(target, &ops)? {
+            oracle = Some(Catch {
+                first: format!("seed {seed}: {}", f.violation),
+                after: t2.elapsed(),
+            });
+            break;
+        }
+    }
     Ok(Row {
         board: board.to_string(),
         suite: first_fail,
         golden: first_divergence,
         fuzz,
+        oracle,
     })
 }
 
@@ -142,7 +166,7 @@ pub fn render(rows: &[Row]) -> String {
         None => "-".into(),
     };
     let mut s = String::from(
-        "| board | conformance suite | golden traces | differential fuzz | verdict |\n|---|---:|---:|---:|---|\n",
+        "| board | conformance suite | golden traces | differential fuzz | fuzz oracle | verdict |\n|---|---:|---:|---:|---:|---|\n",
     );
     for r in rows {
         let verdict = match (r.board == "clean", r.caught()) {
@@ -152,11 +176,12 @@ pub fn render(rows: &[Row]) -> String {
             (false, false) => "MISSED",
         };
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {verdict} |\n",
+            "| {} | {} | {} | {} | {} | {verdict} |\n",
             r.board,
             cell(&r.suite),
             cell(&r.golden),
-            cell(&r.fuzz)
+            cell(&r.fuzz),
+            cell(&r.oracle)
         ));
     }
     s

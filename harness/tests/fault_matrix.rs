@@ -24,6 +24,20 @@ fn every_fault_is_caught_and_the_clean_board_is_not() {
     assert!(all_as_expected(&rows), "{table}");
     assert_eq!(rows.len(), CATALOGUE.len() + 1);
     assert!(!rows[0].caught(), "{table}");
+    // The fuzz oracle's invariants on the board's own replies catch the
+    // faults they exist for (docs/invariants.md).
+    let oracle = |name: &str| {
+        let row = rows.iter().find(|r| r.board == name).expect("a row");
+        row.oracle.as_ref().map(|c| c.first.clone())
+    };
+    for (fault, invariant) in [
+        ("int-ignores-mask", "int-mask"),
+        ("phase-step-skipped", "phase-pattern"),
+        ("remaining-off-by-one", "remaining-pulses"),
+    ] {
+        let first = oracle(fault).unwrap_or_else(|| panic!("{fault}: oracle missed it\n{table}"));
+        assert!(first.contains(invariant), "{fault}: {first}");
+    }
 }
 
 /// The regression scenario `to-scenario` made from the minimized finding

@@ -23,7 +23,7 @@ fn the_command_runs_over_the_pty() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(0), "{text}");
     assert!(
-        text.contains("| clean | - | - | - | no false alarm |"),
+        text.contains("| clean | - | - | - | - | no false alarm |"),
         "{text}"
     );
     assert!(text.contains("| dir-inverted |"), "{text}");

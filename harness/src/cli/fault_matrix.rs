@@ -1,5 +1,6 @@
 //! `ppmc fault-matrix`: every catalogued board fault against the suite,
-//! the golden traces and a bounded differential fuzz, over the pty.
+//! the golden traces, a bounded differential fuzz and the fuzz oracle,
+//! over the pty.
 
 use crate::backend::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use crate::bridge::sim::{LinkFaults, PtyBridge};
@@ -24,10 +25,11 @@ pub struct MatrixArgs {
     /// Run each board in process instead of behind `bridge-sim` on a pty.
     #[arg(long)]
     in_process: bool,
-    /// Differential fuzz seeds per board.
+    /// Fuzz seeds per board (the differential fuzz and the oracle run the
+    /// same programs).
     #[arg(long, default_value_t = 8)]
     fuzz_seeds: u64,
-    /// Actions per differential fuzz seed.
+    /// Actions per fuzz seed.
     #[arg(long, default_value_t = 300)]
     fuzz_actions: usize,
     /// Golden trace directory.
@@ -95,6 +97,7 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 ("suite", &r.suite),
                 ("golden", &r.golden),
                 ("fuzz", &r.fuzz),
+                ("oracle", &r.oracle),
             ] {
                 if let Some(c) = c {
                     text.push_str(&format!(
@@ -146,6 +149,7 @@ fn board_row(
                 }),
                 golden: None,
                 fuzz: None,
+                oracle: None,
             })
         }
         Err(e) => return Err(e.to_string()),

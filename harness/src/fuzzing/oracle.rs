@@ -4,9 +4,11 @@
 
 use super::bus::BusOp;
 use crate::emu::{Board, ChipError, ModelConfig};
-use crate::protocol::capture::{Pin, Record};
-use crate::protocol::{Command, FinishStatus, Register, Status, StatusField, Straps};
-use crate::time::Instant;
+use crate::protocol::capture::{MoveStart, Pin, PulseRun, Record};
+use crate::protocol::{
+    Command, FinishStatus, InitData, MoveKind, Register, Status, StatusField, Straps,
+};
+use crate::time::{Duration, Instant};
 use crate::trace::Trace;
 use std::fmt;
 
@@ -24,6 +26,8 @@ pub const INVARIANTS: &[(&str, &str)] = &[
     ("busy-covers-pulses", "3-1-1"),
     ("int-mask", "3-3-1"),
     ("int-release", "3-4-1"),
+    ("phase-pattern", "3-2-1"),
+    ("min-interval", "3-2-2"),
     ("time-monotonic", "model"),
     ("record-ordered", "model"),
     ("trace-round-trip", "trace format"),
@@ -68,6 +72,13 @@ pub fn check(ops: &[BusOp], cfg: ModelConfig) -> Result<Option<Violation>, ChipE
     Ok(c.finish().err())
 }
 
+/// A byte the host wrote, to the command or the data register.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Written {
+    Command(u8),
+    Data(u8),
+}
+
 /// A register read in progress, as the host sees it.
 #[derive(Debug)]
 struct Reading {
@@ -95,22 +106,32 @@ pub struct Seen {
 /// chip ([`Checker`]) and on any target's replies ([`super::replay`]).
 #[derive(Debug, Default)]
 pub struct Judge {
+    /// The board's straps: they fix the pulse clock (`min-interval`).
+    straps: Straps,
     ops: usize,
     last_at: Instant,
     reading: Option<Reading>,
     /// Moves ended (BUSY falls) when the finish status was last read.
     stops_at_finish_read: usize,
-    /// Each operation command the chip took: when it was written, and
-    /// whether it asks for the termination interrupt (bit 4 = 0).
-    operations: Vec<(Instant, bool)>,
-    /// The last operation command written, until the chip takes it (IBF
-    /// seen at 0) or a later write replaces it.
-    pending_operation: Option<(Instant, bool)>,
+    /// Every byte the chip took, with the time it was written: IBF was
+    /// seen at 0 after it and no later write replaced it.
+    taken: Vec<(Instant, Written)>,
+    /// The last byte written, until the chip takes it (IBF seen at 0) or a
+    /// later write replaces it (Section 3-1-1 (2)).
+    pending: Option<(Instant, Written)>,
     /// When each finish status read command (0x80) was written.
     finish_reads: Vec<Instant>,
 }
 
 impl Judge {
+    /// A judge for a board with these straps.
+    pub fn new(straps: Straps) -> Judge {
+        Judge {
+            straps,
+            ..Judge::default()
+        }
+    }
+
     /// Judges op number `self.ops` given what was seen of it and the
     /// capture, which may run past `seen.at` (it is looked at as of then).
     pub fn op(&mut self, op: BusOp, seen: Seen, rec: &Record) -> Result<(), Violation> {
@@ -121,21 +142,23 @@ impl Judge {
             op: i,
             detail,
         };
-        if seen.before.ibf() && matches!(op, BusOp::Command(_) | BusOp::Data(_)) {
+        if !seen.before.ibf() {
+            self.taken.extend(self.pending.take());
+        } else if matches!(op, BusOp::Command(_) | BusOp::Data(_)) {
             // The byte waiting may be the read command: it could be lost.
             if self.reading.as_ref().is_some_and(|r| !r.taken) {
                 self.reading = None;
             }
-            // So may an operation command.
-            self.pending_operation = None;
+            // Whatever it was, this write replaces it.
+            self.pending = None;
         }
         match (op, seen.value) {
+            (BusOp::Data(b), _) => self.pending = Some((seen.at, Written::Data(b))),
             (BusOp::Command(b), _) => {
-                match Command::decode(b) {
-                    Command::Move(m) => self.pending_operation = Some((seen.at, m.flags.interrupt)),
-                    Command::Read(Register::FinishStatus) => self.finish_reads.push(seen.at),
-                    _ => {}
+                if Command::decode(b) == Command::Read(Register::FinishStatus) {
+                    self.finish_reads.push(seen.at);
                 }
+                self.pending = Some((seen.at, Written::Command(b)));
                 self.reading = Some(Reading {
                     command: b,
                     taken: false,
@@ -175,7 +198,7 @@ impl Judge {
             r.taken |= !seen.after.ibf();
         }
         if !seen.after.ibf() {
-            self.operations.extend(self.pending_operation.take());
+            self.taken.extend(self.pending.take());
         }
         if seen.at < self.last_at {
             return Err(fail(
@@ -203,6 +226,12 @@ impl Judge {
         }
         if let Some((invariant, d)) = self.int_breaks(rec) {
             return Err(at_end(invariant, d));
+        }
+        if let Some(d) = phase_breaks(rec) {
+            return Err(at_end("phase-pattern", d));
+        }
+        if let Some(d) = self.interval_breaks(rec) {
+            return Err(at_end("min-interval", d));
         }
         if let Some(d) = trace_round_trip(rec) {
             return Err(at_end("trace-round-trip", d));
@@ -237,8 +266,14 @@ impl Judge {
                 }
                 // The operation command that started it: the last one
                 // written by its final byte.
-                let Some(&(_, interrupt)) = self.operations.iter().rev().find(|(t, _)| *t <= m.at)
-                else {
+                let interrupt = self.taken.iter().rev().find_map(|&(t, w)| match w {
+                    Written::Command(b) if t <= m.at => match Command::decode(b) {
+                        Command::Move(c) => Some(c.flags.interrupt),
+                        _ => None,
+                    },
+                    _ => None,
+                });
+                let Some(interrupt) = interrupt else {
                     continue;
                 };
                 if !interrupt {
@@ -277,6 +312,109 @@ impl Judge {
             }
         }
         None
+    }
+
+    /// Section 3-2-2 and Equations 3-1 to 3-4: within a move, no pulse
+    /// interval is shorter than the move's rate allows: the high speed
+    /// rate RH of an initialization for the ramped moves (acceleration only
+    /// ever lengthens it), the command's own rate byte for the constant
+    /// ones. The judge knows those from the bytes the chip took; since it
+    /// cannot see which initialization the chip kept (one refused with
+    /// error 1 or 5 keeps the one before), it takes the fastest of every
+    /// initialization taken before the move with rates the datasheet allows
+    /// (255 > RL > RH > 0), on the clock each selects. A move whose
+    /// command bytes it did not see all taken is not judged.
+    fn interval_breaks(&self, rec: &Record) -> Option<String> {
+        for (k, m) in rec.moves.iter().enumerate() {
+            let Some(params) = self.params_of(m) else {
+                continue;
+            };
+            let rates: Vec<u8> = match m.kind {
+                MoveKind::SingleStep => continue,
+                MoveKind::AccelDecel | MoveKind::ContinuousHigh => Vec::new(),
+                MoveKind::Constant | MoveKind::ContinuousConstant | MoveKind::OriginSearch => {
+                    vec![params[0]]
+                }
+            };
+            let bound = self
+                .inits_before(m.at)
+                .filter_map(|(clock, data)| {
+                    let tclock = self.straps.tclock(clock)?;
+                    let rate = rates.first().copied().unwrap_or(data.rh);
+                    Some(self.straps.pulse_interval(rate, tclock))
+                })
+                .min();
+            let Some(bound) = bound else {
+                continue;
+            };
+            let end = rec.moves.get(k + 1).map_or(rec.runs.len(), |n| n.first_run);
+            let runs = &rec.runs[m.first_run.min(end)..end];
+            if let Some(d) = shortest_interval_below(runs, bound) {
+                let rate = match rates.first() {
+                    Some(r) => format!("its rate byte {r}"),
+                    None => "the fastest high speed rate RH initialized".into(),
+                };
+                return Some(format!(
+                    "{d} in the {} move written at {}, shorter than the {bound} of {rate}",
+                    m.kind.name(),
+                    m.at
+                ));
+            }
+        }
+        None
+    }
+
+    /// The parameter bytes of move `m`: the data bytes the chip took after
+    /// the last command byte it took by `m.at`, if that command is the
+    /// move's and they are all there.
+    fn params_of(&self, m: &MoveStart) -> Option<Vec<u8>> {
+        let upto = self.taken.partition_point(|(t, _)| *t <= m.at);
+        let taken = &self.taken[..upto];
+        let k = taken
+            .iter()
+            .rposition(|(_, w)| matches!(w, Written::Command(_)))?;
+        let Written::Command(c) = taken[k].1 else {
+            return None;
+        };
+        let Command::Move(mc) = Command::decode(c) else {
+            return None;
+        };
+        let params: Vec<u8> = taken[k + 1..]
+            .iter()
+            .filter_map(|(_, w)| match w {
+                Written::Data(b) => Some(*b),
+                Written::Command(_) => None,
+            })
+            .collect();
+        (mc.kind == m.kind && params.len() == usize::from(mc.kind.param_count())).then_some(params)
+    }
+
+    /// Every initialization the chip took whose four data bytes were all
+    /// written by `at`, with rates Section 3-2-2 allows.
+    fn inits_before(
+        &self,
+        at: Instant,
+    ) -> impl Iterator<Item = (crate::protocol::ClockSource, InitData)> + '_ {
+        self.taken
+            .iter()
+            .enumerate()
+            .filter_map(move |(k, &(t, w))| {
+                let Written::Command(c) = w else {
+                    return None;
+                };
+                let Command::Init(ic) = Command::decode(c) else {
+                    return None;
+                };
+                let mut data = [0u8; 4];
+                for (i, slot) in data.iter_mut().enumerate() {
+                    match self.taken.get(k + 1 + i) {
+                        Some(&(t, Written::Data(b))) if t <= at => *slot = b,
+                        _ => return None,
+                    }
+                }
+                let d = InitData::from_bytes(data);
+                (t <= at && 0 < d.rh && d.rh < d.rl && d.rl < 255).then_some((ic.clock, d))
+            })
     }
 
     /// Checks a register read once all its bytes are in: the remaining
@@ -340,7 +478,7 @@ impl Checker {
     pub fn new(cfg: ModelConfig) -> Result<Checker, ChipError> {
         Ok(Checker {
             board: Board::new(Straps::default(), cfg)?,
-            judge: Judge::default(),
+            judge: Judge::new(Straps::default()),
         })
     }
 
@@ -448,6 +586,123 @@ fn pulse_outside_busy(rec: &Record) -> Option<String> {
                 r.last()
             ));
         }
+    }
+    None
+}
+
+/// The first interval among `runs` (one move's pulses) that is surely
+/// shorter than `bound`: within a run, its mean interval less what its
+/// jitter leaves unknown; between runs, the gap less both runs' jitter.
+fn shortest_interval_below(runs: &[PulseRun], bound: Duration) -> Option<String> {
+    let mut prev: Option<&PulseRun> = None;
+    for r in runs {
+        if let Some(p) = prev {
+            let gap = r.start.saturating_since(p.last());
+            if gap + p.jitter + r.jitter < bound {
+                return Some(format!(
+                    "pulses at {} and {}, {gap} apart,",
+                    p.last(),
+                    r.start
+                ));
+            }
+        }
+        if r.count > 1 {
+            let spread = if r.is_exact() {
+                Duration::ZERO
+            } else {
+                r.jitter.saturating_mul(2) + Duration::from_nanos(1)
+            };
+            if r.interval() + spread < bound {
+                return Some(format!(
+                    "{} pulses from {} every {}",
+                    r.count,
+                    r.start,
+                    r.interval()
+                ));
+            }
+        }
+        prev = Some(r);
+    }
+    None
+}
+
+/// Section 3-2-1 (the excitation sequences) and 3-3: each pulse of a move
+/// in phase excitation mode steps the phases once, in the move's
+/// direction, so a move starts where the one before left the phases: its
+/// start index is the last one's advanced by that move's pulses. Moves in
+/// POUT mode hold the phases. Where the phases were set outside stepping
+/// between two moves (initialization, excitation off), the move starts at
+/// the pattern last set, which must be a step of its sequence. No claim
+/// for a move written before the one before it put out its last pulse, or
+/// while the phases were still being set (a change after its command and
+/// before its first pulse), nor for the move after it.
+fn phase_breaks(rec: &Record) -> Option<String> {
+    let mut pins = rec.pins.iter().filter(|p| p.pin == Pin::Phases).peekable();
+    // Where the last stepping move left the phases: its winding, index and
+    // last pulse.
+    let mut left: Option<(crate::protocol::Winding, u32, Instant)> = None;
+    let mut set: Option<u8> = None;
+    for (k, m) in rec.moves.iter().enumerate() {
+        while let Some(p) = pins.next_if(|p| p.at <= m.at) {
+            set = Some(p.value);
+            left = None;
+        }
+        let end = rec.moves.get(k + 1).map_or(rec.runs.len(), |n| n.first_run);
+        let runs = &rec.runs[m.first_run.min(end)..end];
+        let horizon = runs.first().map_or(m.at, |r| r.start);
+        let mut unsettled = false;
+        while let Some(p) = pins.next_if(|p| p.at <= horizon) {
+            set = Some(p.value);
+            unsettled = true;
+        }
+        if let Some(r) = runs.iter().find(|r| r.dir != m.dir) {
+            return Some(format!(
+                "the {} move written at {} is commanded {}, but its pulses from {} go {}",
+                m.kind.name(),
+                m.at,
+                m.dir.name(),
+                r.start,
+                r.dir.name()
+            ));
+        }
+        let Some(w) = m.winding else {
+            continue; // POUT mode: the phases hold
+        };
+        if unsettled {
+            left = None;
+            set = None;
+            continue;
+        }
+        let start = m.phase_index % w.steps_per_cycle();
+        if let Some(v) = set.take().filter(|v| *v != 0) {
+            if w.pattern(start) != v {
+                let legal = (0..w.steps_per_cycle()).any(|i| w.pattern(i) == v);
+                return Some(format!(
+                    "the {} move written at {} starts at step {start} of {} ({:05b}), but the phases were last set to {v:05b}{}",
+                    m.kind.name(),
+                    m.at,
+                    w.name(),
+                    w.pattern(start),
+                    if legal { "" } else { ", which is no step of that sequence" }
+                ));
+            }
+        } else if let Some((_, index, last)) = left.filter(|(lw, ..)| *lw == w) {
+            if last <= m.at && start != index {
+                return Some(format!(
+                    "the {} move written at {} starts at step {start} of {}, but the pulses before it left the phases at step {index}",
+                    m.kind.name(),
+                    m.at,
+                    w.name()
+                ));
+            }
+        }
+        let mut index = start;
+        let mut last = m.at;
+        for r in runs {
+            index = w.advance(index, r.dir, u64::from(r.count));
+            last = r.last();
+        }
+        left = Some((w, index, last));
     }
     None
 }
@@ -646,6 +901,141 @@ mod tests {
         assert!(
             v.detail.contains("since the last release at 5.000us"),
             "{v}"
+        );
+    }
+
+    /// `init_and_step`, then a second single step.
+    fn init_and_two_steps() -> Vec<BusOp> {
+        let mut ops = init_and_step();
+        ops.extend([Command(0x4A), Advance(Duration::from_millis(5)), ReadStatus]);
+        ops
+    }
+
+    /// Section 3-2-1: each pulse steps the phases once, so the second step
+    /// (0x4A: CCW, 1-2 phase on a 4-phase motor, 8 steps a cycle) starts
+    /// where the first left them, one step back from 0. A board whose phases miss the
+    /// first step of every move breaks `phase-pattern` at the second.
+    #[test]
+    fn a_skipped_phase_step_is_caught_at_the_next_move() {
+        assert_eq!(
+            check(&init_and_two_steps(), ModelConfig::default()).expect("chip"),
+            None
+        );
+        let v = check(&init_and_two_steps(), faulty("phase-step-skipped"))
+            .expect("chip")
+            .expect("a break");
+        assert_eq!(v.invariant, "phase-pattern", "{v}");
+        assert!(
+            v.detail.contains("starts at step 0 of 4ph-12")
+                && v.detail.contains("left the phases at step 7"),
+            "{v}"
+        );
+        // One move alone shows nothing: the skip shows where the next
+        // move starts.
+        assert_eq!(
+            check(&init_and_step(), faulty("phase-step-skipped")).expect("chip"),
+            None
+        );
+    }
+
+    /// Section 3-2-1: a move starts at the pattern the phases were set to;
+    /// a pattern of no step of the sequence breaks `phase-pattern`.
+    #[test]
+    fn phases_set_to_no_step_of_the_sequence_are_caught() {
+        use crate::protocol::{Direction, Excitation, MotorType, Winding};
+        let w = Winding {
+            motor: MotorType::FourPhase,
+            excitation: Excitation::TwoPhase,
+        };
+        let mut rec = Record::default();
+        rec.pin(Instant::from_nanos(1_000), Pin::Phases, 0b11000);
+        rec.moves.push(MoveStart {
+            at: Instant::from_nanos(5_000),
+            kind: MoveKind::SingleStep,
+            dir: Direction::Cw,
+            pout: false,
+            steps: 1,
+            first_run: 0,
+            phase_index: 0,
+            winding: Some(w),
+        });
+        assert_eq!(phase_breaks(&rec), None);
+        rec.pins[0].value = 0b10100;
+        let d = phase_breaks(&rec).expect("a break");
+        assert!(d.contains("no step of that sequence"), "{d}");
+    }
+
+    /// Section 3-2-2: init RL 100, RH 20 on the internal 2 us clock (a
+    /// high speed interval of 21 x 2 us = 42 us), then an acceleration/
+    /// deceleration move; a run of pulses 40 us apart breaks
+    /// `min-interval`, 42 us apart keeps it.
+    #[test]
+    fn pulses_faster_than_the_high_speed_rate_are_caught() {
+        use crate::protocol::{Command as C, Direction, MoveCommand};
+        let t = |us: u64| Instant::from_nanos(us * 1_000);
+        let accel = C::Move(MoveCommand::new(MoveKind::AccelDecel, Direction::Cw, false)).encode();
+        let taken = [
+            (t(0), Written::Command(0x06)),
+            (t(1), Written::Data(100)),
+            (t(2), Written::Data(20)),
+            (t(3), Written::Data(100)),
+            (t(4), Written::Data(0)),
+            (t(500), Written::Command(accel)),
+            (t(501), Written::Data(10)),
+            (t(502), Written::Data(0)),
+            (t(503), Written::Data(0)),
+        ];
+        let judge = Judge {
+            taken: taken.to_vec(),
+            ..Judge::new(Straps::default())
+        };
+        let record = |interval_us| {
+            let mut rec = Record::default();
+            rec.pin(t(490), Pin::Busy, 1);
+            rec.moves.push(MoveStart {
+                at: t(503),
+                kind: MoveKind::AccelDecel,
+                dir: Direction::Cw,
+                pout: true,
+                steps: 11,
+                first_run: 0,
+                phase_index: 0,
+                winding: None,
+            });
+            rec.push_pulses(
+                t(600),
+                Duration::from_micros(interval_us),
+                11,
+                Direction::Cw,
+                true,
+            );
+            rec.pin(t(2_000), Pin::Busy, 0);
+            rec
+        };
+        assert_eq!(judge.finish(&record(42)), Ok(()));
+        let v = judge.finish(&record(40)).expect_err("a break");
+        assert_eq!(v.invariant, "min-interval", "{v}");
+        assert!(v.detail.contains("every 40.000us"), "{v}");
+        // An initialization with RH = 0 is refused (error 5): it does not
+        // lower the bound.
+        let mut bad = taken.to_vec();
+        bad.splice(
+            5..5,
+            [
+                (t(10), Written::Command(0x06)),
+                (t(11), Written::Data(100)),
+                (t(12), Written::Data(0)),
+                (t(13), Written::Data(100)),
+                (t(14), Written::Data(0)),
+            ],
+        );
+        let judge = Judge {
+            taken: bad,
+            ..Judge::new(Straps::default())
+        };
+        assert_eq!(
+            judge.finish(&record(40)).map_err(|v| v.invariant),
+            Err("min-interval")
         );
     }
 

@@ -7,7 +7,7 @@
 use super::bus::BusOp;
 use super::oracle::{self, Judge, Seen, Violation};
 use crate::backend::{Op, Reply, Target, TargetError};
-use crate::protocol::Record;
+use crate::protocol::{Record, Straps};
 use crate::scenario::{Driver, Failure, HarnessError, Outcome, Stop};
 use crate::trace::BusEvent;
 
@@ -36,7 +36,7 @@ pub fn regression(d: &mut Driver, ops: &[BusOp]) -> Outcome {
         }
     }
     let capture = d.capture()?.clone();
-    match judge(ops, &replies, &capture) {
+    match judge(ops, &replies, &capture, d.straps()) {
         Err(e) => Err(Stop::Error(HarnessError::Reply(e))),
         Ok(None) => Ok(()),
         Ok(Some(f)) => {
@@ -88,9 +88,15 @@ pub struct Found {
     pub at: crate::time::Instant,
 }
 
-/// Judges the replies to [`probed_ops`]`(ops)` and the capture after them.
+/// Judges the replies to [`probed_ops`]`(ops)` and the capture after them,
+/// on a board with these straps.
 /// `Err` when the replies do not fit the ops (a target bug, not a finding).
-pub fn judge(ops: &[BusOp], replies: &[Reply], capture: &Record) -> Result<Option<Found>, String> {
+pub fn judge(
+    ops: &[BusOp],
+    replies: &[Reply],
+    capture: &Record,
+    straps: Straps,
+) -> Result<Option<Found>, String> {
     if replies.len() != ops.len() * OPS_PER_BUS_OP {
         return Err(format!(
             "the target answered {} of {} operations",
@@ -102,7 +108,7 @@ pub fn judge(ops: &[BusOp], replies: &[Reply], capture: &Record) -> Result<Optio
         Reply::Status { status, .. } => Ok(status),
         other => Err(format!("expected a status reply, got {other}")),
     };
-    let mut judge = Judge::default();
+    let mut judge = Judge::new(straps);
     let mut last_at = crate::time::Instant::ZERO;
     for (op, r) in ops.iter().zip(replies.chunks(OPS_PER_BUS_OP)) {
         let value = match (op, &r[1]) {
@@ -137,6 +143,6 @@ pub fn judge(ops: &[BusOp], replies: &[Reply], capture: &Record) -> Result<Optio
 pub fn replay(target: &mut dyn Target, ops: &[BusOp]) -> Result<Option<Found>, TargetError> {
     target.execute(&[Op::Reset])?;
     let (replies, capture) = target.execute_then_capture(&probed_ops(ops))?;
-    judge(ops, &replies, &capture)
+    judge(ops, &replies, &capture, target.straps())
         .map_err(|message| TargetError::new(crate::backend::TargetErrorKind::Other, message))
 }
