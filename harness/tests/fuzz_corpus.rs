@@ -192,7 +192,7 @@ fn typed_actions_corpus_replays() {
 #[test]
 fn trace_text_corpus_replays() {
     let n = replay("trace_text", ppmc::fuzzing::trace_text);
-    assert!(n >= 8, "the seed corpus is there ({n} inputs)");
+    assert!(n >= 14, "the seed corpus is there ({n} inputs)");
 }
 
 /// The typed seeds reach the deep states the target exists for: moves
@@ -224,7 +224,9 @@ fn typed_seeds_move_the_motor() {
 
 /// Writes the seed corpus of `typed_actions` (deterministic: seeded random
 /// bytes, each decoding to a few dozen actions) and of `trace_text` (a few
-/// suite traces). Run with `cargo test --test fuzz_corpus -- --ignored`.
+/// suite traces as text, and a few scenarios' bus traffic as ops, whose
+/// emulator traces it round-trips). Run with `cargo test --test
+/// fuzz_corpus -- --ignored`.
 #[test]
 #[ignore]
 fn write_typed_and_trace_seeds() {
@@ -242,5 +244,13 @@ fn write_typed_and_trace_seeds() {
     fs::create_dir_all(&traces).expect("corpus dir");
     for (name, trace) in suite_traces().into_iter().step_by(10) {
         fs::write(traces.join(format!("{name}.trace")), trace.render()).expect("seed written");
+    }
+    for (name, trace) in suite_traces().into_iter().skip(5).step_by(16) {
+        let ops = ppmc::fuzzing::bus::from_trace(&trace);
+        fs::write(
+            traces.join(format!("ops-{name}.bin")),
+            ppmc::fuzzing::bus::encode(&ops),
+        )
+        .expect("seed written");
     }
 }

@@ -38,7 +38,11 @@ const FILES: [&str; 12] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 17] = [
+const ELSEWHERE: [(&str, &str); 18] = [
+    (
+        "scripts/fuzz-figures",
+        "in .ci/run (the fuzz step runs every row, 1 s each; it needs nightly and cargo-fuzz)",
+    ),
     (
         "scripts/network-figures",
         "in scenarios/tests/cli_network.rs (every row once, the debug build)",

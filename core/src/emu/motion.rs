@@ -16,7 +16,8 @@
 //! deceleration started early (stop command or high-speed limit) from speed
 //! `c` at pulse `j0` caps the index at `c - 1 - (j - j0)`. Because the plan
 //! is a closed formula, a stretch at one period is emitted in O(1) whatever
-//! its length.
+//! its length, and the acceleration periods are computed as pulses need
+//! them, not as a table at each initialization.
 
 use super::config::AccelCurve;
 use crate::protocol::{Direction, MoveKind, StopCause, Straps};
@@ -24,52 +25,143 @@ use crate::time::{Duration, Instant};
 use alloc::sync::Arc;
 use alloc::vec::Vec;
 
+/// The most ramp pulses one stretch covers: finding a stretch's end costs
+/// a step per pulse, so a stretch cut short by the next timer (a host
+/// operation, an input) wastes at most this much.
+const RAMP_STRETCH_MAX: u32 = 64;
+
 /// The periods a move is built from.
 #[derive(Debug, Clone)]
 pub(crate) enum Profile {
     /// One period for every pulse (constant-speed operations, single step).
     Constant { interval: Duration },
-    /// `table[v]` for speed index `v < PA - 1`, `cruise` at `v = PA - 1`.
-    Ramped {
-        table: Arc<[Duration]>,
-        cruise: Duration,
-    },
+    /// `ramp.period(v)` for speed index `v < PA - 1`, `cruise` at
+    /// `v = PA - 1`.
+    Ramped { ramp: Ramp, cruise: Duration },
 }
 
-/// Builds the acceleration table: the periods between the PA acceleration
-/// pulses (PA - 1 of them), from the start-up rate RL towards the high speed
-/// rate RH, on the chip's rate grid `(R + 1) x Tclock (+ 7.5 us)`.
-pub(crate) fn accel_table(
+/// The periods between the PA acceleration pulses (PA - 1 of them),
+/// computed when a move first needs them ([`Ramp::cover`]) and kept for the
+/// moves after it: an initialization costs nothing per acceleration pulse,
+/// and a short move only the periods it can reach.
+#[derive(Debug, Clone)]
+pub(crate) struct Ramp {
+    /// Where the periods come from (`None`: given outright, in tests).
+    accel: Option<AccelRamp>,
+    /// The periods of indices `0..table.len()`.
+    table: Arc<[Duration]>,
+    len: u32,
+}
+
+impl Ramp {
+    pub(crate) fn new(accel: AccelRamp) -> Ramp {
+        Ramp {
+            len: accel.len(),
+            accel: Some(accel),
+            table: Arc::from(Vec::new()),
+        }
+    }
+
+    /// Every period given (the motion tests).
+    #[cfg(test)]
+    fn table(periods: Vec<Duration>) -> Ramp {
+        Ramp {
+            len: periods.len() as u32,
+            accel: None,
+            table: periods.into(),
+        }
+    }
+
+    /// Computes the periods of indices below `need` not computed yet.
+    pub(crate) fn cover(&mut self, need: u32) {
+        let need = need.min(self.len);
+        let have = self.table.len() as u32;
+        if let Some(a) = self.accel.filter(|_| have < need) {
+            let mut t = self.table.to_vec();
+            t.extend((have..need).map(|v| a.period(v)));
+            self.table = t.into();
+        }
+    }
+
+    fn len(&self) -> u32 {
+        self.len
+    }
+
+    fn period(&self, v: u32) -> Option<Duration> {
+        if v >= self.len {
+            return None;
+        }
+        match (self.table.get(v as usize), self.accel) {
+            (Some(d), _) => Some(*d),
+            (None, Some(a)) => Some(a.period(v)),
+            (None, None) => None,
+        }
+    }
+}
+
+/// The acceleration from the start-up rate RL towards the high speed rate
+/// RH, on the chip's rate grid `(R + 1) x Tclock (+ 7.5 us)`: the period
+/// after acceleration pulse `v` (of PA - 1) by [`AccelRamp::period`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AccelRamp {
     curve: AccelCurve,
-    straps: &Straps,
+    straps: Straps,
     tclock: Duration,
     rl: u8,
     rh: u8,
-    pa: u16,
-) -> Vec<Duration> {
-    let period = |r: u8| straps.pulse_interval(r, tclock);
-    let steps = pa.saturating_sub(1).max(1);
-    let pa_f = f64::from(steps);
-    (0..steps)
-        .map(|v| {
-            let r = match curve {
-                AccelCurve::LinearSpeed => {
-                    let sl = 1e9 / period(rl).as_nanos() as f64;
-                    let sh = 1e9 / period(rh).as_nanos() as f64;
-                    let speed = sl + (sh - sl) * f64::from(v) / pa_f;
-                    let target_ns = 1e9 / speed;
-                    let off = straps.vsel_offset(tclock).as_nanos() as f64;
-                    let r = libm::round((target_ns - off) / tclock.as_nanos() as f64) - 1.0;
-                    r.clamp(f64::from(rh), f64::from(rl)) as u8
-                }
-                AccelCurve::LinearRate => {
-                    let drop = libm::round(f64::from(rl - rh) * f64::from(v) / pa_f) as u8;
-                    rl - drop
-                }
-            };
-            period(r)
-        })
-        .collect()
+    steps: u16,
+    /// Start-up and high speed in pulses per second, and VSEL low's term
+    /// in nanoseconds (the linear-speed curve's constants).
+    sl: f64,
+    sh: f64,
+    off: f64,
+}
+
+impl AccelRamp {
+    pub(crate) fn new(
+        curve: AccelCurve,
+        straps: &Straps,
+        tclock: Duration,
+        rl: u8,
+        rh: u8,
+        pa: u16,
+    ) -> AccelRamp {
+        let period = |r: u8| straps.pulse_interval(r, tclock);
+        AccelRamp {
+            curve,
+            straps: *straps,
+            tclock,
+            rl,
+            rh,
+            steps: pa.saturating_sub(1).max(1),
+            sl: 1e9 / period(rl).as_nanos() as f64,
+            sh: 1e9 / period(rh).as_nanos() as f64,
+            off: straps.vsel_offset(tclock).as_nanos() as f64,
+        }
+    }
+
+    fn len(&self) -> u32 {
+        u32::from(self.steps)
+    }
+
+    /// The period after acceleration pulse `v` (`v < PA - 1`).
+    fn period(&self, v: u32) -> Duration {
+        let pa_f = f64::from(self.steps);
+        let (rl, rh) = (self.rl, self.rh);
+        let r = match self.curve {
+            AccelCurve::LinearSpeed => {
+                let speed = self.sl + (self.sh - self.sl) * f64::from(v) / pa_f;
+                let target_ns = 1e9 / speed;
+                let r = libm::round((target_ns - self.off) / self.tclock.as_nanos() as f64) - 1.0;
+                r.clamp(f64::from(rh), f64::from(rl)) as u8
+            }
+            AccelCurve::LinearRate => {
+                let drop = libm::round(f64::from(rl - rh) * f64::from(v) / pa_f) as u8;
+                rl - drop
+            }
+        };
+        self.straps.pulse_interval(r, self.tclock)
+    }
 }
 
 /// One move in progress, from the moment its final byte was accepted until
@@ -140,7 +232,7 @@ impl Motion {
     fn cruise_index(&self) -> u32 {
         match &self.profile {
             Profile::Constant { .. } => 0,
-            Profile::Ramped { table, .. } => table.len() as u32,
+            Profile::Ramped { ramp, .. } => ramp.len(),
         }
     }
 
@@ -162,10 +254,7 @@ impl Motion {
     pub fn interval_after(&self, j: u32) -> Duration {
         match &self.profile {
             Profile::Constant { interval } => *interval,
-            Profile::Ramped { table, cruise } => {
-                let v = self.speed(j) as usize;
-                table.get(v).copied().unwrap_or(*cruise)
-            }
+            Profile::Ramped { ramp, cruise } => ramp.period(self.speed(j)).unwrap_or(*cruise),
         }
     }
 
@@ -197,10 +286,69 @@ impl Motion {
                     let run = (c_end + 2 - i64::from(j)).clamp(1, i64::from(left));
                     (*cruise, run as u32)
                 } else {
-                    (self.interval_after(j), 1)
+                    self.ramp_stretch(j, left)
                 }
             }
         }
+    }
+
+    /// The ramp pulses from `j` on that are one period apart: the period
+    /// after a speed index falls as the index grows (the rate grid is
+    /// coarser than the ramp), so the indices sharing pulse `j`'s period
+    /// are a range, found by galloping out from `j`'s; the pulses follow
+    /// while their speed index stays in it, [`RAMP_STRETCH_MAX`] at most.
+    fn ramp_stretch(&self, j: u32, left: u32) -> (Duration, u32) {
+        let d = self.interval_after(j);
+        let Profile::Ramped { ramp, cruise } = &self.profile else {
+            return (d, left);
+        };
+        // Ramp indices only: cruise (index PA) is a stretch of its own.
+        let top = self.cruise_index().saturating_sub(1);
+        let per = |v: u32| ramp.period(v).unwrap_or(*cruise);
+        let v0 = self.speed(j);
+        if v0 > top {
+            return (d, 1);
+        }
+        // Largest index up from v0 (at most top), smallest down, with d.
+        let gallop = |up: bool| {
+            let (mut good, mut step) = (0u32, 1u32);
+            let room = (if up { top - v0 } else { v0 }).min(RAMP_STRETCH_MAX);
+            loop {
+                let probe = good.saturating_add(step).min(room);
+                let v = if up { v0 + probe } else { v0 - probe };
+                if probe == good || per(v) != d {
+                    break;
+                }
+                good = probe;
+                step = step.saturating_mul(2);
+            }
+            // Narrow between good (d) and good + step (not d, or past room).
+            let mut bad = good.saturating_add(step).min(room + 1);
+            while bad - good > 1 {
+                let mid = good + (bad - good) / 2;
+                let v = if up { v0 + mid } else { v0 - mid };
+                if per(v) == d {
+                    good = mid;
+                } else {
+                    bad = mid;
+                }
+            }
+            good
+        };
+        let (hi, lo) = (v0 + gallop(true), v0 - gallop(false));
+        let most = left.min(RAMP_STRETCH_MAX);
+        let mut count = 1;
+        while count < most && (lo..=hi).contains(&self.speed(j + count - 1)) {
+            count += 1;
+        }
+        (d, count)
+    }
+
+    /// Whether the next stretch is on the ramp (each pulse recorded as if
+    /// put out alone), not at cruise or a constant rate.
+    pub fn on_ramp(&self) -> bool {
+        let j = self.emitted;
+        self.ramped() && !(self.end - j > 1 && self.speed(j) == self.cruise_index())
     }
 
     fn ramped(&self) -> bool {
@@ -251,6 +399,7 @@ impl Motion {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use alloc::vec::Vec;
 
     fn ramped(total: u32, pa: usize) -> Motion {
         let table: Vec<Duration> = (0..pa)
@@ -266,7 +415,7 @@ mod tests {
             total,
             Some(Instant::ZERO),
             Profile::Ramped {
-                table: table.into(),
+                ramp: Ramp::table(table),
                 cruise: Duration::from_micros(42),
             },
         )
@@ -298,8 +447,56 @@ mod tests {
         m.emitted = 4;
         // Pulses 4..=995 are 42 us apart: 992 pulses.
         assert_eq!(m.constant_stretch(), (Duration::from_micros(42), 992));
+        // On the ramp, pulse 2 and the pulse 198 us after it: the period
+        // after pulse 3 is 197 us.
         m.emitted = 2;
-        assert_eq!(m.constant_stretch(), (Duration::from_micros(198), 1));
+        assert_eq!(m.constant_stretch(), (Duration::from_micros(198), 2));
+    }
+
+    /// Ramp periods on the coarse rate grid repeat: the pulses one period
+    /// apart are one stretch, on the way up and on the way down, and the
+    /// stretches put out the same pulses as one pulse at a time.
+    #[test]
+    fn equal_ramp_periods_are_one_stretch() {
+        let table = [200, 200, 200, 199, 199, 150].map(Duration::from_micros);
+        let mut m = Motion::new(
+            1,
+            MoveKind::AccelDecel,
+            Direction::Cw,
+            false,
+            true,
+            Instant::ZERO,
+            20,
+            Some(Instant::ZERO),
+            Profile::Ramped {
+                ramp: Ramp::table(table.to_vec()),
+                cruise: Duration::from_micros(42),
+            },
+        );
+        // Pulses 0..=3 are 200 us apart; the period after pulse 3 is 199 us.
+        assert_eq!(m.constant_stretch(), (Duration::from_micros(200), 4));
+        // Pulses 16..=19 on the way down: after 16 (index 2) 200 us, the
+        // rest too.
+        m.emitted = 16;
+        assert_eq!(m.constant_stretch(), (Duration::from_micros(200), 4));
+        let one_by_one = intervals(&m.clone());
+        let mut times = Vec::new();
+        let mut t = Instant::ZERO;
+        m.emitted = 0;
+        while m.emitted < m.end {
+            let (d, n) = m.constant_stretch();
+            for _ in 0..n {
+                times.push(t);
+                t += d;
+            }
+            m.emitted += n;
+            t = *times.last().expect("a pulse") + m.interval_after(m.emitted - 1);
+        }
+        let gaps: Vec<u64> = times
+            .windows(2)
+            .map(|w| w[1].saturating_since(w[0]).as_nanos() / 1_000)
+            .collect();
+        assert_eq!(gaps, one_by_one);
     }
 
     #[test]

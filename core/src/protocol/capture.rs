@@ -303,6 +303,39 @@ impl Record {
         self.runs.push(run);
     }
 
+    /// Appends `count` pulses spaced exactly `interval` apart as
+    /// [`Record::push_pulses`] would record them pushed one at a time: the
+    /// first may join the previous run, the rest join it too if they keep
+    /// its spacing, else they are a run of their own. Costs O(1).
+    pub fn push_pulses_singly(
+        &mut self,
+        start: Instant,
+        interval: Duration,
+        count: u32,
+        dir: Direction,
+        new_move: bool,
+    ) {
+        if count == 0 {
+            return;
+        }
+        self.push_pulses(start, interval, 1, dir, new_move);
+        if count == 1 {
+            return;
+        }
+        let rest = count - 1;
+        if let Some(last) = self.runs.last_mut() {
+            let joins = last.count == 1 || last.interval() == interval;
+            if joins && interval > Duration::ZERO && last.is_exact() {
+                last.count += rest;
+                last.span += interval.saturating_mul(u64::from(rest));
+                return;
+            }
+        }
+        // The second pulse starts a run; every later one keeps its spacing.
+        self.runs
+            .push(PulseRun::exact(start + interval, interval, rest, dir));
+    }
+
     pub fn pin(&mut self, at: Instant, pin: Pin, value: u8) {
         self.pins.push(PinEvent { at, pin, value });
     }
@@ -475,6 +508,35 @@ mod tests {
 
     fn t(us: u64) -> Instant {
         Instant::from_nanos(us * 1_000)
+    }
+
+    proptest::proptest! {
+        /// `push_pulses_singly` records what pushing the pulses one at a
+        /// time records, whatever runs came before.
+        #[test]
+        fn pushing_singly_is_one_at_a_time(
+            before in proptest::collection::vec((1u64..5, 1u32..4), 0..4),
+            gap in 1u64..5,
+            interval in 1u64..5,
+            count in 1u32..6,
+            new_move: bool,
+        ) {
+            let mut rec = Record::default();
+            let mut at = 0;
+            for (i, (dt, n)) in before.iter().enumerate() {
+                at += 10;
+                rec.push_pulses(t(at), Duration::from_micros(*dt), *n, Direction::Cw, i == 0);
+                at += dt * u64::from(n - 1);
+            }
+            let start = t(at + gap);
+            let d = Duration::from_micros(interval);
+            let mut one_by_one = rec.clone();
+            for k in 0..count {
+                one_by_one.push_pulses(start + d.saturating_mul(u64::from(k)), d, 1, Direction::Cw, new_move && k == 0);
+            }
+            rec.push_pulses_singly(start, d, count, Direction::Cw, new_move);
+            proptest::prop_assert_eq!(rec, one_by_one);
+        }
     }
 
     #[test]

@@ -105,6 +105,19 @@ impl fmt::Display for BusOp {
     }
 }
 
+/// Applies one op to a chip on its board; the byte a read returned.
+pub fn apply(chip: &mut crate::emu::Board, op: BusOp) -> Option<u8> {
+    match op {
+        BusOp::Command(b) => chip.write_command(b),
+        BusOp::Data(b) => chip.write_data(b),
+        BusOp::ReadStatus => return Some(chip.read_status().0),
+        BusOp::ReadData => return Some(chip.read_data()),
+        BusOp::Input { input, asserted } => chip.set_input(input, asserted),
+        BusOp::Advance(d) => chip.advance_to(chip.now() + d),
+    }
+    None
+}
+
 /// Advances that add up to `d` (to the microsecond), each one that
 /// [`BusOp::encode`] holds exactly.
 pub fn advances(d: Duration) -> Vec<BusOp> {

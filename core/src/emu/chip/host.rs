@@ -219,16 +219,15 @@ impl Chip {
             self.out_winding = self.winding;
         }
         let ramp = self.straps.tclock(cmd.clock).map(|tclock| {
-            let table = accel_table(
-                self.cfg.accel_curve,
-                &self.straps,
-                tclock,
-                data.rl,
-                data.rh,
-                data.pa,
-            );
             (
-                Arc::from(table),
+                Ramp::new(AccelRamp::new(
+                    self.cfg.accel_curve,
+                    &self.straps,
+                    tclock,
+                    data.rl,
+                    data.rh,
+                    data.pa,
+                )),
                 self.straps.pulse_interval(data.rh, tclock),
             )
         });

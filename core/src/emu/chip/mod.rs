@@ -15,7 +15,7 @@
 //! operation.
 
 use super::config::{ConfigError, ModelConfig};
-use super::motion::{accel_table, Motion, Profile};
+use super::motion::{AccelRamp, Motion, Profile, Ramp};
 use crate::protocol::capture::{MoveStart, Pin, Pins, Record};
 use crate::protocol::{
     AuxInputStatus, ClockSource, Command, Direction, ErrorCode, FinishStatus, InitCommand,
@@ -24,7 +24,6 @@ use crate::protocol::{
 };
 use crate::time::{Duration, Instant};
 use alloc::collections::VecDeque;
-use alloc::sync::Arc;
 use alloc::vec;
 use alloc::vec::Vec;
 
@@ -77,8 +76,8 @@ struct Setup {
     clock: ClockSource,
     stop_switching: bool,
     data: InitData,
-    /// Acceleration table and high-speed period, `None` without a clock.
-    ramp: Option<(Arc<[Duration]>, Duration)>,
+    /// Acceleration periods and high-speed period, `None` without a clock.
+    ramp: Option<(Ramp, Duration)>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

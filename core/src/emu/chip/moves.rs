@@ -8,10 +8,6 @@ impl Chip {
     // ----- moves (Section 3-3) --------------------------------------------
 
     pub(super) fn start_move(&mut self, cmd: MoveCommand, params: [u8; 4], base: Instant) {
-        let Some(setup) = self.setup.clone() else {
-            self.set_error(ErrorCode::NotInitialized);
-            return;
-        };
         let kind = cmd.kind;
         let total = match kind {
             MoveKind::SingleStep => 1,
@@ -21,9 +17,19 @@ impl Chip {
             MoveKind::Constant => PulseCount::from_bytes([params[1], params[2], params[3]]).steps(),
             _ => PulseCount::MAX.steps(),
         };
+        // The speed index of a move of N pulses stays below N / 2 + 1.
+        if let Some((ramp, _)) = self.setup.as_mut().and_then(|s| s.ramp.as_mut()) {
+            if kind.ramped() {
+                ramp.cover((total / 2).saturating_add(1));
+            }
+        }
+        let Some(setup) = self.setup.clone() else {
+            self.set_error(ErrorCode::NotInitialized);
+            return;
+        };
         let tclock = self.straps.tclock(setup.clock);
         let (profile, first_pout) = match (kind, &setup.ramp) {
-            (MoveKind::AccelDecel | MoveKind::ContinuousHigh, Some((table, cruise))) => {
+            (MoveKind::AccelDecel | MoveKind::ContinuousHigh, Some((ramp, cruise))) => {
                 let pa = u32::from(setup.data.pa);
                 let mut first = self.cfg.accel_first_pout;
                 if total < 2 * pa {
@@ -38,7 +44,7 @@ impl Chip {
                 }
                 (
                     Profile::Ramped {
-                        table: Arc::clone(table),
+                        ramp: ramp.clone(),
                         cruise: *cruise,
                     },
                     Some(first),
@@ -252,8 +258,11 @@ impl Chip {
     pub(super) fn next_stretch(&self) -> Option<(Instant, Duration, u32)> {
         let m = self.motion.as_ref().filter(|m| m.pulses_left())?;
         let (interval, count) = m.constant_stretch();
-        // The first pulse samples the inputs (notes N27).
-        let count = if m.emitted == 0 || Self::pout_hs_check(m, self.inputs) {
+        // The first pulse samples the inputs (notes N27). A firmware
+        // starved by the speed limit is served again after the first pulse
+        // whose period is within it (N7): that pulse ends the stretch.
+        let serves_again = self.pick_starved && interval >= self.straps.min_interval(m.pout);
+        let count = if m.emitted == 0 || Self::pout_hs_check(m, self.inputs) || serves_again {
             count.min(1)
         } else {
             count
@@ -280,6 +289,7 @@ impl Chip {
         let Some(m) = self.motion.as_mut() else {
             return;
         };
+        let on_ramp = m.on_ramp();
         let fit = if stretch <= 1 || interval == Duration::ZERO {
             stretch
         } else {
@@ -306,8 +316,15 @@ impl Chip {
         } else {
             fit
         };
-        self.record
-            .push_pulses(first, interval, on_wire, dir, new_move);
+        // A ramp's pulses are recorded as one at a time, as they always
+        // were: the stretch is how the model runs, not what it records.
+        if on_ramp {
+            self.record
+                .push_pulses_singly(first, interval, on_wire, dir, new_move);
+        } else {
+            self.record
+                .push_pulses(first, interval, on_wire, dir, new_move);
+        }
         if steps_phases {
             if let Some(w) = self.winding {
                 // Fault: the first step of each move never reaches the phases.
