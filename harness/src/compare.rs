@@ -126,11 +126,13 @@ struct Streams {
     pulses: Vec<Run>,
     pins: BTreeMap<Pin, Vec<(Instant, u8, Instant)>>,
     measures: BTreeMap<String, Vec<(Instant, Duration)>>,
+    /// The anchor in force at the end.
+    anchor: Instant,
 }
 
-fn streams(t: &Trace) -> Streams {
+fn streams(t: &Trace, anchor: Instant) -> Streams {
     let mut s = Streams::default();
-    let mut anchor = Instant::ZERO;
+    let mut anchor = anchor;
     let mut pending_first = false;
     for e in &t.events {
         match &e.kind {
@@ -166,6 +168,7 @@ fn streams(t: &Trace) -> Streams {
             }
         }
     }
+    s.anchor = anchor;
     s
 }
 
@@ -197,24 +200,78 @@ fn band_text((lo, hi): (Duration, Duration)) -> String {
 /// Compares `got` with `golden`; `Ok(())` when every quantity is within
 /// its rule, else the first divergence in time.
 pub fn compare(golden: &Trace, got: &Trace, tol: &Tolerances) -> Result<(), Divergence> {
-    let g = streams(golden);
-    let o = streams(got);
+    compare_from(golden, got, tol, &Resume::default())
+}
+
+/// What two traces compared equal up to a point where both were at rest
+/// (no move in progress): how many of each stream's events, and the anchor
+/// in force on each side. A compare of what came after, from there
+/// ([`compare_from`]), judges and names every event as the compare of the
+/// whole would, at a cost in what came after alone.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Resume {
+    bus: usize,
+    moves: usize,
+    pulses: u64,
+    pins: BTreeMap<Pin, usize>,
+    measures: BTreeMap<String, usize>,
+    /// The anchor in force (golden, got).
+    anchors: (Instant, Instant),
+}
+
+impl Resume {
+    /// Where a compare of what comes after `golden` and `got` (compared
+    /// equal from `self`) picks up.
+    pub fn after(&self, golden: &Trace, got: &Trace) -> Resume {
+        let (g, o) = (
+            streams(golden, self.anchors.0),
+            streams(got, self.anchors.1),
+        );
+        let mut next = self.clone();
+        next.bus += o.bus.len();
+        next.moves += o.moves.len();
+        next.pulses += o.pulses.iter().map(|r| u64::from(r.run.count)).sum::<u64>();
+        for (pin, changes) in &o.pins {
+            *next.pins.entry(*pin).or_default() += changes.len();
+        }
+        for (name, values) in &o.measures {
+            *next.measures.entry(name.clone()).or_default() += values.len();
+        }
+        next.anchors = (g.anchor, o.anchor);
+        next
+    }
+}
+
+/// [`compare`] of traces that continue where `from` left off: event
+/// numbers count from there, and times are taken from the anchors then in
+/// force.
+pub fn compare_from(
+    golden: &Trace,
+    got: &Trace,
+    tol: &Tolerances,
+    from: &Resume,
+) -> Result<(), Divergence> {
+    let g = streams(golden, from.anchors.0);
+    let o = streams(got, from.anchors.1);
     let mut first = First::default();
-    compare_bus(&g, &o, tol, &mut first);
-    compare_moves(&g, &o, &mut first);
-    compare_pulses(&g, &o, tol, &mut first);
-    compare_pins(&g, &o, tol, &mut first);
-    compare_measures(&g, &o, tol, &got.straps, &mut first);
+    compare_bus(&g, &o, tol, from.bus, &mut first);
+    compare_moves(&g, &o, from.moves, &mut first);
+    compare_pulses(&g, &o, tol, from.pulses, &mut first);
+    compare_pins(&g, &o, tol, &from.pins, &mut first);
+    compare_measures(&g, &o, tol, &got.straps, &from.measures, &mut first);
     match first.0 {
         Some(d) => Err(d),
         None => Ok(()),
     }
 }
 
+/// Whether the two streams hold as many events, counting `before` on
+/// each side already compared.
 fn count_divergence<T>(
     what: &str,
     g: &[T],
     o: &[T],
+    before: usize,
     at: impl Fn(&T) -> Instant,
 ) -> Option<Divergence> {
     if g.len() == o.len() {
@@ -225,18 +282,18 @@ fn count_divergence<T>(
     Some(Divergence {
         at: when,
         quantity: format!("number of {what}"),
-        golden: g.len().to_string(),
-        got: o.len().to_string(),
+        golden: (before + g.len()).to_string(),
+        got: (before + o.len()).to_string(),
         allowed: "equal".into(),
     })
 }
 
-fn compare_bus(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
+fn compare_bus(g: &Streams, o: &Streams, tol: &Tolerances, before: usize, first: &mut First) {
     for (i, ((_, ge), (ot, oe))) in g.bus.iter().zip(&o.bus).enumerate() {
         if first.beaten_by(*ot) {
             return;
         }
-        let quantity = format!("bus transaction {} ({ge})", i + 1);
+        let quantity = format!("bus transaction {} ({ge})", before + i + 1);
         let mismatch = match (ge, oe) {
             (
                 BusEvent::Await {
@@ -348,17 +405,17 @@ fn compare_bus(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
             return;
         }
     }
-    if let Some(d) = count_divergence("bus transactions", &g.bus, &o.bus, |e| e.0) {
+    if let Some(d) = count_divergence("bus transactions", &g.bus, &o.bus, before, |e| e.0) {
         first.offer(d);
     }
 }
 
-fn compare_moves(g: &Streams, o: &Streams, first: &mut First) {
+fn compare_moves(g: &Streams, o: &Streams, before: usize, first: &mut First) {
     for (i, ((_, gm), (ot, om))) in g.moves.iter().zip(&o.moves).enumerate() {
         if gm != om {
             first.offer(Divergence {
                 at: *ot,
-                quantity: format!("move {}", i + 1),
+                quantity: format!("move {}", before + i + 1),
                 golden: gm.to_string(),
                 got: om.to_string(),
                 allowed: "equal".into(),
@@ -366,7 +423,7 @@ fn compare_moves(g: &Streams, o: &Streams, first: &mut First) {
             return;
         }
     }
-    if let Some(d) = count_divergence("moves", &g.moves, &o.moves, |e| e.0) {
+    if let Some(d) = count_divergence("moves", &g.moves, &o.moves, before, |e| e.0) {
         first.offer(d);
     }
 }
@@ -381,11 +438,11 @@ struct Cursor {
 /// Compares the pulse streams run by run: a stretch where both traces keep
 /// one period costs one check, so a 16-million-pulse move compares in
 /// O(runs).
-fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
-    let total = |runs: &[Run]| runs.iter().map(|r| u64::from(r.run.count)).sum::<u64>();
+fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, before: u64, first: &mut First) {
+    let total = |runs: &[Run]| before + runs.iter().map(|r| u64::from(r.run.count)).sum::<u64>();
     let (mut gc, mut oc) = (Cursor::default(), Cursor::default());
-    let mut n: u64 = 0; // pulses compared so far
-                        // The previous (golden, got) pulse and how far each may be off.
+    let mut n: u64 = before; // pulses compared so far
+                             // The previous (golden, got) pulse and how far each may be off.
     let mut prev: Option<(Instant, Instant, Duration)> = None;
     while gc.run < g.pulses.len() && oc.run < o.pulses.len() {
         let (gr, or) = (g.pulses[gc.run], o.pulses[oc.run]);
@@ -505,18 +562,25 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First)
     }
 }
 
-fn compare_pins(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
+fn compare_pins(
+    g: &Streams,
+    o: &Streams,
+    tol: &Tolerances,
+    before: &BTreeMap<Pin, usize>,
+    first: &mut First,
+) {
     let empty = Vec::new();
     let pins: std::collections::BTreeSet<&Pin> = g.pins.keys().chain(o.pins.keys()).collect();
     for pin in pins {
         let gs = g.pins.get(pin).unwrap_or(&empty);
         let os = o.pins.get(pin).unwrap_or(&empty);
+        let done = before.get(pin).copied().unwrap_or(0);
         let mut diverged = false;
         for (i, (&(_, gv, ga), &(ot, ov, oa))) in gs.iter().zip(os).enumerate() {
             if first.beaten_by(ot) {
                 break;
             }
-            let quantity = format!("pin {} change {}", pin.name(), i + 1);
+            let quantity = format!("pin {} change {}", pin.name(), done + i + 1);
             if gv != ov {
                 first.offer(Divergence {
                     at: ot,
@@ -544,7 +608,9 @@ fn compare_pins(g: &Streams, o: &Streams, tol: &Tolerances, first: &mut First) {
             }
         }
         if !diverged {
-            if let Some(d) = count_divergence(&format!("{} changes", pin.name()), gs, os, |e| e.0) {
+            if let Some(d) =
+                count_divergence(&format!("{} changes", pin.name()), gs, os, done, |e| e.0)
+            {
                 first.offer(d);
             }
         }
@@ -556,6 +622,7 @@ fn compare_measures(
     o: &Streams,
     tol: &Tolerances,
     straps: &Straps,
+    before: &BTreeMap<String, usize>,
     first: &mut First,
 ) {
     let empty = Vec::new();
@@ -564,8 +631,9 @@ fn compare_measures(
     for name in names {
         let gs = g.measures.get(name).unwrap_or(&empty);
         let os = o.measures.get(name).unwrap_or(&empty);
+        let done = before.get(name).copied().unwrap_or(0);
         for (i, (&(_, gv), &(ot, ov))) in gs.iter().zip(os).enumerate() {
-            let quantity = format!("measurement {name} #{}", i + 1);
+            let quantity = format!("measurement {name} #{}", done + i + 1);
             if let Some(id) = TimingId::from_name(name) {
                 let band = id.row().band_for(straps);
                 if !within(ov, band) {
@@ -591,7 +659,7 @@ fn compare_measures(
                 break;
             }
         }
-        if let Some(d) = count_divergence(&format!("{name} measurements"), gs, os, |e| e.0) {
+        if let Some(d) = count_divergence(&format!("{name} measurements"), gs, os, done, |e| e.0) {
             first.offer(d);
         }
     }

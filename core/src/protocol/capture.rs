@@ -259,6 +259,14 @@ impl PulseSummary {
     }
 }
 
+/// A point in a [`Record`]: how many runs, pin changes and moves it held.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RecordMark {
+    pub runs: usize,
+    pub pins: usize,
+    pub moves: usize,
+}
+
 /// Everything observable on the output side since reset.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Record {
@@ -338,6 +346,35 @@ impl Record {
 
     pub fn pin(&mut self, at: Instant, pin: Pin, value: u8) {
         self.pins.push(PinEvent { at, pin, value });
+    }
+
+    /// How far the record reaches: where [`Record::since`] starts.
+    pub fn mark(&self) -> RecordMark {
+        RecordMark {
+            runs: self.runs.len(),
+            pins: self.pins.len(),
+            moves: self.moves.len(),
+        }
+    }
+
+    /// The record from `mark` on: the runs, pin changes and moves added
+    /// since (a move's `first_run` counted from the mark's first run).
+    pub fn since(&self, mark: RecordMark) -> Record {
+        Record {
+            runs: self.runs.get(mark.runs..).unwrap_or_default().to_vec(),
+            pins: self.pins.get(mark.pins..).unwrap_or_default().to_vec(),
+            moves: self
+                .moves
+                .get(mark.moves..)
+                .unwrap_or_default()
+                .iter()
+                .map(|m| MoveStart {
+                    first_run: m.first_run.saturating_sub(mark.runs),
+                    ..*m
+                })
+                .collect(),
+            overwritten_bytes: self.overwritten_bytes,
+        }
     }
 
     /// The last move whose final command byte was written by `at`, with

@@ -10,7 +10,9 @@ pub mod rates;
 pub mod registers;
 pub mod timing;
 
-pub use capture::{EdgeRuns, MoveStart, Pin, PinEvent, Pins, PulseRun, PulseSummary, Record};
+pub use capture::{
+    EdgeRuns, MoveStart, Pin, PinEvent, Pins, PulseRun, PulseSummary, Record, RecordMark,
+};
 pub use command::{
     ClockSource, Command, Direction, Excitation, InitCommand, InitData, MotorType, MoveCommand,
     MoveKind, OpFlags, OutputLogic, PulseCount, Register,

@@ -3,7 +3,7 @@
 
 use super::{Op, Reply, Target, TargetError, TargetInfo};
 use crate::emu::{Chip, ChipError, ModelConfig};
-use crate::protocol::{Record, Straps};
+use crate::protocol::{Record, RecordMark, Straps};
 use ppmc_core::bus::{Bus, EmuBus};
 
 /// The in-process emulator. Batches run instantly in wall time; waits are
@@ -65,5 +65,14 @@ impl Target for EmuTarget {
 
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
         Ok(ops.iter().map(|op| self.bus.run(*op)).collect())
+    }
+
+    fn execute_then_capture_since(
+        &mut self,
+        ops: &[Op],
+        from: RecordMark,
+    ) -> Result<(Vec<Reply>, Record), TargetError> {
+        let replies = self.execute(ops)?;
+        Ok((replies, self.bus.record().since(from)))
     }
 }

@@ -19,7 +19,7 @@ pub use self::serial::{
 
 pub use ppmc_core::bus::{Op, Reply};
 
-use crate::protocol::{Record, Straps};
+use crate::protocol::{Record, RecordMark, Straps};
 use std::fmt;
 
 /// What kind of failure a target error is, so that generic code can tell a
@@ -124,6 +124,18 @@ pub trait Target: Send {
     fn execute_then_capture(&mut self, ops: &[Op]) -> Result<(Vec<Reply>, Record), TargetError> {
         let replies = self.execute(ops)?;
         Ok((replies, self.capture()?))
+    }
+
+    /// [`Target::execute_then_capture`] with the capture from `from` on
+    /// ([`Record::since`]): what a caller that has the rest needs, without
+    /// copying the whole record on every call.
+    fn execute_then_capture_since(
+        &mut self,
+        ops: &[Op],
+        from: RecordMark,
+    ) -> Result<(Vec<Reply>, Record), TargetError> {
+        let (replies, capture) = self.execute_then_capture(ops)?;
+        Ok((replies, capture.since(from)))
     }
 
     /// Runs one op.

@@ -6,10 +6,10 @@
 
 use super::actions::{self, Action};
 use crate::backend::{EmuTarget, Op, Reply, Target, TargetError, TargetErrorKind};
-use crate::compare::{compare, Divergence, Tolerances};
+use crate::compare::{compare_from, Divergence, Resume, Tolerances};
 use crate::console::{self, ConsoleOptions};
 use crate::emu::ModelConfig;
-use crate::protocol::{Record, Status, Straps};
+use crate::protocol::{Record, RecordMark, Status, Straps};
 use crate::trace::{Event, EventKind, Trace};
 use rand::{Rng, SeedableRng};
 use std::fmt::Write as _;
@@ -69,16 +69,21 @@ impl std::fmt::Display for Departure {
     }
 }
 
-/// One side of a run: a target and what it has shown so far.
+/// One side of a run: a target and what it has shown since the last
+/// checkpoint (both sides at rest, everything before compared equal).
 struct Side<'a> {
     target: &'a mut dyn Target,
+    /// Bus events since the checkpoint.
     bus: Vec<Event>,
+    /// The capture since the checkpoint, and where the checkpoint cut the
+    /// whole.
     capture: Record,
+    mark: RecordMark,
 }
 
 impl Side<'_> {
     fn run(&mut self, stmts: &[console::Stmt], ops: &[Op]) -> Result<Status, TargetError> {
-        let (replies, capture) = self.target.execute_then_capture(ops)?;
+        let (replies, capture) = self.target.execute_then_capture_since(ops, self.mark)?;
         if replies.len() != ops.len() {
             return Err(TargetError::new(
                 TargetErrorKind::Other,
@@ -110,6 +115,8 @@ impl Side<'_> {
         }
     }
 
+    /// The trace since the checkpoint: the bus, and the capture too if
+    /// `with_capture`.
     fn trace(&self, name: &str, with_capture: bool) -> Trace {
         let empty = Record::default();
         let capture = if with_capture { &self.capture } else { &empty };
@@ -119,6 +126,18 @@ impl Side<'_> {
             capture,
             Vec::new(),
         )
+    }
+
+    /// Everything so far was compared: the next window starts here.
+    fn checkpoint(&mut self) {
+        self.bus.clear();
+        let window = self.capture.mark();
+        self.mark = RecordMark {
+            runs: self.mark.runs + window.runs,
+            pins: self.mark.pins + window.pins,
+            moves: self.mark.moves + window.moves,
+        };
+        self.capture = Record::default();
     }
 }
 
@@ -150,12 +169,18 @@ pub fn run(
         target,
         bus: Vec::new(),
         capture: Record::default(),
+        mark: RecordMark::default(),
     };
     let mut want = Side {
         target: &mut reference,
         bus: Vec::new(),
         capture: Record::default(),
+        mark: RecordMark::default(),
     };
+    // What was compared before the windows begin: each compare looks at
+    // what came since the last time both sides were at rest and agreed, so
+    // a run costs time linear in its length.
+    let mut from = Resume::default();
     let mut last = 0;
     for (i, a) in acts.into_iter().enumerate() {
         last = i;
@@ -171,25 +196,31 @@ pub fn run(
         got.run(&stmts, &ops)?;
         // Pulses are compared when the chip is idle, so a board's clock
         // a hair off the emulator's cannot split a move differently.
-        if let Err(divergence) = compare(
-            &want.trace("differential", idle),
-            &got.trace("differential", idle),
-            &s.tolerances,
-        ) {
+        let (w, g) = (
+            want.trace("differential", idle),
+            got.trace("differential", idle),
+        );
+        if let Err(divergence) = compare_from(&w, &g, &s.tolerances, &from) {
             return Ok(Some(Departure {
                 action: i,
                 divergence,
             }));
         }
+        if idle {
+            from = from.after(&w, &g);
+            want.checkpoint();
+            got.checkpoint();
+        }
         if !progress(i + 1) {
             break;
         }
     }
-    // At the end, everything.
-    if let Err(divergence) = compare(
+    // At the end, everything since the last checkpoint.
+    if let Err(divergence) = compare_from(
         &want.trace("differential", true),
         &got.trace("differential", true),
         &s.tolerances,
+        &from,
     ) {
         return Ok(Some(Departure {
             action: last,
