@@ -200,7 +200,7 @@ fn band_text((lo, hi): (Duration, Duration)) -> String {
 /// Compares `got` with `golden`; `Ok(())` when every quantity is within
 /// its rule, else the first divergence in time.
 pub fn compare(golden: &Trace, got: &Trace, tol: &Tolerances) -> Result<(), Divergence> {
-    compare_from(golden, got, tol, &Resume::default())
+    compare_from(golden, got, tol, &Resume::default()).map(|_| ())
 }
 
 /// What two traces compared equal up to a point where both were at rest
@@ -220,13 +220,9 @@ pub struct Resume {
 }
 
 impl Resume {
-    /// Where a compare of what comes after `golden` and `got` (compared
-    /// equal from `self`) picks up.
-    pub fn after(&self, golden: &Trace, got: &Trace) -> Resume {
-        let (g, o) = (
-            streams(golden, self.anchors.0),
-            streams(got, self.anchors.1),
-        );
+    /// Where a compare picks up after the streams `g` and `o`, compared
+    /// equal from `self`.
+    fn after(&self, g: &Streams, o: &Streams) -> Resume {
         let mut next = self.clone();
         next.bus += o.bus.len();
         next.moves += o.moves.len();
@@ -244,13 +240,14 @@ impl Resume {
 
 /// [`compare`] of traces that continue where `from` left off: event
 /// numbers count from there, and times are taken from the anchors then in
-/// force.
+/// force. When they agree, where a compare of what follows them picks up
+/// (meaningful when both end at rest).
 pub fn compare_from(
     golden: &Trace,
     got: &Trace,
     tol: &Tolerances,
     from: &Resume,
-) -> Result<(), Divergence> {
+) -> Result<Resume, Divergence> {
     let g = streams(golden, from.anchors.0);
     let o = streams(got, from.anchors.1);
     let mut first = First::default();
@@ -261,7 +258,7 @@ pub fn compare_from(
     compare_measures(&g, &o, tol, &got.straps, &from.measures, &mut first);
     match first.0 {
         Some(d) => Err(d),
-        None => Ok(()),
+        None => Ok(from.after(&g, &o)),
     }
 }
 

@@ -50,13 +50,11 @@ pub(crate) struct Ramp {
     accel: Option<AccelRamp>,
     /// The periods of indices `0..table.len()`.
     table: Arc<[Duration]>,
-    len: u32,
 }
 
 impl Ramp {
     pub(crate) fn new(accel: AccelRamp) -> Ramp {
         Ramp {
-            len: accel.len(),
             accel: Some(accel),
             table: Arc::from(Vec::new()),
         }
@@ -66,7 +64,6 @@ impl Ramp {
     #[cfg(test)]
     fn table(periods: Vec<Duration>) -> Ramp {
         Ramp {
-            len: periods.len() as u32,
             accel: None,
             table: periods.into(),
         }
@@ -74,7 +71,7 @@ impl Ramp {
 
     /// Computes the periods of indices below `need` not computed yet.
     pub(crate) fn cover(&mut self, need: u32) {
-        let need = need.min(self.len);
+        let need = need.min(self.len());
         let have = self.table.len() as u32;
         if let Some(a) = self.accel.filter(|_| have < need) {
             let mut t = self.table.to_vec();
@@ -83,15 +80,16 @@ impl Ramp {
         }
     }
 
+    /// PA - 1: the speed index of the cruise.
     fn len(&self) -> u32 {
-        self.len
+        self.accel.map_or(self.table.len() as u32, |a| a.len())
     }
 
     fn period(&self, v: u32) -> Option<Duration> {
-        if v >= self.len {
+        if v >= self.len() {
             return None;
         }
-        match (self.table.get(v as usize), self.accel) {
+        match (self.table.get(v as usize), &self.accel) {
             (Some(d), _) => Some(*d),
             (None, Some(a)) => Some(a.period(v)),
             (None, None) => None,
@@ -275,9 +273,9 @@ impl Motion {
         let left = self.end - j;
         match &self.profile {
             Profile::Constant { interval } => (*interval, left),
-            Profile::Ramped { cruise, .. } => {
+            Profile::Ramped { ramp, cruise } => {
                 let pa = self.cruise_index();
-                if left > 1 && self.speed(j) == pa {
+                if self.cruising_from(j) {
                     // Last pulse index whose following period is still cruise.
                     let mut c_end = i64::from(self.total) - 2 - i64::from(pa);
                     if let Some((j0, _)) = self.decel {
@@ -286,7 +284,7 @@ impl Motion {
                     let run = (c_end + 2 - i64::from(j)).clamp(1, i64::from(left));
                     (*cruise, run as u32)
                 } else {
-                    self.ramp_stretch(j, left)
+                    self.ramp_stretch(ramp, *cruise, j, left)
                 }
             }
         }
@@ -297,14 +295,11 @@ impl Motion {
     /// coarser than the ramp), so the indices sharing pulse `j`'s period
     /// are a range, found by galloping out from `j`'s; the pulses follow
     /// while their speed index stays in it, [`RAMP_STRETCH_MAX`] at most.
-    fn ramp_stretch(&self, j: u32, left: u32) -> (Duration, u32) {
+    fn ramp_stretch(&self, ramp: &Ramp, cruise: Duration, j: u32, left: u32) -> (Duration, u32) {
         let d = self.interval_after(j);
-        let Profile::Ramped { ramp, cruise } = &self.profile else {
-            return (d, left);
-        };
         // Ramp indices only: cruise (index PA) is a stretch of its own.
         let top = self.cruise_index().saturating_sub(1);
-        let per = |v: u32| ramp.period(v).unwrap_or(*cruise);
+        let per = |v: u32| ramp.period(v).unwrap_or(cruise);
         let v0 = self.speed(j);
         if v0 > top {
             return (d, 1);
@@ -347,8 +342,13 @@ impl Motion {
     /// Whether the next stretch is on the ramp (each pulse recorded as if
     /// put out alone), not at cruise or a constant rate.
     pub fn on_ramp(&self) -> bool {
-        let j = self.emitted;
-        self.ramped() && !(self.end - j > 1 && self.speed(j) == self.cruise_index())
+        self.ramped() && !self.cruising_from(self.emitted)
+    }
+
+    /// Whether pulse `j` and the one after it are at the high speed (a
+    /// cruise stretch starts at `j`).
+    fn cruising_from(&self, j: u32) -> bool {
+        self.end - j > 1 && self.speed(j) == self.cruise_index()
     }
 
     fn ramped(&self) -> bool {

@@ -381,12 +381,21 @@ impl Record {
     /// its pulse runs (up to the next move's first).
     pub fn move_written_by(&self, at: Instant) -> Option<(&MoveStart, &[PulseRun])> {
         let k = self.moves.iter().rposition(|m| m.at <= at)?;
-        let m = &self.moves[k];
+        Some((&self.moves[k], self.runs_of_move(k)))
+    }
+
+    /// The pulse runs of move `k` (of [`Record::moves`]): from its first
+    /// run up to the next move's first; none for a move not recorded.
+    pub fn runs_of_move(&self, k: usize) -> &[PulseRun] {
+        let Some(m) = self.moves.get(k) else {
+            return &[];
+        };
         let end = self
             .moves
             .get(k + 1)
-            .map_or(self.runs.len(), |n| n.first_run);
-        Some((m, &self.runs[m.first_run.min(end)..end]))
+            .map_or(self.runs.len(), |n| n.first_run)
+            .min(self.runs.len());
+        &self.runs[m.first_run.min(end)..end]
     }
 
     /// Summary of the pulses of the most recent move (all pulses if no move

@@ -196,20 +196,24 @@ pub fn run(
         got.run(&stmts, &ops)?;
         // Pulses are compared when the chip is idle, so a board's clock
         // a hair off the emulator's cannot split a move differently.
-        let (w, g) = (
-            want.trace("differential", idle),
-            got.trace("differential", idle),
-        );
-        if let Err(divergence) = compare_from(&w, &g, &s.tolerances, &from) {
-            return Ok(Some(Departure {
-                action: i,
-                divergence,
-            }));
-        }
-        if idle {
-            from = from.after(&w, &g);
-            want.checkpoint();
-            got.checkpoint();
+        match compare_from(
+            &want.trace("differential", idle),
+            &got.trace("differential", idle),
+            &s.tolerances,
+            &from,
+        ) {
+            Err(divergence) => {
+                return Ok(Some(Departure {
+                    action: i,
+                    divergence,
+                }))
+            }
+            Ok(next) if idle => {
+                from = next;
+                want.checkpoint();
+                got.checkpoint();
+            }
+            Ok(_) => {}
         }
         if !progress(i + 1) {
             break;

@@ -324,28 +324,29 @@ impl Judge {
             let Some(params) = self.params_of(m) else {
                 continue;
             };
-            let rates: Vec<u8> = match m.kind {
+            // The constant-rate moves' own rate byte; the ramped ones run
+            // up to an initialization's RH.
+            let own_rate = match m.kind {
                 MoveKind::SingleStep => continue,
-                MoveKind::AccelDecel | MoveKind::ContinuousHigh => Vec::new(),
+                MoveKind::AccelDecel | MoveKind::ContinuousHigh => None,
                 MoveKind::Constant | MoveKind::ContinuousConstant | MoveKind::OriginSearch => {
-                    vec![params[0]]
+                    Some(params[0])
                 }
             };
             let bound = self
                 .inits_before(m.at)
                 .filter_map(|(clock, data)| {
                     let tclock = self.straps.tclock(clock)?;
-                    let rate = rates.first().copied().unwrap_or(data.rh);
+                    let rate = own_rate.unwrap_or(data.rh);
                     Some(self.straps.pulse_interval(rate, tclock))
                 })
                 .min();
             let Some(bound) = bound else {
                 continue;
             };
-            let end = rec.moves.get(k + 1).map_or(rec.runs.len(), |n| n.first_run);
-            let runs = &rec.runs[m.first_run.min(end)..end];
+            let runs = rec.runs_of_move(k);
             if let Some(d) = shortest_interval_below(runs, bound) {
-                let rate = match rates.first() {
+                let rate = match own_rate {
                     Some(r) => format!("its rate byte {r}"),
                     None => "the fastest high speed rate RH initialized".into(),
                 };
@@ -623,8 +624,7 @@ fn phase_breaks(rec: &Record) -> Option<String> {
             set = Some(p.value);
             left = None;
         }
-        let end = rec.moves.get(k + 1).map_or(rec.runs.len(), |n| n.first_run);
-        let runs = &rec.runs[m.first_run.min(end)..end];
+        let runs = rec.runs_of_move(k);
         let horizon = runs.first().map_or(m.at, |r| r.start);
         let mut unsettled = false;
         while let Some(p) = pins.next_if(|p| p.at <= horizon) {
