@@ -7,22 +7,12 @@ use std::fs;
 use std::path::Path;
 
 fn replay(target: &str, body: fn(&[u8])) -> usize {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz");
-    let mut n = 0;
-    for dir in ["corpus", "regressions"] {
-        let Ok(entries) = fs::read_dir(root.join(dir).join(target)) else {
-            continue;
-        };
-        let mut files: Vec<_> = entries.filter_map(Result::ok).map(|e| e.path()).collect();
-        files.sort();
-        for f in files.into_iter().filter(|f| f.is_file()) {
-            let data = fs::read(&f).expect("readable corpus file");
-            let ok = std::panic::catch_unwind(|| body(&data));
-            assert!(ok.is_ok(), "{} fails", f.display());
-            n += 1;
-        }
+    let inputs = common::fuzz_inputs(target);
+    for (f, data) in &inputs {
+        let ok = std::panic::catch_unwind(|| body(data));
+        assert!(ok.is_ok(), "{} fails", f.display());
     }
-    n
+    inputs.len()
 }
 
 #[test]

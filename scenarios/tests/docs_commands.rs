@@ -313,8 +313,8 @@ impl Drop for Bridge {
 }
 
 /// A scratch directory that looks like a checkout to the commands: the
-/// golden traces, examples and fuzz corpus, a script, and a findings
-/// folder.
+/// golden traces, examples, fuzz corpus and regression inputs, a script,
+/// and a findings folder.
 fn workspace(tag: &str) -> tempfile::TempDir {
     let dir = scratch(tag);
     let d = dir.path();
@@ -324,6 +324,8 @@ fn workspace(tag: &str) -> tempfile::TempDir {
     std::os::unix::fs::symlink(r.join("docs/examples"), d.join("docs/examples")).expect("link");
     std::fs::create_dir_all(d.join("fuzz/artifacts/bus_bytes")).expect("fuzz");
     std::os::unix::fs::symlink(r.join("fuzz/corpus"), d.join("fuzz/corpus")).expect("link");
+    std::os::unix::fs::symlink(r.join("fuzz/regressions"), d.join("fuzz/regressions"))
+        .expect("link");
     for f in std::fs::read_dir(r.join("fuzz/regressions/bus_bytes")).expect("regressions") {
         let f = f.expect("entry").path();
         let name = f.file_name().expect("name");
@@ -466,7 +468,9 @@ fn every_documented_command_runs_as_shown() {
                     let shown = doc.command.trim_start_matches("cd ");
                     let in_ci = ci.contains(shown)
                         || (doc.command.starts_with("cargo +nightly fuzz run")
-                            && ci.contains("cargo +nightly fuzz run \"$target\" \"$scratch\" \"corpus/$target\""))
+                            && ci.contains(
+                                "cargo +nightly fuzz run \"$target\" \"$scratch\" \"$seeds\"",
+                            ))
                         || (doc.command.starts_with("mkdir -p ../target/fuzz-corpus")
                             && ci.contains("scratch=\"$PWD/target/fuzz-corpus/$target\""));
                     if !in_ci {

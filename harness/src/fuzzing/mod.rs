@@ -9,7 +9,9 @@ pub mod campaign;
 pub mod differential;
 pub mod finding;
 pub mod oracle;
+pub mod plain;
 pub mod replay;
+pub mod twin;
 
 use crate::bridge::frame::{self, FrameDecoder};
 use crate::bridge::wire::{Request, Response, Timer};

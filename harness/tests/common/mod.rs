@@ -293,3 +293,23 @@ pub fn suite_in_process() -> Vec<ppmc::scenario::ScenarioResult> {
         |_| {},
     )
 }
+
+/// Every committed input of a fuzz target, seeds (`fuzz/corpus/<target>/`)
+/// then regressions (`fuzz/regressions/<target>/`), each sorted by name:
+/// `(path, bytes)`.
+pub fn fuzz_inputs(target: &str) -> Vec<(std::path::PathBuf, Vec<u8>)> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz");
+    let mut out = Vec::new();
+    for dir in ["corpus", "regressions"] {
+        let Ok(entries) = std::fs::read_dir(root.join(dir).join(target)) else {
+            continue;
+        };
+        let mut files: Vec<_> = entries.filter_map(Result::ok).map(|e| e.path()).collect();
+        files.sort();
+        for f in files.into_iter().filter(|f| f.is_file()) {
+            let data = std::fs::read(&f).expect("readable corpus file");
+            out.push((f, data));
+        }
+    }
+    out
+}

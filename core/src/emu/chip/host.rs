@@ -30,6 +30,22 @@ impl Chip {
         self.pick_timer = Some(self.schedule(at, Timer::Pick));
     }
 
+    /// The firmware serves the host again after the speed limit held it
+    /// back (notes N7): the waiting byte is taken when the firmware is free,
+    /// and never sooner than the pickup time after its own write.
+    pub(super) fn serve_again(&mut self) {
+        if !self.pick_starved {
+            return;
+        }
+        self.pick_starved = false;
+        let Some(inb) = self.inbuf else { return };
+        let at = self
+            .now
+            .max(self.proc_free_at)
+            .max(inb.written + self.fw(self.cfg.byte_pickup));
+        self.schedule_pick(at);
+    }
+
     /// The firmware cannot serve the host while pulsing faster than the
     /// speed limit (Section 3-2-2, notes N7).
     pub(super) fn starved(&self) -> bool {
@@ -239,7 +255,10 @@ impl Chip {
         });
         self.config_epoch += 1;
         let epoch = self.config_epoch;
+        // No stop switching while an initialization is processed
+        // (3-2-1 (3), notes N39).
         self.set_switching(None);
+        self.initializing = true;
         let span = self
             .cfg
             .init_time_max

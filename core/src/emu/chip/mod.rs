@@ -148,6 +148,9 @@ pub struct Chip {
     setup: Option<Setup>,
     switch_on: Duration,
     switch_off: Duration,
+    /// An initialization is being processed: no stop switching until it
+    /// completes (3-2-1 (3), notes N39).
+    initializing: bool,
     /// Bumped by software reset and re-initialization, to void stale timers.
     config_epoch: u64,
 
@@ -181,6 +184,7 @@ impl Chip {
         Ok(Chip {
             switch_on: straps.firmware_time(cfg.switching_on),
             switch_off: straps.firmware_time(cfg.switching_off),
+            initializing: false,
             straps,
             cfg,
             now: Instant::ZERO,
@@ -414,6 +418,7 @@ impl Chip {
                 self.record_phases();
             }
             Timer::InitDone { epoch } if epoch == self.config_epoch && self.motion.is_none() => {
+                self.initializing = false;
                 self.set_hold(true);
                 self.start_switching_if_enabled();
             }
@@ -490,10 +495,6 @@ impl Chip {
         let epoch = self.hold_epoch;
         let hold_at = m.last_pulse.unwrap_or(now) + self.fw(self.cfg.hold_on);
         self.schedule(hold_at, Timer::HoldOn { epoch });
-        if self.pick_starved {
-            self.pick_starved = false;
-            let at = self.proc_free_at.max(now);
-            self.schedule_pick(at);
-        }
+        self.serve_again();
     }
 }

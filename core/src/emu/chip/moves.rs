@@ -214,6 +214,9 @@ impl Chip {
             now + self.straps.firmware_time(self.cfg.interrupt_delay)
         };
         self.schedule(end.max(now), Timer::Terminate { id });
+        // Pulse output is over, and with it the starvation of notes N7: a
+        // byte the speed limit held back is taken now (notes N49).
+        self.serve_again();
     }
 
     pub(super) fn check_inputs_before_first_pulse(&mut self) {
@@ -338,17 +341,23 @@ impl Chip {
             self.high_speed_limit(true);
         }
         if done {
-            let end = if kind == MoveKind::SingleStep {
-                base + self.fw(self.cfg.single_step_done)
+            let (end, free) = if kind == MoveKind::SingleStep {
+                let done = base + self.fw(self.cfg.single_step_done);
+                (done, done)
             } else {
-                last + self.fw(self.cfg.interrupt_delay)
+                (
+                    last + self.fw(self.cfg.interrupt_delay),
+                    last + self.fw(self.cfg.next_command),
+                )
             };
             self.schedule(end, Timer::Terminate { id });
+            // From the final POUT the firmware is busy until it accepts the
+            // next command (Table 3-3, notes N12): a byte written after the
+            // last pulse waits, it is not taken before BUSY falls.
+            self.proc_free_at = self.proc_free_at.max(free);
         }
-        if self.pick_starved && !self.starved() {
-            self.pick_starved = false;
-            let at = self.now.max(self.proc_free_at);
-            self.schedule_pick(at);
+        if !self.starved() {
+            self.serve_again();
         }
     }
 
@@ -370,7 +379,7 @@ impl Chip {
 
     pub(super) fn start_switching_if_enabled(&mut self) {
         let enabled = self.setup.as_ref().is_some_and(|s| s.stop_switching);
-        if enabled && self.phases_on {
+        if enabled && self.phases_on && !self.initializing {
             self.set_switching(Some(self.now));
         }
     }

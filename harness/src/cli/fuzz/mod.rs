@@ -7,6 +7,7 @@ mod reproduce;
 mod run;
 mod to_scenario;
 mod triage;
+mod twin;
 
 use crate::cli::{usage, CliError};
 use crate::emu::ModelConfig;
@@ -82,6 +83,20 @@ enum FuzzCommand {
         /// Which fuzz target the inputs are for.
         #[arg(long, value_enum, default_value = "bus-bytes")]
         kind: InputKind,
+    },
+    /// Run a `bus_bytes` input (a crash file from fuzz/artifacts/model_twin/,
+    /// or any corpus entry) on the emulator and on the plain model, the
+    /// second model written from the datasheet alone, and show where they
+    /// first differ. When they do, the input is shrunk to the fewest ops
+    /// that still differ, written as `<file>.min` (unless -o) and printed as
+    /// a bus script. Exit status 0 when they agree, 1 when they differ, 2
+    /// on a usage or file error.
+    Twin {
+        /// The input file.
+        file: PathBuf,
+        /// Where to write the shrunk input.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
     },
     /// A differential run: a seeded stream of protocol-respecting actions
     /// against a target and the emulator side by side (the default when no
@@ -168,6 +183,7 @@ pub fn run(args: FuzzArgs) -> Result<(), CliError> {
         Some(FuzzCommand::Reproduce { input }) => reproduce::run(&input),
         Some(FuzzCommand::Minimize { input, output }) => minimize::run(&input, output),
         Some(FuzzCommand::ToScenario { input, dir }) => to_scenario::run(&input, &dir),
+        Some(FuzzCommand::Twin { file, output }) => twin::run(&file, output),
     }
 }
 

@@ -1,0 +1,271 @@
+//! The emulator against the plain model ([`super::plain`]): the same bus
+//! ops on both, and everything a host or a logic analyser could see
+//! compared after every op. The first difference is a [`Disagreement`];
+//! which model is right is then a question for the datasheet
+//! (`docs/datasheet-notes.md` records each one decided).
+//!
+//! Compared: the byte every status and data register read returns, the
+//! output pins after every op (INT*, HOLD, AUX*, AUXO0..3, the phases
+//! as energized and as pin levels, DIR, BUSY), every pulse (its time to
+//! the nanosecond and its direction) and every change of a pin outside
+//! pulse stepping, with its time.
+
+use super::bus::{self, BusOp};
+use super::plain::PlainChip;
+use crate::emu::{Board, ModelConfig};
+use crate::protocol::{Pin, PinEvent, Straps};
+use std::fmt;
+
+/// Where the two models first differ.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Disagreement {
+    /// Index of the op after which they differ.
+    pub op: usize,
+    /// The op itself.
+    pub what_op: BusOp,
+    /// What differs: the emulator's side first, then the plain model's.
+    pub detail: String,
+}
+
+impl fmt::Display for Disagreement {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "after op {} ({}): {}",
+            self.op + 1,
+            self.what_op,
+            self.detail
+        )
+    }
+}
+
+/// How far a check got.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Agreement {
+    /// Ops compared.
+    pub ops: usize,
+    /// Pulses compared.
+    pub pulses: usize,
+    /// Pin changes compared.
+    pub pin_changes: usize,
+    /// The plain model reached its pulse budget and the check stopped
+    /// there.
+    pub cut_short: bool,
+}
+
+/// Runs `ops` on the emulator (on a fault-free board) and on the plain
+/// model, both with `cfg`'s latencies, comparing after every op.
+pub fn check(ops: &[BusOp], straps: Straps, cfg: &ModelConfig) -> Result<Agreement, Disagreement> {
+    let cfg = ModelConfig {
+        faults: Default::default(),
+        board: Default::default(),
+        ..cfg.clone()
+    };
+    check_against(ops, straps, &cfg, &cfg)
+}
+
+/// [`check`] with a configuration for each side: the emulator's may carry
+/// deliberate faults (the plain model has none), which is how a test shows
+/// that the check catches a wrong emulator.
+pub fn check_against(
+    ops: &[BusOp],
+    straps: Straps,
+    emulator: &ModelConfig,
+    plain: &ModelConfig,
+) -> Result<Agreement, Disagreement> {
+    let Ok(mut fast) = Board::new(straps, emulator.clone()) else {
+        // Straps or a config the emulator refuses: nothing to compare.
+        return Ok(Agreement::default());
+    };
+    let mut plain = PlainChip::new(straps, plain.clone());
+    let mut seen = Agreement::default();
+    let mut fast_pins = Changes::default();
+    let mut plain_pins = Changes::default();
+    for (i, &op) in ops.iter().enumerate() {
+        let disagree = |detail: String| Disagreement {
+            op: i,
+            what_op: op,
+            detail,
+        };
+        let a = bus::apply(&mut fast, op);
+        let b = apply(&mut plain, op);
+        if plain.exhausted() {
+            seen.cut_short = true;
+            return Ok(seen);
+        }
+        if a != b {
+            return Err(disagree(format!(
+                "the read returned {} on the emulator, {} on the plain model",
+                byte(a),
+                byte(b)
+            )));
+        }
+        if fast.now() != plain.now() {
+            return Err(disagree(format!(
+                "clocks at {} and {}",
+                fast.now(),
+                plain.now()
+            )));
+        }
+        let (pa, pb) = (fast.pins(), plain.pins());
+        if pa != pb {
+            fast_pins.add(&fast.record().pins);
+            plain_pins.add(plain.pin_events());
+            return Err(disagree(format!(
+                "pins {pa:?} against {pb:?}; the last pin changes: {} against {}",
+                fast_pins.last(3),
+                plain_pins.last(3)
+            )));
+        }
+        let pulses: Vec<_> = fast.record().pulses().skip(seen.pulses).collect();
+        let theirs = &plain.pulses()[seen.pulses.min(plain.pulses().len())..];
+        for (k, (x, y)) in pulses.iter().zip(theirs).enumerate() {
+            if x != y {
+                return Err(disagree(format!(
+                    "pulse {} at {} {:?} against {} {:?}",
+                    seen.pulses + k + 1,
+                    x.0,
+                    x.1,
+                    y.0,
+                    y.1
+                )));
+            }
+        }
+        if pulses.len() != theirs.len() {
+            return Err(disagree(format!(
+                "{} pulses against {}",
+                seen.pulses + pulses.len(),
+                seen.pulses + theirs.len()
+            )));
+        }
+        seen.pulses += pulses.len();
+        fast_pins.add(&fast.record().pins);
+        plain_pins.add(plain.pin_events());
+        let n = fast_pins.changes.len().min(plain_pins.changes.len());
+        for k in seen.pin_changes..n {
+            let (x, y) = (fast_pins.changes[k], plain_pins.changes[k]);
+            if x != y {
+                return Err(disagree(format!(
+                    "pin change {}: {} against {}",
+                    k + 1,
+                    change(x),
+                    change(y)
+                )));
+            }
+        }
+        if fast_pins.changes.len() != plain_pins.changes.len() {
+            let (longer, which) = if fast_pins.changes.len() > n {
+                (&fast_pins.changes, "the emulator")
+            } else {
+                (&plain_pins.changes, "the plain model")
+            };
+            return Err(disagree(format!(
+                "only {} shows pin change {}: {}",
+                which,
+                n + 1,
+                change(longer[n])
+            )));
+        }
+        seen.pin_changes = n;
+        seen.ops = i + 1;
+    }
+    Ok(seen)
+}
+
+/// Applies one op to the plain model; the byte a read returned.
+pub fn apply(chip: &mut PlainChip, op: BusOp) -> Option<u8> {
+    match op {
+        BusOp::Command(b) => chip.write_command(b),
+        BusOp::Data(b) => chip.write_data(b),
+        BusOp::ReadStatus => return Some(chip.read_status()),
+        BusOp::ReadData => return Some(chip.read_data()),
+        BusOp::Input { input, asserted } => chip.set_input(input, asserted),
+        BusOp::Advance(d) => chip.advance_to(chip.now() + d),
+    }
+    None
+}
+
+fn byte(b: Option<u8>) -> String {
+    b.map_or("nothing".into(), |b| format!("0x{b:02X}"))
+}
+
+fn change(e: PinEvent) -> String {
+    format!("{} = {} at {}", e.pin.name(), e.value, e.at)
+}
+
+/// The pin events of a record that change a level, in order.
+#[derive(Default)]
+struct Changes {
+    read: usize,
+    level: [u8; Pin::ALL.len()],
+    changes: Vec<PinEvent>,
+}
+
+impl Changes {
+    fn last(&self, n: usize) -> String {
+        let from = self.changes.len().saturating_sub(n);
+        let list: Vec<String> = self.changes[from..].iter().map(|e| change(*e)).collect();
+        format!("[{}]", list.join(", "))
+    }
+
+    fn add(&mut self, events: &[PinEvent]) {
+        for e in &events[self.read.min(events.len())..] {
+            let slot = &mut self.level[e.pin as usize];
+            if *slot != e.value {
+                *slot = e.value;
+                self.changes.push(*e);
+            }
+        }
+        self.read = events.len();
+    }
+}
+
+/// Checks one fuzz input (bus-byte format, [`bus::decode`]) at the
+/// default straps and model: the body of the `model_twin` fuzz target.
+/// Inputs are cut at [`MAX_OPS`] ops, so that each runs in bounded time.
+pub fn fuzz(data: &[u8]) {
+    let ops = bus::decode(data);
+    let ops = &ops[..ops.len().min(MAX_OPS)];
+    if let Err(d) = check(ops, Straps::default(), &ModelConfig::default()) {
+        panic!("model-twin: {d}");
+    }
+}
+
+/// Ops of one input the `model_twin` target compares.
+pub const MAX_OPS: usize = 64;
+
+/// Shrinks `ops` while the two models still disagree: drops chunks of
+/// ops, then single ops, halving the chunk each round (ddmin-style). The
+/// disagreement found at the end may differ in detail from the first; it
+/// is returned with the ops.
+pub fn minimize(
+    ops: &[BusOp],
+    straps: Straps,
+    cfg: &ModelConfig,
+) -> Option<(Vec<BusOp>, Disagreement)> {
+    let mut best = ops.to_vec();
+    let mut found = check(&best, straps, cfg).err()?;
+    // Nothing after the op where they first differ matters.
+    best.truncate(found.op + 1);
+    let mut chunk = best.len().div_ceil(2).max(1);
+    loop {
+        let mut i = 0;
+        while i < best.len() {
+            let mut trial = best.clone();
+            trial.drain(i..(i + chunk).min(trial.len()));
+            match check(&trial, straps, cfg) {
+                Err(d) => {
+                    trial.truncate(d.op + 1);
+                    best = trial;
+                    found = d;
+                }
+                Ok(_) => i += chunk,
+            }
+        }
+        if chunk == 1 {
+            break;
+        }
+        chunk = chunk.div_ceil(2);
+    }
+    Some((best, found))
+}
