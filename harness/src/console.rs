@@ -33,6 +33,13 @@ pub enum Stmt {
         value: bool,
         timeout: Option<Duration>,
     },
+    /// `await pulse=<n> [<timeout>]`: until the most recent move has put
+    /// out its `n`-th pulse, so that the next statement acts right after
+    /// it, on the target's own clock.
+    AwaitPulse {
+        count: u64,
+        timeout: Option<Duration>,
+    },
     /// `set <input> <on|off>`.
     Set { input: Input, asserted: bool },
     /// `pins`.
@@ -130,16 +137,25 @@ fn parse_stmt(text: &str) -> Result<Stmt, String> {
             let (flag, value) = args[0]
                 .split_once('=')
                 .ok_or_else(|| format!("`{}` should be <flag>=<0|1>", args[0]))?;
-            let flag = Flag::from_name(&flag.to_ascii_lowercase())
-                .ok_or_else(|| format!("unknown flag `{flag}` (expected ibf, obf, busy or err)"))?;
+            let timeout = match args.get(1) {
+                Some(t) => Some(t.parse().map_err(|e| format!("{e}"))?),
+                None => None,
+            };
+            if flag.eq_ignore_ascii_case("pulse") {
+                let count = value
+                    .parse::<u64>()
+                    .ok()
+                    .filter(|n| *n > 0)
+                    .ok_or_else(|| format!("pulse number `{value}` should be 1 or more"))?;
+                return Ok(Stmt::AwaitPulse { count, timeout });
+            }
+            let flag = Flag::from_name(&flag.to_ascii_lowercase()).ok_or_else(|| {
+                format!("unknown flag `{flag}` (expected ibf, obf, busy, err or pulse)")
+            })?;
             let value = match value {
                 "0" => false,
                 "1" => true,
                 _ => return Err(format!("flag value `{value}` should be 0 or 1")),
-            };
-            let timeout = match args.get(1) {
-                Some(t) => Some(t.parse().map_err(|e| format!("{e}"))?),
-                None => None,
             };
             Stmt::Await {
                 flag,
@@ -218,6 +234,13 @@ impl fmt::Display for Stmt {
                 timeout,
             } => {
                 write!(f, "await {}={}", flag.name(), u8::from(value))?;
+                if let Some(t) = timeout {
+                    write!(f, " {}ns", t.as_nanos())?;
+                }
+                Ok(())
+            }
+            Stmt::AwaitPulse { count, timeout } => {
+                write!(f, "await pulse={count}")?;
                 if let Some(t) = timeout {
                     write!(f, " {}ns", t.as_nanos())?;
                 }
@@ -303,6 +326,10 @@ pub fn to_op(stmt: Stmt, opts: &ConsoleOptions) -> Op {
             value,
             timeout,
         } => Op::await_flag(flag, value, timeout.unwrap_or(opts.await_timeout)),
+        Stmt::AwaitPulse { count, timeout } => Op::AwaitPulses {
+            count,
+            timeout: timeout.unwrap_or(opts.await_timeout),
+        },
         Stmt::Set { input, asserted } => Op::SetInput { input, asserted },
         Stmt::Pins => Op::ReadPins,
         Stmt::Pulses => Op::ReadPulses,
@@ -356,6 +383,14 @@ pub fn bus_event(stmt: Stmt, reply: &Reply) -> Option<BusEvent> {
         (Stmt::Set { input, asserted }, Reply::InputSet { .. }) => {
             BusEvent::SetInput { input, asserted }
         }
+        (Stmt::AwaitPulse { count, .. }, Reply::PulsesReached { .. }) => BusEvent::AwaitPulses {
+            count,
+            reached: true,
+        },
+        (Stmt::AwaitPulse { count, .. }, Reply::PulsesTimedOut { .. }) => BusEvent::AwaitPulses {
+            count,
+            reached: false,
+        },
         _ => return None,
     })
 }
@@ -389,6 +424,12 @@ pub fn format_reply(stmt: Stmt, reply: &Reply) -> Option<String> {
         )),
         (Stmt::Await { flag, value, .. }, Reply::AwaitTimedOut { .. }) => {
             Some(format!("await {}={} timeout", flag.name(), u8::from(value)))
+        }
+        (Stmt::AwaitPulse { count, .. }, Reply::PulsesReached { at }) => {
+            Some(format!("await pulse={count} at {at}"))
+        }
+        (Stmt::AwaitPulse { count, .. }, Reply::PulsesTimedOut { count: seen, .. }) => {
+            Some(format!("await pulse={count} timeout after {seen} pulses"))
         }
         (Stmt::Pins, Reply::Pins { pins, .. }) => Some(format!(
             "pins int={} hold={} aux={} auxo=0b{:04b} s=0b{:05b} dir={}",
@@ -539,7 +580,8 @@ mod tests {
                 2 => Stmt::ReadStatus,
                 3 => Stmt::ReadData { wait: b },
                 4 => Stmt::Wait(Duration::from_nanos(ns)),
-                5 => Stmt::Await { flag: flags[flag], value: b, timeout: b.then_some(Duration::from_nanos(ns)) },
+                5 if byte % 2 == 0 => Stmt::Await { flag: flags[flag], value: b, timeout: b.then_some(Duration::from_nanos(ns)) },
+                5 => Stmt::AwaitPulse { count: 1 + ns, timeout: b.then_some(Duration::from_nanos(ns)) },
                 6 => Stmt::Set { input: Input::ALL[inp], asserted: b },
                 7 => Stmt::Pins,
                 8 => Stmt::Pulses,

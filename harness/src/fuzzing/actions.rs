@@ -70,6 +70,11 @@ pub enum Action {
     RawCommand(u8),
     /// Any byte to the data register.
     RawData(u8),
+    /// A stop placed against the pulse train: wait for pulse `1 + pulse %
+    /// 1000` of the move, then `micros` us, then Immediate or Decelerating
+    /// Stop. Placed so that the stop's latency decides which pulse it
+    /// acts after (Table 3-3's 17 us; see [`crate::fuzzing::differential`]).
+    StopNearPulse { decel: bool, pulse: u16, micros: u8 },
 }
 
 fn wc(byte: u8) -> Stmt {
@@ -189,6 +194,21 @@ impl Action {
             Action::AuxOutput { bits } => vec![wc(Command::AuxOutput.encode()), wd(bits & 0x0F)],
             Action::Switching { on, off } => {
                 vec![wc(Command::SwitchingParams.encode()), wd(on), wd(off)]
+            }
+            Action::StopNearPulse {
+                decel,
+                pulse,
+                micros,
+            } => {
+                let mut v = vec![
+                    Stmt::AwaitPulse {
+                        count: 1 + u64::from(pulse % 1_000),
+                        timeout: Some(IDLE_TIMEOUT),
+                    },
+                    Stmt::Wait(Duration::from_micros(u64::from(micros))),
+                ];
+                v.extend(Action::Stop { decel }.stmts());
+                v
             }
             Action::RawCommand(b) => vec![wc(b)],
             Action::RawData(b) => vec![wd(b)],

@@ -19,9 +19,11 @@ use std::fmt::Write as _;
 /// ever. `program(seed).take(n)` is the run of `n` actions; memory does not
 /// grow with `n`.
 pub fn program(seed: u64) -> Program {
+    let init = Action::default_init();
     Program {
         rng: rand::rngs::StdRng::seed_from_u64(seed),
-        pending: std::collections::VecDeque::from([Action::default_init()]),
+        pending: std::collections::VecDeque::from([init]),
+        ramp: Ramp::of(&init),
     }
 }
 
@@ -30,6 +32,32 @@ pub fn program(seed: u64) -> Program {
 pub struct Program {
     rng: rand::rngs::StdRng,
     pending: std::collections::VecDeque<Action>,
+    /// The ramp of the last initialization generated.
+    ramp: Option<Ramp>,
+}
+
+/// What a generated initialization sets: RH and PA as written.
+#[derive(Debug, Clone, Copy)]
+struct Ramp {
+    rh: u8,
+    pa: u16,
+}
+
+impl Ramp {
+    fn of(a: &Action) -> Option<Ramp> {
+        let stmts = a.stmts();
+        let byte = |i: usize| match stmts.get(i) {
+            Some(crate::console::Stmt::WriteData { byte, .. }) => Some(*byte),
+            _ => None,
+        };
+        match a {
+            Action::Init { .. } => Some(Ramp {
+                rh: byte(2)?,
+                pa: u16::from_le_bytes([byte(3)?, byte(4)?]),
+            }),
+            _ => None,
+        }
+    }
 }
 
 impl Iterator for Program {
@@ -38,9 +66,47 @@ impl Iterator for Program {
     fn next(&mut self) -> Option<Action> {
         while self.pending.is_empty() {
             let bytes: Vec<u8> = (0..256).map(|_| self.rng.random()).collect();
-            self.pending.extend(actions::decode(&bytes));
+            for a in actions::decode(&bytes) {
+                self.push(a);
+            }
         }
         self.pending.pop_front()
+    }
+}
+
+impl Program {
+    fn push(&mut self, a: Action) {
+        if let Some(r) = Ramp::of(&a) {
+            self.ramp = Some(r);
+        }
+        match (a, self.ramp) {
+            // A probe of the stop latencies: a 1,000-step move and a
+            // Decelerating Stop written so that, on the reference board
+            // (Tclock 2 us), it takes effect 1 us before a pulse at high
+            // speed (Table 3-3: 17 us after the write). A stop that acts
+            // even 1 us late acts after that pulse instead, and the move
+            // ends a pulse later: the one departure a stop latency makes
+            // that the tolerances cannot absorb.
+            (Action::StopNearPulse { pulse, .. }, Some(r)) => {
+                let period = 2 * (u32::from(r.rh) + 1);
+                let cruise = 1_000u16.saturating_sub(2 * r.pa + 2).max(1);
+                self.pending.push_back(Action::AwaitIdle);
+                self.pending.push_back(Action::Move {
+                    kind: 1,
+                    ccw: pulse % 2 == 1,
+                    interrupt: true,
+                    pout: false,
+                    rate: 0,
+                    steps: 999,
+                });
+                self.pending.push_back(Action::StopNearPulse {
+                    decel: true,
+                    pulse: r.pa + pulse % cruise,
+                    micros: u8::try_from(period.saturating_sub(18)).unwrap_or(u8::MAX),
+                });
+            }
+            _ => self.pending.push_back(a),
+        }
     }
 }
 

@@ -215,6 +215,25 @@ pub fn lower(
                     Stmt::Set { input, asserted } => {
                         run(&mut c, bus::BusOp::Input { input, asserted }, &mut ops)?
                     }
+                    Stmt::AwaitPulse { count, timeout } => {
+                        // Time passes to that pulse (to the microsecond
+                        // after it), or not at all if the move will not
+                        // reach it in time.
+                        let deadline = c.board().now() + timeout.unwrap_or(second);
+                        while c.board().move_pulses() < count {
+                            let now = c.board().now();
+                            let Some(at) = c.board().predict_pulse(count) else {
+                                break;
+                            };
+                            if at > deadline {
+                                break;
+                            }
+                            let us = at.saturating_since(now).as_nanos().div_ceil(1_000).max(1);
+                            for op in bus::advances(Duration::from_micros(us)) {
+                                run(&mut c, op, &mut ops)?;
+                            }
+                        }
+                    }
                     Stmt::Pins | Stmt::Pulses | Stmt::Now => {}
                 }
             }
