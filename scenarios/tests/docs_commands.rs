@@ -469,7 +469,7 @@ fn every_documented_command_runs_as_shown() {
                     let in_ci = ci.contains(shown)
                         || (doc.command.starts_with("cargo +nightly fuzz run")
                             && ci.contains(
-                                "cargo +nightly fuzz run \"$target\" \"$scratch\" \"$seeds\"",
+                                "cargo +nightly fuzz run $(./flags \"$target\") \"$target\" \"$scratch\" \"$seeds\"",
                             ))
                         || (doc.command.starts_with("mkdir -p ../target/fuzz-corpus")
                             && ci.contains("scratch=\"$PWD/target/fuzz-corpus/$target\""));

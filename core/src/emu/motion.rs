@@ -108,11 +108,11 @@ pub(crate) struct AccelRamp {
     rl: u8,
     rh: u8,
     steps: u16,
-    /// Start-up and high speed in pulses per second, and VSEL low's term
-    /// in nanoseconds (the linear-speed curve's constants).
-    sl: f64,
-    sh: f64,
-    off: f64,
+    /// The start-up and high speed periods and VSEL low's term, in
+    /// nanoseconds (the linear-speed curve's constants).
+    pl: u64,
+    ph: u64,
+    off: u64,
 }
 
 impl AccelRamp {
@@ -132,9 +132,9 @@ impl AccelRamp {
             rl,
             rh,
             steps: pa.saturating_sub(1).max(1),
-            sl: 1e9 / period(rl).as_nanos() as f64,
-            sh: 1e9 / period(rh).as_nanos() as f64,
-            off: straps.vsel_offset(tclock).as_nanos() as f64,
+            pl: period(rl).as_nanos(),
+            ph: period(rh).as_nanos(),
+            off: straps.vsel_offset(tclock).as_nanos(),
         }
     }
 
@@ -148,10 +148,20 @@ impl AccelRamp {
         let (rl, rh) = (self.rl, self.rh);
         let r = match self.curve {
             AccelCurve::LinearSpeed => {
-                let speed = self.sl + (self.sh - self.sl) * f64::from(v) / pa_f;
-                let target_ns = 1e9 / speed;
-                let r = libm::round((target_ns - self.off) / self.tclock.as_nanos() as f64) - 1.0;
-                r.clamp(f64::from(rh), f64::from(rl)) as u8
+                // Speed linear in v from 1/pl to 1/ph over K = PA - 1 steps:
+                // the period is pl ph K / (ph K + (pl - ph) v). The rate
+                // value R is the one whose period (R + 1) Tclock + off is
+                // nearest, computed exactly; a tie (the period exactly
+                // between two rate values) goes to the slower one (notes
+                // N16, N49: floating point once put such ties either way).
+                let (pl, ph) = (u128::from(self.pl), u128::from(self.ph));
+                let k = u128::from(self.steps);
+                let den = ph * k + (pl - ph) * u128::from(v);
+                let num = (pl * ph * k).saturating_sub(u128::from(self.off) * den);
+                let step = den * u128::from(self.tclock.as_nanos().max(1));
+                let r1 = (2 * num + step) / (2 * step);
+                let r = r1.saturating_sub(1).clamp(u128::from(rh), u128::from(rl));
+                r as u8
             }
             AccelCurve::LinearRate => {
                 let drop = libm::round(f64::from(rl - rh) * f64::from(v) / pa_f) as u8;

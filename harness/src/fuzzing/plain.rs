@@ -622,7 +622,9 @@ impl PlainChip {
                 self.busy_fall()
             }
             Event::Decelerate { id, limit } if live(self, id) => self.decelerate(limit),
-            Event::HoldOn { epoch } if epoch == self.hold_epoch && self.mv.is_none() => {
+            // A timer: it fires even when the next move is already taken,
+            // and BUSY rising turns HOLD off again (N38).
+            Event::HoldOn { epoch } if epoch == self.hold_epoch => {
                 self.set_hold(true);
                 if self.setup.is_some_and(|s| s.switching) && !self.initializing {
                     self.set_switching(true);

@@ -118,6 +118,12 @@ impl Chip {
             self.halt(StopCause::StopCommand, base);
             return;
         }
+        if !m.pulses_left() {
+            // Past its last pulse (or halted): the stop changes nothing,
+            // error 7 included, since no deceleration is pending or
+            // running any more (notes N28, N49).
+            return;
+        }
         if m.decelerating() || m.decel_requested {
             self.set_error(ErrorCode::DecelStopDuringDecel);
             return;
