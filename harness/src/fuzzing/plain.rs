@@ -265,8 +265,6 @@ struct Move {
     index: i64,
     /// Constant-rate moves: their period.
     constant: Option<u64>,
-    /// The period being timed now, once the first pulse is out.
-    period: Option<u64>,
     tclock: Option<u64>,
     /// A deceleration is pending or running (error 7, notes N6).
     decelerating: bool,
@@ -336,7 +334,7 @@ pub struct PlainChip {
     finish: u8,
     remaining: u32,
     mv: Option<Move>,
-    last_move: u64,
+    move_seq: u64,
 
     pulses: Vec<(Instant, Direction)>,
     pins: Vec<PinEvent>,
@@ -384,7 +382,7 @@ impl PlainChip {
             finish: 0,
             remaining: 0,
             mv: None,
-            last_move: 0,
+            move_seq: 0,
             pulses: Vec::new(),
             pins: Vec::new(),
             exhausted: false,
@@ -952,8 +950,8 @@ impl PlainChip {
             ClockSource::Internal
         };
         let tclock = self.straps.tclock(source).map(|t| t.as_nanos());
-        self.last_move += 1;
-        let id = self.last_move;
+        self.move_seq += 1;
+        let id = self.move_seq;
         self.mv = Some(Move {
             id,
             op,
@@ -965,7 +963,6 @@ impl PlainChip {
             emitted: 0,
             index: -1,
             constant: rate.zip(tclock).map(|(r, t)| self.period(r, t)),
-            period: None,
             tclock,
             decelerating: false,
             cause: 0,
@@ -1129,15 +1126,11 @@ impl PlainChip {
                 self.ramp_period(k, tclock)
             }
         };
-        let m = self.mv.as_mut().expect("checked above");
-        m.period = Some(period);
+        let m = self.mv.as_ref().expect("checked above");
         let (id, pout) = (m.id, m.pout);
-        let over = self.over_limit(period, pout);
-        if self.starved && !over {
-            self.starved = false;
-        } else if over {
-            self.starved = true;
-        }
+        // Starved while the period being timed is over the speed limit,
+        // served again from the first pulse after which it is not (N7).
+        self.starved = self.over_limit(period, pout);
         self.schedule(now + period, Event::Pulse { id });
     }
 
