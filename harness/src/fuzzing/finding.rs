@@ -56,26 +56,10 @@ pub fn minimize(ops: &[BusOp], cfg: &ModelConfig, invariant: &str) -> Option<Min
         let before = best.clone();
         // Nothing after the op where the break shows matters.
         best.truncate(v.op + 1);
-        // Drop chunks, largest first.
-        let mut chunk = best.len().div_ceil(2).max(1);
-        loop {
-            let mut i = 0;
-            while i < best.len() {
-                let mut cand = best.clone();
-                cand.drain(i..(i + chunk).min(cand.len()));
-                match breaks(&cand) {
-                    Some(nv) => {
-                        best = cand;
-                        v = nv;
-                    }
-                    None => i += chunk,
-                }
-            }
-            if chunk == 1 {
-                break;
-            }
-            chunk = chunk.div_ceil(2);
-        }
+        drop_chunks(&mut best, |cand| {
+            v = breaks(&cand)?;
+            Some(cand)
+        });
         // Merge neighbouring waits.
         let merged = merge_waits(&best);
         if merged != best {
@@ -135,6 +119,33 @@ pub fn minimize(ops: &[BusOp], cfg: &ModelConfig, invariant: &str) -> Option<Min
         violation: v,
         tries,
     })
+}
+
+/// Drops chunks of `ops`, largest first (half the ops, then halving the
+/// chunk down to single ops): each candidate goes to `keep`, which gives
+/// back what to keep when the candidate still fails (the candidate, or a
+/// cut of it), `None` when it does not. Shared by the oracle's minimizer
+/// and the two-model one ([`super::twin::minimize`]).
+pub(crate) fn drop_chunks(
+    ops: &mut Vec<BusOp>,
+    mut keep: impl FnMut(Vec<BusOp>) -> Option<Vec<BusOp>>,
+) {
+    let mut chunk = ops.len().div_ceil(2).max(1);
+    loop {
+        let mut i = 0;
+        while i < ops.len() {
+            let mut cand = ops.clone();
+            cand.drain(i..(i + chunk).min(cand.len()));
+            match keep(cand) {
+                Some(kept) => *ops = kept,
+                None => i += chunk,
+            }
+        }
+        if chunk == 1 {
+            break;
+        }
+        chunk = chunk.div_ceil(2);
+    }
 }
 
 /// Neighbouring waits as one.

@@ -13,7 +13,8 @@
 use super::bus::{self, BusOp};
 use super::plain::PlainChip;
 use crate::emu::{Board, ModelConfig};
-use crate::protocol::{Pin, PinEvent, Straps};
+use crate::protocol::{Direction, Pin, PinEvent, PulseRun, Straps};
+use crate::time::Instant;
 use std::fmt;
 
 /// Where the two models first differ.
@@ -79,6 +80,8 @@ pub fn check_against(
     };
     let mut plain = PlainChip::new(straps, plain.clone());
     let mut seen = Agreement::default();
+    // The emulator's next unread pulse: run index and pulse within it.
+    let mut cursor = (0usize, 0u32);
     let mut fast_pins = Changes::default();
     let mut plain_pins = Changes::default();
     for (i, &op) in ops.iter().enumerate() {
@@ -117,7 +120,7 @@ pub fn check_against(
                 plain_pins.last(3)
             )));
         }
-        let pulses: Vec<_> = fast.record().pulses().skip(seen.pulses).collect();
+        let pulses = fresh_pulses(&fast.record().runs, &mut cursor);
         let theirs = &plain.pulses()[seen.pulses.min(plain.pulses().len())..];
         for (k, (x, y)) in pulses.iter().zip(theirs).enumerate() {
             if x != y {
@@ -170,6 +173,23 @@ pub fn check_against(
         seen.ops = i + 1;
     }
     Ok(seen)
+}
+
+/// The pulses of `runs` from `cursor` on, one by one, and the cursor moved
+/// past them. Only the last run of a record grows, so what came before
+/// the cursor is never read again: a check costs time linear in its
+/// pulses, not quadratic.
+fn fresh_pulses(runs: &[PulseRun], cursor: &mut (usize, u32)) -> Vec<(Instant, Direction)> {
+    let mut out = Vec::new();
+    while let Some(r) = runs.get(cursor.0) {
+        out.extend((cursor.1..r.count).map(|i| (r.at(i), r.dir)));
+        if cursor.0 + 1 == runs.len() {
+            cursor.1 = r.count;
+            break;
+        }
+        *cursor = (cursor.0 + 1, 0);
+    }
+    out
 }
 
 /// Applies one op to the plain model; the byte a read returned.
@@ -247,25 +267,11 @@ pub fn minimize(
     let mut found = check(&best, straps, cfg).err()?;
     // Nothing after the op where they first differ matters.
     best.truncate(found.op + 1);
-    let mut chunk = best.len().div_ceil(2).max(1);
-    loop {
-        let mut i = 0;
-        while i < best.len() {
-            let mut trial = best.clone();
-            trial.drain(i..(i + chunk).min(trial.len()));
-            match check(&trial, straps, cfg) {
-                Err(d) => {
-                    trial.truncate(d.op + 1);
-                    best = trial;
-                    found = d;
-                }
-                Ok(_) => i += chunk,
-            }
-        }
-        if chunk == 1 {
-            break;
-        }
-        chunk = chunk.div_ceil(2);
-    }
+    super::finding::drop_chunks(&mut best, |mut trial| {
+        let d = check(&trial, straps, cfg).err()?;
+        trial.truncate(d.op + 1);
+        found = d;
+        Some(trial)
+    });
     Some((best, found))
 }
