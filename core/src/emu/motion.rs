@@ -24,11 +24,7 @@ use crate::protocol::{Direction, MoveKind, StopCause, Straps};
 use crate::time::{Duration, Instant};
 use alloc::sync::Arc;
 use alloc::vec::Vec;
-
-/// The most ramp pulses one stretch covers: finding a stretch's end costs
-/// a step per pulse, so a stretch cut short by the next timer (a host
-/// operation, an input) wastes at most this much.
-const RAMP_STRETCH_MAX: u32 = 64;
+use core::cell::Cell;
 
 /// The periods a move is built from.
 #[derive(Debug, Clone)]
@@ -40,66 +36,113 @@ pub(crate) enum Profile {
     Ramped { ramp: Ramp, cruise: Duration },
 }
 
-/// The periods between the PA acceleration pulses (PA - 1 of them),
-/// computed when a move first needs them ([`Ramp::cover`]) and kept for the
-/// moves after it: an initialization costs nothing per acceleration pulse,
-/// and a short move only the periods it can reach.
+/// The periods between the PA acceleration pulses (PA - 1 speed indices).
+/// The rate grid is coarser than the ramp, so consecutive indices share a
+/// period: the ramp is kept as steps, at most one per rate value (so at
+/// most 254 for up to 11,219 indices), each found in closed form
+/// ([`AccelRamp::end_of`]). They are computed when a move first needs them
+/// ([`Ramp::cover`]) and kept for the moves after it: an initialization
+/// costs nothing, and a short move only the steps it can reach.
 #[derive(Debug, Clone)]
 pub(crate) struct Ramp {
     /// Where the periods come from (`None`: given outright, in tests).
     accel: Option<AccelRamp>,
-    /// The periods of indices `0..table.len()`.
-    table: Arc<[Duration]>,
+    /// `(first index, period)` of each step, first indices rising from 0;
+    /// a step runs up to the next one's first index, the last one up to
+    /// `covered`.
+    steps: Arc<[(u32, Duration)]>,
+    /// The step last asked for: a move asks for the step of the same
+    /// index, or the next one, a few times a stretch.
+    hint: Cell<usize>,
+    /// The indices `0..covered` are in `steps`.
+    covered: u32,
+    /// PA - 1: the speed index of the cruise.
+    len: u32,
 }
 
 impl Ramp {
     pub(crate) fn new(accel: AccelRamp) -> Ramp {
         Ramp {
             accel: Some(accel),
-            table: Arc::from(Vec::new()),
+            steps: Arc::from(Vec::new()),
+            hint: Cell::new(0),
+            covered: 0,
+            len: accel.len(),
         }
     }
 
     /// Every period given (the motion tests).
     #[cfg(test)]
     fn table(periods: Vec<Duration>) -> Ramp {
+        let mut steps: Vec<(u32, Duration)> = Vec::new();
+        for (v, d) in periods.iter().enumerate() {
+            if steps.last().is_none_or(|s| s.1 != *d) {
+                steps.push((v as u32, *d));
+            }
+        }
         Ramp {
             accel: None,
-            table: periods.into(),
+            steps: steps.into(),
+            hint: Cell::new(0),
+            covered: periods.len() as u32,
+            len: periods.len() as u32,
         }
     }
 
-    /// Computes the periods of indices below `need` not computed yet.
+    /// Computes the steps holding the indices below `need` not computed
+    /// yet: two divisions a step, whatever its length.
     pub(crate) fn cover(&mut self, need: u32) {
-        let need = need.min(self.len());
-        let have = self.table.len() as u32;
-        if let Some(a) = self.accel.filter(|_| have < need) {
-            let mut t = self.table.to_vec();
-            t.extend((have..need).map(|v| a.period(v)));
-            self.table = t.into();
+        let need = need.min(self.len);
+        let Some(a) = self.accel.filter(|_| self.covered < need) else {
+            return;
+        };
+        let mut steps = self.steps.to_vec();
+        let mut v = self.covered;
+        while v < need {
+            let r = a.rate(v);
+            // The rate falls as the index rises, so the step ends where the
+            // indices at rate `r` or above end.
+            let end = a.end_of(r).max(v + 1);
+            steps.push((v, a.interval(r)));
+            v = end;
         }
+        self.covered = v;
+        self.steps = steps.into();
     }
 
-    /// PA - 1: the speed index of the cruise.
-    fn len(&self) -> u32 {
-        self.accel.map_or(self.table.len() as u32, |a| a.len())
+    /// The step holding speed index `v`: its first and last index and its
+    /// period; `None` at the cruise index and above.
+    fn step_of(&self, v: u32) -> Option<(u32, u32, Duration)> {
+        if v >= self.len {
+            return None;
+        }
+        if v >= self.covered {
+            // Past what a move asked for (never, as moves cover their
+            // reach): the index on its own.
+            let a = self.accel?;
+            return Some((v, v, a.interval(a.rate(v))));
+        }
+        let end = |i: usize| self.steps.get(i + 1).map_or(self.covered, |s| s.0);
+        let holds = |i: usize| self.steps.get(i).is_some_and(|s| s.0 <= v) && v < end(i);
+        let near = self.hint.get();
+        let i = [near, near + 1, near.wrapping_sub(1)]
+            .into_iter()
+            .find(|&i| holds(i))
+            .or_else(|| self.steps.partition_point(|s| s.0 <= v).checked_sub(1))?;
+        self.hint.set(i);
+        let (first, d) = self.steps[i];
+        Some((first, end(i) - 1, d))
     }
 
     fn period(&self, v: u32) -> Option<Duration> {
-        if v >= self.len() {
-            return None;
-        }
-        match (self.table.get(v as usize), &self.accel) {
-            (Some(d), _) => Some(*d),
-            (None, Some(a)) => Some(a.period(v)),
-            (None, None) => None,
-        }
+        self.step_of(v).map(|(_, _, d)| d)
     }
 }
 
 /// The acceleration from the start-up rate RL towards the high speed rate
-/// RH, on the chip's rate grid `(R + 1) x Tclock (+ 7.5 us)`: the period
-/// after acceleration pulse `v` (of PA - 1) by [`AccelRamp::period`].
+/// RH, on the chip's rate grid `(R + 1) x Tclock (+ 7.5 us)`: the rate
+/// value after acceleration pulse `v` (of PA - 1) by [`AccelRamp::rate`],
+/// and where each rate value's indices end by [`AccelRamp::end_of`].
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct AccelRamp {
     curve: AccelCurve,
@@ -116,6 +159,8 @@ pub(crate) struct AccelRamp {
 }
 
 impl AccelRamp {
+    /// The ramp from `rl` down to `rh` (`rh < rl`, as an initialization
+    /// checks) over `pa` acceleration pulses.
     pub(crate) fn new(
         curve: AccelCurve,
         straps: &Straps,
@@ -130,10 +175,10 @@ impl AccelRamp {
             straps: *straps,
             tclock,
             rl,
-            rh,
+            rh: rh.min(rl),
             steps: pa.saturating_sub(1).max(1),
             pl: period(rl).as_nanos(),
-            ph: period(rh).as_nanos(),
+            ph: period(rh.min(rl)).as_nanos(),
             off: straps.vsel_offset(tclock).as_nanos(),
         }
     }
@@ -142,11 +187,16 @@ impl AccelRamp {
         u32::from(self.steps)
     }
 
-    /// The period after acceleration pulse `v` (`v < PA - 1`).
-    fn period(&self, v: u32) -> Duration {
-        let pa_f = f64::from(self.steps);
+    fn interval(&self, r: u8) -> Duration {
+        self.straps.pulse_interval(r, self.tclock)
+    }
+
+    /// The rate value after acceleration pulse `v` (`v < PA - 1`).
+    fn rate(&self, v: u32) -> u8 {
         let (rl, rh) = (self.rl, self.rh);
-        let r = match self.curve {
+        let k = u128::from(self.steps);
+        let v = u128::from(v);
+        match self.curve {
             AccelCurve::LinearSpeed => {
                 // Speed linear in v from 1/pl to 1/ph over K = PA - 1 steps:
                 // the period is pl ph K / (ph K + (pl - ph) v). The rate
@@ -155,20 +205,57 @@ impl AccelRamp {
                 // between two rate values) goes to the slower one (notes
                 // N16, N49: floating point once put such ties either way).
                 let (pl, ph) = (u128::from(self.pl), u128::from(self.ph));
-                let k = u128::from(self.steps);
-                let den = ph * k + (pl - ph) * u128::from(v);
+                let den = ph * k + (pl - ph) * v;
                 let num = (pl * ph * k).saturating_sub(u128::from(self.off) * den);
-                let step = den * u128::from(self.tclock.as_nanos().max(1));
+                let step = den * self.tc();
                 let r1 = (2 * num + step) / (2 * step);
-                let r = r1.saturating_sub(1).clamp(u128::from(rh), u128::from(rl));
-                r as u8
+                r1.saturating_sub(1).clamp(u128::from(rh), u128::from(rl)) as u8
             }
             AccelCurve::LinearRate => {
-                let drop = libm::round(f64::from(rl - rh) * f64::from(v) / pa_f) as u8;
-                rl - drop
+                // RL - (RL - RH) v / K, rounded half up.
+                let span = u128::from(rl - rh);
+                let drop = (2 * span * v + k) / (2 * k);
+                rl - drop.min(span) as u8
+            }
+        }
+    }
+
+    /// How many indices have a rate value of `r` or above: where the step
+    /// at `r` ends, as the rate never rises with the index. Closed forms of
+    /// [`AccelRamp::rate`]'s roundings, checked against it index by index
+    /// in the tests.
+    fn end_of(&self, r: u8) -> u32 {
+        if r <= self.rh {
+            return self.len();
+        }
+        let k = u128::from(self.steps);
+        let n = match self.curve {
+            AccelCurve::LinearSpeed => {
+                // rate >= r  <=>  r1 >= m = r + 1  <=>  2 num >= (2m - 1) step
+                // <=>  den <= 2 pl ph K / (2 off + (2m - 1) Tclock)  (num
+                // saturating at 0 changes nothing: it fails both sides).
+                let (pl, ph) = (u128::from(self.pl), u128::from(self.ph));
+                let m = u128::from(r) + 1;
+                let most = 2 * pl * ph * k / (2 * u128::from(self.off) + (2 * m - 1) * self.tc());
+                match most.checked_sub(ph * k) {
+                    // den = ph K + (pl - ph) v
+                    Some(room) => room / (pl - ph) + 1,
+                    None => 0,
+                }
+            }
+            AccelCurve::LinearRate => {
+                // rate >= r  <=>  drop <= rl - r  <=>  2 span v + K < 2 m K
+                // with m = rl - r + 1  <=>  v < (2m - 1) K / (2 span).
+                let span = u128::from(self.rl - self.rh);
+                let m = u128::from(self.rl - r) + 1;
+                ((2 * m - 1) * k).div_ceil(2 * span)
             }
         };
-        self.straps.pulse_interval(r, self.tclock)
+        n.min(k) as u32
+    }
+
+    fn tc(&self) -> u128 {
+        u128::from(self.tclock.as_nanos().max(1))
     }
 }
 
@@ -240,7 +327,7 @@ impl Motion {
     fn cruise_index(&self) -> u32 {
         match &self.profile {
             Profile::Constant { .. } => 0,
-            Profile::Ramped { ramp, .. } => ramp.len(),
+            Profile::Ramped { ramp, .. } => ramp.len,
         }
     }
 
@@ -300,53 +387,38 @@ impl Motion {
         }
     }
 
-    /// The ramp pulses from `j` on that are one period apart: the period
-    /// after a speed index falls as the index grows (the rate grid is
-    /// coarser than the ramp), so the indices sharing pulse `j`'s period
-    /// are a range, found by galloping out from `j`'s; the pulses follow
-    /// while their speed index stays in it, [`RAMP_STRETCH_MAX`] at most.
+    /// The ramp pulses from `j` on that are one period apart: those whose
+    /// speed index stays in the ramp step holding pulse `j`'s. Found in
+    /// O(1) from the shape of [`Motion::speed`]: the index rises (by one a
+    /// pulse) only where it equals the pulse number, and once it has
+    /// stopped rising it never rises again but falls, by at most one a
+    /// pulse. So the pulses leave the step upwards only at pulse `hi + 1`,
+    /// where the index would be `hi + 1`, and downwards at the first pulse
+    /// where one of the falling bounds of the index drops below `lo`.
     fn ramp_stretch(&self, ramp: &Ramp, cruise: Duration, j: u32, left: u32) -> (Duration, u32) {
-        let d = self.interval_after(j);
-        // Ramp indices only: cruise (index PA) is a stretch of its own.
-        let top = self.cruise_index().saturating_sub(1);
-        let per = |v: u32| ramp.period(v).unwrap_or(cruise);
         let v0 = self.speed(j);
-        if v0 > top {
-            return (d, 1);
-        }
-        // Largest index up from v0 (at most top), smallest down, with d.
-        let gallop = |up: bool| {
-            let (mut good, mut step) = (0u32, 1u32);
-            let room = (if up { top - v0 } else { v0 }).min(RAMP_STRETCH_MAX);
-            loop {
-                let probe = good.saturating_add(step).min(room);
-                let v = if up { v0 + probe } else { v0 - probe };
-                if probe == good || per(v) != d {
-                    break;
-                }
-                good = probe;
-                step = step.saturating_mul(2);
-            }
-            // Narrow between good (d) and good + step (not d, or past room).
-            let mut bad = good.saturating_add(step).min(room + 1);
-            while bad - good > 1 {
-                let mid = good + (bad - good) / 2;
-                let v = if up { v0 + mid } else { v0 - mid };
-                if per(v) == d {
-                    good = mid;
-                } else {
-                    bad = mid;
-                }
-            }
-            good
+        // The cruise (index PA) is a stretch of its own.
+        let Some((lo, hi, d)) = ramp.step_of(v0) else {
+            return (cruise, 1);
         };
-        let (hi, lo) = (v0 + gallop(true), v0 - gallop(false));
-        let most = left.min(RAMP_STRETCH_MAX);
-        let mut count = 1;
-        while count < most && (lo..=hi).contains(&self.speed(j + count - 1)) {
-            count += 1;
+        let (j, lo) = (i64::from(j), i64::from(lo));
+        // The first pulse past `j` whose following period is not `d`.
+        let mut exit = j + i64::from(left);
+        let up = hi + 1;
+        if i64::from(up) > j && self.speed(up) > hi {
+            exit = exit.min(i64::from(up));
         }
-        (d, count)
+        if lo > 0 {
+            // total - 2 - k < lo, and c - 1 - (k - j0) < lo from j0 on.
+            exit = exit.min(i64::from(self.total) - 1 - lo);
+            if let Some((j0, c)) = self.decel {
+                let j0 = i64::from(j0);
+                exit = exit.min(j0 + (i64::from(c) - lo).max(0));
+            }
+        }
+        // Pulse j and one more for each index in the step from j on.
+        let count = (exit - j + 1).clamp(1, i64::from(left));
+        (d, count as u32)
     }
 
     /// Whether the next stretch is on the ramp (each pulse recorded as if
@@ -507,6 +579,122 @@ mod tests {
             .map(|w| w[1].saturating_since(w[0]).as_nanos() / 1_000)
             .collect();
         assert_eq!(gaps, one_by_one);
+    }
+
+    /// The ramp's steps, found in closed form, hold exactly the rate
+    /// [`AccelRamp::rate`] gives each index, and each step is as long as
+    /// it can be: on both curves, over straps whose clocks and VSEL term
+    /// differ, and rates and PA from the smallest to the largest.
+    #[test]
+    fn ramp_steps_hold_the_rate_of_every_index() {
+        let ext = |hz| Straps {
+            ext_clock_hz: Some(hz),
+            ..Straps::default()
+        };
+        let straps = [
+            Straps::default(),
+            Straps {
+                csel_high: false,
+                vsel_high: false,
+                ..Straps::default()
+            },
+            Straps {
+                sysclk_hz: 40_000_000,
+                vsel_high: false,
+                ..Straps::default()
+            },
+            ext(115_200),
+        ];
+        let rates = [(254, 1), (254, 253), (2, 1), (200, 33), (100, 99), (37, 5)];
+        let pas = [1, 2, 3, 7, 100, 1_001, 5_435, 11_220];
+        for curve in [AccelCurve::LinearSpeed, AccelCurve::LinearRate] {
+            for s in &straps {
+                let tclock = s
+                    .tclock(crate::protocol::ClockSource::Internal)
+                    .or(s.tclock(crate::protocol::ClockSource::External))
+                    .expect("a clock");
+                for &(rl, rh) in &rates {
+                    for &pa in &pas {
+                        let a = AccelRamp::new(curve, s, tclock, rl, rh, pa);
+                        let mut ramp = Ramp::new(a);
+                        // Covered in two goes, as two moves would.
+                        ramp.cover(a.len() / 3);
+                        ramp.cover(a.len());
+                        for v in 0..a.len() {
+                            let (first, last, d) = ramp.step_of(v).expect("a ramp index");
+                            let at = |i| a.interval(a.rate(i));
+                            let case = (curve, s, rl, rh, pa, v);
+                            assert_eq!(d, at(v), "{case:?}");
+                            assert!(first <= v && v <= last, "{case:?}");
+                            assert!(first == 0 || at(first - 1) != d, "{case:?}");
+                            assert!(last + 1 == a.len() || at(last + 1) != d, "{case:?}");
+                        }
+                        assert_eq!(ramp.step_of(a.len()), None);
+                    }
+                }
+            }
+        }
+    }
+
+    proptest::proptest! {
+        /// A ramp stretch found in O(1) is the run of pulses one period
+        /// apart that walking them pulse by pulse finds: on trapezoids and
+        /// triangles, with or without an early deceleration.
+        #[test]
+        fn ramp_stretches_are_the_pulses_one_period_apart(
+            drops in proptest::collection::vec(0u64..3, 1..40),
+            total in 1u32..120,
+            stop_at in proptest::option::of(0u32..120),
+        ) {
+            let mut us = 300;
+            let table: Vec<Duration> = drops
+                .iter()
+                .map(|d| {
+                    us -= d;
+                    Duration::from_micros(us)
+                })
+                .collect();
+            let mut m = Motion::new(
+                1,
+                MoveKind::AccelDecel,
+                Direction::Cw,
+                false,
+                true,
+                Instant::ZERO,
+                total,
+                Some(Instant::ZERO),
+                Profile::Ramped {
+                    ramp: Ramp::table(table),
+                    cruise: Duration::from_micros(42),
+                },
+            );
+            while m.pulses_left() {
+                if stop_at == Some(m.emitted) {
+                    m.begin_decel();
+                    if !m.pulses_left() {
+                        break;
+                    }
+                }
+                let (d, n) = m.constant_stretch();
+                let j = m.emitted;
+                if m.on_ramp() {
+                    let mut walked = 1;
+                    while j + walked < m.end && m.interval_after(j + walked - 1) == d {
+                        walked += 1;
+                    }
+                    // The stretch ends where the period changes (the
+                    // table's steps hold every run of equal periods), or
+                    // at the last pulse.
+                    proptest::prop_assert_eq!(n, walked, "pulse {}", j);
+                }
+                // Stop where asked even inside a stretch.
+                let n = match stop_at {
+                    Some(s) if s > j && s < j + n => s - j,
+                    _ => n,
+                };
+                m.emitted += n;
+            }
+        }
     }
 
     #[test]

@@ -238,9 +238,16 @@ impl Chip {
             self.halt(StopCause::Limit, now);
         } else if kind == MoveKind::OriginSearch && inputs.contains(Input::Cnp) {
             self.halt(StopCause::Completed, now);
-        } else if kind.ramped() && !pout && inputs.contains(Input::high_speed_limit_for(dir)) {
+        } else if kind.ramped()
+            && !pout
+            && !m.decel_requested
+            && inputs.contains(Input::high_speed_limit_for(dir))
+        {
             // Detected before the first pulse: decelerate from standstill,
-            // which leaves the one pulse already being timed.
+            // which leaves the one pulse already being timed. A
+            // deceleration already requested (a Decelerating Stop waiting
+            // for its latency) makes the limit change nothing, as during
+            // the move (notes N27, N49).
             if let Some(m) = self.motion.as_mut() {
                 if m.begin_decel() {
                     m.cause = StopCause::HighSpeedLimit;
