@@ -15,6 +15,39 @@ fn replay(target: &str, body: fn(&[u8])) -> usize {
     inputs.len()
 }
 
+/// The fuzz targets reuse one checker, reset, for input after input: a
+/// reset checker (chip, board and judge) runs every committed input to the
+/// state a fresh one reaches, whatever it ran before, on a plain board and
+/// on one whose outputs are miswired (the board keeps a record of its own).
+#[test]
+fn a_reset_checker_runs_as_a_fresh_one() {
+    use ppmc::emu::{BoardFaults, ModelConfig};
+    use ppmc::fuzzing::{bus, oracle::Checker};
+    let inputs = common::fuzz_inputs("bus_bytes");
+    assert!(inputs.len() > 50, "the corpus is there");
+    for cfg in [
+        ModelConfig::default(),
+        ModelConfig {
+            board: BoardFaults {
+                dir_inverted: true,
+                ..BoardFaults::default()
+            },
+            ..ModelConfig::default()
+        },
+    ] {
+        let mut reused = Checker::new(cfg.clone()).expect("a valid configuration");
+        for (f, data) in &inputs {
+            let run = |c: &mut Checker| {
+                let verdict = bus::decode(data).into_iter().try_for_each(|op| c.apply(op));
+                (verdict.and_then(|()| c.finish()), format!("{c:?}"))
+            };
+            let mut fresh = Checker::new(cfg.clone()).expect("a valid configuration");
+            reused.reset();
+            assert_eq!(run(&mut reused), run(&mut fresh), "{}", f.display());
+        }
+    }
+}
+
 #[test]
 fn frame_decoder_corpus_replays() {
     let n = replay("frame_decoder", ppmc::fuzzing::frame_decoder);

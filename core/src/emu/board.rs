@@ -155,6 +155,20 @@ impl Board {
         })
     }
 
+    /// Back to the board [`Board::new`] made, keeping the memory of the
+    /// chip's record and timers ([`Chip::reset`]).
+    pub fn reset(&mut self) {
+        self.chip.reset();
+        if let Some(seen) = self.seen.as_mut() {
+            let mut record = core::mem::take(&mut seen.record);
+            record.clear();
+            *seen = Seen {
+                record,
+                ..Seen::default()
+            };
+        }
+    }
+
     /// The model itself, without the board.
     pub fn chip(&self) -> &Chip {
         &self.chip

@@ -61,6 +61,20 @@ impl PulseRun {
         }
     }
 
+    /// Whether the pulses are exactly `interval` apart (always, for a single
+    /// pulse): [`PulseRun::is_exact`] with that [`PulseRun::interval`],
+    /// without a division.
+    pub fn spaced(&self, interval: Duration) -> bool {
+        self.jitter == Duration::ZERO
+            && match self.count {
+                0 => interval == Duration::ZERO,
+                1 => true,
+                n => {
+                    interval.as_nanos().checked_mul(u64::from(n - 1)) == Some(self.span.as_nanos())
+                }
+            }
+    }
+
     /// Whether the pulses are equally spaced to the nanosecond.
     pub fn is_exact(&self) -> bool {
         self.jitter == Duration::ZERO
@@ -279,6 +293,14 @@ pub struct Record {
 }
 
 impl Record {
+    /// Empties the record, keeping the memory it had.
+    pub fn clear(&mut self) {
+        self.runs.clear();
+        self.pins.clear();
+        self.moves.clear();
+        self.overwritten_bytes = 0;
+    }
+
     /// Appends `count` pulses spaced exactly `interval` apart starting at
     /// `start`, merging with the previous run when the spacing continues
     /// it.
@@ -296,11 +318,10 @@ impl Record {
         let run = PulseRun::exact(start, interval, count, dir);
         if !new_move {
             if let Some(last) = self.runs.last_mut() {
-                if last.dir == dir && last.is_exact() {
-                    let gap = start.saturating_since(last.last());
-                    let spacing_matches = last.count == 1 || last.interval() == gap;
+                let gap = start.saturating_since(last.last());
+                if last.dir == dir && last.spaced(gap) {
                     let continues = count == 1 || interval == gap;
-                    if spacing_matches && continues && gap > Duration::ZERO {
+                    if continues && gap > Duration::ZERO {
                         last.count += count;
                         last.span = run.last().saturating_since(last.start);
                         return;
@@ -332,8 +353,7 @@ impl Record {
         }
         let rest = count - 1;
         if let Some(last) = self.runs.last_mut() {
-            let joins = last.count == 1 || last.interval() == interval;
-            if joins && interval > Duration::ZERO && last.is_exact() {
+            if interval > Duration::ZERO && last.spaced(interval) {
                 last.count += rest;
                 last.span += interval.saturating_mul(u64::from(rest));
                 return;

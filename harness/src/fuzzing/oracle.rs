@@ -9,6 +9,7 @@ use crate::protocol::{
     Command, FinishStatus, InitData, MoveKind, Register, Status, StatusField, Straps,
 };
 use crate::time::{Duration, Instant};
+use std::cell::Cell;
 use std::fmt;
 
 /// Largest number of parameter bytes any command takes (Initialization,
@@ -61,13 +62,23 @@ impl fmt::Display for Violation {
 
 /// Runs `ops` on a fresh chip and returns the first invariant break.
 pub fn check(ops: &[BusOp], cfg: ModelConfig) -> Result<Option<Violation>, ChipError> {
-    let mut c = Checker::new(cfg)?;
-    for op in ops {
-        if let Err(v) = c.apply(*op) {
-            return Ok(Some(v));
-        }
+    // A fuzz target checks an input after another on one thread: the
+    // checker of the last one, reset, keeps the memory it grew (and stays
+    // off the stack, where AddressSanitizer's fake stack makes a large
+    // frame costly).
+    thread_local! {
+        static SPARE: Cell<Option<Box<Checker>>> = const { Cell::new(None) };
     }
-    Ok(c.finish().err())
+    let mut c = match SPARE.take() {
+        Some(mut c) if *c.board.chip().config() == cfg => {
+            c.reset();
+            c
+        }
+        _ => Box::new(Checker::new(cfg)?),
+    };
+    let verdict = c.run(ops);
+    SPARE.set(Some(c));
+    Ok(verdict)
 }
 
 /// A byte the host wrote, to the command or the data register.
@@ -128,6 +139,19 @@ impl Judge {
             straps,
             ..Judge::default()
         }
+    }
+
+    /// Back to a new judge, keeping the memory of its byte lists.
+    pub fn reset(&mut self) {
+        let mut taken = std::mem::take(&mut self.taken);
+        let mut finish_reads = std::mem::take(&mut self.finish_reads);
+        taken.clear();
+        finish_reads.clear();
+        *self = Judge {
+            taken,
+            finish_reads,
+            ..Judge::new(self.straps)
+        };
     }
 
     /// Judges op number `self.ops` given what was seen of it and the
@@ -320,7 +344,23 @@ impl Judge {
     /// (255 > RL > RH > 0), on the clock each selects. A move whose
     /// command bytes it did not see all taken is not judged.
     fn interval_breaks(&self, rec: &Record) -> Option<String> {
+        // The initializations taken so far, as the moves come (both in time
+        // order): the fastest RH period among them, and the clocks they
+        // chose. One pass, however many moves and bytes.
+        let inits = self.inits();
+        let mut next_init = inits.iter().peekable();
+        let mut fastest_rh: Option<Duration> = None;
+        let mut tclocks: Vec<Duration> = Vec::new();
         for (k, m) in rec.moves.iter().enumerate() {
+            while let Some((_, clock, data)) = next_init.next_if(|(done, _, _)| *done <= m.at) {
+                if let Some(tclock) = self.straps.tclock(*clock) {
+                    let rh = self.straps.pulse_interval(data.rh, tclock);
+                    fastest_rh = Some(fastest_rh.map_or(rh, |f| f.min(rh)));
+                    if !tclocks.contains(&tclock) {
+                        tclocks.push(tclock);
+                    }
+                }
+            }
             let Some(params) = self.params_of(m) else {
                 continue;
             };
@@ -333,14 +373,15 @@ impl Judge {
                     Some(params[0])
                 }
             };
-            let bound = self
-                .inits_before(m.at)
-                .filter_map(|(clock, data)| {
-                    let tclock = self.straps.tclock(clock)?;
-                    let rate = own_rate.unwrap_or(data.rh);
-                    Some(self.straps.pulse_interval(rate, tclock))
-                })
-                .min();
+            let bound = match own_rate {
+                // The period is not monotonic in Tclock (VSEL low's term
+                // shrinks as it grows): every clock chosen is tried.
+                Some(rate) => tclocks
+                    .iter()
+                    .map(|t| self.straps.pulse_interval(rate, *t))
+                    .min(),
+                None => fastest_rh,
+            };
             let Some(bound) = bound else {
                 continue;
             };
@@ -363,7 +404,7 @@ impl Judge {
     /// The parameter bytes of move `m`: the data bytes the chip took after
     /// the last command byte it took by `m.at`, if that command is the
     /// move's and they are all there.
-    fn params_of(&self, m: &MoveStart) -> Option<Vec<u8>> {
+    fn params_of(&self, m: &MoveStart) -> Option<[u8; MAX_PARAMS as usize]> {
         let upto = self.taken.partition_point(|(t, _)| *t <= m.at);
         let taken = &self.taken[..upto];
         let k = taken
@@ -375,26 +416,27 @@ impl Judge {
         let Command::Move(mc) = Command::decode(c) else {
             return None;
         };
-        let params: Vec<u8> = taken[k + 1..]
-            .iter()
-            .filter_map(|(_, w)| match w {
-                Written::Data(b) => Some(*b),
-                Written::Command(_) => None,
-            })
-            .collect();
-        (mc.kind == m.kind && params.len() == usize::from(mc.kind.param_count())).then_some(params)
+        let mut params = [0; MAX_PARAMS as usize];
+        let mut n = 0;
+        for (_, w) in &taken[k + 1..] {
+            if let Written::Data(b) = w {
+                if let Some(slot) = params.get_mut(n) {
+                    *slot = *b;
+                }
+                n += 1;
+            }
+        }
+        (mc.kind == m.kind && n == usize::from(mc.kind.param_count())).then_some(params)
     }
 
-    /// Every initialization the chip took whose four data bytes were all
-    /// written by `at`, with rates Section 3-2-2 allows.
-    fn inits_before(
-        &self,
-        at: Instant,
-    ) -> impl Iterator<Item = (crate::protocol::ClockSource, InitData)> + '_ {
+    /// Every initialization the chip took with rates Section 3-2-2 allows,
+    /// in time order: when its fourth data byte was taken, its clock and
+    /// its data.
+    fn inits(&self) -> Vec<(Instant, crate::protocol::ClockSource, InitData)> {
         self.taken
             .iter()
             .enumerate()
-            .filter_map(move |(k, &(t, w))| {
+            .filter_map(|(k, &(_, w))| {
                 let Written::Command(c) = w else {
                     return None;
                 };
@@ -402,15 +444,21 @@ impl Judge {
                     return None;
                 };
                 let mut data = [0u8; 4];
+                let mut done = None;
                 for (i, slot) in data.iter_mut().enumerate() {
                     match self.taken.get(k + 1 + i) {
-                        Some(&(t, Written::Data(b))) if t <= at => *slot = b,
+                        Some(&(t, Written::Data(b))) => {
+                            *slot = b;
+                            done = Some(t);
+                        }
                         _ => return None,
                     }
                 }
                 let d = InitData::from_bytes(data);
-                (t <= at && 0 < d.rh && d.rh < d.rl && d.rl < 255).then_some((ic.clock, d))
+                let legal = 0 < d.rh && d.rh < d.rl && d.rl < 255;
+                legal.then_some((done?, ic.clock, d))
             })
+            .collect()
     }
 
     /// Checks a register read once all its bytes are in: the remaining
@@ -468,6 +516,8 @@ pub struct Checker {
     /// The model on its board: the oracle reads status as a host does.
     board: Board,
     judge: Judge,
+    /// The status register after the last op (none before the first).
+    status: Option<Status>,
 }
 
 impl Checker {
@@ -475,6 +525,7 @@ impl Checker {
         Ok(Checker {
             board: Board::new(Straps::default(), cfg)?,
             judge: Judge::new(Straps::default()),
+            status: None,
         })
     }
 
@@ -488,14 +539,37 @@ impl Checker {
         self.judge.ops
     }
 
+    /// Back to a fresh chip and judge, keeping the memory they grew.
+    pub fn reset(&mut self) {
+        self.board.reset();
+        self.judge.reset();
+        self.status = None;
+    }
+
+    /// Applies every op, judging each, then the whole record: the first
+    /// invariant broken.
+    fn run(&mut self, ops: &[BusOp]) -> Option<Violation> {
+        for op in ops {
+            if let Err(v) = self.apply(*op) {
+                return Some(v);
+            }
+        }
+        self.finish().err()
+    }
+
     /// Applies one op and judges it.
     pub fn apply(&mut self, op: BusOp) -> Result<(), Violation> {
         let chip = &mut self.board;
-        let before = chip.read_status();
+        // Nothing happens between two ops, and reading the status register
+        // has no side effect (Section 3-1-1): the status after one op is
+        // the status before the next.
+        let before = self.status.unwrap_or_else(|| chip.read_status());
         let value = super::bus::apply(chip, op);
+        let after = chip.read_status();
+        self.status = Some(after);
         let seen = Seen {
             before,
-            after: chip.read_status(),
+            after,
             value,
             at: chip.now(),
         };

@@ -224,6 +224,26 @@ impl Chip {
         })
     }
 
+    /// Back to the chip [`Chip::new`] made, with the same straps and
+    /// configuration, keeping the memory of its record and its timers: a
+    /// fuzz target runs a fresh chip for every input.
+    pub fn reset(&mut self) {
+        let mut timers = core::mem::take(&mut self.timers);
+        let mut record = core::mem::take(&mut self.record);
+        let mut out_pending = core::mem::take(&mut self.out_pending);
+        timers.clear();
+        record.clear();
+        out_pending.clear();
+        // `new` took these straps and this configuration when it made
+        // this chip.
+        if let Ok(fresh) = Chip::new(self.straps, self.cfg.clone()) {
+            *self = fresh;
+        }
+        self.timers = timers;
+        self.record = record;
+        self.out_pending = out_pending;
+    }
+
     pub fn straps(&self) -> &Straps {
         &self.straps
     }

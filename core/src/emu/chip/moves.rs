@@ -267,18 +267,24 @@ impl Chip {
     }
 
     /// The pulses the move will output next without any decision in
-    /// between: `(first, interval, count)`. A whole constant-period stretch,
-    /// or one pulse where the model must look again after it (a ramp, the
-    /// first pulse, a pending POUT high-speed-limit check). Both [`Self::poll_at`] and
-    /// [`Self::emit_pulses`] use it, so waiting never skips a decision.
+    /// between: `(first, interval, count)`. A whole constant-period stretch
+    /// (on the ramp, the pulses whose speed index stays in one step of the
+    /// rate grid), or one pulse where the model must look again after it
+    /// (the first pulse, a firmware served again). Both [`Self::poll_at`]
+    /// and [`Self::emit_pulses`] use it, so waiting never skips a decision.
     pub(super) fn next_stretch(&self) -> Option<(Instant, Duration, u32)> {
         let m = self.motion.as_ref().filter(|m| m.pulses_left())?;
         let (interval, count) = m.constant_stretch();
         // The first pulse samples the inputs (notes N27). A firmware
         // starved by the speed limit is served again after the first pulse
-        // whose period is within it (N7): that pulse ends the stretch.
+        // whose period is within it (N7): that pulse ends the stretch. A
+        // pending POUT high-speed-limit check looks after every pulse for
+        // high speed, which a ramp stretch reaches at its last pulse if at
+        // all (its indices are below the cruise's): only off the ramp does
+        // it take the pulses one at a time.
         let serves_again = self.pick_starved && interval >= self.straps.min_interval(m.pout);
-        let count = if m.emitted == 0 || Self::pout_hs_check(m, self.inputs) || serves_again {
+        let hs_check = Self::pout_hs_check(m, self.inputs) && !m.on_ramp();
+        let count = if m.emitted == 0 || hs_check || serves_again {
             count.min(1)
         } else {
             count
@@ -306,7 +312,8 @@ impl Chip {
             return;
         };
         let on_ramp = m.on_ramp();
-        let fit = if stretch <= 1 || interval == Duration::ZERO {
+        let whole = first + interval.saturating_mul(u64::from(stretch.saturating_sub(1)));
+        let fit = if stretch <= 1 || interval == Duration::ZERO || whole <= horizon {
             stretch
         } else {
             let span = horizon.saturating_since(first).as_nanos() / interval.as_nanos();
@@ -324,7 +331,8 @@ impl Chip {
             m.next_pulse = Some(last + m.interval_after(m.emitted - 1));
         }
         let done = m.emitted >= m.end;
-        let at_speed = m.at_high_speed();
+        // Only a POUT move with its high-speed limit asserted asks.
+        let hs_limit_now = pout_hs_check && !done && m.at_high_speed();
         let (id, kind, base) = (m.id, m.kind, m.base);
         // Fault: the final pulse of the move never reaches the wire.
         let on_wire = if done && self.cfg.faults.drop_last_pulse {
@@ -350,7 +358,7 @@ impl Chip {
             }
         }
         self.now = last;
-        if pout_hs_check && at_speed && !done {
+        if hs_limit_now {
             self.high_speed_limit(true);
         }
         if done {
@@ -369,7 +377,7 @@ impl Chip {
             // last pulse waits, it is not taken before BUSY falls.
             self.proc_free_at = self.proc_free_at.max(free);
         }
-        if !self.starved() {
+        if self.pick_starved && !self.starved() {
             self.serve_again();
         }
     }
