@@ -43,7 +43,7 @@ pub(crate) enum Profile {
 /// ([`AccelRamp::end_of`]). They are computed when a move first needs them
 /// ([`Ramp::cover`]) and kept for the moves after it: an initialization
 /// costs nothing, and a short move only the steps it can reach.
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub(crate) struct Ramp {
     /// Where the periods come from (`None`: given outright, in tests).
     accel: Option<AccelRamp>,
@@ -58,6 +58,17 @@ pub(crate) struct Ramp {
     covered: u32,
     /// PA - 1: the speed index of the cruise.
     len: u32,
+}
+
+/// The ramp as its definition: the steps computed so far are derived
+/// from it, and a ramp reused from an earlier move or chip may have more.
+impl core::fmt::Debug for Ramp {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Ramp")
+            .field("accel", &self.accel)
+            .field("len", &self.len)
+            .finish_non_exhaustive()
+    }
 }
 
 impl Ramp {
@@ -87,6 +98,12 @@ impl Ramp {
             covered: periods.len() as u32,
             len: periods.len() as u32,
         }
+    }
+
+    /// Whether this is the ramp `accel` describes (with whatever steps it
+    /// has computed so far, which are the same).
+    pub(crate) fn is_of(&self, accel: &AccelRamp) -> bool {
+        self.accel.as_ref() == Some(accel)
     }
 
     /// Computes the steps holding the indices below `need` not computed
@@ -143,7 +160,7 @@ impl Ramp {
 /// RH, on the chip's rate grid `(R + 1) x Tclock (+ 7.5 us)`: the rate
 /// value after acceleration pulse `v` (of PA - 1) by [`AccelRamp::rate`],
 /// and where each rate value's indices end by [`AccelRamp::end_of`].
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct AccelRamp {
     curve: AccelCurve,
     straps: Straps,

@@ -235,15 +235,16 @@ impl Chip {
             self.out_winding = self.winding;
         }
         let ramp = self.straps.tclock(cmd.clock).map(|tclock| {
+            let accel = AccelRamp::new(
+                self.cfg.accel_curve,
+                &self.straps,
+                tclock,
+                data.rl,
+                data.rh,
+                data.pa,
+            );
             (
-                Ramp::new(AccelRamp::new(
-                    self.cfg.accel_curve,
-                    &self.straps,
-                    tclock,
-                    data.rl,
-                    data.rh,
-                    data.pa,
-                )),
+                self.ramp_of(accel),
                 self.straps.pulse_interval(data.rh, tclock),
             )
         });

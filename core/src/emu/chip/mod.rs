@@ -174,6 +174,21 @@ pub struct Chip {
     motion_seq: u64,
 
     record: Record,
+    /// The ramp of the last initialization, kept for the next one with
+    /// the same rates, clock and PA, and across [`Chip::reset`]: its steps
+    /// are a pure function of those, and fuzz inputs initialize alike.
+    ramp_cache: RampCache,
+}
+
+/// A cache, not state: shown as its size only, so a reset chip prints as
+/// a new one.
+#[derive(Clone, Default)]
+struct RampCache(Option<Ramp>);
+
+impl core::fmt::Debug for RampCache {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("RampCache")
+    }
 }
 
 impl Chip {
@@ -221,6 +236,7 @@ impl Chip {
             motion: None,
             motion_seq: 0,
             record: Record::default(),
+            ramp_cache: RampCache::default(),
         })
     }
 
@@ -231,6 +247,7 @@ impl Chip {
         let mut timers = core::mem::take(&mut self.timers);
         let mut record = core::mem::take(&mut self.record);
         let mut out_pending = core::mem::take(&mut self.out_pending);
+        let ramp_cache = self.keep_ramp();
         timers.clear();
         record.clear();
         out_pending.clear();
@@ -242,6 +259,29 @@ impl Chip {
         self.timers = timers;
         self.record = record;
         self.out_pending = out_pending;
+        self.ramp_cache = ramp_cache;
+    }
+
+    /// The ramp worth keeping: the one in force (it may have computed more
+    /// steps since it was cached), else the one cached.
+    fn keep_ramp(&mut self) -> RampCache {
+        let current = self.setup.as_ref().and_then(|s| s.ramp.as_ref());
+        match current {
+            Some((ramp, _)) => RampCache(Some(ramp.clone())),
+            None => core::mem::take(&mut self.ramp_cache),
+        }
+    }
+
+    /// The ramp `accel` describes, with the steps already computed when
+    /// the last initialization (or the chip before a reset) had it.
+    fn ramp_of(&mut self, accel: AccelRamp) -> Ramp {
+        let cache = self.keep_ramp();
+        let ramp = match cache.0 {
+            Some(r) if r.is_of(&accel) => r,
+            _ => Ramp::new(accel),
+        };
+        self.ramp_cache = RampCache(Some(ramp.clone()));
+        ramp
     }
 
     pub fn straps(&self) -> &Straps {
