@@ -16,8 +16,9 @@
 //! deceleration started early (stop command or high-speed limit) from speed
 //! `c` at pulse `j0` caps the index at `c - 1 - (j - j0)`. Because the plan
 //! is a closed formula, a stretch at one period is emitted in O(1) whatever
-//! its length, and the acceleration periods are computed as pulses need
-//! them, not as a table at each initialization.
+//! its length: at high speed, and on the ramp, whose periods come in steps
+//! of one rate value each ([`Ramp`]), found in closed form as far as a move
+//! can reach rather than as a table at each initialization.
 
 use super::config::AccelCurve;
 use crate::protocol::{Direction, MoveKind, StopCause, Straps};
