@@ -505,6 +505,12 @@ mod tests {
         let table: Vec<Duration> = (0..pa)
             .map(|v| Duration::from_micros(200 - v as u64))
             .collect();
+        on_table(total, table)
+    }
+
+    /// A CW accel/decel move of `total` pulses on a ramp of `table`'s
+    /// periods, cruising at 42 us.
+    fn on_table(total: u32, table: Vec<Duration>) -> Motion {
         Motion::new(
             1,
             MoveKind::AccelDecel,
@@ -559,20 +565,7 @@ mod tests {
     #[test]
     fn equal_ramp_periods_are_one_stretch() {
         let table = [200, 200, 200, 199, 199, 150].map(Duration::from_micros);
-        let mut m = Motion::new(
-            1,
-            MoveKind::AccelDecel,
-            Direction::Cw,
-            false,
-            true,
-            Instant::ZERO,
-            20,
-            Some(Instant::ZERO),
-            Profile::Ramped {
-                ramp: Ramp::table(table.to_vec()),
-                cruise: Duration::from_micros(42),
-            },
-        );
+        let mut m = on_table(20, table.to_vec());
         // Pulses 0..=3 are 200 us apart; the period after pulse 3 is 199 us.
         assert_eq!(m.constant_stretch(), (Duration::from_micros(200), 4));
         // Pulses 16..=19 on the way down: after 16 (index 2) 200 us, the
@@ -672,20 +665,7 @@ mod tests {
                     Duration::from_micros(us)
                 })
                 .collect();
-            let mut m = Motion::new(
-                1,
-                MoveKind::AccelDecel,
-                Direction::Cw,
-                false,
-                true,
-                Instant::ZERO,
-                total,
-                Some(Instant::ZERO),
-                Profile::Ramped {
-                    ramp: Ramp::table(table),
-                    cruise: Duration::from_micros(42),
-                },
-            );
+            let mut m = on_table(total, table);
             while m.pulses_left() {
                 if stop_at == Some(m.emitted) {
                     m.begin_decel();
