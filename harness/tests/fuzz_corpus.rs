@@ -37,10 +37,8 @@ fn a_reset_checker_runs_as_a_fresh_one() {
     ] {
         let mut reused = Checker::new(cfg.clone()).expect("a valid configuration");
         for (f, data) in &inputs {
-            let run = |c: &mut Checker| {
-                let verdict = bus::decode(data).into_iter().try_for_each(|op| c.apply(op));
-                (verdict.and_then(|()| c.finish()), format!("{c:?}"))
-            };
+            let ops = bus::decode(data);
+            let run = |c: &mut Checker| (c.run(&ops), format!("{c:?}"));
             let mut fresh = Checker::new(cfg.clone()).expect("a valid configuration");
             reused.reset();
             assert_eq!(run(&mut reused), run(&mut fresh), "{}", f.display());

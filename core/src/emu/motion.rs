@@ -598,6 +598,7 @@ mod tests {
     /// differ, and rates and PA from the smallest to the largest.
     #[test]
     fn ramp_steps_hold_the_rate_of_every_index() {
+        use crate::protocol::ClockSource;
         let ext = |hz| Straps {
             ext_clock_hz: Some(hz),
             ..Straps::default()
@@ -619,11 +620,12 @@ mod tests {
         let rates = [(254, 1), (254, 253), (2, 1), (200, 33), (100, 99), (37, 5)];
         let pas = [1, 2, 3, 7, 100, 1_001, 5_435, 11_220];
         for curve in [AccelCurve::LinearSpeed, AccelCurve::LinearRate] {
-            for s in &straps {
-                let tclock = s
-                    .tclock(crate::protocol::ClockSource::Internal)
-                    .or(s.tclock(crate::protocol::ClockSource::External))
-                    .expect("a clock");
+            let clocks = straps.iter().flat_map(|s| {
+                [ClockSource::Internal, ClockSource::External]
+                    .into_iter()
+                    .filter_map(move |c| Some((s, s.tclock(c)?)))
+            });
+            for (s, tclock) in clocks {
                 for &(rl, rh) in &rates {
                     for &pa in &pas {
                         let a = AccelRamp::new(curve, s, tclock, rl, rh, pa);
@@ -634,7 +636,7 @@ mod tests {
                         for v in 0..a.len() {
                             let (first, last, d) = ramp.step_of(v).expect("a ramp index");
                             let at = |i| a.interval(a.rate(i));
-                            let case = (curve, s, rl, rh, pa, v);
+                            let case = (curve, s, tclock, rl, rh, pa, v);
                             assert_eq!(d, at(v), "{case:?}");
                             assert!(first <= v && v <= last, "{case:?}");
                             assert!(first == 0 || at(first - 1) != d, "{case:?}");

@@ -185,21 +185,21 @@ pub fn decode(data: &[u8]) -> Vec<BusOp> {
     for chunk in data.chunks(8) {
         if let Ok(bytes) = <[u8; 8]>::try_from(chunk) {
             // The bytes equal to F, each as its top bit (the SWAR test for
-            // a zero byte, exact here: it may flag a byte only after a
-            // zero byte, and the lowest flag is always right).
+            // a zero byte: it may also flag a byte just above a true one,
+            // which the comparison with the separator then rejects).
             let x = u64::from_le_bytes(bytes) ^ FS;
             let mut fs = x.wrapping_sub(ONES) & !x & (ONES << 7);
             while fs != 0 {
                 let i = base + fs.trailing_zeros() as usize / 8;
-                if data[i] == SEPARATOR[0] && is_separator(i) {
+                if is_separator(i) {
                     cut(i, &mut ops);
                 }
                 fs &= fs - 1;
             }
         } else {
-            for (k, &b) in chunk.iter().enumerate() {
-                if b == SEPARATOR[0] && is_separator(base + k) {
-                    cut(base + k, &mut ops);
+            for i in base..base + chunk.len() {
+                if is_separator(i) {
+                    cut(i, &mut ops);
                 }
             }
         }

@@ -548,7 +548,7 @@ impl Checker {
 
     /// Applies every op, judging each, then the whole record: the first
     /// invariant broken.
-    fn run(&mut self, ops: &[BusOp]) -> Option<Violation> {
+    pub fn run(&mut self, ops: &[BusOp]) -> Option<Violation> {
         for op in ops {
             if let Err(v) = self.apply(*op) {
                 return Some(v);
