@@ -84,6 +84,10 @@ impl Duration {
         if den == 0 {
             return Duration::MAX;
         }
+        // Most products fit in 64 bits, where division is cheap.
+        if let Some(half_up) = self.0.checked_mul(num).and_then(|p| p.checked_add(den / 2)) {
+            return Duration(half_up / den);
+        }
         let wide = (self.0 as u128 * num as u128 + den as u128 / 2) / den as u128;
         Duration(u64::try_from(wide).unwrap_or(u64::MAX))
     }

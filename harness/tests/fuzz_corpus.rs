@@ -38,7 +38,7 @@ fn a_reset_checker_runs_as_a_fresh_one() {
         let mut reused = Checker::new(cfg.clone()).expect("a valid configuration");
         for (f, data) in &inputs {
             let ops = bus::decode(data);
-            let run = |c: &mut Checker| (c.run(&ops), format!("{c:?}"));
+            let run = |c: &mut Checker| (c.run(ops.iter().copied()), format!("{c:?}"));
             let mut fresh = Checker::new(cfg.clone()).expect("a valid configuration");
             reused.reset();
             assert_eq!(run(&mut reused), run(&mut fresh), "{}", f.display());

@@ -164,49 +164,87 @@ pub fn from_trace(trace: &Trace) -> Vec<BusOp> {
     out
 }
 
-/// Splits an input into its ops. This runs on every fuzz input, in a
-/// build that counts every branch taken, so it reads the input eight bytes
-/// at a time: a word with no `F` holds no separator start, and only an `F`
-/// is compared with the separator. (No byte of "FUZZ" after the first is an
-/// `F`, so separators never overlap and every match is a cut.)
+/// Splits an input into its ops.
 pub fn decode(data: &[u8]) -> Vec<BusOp> {
-    const WORD: u32 = u32::from_le_bytes(*SEPARATOR);
-    const ONES: u64 = u64::from_le_bytes([1; 8]);
-    const FS: u64 = ONES * SEPARATOR[0] as u64;
-    let is_separator = |i: usize| matches!(data.get(i..i + 4), Some(&[a, b, c, d]) if u32::from_le_bytes([a, b, c, d]) == WORD);
-    // An op and its separator take at least five bytes.
-    let mut ops = Vec::with_capacity(data.len() / 5 + 1);
-    let mut start = 0;
-    let mut cut = |i: usize, ops: &mut Vec<BusOp>| {
-        ops.extend(BusOp::decode(&data[start..i]));
-        start = i + SEPARATOR.len();
-    };
-    let mut base = 0;
-    for chunk in data.chunks(8) {
-        if let Ok(bytes) = <[u8; 8]>::try_from(chunk) {
-            // The bytes equal to F, each as its top bit (the SWAR test for
-            // a zero byte: it may also flag a byte just above a true one,
-            // which the comparison with the separator then rejects).
-            let x = u64::from_le_bytes(bytes) ^ FS;
-            let mut fs = x.wrapping_sub(ONES) & !x & (ONES << 7);
-            while fs != 0 {
-                let i = base + fs.trailing_zeros() as usize / 8;
-                if is_separator(i) {
-                    cut(i, &mut ops);
-                }
-                fs &= fs - 1;
-            }
-        } else {
-            for i in base..base + chunk.len() {
-                if is_separator(i) {
-                    cut(i, &mut ops);
-                }
-            }
-        }
-        base += chunk.len();
+    ops(data).collect()
+}
+
+/// The ops of an input, one at a time, as [`decode`] gives them.
+pub fn ops(data: &[u8]) -> Ops<'_> {
+    Ops {
+        data,
+        start: 0,
+        base: 0,
+        fs: 0,
+        done: false,
     }
-    ops.extend(BusOp::decode(&data[start..]));
-    ops
+}
+
+/// The iterator of [`ops`]. It runs on every fuzz input, in a build that
+/// counts every branch taken, so it reads the input eight bytes at a time:
+/// a word with no `F` holds no separator start, and only an `F` is
+/// compared with the separator. (No byte of "FUZZ" after the first is an
+/// `F`, so separators never overlap and every match is a cut.)
+#[derive(Debug, Clone)]
+pub struct Ops<'a> {
+    data: &'a [u8],
+    /// Where the op being scanned starts.
+    start: usize,
+    /// Where the next word to scan starts.
+    base: usize,
+    /// The candidate `F`s of the word before `base`, each as its top bit.
+    fs: u64,
+    /// The last op (after the last separator) has been given.
+    done: bool,
+}
+
+impl Iterator for Ops<'_> {
+    type Item = BusOp;
+
+    fn next(&mut self) -> Option<BusOp> {
+        const WORD: u32 = u32::from_le_bytes(*SEPARATOR);
+        const ONES: u64 = u64::from_le_bytes([1; 8]);
+        const FS: u64 = ONES * SEPARATOR[0] as u64;
+        let data = self.data;
+        loop {
+            while self.fs != 0 {
+                let i = self.base - 8 + self.fs.trailing_zeros() as usize / 8;
+                self.fs &= self.fs - 1;
+                let cut = matches!(data.get(i..i + 4), Some(&[a, b, c, d]) if u32::from_le_bytes([a, b, c, d]) == WORD);
+                if cut {
+                    let op = BusOp::decode(data.get(self.start..i).unwrap_or_default());
+                    self.start = i + SEPARATOR.len();
+                    if op.is_some() {
+                        return op;
+                    }
+                }
+            }
+            if self.base >= data.len() {
+                break;
+            }
+            // The next eight bytes (the last word padded with zeros), and
+            // the bytes equal to F in it, each as its top bit: the SWAR
+            // test for a zero byte, which may also flag a byte just above
+            // a true one; the comparison with the separator rejects it.
+            let word = match data.get(self.base..self.base + 8) {
+                Some(bytes) => <[u8; 8]>::try_from(bytes).unwrap_or_default(),
+                None => {
+                    let mut word = [0u8; 8];
+                    let tail = &data[self.base..];
+                    word[..tail.len()].copy_from_slice(tail);
+                    word
+                }
+            };
+            let x = u64::from_le_bytes(word) ^ FS;
+            self.fs = x.wrapping_sub(ONES) & !x & (ONES << 7);
+            self.base += 8;
+        }
+        if self.done {
+            return None;
+        }
+        self.done = true;
+        BusOp::decode(data.get(self.start..).unwrap_or_default())
+    }
 }
 
 /// Joins ops into an input that decodes to them.

@@ -66,8 +66,7 @@ pub fn bus_bytes(data: &[u8]) {
 
 /// [`bus_bytes`] on a model with a configuration (e.g. an injected fault).
 pub fn bus_bytes_with(data: &[u8], cfg: ModelConfig) {
-    let ops = bus::decode(data);
-    match oracle::check(&ops, cfg) {
+    match oracle::check_ops(bus::ops(data), cfg) {
         Ok(None) => {}
         Ok(Some(v)) => panic!("invariant {v}"),
         Err(e) => panic!("the model refused its configuration: {e}"),

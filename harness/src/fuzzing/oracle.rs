@@ -6,7 +6,7 @@ use super::bus::BusOp;
 use crate::emu::{Board, ChipError, ModelConfig};
 use crate::protocol::capture::{MoveStart, Pin, PulseRun, Record};
 use crate::protocol::{
-    Command, FinishStatus, InitData, MoveKind, Register, Status, StatusField, Straps,
+    ClockSource, Command, FinishStatus, InitData, MoveKind, Register, Status, StatusField, Straps,
 };
 use crate::time::{Duration, Instant};
 use std::cell::Cell;
@@ -62,6 +62,14 @@ impl fmt::Display for Violation {
 
 /// Runs `ops` on a fresh chip and returns the first invariant break.
 pub fn check(ops: &[BusOp], cfg: ModelConfig) -> Result<Option<Violation>, ChipError> {
+    check_ops(ops.iter().copied(), cfg)
+}
+
+/// [`check`] on ops as they come (a fuzz input's, as they are decoded).
+pub fn check_ops(
+    ops: impl IntoIterator<Item = BusOp>,
+    cfg: ModelConfig,
+) -> Result<Option<Violation>, ChipError> {
     // A fuzz target checks an input after another on one thread: the
     // checker of the last one, reset, keeps the memory it grew (and stays
     // off the stack, where AddressSanitizer's fake stack makes a large
@@ -95,7 +103,9 @@ struct Reading {
     /// IBF has been seen at 0 since the command was written, so the chip
     /// took it (rather than losing it to a later write).
     taken: bool,
-    bytes: Vec<u8>,
+    /// The bytes read so far (a register has at most three) and how many.
+    bytes: [u8; 3],
+    got: usize,
 }
 
 /// What the host saw of one op: the status register just before and just
@@ -184,7 +194,8 @@ impl Judge {
                 self.reading = Some(Reading {
                     command: b,
                     taken: false,
-                    bytes: Vec::new(),
+                    bytes: [0; 3],
+                    got: 0,
                 });
             }
             (BusOp::ReadStatus, Some(v)) => {
@@ -208,7 +219,10 @@ impl Judge {
             }
             (BusOp::ReadData, Some(byte)) if seen.before.obf() => {
                 if let Some(r) = self.reading.as_mut().filter(|r| r.taken) {
-                    r.bytes.push(byte);
+                    if let Some(slot) = r.bytes.get_mut(r.got) {
+                        *slot = byte;
+                    }
+                    r.got += 1;
                 }
                 if let Some((invariant, detail)) = self.register_breaks(rec, seen.at) {
                     return Err(fail(invariant, detail));
@@ -347,18 +361,16 @@ impl Judge {
         // The initializations taken so far, as the moves come (both in time
         // order): the fastest RH period among them, and the clocks they
         // chose. One pass, however many moves and bytes.
-        let inits = self.inits();
-        let mut next_init = inits.iter().peekable();
+        let mut next_init = self.inits().peekable();
         let mut fastest_rh: Option<Duration> = None;
-        let mut tclocks: Vec<Duration> = Vec::new();
+        // The pulse clock of each source chosen (internal, external).
+        let mut tclocks: [Option<Duration>; 2] = [None; 2];
         for (k, m) in rec.moves.iter().enumerate() {
             while let Some((_, clock, data)) = next_init.next_if(|(done, _, _)| *done <= m.at) {
-                if let Some(tclock) = self.straps.tclock(*clock) {
+                if let Some(tclock) = self.straps.tclock(clock) {
                     let rh = self.straps.pulse_interval(data.rh, tclock);
                     fastest_rh = Some(fastest_rh.map_or(rh, |f| f.min(rh)));
-                    if !tclocks.contains(&tclock) {
-                        tclocks.push(tclock);
-                    }
+                    tclocks[usize::from(clock == ClockSource::External)] = Some(tclock);
                 }
             }
             let Some(params) = self.params_of(m) else {
@@ -378,6 +390,7 @@ impl Judge {
                 // shrinks as it grows): every clock chosen is tried.
                 Some(rate) => tclocks
                     .iter()
+                    .flatten()
                     .map(|t| self.straps.pulse_interval(rate, *t))
                     .min(),
                 None => fastest_rh,
@@ -432,33 +445,29 @@ impl Judge {
     /// Every initialization the chip took with rates Section 3-2-2 allows,
     /// in time order: when its fourth data byte was taken, its clock and
     /// its data.
-    fn inits(&self) -> Vec<(Instant, crate::protocol::ClockSource, InitData)> {
-        self.taken
-            .iter()
-            .enumerate()
-            .filter_map(|(k, &(_, w))| {
-                let Written::Command(c) = w else {
-                    return None;
-                };
-                let Command::Init(ic) = Command::decode(c) else {
-                    return None;
-                };
-                let mut data = [0u8; 4];
-                let mut done = None;
-                for (i, slot) in data.iter_mut().enumerate() {
-                    match self.taken.get(k + 1 + i) {
-                        Some(&(t, Written::Data(b))) => {
-                            *slot = b;
-                            done = Some(t);
-                        }
-                        _ => return None,
+    fn inits(&self) -> impl Iterator<Item = (Instant, ClockSource, InitData)> + '_ {
+        self.taken.iter().enumerate().filter_map(|(k, &(_, w))| {
+            let Written::Command(c) = w else {
+                return None;
+            };
+            let Command::Init(ic) = Command::decode(c) else {
+                return None;
+            };
+            let mut data = [0u8; 4];
+            let mut done = None;
+            for (i, slot) in data.iter_mut().enumerate() {
+                match self.taken.get(k + 1 + i) {
+                    Some(&(t, Written::Data(b))) => {
+                        *slot = b;
+                        done = Some(t);
                     }
+                    _ => return None,
                 }
-                let d = InitData::from_bytes(data);
-                let legal = 0 < d.rh && d.rh < d.rl && d.rl < 255;
-                legal.then_some((done?, ic.clock, d))
-            })
-            .collect()
+            }
+            let d = InitData::from_bytes(data);
+            let legal = 0 < d.rh && d.rh < d.rl && d.rl < 255;
+            legal.then_some((done?, ic.clock, d))
+        })
     }
 
     /// Checks a register read once all its bytes are in: the remaining
@@ -466,9 +475,14 @@ impl Judge {
     /// The chip takes a read command only when BUSY = 0, so the move the
     /// register tells of has ended by `at`.
     fn register_breaks(&mut self, rec: &Record, at: Instant) -> Option<(&'static str, String)> {
-        let Reading { command, bytes, .. } = self.reading.as_ref()?;
+        let Reading {
+            command,
+            bytes,
+            got,
+            ..
+        } = self.reading.as_ref()?;
         match Command::decode(*command) {
-            Command::Read(Register::RemainingPulses) if bytes.len() == 3 => {
+            Command::Read(Register::RemainingPulses) if *got == 3 => {
                 let read = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], 0]);
                 let (m, runs) = rec.move_written_by(at)?;
                 let out: u64 = runs.iter().map(|r| u64::from(r.count_until(at))).sum();
@@ -484,7 +498,7 @@ impl Judge {
                     )
                 })
             }
-            Command::Read(Register::FinishStatus) if bytes.len() == 1 => {
+            Command::Read(Register::FinishStatus) if *got == 1 => {
                 let stops = rec
                     .pins
                     .iter()
@@ -548,9 +562,9 @@ impl Checker {
 
     /// Applies every op, judging each, then the whole record: the first
     /// invariant broken.
-    pub fn run(&mut self, ops: &[BusOp]) -> Option<Violation> {
+    pub fn run(&mut self, ops: impl IntoIterator<Item = BusOp>) -> Option<Violation> {
         for op in ops {
-            if let Err(v) = self.apply(*op) {
+            if let Err(v) = self.apply(op) {
                 return Some(v);
             }
         }
@@ -565,7 +579,11 @@ impl Checker {
         // the status before the next.
         let before = self.status.unwrap_or_else(|| chip.read_status());
         let value = super::bus::apply(chip, op);
-        let after = chip.read_status();
+        // A status read's own value is the status after it.
+        let after = match (op, value) {
+            (BusOp::ReadStatus, Some(v)) => Status(v),
+            _ => chip.read_status(),
+        };
         self.status = Some(after);
         let seen = Seen {
             before,

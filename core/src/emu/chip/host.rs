@@ -183,19 +183,20 @@ impl Chip {
     }
 
     pub(super) fn load_register(&mut self, reg: Register, base: Instant) {
-        let bytes: Vec<u8> = match reg {
+        // One byte, or the remaining pulses' three (Section 3-4).
+        let (bytes, len) = match reg {
             Register::FinishStatus => {
                 let value = self.finish.0;
                 if !self.cfg.faults.finish_flag_sticky {
                     self.finish = self.finish.without_polling();
                 }
                 self.set_int(false);
-                vec![value]
+                ([value, 0, 0], 1)
             }
-            Register::InputSignals => vec![InputStatus::from_inputs(self.inputs).0],
+            Register::InputSignals => ([InputStatus::from_inputs(self.inputs).0, 0, 0], 1),
             Register::OutputSignals => {
                 let levels = self.levels(self.energized(self.now));
-                vec![OutputStatus::new(self.dir, self.hold, levels).0]
+                ([OutputStatus::new(self.dir, self.hold, levels).0, 0, 0], 1)
             }
             Register::RemainingPulses => {
                 let value = if self.cfg.faults.remaining_off_by_one {
@@ -204,11 +205,11 @@ impl Chip {
                     self.remaining.saturating_sub(1)
                 };
                 let [lo, mid, hi, _] = value.to_le_bytes();
-                vec![lo, mid, hi]
+                ([lo, mid, hi], 3)
             }
-            Register::AuxInputs => vec![AuxInputStatus::from_inputs(self.inputs).0],
+            Register::AuxInputs => ([AuxInputStatus::from_inputs(self.inputs).0, 0, 0], 1),
         };
-        self.out_pending.extend(bytes);
+        self.out_pending.extend(&bytes[..len]);
         self.schedule(base + self.fw(self.cfg.obf_ready), Timer::ObfReady);
     }
 

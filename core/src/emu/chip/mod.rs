@@ -24,7 +24,6 @@ use crate::protocol::{
 };
 use crate::time::{Duration, Instant};
 use alloc::collections::VecDeque;
-use alloc::vec;
 use alloc::vec::Vec;
 
 mod host;
