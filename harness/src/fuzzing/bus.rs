@@ -201,6 +201,7 @@ pub struct Ops<'a> {
 impl Iterator for Ops<'_> {
     type Item = BusOp;
 
+    #[inline]
     fn next(&mut self) -> Option<BusOp> {
         const WORD: u32 = u32::from_le_bytes(*SEPARATOR);
         const ONES: u64 = u64::from_le_bytes([1; 8]);

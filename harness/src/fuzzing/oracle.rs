@@ -164,6 +164,13 @@ impl Judge {
         };
     }
 
+    /// The byte written last was taken (IBF seen at 0).
+    fn take_pending(&mut self) {
+        if let Some(p) = self.pending.take() {
+            self.taken.push(p);
+        }
+    }
+
     /// Judges op number `self.ops` given what was seen of it and the
     /// capture, which may run past `seen.at` (it is looked at as of then).
     pub fn op(&mut self, op: BusOp, seen: Seen, rec: &Record) -> Result<(), Violation> {
@@ -175,7 +182,7 @@ impl Judge {
             detail,
         };
         if !seen.before.ibf() {
-            self.taken.extend(self.pending.take());
+            self.take_pending();
         } else if matches!(op, BusOp::Command(_) | BusOp::Data(_)) {
             // The byte waiting may be the read command: it could be lost.
             if self.reading.as_ref().is_some_and(|r| !r.taken) {
@@ -234,7 +241,7 @@ impl Judge {
             r.taken |= !seen.after.ibf();
         }
         if !seen.after.ibf() {
-            self.taken.extend(self.pending.take());
+            self.take_pending();
         }
         if seen.at < self.last_at {
             return Err(fail(
