@@ -293,4 +293,19 @@ mod tests {
         );
         assert_eq!(Duration::from_nanos(5).scale(1, 0), Duration::MAX);
     }
+
+    #[test]
+    fn scale_past_64_bits_rounds_the_same_and_saturates() {
+        // The product overflows 64 bits: the wide division, same rounding.
+        assert_eq!(
+            Duration::from_nanos(u64::MAX / 2).scale(3, 2),
+            Duration::from_nanos(13_835_058_055_282_163_711)
+        );
+        // Only the half added for rounding overflows.
+        assert_eq!(
+            Duration::from_nanos(u64::MAX).scale(1, 2),
+            Duration::from_nanos(1 << 63)
+        );
+        assert_eq!(Duration::MAX.scale(2, 1), Duration::MAX);
+    }
 }
