@@ -46,6 +46,104 @@ fn a_reset_checker_runs_as_a_fresh_one() {
     }
 }
 
+/// Time advanced in one step or in many uneven ones is the same time: every
+/// committed bus_bytes input, with each advance cut into pieces, puts out
+/// the same pulses and pin changes and reads the same bytes. The model
+/// batches the pulses due within one advance (a constant stretch, ramp
+/// stretches up to the next decision); this holds it to putting out what
+/// it would pulse by pulse, wherever an advance ends (Section 3-3: the
+/// pulses follow the rate and step counts, not the host's polling).
+#[test]
+fn advancing_in_pieces_changes_nothing() {
+    use ppmc::emu::{Board, ModelConfig};
+    use ppmc::fuzzing::bus::{self, BusOp};
+    use ppmc::protocol::capture::{MoveStart, PulseRun, Record};
+    use ppmc::protocol::Straps;
+    use ppmc::time::Duration;
+
+    // The record with each move's runs cut as pushing its pulses one at a
+    // time cuts them: how the pulses group into runs follows where the
+    // model batched them (a stretch is a run of its own), and only the
+    // pulses are the same whatever the batching. Compare reads runs pulse
+    // by pulse (`compare::compare_pulses`), so the grouping is not part
+    // of what a trace says.
+    let canonical = |r: &Record| {
+        let mut c = Record {
+            pins: r.pins.clone(),
+            overwritten_bytes: r.overwritten_bytes,
+            ..Record::default()
+        };
+        let before = r.moves.first().map_or(r.runs.len(), |m| m.first_run);
+        let push = |c: &mut Record, runs: &[PulseRun], new_move: bool| {
+            for (i, run) in runs.iter().enumerate() {
+                let step = run.interval();
+                c.push_pulses_singly(run.start, step, run.count, run.dir, new_move && i == 0);
+            }
+        };
+        push(&mut c, &r.runs[..before.min(r.runs.len())], false);
+        for k in 0..r.moves.len() {
+            c.moves.push(MoveStart {
+                first_run: c.runs.len(),
+                ..r.moves[k]
+            });
+            push(&mut c, r.runs_of_move(k), true);
+        }
+        c
+    };
+    let run = |ops: &[BusOp]| {
+        let mut board = Board::new(Straps::default(), ModelConfig::default()).expect("board");
+        let reads: Vec<Option<u8>> = ops.iter().map(|op| bus::apply(&mut board, *op)).collect();
+        (
+            reads,
+            canonical(board.record()),
+            board.read_status(),
+            board.now(),
+        )
+    };
+    let inputs = common::fuzz_inputs("bus_bytes");
+    assert!(inputs.len() > 50, "the corpus is there");
+    let mut cut = 0;
+    for (f, data) in &inputs {
+        let ops = bus::decode(data);
+        // Each advance in up to 13 pieces of growing length, the piece ends
+        // falling anywhere relative to the pulses; a read between the
+        // pieces stands for the op's read.
+        let mut pieces = Vec::new();
+        let mut map = Vec::new();
+        for op in &ops {
+            if let BusOp::Advance(d) = op {
+                let ns = d.as_nanos();
+                let mut done = 0;
+                for k in 1..=13u64 {
+                    let to = ns * k * (k + 1) / (13 * 14);
+                    if to > done {
+                        pieces.push(BusOp::Advance(Duration::from_nanos(to - done)));
+                        done = to;
+                        cut += 1;
+                    }
+                }
+            } else {
+                pieces.push(*op);
+            }
+            map.push(pieces.len());
+        }
+        let (reads, record, status, now) = run(&ops);
+        let (piece_reads, piece_record, piece_status, piece_now) = run(&pieces);
+        let piece_reads: Vec<Option<u8>> = map
+            .iter()
+            .zip(&ops)
+            .map(|(end, op)| match op {
+                BusOp::Advance(_) => None,
+                _ => piece_reads[end - 1],
+            })
+            .collect();
+        assert_eq!(piece_reads, reads, "{}: reads", f.display());
+        assert_eq!(piece_record, record, "{}: capture", f.display());
+        assert_eq!((piece_status, piece_now), (status, now), "{}", f.display());
+    }
+    assert!(cut > 1000, "advances were cut ({cut} pieces)");
+}
+
 #[test]
 fn frame_decoder_corpus_replays() {
     let n = replay("frame_decoder", ppmc::fuzzing::frame_decoder);

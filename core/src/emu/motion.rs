@@ -140,16 +140,28 @@ impl Ramp {
             let a = self.accel?;
             return Some((v, v, a.interval(a.rate(v))));
         }
-        let end = |i: usize| self.steps.get(i + 1).map_or(self.covered, |s| s.0);
-        let holds = |i: usize| self.steps.get(i).is_some_and(|s| s.0 <= v) && v < end(i);
+        let steps: &[(u32, Duration)] = &self.steps;
+        // Whether step `i` starts at or before `v` (steps[0] starts at 0):
+        // `v` is in the last such step.
+        let from = |i: usize| steps.get(i).is_some_and(|s| s.0 <= v);
         let near = self.hint.get();
-        let i = [near, near + 1, near.wrapping_sub(1)]
-            .into_iter()
-            .find(|&i| holds(i))
-            .or_else(|| self.steps.partition_point(|s| s.0 <= v).checked_sub(1))?;
+        let i = if from(near) {
+            if !from(near + 1) {
+                near
+            } else if !from(near + 2) {
+                near + 1
+            } else {
+                steps.partition_point(|s| s.0 <= v) - 1
+            }
+        } else if near > 0 && from(near - 1) {
+            near - 1
+        } else {
+            steps.partition_point(|s| s.0 <= v).checked_sub(1)?
+        };
         self.hint.set(i);
-        let (first, d) = self.steps[i];
-        Some((first, end(i) - 1, d))
+        let (first, d) = *steps.get(i)?;
+        let end = steps.get(i + 1).map_or(self.covered, |s| s.0);
+        Some((first, end - 1, d))
     }
 
     fn period(&self, v: u32) -> Option<Duration> {
@@ -277,6 +289,17 @@ impl AccelRamp {
     }
 }
 
+/// The pulses a move puts out next at one period: `count` pulses from
+/// the next one on, each `interval` after the one before.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Stretch {
+    pub interval: Duration,
+    pub count: u32,
+    /// On the ramp, not at cruise or a constant rate: each pulse is
+    /// recorded as if put out alone.
+    pub on_ramp: bool,
+}
+
 /// One move in progress, from the moment its final byte was accepted until
 /// its termination is processed.
 #[derive(Debug, Clone)]
@@ -384,10 +407,21 @@ impl Motion {
     /// The next `(period, count)`: `count` pulses starting with the next one,
     /// each `period` after the one before. `count` is 1 on a ramp.
     pub fn constant_stretch(&self) -> (Duration, u32) {
+        let s = self.stretch();
+        (s.interval, s.count)
+    }
+
+    /// The next pulses at one period ([`Motion::constant_stretch`]), and
+    /// whether they are on the ramp.
+    pub fn stretch(&self) -> Stretch {
         let j = self.emitted;
         let left = self.end - j;
         match &self.profile {
-            Profile::Constant { interval } => (*interval, left),
+            Profile::Constant { interval } => Stretch {
+                interval: *interval,
+                count: left,
+                on_ramp: false,
+            },
             Profile::Ramped { ramp, cruise } => {
                 let pa = self.cruise_index();
                 if self.cruising_from(j) {
@@ -397,9 +431,18 @@ impl Motion {
                         c_end = c_end.min(i64::from(j0) - 1);
                     }
                     let run = (c_end + 2 - i64::from(j)).clamp(1, i64::from(left));
-                    (*cruise, run as u32)
+                    Stretch {
+                        interval: *cruise,
+                        count: run as u32,
+                        on_ramp: false,
+                    }
                 } else {
-                    self.ramp_stretch(ramp, *cruise, j, left)
+                    let (interval, count) = self.ramp_stretch(ramp, *cruise, j, left);
+                    Stretch {
+                        interval,
+                        count,
+                        on_ramp: true,
+                    }
                 }
             }
         }
@@ -437,12 +480,6 @@ impl Motion {
         // Pulse j and one more for each index in the step from j on.
         let count = (exit - j + 1).clamp(1, i64::from(left));
         (d, count as u32)
-    }
-
-    /// Whether the next stretch is on the ramp (each pulse recorded as if
-    /// put out alone), not at cruise or a constant rate.
-    pub fn on_ramp(&self) -> bool {
-        self.ramped() && !self.cruising_from(self.emitted)
     }
 
     /// Whether pulse `j` and the one after it are at the high speed (a
@@ -675,9 +712,9 @@ mod tests {
                         break;
                     }
                 }
-                let (d, n) = m.constant_stretch();
+                let Stretch { interval: d, count: n, on_ramp } = m.stretch();
                 let j = m.emitted;
-                if m.on_ramp() {
+                if on_ramp {
                     let mut walked = 1;
                     while j + walked < m.end && m.interval_after(j + walked - 1) == d {
                         walked += 1;

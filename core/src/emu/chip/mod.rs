@@ -15,7 +15,7 @@
 //! operation.
 
 use super::config::{ConfigError, ModelConfig};
-use super::motion::{AccelRamp, Motion, Profile, Ramp};
+use super::motion::{AccelRamp, Motion, Profile, Ramp, Stretch};
 use crate::protocol::capture::{MoveStart, Pin, Pins, Record};
 use crate::protocol::{
     AuxInputStatus, ClockSource, Command, Direction, ErrorCode, FinishStatus, InitCommand,
@@ -402,7 +402,7 @@ impl Chip {
         let timer = self.next_timer().map(|(at, _)| at);
         let pulse = self
             .next_stretch()
-            .map(|(first, interval, count)| first + interval.saturating_mul(u64::from(count - 1)));
+            .map(|(first, s)| first + s.interval.saturating_mul(u64::from(s.count - 1)));
         match (timer, pulse) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
@@ -418,16 +418,18 @@ impl Chip {
         loop {
             let next_timer = self.next_timer();
             let horizon = next_timer.map_or(until, |(at, _)| at.min(until));
-            // A move without a base clock has no next pulse: it never
-            // comes, however far time is advanced.
-            let pulse_at = self
-                .motion
-                .as_ref()
-                .filter(|m| m.pulses_left())
-                .and_then(|m| m.next_pulse);
-            if let Some(pulse_at) = pulse_at.filter(|at| *at <= horizon) {
-                self.now = self.now.max(pulse_at);
-                self.emit_pulses(horizon);
+            if self.pulse_due(horizon).is_some() {
+                // The stretches due by the horizon, one after another: it
+                // stands until emitting schedules a timer (a decision:
+                // the move's end, a deceleration, the host served again).
+                let seq = self.timer_seq;
+                while let Some(pulse_at) = self.pulse_due(horizon) {
+                    self.now = self.now.max(pulse_at);
+                    self.emit_pulses(horizon);
+                    if self.timer_seq != seq {
+                        break;
+                    }
+                }
                 continue;
             }
             match next_timer {
@@ -440,6 +442,17 @@ impl Chip {
             }
         }
         self.now = until;
+    }
+
+    /// When the move's next pulse comes, if it comes by `horizon`. A move
+    /// without a base clock has no next pulse: it never comes, however far
+    /// time is advanced.
+    fn pulse_due(&self, horizon: Instant) -> Option<Instant> {
+        self.motion
+            .as_ref()
+            .filter(|m| m.pulses_left())
+            .and_then(|m| m.next_pulse)
+            .filter(|at| *at <= horizon)
     }
 
     // ----- timers ---------------------------------------------------------

@@ -272,9 +272,9 @@ impl Chip {
     /// rate grid), or one pulse where the model must look again after it
     /// (the first pulse, a firmware served again). Both [`Self::poll_at`]
     /// and [`Self::emit_pulses`] use it, so waiting never skips a decision.
-    pub(super) fn next_stretch(&self) -> Option<(Instant, Duration, u32)> {
+    pub(super) fn next_stretch(&self) -> Option<(Instant, Stretch)> {
         let m = self.motion.as_ref().filter(|m| m.pulses_left())?;
-        let (interval, count) = m.constant_stretch();
+        let mut s = m.stretch();
         // The first pulse samples the inputs (notes N27). A firmware
         // starved by the speed limit is served again after the first pulse
         // whose period is within it (N7): that pulse ends the stretch. A
@@ -282,19 +282,21 @@ impl Chip {
         // high speed, which a ramp stretch reaches at its last pulse if at
         // all (its indices are below the cruise's): only off the ramp does
         // it take the pulses one at a time.
-        let serves_again = self.pick_starved && interval >= self.straps.min_interval(m.pout);
-        let hs_check = Self::pout_hs_check(m, self.inputs) && !m.on_ramp();
-        let count = if m.emitted == 0 || hs_check || serves_again {
-            count.min(1)
-        } else {
-            count
-        };
-        Some((m.next_pulse?, interval, count))
+        let serves_again = self.pick_starved && s.interval >= self.straps.min_interval(m.pout);
+        let hs_check = !s.on_ramp && Self::pout_hs_check(m, self.inputs);
+        if m.emitted == 0 || hs_check || serves_again {
+            s.count = s.count.min(1);
+        }
+        Some((m.next_pulse?, s))
     }
 
-    /// Emits the next pulses due at or before `horizon`: one ramp pulse, or a
-    /// whole constant-period stretch in one step.
+    /// Emits the next pulses due at or before `horizon`: a whole
+    /// constant-period stretch in one step, or the ramp stretches up to
+    /// the next decision.
     pub(super) fn emit_pulses(&mut self, horizon: Instant) {
+        if self.walk_ramp(horizon) {
+            return;
+        }
         let Some(m) = self.motion.as_ref() else {
             return;
         };
@@ -305,13 +307,17 @@ impl Chip {
             return;
         };
         let pout_hs_check = Self::pout_hs_check(m, self.inputs);
-        let Some((first, interval, stretch)) = self.next_stretch() else {
+        let Some((first, stretch)) = self.next_stretch() else {
             return;
         };
         let Some(m) = self.motion.as_mut() else {
             return;
         };
-        let on_ramp = m.on_ramp();
+        let Stretch {
+            interval,
+            count: stretch,
+            on_ramp,
+        } = stretch;
         let whole = first + interval.saturating_mul(u64::from(stretch.saturating_sub(1)));
         let fit = if stretch <= 1 || interval == Duration::ZERO || whole <= horizon {
             stretch
@@ -380,6 +386,42 @@ impl Chip {
         if self.pick_starved && !self.starved() {
             self.serve_again();
         }
+    }
+
+    /// Puts out the ramp stretches due by `horizon` one after another, as
+    /// [`Self::emit_pulses`] would one at a time, while nothing is to be
+    /// decided between them: past the first pulse, with no POUT
+    /// high-speed-limit check pending and no byte held back by the speed
+    /// limit, and short of the move's last pulse (where the move ends).
+    /// Whether it put out any.
+    fn walk_ramp(&mut self, horizon: Instant) -> bool {
+        let Some(m) = self.motion.as_mut() else {
+            return false;
+        };
+        if m.emitted == 0 || self.pick_starved || Self::pout_hs_check(m, self.inputs) {
+            return false;
+        }
+        let start = m.emitted;
+        while let Some(first) = m.next_pulse.filter(|t| *t <= horizon && m.pulses_left()) {
+            let s = m.stretch();
+            let last = first + s.interval.saturating_mul(u64::from(s.count - 1));
+            if !s.on_ramp || last > horizon || m.end - m.emitted <= s.count {
+                break;
+            }
+            m.emitted += s.count;
+            m.last_pulse = Some(last);
+            m.next_pulse = Some(last + m.interval_after(m.emitted - 1));
+            self.record
+                .push_pulses_singly(first, s.interval, s.count, m.dir, false);
+            self.now = last;
+        }
+        let walked = m.emitted - start;
+        if !m.pout {
+            if let Some(w) = self.winding {
+                self.phase_index = w.advance(self.phase_index, m.dir, u64::from(walked));
+            }
+        }
+        walked > 0
     }
 
     // ----- outputs --------------------------------------------------------
