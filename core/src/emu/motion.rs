@@ -394,6 +394,19 @@ impl Motion {
         }
     }
 
+    /// Counts `n` pulses, the first at `first` and each `interval` after
+    /// the one before, as put out, and plans the next one if any remain.
+    /// The time of the last.
+    pub fn put_out(&mut self, first: Instant, interval: Duration, n: u32) -> Instant {
+        let last = first + interval.saturating_mul(u64::from(n.saturating_sub(1)));
+        self.emitted += n;
+        self.last_pulse = Some(last);
+        if self.emitted < self.end {
+            self.next_pulse = Some(last + self.interval_after(self.emitted - 1));
+        }
+        last
+    }
+
     /// Whether more pulses are to come.
     pub fn pulses_left(&self) -> bool {
         !self.halted && self.emitted < self.end
@@ -404,15 +417,9 @@ impl Motion {
         (self.emitted > 0 && self.pulses_left()).then(|| self.interval_after(self.emitted - 1))
     }
 
-    /// The next `(period, count)`: `count` pulses starting with the next one,
-    /// each `period` after the one before. `count` is 1 on a ramp.
-    pub fn constant_stretch(&self) -> (Duration, u32) {
-        let s = self.stretch();
-        (s.interval, s.count)
-    }
-
-    /// The next pulses at one period ([`Motion::constant_stretch`]), and
-    /// whether they are on the ramp.
+    /// The next pulses at one period: `count` pulses starting with the
+    /// next one, each `interval` after the one before, and whether they
+    /// are on the ramp.
     pub fn stretch(&self) -> Stretch {
         let j = self.emitted;
         let left = self.end - j;
@@ -589,11 +596,25 @@ mod tests {
         let mut m = ramped(1_000, 4);
         m.emitted = 4;
         // Pulses 4..=995 are 42 us apart: 992 pulses.
-        assert_eq!(m.constant_stretch(), (Duration::from_micros(42), 992));
+        assert_eq!(
+            m.stretch(),
+            Stretch {
+                interval: Duration::from_micros(42),
+                count: 992,
+                on_ramp: false
+            }
+        );
         // On the ramp, pulse 2 and the pulse 198 us after it: the period
         // after pulse 3 is 197 us.
         m.emitted = 2;
-        assert_eq!(m.constant_stretch(), (Duration::from_micros(198), 2));
+        assert_eq!(
+            m.stretch(),
+            Stretch {
+                interval: Duration::from_micros(198),
+                count: 2,
+                on_ramp: true
+            }
+        );
     }
 
     /// Ramp periods on the coarse rate grid repeat: the pulses one period
@@ -604,17 +625,35 @@ mod tests {
         let table = [200, 200, 200, 199, 199, 150].map(Duration::from_micros);
         let mut m = on_table(20, table.to_vec());
         // Pulses 0..=3 are 200 us apart; the period after pulse 3 is 199 us.
-        assert_eq!(m.constant_stretch(), (Duration::from_micros(200), 4));
+        assert_eq!(
+            m.stretch(),
+            Stretch {
+                interval: Duration::from_micros(200),
+                count: 4,
+                on_ramp: true
+            }
+        );
         // Pulses 16..=19 on the way down: after 16 (index 2) 200 us, the
         // rest too.
         m.emitted = 16;
-        assert_eq!(m.constant_stretch(), (Duration::from_micros(200), 4));
+        assert_eq!(
+            m.stretch(),
+            Stretch {
+                interval: Duration::from_micros(200),
+                count: 4,
+                on_ramp: true
+            }
+        );
         let one_by_one = intervals(&m.clone());
         let mut times = Vec::new();
         let mut t = Instant::ZERO;
         m.emitted = 0;
         while m.emitted < m.end {
-            let (d, n) = m.constant_stretch();
+            let Stretch {
+                interval: d,
+                count: n,
+                ..
+            } = m.stretch();
             for _ in 0..n {
                 times.push(t);
                 t += d;

@@ -389,9 +389,9 @@ impl Chip {
         if n <= u64::from(m.emitted) {
             return None;
         }
-        let (interval, stretch) = m.constant_stretch();
-        let k = (n - u64::from(m.emitted)).min(u64::from(stretch));
-        Some(next + interval.saturating_mul(k - 1))
+        let s = m.stretch();
+        let k = (n - u64::from(m.emitted)).min(u64::from(s.count));
+        Some(next + s.interval.saturating_mul(k - 1))
     }
 
     /// The next instant at which the status register, a pin or the

@@ -294,9 +294,6 @@ impl Chip {
     /// constant-period stretch in one step, or the ramp stretches up to
     /// the next decision.
     pub(super) fn emit_pulses(&mut self, horizon: Instant) {
-        if self.walk_ramp(horizon) {
-            return;
-        }
         let Some(m) = self.motion.as_ref() else {
             return;
         };
@@ -307,7 +304,18 @@ impl Chip {
             return;
         };
         let pout_hs_check = Self::pout_hs_check(m, self.inputs);
-        let Some((first, stretch)) = self.next_stretch() else {
+        // Past the first pulse, with no POUT high-speed-limit check pending
+        // and no byte held back by the speed limit, nothing is decided
+        // between two ramp stretches.
+        let walk = m.emitted > 0 && !self.pick_starved && !pout_hs_check;
+        let Some(next) = self.next_stretch() else {
+            return;
+        };
+        let Some((first, stretch)) = (if walk {
+            self.walk_ramp(next, horizon)
+        } else {
+            Some(next)
+        }) else {
             return;
         };
         let Some(m) = self.motion.as_mut() else {
@@ -327,15 +335,10 @@ impl Chip {
                 .unwrap_or(u32::MAX)
                 .min(stretch)
         };
-        let last = first + interval.saturating_mul(u64::from(fit - 1));
         let new_move = m.emitted == 0;
         let dir = m.dir;
         let steps_phases = !m.pout;
-        m.emitted += fit;
-        m.last_pulse = Some(last);
-        if m.emitted < m.end {
-            m.next_pulse = Some(last + m.interval_after(m.emitted - 1));
-        }
+        let last = m.put_out(first, interval, fit);
         let done = m.emitted >= m.end;
         // Only a POUT move with its high-speed limit asserted asks.
         let hs_limit_now = pout_hs_check && !done && m.at_high_speed();
@@ -388,40 +391,45 @@ impl Chip {
         }
     }
 
-    /// Puts out the ramp stretches due by `horizon` one after another, as
-    /// [`Self::emit_pulses`] would one at a time, while nothing is to be
-    /// decided between them: past the first pulse, with no POUT
-    /// high-speed-limit check pending and no byte held back by the speed
-    /// limit, and short of the move's last pulse (where the move ends).
-    /// Whether it put out any.
-    fn walk_ramp(&mut self, horizon: Instant) -> bool {
+    /// Puts out ramp stretches one after another from `next` (the next
+    /// stretch, first pulse and all), as [`Self::emit_pulses`] would one
+    /// call at a time, while they lie whole by `horizon` and short of the
+    /// move's last pulse (where the move ends); the caller has checked that
+    /// nothing else is to be decided between them. The stretch after the
+    /// walked ones, for the caller to put out, if it is due by `horizon`.
+    fn walk_ramp(
+        &mut self,
+        next: (Instant, Stretch),
+        horizon: Instant,
+    ) -> Option<(Instant, Stretch)> {
         let Some(m) = self.motion.as_mut() else {
-            return false;
+            return Some(next);
         };
-        if m.emitted == 0 || self.pick_starved || Self::pout_hs_check(m, self.inputs) {
-            return false;
-        }
         let start = m.emitted;
-        while let Some(first) = m.next_pulse.filter(|t| *t <= horizon && m.pulses_left()) {
-            let s = m.stretch();
+        let (mut first, mut s) = next;
+        let rest = loop {
             let last = first + s.interval.saturating_mul(u64::from(s.count - 1));
             if !s.on_ramp || last > horizon || m.end - m.emitted <= s.count {
-                break;
+                break Some((first, s));
             }
-            m.emitted += s.count;
-            m.last_pulse = Some(last);
-            m.next_pulse = Some(last + m.interval_after(m.emitted - 1));
+            // Pulses remain after the stretch, so a next one is planned.
+            m.put_out(first, s.interval, s.count);
             self.record
                 .push_pulses_singly(first, s.interval, s.count, m.dir, false);
             self.now = last;
-        }
+            match m.next_pulse {
+                Some(at) if at <= horizon => first = at,
+                _ => break None,
+            }
+            s = m.stretch();
+        };
         let walked = m.emitted - start;
         if !m.pout {
             if let Some(w) = self.winding {
                 self.phase_index = w.advance(self.phase_index, m.dir, u64::from(walked));
             }
         }
-        walked > 0
+        rest
     }
 
     // ----- outputs --------------------------------------------------------
