@@ -7,7 +7,13 @@
 //!   one, never half; on any error the temporary file is removed;
 //! - the rename replaces a regular file only: a directory, a symlink, a
 //!   FIFO or a device at the destination is refused by name;
-//! - [`create_new`] never replaces anything, not even a dangling symlink;
+//! - [`create_new`] never replaces anything, not even a dangling symlink:
+//!   the new file is linked into place only if the name is free, so of two
+//!   processes creating one file, one creates it and the other is told;
+//! - [`check_writable`] and [`prepare_folder`] try, before a long run, what
+//!   the writes at its end will do (a read-only folder, a parent that is a
+//!   regular file), so that a run's work is never lost to a bad path;
+//!   [`same_file`] tells two spellings of one output apart from two files;
 //! - a read takes regular files only (never blocks on a FIFO, never reads
 //!   `/dev/zero` until memory runs out) and refuses one beyond a size limit;
 //! - every error names the path and what was being done to it.
@@ -34,6 +40,10 @@ pub enum Action {
     Syncing,
     Renaming,
     Creating,
+    /// Trying, before a run, whether a file can be created in a folder.
+    Probing,
+    /// Creating, before a run, a folder that outputs go into.
+    PreparingFolder,
 }
 
 impl fmt::Display for Action {
@@ -46,6 +56,8 @@ impl fmt::Display for Action {
             Action::Syncing => "cannot flush to disk",
             Action::Renaming => "cannot move the new file into place",
             Action::Creating => "cannot create",
+            Action::Probing => "cannot create files in its folder",
+            Action::PreparingFolder => "cannot create this folder",
         })
     }
 }
@@ -78,6 +90,13 @@ pub enum FileError {
     /// [`create_new`] found something at the path.
     #[error("{}: exists; ppmc does not replace it", path.display())]
     Exists { path: PathBuf },
+    /// A folder on the way to the path is something else (a regular file).
+    #[error("{}: {} is {kind}, not a folder", path.display(), folder.display())]
+    NotAFolder {
+        path: PathBuf,
+        folder: PathBuf,
+        kind: &'static str,
+    },
 }
 
 impl FileError {
@@ -102,7 +121,8 @@ impl FileError {
             | FileError::NotRegularSource { path, .. }
             | FileError::TooLarge { path, .. }
             | FileError::NotText { path, .. }
-            | FileError::Exists { path } => path,
+            | FileError::Exists { path }
+            | FileError::NotAFolder { path, .. } => path,
         }
     }
 }
@@ -188,6 +208,15 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String, FileError> {
     })
 }
 
+/// Whether a look-up failed because nothing is at the path: not there, or
+/// a folder on the way is not a folder (which [`check_writable`] then names).
+fn gone(e: &io::Error) -> bool {
+    matches!(
+        e.kind(),
+        io::ErrorKind::NotFound | io::ErrorKind::NotADirectory
+    )
+}
+
 /// Refuses a destination that exists and is not a regular file; returns
 /// the permissions of the regular file it will replace.
 fn check_destination(path: &Path) -> Result<Option<fs::Permissions>, FileError> {
@@ -199,7 +228,7 @@ fn check_destination(path: &Path) -> Result<Option<fs::Permissions>, FileError> 
             }),
             None => Ok(Some(meta.permissions())),
         },
-        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(None),
+        Err(e) if gone(&e) => Ok(None),
         Err(source) => Err(FileError::Io {
             path: path.to_path_buf(),
             action: Action::Reading,
@@ -208,22 +237,128 @@ fn check_destination(path: &Path) -> Result<Option<fs::Permissions>, FileError> 
     }
 }
 
+/// Checks that `path` holds nothing or a regular file, which a write may
+/// replace (a symlink, a FIFO, a device or a directory is refused by name).
+pub fn check_replaceable(path: &Path) -> Result<(), FileError> {
+    check_destination(path).map(|_| ())
+}
+
 /// Checks, before a long run, that a report can later be written at `path`
-/// (`-`, standard output, always can): nothing there, or a regular file.
+/// (`-`, standard output, always can): nothing there or a regular file, and
+/// a folder in which a file can be created (tried: a temporary file is
+/// created there and removed). A folder not there yet is tried in the
+/// nearest one that is, which the write will create it in; nothing is
+/// created or left behind.
 pub fn check_writable(path: &Path) -> Result<(), FileError> {
     if path.as_os_str() == "-" {
         return Ok(());
     }
-    check_destination(path).map(|_| ())
+    check_destination(path)?;
+    let folder = nearest_folder(path, parent_of(path))?;
+    probe(path, &folder)
+}
+
+/// Makes sure `dir` is a folder ppmc can write files into: created if it
+/// is not there, then tried with a temporary file (removed at once).
+pub fn prepare_folder(dir: &Path) -> Result<(), FileError> {
+    nearest_folder(dir, dir)?;
+    fs::create_dir_all(dir).map_err(FileError::io(dir, Action::PreparingFolder))?;
+    probe(dir, dir)
+}
+
+/// The nearest folder that exists from `start` up (`start` itself, or the
+/// one a write to `path` would create the rest in); an entry on the way
+/// that is not a folder is refused by name.
+fn nearest_folder(path: &Path, start: &Path) -> Result<PathBuf, FileError> {
+    let mut folder = start.to_path_buf();
+    loop {
+        match fs::metadata(&folder) {
+            Ok(meta) if meta.is_dir() => return Ok(folder),
+            Ok(meta) => {
+                return Err(FileError::NotAFolder {
+                    path: path.to_path_buf(),
+                    folder,
+                    kind: kind_of(meta.file_type()).unwrap_or("a regular file"),
+                })
+            }
+            Err(e) if gone(&e) => match folder.parent() {
+                Some(up) if !up.as_os_str().is_empty() => folder = up.to_path_buf(),
+                _ => return Ok(PathBuf::from(".")),
+            },
+            Err(source) => {
+                return Err(FileError::Io {
+                    path: path.to_path_buf(),
+                    action: Action::Probing,
+                    source,
+                })
+            }
+        }
+    }
+}
+
+/// Creates a temporary file exclusively in `folder` and removes it: the
+/// folder takes new files (a read-only one does not, except for root).
+fn probe(path: &Path, folder: &Path) -> Result<(), FileError> {
+    tempfile::Builder::new()
+        .prefix(".ppmc-probe.")
+        .suffix(".tmp")
+        .tempfile_in(folder)
+        .map(drop)
+        .map_err(FileError::io(path, Action::Probing))
+}
+
+/// The folder `path` is in (`.` for a bare name).
+fn parent_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// What names a file system entry, however its path is spelled.
+#[derive(Debug, PartialEq, Eq)]
+enum Identity {
+    /// An existing entry: its device and inode (a hard link or a symlink
+    /// to it is the same file).
+    #[cfg(unix)]
+    Inode(u64, u64),
+    /// A name not there yet: its folder made absolute (symlinks resolved
+    /// when the folder exists) and its own name.
+    Name(PathBuf),
+}
+
+fn identity(path: &Path) -> Option<Identity> {
+    #[cfg(unix)]
+    if let Ok(meta) = fs::metadata(path) {
+        use std::os::unix::fs::MetadataExt;
+        return Some(Identity::Inode(meta.dev(), meta.ino()));
+    }
+    let folder = parent_of(path);
+    let folder = fs::canonicalize(folder)
+        .or_else(|_| std::path::absolute(folder))
+        .ok()?;
+    Some(Identity::Name(folder.join(path.file_name()?)))
+}
+
+/// Whether `a` and `b` are one file: the same existing file (by device and
+/// inode, so `./x`, `x`, a hard link and a symlink all match), or the same
+/// name in the same folder when it is not there yet. `-` (standard output)
+/// is no file.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    if a.as_os_str() == "-" || b.as_os_str() == "-" {
+        return false;
+    }
+    match (identity(a), identity(b)) {
+        (Some(x), Some(y)) => x == y,
+        // A path that cannot even be made absolute: compare as written.
+        _ => a == b,
+    }
 }
 
 /// A temporary file beside `path`, created exclusively (`O_EXCL`, a random
 /// name: a planted symlink is never followed) and removed if dropped.
 fn temporary_beside(path: &Path) -> Result<tempfile::NamedTempFile, FileError> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
+    let dir = parent_of(path);
     fs::create_dir_all(dir).map_err(FileError::io(dir, Action::CreatingFolder))?;
     let name = path
         .file_name()
@@ -417,6 +552,120 @@ mod tests {
         ));
         assert_eq!(fs::read(&q).expect("read"), b"x");
         assert!(leftovers(d.path()).is_empty());
+    }
+
+    #[test]
+    fn check_writable_refuses_a_folder_that_is_a_file_or_a_directory_destination() {
+        let d = scratch("files");
+        let file = d.path().join("plain");
+        fs::write(&file, b"x").expect("file");
+        let e = check_writable(&file.join("report.xml")).expect_err("parent is a file");
+        assert!(matches!(e, FileError::NotAFolder { .. }), "{e}");
+        assert!(
+            e.to_string()
+                .contains("plain is a regular file, not a folder"),
+            "{e}"
+        );
+        // Deeper under the file too, and the same for a folder to prepare.
+        let e = check_writable(&file.join("a/b/report.xml")).expect_err("under a file");
+        assert!(
+            e.to_string()
+                .contains("plain is a regular file, not a folder"),
+            "{e}"
+        );
+        let e = prepare_folder(&file.join("arts")).expect_err("artifacts under a file");
+        assert!(
+            e.to_string()
+                .contains("plain is a regular file, not a folder"),
+            "{e}"
+        );
+        let e = prepare_folder(&file).expect_err("artifacts folder is a file");
+        assert!(matches!(e, FileError::NotAFolder { .. }), "{e}");
+        let e = check_writable(d.path()).expect_err("a directory");
+        assert!(e.to_string().contains("a directory"), "{e}");
+    }
+
+    #[test]
+    fn check_writable_creates_nothing_and_prepare_folder_creates_the_folder() {
+        let d = scratch("files");
+        check_writable(&d.path().join("new/deeper/r.json")).expect("can be written later");
+        check_writable(&d.path().join("r.json")).expect("can be written");
+        assert_eq!(
+            fs::read_dir(d.path()).expect("dir").count(),
+            0,
+            "nothing left"
+        );
+        let arts = d.path().join("arts/board");
+        prepare_folder(&arts).expect("created");
+        assert!(arts.is_dir());
+        assert_eq!(
+            fs::read_dir(&arts).expect("dir").count(),
+            0,
+            "probe removed"
+        );
+        prepare_folder(&arts).expect("again");
+    }
+
+    /// A read-only folder is found before the run. Root writes into it all
+    /// the same, so under root the test says so and checks nothing.
+    #[cfg(unix)]
+    #[test]
+    fn check_writable_and_prepare_folder_find_a_read_only_folder() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = scratch("files");
+        let ro = d.path().join("ro");
+        fs::create_dir(&ro).expect("dir");
+        fs::set_permissions(&ro, fs::Permissions::from_mode(0o555)).expect("chmod");
+        let root = fs::write(ro.join("probe"), b"").is_ok();
+        if root {
+            eprintln!("note: running as root, a read-only folder is writable; not checked");
+        } else {
+            let e = check_writable(&ro.join("r.xml")).expect_err("read-only");
+            assert!(
+                matches!(
+                    e,
+                    FileError::Io {
+                        action: Action::Probing,
+                        ..
+                    }
+                ),
+                "{e}"
+            );
+            assert!(
+                e.to_string()
+                    .contains("r.xml: cannot create files in its folder"),
+                "{e}"
+            );
+            let e = check_writable(&ro.join("sub/r.xml")).expect_err("read-only above");
+            assert!(e.to_string().contains("cannot create files"), "{e}");
+            assert!(prepare_folder(&ro).is_err());
+        }
+        fs::set_permissions(&ro, fs::Permissions::from_mode(0o755)).expect("chmod back");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn same_file_sees_through_spellings_hard_links_and_symlinks() {
+        let d = scratch("files");
+        let x = d.path().join("x.json");
+        let dotted = d.path().join(".").join("x.json");
+        let up = d.path().join("sub").join("..").join("x.json");
+        fs::create_dir(d.path().join("sub")).expect("sub");
+        // Not there yet: the same name in the same folder.
+        assert!(same_file(&x, &dotted));
+        assert!(same_file(&x, &up));
+        assert!(!same_file(&x, &d.path().join("y.json")));
+        fs::write(&x, b"{}").expect("x");
+        assert!(same_file(&x, &dotted));
+        let hard = d.path().join("hard.json");
+        fs::hard_link(&x, &hard).expect("hard link");
+        assert!(same_file(&x, &hard));
+        let soft = d.path().join("soft.json");
+        std::os::unix::fs::symlink(&x, &soft).expect("symlink");
+        assert!(same_file(&soft, &x));
+        fs::write(d.path().join("y.json"), b"{}").expect("y");
+        assert!(!same_file(&x, &d.path().join("y.json")));
+        assert!(!same_file(Path::new("-"), Path::new("-")));
     }
 
     #[cfg(unix)]

@@ -109,25 +109,38 @@ pub enum Written {
 }
 
 /// Writes `trace` as the golden file of its scenario in `dir`. An existing
-/// file with other content is replaced only with `bless`.
+/// file with other content is replaced only with `bless` (atomically, by a
+/// rename). A new file is created exclusively: of two recorders into one
+/// folder, the second finds the first's file and says `Unchanged` or
+/// [`GoldenError::Exists`], never replaces it silently.
 pub fn write(dir: &Path, trace: &Trace, bless: bool) -> Result<Written, GoldenError> {
     let path = dir.join(format!("{}.snap", trace.scenario));
     let text = format!("{SNAPSHOT_HEADER}{}", trace.render());
-    // A symlink or a FIFO at the name is refused before it is read.
-    files::check_writable(&path)?;
-    let existing = match files::read_text(&path, MAX_TRACE_BYTES) {
-        Ok(t) => Some(t),
-        Err(e) if e.is_not_found() => None,
-        Err(e) => return Err(e.into()),
-    };
-    let outcome = match existing {
-        Some(t) if t == text => return Ok(Written::Unchanged),
-        Some(_) if !bless => return Err(GoldenError::Exists { path }),
-        Some(_) => Written::Replaced,
-        None => Written::Created,
-    };
-    files::write(&path, text.as_bytes())?;
-    Ok(outcome)
+    // Once more if another process creates the file between the look and
+    // the creation: the second look sees its file.
+    for _ in 0..2 {
+        // A symlink or a FIFO at the name is refused before it is read.
+        files::check_replaceable(&path)?;
+        let existing = match files::read_text(&path, MAX_TRACE_BYTES) {
+            Ok(t) => Some(t),
+            Err(e) if e.is_not_found() => None,
+            Err(e) => return Err(e.into()),
+        };
+        match existing {
+            Some(t) if t == text => return Ok(Written::Unchanged),
+            Some(_) if !bless => return Err(GoldenError::Exists { path }),
+            Some(_) => {
+                files::write(&path, text.as_bytes())?;
+                return Ok(Written::Replaced);
+            }
+            None => match files::create_new(&path, text.as_bytes()) {
+                Ok(()) => return Ok(Written::Created),
+                Err(FileError::Exists { .. }) => continue,
+                Err(e) => return Err(e.into()),
+            },
+        }
+    }
+    Err(GoldenError::Exists { path })
 }
 
 #[cfg(test)]
@@ -169,6 +182,66 @@ mod tests {
             .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
             .collect();
         assert!(leftovers.is_empty());
+    }
+
+    /// Writers racing for the same new files: each file is created by
+    /// exactly one, and every other writer sees it (unchanged when its
+    /// trace is the same, refused when not); no file is replaced.
+    #[test]
+    fn racing_writers_create_each_file_once_and_never_replace_it() {
+        let dir = scratch("golden");
+        let d = dir.path();
+        let names: Vec<String> = (0..40).map(|i| format!("s{i}")).collect();
+        // Writers 0 and 1 write the same traces, 2 and 3 other ones.
+        let results: Vec<Vec<&str>> = std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..4)
+                .map(|w| {
+                    let names = &names;
+                    scope.spawn(move || {
+                        names
+                            .iter()
+                            .map(|n| {
+                                let mut t = trace(n);
+                                if w >= 2 {
+                                    t.section = "3-2".into();
+                                }
+                                match write(d, &t, false) {
+                                    Ok(Written::Created) => "created",
+                                    Ok(Written::Unchanged) => "unchanged",
+                                    Ok(Written::Replaced) => "replaced",
+                                    Err(GoldenError::Exists { .. }) => "refused",
+                                    Err(e) => panic!("{e}"),
+                                }
+                            })
+                            .collect()
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().expect("writer"))
+                .collect()
+        });
+        for (i, n) in names.iter().enumerate() {
+            let outcomes: Vec<&str> = results.iter().map(|r| r[i]).collect();
+            let created: Vec<usize> = (0..4).filter(|w| outcomes[*w] == "created").collect();
+            assert_eq!(created.len(), 1, "{n}: {outcomes:?}");
+            // The file is the creator's; each other writer saw it as it is.
+            let winner = created[0] >= 2;
+            let on_disk = load(d, n).expect("loads").section == "3-2";
+            assert_eq!(on_disk, winner, "{n}: {outcomes:?}");
+            for w in (0..4).filter(|w| *w != created[0]) {
+                let same = (w >= 2) == winner;
+                let want = if same { "unchanged" } else { "refused" };
+                assert_eq!(outcomes[w], want, "{n}: writer {w}: {outcomes:?}");
+            }
+        }
+        let leftovers = fs::read_dir(d)
+            .expect("dir")
+            .filter_map(Result::ok)
+            .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+            .count();
+        assert_eq!(leftovers, 0);
     }
 
     #[test]

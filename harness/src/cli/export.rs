@@ -30,9 +30,10 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
             )))
         }
     };
-    let out = args
-        .output
-        .unwrap_or_else(|| args.trace.with_extension("vcd"));
+    let out = match &args.output {
+        Some(o) => o.clone(),
+        None => args.trace.with_extension("vcd"),
+    };
     // Streamed: a 16-million-pulse trace costs time, not memory.
     if out.as_os_str() == "-" {
         let stdout = std::io::stdout().lock();
@@ -44,6 +45,17 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
             _ => Ok(()),
         };
     }
+    if files::same_file(&out, &args.trace) {
+        let how = match args.output {
+            Some(_) => "-o names the input trace",
+            None => "the default output (the trace's name with .vcd) is the input trace itself",
+        };
+        return Err(usage(format!(
+            "{}: {how}; ppmc does not write over its input (give another -o, or - for standard output)",
+            out.display()
+        )));
+    }
+    files::check_writable(&out)?;
     files::write_with(&out, |w| crate::vcd_export::export(&trace, w))?;
     outln!("wrote {}", out.display());
     Ok(())

@@ -54,6 +54,10 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
             args.golden.display()
         )));
     }
+    // Tried before the matrix runs, not found unusable after it.
+    if let Some(path) = &args.output {
+        crate::files::check_writable(path)?;
+    }
     let mut boards: Vec<(String, ModelConfig)> = vec![("clean".into(), ModelConfig::default())];
     for f in CATALOGUE {
         if args.only.is_empty() || args.only.iter().any(|n| n == f.name) {

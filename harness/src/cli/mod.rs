@@ -164,7 +164,12 @@ impl CliError {
                 use crate::files::{Action, FileError};
                 errln!("ppmc: {e}");
                 let users = match &e {
-                    FileError::Io { action, .. } => *action == Action::Reading,
+                    // A file the user gave that cannot be read, or an
+                    // output folder found unusable before the run.
+                    FileError::Io { action, .. } => matches!(
+                        action,
+                        Action::Reading | Action::Probing | Action::PreparingFolder
+                    ),
                     _ => true,
                 };
                 ExitCode::from(if users { 2 } else { 1 })

@@ -3,6 +3,7 @@
 use super::args::{SelectArgs, TargetArgs};
 use super::progress::Progress;
 use crate::cli::{usage, CliError};
+use crate::files;
 use crate::golden::{self, GoldenError, Written};
 use crate::runner::run_suite;
 use crate::scenario::{DriverOptions, Scenario, ScenarioResult, Verdict};
@@ -37,6 +38,9 @@ pub fn run(args: RecordArgs, suite: &[Scenario]) -> Result<(), CliError> {
         Ok(s) => s,
         Err(e) => return Err(usage(e)),
     };
+    // The folder is made and tried before the run, not found unusable
+    // after it.
+    files::prepare_folder(&args.out)?;
     let mut target = args.target.open()?;
     let progress = Progress::new(scenarios.len());
     let mut tally = Tally::default();

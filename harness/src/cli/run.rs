@@ -192,9 +192,22 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             args.marginal
         )));
     }
+    // Every output is tried before the run, not found unusable after it.
+    if let Some(dir) = &args.artifacts {
+        files::prepare_folder(dir)?;
+    }
     let reports: Vec<&PathBuf> = [&args.junit, &args.json].into_iter().flatten().collect();
     for report in &reports {
         files::check_writable(report)?;
+    }
+    if let (Some(junit), Some(json)) = (&args.junit, &args.json) {
+        if files::same_file(junit, json) {
+            return Err(usage(format!(
+                "--junit {} and --json {} are the same file: give each report its own",
+                junit.display(),
+                json.display()
+            )));
+        }
     }
     match reports.iter().filter(|p| p.as_os_str() == "-").count() {
         0 => {}

@@ -43,6 +43,17 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
         Ok(s) => s,
         Err(e) => return Err(usage(e)),
     };
+    let seed = args.seed.unwrap_or_else(|| {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(1, |d| d.as_nanos() as u64)
+    });
+    // Where a departure's reproducer goes, tried before the run.
+    let out = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("fuzz-diff-{seed}.ppmc")));
+    crate::files::check_writable(&out)?;
     let mut target: Box<dyn Target> = if args.target.name() == "emu" {
         let mut model = args.target.model();
         if let Err(e) = crate::faults::apply_all(&args.chip_faults, &mut model) {
@@ -59,11 +70,6 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
     } else {
         args.target.open()?
     };
-    let seed = args.seed.unwrap_or_else(|| {
-        std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map_or(1, |d| d.as_nanos() as u64)
-    });
     // On a board, its bridge's straps (the emulator's are those given).
     let straps = target.straps();
     let settings = DiffSettings {
@@ -128,9 +134,6 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
             (acts, d.clone())
         }
     };
-    let out = args
-        .output
-        .unwrap_or_else(|| PathBuf::from(format!("fuzz-diff-{seed}.ppmc")));
     let text = differential::script(&acts_out, &d_out, seed, &name);
     crate::files::write(&out, text.as_bytes())?;
     outln!(
