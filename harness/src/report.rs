@@ -69,10 +69,15 @@ impl BoardInfo {
     }
 
     /// A board that could not be reached: nothing is known of it but its
-    /// name and why.
-    pub fn unreached(name: String, board_rev: Option<String>, why: String) -> BoardInfo {
+    /// name, the address it was tried at (`target`) and why.
+    pub fn unreached(
+        name: String,
+        target: String,
+        board_rev: Option<String>,
+        why: String,
+    ) -> BoardInfo {
         BoardInfo {
-            target: name.clone(),
+            target,
             name,
             target_details: BTreeMap::new(),
             board_rev,

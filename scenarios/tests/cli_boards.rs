@@ -307,3 +307,51 @@ fn each_keeps_every_boards_artifacts_apart() {
         .join("emu#2/s3_1_1_status_is_idle_after_reset.trace")
         .is_file());
 }
+
+/// One board of several that cannot be reached makes the run an
+/// infrastructure error (exit 1), though every scenario passed on the
+/// other; its record names the address it was tried at as its `target`,
+/// and its label as its `name`.
+#[test]
+fn an_unreachable_board_fails_the_run_and_its_record_names_its_address() {
+    let dir = scratch("boards");
+    let (junit, record) = (dir.path().join("r.xml"), dir.path().join("r.json"));
+    let missing = dir.path().join("no-such-port");
+    let address = format!("serial:{}", missing.display());
+    let out = ppmc(&[
+        "run",
+        "--target",
+        "emu",
+        "--target",
+        &format!("{address},name=ghost"),
+        "--filter",
+        "s3_1_1",
+        "--junit",
+        junit.to_str().expect("utf-8"),
+        "--json",
+        record.to_str().expect("utf-8"),
+    ]);
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert_eq!(out.status.code(), Some(1), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains(" 0 failed, 0 errors, 0 not run"),
+        "{stdout}"
+    );
+    assert!(
+        stderr.contains(&format!(
+            "ppmc: infrastructure error: 1 of 2 boards could not be reached and took no part in the run: ghost ({address})"
+        )),
+        "{stderr}"
+    );
+    let v = json(&record);
+    check_record(&run_record_schema(), &v);
+    let ghost = &v["run"]["boards"][1];
+    assert_eq!(ghost["name"], "ghost");
+    assert_eq!(ghost["target"], address.as_str());
+    assert!(ghost["error"].is_string(), "{ghost}");
+    let xml = std::fs::read_to_string(&junit).expect("JUnit written");
+    assert!(
+        xml.contains(&format!(r#"name="board.ghost.target" value="{address}""#)),
+        "{xml}"
+    );
+}

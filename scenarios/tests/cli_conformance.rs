@@ -261,6 +261,12 @@ fn bad_usage_exits_2() {
             "0.5",
         ],
         &["run", "--clock-mhz", "41"],
+        // A malformed network address is the user's typing, not the
+        // network's failure.
+        &["run", "--target", "tcp://[::1"],
+        &["run", "--target", "tcp://[::1:4321"],
+        &["run", "--target", "rfc2217://[::1,baud=115200"],
+        &["run", "--target", "tcp://bench 1:4321"],
     ] {
         let out = ppmc(args);
         assert_eq!(
@@ -276,6 +282,57 @@ fn bad_usage_exits_2() {
         text(&out.stderr).contains("--clock-mhz 0.5: the system clock must be 1 to 40 MHz"),
         "{}",
         text(&out.stderr)
+    );
+    let out = ppmc(&["run", "--target", "tcp://[::1"]);
+    assert!(
+        text(&out.stderr).contains(
+            "bad target `tcp://[::1`: write tcp://<host>:<port> (an IPv6 address in brackets: [::1])"
+        ),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+/// A golden or compared file that cannot be used is an error of its own in
+/// `compare`'s count (the file is at fault, not the board), apart from the
+/// traces that diverge, and still makes the exit status non-zero.
+#[test]
+fn compare_counts_an_unusable_file_as_an_error_not_a_failure() {
+    let g_dir = scratch("compare-bad");
+    let g = g_dir.path();
+    for name in ["e0_undefined_command_code", "e0_motor_type_code_00"] {
+        fs::copy(
+            golden_dir().join(format!("{name}.snap")),
+            g.join(format!("{name}.snap")),
+        )
+        .expect("copy");
+    }
+    // Unreadable as a trace: not UTF-8.
+    fs::write(g.join("e0_motor_type_code_00.snap"), [0xFF, 0xFE, 0x00]).expect("spoil");
+    let traces = golden_dir();
+    let args = |extra: &[&str]| {
+        let mut v = vec!["compare", s(g), "--traces", s(&traces)];
+        v.extend_from_slice(extra);
+        ppmc(&v)
+    };
+    let out = args(&["--filter", "e0_undefined"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("compare: 1 passed, 0 failed, 0 errors"),
+        "{}",
+        text(&out.stdout)
+    );
+    let out = args(&["--filter", "e0_motor_type_code_00"]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("BAD FILE e0_motor_type_code_00"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("not UTF-8 text"), "{stdout}");
+    assert!(
+        stdout.contains("compare: 0 passed, 0 failed, 1 errors"),
+        "{stdout}"
     );
 }
 

@@ -281,11 +281,15 @@ impl TargetSpec {
             Ok(Address::Serial { path, baud })
         } else if a.starts_with("tcp://") {
             crate::backend::parse_tcp(a)
+                .filter(|addr| host_and_port(addr))
                 .map(Address::Tcp)
-                .ok_or_else(|| bad("tcp://<host>:<port>"))
+                .ok_or_else(|| bad("tcp://<host>:<port> (an IPv6 address in brackets: [::1])"))
         } else if a.starts_with("rfc2217://") {
             let (addr, baud) = crate::backend::parse_rfc2217(a)
-                .ok_or_else(|| bad("rfc2217://<host>:<port>[,baud=N]"))?;
+                .filter(|(addr, _)| host_and_port(addr))
+                .ok_or_else(|| {
+                    bad("rfc2217://<host>:<port>[,baud=N] (an IPv6 address in brackets: [::1])")
+                })?;
             Ok(Address::Rfc2217 { addr, baud })
         } else if a.starts_with("labgrid:") {
             crate::backend::parse_labgrid(a)
@@ -297,6 +301,30 @@ impl TargetSpec {
             ))
         }
     }
+}
+
+/// Whether `addr` reads as `host:port` that a connection can be tried to:
+/// a port from 1 to 65535 after a host name, an IPv4 address or an IPv6
+/// address in brackets (`[::1]:4321`). Anything else (`[::1`, `::1:4321`,
+/// a space in the name) is the user's typing, refused before any
+/// connection, never a network failure.
+fn host_and_port(addr: &str) -> bool {
+    let Some((host, port)) = addr.rsplit_once(':') else {
+        return false;
+    };
+    let port_ok = port.parse::<u16>().is_ok_and(|p| p != 0);
+    let host_ok = match host.strip_prefix('[') {
+        Some(v6) => v6
+            .strip_suffix(']')
+            .is_some_and(|v6| v6.parse::<std::net::Ipv6Addr>().is_ok()),
+        None => {
+            !host.is_empty()
+                && host
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '.' | '_'))
+        }
+    };
+    port_ok && host_ok
 }
 
 /// Where a target's chip is, as its backend takes it.
@@ -581,5 +609,50 @@ impl ToleranceArgs {
             interval_bp: bp(self.interval_tol, "interval-tol")?,
             floor: self.time_floor,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn network_addresses_are_host_and_port_or_the_users_mistake() {
+        for good in [
+            "bench1.lab:4321",
+            "127.0.0.1:2001",
+            "[::1]:4321",
+            "[fe80::1]:1",
+            "rig_1:65535",
+        ] {
+            assert!(host_and_port(good), "{good}");
+        }
+        for bad in [
+            "[::1",
+            "[::1]",
+            "[::1:4321",
+            "::1:4321",
+            "[nothost]:4321",
+            "host:0",
+            "host:65536",
+            ":4321",
+            "host name:4321",
+            "host",
+        ] {
+            assert!(!host_and_port(bad), "{bad}");
+        }
+        let spec = |t: &str| TargetSpec::parse(t).expect("splits");
+        for t in ["tcp://[::1", "tcp://[::1:4321", "rfc2217://[::1,baud=9600"] {
+            let e = spec(t).parsed().err().expect("refused");
+            assert!(e.contains("an IPv6 address in brackets"), "{t}: {e}");
+        }
+        assert!(matches!(
+            spec("tcp://[::1]:4321").parsed(),
+            Ok(Address::Tcp(a)) if a == "[::1]:4321"
+        ));
+        assert!(matches!(
+            spec("rfc2217://[::1]:4321,baud=9600").parsed(),
+            Ok(Address::Rfc2217 { baud: 9600, .. })
+        ));
     }
 }

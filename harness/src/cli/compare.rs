@@ -63,7 +63,10 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             dir.display()
         )));
     }
-    let (mut ok, mut bad) = (0usize, 0usize);
+    // A trace that diverges fails; a file that cannot be used (missing,
+    // unreadable, corrupt, at other straps) is an error of its own: the
+    // file is at fault, not the board.
+    let (mut ok, mut bad, mut errors) = (0usize, 0usize, 0usize);
     for s in &scenarios {
         // Traces at other straps than the golden's are refused by name.
         let pair = golden::load(dir, s.name)
@@ -80,14 +83,14 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 }
             },
             Err(e) => {
-                bad += 1;
+                errors += 1;
                 format!("BAD FILE {}\n         {e}", s.name)
             }
         };
         outln!("{line}");
     }
-    outln!("compare: {ok} passed, {bad} failed");
-    if bad == 0 {
+    outln!("compare: {ok} passed, {bad} failed, {errors} errors");
+    if bad + errors == 0 {
         Ok(())
     } else {
         Err(CliError::Verdict)

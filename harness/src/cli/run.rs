@@ -268,7 +268,12 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             }
             Err(OpenError::Usage(m)) => return Err(usage(m)),
             Err(e @ OpenError::Infrastructure(_)) => {
-                boards.push(BoardInfo::unreached(name, rev, e.to_string()));
+                boards.push(BoardInfo::unreached(
+                    name,
+                    spec.address.clone(),
+                    rev,
+                    e.to_string(),
+                ));
                 unreached.push((b, e));
             }
         }
@@ -415,6 +420,25 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     }
     if interrupted {
         Err(CliError::Interrupted)
+    } else if !unreached.is_empty() {
+        // A board that took no part is an infrastructure error however well
+        // the others did: CI must see that the farm is not whole.
+        Err(CliError::Infrastructure(format!(
+            "{} of {} boards could not be reached and took no part in the run: {}",
+            unreached.len(),
+            info.boards.len(),
+            unreached
+                .iter()
+                .map(|(b, _)| {
+                    let board = &info.boards[*b];
+                    match board.name == board.target {
+                        true => board.name.clone(),
+                        false => format!("{} ({})", board.name, board.target),
+                    }
+                })
+                .collect::<Vec<_>>()
+                .join(", ")
+        )))
     } else if tally.ok() && problems.is_empty() {
         Ok(())
     } else {
