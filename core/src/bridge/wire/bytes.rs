@@ -225,11 +225,15 @@ impl<'a> R<'a> {
         }
         Ok(n)
     }
-    pub(super) fn count(&mut self, max_item: usize) -> Result<usize, WireError> {
+    /// A `count` u16 of entries that follow, each at least `min_item`
+    /// bytes on the wire: a count that promises more entries than the
+    /// bytes left could hold is refused before anything is allocated for
+    /// them, so a lying count costs nothing (`Vec::with_capacity(count)`
+    /// is safe after it).
+    pub(super) fn count(&mut self, min_item: usize) -> Result<usize, WireError> {
         let at = self.at;
         let n = usize::from(self.u16()?);
-        // A count cannot promise more items than bytes left.
-        if n.saturating_mul(max_item.max(1)) > (self.b.len() - self.at).saturating_mul(64) {
+        if n.saturating_mul(min_item.max(1)) > self.b.len() - self.at {
             return Err(WireError::BadValue {
                 at,
                 field: "count",

@@ -207,7 +207,12 @@ pub fn fragment(payload: &[u8], size: usize) -> Vec<Vec<u8>> {
 /// is not one.
 pub fn parse_fragment(payload: &[u8]) -> Option<(u8, u8, u8, &[u8])> {
     match payload {
-        [seq, k, i, n, data @ ..] if *k == kind::FRAGMENT && *n > 0 && i < n => {
+        // A fragment carries at most FRAGMENT_DATA bytes (255 of them make
+        // the longest response): a longer one is not a fragment, so that a
+        // lying bridge cannot make the host hold 255 frames of 4 KiB.
+        [seq, k, i, n, data @ ..]
+            if *k == kind::FRAGMENT && *n > 0 && i < n && data.len() <= FRAGMENT_DATA =>
+        {
             Some((*seq, *i, *n, data))
         }
         _ => None,
@@ -494,6 +499,14 @@ impl Response {
 
     /// `(seq, response)` from a frame payload, times in ticks of `timer`.
     pub fn decode(payload: &[u8], timer: Timer) -> Result<(u8, Response), WireError> {
+        // No bridge sends a longer one (it answers OVERFLOW instead).
+        if payload.len() > MAX_REPLY {
+            return Err(WireError::BadValue {
+                at: 0,
+                field: "response length",
+                value: payload.len() as u64,
+            });
+        }
         let mut r = R::new(payload, timer);
         let seq = r.u8()?;
         let resp = match r.u8()? {

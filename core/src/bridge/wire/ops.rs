@@ -243,8 +243,18 @@ pub(super) fn put_samples(w: &mut W, pairs: &[Reply], t0: u64, step: u64) {
     }
 }
 
+/// The fewest bytes a reply entry takes: a code and a time (DELAYED,
+/// INPUT_SET, PULSES_REACHED, RESET_DONE).
+pub(super) const MIN_REPLY_ENTRY: usize = 1 + 8;
+
+/// The most replies one response can stand for: a reply per op of a
+/// batch of [`MAX_BATCH_OPS`] wire ops, each at most a SAMPLE op of
+/// [`MAX_SAMPLES`] pairs. A reply that expands to more is refused, so a
+/// lying bridge cannot make the host allocate more than that.
+pub(super) const MAX_REPLIES: usize = 2 * MAX_SAMPLES * MAX_BATCH_OPS as usize;
+
 pub(super) fn get_replies(r: &mut R) -> Result<Vec<Reply>, WireError> {
-    let n = r.count(9)?;
+    let n = r.count(MIN_REPLY_ENTRY)?;
     let mut v = Vec::with_capacity(n);
     for _ in 0..n {
         if r.peek() == Some(rep::SAMPLES) {
@@ -261,7 +271,24 @@ pub(super) fn get_samples(r: &mut R, out: &mut Vec<Reply>) -> Result<(), WireErr
     let (t0, step) = (r.u64()?, r.u64()?);
     let at = r.at;
     let samples = r.samples()?;
+    let runs_at = r.at;
     let runs = r.count(SAMPLES_RUN)?;
+    // Each run holds at least one sample; and the replies of a whole
+    // response stay within what a batch can ask for.
+    if runs > samples {
+        return Err(WireError::BadValue {
+            at: runs_at,
+            field: "sample runs (more than samples)",
+            value: runs as u64,
+        });
+    }
+    if out.len() + 2 * samples > MAX_REPLIES {
+        return Err(WireError::BadValue {
+            at,
+            field: "samples (more replies than a batch can ask for)",
+            value: samples as u64,
+        });
+    }
     let timer = r.timer;
     let time = |ticks: Option<u64>| {
         ticks
@@ -274,7 +301,17 @@ pub(super) fn get_samples(r: &mut R, out: &mut Vec<Reply>) -> Result<(), WireErr
     };
     let mut i: u64 = 0;
     for _ in 0..runs {
+        let nat = r.at;
         let n = r.u16()?;
+        // Checked before expanding: a run past the sample count would
+        // otherwise push up to 131,070 replies of a lie.
+        if n == 0 || i + u64::from(n) > samples as u64 {
+            return Err(WireError::BadValue {
+                at: nat,
+                field: "sample run length",
+                value: u64::from(n),
+            });
+        }
         let pins = get_pins(r)?;
         for _ in 0..n {
             let start = step.checked_mul(i).and_then(|d| t0.checked_add(d));
