@@ -12,7 +12,7 @@
 //! model behind it; a bridge firmware implements it over the real chip.
 
 use crate::emu::{Board, Chip, ChipError, ModelConfig};
-use crate::protocol::{Flag, Input, Pins, PulseSummary, Record, Status, Straps};
+use crate::protocol::{Flag, Input, Pins, PulseSummary, Record, RecordMark, Status, Straps};
 use crate::time::{Duration, Instant};
 
 /// One bus-level operation.
@@ -291,6 +291,12 @@ impl EmuBus {
     /// The model on its board, as the bus sees it.
     pub fn board(&self) -> &Board {
         &self.board
+    }
+
+    /// Drops the record before `mark` as far as the model allows
+    /// ([`Board::forget_record_before`]); what was dropped.
+    pub fn forget_record_before(&mut self, mark: RecordMark) -> RecordMark {
+        self.board.forget_record_before(mark)
     }
 
     /// The model configuration the chip was built with (and is rebuilt

@@ -6,7 +6,8 @@
 
 use super::{Chip, ChipError, ModelConfig};
 use crate::protocol::{
-    Direction, ErrorCode, Input, InputSet, Pin, PinEvent, Pins, PulseRun, Record, Status, Straps,
+    Direction, ErrorCode, Input, InputSet, Pin, PinEvent, Pins, PulseRun, Record, RecordMark,
+    Status, Straps,
 };
 use crate::time::Instant;
 
@@ -231,6 +232,30 @@ impl Board {
             Some(seen) => &seen.record,
             None => self.chip.record(),
         }
+    }
+
+    /// Drops [`Board::record`] before `mark` (a mark of it) as far as the
+    /// chip allows ([`Chip::forget_record_before`]); what was dropped of
+    /// it.
+    pub fn forget_record_before(&mut self, mark: RecordMark) -> RecordMark {
+        let Some(seen) = self.seen.as_mut() else {
+            return self.chip.forget_record_before(mark);
+        };
+        // Runs and moves at the connector are the chip's one to one; the
+        // chip's pin changes taken in are all behind the connector's.
+        let chip = self.chip.forget_record_before(RecordMark {
+            runs: mark.runs.min(seen.runs),
+            pins: seen.pins,
+            moves: mark.moves,
+        });
+        seen.runs -= chip.runs;
+        seen.pins -= chip.pins;
+        let dropped = RecordMark {
+            pins: mark.pins.min(seen.record.pins.len()),
+            ..chip
+        };
+        seen.record.drop_front(dropped);
+        dropped
     }
 
     /// The output pins at the board's connector.

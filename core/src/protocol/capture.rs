@@ -377,6 +377,40 @@ impl Record {
         }
     }
 
+    /// Drops what came before `mark` (a mark of this record), as far as
+    /// it may go: the last move and its pulse runs stay (the last run may
+    /// still grow, and the pulses of the last move are still read). A run
+    /// that has compared what came before keeps only a window so, and its
+    /// memory does not grow with its length. Returns what was dropped: a
+    /// mark taken before counts from the new start once it is subtracted.
+    pub fn forget_before(&mut self, mark: RecordMark) -> RecordMark {
+        let moves = mark.moves.min(self.moves.len().saturating_sub(1));
+        let runs = mark
+            .runs
+            .min(self.runs.len().saturating_sub(1))
+            .min(self.moves.get(moves).map_or(usize::MAX, |m| m.first_run));
+        let dropped = RecordMark {
+            runs,
+            pins: mark.pins.min(self.pins.len()),
+            moves,
+        };
+        self.drop_front(dropped);
+        dropped
+    }
+
+    /// Drops the first `n.runs` runs, `n.pins` pin changes and `n.moves`
+    /// moves (each at most what there is); the moves left count their
+    /// runs from the new first.
+    pub fn drop_front(&mut self, n: RecordMark) {
+        let runs = n.runs.min(self.runs.len());
+        self.runs.drain(..runs);
+        self.pins.drain(..n.pins.min(self.pins.len()));
+        self.moves.drain(..n.moves.min(self.moves.len()));
+        for m in &mut self.moves {
+            m.first_run = m.first_run.saturating_sub(runs);
+        }
+    }
+
     /// The record from `mark` on: the runs, pin changes and moves added
     /// since (a move's `first_run` counted from the mark's first run).
     pub fn since(&self, mark: RecordMark) -> Record {
@@ -574,6 +608,62 @@ mod tests {
 
     fn t(us: u64) -> Instant {
         Instant::from_nanos(us * 1_000)
+    }
+
+    /// Forgetting keeps the last move and its runs (the model still reads
+    /// its pulses), whatever the mark asks; the moves left count their runs
+    /// from the new first, and the last move's pulses read as before.
+    #[test]
+    fn forgetting_keeps_the_last_move_and_rebases_it() {
+        let mut rec = Record::default();
+        for k in 0..3u32 {
+            rec.moves.push(MoveStart {
+                at: t(u64::from(k) * 100),
+                kind: MoveKind::Constant,
+                dir: Direction::Cw,
+                pout: false,
+                steps: 4,
+                first_run: rec.runs.len(),
+                phase_index: 0,
+                winding: None,
+            });
+            rec.push_pulses(
+                t(u64::from(k) * 100 + 1),
+                Duration::from_micros(1),
+                2,
+                Direction::Cw,
+                true,
+            );
+            rec.push_pulses(
+                t(u64::from(k) * 100 + 10),
+                Duration::from_micros(2),
+                2,
+                Direction::Cw,
+                false,
+            );
+            rec.pin(t(u64::from(k) * 100 + 20), Pin::Busy, 0);
+        }
+        let last = rec.last_move_pulses();
+        let everything = rec.mark();
+        let dropped = rec.forget_before(everything);
+        assert_eq!(
+            dropped,
+            RecordMark {
+                runs: 4,
+                pins: 3,
+                moves: 2
+            }
+        );
+        assert_eq!((rec.runs.len(), rec.pins.len(), rec.moves.len()), (2, 0, 1));
+        assert_eq!(rec.moves[0].first_run, 0);
+        assert_eq!(rec.last_move_pulses(), last);
+        // A mark short of that drops only what lies before it.
+        let mut again = rec.clone();
+        assert_eq!(
+            again.forget_before(RecordMark::default()),
+            RecordMark::default()
+        );
+        assert_eq!(again, rec);
     }
 
     proptest::proptest! {

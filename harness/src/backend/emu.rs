@@ -75,4 +75,8 @@ impl Target for EmuTarget {
         let replies = self.execute(ops)?;
         Ok((replies, self.bus.record().since(from)))
     }
+
+    fn forget_capture_before(&mut self, mark: RecordMark) -> RecordMark {
+        self.bus.forget_record_before(mark)
+    }
 }

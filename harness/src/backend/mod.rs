@@ -138,6 +138,16 @@ pub trait Target: Send {
         Ok((replies, capture.since(from)))
     }
 
+    /// Lets the target drop its capture before `mark` (a mark of
+    /// [`Target::capture`]), which the caller has done with: what it
+    /// dropped, from which later marks count down. A long differential run
+    /// so keeps a window, not its whole history. A target may keep
+    /// everything (the default drops nothing) or less than asked.
+    fn forget_capture_before(&mut self, mark: RecordMark) -> RecordMark {
+        let _ = mark;
+        RecordMark::default()
+    }
+
     /// Runs one op.
     fn execute_one(&mut self, op: Op) -> Result<Reply, TargetError> {
         let mut replies = self.execute(std::slice::from_ref(&op))?;

@@ -194,14 +194,22 @@ impl Side<'_> {
         )
     }
 
-    /// Everything so far was compared: the next window starts here.
+    /// Everything so far was compared: the next window starts here, and
+    /// the target may drop what came before (its record then keeps about
+    /// the last move: memory stays flat however long the run).
     fn checkpoint(&mut self) {
         self.bus.clear();
         let window = self.capture.mark();
-        self.mark = RecordMark {
+        let mark = RecordMark {
             runs: self.mark.runs + window.runs,
             pins: self.mark.pins + window.pins,
             moves: self.mark.moves + window.moves,
+        };
+        let dropped = self.target.forget_capture_before(mark);
+        self.mark = RecordMark {
+            runs: mark.runs - dropped.runs.min(mark.runs),
+            pins: mark.pins - dropped.pins.min(mark.pins),
+            moves: mark.moves - dropped.moves.min(mark.moves),
         };
         self.capture = Record::default();
     }
@@ -399,6 +407,39 @@ mod tests {
                 |_| true,
             );
             assert_eq!(d.expect("runs"), None, "seed {seed}");
+        }
+    }
+
+    /// What the target holds of its capture: its records of every kind.
+    fn held(t: &EmuTarget) -> usize {
+        let r = t.board().record();
+        r.runs.len() + r.pins.len() + r.moves.len()
+    }
+
+    /// A long run keeps a window of the capture, not its history: the
+    /// target's record stays small however many actions run (here 20,000,
+    /// whose whole record would be several times the bound), also on a
+    /// board whose miswired output keeps a record of its own.
+    #[test]
+    fn a_long_run_keeps_only_a_window_of_the_capture() {
+        for fault in [None, Some("dir-inverted")] {
+            let cfg = fault.map_or_else(ModelConfig::default, |f| {
+                faults::find(f).expect("fault").model()
+            });
+            let s = DiffSettings {
+                reference: cfg.clone(),
+                ..DiffSettings::default()
+            };
+            let mut t = emu(cfg);
+            let mut seen = 0;
+            let d = run(&mut t, program(5).take(20_000), &s, |n| {
+                seen = n;
+                true
+            });
+            assert_eq!(d.expect("runs"), None, "{fault:?}");
+            assert_eq!(seen, 20_000);
+            let held = held(&t);
+            assert!(held <= 2_000, "{fault:?}: {held} records held");
         }
     }
 

@@ -16,7 +16,7 @@
 
 use super::config::{ConfigError, ModelConfig};
 use super::motion::{AccelRamp, Motion, Profile, Ramp, Stretch};
-use crate::protocol::capture::{MoveStart, Pin, Pins, Record};
+use crate::protocol::capture::{MoveStart, Pin, Pins, Record, RecordMark};
 use crate::protocol::{
     AuxInputStatus, ClockSource, Command, Direction, ErrorCode, FinishStatus, InitCommand,
     InitData, Input, InputSet, InputStatus, MoveCommand, MoveKind, OutputLogic, OutputStatus,
@@ -299,6 +299,14 @@ impl Chip {
     /// The output record since reset.
     pub fn record(&self) -> &Record {
         &self.record
+    }
+
+    /// Drops the record before `mark` as far as the model allows
+    /// ([`Record::forget_before`]: it still reads the last move's pulses);
+    /// what was dropped. For a long differential run, which has compared
+    /// everything before its last point of rest.
+    pub fn forget_record_before(&mut self, mark: RecordMark) -> RecordMark {
+        self.record.forget_before(mark)
     }
 
     pub fn inputs(&self) -> InputSet {

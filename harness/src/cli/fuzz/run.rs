@@ -19,6 +19,9 @@ pub struct DiffArgs {
     seed: Option<u64>,
     /// Actions to run (each a command with its parameter bytes, a wait, an
     /// input change or a register read, with the flowchart's waits).
+    /// Memory does not grow with them: the run keeps what came since both
+    /// sides were last at rest and agreed (and the last move's records);
+    /// a departure is replayed from the seed, not from memory.
     #[arg(long, default_value_t = 1_000)]
     ops: usize,
     /// Stop after this much wall time (e.g. 30s, 5m is 300s) even if
