@@ -22,6 +22,7 @@ pub mod golden;
 pub mod report;
 pub mod runner;
 pub mod scenario;
+pub mod soak;
 pub mod trace;
 pub mod vcd_export;
 

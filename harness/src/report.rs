@@ -3,6 +3,7 @@
 
 use crate::backend::TargetInfo;
 use crate::scenario::{Grade, NotRun, ScenarioResult, Verdict};
+use crate::soak::Repeated;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -199,6 +200,45 @@ impl Tally {
     }
 }
 
+/// What a report lists: the results one by one (with, for each, the files
+/// saved for it, its board as an index into `RunInfo::boards`, and its pass
+/// when the run repeats), and a soak run's repeated runs
+/// ([`crate::soak`]), with the tally of the whole run.
+#[derive(Debug, Clone, Copy)]
+pub struct Listing<'a> {
+    pub results: &'a [ScenarioResult],
+    /// In the results' order; missing entries mean none.
+    pub attachments: &'a [Vec<String>],
+    pub boards: &'a [Option<usize>],
+    /// Each result's pass, from 1; empty when the run does not repeat.
+    pub passes: &'a [usize],
+    pub repeated: &'a [Repeated],
+    /// Every verdict of the run, listed or not.
+    pub tally: Tally,
+}
+
+impl<'a> Listing<'a> {
+    /// Every result of a run, listed one by one.
+    pub fn all(
+        results: &'a [ScenarioResult],
+        attachments: &'a [Vec<String>],
+        boards: &'a [Option<usize>],
+    ) -> Listing<'a> {
+        Listing {
+            results,
+            attachments,
+            boards,
+            passes: &[],
+            repeated: &[],
+            tally: Tally::of(results),
+        }
+    }
+
+    fn board_of(&self, i: usize) -> Option<usize> {
+        self.boards.get(i).copied().flatten()
+    }
+}
+
 /// JUnit XML for CI systems, valid under the Jenkins xunit schema
 /// (`junit-10.xsd`) and read by GitLab and junitparser: one test case per
 /// scenario run (classname = datasheet section; names made unique under
@@ -223,42 +263,152 @@ pub fn junit(
     attachments: &[Vec<String>],
     boards: &[Option<usize>],
 ) -> Result<String, ReportError> {
-    let tally = Tally::of(results);
-    let skipped = |rs: &[&ScenarioResult]| {
-        rs.iter()
-            .filter(|r| r.verdict == Verdict::NotRun(NotRun::Interrupted))
+    junit_listing(info, &Listing::all(results, attachments, boards))
+}
+
+/// A test case: a result, or a scenario's repeated runs.
+enum Case<'a> {
+    One(usize),
+    Many(&'a Repeated),
+}
+
+/// The child element a test case's verdict gives it, if any: failure,
+/// error or skipped, with its type and message.
+fn verdict_element(v: &Verdict) -> Option<(&'static str, &'static str, String)> {
+    match v {
+        Verdict::Passed | Verdict::Marginal => None,
+        Verdict::Failed(f) => Some(("failure", "device", f.to_string())),
+        Verdict::Error(e) => Some(("error", "harness", e.to_string())),
+        Verdict::NotRun(NotRun::Interrupted) => {
+            Some(("skipped", "interrupted", NotRun::Interrupted.to_string()))
+        }
+        Verdict::NotRun(why) => Some(("error", "infrastructure", why.to_string())),
+    }
+}
+
+/// The element of a scenario's repeated runs: a failure or error when runs
+/// that did not pass were counted past the listing's cap.
+fn repeated_element(r: &Repeated) -> Option<(&'static str, &'static str, String)> {
+    let t = &r.tally;
+    let past = format!(
+        "past the first {} results after the first pass that did not pass, which are listed one by one",
+        crate::soak::MAX_LISTED
+    );
+    let lost = t.not_run - r.interrupted;
+    if t.failed > 0 {
+        Some((
+            "failure",
+            "device",
+            format!("{} runs failed {past}", t.failed),
+        ))
+    } else if t.errors > 0 {
+        Some((
+            "error",
+            "harness",
+            format!("{} runs were errors {past}", t.errors),
+        ))
+    } else if lost > 0 {
+        Some((
+            "error",
+            "infrastructure",
+            format!("{lost} runs were not run {past}"),
+        ))
+    } else {
+        None
+    }
+}
+
+/// [`junit`] of what `listing` lists: each listed result a test case (named
+/// ` [pass K]` when the run repeats), and each scenario's repeated runs one
+/// test case, ` [passes A-B]` (with ` on <board>` in a suite several
+/// boards share), whose `system-out` gives their counts and each
+/// measurement's range, `time` their wall time and `device_time` their
+/// virtual time, summed.
+pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> {
+    let results = l.results;
+    let repeats = info.options.repeat > 1 && !l.passes.is_empty();
+    let in_board = |b: Option<usize>| {
+        (0..results.len())
+            .filter(move |&i| l.board_of(i) == b)
+            .map(Case::One)
+    };
+    let many_in = |b: Option<usize>| {
+        l.repeated
+            .iter()
+            .filter(move |r| r.board == b)
+            .map(Case::Many)
+    };
+    // The suites: their board (when they have one) and their cases.
+    let groups: Vec<(Option<usize>, Vec<Case>)> = if info.spread == "each" {
+        (0..info.boards.len())
+            .map(|b| (Some(b), in_board(Some(b)).chain(many_in(Some(b))).collect()))
+            .collect()
+    } else {
+        let board = (info.boards.len() == 1).then_some(0);
+        let cases = (0..results.len())
+            .map(Case::One)
+            .chain(l.repeated.iter().map(Case::Many))
+            .collect();
+        vec![(board, cases)]
+    };
+    let element = |c: &Case| match c {
+        Case::One(i) => verdict_element(&results[*i].verdict),
+        Case::Many(r) => repeated_element(r),
+    };
+    let kind_count = |cases: &[Case], tag: &str| {
+        cases
+            .iter()
+            .filter(|c| element(c).is_some_and(|(t, _, _)| t == tag))
             .count()
     };
-    let all: Vec<&ScenarioResult> = results.iter().collect();
-    let errors = tally.errors + tally.not_run - skipped(&all);
-    let board_of = |i: usize| boards.get(i).copied().flatten();
-    // The suites: their board (when they have one) and their results.
-    let groups: Vec<(Option<usize>, Vec<usize>)> = if info.spread == "each" {
-        (0..info.boards.len())
-            .map(|b| {
-                let cases = (0..results.len()).filter(|&i| board_of(i) == Some(b));
-                (Some(b), cases.collect())
-            })
-            .collect()
-    } else if info.boards.len() == 1 {
-        vec![(Some(0), (0..results.len()).collect())]
-    } else {
-        vec![(None, (0..results.len()).collect())]
-    };
+    let all: usize = groups.iter().map(|(_, c)| c.len()).sum();
+    let (failures, errors): (usize, usize) = groups.iter().fold((0, 0), |(f, e), (_, c)| {
+        (f + kind_count(c, "failure"), e + kind_count(c, "error"))
+    });
     let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = writeln!(
         x,
-        "<testsuites name=\"ppmc\" tests=\"{}\" failures=\"{}\" errors=\"{errors}\" time=\"{:.6}\">",
-        results.len(),
-        tally.failed,
+        "<testsuites name=\"ppmc\" tests=\"{all}\" failures=\"{failures}\" errors=\"{errors}\" time=\"{:.6}\">",
         info.wall_s
     );
     for (board, cases) in groups {
-        let rs: Vec<&ScenarioResult> = cases.iter().map(|&i| &results[i]).collect();
-        let t = Tally::of_refs(&rs);
-        let suite_skipped = skipped(&rs);
-        let suite_errors = t.errors + t.not_run - suite_skipped;
-        let wall: f64 = rs.iter().map(|r| r.wall.as_secs_f64()).sum();
+        let shared = board.is_none() && info.boards.len() > 1;
+        let one_names = unique_names(
+            &cases
+                .iter()
+                .filter_map(|c| match c {
+                    Case::One(i) => Some(&results[*i]),
+                    Case::Many(_) => None,
+                })
+                .collect::<Vec<_>>(),
+        );
+        let mut ones = one_names.into_iter();
+        let names: Vec<String> = cases
+            .iter()
+            .map(|c| match c {
+                Case::One(i) => {
+                    let n = ones.next().unwrap_or_default();
+                    match l.passes.get(*i) {
+                        Some(p) if repeats => format!("{} [pass {p}]", results[*i].name),
+                        _ => n,
+                    }
+                }
+                Case::Many(r) => {
+                    let mut n = format!("{} [passes {}-{}]", r.name, r.first_pass, r.last_pass);
+                    if shared {
+                        n.push_str(&format!(" on {}", info.board_name(r.board)));
+                    }
+                    n
+                }
+            })
+            .collect();
+        let wall: f64 = cases
+            .iter()
+            .map(|c| match c {
+                Case::One(i) => results[*i].wall.as_secs_f64(),
+                Case::Many(r) => r.wall.as_secs_f64(),
+            })
+            .sum();
         let mut suite_name = "ppmc-conformance".to_string();
         if let Some(shard) = &info.options.shard {
             suite_name.push_str(&format!(" shard {shard}"));
@@ -266,14 +416,15 @@ pub fn junit(
         if info.spread == "each" {
             suite_name.push_str(&format!(" on {}", info.board_name(board)));
         }
-        let names = unique_names(&rs);
         let _ = writeln!(
             x,
-            "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{suite_errors}\" skipped=\"{suite_skipped}\" \
+            "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" skipped=\"{}\" \
              time=\"{wall:.6}\" timestamp=\"{}\" hostname=\"{}\">",
             esc(&suite_name),
-            rs.len(),
-            t.failed,
+            cases.len(),
+            kind_count(&cases, "failure"),
+            kind_count(&cases, "error"),
+            kind_count(&cases, "skipped"),
             esc(&info.started),
             esc(&info.host)
         );
@@ -288,18 +439,23 @@ pub fn junit(
                 for b in &info.boards {
                     props.extend(board_props(&format!("board.{}.", b.name), b));
                 }
-                props.extend(cases.iter().zip(&names).map(|(&i, n)| {
-                    (
-                        format!("board_of.{n}"),
-                        info.board_name(board_of(i)).to_string(),
-                    )
+                props.extend(cases.iter().zip(&names).map(|(c, n)| {
+                    let b = match c {
+                        Case::One(i) => l.board_of(*i),
+                        Case::Many(r) => r.board,
+                    };
+                    (format!("board_of.{n}"), info.board_name(b).to_string())
                 }));
             }
         }
-        props.extend(rs.iter().zip(&names).map(|(r, n)| {
+        props.extend(cases.iter().zip(&names).map(|(c, n)| {
+            let elapsed = match c {
+                Case::One(i) => results[*i].elapsed,
+                Case::Many(r) => r.elapsed,
+            };
             (
                 format!("device_time.{n}"),
-                format!("{:.9}", r.elapsed.as_nanos() as f64 / 1e9),
+                format!("{:.9}", elapsed.as_nanos() as f64 / 1e9),
             )
         }));
         for (k, v) in props {
@@ -311,14 +467,75 @@ pub fn junit(
             );
         }
         x.push_str("    </properties>\n");
-        for (&i, name) in cases.iter().zip(&names) {
-            let shared = board.is_none().then(|| info.board_name(board_of(i)));
-            testcase(&mut x, &results[i], name, attachments.get(i), shared);
+        for (c, name) in cases.iter().zip(&names) {
+            match c {
+                Case::One(i) => {
+                    let shared = board.is_none().then(|| info.board_name(l.board_of(*i)));
+                    testcase(&mut x, &results[*i], name, l.attachments.get(*i), shared);
+                }
+                Case::Many(r) => {
+                    let shared = board.is_none().then(|| info.board_name(r.board));
+                    repeated_case(&mut x, r, name, shared);
+                }
+            }
         }
         x.push_str("  </testsuite>\n");
     }
     x.push_str("</testsuites>\n");
     Ok(x)
+}
+
+/// One `<testcase>` for a scenario's repeated runs.
+fn repeated_case(x: &mut String, r: &Repeated, name: &str, board: Option<&str>) {
+    let t = &r.tally;
+    let mut out = Vec::new();
+    if let Some(b) = board {
+        out.push(format!("board: {b}"));
+    }
+    out.push(format!(
+        "repeated: {} runs of passes {}-{} not listed one by one: {} passed, {} marginal, {} failed, {} errors, {} not run ({} interrupted)",
+        r.runs(),
+        r.first_pass,
+        r.last_pass,
+        t.passed,
+        t.marginal,
+        t.failed,
+        t.errors,
+        t.not_run,
+        r.interrupted
+    ));
+    out.extend(r.measurements.iter().map(|m| {
+        format!(
+            "{}: {} runs, min {}, mean {}, max {}, worst {}",
+            m.name,
+            m.count,
+            m.min,
+            m.mean(),
+            m.max,
+            m.worst.name()
+        )
+    }));
+    let _ = writeln!(
+        x,
+        "    <testcase name=\"{}\" classname=\"section {}\" time=\"{:.6}\">",
+        esc(name),
+        esc(r.section),
+        r.wall.as_secs_f64()
+    );
+    if let Some((tag, kind, message)) = repeated_element(r) {
+        let _ = writeln!(
+            x,
+            "      <{tag} type=\"{kind}\" message=\"{}\">{}</{tag}>",
+            esc(&message),
+            esc_text(&message)
+        );
+    }
+    let _ = writeln!(
+        x,
+        "      <system-out>{}</system-out>",
+        esc_text(&out.join("\n"))
+    );
+    x.push_str("    </testcase>\n");
 }
 
 /// A board's facts as suite properties, their names prefixed by `prefix`.
@@ -361,22 +578,13 @@ fn testcase(
         r.wall.as_secs_f64()
     );
     let mut body = String::new();
-    let mut element = |tag: &str, kind: &str, message: &str| {
+    if let Some((tag, kind, message)) = verdict_element(&r.verdict) {
         let _ = writeln!(
             body,
             "      <{tag} type=\"{kind}\" message=\"{}\">{}</{tag}>",
-            esc(message),
-            esc_text(message)
+            esc(&message),
+            esc_text(&message)
         );
-    };
-    match &r.verdict {
-        Verdict::Passed | Verdict::Marginal => {}
-        Verdict::Failed(f) => element("failure", "device", &f.to_string()),
-        Verdict::Error(e) => element("error", "harness", &e.to_string()),
-        Verdict::NotRun(NotRun::Interrupted) => {
-            element("skipped", "interrupted", &NotRun::Interrupted.to_string())
-        }
-        Verdict::NotRun(why) => element("error", "infrastructure", &why.to_string()),
     }
     let mut out: Vec<String> = Vec::new();
     if let Some(b) = board {
@@ -498,6 +706,9 @@ struct JsonError {
 #[derive(Serialize)]
 struct JsonScenario<'a> {
     name: &'a str,
+    /// Its pass, from 1, when the run repeats.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pass: Option<usize>,
     /// The board it ran on (`run.boards[].name`); null if none took it.
     board: Option<&'a str>,
     section: &'a str,
@@ -530,6 +741,38 @@ struct JsonRun<'a> {
     run: &'a RunInfo,
     summary: Tally,
     scenarios: Vec<JsonScenario<'a>>,
+    /// Under `--repeat`: each scenario's runs after the first pass that
+    /// are not in `scenarios`, counted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    repeated: Option<Vec<JsonRepeated<'a>>>,
+}
+
+/// One measurement over a scenario's repeated runs.
+#[derive(Serialize)]
+struct JsonRange<'a> {
+    name: &'a str,
+    count: u64,
+    min_ns: u64,
+    mean_ns: u64,
+    max_ns: u64,
+    worst_grade: &'static str,
+}
+
+/// A scenario's runs on one board after the first pass, counted.
+#[derive(Serialize)]
+struct JsonRepeated<'a> {
+    name: &'a str,
+    board: Option<&'a str>,
+    section: &'a str,
+    tags: &'a [&'a str],
+    first_pass: usize,
+    last_pass: usize,
+    runs: usize,
+    summary: Tally,
+    interrupted: usize,
+    elapsed_ns: u64,
+    wall_s: f64,
+    measurements: Vec<JsonRange<'a>>,
 }
 
 fn finite(d: crate::time::Duration) -> Option<u64> {
@@ -543,15 +786,57 @@ pub fn json(
     results: &[ScenarioResult],
     boards: &[Option<usize>],
 ) -> Result<String, ReportError> {
+    json_listing(info, &Listing::all(results, &[], boards))
+}
+
+/// [`json`] of what `listing` lists: `summary` counts every run; under
+/// `--repeat` each listed scenario carries its `pass`, and `repeated`
+/// holds each scenario's other runs after the first pass, counted, with
+/// each measurement's range.
+pub fn json_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> {
+    let (results, boards) = (l.results, l.boards);
+    let repeats = info.options.repeat > 1 && !l.passes.is_empty();
+    let board_name = |b: Option<usize>| b.and_then(|b| info.boards.get(b)).map(|b| b.name.as_str());
     let run = JsonRun {
         format: "ppmc-run-record/3",
         run: info,
-        summary: Tally::of(results),
+        summary: l.tally,
+        repeated: repeats.then(|| {
+            l.repeated
+                .iter()
+                .map(|r| JsonRepeated {
+                    name: r.name,
+                    board: board_name(r.board),
+                    section: r.section,
+                    tags: r.tags,
+                    first_pass: r.first_pass,
+                    last_pass: r.last_pass,
+                    runs: r.runs(),
+                    summary: r.tally,
+                    interrupted: r.interrupted,
+                    elapsed_ns: r.elapsed.as_nanos(),
+                    wall_s: r.wall.as_secs_f64(),
+                    measurements: r
+                        .measurements
+                        .iter()
+                        .map(|m| JsonRange {
+                            name: &m.name,
+                            count: m.count,
+                            min_ns: m.min.as_nanos(),
+                            mean_ns: m.mean().as_nanos(),
+                            max_ns: m.max.as_nanos(),
+                            worst_grade: m.worst.name(),
+                        })
+                        .collect(),
+                })
+                .collect()
+        }),
         scenarios: results
             .iter()
             .enumerate()
             .map(|(i, r)| JsonScenario {
                 name: r.name,
+                pass: l.passes.get(i).copied().filter(|_| repeats),
                 board: boards
                     .get(i)
                     .copied()

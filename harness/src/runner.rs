@@ -230,6 +230,8 @@ struct Report {
 ///
 /// The results come back in a fixed order whatever the timing: with
 /// `Share`, the suite's order (pass by pass); with `Each`, board by board.
+/// All of them are kept: a soak run that should not keep them streams them
+/// with [`stream_on_boards`].
 pub fn run_on_boards(
     boards: &mut [Box<dyn Target>],
     scenarios: &[Scenario],
@@ -237,8 +239,39 @@ pub fn run_on_boards(
     opts: DriverOptions,
     spread: Spread,
     stop: impl Fn() -> bool + Sync,
-    mut on_result: impl FnMut(usize, Option<usize>, &mut ScenarioResult),
+    on_result: impl FnMut(usize, Option<usize>, &mut ScenarioResult),
 ) -> Vec<BoardResult> {
+    let mut all = Vec::new();
+    stream_on_boards(
+        boards,
+        scenarios,
+        repeat,
+        opts,
+        spread,
+        stop,
+        on_result,
+        |r| all.push(r),
+    );
+    all.sort_by_key(|r| r.slot);
+    all
+}
+
+/// [`run_on_boards`] that keeps nothing: each result goes to `keep` once
+/// `on_result` has seen it, those that ran in the order they finish, then
+/// those no board took in the order of their slots. The run itself holds
+/// no result, so a soak run of a million passes costs the memory of what
+/// `keep` keeps.
+#[allow(clippy::too_many_arguments)]
+pub fn stream_on_boards(
+    boards: &mut [Box<dyn Target>],
+    scenarios: &[Scenario],
+    repeat: usize,
+    opts: DriverOptions,
+    spread: Spread,
+    stop: impl Fn() -> bool + Sync,
+    mut on_result: impl FnMut(usize, Option<usize>, &mut ScenarioResult),
+    mut keep: impl FnMut(BoardResult),
+) {
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::sync::mpsc;
 
@@ -252,7 +285,6 @@ pub fn run_on_boards(
         Spread::Each => (0..boards.len()).map(|_| AtomicUsize::new(0)).collect(),
     };
     let scenario_of = |slot: usize| &scenarios[slot % per_queue % scenarios.len()];
-    let mut done: Vec<BoardResult> = Vec::new();
     let mut lost: Vec<Option<String>> = vec![None; boards.len()];
     let stop = &stop;
     let queues = &queues;
@@ -290,7 +322,7 @@ pub fn run_on_boards(
             if r.lost.is_some() {
                 lost[r.board] = r.lost;
             }
-            done.push(BoardResult {
+            keep(BoardResult {
                 board: Some(r.board),
                 slot: r.slot,
                 result: r.result,
@@ -306,9 +338,9 @@ pub fn run_on_boards(
         .filter_map(|(b, why)| why.as_ref().map(|w| format!("board {}: {w}", b + 1)))
         .collect::<Vec<_>>()
         .join("; ");
-    done.sort_by_key(|r| r.slot);
-    let mut all = Vec::with_capacity(done.len());
-    let mut done = done.into_iter().peekable();
+    // Every slot a board took has reported (a worker that takes a slot
+    // runs it and reports it): the slots taken are the first of each
+    // queue, and the rest from there have no result.
     for (q, queue) in queues.iter().enumerate() {
         let taken = queue.load(Ordering::SeqCst).min(per_queue);
         let end = match interrupted {
@@ -320,11 +352,7 @@ pub fn run_on_boards(
             Spread::Share => None,
             Spread::Each => Some(q),
         };
-        for slot in q * per_queue..q * per_queue + end.min(per_queue) {
-            if let Some(r) = done.next_if(|r| r.slot == slot) {
-                all.push(r);
-                continue;
-            }
+        for slot in q * per_queue + taken..q * per_queue + end.min(per_queue) {
             let why = match (interrupted, board) {
                 (true, _) => NotRun::Interrupted,
                 (false, Some(b)) => NotRun::TargetLost(lost[b].clone().unwrap_or_default()),
@@ -332,14 +360,13 @@ pub fn run_on_boards(
             };
             let mut result = not_run(scenario_of(slot), why);
             on_result(slot, board, &mut result);
-            all.push(BoardResult {
+            keep(BoardResult {
                 board,
                 slot,
                 result,
             });
         }
     }
-    all
 }
 
 #[cfg(test)]

@@ -167,3 +167,65 @@ fn the_junit_report_keeps_the_jenkins_schema_rules() {
     assert!(xml.contains("[[ATTACHMENT|"), "{xml}");
     assert!(xml.contains("property name=\"device_time.e0_undefined_command_code [pass 1]\""));
 }
+
+/// A soak's reports (`--repeat`): the first pass listed, then one test
+/// case per scenario for the later passes with their counts and each
+/// measurement's range; the record validates with its `pass` and
+/// `repeated` fields, and the summary counts every run.
+#[test]
+fn a_soak_lists_the_first_pass_and_counts_the_rest() {
+    let validator = schema();
+    let dir = scratch("reports");
+    let junit = dir.path().join("r.xml");
+    let json = dir.path().join("run.json");
+    let out = ppmc(&[
+        "run",
+        "--junit",
+        junit.to_str().expect("utf-8"),
+        "--json",
+        json.to_str().expect("utf-8"),
+        "--filter",
+        "s3_3_5_constant_speed",
+        "--repeat",
+        "5",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("written")).expect("JSON");
+    check(&validator, &record);
+    let listed = record["scenarios"].as_array().expect("scenarios");
+    let repeated = record["repeated"].as_array().expect("repeated");
+    assert!(!listed.is_empty());
+    assert_eq!(repeated.len(), listed.len(), "one entry per scenario");
+    assert!(listed.iter().all(|s| s["pass"] == 1), "{listed:?}");
+    assert_eq!(
+        record["summary"]["passed"].as_u64().expect("count") as usize
+            + record["summary"]["marginal"].as_u64().expect("count") as usize,
+        5 * listed.len()
+    );
+    let r = &repeated[0];
+    assert_eq!(
+        (r["first_pass"].clone(), r["last_pass"].clone()),
+        (2.into(), 5.into())
+    );
+    assert_eq!(r["runs"], 4);
+    let m = &r["measurements"][0];
+    assert_eq!(m["count"], 4, "{r}");
+    assert!(m["min_ns"].as_u64() <= m["max_ns"].as_u64(), "{m}");
+
+    let xml = std::fs::read_to_string(&junit).expect("written");
+    let report = quick_junit::Report::deserialize_from_str(&xml).expect("parses");
+    let suite = &report.test_suites[0];
+    assert_eq!(report.tests, 2 * listed.len());
+    assert_eq!(suite.test_cases.len(), 2 * listed.len());
+    let name = listed[0]["name"].as_str().expect("name");
+    let names: Vec<&str> = suite.test_cases.iter().map(|c| c.name.as_str()).collect();
+    assert!(
+        names.contains(&format!("{name} [pass 1]").as_str()),
+        "{names:?}"
+    );
+    let soak = format!("{name} [passes 2-5]");
+    assert!(names.contains(&soak.as_str()), "{names:?}");
+    assert!(xml.contains(&format!("property name=\"device_time.{soak}\"")));
+    assert!(xml.contains("repeated: 4 runs of passes 2-5"), "{xml}");
+}

@@ -7,12 +7,14 @@ use crate::cli::{usage, CliError};
 use crate::compare::{compare, Tolerances};
 use crate::files;
 use crate::golden::{self};
-use crate::report::{self, BoardInfo, RunInfo, RunOptions, Tally};
-use crate::runner::{run_on_boards, Spread};
+use crate::report::{self, BoardInfo, Listing, RunInfo, RunOptions, Tally};
+use crate::runner::{stream_on_boards, Spread};
 use crate::scenario::{
     DriverOptions, Failure, Grading, HarnessError, NotRun, Scenario, ScenarioResult, Verdict,
 };
+use crate::soak::Soak;
 use clap::Args;
+use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
@@ -49,8 +51,12 @@ pub struct RunArgs {
     /// (to compare boards), instead of spreading it over them.
     #[arg(long)]
     pub(super) each: bool,
-    /// Run the selection this many times (soak runs). SIGINT or SIGTERM
-    /// stops after the scenario under way and still writes the reports.
+    /// Run the selection this many times (soak runs). Memory stays flat:
+    /// the reports list the first pass and every run that did not pass (up
+    /// to 1,000 after the first pass), and count the other runs per
+    /// scenario and board (verdicts, each measurement's min, mean and
+    /// max). SIGINT or SIGTERM stops after the scenario under way and
+    /// still writes the reports.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     pub(super) repeat: u32,
     /// Width of the MARGINAL zone inside each Table 3-3 limit, in percent of
@@ -342,13 +348,16 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     };
     let progress = Progress::new(scenarios.len() * repeat * runs);
     let mut problems = Vec::new();
-    // The files saved for each result, by its slot.
-    let mut saved: BTreeMap<usize, Vec<String>> = BTreeMap::new();
+    // The files saved for each result, by its slot, until the soak takes it.
+    let saved: RefCell<BTreeMap<usize, Vec<String>>> = RefCell::new(BTreeMap::new());
+    // What the reports keep of the results as they come (`--repeat`: the
+    // first pass and what did not pass, in full; the rest counted).
+    let mut soak = Soak::new(scenarios.len(), repeat);
     let stop = super::signals::stop_requested();
     let stopped = || stop.load(Ordering::Relaxed) || super::out::stdout_closed();
     let several = info.boards.len() > 1;
     let board_name = |t: Option<usize>| info.board_name(t.map(|t| reached[t])).to_string();
-    let results = run_on_boards(
+    stream_on_boards(
         &mut targets,
         &scenarios,
         repeat,
@@ -369,6 +378,7 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
                     Spread::Each => dir.join(file_name(&name)),
                     Spread::Share => dir.clone(),
                 };
+                let mut saved = saved.borrow_mut();
                 if let Err(e) = save_artifacts(&dir, r, saved.entry(slot).or_default()) {
                     problems.push(e);
                 }
@@ -376,44 +386,70 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             // Judged, compared and saved: a soak run need not keep it.
             r.trace = None;
         },
+        |r| {
+            let board = r.board.map(|t| reached[t]);
+            let files = saved.borrow_mut().remove(&r.slot).unwrap_or_default();
+            soak.add(r, board, files);
+        },
     );
     progress.finish();
     let interrupted = stopped();
     info.wall_s = started.elapsed().as_secs_f64();
-    let mut on: Vec<Option<usize>> = results
-        .iter()
-        .map(|r| r.board.map(|t| reached[t]))
-        .collect();
-    let attachments: Vec<Vec<String>> = results
-        .iter()
-        .map(|r| saved.remove(&r.slot).unwrap_or_default())
-        .collect();
-    let mut results: Vec<ScenarioResult> = results.into_iter().map(|r| r.result).collect();
-    // With --each, a board that could not be reached runs nothing.
+    // With --each, a board that could not be reached runs nothing: its
+    // slots come after the boards reached.
     if spread == Spread::Each {
-        for (b, e) in &unreached {
-            for _ in 0..repeat {
-                for s in &scenarios {
-                    results.push(not_reached(s, &e.to_string()));
-                    on.push(Some(*b));
-                }
+        let per_queue = scenarios.len() * repeat;
+        for (k, (b, e)) in unreached.iter().enumerate() {
+            let first = per_queue * (targets.len() + k);
+            for (i, s) in (0..repeat).flat_map(|_| &scenarios).enumerate() {
+                let r = crate::runner::BoardResult {
+                    board: None,
+                    slot: first + i,
+                    result: not_reached(s, &e.to_string()),
+                };
+                soak.add(r, Some(*b), Vec::new());
             }
         }
     }
-    let tally = Tally::of(&results);
+    let tally = soak.tally();
+    let unlisted = soak.unlisted();
+    let board_tallies: Vec<Tally> = (0..info.boards.len())
+        .map(|b| soak.board_tally(Some(b)))
+        .collect();
+    let (listed, repeated) = soak.finish();
+    let on: Vec<Option<usize>> = listed.iter().map(|l| l.board).collect();
+    let passes: Vec<usize> = listed.iter().map(|l| l.pass).collect();
+    let (results, attachments): (Vec<ScenarioResult>, Vec<Vec<String>>) = listed
+        .into_iter()
+        .map(|l| (l.result, l.attachments))
+        .unzip();
+    let listing = Listing {
+        results: &results,
+        attachments: &attachments,
+        boards: &on,
+        passes: &passes,
+        repeated: &repeated,
+        tally,
+    };
     if let Some(p) = &args.junit {
-        if let Err(e) = write_report(p, report::junit(&info, &results, &attachments, &on)) {
+        if let Err(e) = write_report(p, report::junit_listing(&info, &listing)) {
             problems.push(e);
         }
     }
     if let Some(p) = &args.json {
-        if let Err(e) = write_report(p, report::json(&info, &results, &on)) {
+        if let Err(e) = write_report(p, report::json_listing(&info, &listing)) {
             problems.push(e);
         }
     }
-    summary_lines(&tally, results.len());
+    if unlisted > 0 {
+        outln!(
+            "{unlisted} runs that did not pass are counted, not listed: the reports list the first {} after the first pass",
+            crate::soak::MAX_LISTED
+        );
+    }
+    summary_lines(&tally, runs_of(&tally));
     if several {
-        board_lines(&info, &results, &on);
+        board_lines(&info, &board_tallies);
     }
     for p in &problems {
         errln!("ppmc: {p}");
@@ -458,16 +494,15 @@ fn file_name(label: &str) -> String {
         .collect()
 }
 
-/// One line per board: how many scenarios it ran and how they went.
-fn board_lines(info: &RunInfo, results: &[ScenarioResult], on: &[Option<usize>]) {
-    for (b, board) in info.boards.iter().enumerate() {
-        let mine: Vec<&ScenarioResult> = results
-            .iter()
-            .zip(on)
-            .filter(|(_, o)| **o == Some(b))
-            .map(|(r, _)| r)
-            .collect();
-        let t = Tally::of_refs(&mine);
+/// How many runs a tally counts.
+fn runs_of(t: &Tally) -> usize {
+    t.passed + t.marginal + t.failed + t.errors + t.not_run
+}
+
+/// One line per board: how many scenarios it ran and how they went
+/// (`tallies` in the order of the boards).
+fn board_lines(info: &RunInfo, tallies: &[Tally]) {
+    for (board, t) in info.boards.iter().zip(tallies) {
         let state = match &board.error {
             Some(_) => " (not reached)",
             None => "",
@@ -475,7 +510,7 @@ fn board_lines(info: &RunInfo, results: &[ScenarioResult], on: &[Option<usize>])
         outln!(
             "board {}{state}: {} scenarios, {} passed, {} failed, {} errors, {} not run",
             board.name,
-            mine.len(),
+            runs_of(t),
             t.passed + t.marginal,
             t.failed,
             t.errors,
