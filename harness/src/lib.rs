@@ -12,6 +12,7 @@
 
 pub mod backend;
 pub mod bridge;
+pub mod chaos;
 pub mod cli;
 pub mod compare;
 pub mod console;
@@ -23,6 +24,7 @@ pub mod report;
 pub mod runner;
 pub mod scenario;
 pub mod soak;
+pub mod stop;
 pub mod trace;
 pub mod vcd_export;
 

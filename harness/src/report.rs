@@ -1,8 +1,8 @@
 //! Run reports: JUnit XML for CI systems, and a JSON run record with every
 //! measurement and its limits.
 
-use crate::backend::TargetInfo;
-use crate::scenario::{Grade, NotRun, ScenarioResult, Verdict};
+use crate::backend::{TargetErrorKind, TargetInfo};
+use crate::scenario::{Grade, HarnessError, NotRun, ScenarioResult, Verdict};
 use crate::soak::Repeated;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -278,7 +278,7 @@ fn verdict_element(v: &Verdict) -> Option<(&'static str, &'static str, String)> 
     match v {
         Verdict::Passed | Verdict::Marginal => None,
         Verdict::Failed(f) => Some(("failure", "device", f.to_string())),
-        Verdict::Error(e) => Some(("error", "harness", e.to_string())),
+        Verdict::Error(e) => Some(("error", error_kind(e), e.to_string())),
         Verdict::NotRun(NotRun::Interrupted) => {
             Some(("skipped", "interrupted", NotRun::Interrupted.to_string()))
         }
@@ -858,7 +858,7 @@ pub fn json_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> 
                 },
                 error: match &r.verdict {
                     Verdict::Error(e) => Some(JsonError {
-                        kind: "harness",
+                        kind: error_kind(e),
                         message: e.to_string(),
                     }),
                     Verdict::NotRun(NotRun::Interrupted) => Some(JsonError {
@@ -891,4 +891,73 @@ pub fn json_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> 
             .collect(),
     };
     serde_json::to_string_pretty(&run).map_err(ReportError::Json)
+}
+
+/// How a report types a scenario's error: `infrastructure` when the link
+/// to the target failed under it (the board is not to blame, and neither
+/// is the harness), else `harness`.
+fn error_kind(e: &HarnessError) -> &'static str {
+    match e {
+        HarnessError::Target {
+            kind: TargetErrorKind::Link,
+            ..
+        } => "infrastructure",
+        _ => "harness",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::backend::TargetInfo;
+
+    /// A scenario cut short because the link to the board failed is the
+    /// infrastructure's, in both reports; a scenario's own bug stays the
+    /// harness's.
+    #[test]
+    fn a_scenario_the_link_failed_is_typed_infrastructure() {
+        let info = RunInfo::new(
+            vec![BoardInfo::new(
+                "tcp://127.0.0.1:2000".into(),
+                &TargetInfo {
+                    name: "tcp://127.0.0.1:2000".into(),
+                    straps: crate::protocol::Straps::default(),
+                    extra: Vec::new(),
+                },
+                None,
+            )],
+            "one",
+        );
+        let result = |name, e| ScenarioResult {
+            name,
+            section: "3-1-1",
+            tags: &[],
+            verdict: Verdict::Error(e),
+            measurements: Vec::new(),
+            trace: None,
+            elapsed: crate::time::Duration::ZERO,
+            wall: std::time::Duration::ZERO,
+        };
+        let results = [
+            result(
+                "cut",
+                HarnessError::Target {
+                    kind: TargetErrorKind::Link,
+                    message: "link lost".into(),
+                },
+            ),
+            result("bug", HarnessError::Scenario("panicked".into())),
+        ];
+        let on = [Some(0), Some(0)];
+        let xml = junit(&info, &results, &[Vec::new(), Vec::new()], &on).expect("junit");
+        assert!(
+            xml.contains("<error type=\"infrastructure\" message=\"target: link lost\""),
+            "{xml}"
+        );
+        assert!(xml.contains("<error type=\"harness\" message=\"panicked\""), "{xml}");
+        let record: serde_json::Value =
+            serde_json::from_str(&json(&info, &results, &on).expect("json")).expect("JSON");
+        assert_eq!(record["scenarios"][0]["error"]["kind"], "infrastructure");
+        assert_eq!(record["scenarios"][1]["error"]["kind"], "harness");
+    }
 }

@@ -38,6 +38,7 @@ fn fast() -> SerialOptions {
         backoff: WallDuration::from_millis(20),
         quiet: WallDuration::from_millis(4),
         pad: 0,
+        ..SerialOptions::default()
     }
 }
 
@@ -298,4 +299,20 @@ fn a_capture_overrun_is_an_error_of_that_scenario_and_the_run_goes_on() {
     let detail = results[0].verdict.detail().unwrap_or_default();
     assert!(detail.contains("capture buffer overran"), "{detail}");
     assert!(detail.contains("the buffer holds 40"), "{detail}");
+}
+
+/// At most once across reconnects, on the bridge simulator: the
+/// connection cut at every frame boundary of two scenarios in turn, through
+/// a proxy that keeps its own connection to the bridge.
+#[test]
+fn a_connection_cut_at_every_frame_boundary_changes_no_verdict() {
+    let sim = Sim::clean();
+    let frames = common::drop_at_every_frame(
+        ppmc::chaos::Upstream::Serial(sim.0.path().to_string()),
+        &[
+            "s3_2_2_ramp_runs_from_rl_to_rh",
+            "e1_operation_command_while_busy",
+        ],
+    );
+    assert!(frames >= 10, "{frames} frames");
 }

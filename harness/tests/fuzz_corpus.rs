@@ -200,6 +200,7 @@ fn write_frame_decoder_seeds() {
     let requests = [
         Request::Hello {
             version: ppmc::bridge::wire::PROTOCOL_VERSION,
+            host: 0x5EED_0001,
         },
         Request::Batch(ops.clone()),
         // Pin samples: a SAMPLE op, answered with a SAMPLES entry.
@@ -245,7 +246,13 @@ fn write_frame_decoder_seeds() {
         .flat_map(|f| encode(f))
         .collect();
     put("fragments", &frags);
-    let mut bad = encode(&Request::Hello { version: 1 }.encode(9, t));
+    let mut bad = encode(
+        &Request::Hello {
+            version: 1,
+            host: 0,
+        }
+        .encode(9, t),
+    );
     bad[2] ^= 0x10;
     put("bad-crc", &bad);
     put(

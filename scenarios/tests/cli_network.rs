@@ -43,7 +43,8 @@ impl Drop for Killed {
 
 /// A bridge simulator and ser2net in front of its pty, on 127.0.0.1.
 struct Served {
-    port: u16,
+    /// One port per accepter, in the order given.
+    ports: Vec<u16>,
     ser2net: Killed,
     _bridge: Killed,
     _dir: tempfile::TempDir,
@@ -60,6 +61,12 @@ impl Served {
     /// ser2net with `accepter` (`tcp` for raw, `telnet(rfc2217),tcp` for
     /// RFC 2217) on a free port of 127.0.0.1.
     fn start(accepter: &str) -> Served {
+        Served::start_all(&[accepter])
+    }
+
+    /// ser2net with one connection per accepter, all to the same bridge:
+    /// a lab that serves one board both raw and over RFC 2217.
+    fn start_all(accepters: &[&str]) -> Served {
         let dir = scratch("ser2net");
         let mut bridge = Command::new(env!("CARGO_BIN_EXE_ppmc"))
             .args(["bridge-sim", "--link"])
@@ -78,15 +85,15 @@ impl Served {
             .expect("a pty")
             .to_string();
         let bridge = Killed(bridge);
-        let port = free_port();
+        let ports: Vec<u16> = accepters.iter().map(|_| free_port()).collect();
         let config = dir.path().join("ser2net.yaml");
-        std::fs::write(
-            &config,
-            format!(
-                "%YAML 1.1\n---\nconnection: &bridge\n    accepter: {accepter},127.0.0.1,{port}\n    connector: serialdev,{pty},115200n81,local\n"
-            ),
-        )
-        .expect("config written");
+        let mut yaml = String::from("%YAML 1.1\n---\n");
+        for (i, (accepter, port)) in accepters.iter().zip(&ports).enumerate() {
+            yaml.push_str(&format!(
+                "connection: &bridge{i}\n    accepter: {accepter},127.0.0.1,{port}\n    connector: serialdev,{pty},115200n81,local\n"
+            ));
+        }
+        std::fs::write(&config, yaml).expect("config written");
         let ser2net = Killed(
             Command::new("ser2net")
                 .arg("-n")
@@ -101,18 +108,20 @@ impl Served {
         );
         // Until it listens (bounded).
         let deadline = Instant::now() + Duration::from_secs(10);
-        while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
-            assert!(
-                Instant::now() < deadline,
-                "ser2net did not listen on {port}"
-            );
-            std::thread::sleep(Duration::from_millis(20));
+        for &port in &ports {
+            while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+                assert!(
+                    Instant::now() < deadline,
+                    "ser2net did not listen on {port}"
+                );
+                std::thread::sleep(Duration::from_millis(20));
+            }
         }
         // That probe connection is closed; give ser2net a moment to free
         // the port for the next client.
         std::thread::sleep(Duration::from_millis(100));
         Served {
-            port,
+            ports,
             ser2net,
             _bridge: bridge,
             _dir: dir,
@@ -120,7 +129,11 @@ impl Served {
     }
 
     fn target(&self, scheme: &str) -> String {
-        format!("{scheme}://127.0.0.1:{}", self.port)
+        self.target_at(0, scheme)
+    }
+
+    fn target_at(&self, accepter: usize, scheme: &str) -> String {
+        format!("{scheme}://127.0.0.1:{}", self.ports[accepter])
     }
 }
 
@@ -151,6 +164,37 @@ fn the_suite_passes_through_ser2net_with_its_defaults() {
 fn the_suite_passes_through_ser2net_in_rfc2217_mode() {
     if have_ser2net() {
         suite_through("telnet(rfc2217),tcp", "rfc2217");
+    }
+}
+
+/// One bridge behind one ser2net, reached raw and over RFC 2217 in turn,
+/// as a lab switches between its tools: every suite passes. (A host that
+/// took the session of the HELLO it had not yet heard for a restart once
+/// failed most of these switches.)
+#[test]
+fn alternating_raw_and_rfc2217_through_one_ser2net_passes_every_time() {
+    if !have_ser2net() {
+        return;
+    }
+    let served = Served::start_all(&["tcp", "telnet(rfc2217),tcp"]);
+    for i in 0..20 {
+        let target = match i % 2 {
+            0 => served.target_at(0, "tcp"),
+            _ => served.target_at(1, "rfc2217"),
+        };
+        let out = ppmc(&["run", "--target", &target]);
+        let stdout = text(&out.stdout);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "switch {i} ({target}): {}{}",
+            stdout.lines().last().unwrap_or_default(),
+            text(&out.stderr)
+        );
+        assert!(
+            stdout.contains("suite: 96 passed, 0 failed, 0 errors, 0 not run"),
+            "switch {i}"
+        );
     }
 }
 

@@ -38,7 +38,11 @@ const FILES: [&str; 12] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 18] = [
+const ELSEWHERE: [(&str, &str); 19] = [
+    (
+        "timeout -s INT 5 ppmc run",
+        "in scenarios/tests/cli_signals.rs (timeout -s INT during the long move on a real-time bridge, ten times)",
+    ),
     (
         "scripts/fuzz-figures",
         "in .ci/run (the fuzz step runs every row, 1 s each; it needs nightly and cargo-fuzz)",
@@ -108,7 +112,11 @@ const ELSEWHERE: [(&str, &str); 18] = [
 /// local stand-in: `(text in the command, where)`. Those "in
 /// scenarios/tests/labgrid/place.sh" must appear in that script as written
 /// (with `"$ppmc"` for `ppmc`).
-const PPMC_ELSEWHERE: [(&str, &str); 2] = [
+const PPMC_ELSEWHERE: [(&str, &str); 3] = [
+    (
+        "127.0.0.1:4000",
+        "in scenarios/tests/cli_chaos.rs (the chaos proxy in front of a bridge-sim, a suite run through it)",
+    ),
     (
         "bench1.lab:4321",
         "in scenarios/tests/cli_network.rs (the suite through ser2net on 127.0.0.1, both modes)",

@@ -4,10 +4,13 @@
 //! real chip.
 //!
 //! [`BridgeEngine::on_bytes`] takes bytes from the link and returns the
-//! bytes to send back. It keeps the last request and its response, so a
-//! request retransmitted with the same sequence number (because its
-//! response was lost or corrupted) is answered again without running twice:
-//! every retry the host makes is safe.
+//! bytes to send back. It keeps the last request that ran anything and its
+//! response, so a request retransmitted with the same sequence number
+//! (because its response was lost or corrupted) is answered again without
+//! running twice: every retry the host makes is safe. The cache outlives a
+//! HELLO from the same host session, so a host that reconnects after a
+//! dropped connection and sends its request again is answered from it too
+//! (at most once, `docs/bridge-protocol.md` section 3).
 
 use super::frame::{self, FrameDecoder, FrameError};
 use super::wire::{
@@ -26,6 +29,13 @@ const CHUNK_RUNS: usize = 300;
 const CHUNK_PINS: usize = 300;
 const CHUNK_MOVES: usize = 60;
 
+/// A request payload and the frames that answered it.
+#[derive(Debug)]
+struct Answered {
+    payload: Vec<u8>,
+    frames: Vec<Vec<u8>>,
+}
+
 /// A bridge in front of a chip.
 #[derive(Debug)]
 pub struct BridgeEngine<B> {
@@ -40,8 +50,14 @@ pub struct BridgeEngine<B> {
     /// in HELLO_REPLY); beyond it the capture is overrun until the next
     /// chip reset.
     capture_capacity: u32,
-    /// The last request payload and the frames sent for it.
-    last: Option<(Vec<u8>, Vec<Vec<u8>>)>,
+    /// The host session of the last HELLO (0: none yet).
+    host: u32,
+    /// The last request that was not a HELLO, LINK or RESEND, and the
+    /// frames sent for it: what a retransmission is answered from.
+    last: Option<Answered>,
+    /// The last HELLO or LINK, when it came after `last` (they change
+    /// nothing on the chip, and leave `last` alone).
+    control: Option<Answered>,
     /// Data bytes per reply fragment, as the host last asked (LINK).
     fragment: usize,
     /// Every reply is padded with 0x00 to a multiple of this (LINK; 0:
@@ -64,7 +80,9 @@ impl<B: Bus> BridgeEngine<B> {
             timer: Timer::NANOS,
             virtual_time,
             capture_capacity: u32::MAX,
+            host: 0,
             last: None,
+            control: None,
             fragment: wire::FRAGMENT_DATA,
             pad: 0,
             frames: 0,
@@ -137,28 +155,45 @@ impl<B: Bus> BridgeEngine<B> {
     }
 
     /// The frames answering one request payload.
+    ///
+    /// The at-most-once rule (`docs/bridge-protocol.md` section 3): a
+    /// payload byte for byte the same as the last request's, or as the last
+    /// HELLO's or LINK's, is answered with the same frames and not run
+    /// again. HELLO, LINK and RESEND never replace the cached request, so a
+    /// host that reconnects, says HELLO with its own host session again and
+    /// resends the request whose reply it lost gets that reply; a HELLO
+    /// with another host session (another host) clears the cache.
     fn on_payload(&mut self, payload: &[u8]) -> Vec<Vec<u8>> {
-        if let Some((req, frames)) = &self.last {
-            if req == payload {
-                return frames.clone();
+        for cached in [&self.control, &self.last].into_iter().flatten() {
+            if cached.payload == payload {
+                return cached.frames.clone();
             }
         }
         let seq = payload.first().copied().unwrap_or(0);
         let decoded = Request::decode(payload, self.timer);
         if let Ok((s, Request::Resend { fragments })) = &decoded {
-            // Only for the request answered last.
-            return match &self.last {
-                Some((req, frames)) if req.first() == Some(s) => fragments
+            // Only for the request answered last, or the one before a
+            // HELLO or LINK.
+            let answered = [&self.control, &self.last]
+                .into_iter()
+                .flatten()
+                .find(|a| a.payload.first() == Some(s));
+            return match answered {
+                Some(a) => fragments
                     .iter()
-                    .filter_map(|i| frames.get(usize::from(*i)).cloned())
+                    .filter_map(|i| a.frames.get(usize::from(*i)).cloned())
                     .collect(),
-                _ => vec![Response::Error {
+                None => vec![Response::Error {
                     code: BridgeErrorCode::Malformed,
                     detail: format!("no reply to sequence {s} to resend"),
                 }
                 .encode(seq, self.timer)],
             };
         }
+        let control = matches!(
+            decoded,
+            Ok((_, Request::Hello { .. } | Request::Link { .. }))
+        );
         let mut reply = match decoded {
             Ok((_, req)) => self.respond(seq, req),
             Err(e) => Response::Error {
@@ -184,7 +219,16 @@ impl<B: Bus> BridgeEngine<B> {
             .encode(seq, self.timer);
         }
         let frames = fragment(&reply, self.fragment);
-        self.last = Some((payload.to_vec(), frames.clone()));
+        let answered = Some(Answered {
+            payload: payload.to_vec(),
+            frames: frames.clone(),
+        });
+        if control {
+            self.control = answered;
+        } else {
+            self.last = answered;
+            self.control = None;
+        }
         frames
     }
 
@@ -228,11 +272,12 @@ impl<B: Bus> BridgeEngine<B> {
 
     fn handle(&mut self, req: Request) -> Response {
         match req {
-            Request::Hello { version } if version != PROTOCOL_VERSION => Response::Error {
+            Request::Hello { version, .. } if version != PROTOCOL_VERSION => Response::Error {
                 code: BridgeErrorCode::Version,
                 detail: format!("bridge speaks protocol {PROTOCOL_VERSION}, host {version}"),
             },
-            Request::Hello { .. } => Response::Hello(Hello {
+            Request::Hello { host, .. } => Response::Hello(Hello {
+                resumed: self.greet(host),
                 version: PROTOCOL_VERSION,
                 session: self.session,
                 timer_hz: self.timer.hz,
@@ -275,6 +320,20 @@ impl<B: Bus> BridgeEngine<B> {
                 }
             }
         }
+    }
+
+    /// Takes a HELLO from host session `host`: whether the bridge kept
+    /// that host's cached request (the same host, and no other since). A
+    /// new host starts with nothing cached, so that a request of its own
+    /// that happens to match the last host's is run, not answered from the
+    /// cache. Host session 0 is nobody's: it always starts afresh.
+    fn greet(&mut self, host: u32) -> bool {
+        let resumed = host != 0 && host == self.host;
+        if !resumed {
+            self.last = None;
+            self.host = host;
+        }
+        resumed
     }
 
     /// Runs a batch's ops within the batch limit; the error response
@@ -391,6 +450,7 @@ mod tests {
             1,
             &Request::Hello {
                 version: PROTOCOL_VERSION,
+                host: 7,
             },
         ) else {
             panic!("hello reply");
@@ -400,7 +460,14 @@ mod tests {
             (42, 1_000_000_000, MAX_BATCH_OPS)
         );
         assert_eq!(h.straps, Straps::default());
-        let r = ask(&mut s, 2, &Request::Hello { version: 99 });
+        let r = ask(
+            &mut s,
+            2,
+            &Request::Hello {
+                version: 99,
+                host: 7,
+            },
+        );
         assert!(matches!(
             r,
             Response::Error {
@@ -415,6 +482,7 @@ mod tests {
         let mut s = server();
         let hello = Request::Hello {
             version: PROTOCOL_VERSION,
+            host: 7,
         };
         let plain = s.on_bytes(&frame::encode(&hello.encode(1, Timer::NANOS)));
         assert_ne!(plain.len() % 64, 0, "unpadded by default");
@@ -443,11 +511,10 @@ mod tests {
         }
         // The padded reply is the unpadded one plus empty frames.
         let padded = s.on_bytes(&frame::encode(&hello.encode(5, Timer::NANOS)));
-        let mut d = FrameDecoder::new();
-        d.extend(&padded);
-        let first = d.decode().expect("valid").expect("a frame");
-        assert_eq!(d.decode(), Ok(None), "nothing but padding after it");
-        assert!(Response::decode(&first, Timer::NANOS).is_ok());
+        let end = padded.iter().rposition(|b| *b != 0).expect("a frame") + 2;
+        assert!(padded[end..].iter().all(|b| *b == 0), "padding is zeros");
+        assert!(matches!(collect(&padded[..end]).1, Response::Hello(_)));
+        assert!(matches!(collect(&padded).1, Response::Hello(_)));
         // Padding is bounded, and 0 turns it off.
         let capped = ask(
             &mut s,
@@ -488,10 +555,88 @@ mod tests {
         assert_eq!(s.now().as_nanos(), 10_000_000);
     }
 
+    fn hello(host: u32) -> Request {
+        Request::Hello {
+            version: PROTOCOL_VERSION,
+            host,
+        }
+    }
+
+    fn resumed(r: Response) -> bool {
+        match r {
+            Response::Hello(h) => h.resumed,
+            other => panic!("not a hello reply: {other:?}"),
+        }
+    }
+
+    /// At most once across a reconnect (section 3): the host's connection
+    /// drops after the bridge ran a batch; it reconnects, says HELLO with
+    /// its own host session again and sends the batch again. The bridge
+    /// answers from its cache.
+    #[test]
+    fn a_batch_sent_again_after_a_hello_of_the_same_host_does_not_run_twice() {
+        let mut s = server();
+        assert!(!resumed(ask(&mut s, 1, &hello(77))), "a new host");
+        let req = Request::Batch(vec![Op::Delay(Duration::from_millis(5))]);
+        let a = ask(&mut s, 2, &req);
+        assert!(resumed(ask(&mut s, 3, &hello(77))), "the same host again");
+        let link = Request::Link {
+            fragment: 48,
+            pad: 0,
+        };
+        ask(&mut s, 4, &link);
+        let b = ask(&mut s, 2, &req);
+        assert_eq!(a, b);
+        assert_eq!(s.now().as_nanos(), 5_000_000, "the delay ran once");
+        // The fragments of its reply can still be asked for after a HELLO.
+        ask(&mut s, 5, &hello(77));
+        let again = s.on_bytes(&frame::encode(
+            &Request::Resend { fragments: vec![0] }.encode(2, Timer::NANOS),
+        ));
+        assert_eq!(collect(&again), (2, a));
+        // A new request runs.
+        ask(&mut s, 6, &req);
+        assert_eq!(s.now().as_nanos(), 10_000_000);
+    }
+
+    /// Another host's request that happens to be byte for byte the same as
+    /// the last host's last one is run: a HELLO from another host session
+    /// forgets the cache, and says so.
+    #[test]
+    fn a_hello_from_another_host_forgets_the_last_hosts_requests() {
+        let mut s = server();
+        ask(&mut s, 1, &hello(1));
+        let req = Request::Batch(vec![Op::Delay(Duration::from_millis(5))]);
+        ask(&mut s, 2, &req);
+        assert!(!resumed(ask(&mut s, 1, &hello(2))), "another host");
+        ask(&mut s, 2, &req);
+        assert_eq!(s.now().as_nanos(), 10_000_000, "the second host's ran");
+        // The first host, back after the second: its state is gone, and
+        // the bridge says so rather than pretend.
+        assert!(!resumed(ask(&mut s, 9, &hello(1))));
+        // Host session 0 never resumes.
+        assert!(!resumed(ask(&mut s, 10, &hello(0))));
+        assert!(!resumed(ask(&mut s, 11, &hello(0))));
+        let gone = s.on_bytes(&frame::encode(
+            &Request::Resend { fragments: vec![0] }.encode(2, Timer::NANOS),
+        ));
+        assert!(matches!(
+            collect(&gone).1,
+            Response::Error {
+                code: BridgeErrorCode::Malformed,
+                ..
+            }
+        ));
+    }
+
     #[test]
     fn corrupt_and_oversized_requests_get_error_codes() {
         let mut s = server();
-        let mut bad = frame::encode(&Request::Hello { version: 1 }.encode(1, Timer::NANOS));
+        let hello = Request::Hello {
+            version: PROTOCOL_VERSION,
+            host: 1,
+        };
+        let mut bad = frame::encode(&hello.encode(1, Timer::NANOS));
         bad[2] ^= 0xFF;
         let code = |r: Response| match r {
             Response::Error { code, .. } => Some(code),

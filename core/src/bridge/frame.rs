@@ -231,9 +231,10 @@ mod cross_check {
     fn matches_the_examples_in_the_protocol_document() {
         let hello = Request::Hello {
             version: PROTOCOL_VERSION,
+            host: 0x1234_5678,
         }
         .encode(1, Timer::NANOS);
-        assert_eq!(hello, [0x01, 0x01, 0x06, 0x00]);
+        assert_eq!(hello, [0x01, 0x01, 0x07, 0x00, 0x78, 0x56, 0x34, 0x12]);
         assert_eq!(super::encode(&hello), HELLO);
         let rs = Request::Batch(vec![Op::ReadStatus]).encode(2, Timer::NANOS);
         assert_eq!(super::encode(&rs), BATCH_RS);
@@ -246,7 +247,9 @@ mod cross_check {
         assert_eq!(super::encode(&samples), BATCH_SAMPLE);
     }
 
-    const HELLO: &[u8] = &[0x04, 0x01, 0x01, 0x06, 0x05, 0x33, 0x22, 0xAC, 0x59, 0x00];
+    const HELLO: &[u8] = &[
+        0x04, 0x01, 0x01, 0x07, 0x09, 0x78, 0x56, 0x34, 0x12, 0xFC, 0x49, 0x2A, 0xD1, 0x00,
+    ];
     const BATCH_RS: &[u8] = &[
         0x04, 0x02, 0x02, 0x01, 0x06, 0x12, 0x0A, 0xAF, 0x13, 0xDE, 0x00,
     ];

@@ -33,6 +33,9 @@ pub enum TargetErrorKind {
     Unsupported,
     /// Anything else inside the harness.
     Other,
+    /// A stop was asked for (SIGINT, SIGTERM) while the target was busy:
+    /// nobody's fault, and no verdict.
+    Interrupted,
 }
 
 /// A failure to run a batch on a target: its [`TargetErrorKind`] for

@@ -11,6 +11,7 @@ use crate::emu::{AccelCurve, ModelConfig};
 use crate::protocol::Straps;
 use crate::runner::{parse_shard, validate_suite, Selection};
 use crate::scenario::Scenario;
+use crate::stop::Stop;
 use crate::time::Duration;
 use clap::{Args, ValueEnum};
 
@@ -63,6 +64,10 @@ pub struct TargetArgs {
     /// Shape of the acceleration ramp (the datasheet's chapter 1 is not available).
     #[arg(long, value_enum, default_value_t = Curve::LinearSpeed)]
     accel_curve: Curve,
+    /// Asked for (a signal), opening a target and every wait on its link
+    /// end early.
+    #[arg(skip)]
+    pub(super) stop: Stop,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -449,11 +454,12 @@ impl TargetArgs {
                 self.open_bridge(link, spec, 0)
             }
             Address::Tcp(addr) => {
-                let link = TcpLink::open(&addr).map_err(infra)?;
+                let link = TcpLink::open_until(&addr, self.stop.clone()).map_err(infra)?;
                 self.open_bridge(link, spec, NETWORK_PAD)
             }
             Address::Rfc2217 { addr, baud } => {
-                let link = Rfc2217Link::open(&addr, baud).map_err(infra)?;
+                let link =
+                    Rfc2217Link::open_until(&addr, baud, self.stop.clone()).map_err(infra)?;
                 self.open_bridge(link, spec, NETWORK_PAD)
             }
             Address::Labgrid(place) => {
@@ -476,6 +482,7 @@ impl TargetArgs {
             reply_timeout: std::time::Duration::from_nanos(self.link_timeout.as_nanos()),
             retries: self.link_retries,
             pad: spec.pad.unwrap_or(pad),
+            stop: self.stop.clone(),
             ..SerialOptions::default()
         };
         let t = SerialTarget::open(link, opts).map_err(infra)?;

@@ -8,6 +8,7 @@ pub(crate) mod out;
 pub(crate) mod args;
 mod bench;
 mod bridge_sim;
+mod chaos_proxy;
 mod compare;
 mod console;
 mod export;
@@ -77,6 +78,11 @@ enum Command {
     /// how fast. Exit status 0 when every fault is caught and the clean
     /// board by nothing, 1 otherwise.
     FaultMatrix(fault_matrix::MatrixArgs),
+    /// Serve a misbehaving TCP proxy in front of a bridge (dropped
+    /// connections, floods, stalls, wrong replies), to check that a link
+    /// that fails never turns into a verdict on the board. Prints where it
+    /// listens; runs until SIGINT.
+    ChaosProxy(chaos_proxy::ChaosProxyArgs),
 }
 
 /// The whole `ppmc` command line over `suite`: parses the process's
@@ -105,6 +111,7 @@ pub fn main(suite: Vec<Scenario>) -> ExitCode {
         Command::BridgeSim(args) => bridge_sim::run(args),
         Command::Fuzz(args) => fuzz::run(args),
         Command::FaultMatrix(args) => fault_matrix::run(args, suite),
+        Command::ChaosProxy(args) => chaos_proxy::run(args),
     };
     match done {
         Ok(()) => ExitCode::SUCCESS,

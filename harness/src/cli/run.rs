@@ -17,7 +17,6 @@ use clap::Args;
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
 
 /// Which scenarios to take.
 #[derive(Debug, Args)]
@@ -183,7 +182,11 @@ impl RunArgs {
     }
 }
 
-pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
+pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
+    // Before anything is opened: a signal during the open still leaves
+    // reports, and ends every wait on a link within a second.
+    let stop = super::signals::install();
+    args.target.stop = stop.clone();
     let scenarios = match args.select.scenarios(suite) {
         Ok(s) => s,
         Err(e) => return Err(usage(e)),
@@ -286,8 +289,12 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     }
     let mut info = RunInfo::new(boards, spread.name(specs.len()));
     info.options = args.options(&tol);
-    let not_reached =
-        |s: &Scenario, why: &str| crate::runner::not_run(s, NotRun::Unreachable(why.to_string()));
+    // A stop asked for while the targets were opened leaves every scenario
+    // interrupted, not blamed on a target.
+    let not_reached = |s: &Scenario, why: &str| match stop.requested() {
+        true => crate::runner::not_run(s, NotRun::Interrupted),
+        false => crate::runner::not_run(s, NotRun::Unreachable(why.to_string())),
+    };
     if targets.is_empty() {
         // Nothing ran: say so in the reports too, so CI shows an
         // infrastructure problem rather than a bad board.
@@ -322,6 +329,9 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             .as_ref()
             .map(|p| write_report(p, report::json(&info, &results, &on)));
         summary_lines(&Tally::of(&results), results.len());
+        if stop.requested() {
+            return Err(CliError::Interrupted);
+        }
         return Err(CliError::Infrastructure(
             why.strip_prefix("infrastructure error: ")
                 .unwrap_or(&why)
@@ -353,8 +363,7 @@ pub fn run(args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     // What the reports keep of the results as they come (`--repeat`: the
     // first pass and what did not pass, in full; the rest counted).
     let mut soak = Soak::new(scenarios.len(), repeat);
-    let stop = super::signals::stop_requested();
-    let stopped = || stop.load(Ordering::Relaxed) || super::out::stdout_closed();
+    let stopped = || stop.requested() || super::out::stdout_closed();
     let several = info.boards.len() > 1;
     let board_name = |t: Option<usize>| info.board_name(t.map(|t| reached[t])).to_string();
     stream_on_boards(

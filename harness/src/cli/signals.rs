@@ -1,11 +1,49 @@
-//! SIGINT and SIGTERM as a request to stop: a long command finishes what it
-//! is doing, writes its reports and cleans up. A second signal ends the
-//! process at once (exit 130) for a user who really means it.
+//! SIGINT and SIGTERM as a request to stop.
+//!
+//! [`install`] serves the commands that write reports (`ppmc run`): the
+//! first signal asks every wait to end within a second and the run to wind
+//! down (the scenario under way is interrupted, the rest not run, the
+//! reports written); a second, as GNU `timeout` and CI runners send one,
+//! hurries that along (no health checks, no reconnecting) and still writes
+//! the reports; only a third ends the process at once (exit 130). The
+//! handlers go in before any target is opened, so a signal during the
+//! open still leaves reports.
+//!
+//! [`stop_requested`] serves commands with nothing to save: a second
+//! signal ends them at once.
 
+use crate::stop::Stop;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-/// A flag that turns true on the first SIGINT or SIGTERM.
+/// Installs the handlers of a command that writes reports; the [`Stop`]
+/// they raise. A thread of its own takes the signals (the handler itself
+/// only wakes it), raises the stop for the first two and ends the process
+/// at the third.
+pub fn install() -> Stop {
+    let stop = Stop::new();
+    #[cfg(unix)]
+    {
+        use signal_hook::consts::{SIGINT, SIGTERM};
+        if let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) {
+            let raised = stop.clone();
+            let _ = std::thread::Builder::new()
+                .name("signals".into())
+                .spawn(move || {
+                    for _ in signals.forever() {
+                        if raised.urgent() {
+                            std::process::exit(130);
+                        }
+                        raised.request();
+                    }
+                });
+        }
+    }
+    stop
+}
+
+/// A flag that turns true on the first SIGINT or SIGTERM; a second one
+/// ends the process at once (exit 130).
 pub fn stop_requested() -> Arc<AtomicBool> {
     let flag = Arc::new(AtomicBool::new(false));
     #[cfg(unix)]

@@ -270,6 +270,14 @@ pub fn run_scenario(
         (Err(Stop::Failed(f)), _) => Verdict::Failed(f),
         (Err(Stop::Error(e)), _) => Verdict::Error(e),
     };
+    // Stopped on request while waiting on the target: no verdict.
+    let verdict = match verdict {
+        Verdict::Error(HarnessError::Target {
+            kind: TargetErrorKind::Interrupted,
+            ..
+        }) => Verdict::NotRun(NotRun::Interrupted),
+        v => v,
+    };
     let capture = capture.ok();
     let measures: Vec<Event> = measurements
         .iter()

@@ -313,3 +313,56 @@ pub fn fuzz_inputs(target: &str) -> Vec<(std::path::PathBuf, Vec<u8>)> {
     }
     out
 }
+
+/// At most once across reconnects (`docs/bridge-protocol.md` section 3),
+/// on a real bridge: the scenarios named run through a chaos proxy on
+/// 127.0.0.1 in front of `bridge` that cuts the connection once, after
+/// frame `k`, for every `k` of a clean run in turn (the bridge's side of
+/// the proxy stays up, as a serial server's does). Every run's verdicts
+/// must be the clean run's: a request the bridge ran, sent again after the
+/// reconnect, must not run again. Returns how many frames a clean run
+/// takes (each a boundary cut at).
+pub fn drop_at_every_frame(bridge: ppmc::chaos::Upstream, names: &[&str]) -> u64 {
+    use ppmc::backend::{SerialOptions, SerialTarget, TcpLink};
+    use ppmc::chaos::{Behaviour, ChaosProxy};
+    use ppmc::scenario::Verdict;
+    let suite: Vec<_> = ppmc_scenarios::all()
+        .into_iter()
+        .filter(|s| names.contains(&s.name))
+        .collect();
+    assert_eq!(suite.len(), names.len(), "every scenario named exists");
+    let run = |behaviour| {
+        let proxy =
+            ChaosProxy::start("127.0.0.1:0", bridge.clone(), behaviour, 1).expect("the proxy");
+        let link = TcpLink::open(&proxy.addr().to_string()).expect("the proxy accepts");
+        let opts = SerialOptions {
+            reply_timeout: std::time::Duration::from_millis(500),
+            ..SerialOptions::default()
+        };
+        let verdicts: Vec<Verdict> = match SerialTarget::open(link, opts) {
+            Ok(mut t) => ppmc::runner::run_suite(
+                &mut t,
+                &suite,
+                1,
+                ppmc::scenario::DriverOptions::default(),
+                |_| {},
+            )
+            .into_iter()
+            .map(|r| r.verdict)
+            .collect(),
+            Err(e) => panic!("{behaviour}: the bridge did not open: {e}"),
+        };
+        (verdicts, proxy.stop())
+    };
+    let (clean, stats) = run(Behaviour::Clean);
+    assert!(
+        clean.iter().all(|v| v.ok()),
+        "the clean run passes: {clean:?}"
+    );
+    for k in 1..=stats.frames {
+        let (verdicts, cut) = run(Behaviour::DropAt(k));
+        assert_eq!(cut.cuts, 1, "cut once, after frame {k}");
+        assert_eq!(verdicts, clean, "the connection cut after frame {k}");
+    }
+    stats.frames
+}

@@ -18,7 +18,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 /// The protocol version this build speaks.
-pub const PROTOCOL_VERSION: u16 = 6;
+pub const PROTOCOL_VERSION: u16 = 7;
 
 /// Message kinds (the second payload byte).
 pub mod kind {
@@ -121,6 +121,11 @@ pub struct Hello {
     pub firmware: String,
     /// How the chip is strapped on its board.
     pub straps: Straps,
+    /// The bridge kept this host's dedupe state across the HELLO: the host
+    /// said HELLO with the same host session before, and no other host has
+    /// used the bridge since, so a request the host sends again is answered
+    /// from the cache, not run twice (`docs/bridge-protocol.md` section 3).
+    pub resumed: bool,
 }
 
 /// A host request.
@@ -128,6 +133,10 @@ pub struct Hello {
 pub enum Request {
     Hello {
         version: u16,
+        /// The host's session: a number the host picks each time it opens
+        /// the link (never 0), kept across its reconnects. A HELLO with
+        /// another one makes the bridge forget the last host's requests.
+        host: u32,
     },
     /// Ops run back to back on the bridge; durations in ticks.
     Batch(Vec<Op>),
@@ -139,9 +148,7 @@ pub enum Request {
         max: u16,
     },
     /// Send these fragments of the reply to this same sequence number again.
-    Resend {
-        fragments: Vec<u8>,
-    },
+    Resend { fragments: Vec<u8> },
     /// A batch, then the capture from these positions on: one round trip
     /// where a host needs both.
     BatchCapture {
@@ -157,10 +164,7 @@ pub enum Request {
     /// to a multiple of `pad` bytes (0: no padding; at most [`MAX_PAD`]),
     /// so that a serial server in between that holds a partial buffer
     /// (ser2net's `chardelay`) sends each reply at once.
-    Link {
-        fragment: u8,
-        pad: u16,
-    },
+    Link { fragment: u8, pad: u16 },
 }
 
 /// Largest response payload sent as one frame; longer ones go as
@@ -366,9 +370,10 @@ impl Request {
         let mut w = W(Vec::new(), timer);
         w.u8(seq);
         match self {
-            Request::Hello { version } => {
+            Request::Hello { version, host } => {
                 w.u8(kind::HELLO);
                 w.u16(*version);
+                w.u32(*host);
             }
             Request::Batch(ops) => {
                 w.u8(kind::BATCH);
@@ -415,7 +420,18 @@ impl Request {
         let mut r = R::new(payload, timer);
         let seq = r.u8()?;
         let req = match r.u8()? {
-            kind::HELLO => Request::Hello { version: r.u16()? },
+            kind::HELLO => {
+                let version = r.u16()?;
+                if version != PROTOCOL_VERSION {
+                    // Another version's HELLO may carry other fields: the
+                    // bridge answers VERSION whatever follows.
+                    return Ok((seq, Request::Hello { version, host: 0 }));
+                }
+                Request::Hello {
+                    version,
+                    host: r.u32()?,
+                }
+            }
             kind::BATCH => Request::Batch(get_ops(&mut r)?),
             kind::CAPTURE => Request::Capture {
                 runs: r.u32()?,
@@ -469,6 +485,7 @@ impl Response {
                 w.u8(u8::from(h.virtual_time));
                 w.str(&h.firmware);
                 put_straps(&mut w, &h.straps);
+                w.u8(u8::from(h.resumed));
             }
             Response::Batch(replies) => {
                 w.u8(kind::BATCH_REPLY);
@@ -521,6 +538,7 @@ impl Response {
                 virtual_time: r.bool("virtual time flag")?,
                 firmware: r.str()?,
                 straps: get_straps(&mut r)?,
+                resumed: r.bool("resumed flag")?,
             }),
             kind::BATCH_REPLY => Response::Batch(get_replies(&mut r)?),
             kind::CAPTURE_REPLY => Response::Capture(get_capture(&mut r)?),
@@ -674,8 +692,39 @@ mod tests {
         assert_eq!(Request::decode(&req.encode(7, T), T), Ok((7, req)));
         let h = Request::Hello {
             version: PROTOCOL_VERSION,
+            host: 0x1234_5678,
         };
         assert_eq!(Request::decode(&h.encode(0, T), T), Ok((0, h)));
+    }
+
+    /// Another version's HELLO is read as far as its version, whatever
+    /// follows, so that the bridge can answer VERSION (section 3).
+    #[test]
+    fn a_hello_of_another_version_is_read_for_its_version() {
+        // A version 6 host's HELLO: no host session.
+        assert_eq!(
+            Request::decode(&[3, kind::HELLO, 6, 0], T),
+            Ok((
+                3,
+                Request::Hello {
+                    version: 6,
+                    host: 0
+                }
+            ))
+        );
+        // A later version's, with fields this one does not know.
+        assert_eq!(
+            Request::decode(&[3, kind::HELLO, 8, 0, 1, 2, 3, 4, 5, 6, 7], T),
+            Ok((
+                3,
+                Request::Hello {
+                    version: 8,
+                    host: 0
+                }
+            ))
+        );
+        // This version's must carry the host session.
+        assert!(Request::decode(&[3, kind::HELLO, PROTOCOL_VERSION as u8, 0], T).is_err());
     }
 
     #[test]
@@ -808,6 +857,7 @@ mod tests {
                 vsel_high: true,
                 ext_clock_hz: Some(500_000),
             },
+            resumed: true,
         });
         assert_eq!(Response::decode(&hello.encode(1, T), T), Ok((1, hello)));
         let cap = Response::Capture(CaptureChunk {
@@ -938,7 +988,11 @@ mod tests {
             Request::decode(&[1, kind::BATCH, 1, 0, 0x99], T),
             Err(WireError::UnknownCode { at: 4, code: 0x99 })
         );
-        let mut ok = Request::Hello { version: 1 }.encode(1, T);
+        let mut ok = Request::Hello {
+            version: PROTOCOL_VERSION,
+            host: 1,
+        }
+        .encode(1, T);
         ok.push(0);
         assert_eq!(Request::decode(&ok, T), Err(WireError::Trailing(1)));
         // A count that promises more than the bytes could hold.

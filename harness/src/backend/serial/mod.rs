@@ -4,9 +4,20 @@
 //! Every request carries a sequence number and the bridge answers a
 //! retransmitted request from its cache without running it again, so a
 //! lost or corrupted reply is simply asked for again. A link that vanishes
-//! (a USB re-enumeration) is reopened with backoff a bounded number of
-//! times; if the bridge comes back as a different session (it restarted)
-//! the run cannot go on safely and the error says so.
+//! (a USB re-enumeration, a dropped TCP connection) is reopened with
+//! backoff a bounded number of times, and the host says HELLO with its own
+//! host session again: the bridge keeps its cache across that, so the
+//! request in flight, sent again, still runs at most once. If the bridge
+//! comes back as a different session (it restarted) or without this host's
+//! cache (another host used it), the run cannot go on safely and the error
+//! says so.
+//!
+//! Every wait has an end (`docs/bridge-protocol.md` section 8): a request
+//! gives up after `retries` silent attempts, after a stretch without
+//! progress however much noise arrives, and at an absolute deadline; a
+//! reconnection is a loop of at most `reopen_attempts`; after
+//! [`MAX_GIVE_UPS`] requests given up the link is not trusted for the rest
+//! of the run. A [`Stop`] request ends any wait within [`Stop::SLICE`].
 
 mod labgrid;
 mod link;
@@ -21,6 +32,7 @@ pub use self::tcp::{parse_tcp, TcpLink};
 use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
 use crate::protocol::Record;
 use crate::protocol::Straps;
+use crate::stop::Stop;
 use crate::time::Instant;
 use ppmc_core::bridge::frame::{self, FrameDecoder};
 use ppmc_core::bridge::wire::MAX_BATCH_OPS;
@@ -44,11 +56,16 @@ pub enum SerialError {
         #[source]
         source: io::Error,
     },
-    #[error("{link}: no bridge answering: no valid reply to {what} after {tries} tries")]
+    #[error("{link}: no bridge answering: no valid reply to {what} after {tries} tries in {secs:.1} s ({heard})")]
     NoAnswer {
         link: String,
         what: String,
         tries: u32,
+        /// Wall time spent on the request.
+        secs: f64,
+        /// What the link brought instead: nothing, noise, replies to other
+        /// requests, errors.
+        heard: String,
     },
     #[error("{link}: bridge speaks protocol version {theirs}, this ppmc speaks {ours}")]
     Version {
@@ -79,6 +96,22 @@ pub enum SerialError {
     },
     #[error("{link}: the bridge restarted (session {old:08x} -> {new:08x}); the chip's state is unknown")]
     Restarted { link: String, old: u32, new: u32 },
+    /// After a reconnect the bridge no longer held this host's cached
+    /// request: another host said HELLO to it while the link was down, and
+    /// may have used the chip.
+    #[error("{link}: after reconnecting, the bridge no longer holds this host's requests (another host used it while the link was down); the chip's state is unknown")]
+    Displaced { link: String },
+    /// The link gave up on too many requests in this run to be trusted
+    /// with another.
+    #[error("{link}: the link gave up on {failures} requests in this run, and is not used for more (the last: {last})")]
+    Exhausted {
+        link: String,
+        failures: u32,
+        last: String,
+    },
+    /// A stop was asked for (SIGINT, SIGTERM) while waiting on the link.
+    #[error("{link}: interrupted by a stop request")]
+    Interrupted { link: String },
     /// A reply came back timed before an earlier one, with no chip reset
     /// in between: the bridge restarted behind the open port (a watchdog,
     /// a brown-out) and the chip's state was lost with it.
@@ -100,7 +133,10 @@ impl SerialError {
     pub fn kind(&self) -> TargetErrorKind {
         match self {
             SerialError::Version { .. } => TargetErrorKind::Unsupported,
-            SerialError::Bridge { .. } | SerialError::Protocol { .. } => TargetErrorKind::Other,
+            SerialError::Interrupted { .. } => TargetErrorKind::Interrupted,
+            // An error or a reply of the wrong kind to a well-formed
+            // request is the bridge's or the link's doing (a firmware bug,
+            // something else answering on the port), never the chip's.
             _ => TargetErrorKind::Link,
         }
     }
@@ -123,7 +159,7 @@ impl From<SerialError> for TargetError {
 /// timer does). `retries` silent attempts in a row end the request as a
 /// link error; a line that answers, however garbled, is alive and gets ten
 /// times as many.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone)]
 pub struct SerialOptions {
     /// The longest wait for a reply beyond the time the batch itself needs
     /// (the first waits, before the round-trip time is known, and the cap
@@ -147,6 +183,24 @@ pub struct SerialOptions {
     /// holds a partly filled buffer (ser2net's 64 bytes) sends it at once;
     /// 0 for none.
     pub pad: u16,
+    /// Asked for, every wait on the link ends within [`Stop::SLICE`] with
+    /// [`SerialError::Interrupted`].
+    pub stop: Stop,
+}
+
+impl SerialOptions {
+    /// How long a request may go without progress (no new reply or
+    /// fragment), however much noise arrives, before it is given up:
+    /// `reply_timeout` for every attempt it may make in silence.
+    pub fn stall_limit(&self) -> WallDuration {
+        self.reply_timeout * (self.retries + 1)
+    }
+
+    /// The longest a request may take beyond its own waits, progress or
+    /// not: three stall limits.
+    pub fn request_limit(&self) -> WallDuration {
+        self.stall_limit() * 3
+    }
 }
 
 impl Default for SerialOptions {
@@ -155,13 +209,19 @@ impl Default for SerialOptions {
             reply_timeout: WallDuration::from_millis(1000),
             min_reply_timeout: WallDuration::from_millis(20),
             retries: 10,
-            reopen_attempts: 5,
+            reopen_attempts: 6,
             backoff: WallDuration::from_millis(100),
             quiet: WallDuration::from_millis(30),
             pad: 0,
+            stop: Stop::default(),
         }
     }
 }
+
+/// Requests a link may give up on in one run: past that it is not used
+/// for more, so that a link that only works now and then ends a run in
+/// bounded time instead of costing every scenario its stall limit.
+pub const MAX_GIVE_UPS: u32 = 3;
 
 /// The pause before the first retry after a fruitless attempt; it doubles
 /// with each one in a row, up to [`MAX_RETRY_PAUSE`].
@@ -331,7 +391,60 @@ pub struct SerialTarget<L: Link> {
     /// The request size in force: halved when a request needed asking
     /// again, doubled back after clean ones.
     request_size: usize,
+    /// This host's session, said in every HELLO (never 0): the bridge
+    /// keeps its cached request across a reconnect for it.
+    host: u32,
+    /// The target is open: the bridge's session is known, and a HELLO
+    /// after a reconnect must find it, and this host's requests, again.
+    opened: bool,
+    /// A reconnect is under way: a link error ends the attempt instead of
+    /// starting another reconnect.
+    recovering: bool,
+    /// Frames that arrived garbled, either way (corrupt frames here,
+    /// bad-frame errors from the bridge): what makes the host shrink its
+    /// requests and the bridge's reply fragments.
+    garbled: u64,
+    /// Requests given up so far, and the last reason.
+    give_ups: u32,
+    last_give_up: String,
     pub stats: LinkStats,
+}
+
+/// Silent tries of a HELLO while reconnecting, before that attempt of the
+/// reconnect loop is counted as failed.
+const RECOVERY_RETRIES: u32 = 3;
+
+/// What a link brought during one request other than its reply.
+#[derive(Debug, Default, Clone, Copy)]
+struct Noise {
+    bytes: u64,
+    corrupt: u64,
+    stale: u64,
+    bad_frames: u64,
+}
+
+impl std::fmt::Display for Noise {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.bytes == 0 {
+            return f.write_str("nothing came back");
+        }
+        write!(
+            f,
+            "{} bytes came back: {} corrupt frames, {} replies to other requests, {} bad-frame errors",
+            self.bytes, self.corrupt, self.stale, self.bad_frames
+        )
+    }
+}
+
+/// A host session: a number no other host is likely to pick, never 0.
+fn host_session() -> u32 {
+    use std::hash::{BuildHasher, Hash, Hasher};
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    std::process::id().hash(&mut h);
+    std::time::SystemTime::now().hash(&mut h);
+    WallInstant::now().hash(&mut h);
+    let x = h.finish();
+    ((x >> 32) as u32 ^ x as u32).max(1)
 }
 
 impl<L: Link> SerialTarget<L> {
@@ -353,6 +466,7 @@ impl<L: Link> SerialTarget<L> {
                 virtual_time: false,
                 firmware: String::new(),
                 straps: Straps::default(),
+                resumed: false,
             },
             timer: Timer::NANOS,
             opts,
@@ -367,6 +481,12 @@ impl<L: Link> SerialTarget<L> {
             clean: 0,
             link_ok: true,
             request_size: MAX_REQUEST,
+            host: host_session(),
+            opened: false,
+            recovering: false,
+            garbled: 0,
+            give_ups: 0,
+            last_give_up: String::new(),
             stats: LinkStats::default(),
         };
         t.hello = t.say_hello()?;
@@ -378,12 +498,17 @@ impl<L: Link> SerialTarget<L> {
         if t.link_ok {
             t.set_link(t.fragment, t.opts.pad)?;
         }
-        let replies =
-            t.run_batch(&[Op::Reset, Op::ReadStatus])
-                .map_err(|e| SerialError::Unhealthy {
+        // From here on a reconnect must find this session again.
+        t.opened = true;
+        let replies = t
+            .run_batch(&[Op::Reset, Op::ReadStatus])
+            .map_err(|e| match e {
+                e @ SerialError::Interrupted { .. } => e,
+                e => SerialError::Unhealthy {
                     link: t.link.name(),
                     detail: e.to_string(),
-                })?;
+                },
+            })?;
         match replies.get(1) {
             Some(Reply::Status { status, .. }) if status.0 == 0 => Ok(t),
             Some(Reply::Status { status, .. }) => Err(SerialError::Unhealthy {
@@ -407,28 +532,51 @@ impl<L: Link> SerialTarget<L> {
         &self.hello
     }
 
+    /// Says HELLO with this host's session and checks the version. Once the
+    /// target is open, the bridge must be the same session, and must have
+    /// kept this host's cached request (`resumed`): otherwise what the
+    /// chip did while the link was down is unknown.
     fn say_hello(&mut self) -> Result<Hello, SerialError> {
         let hello = Request::Hello {
             version: PROTOCOL_VERSION,
+            host: self.host,
         };
         let reply = match self.request(&hello, "hello", WallDuration::ZERO) {
             // A line too noisy for the hello reply's 48-byte fragments:
-            // ask for the smallest and say hello again.
-            Err(SerialError::NoAnswer { .. }) if self.link_ok => {
+            // ask for the smallest and say hello again (not while
+            // reconnecting, where a silent bridge is told by the loop).
+            Err(SerialError::NoAnswer { .. }) if self.link_ok && !self.recovering => {
                 self.want_fragment = MIN_FRAGMENT_DATA as u8;
                 self.request(&hello, "hello", WallDuration::ZERO)?
             }
             other => other?,
         };
-        match reply {
-            Response::Hello(h) if h.version == PROTOCOL_VERSION => Ok(h),
-            Response::Hello(h) => Err(SerialError::Version {
-                link: self.link.name(),
-                ours: PROTOCOL_VERSION,
-                theirs: h.version,
-            }),
-            other => Err(self.unexpected("hello", &other)),
+        let h = match reply {
+            Response::Hello(h) if h.version == PROTOCOL_VERSION => h,
+            Response::Hello(h) => {
+                return Err(SerialError::Version {
+                    link: self.link.name(),
+                    ours: PROTOCOL_VERSION,
+                    theirs: h.version,
+                })
+            }
+            other => return Err(self.unexpected("hello", &other)),
+        };
+        if self.opened {
+            if h.session != self.hello.session {
+                return Err(SerialError::Restarted {
+                    link: self.link.name(),
+                    old: self.hello.session,
+                    new: h.session,
+                });
+            }
+            if !h.resumed {
+                return Err(SerialError::Displaced {
+                    link: self.link.name(),
+                });
+            }
         }
+        Ok(h)
     }
 
     fn unexpected(&self, what: &str, r: &Response) -> SerialError {
@@ -475,13 +623,15 @@ impl<L: Link> SerialTarget<L> {
         what: &str,
         extra: WallDuration,
     ) -> Result<Response, SerialError> {
-        if self.want_fragment != self.fragment && self.link_ok {
+        if self.want_fragment != self.fragment && self.link_ok && !self.recovering {
             self.set_fragment(self.want_fragment)?;
         }
-        let retransmitted = self.stats.retransmissions;
+        let garbled = self.garbled;
         let r = self.exchange(req, what, extra);
         if !matches!(req, Request::Link { .. }) {
-            if self.stats.retransmissions > retransmitted {
+            // Only a garbled frame says the line is noisy: a lost reply, a
+            // stall or a dropped connection does not ask for smaller ones.
+            if self.garbled > garbled {
                 self.clean = 0;
                 self.want_fragment = (self.fragment / 2).max(MIN_FRAGMENT_DATA as u8);
             } else {
@@ -519,7 +669,8 @@ impl<L: Link> SerialTarget<L> {
         Ok(())
     }
 
-    /// One request and its reply, asked again as the line needs.
+    /// One request and its reply, asked again as the line needs, within
+    /// the limits of [`SerialOptions`] (fewer while reconnecting).
     fn exchange(
         &mut self,
         req: &Request,
@@ -533,6 +684,22 @@ impl<L: Link> SerialTarget<L> {
         let full = frame::encode(&payload);
         let mut frags = Fragments::default();
         let mut next = full.clone();
+        // While reconnecting, a hello that hears nothing after a few tries
+        // fails this attempt of the reconnect loop, which has its own limit.
+        let retries = match self.recovering {
+            true => self.opts.retries.min(RECOVERY_RETRIES),
+            false => self.opts.retries,
+        };
+        let start = WallInstant::now();
+        let stall_limit = extra + self.opts.reply_timeout * (retries + 1);
+        let give_up_at = start + extra + self.opts.request_limit();
+        let mut progress_at = start;
+        // What the link brought instead of the reply, for the error.
+        let mut noise = Noise::default();
+        // Silent attempts reconnect once before the request is given up: a
+        // network connection can die without a word (a half-open TCP
+        // connection, a server that stalls).
+        let mut reconnected = self.recovering;
         // Attempts in a row that brought nothing new: `silent` ones heard
         // nothing at all (a dead link: `retries` of them end the request),
         // `fruitless` ones at most heard garbage (a live, noisy line: it
@@ -543,16 +710,58 @@ impl<L: Link> SerialTarget<L> {
         let mut attempts = 0u32;
         let mut wait = self.rtt.timeout(&self.opts);
         let mut pause = WallDuration::ZERO;
-        while silent <= self.opts.retries && fruitless <= self.opts.retries * NOISY_RETRIES {
+        loop {
+            if self.opts.stop.requested() {
+                return Err(self.interrupted());
+            }
+            let now = WallInstant::now();
+            let stalled = now >= progress_at + stall_limit || now >= give_up_at;
+            let out_of_tries = silent > retries || fruitless > retries * NOISY_RETRIES;
+            // The last attempts heard nothing at all, whatever came before.
+            let gone_quiet = silent > retries || (stalled && silent > 0);
+            if gone_quiet && !reconnected {
+                // Nothing comes back any more: reconnect, then try again.
+                reconnected = true;
+                let silence =
+                    io::Error::new(io::ErrorKind::TimedOut, format!("no answer to {what}"));
+                match self.recover(silence) {
+                    Ok(()) => {}
+                    // Say what went unanswered, and that reconnecting did
+                    // not help.
+                    Err(SerialError::LinkLost {
+                        attempts: reconnects,
+                        last,
+                        ..
+                    }) => {
+                        return Err(SerialError::NoAnswer {
+                            link: self.link.name(),
+                            what: what.into(),
+                            tries: attempts,
+                            secs: start.elapsed().as_secs_f64(),
+                            heard: format!(
+                                "nothing came back, and {reconnects} attempts to reconnect failed: {last}"
+                            ),
+                        })
+                    }
+                    Err(e) => return Err(e),
+                }
+                next = self.after_reconnect(req, seq, &mut frags, &full);
+                (silent, fruitless, progress_at) = (0, 0, WallInstant::now());
+                continue;
+            }
+            if stalled || out_of_tries {
+                break;
+            }
             if attempts > 0 {
                 self.stats.retransmissions += 1;
-                std::thread::sleep(pause);
+                if self.opts.stop.sleep(pause) {
+                    return Err(self.interrupted());
+                }
             }
             attempts += 1;
             if let Err(e) = self.link.send(&next) {
-                self.recover(e)?;
-                frags = Fragments::default();
-                next = full.clone();
+                self.link_failed(e)?;
+                next = self.after_reconnect(req, seq, &mut frags, &full);
                 fruitless += 1;
                 silent += 1;
                 continue;
@@ -560,18 +769,21 @@ impl<L: Link> SerialTarget<L> {
             let sent = WallInstant::now();
             self.stats.round_trips += 1;
             let had = frags.received();
-            match self.await_reply(seq, wait + extra, &mut frags) {
+            let budget = (wait + extra).min(give_up_at.saturating_duration_since(sent));
+            match self.await_reply(seq, budget, &mut frags, &mut noise) {
                 Ok(Some(Response::Error {
                     code: BridgeErrorCode::BadFrame,
                     ..
                 })) => {
+                    noise.bad_frames += 1;
+                    self.garbled += 1;
                     garbled += 1;
                     next = full.clone();
                     if garbled >= 2 && frags.received() == 0 && splittable {
                         // Too long for this line? Only if the bridge never
                         // ran it: a bad-frame error does not say which frame
                         // was bad, so ask before splitting.
-                        match self.ran(seq, &mut frags)? {
+                        match self.ran(seq, &mut frags, &mut noise)? {
                             Ran::No => {
                                 return Err(SerialError::Garbled {
                                     link: self.link.name(),
@@ -606,15 +818,15 @@ impl<L: Link> SerialTarget<L> {
                     }
                 }
                 Err(e) => {
-                    self.recover(e)?;
-                    frags = Fragments::default();
-                    next = full.clone();
+                    self.link_failed(e)?;
+                    next = self.after_reconnect(req, seq, &mut frags, &full);
                 }
             }
             if frags.received() > had {
                 fruitless = 0;
                 silent = 0;
                 pause = WallDuration::ZERO;
+                progress_at = WallInstant::now();
             } else {
                 fruitless += 1;
                 // Back off: after silence, wait longer for the reply (a
@@ -638,23 +850,80 @@ impl<L: Link> SerialTarget<L> {
             link: self.link.name(),
             what: what.into(),
             tries: attempts,
+            secs: start.elapsed().as_secs_f64(),
+            heard: noise.to_string(),
         })
+    }
+
+    /// What to send after a reconnect: the fragments of the reply still
+    /// missing (the bridge answers a RESEND from the reply it cached, which
+    /// it kept for this host across the reconnect), or the whole request
+    /// again when none has arrived, which the bridge answers from its cache
+    /// if it ran it (section 3: at most once).
+    /// A HELLO or LINK is sent whole again: it changes nothing on the
+    /// chip, and the bridge keeps the reply of only the newest one, the
+    /// reconnect's own HELLO.
+    /// (Its reply may differ from the first: a HELLO's `resumed`.)
+    fn after_reconnect(
+        &self,
+        req: &Request,
+        seq: u8,
+        frags: &mut Fragments,
+        full: &[u8],
+    ) -> Vec<u8> {
+        match frags.missing() {
+            Some(m) if !matches!(req, Request::Hello { .. } | Request::Link { .. }) => {
+                frame::encode(&Request::Resend { fragments: m }.encode(seq, self.timer))
+            }
+            _ => {
+                *frags = Fragments::default();
+                full.to_vec()
+            }
+        }
+    }
+
+    /// The error for a stop request.
+    fn interrupted(&self) -> SerialError {
+        SerialError::Interrupted {
+            link: self.link.name(),
+        }
+    }
+
+    /// After the link failed mid-exchange: reconnects (the exchange then
+    /// sends its request again), or, while already reconnecting, fails
+    /// this attempt of the reconnect loop.
+    fn link_failed(&mut self, e: io::Error) -> Result<(), SerialError> {
+        if self.opts.stop.requested() {
+            return Err(self.interrupted());
+        }
+        if self.recovering {
+            return Err(SerialError::Io {
+                path: self.link.name(),
+                source: e,
+            });
+        }
+        self.recover(e)
     }
 
     /// Asks the bridge whether it ran request `seq` (a RESEND of its first
     /// reply fragment): it answers with the cached reply if it did, and with
     /// an error naming the sequence if it did not.
-    fn ran(&mut self, seq: u8, frags: &mut Fragments) -> Result<Ran, SerialError> {
+    fn ran(
+        &mut self,
+        seq: u8,
+        frags: &mut Fragments,
+        noise: &mut Noise,
+    ) -> Result<Ran, SerialError> {
         let probe = frame::encode(&Request::Resend { fragments: vec![0] }.encode(seq, self.timer));
         for _ in 0..=self.opts.retries {
             self.stats.retransmissions += 1;
             if let Err(e) = self.link.send(&probe) {
-                self.recover(e)?;
+                self.link_failed(e)?;
                 return Ok(Ran::Unknown);
             }
             self.stats.round_trips += 1;
             let before = frags.received();
-            match self.await_reply(seq, self.rtt.timeout(&self.opts), frags) {
+            match self.await_reply(seq, self.rtt.timeout(&self.opts), frags, noise) {
                 Ok(Some(Response::Error {
                     code: BridgeErrorCode::Malformed,
                     detail,
@@ -662,12 +931,16 @@ impl<L: Link> SerialTarget<L> {
                 Ok(Some(Response::Error {
                     code: BridgeErrorCode::BadFrame,
                     ..
-                })) => {}
+                })) => {
+                    noise.bad_frames += 1;
+                    self.garbled += 1;
+                }
                 Ok(Some(r)) => return Ok(Ran::Yes(r)),
                 Ok(None) if frags.received() > before => return Ok(Ran::Partly),
+                Ok(None) if self.opts.stop.requested() => return Err(self.interrupted()),
                 Ok(None) => {}
                 Err(e) => {
-                    self.recover(e)?;
+                    self.link_failed(e)?;
                     return Ok(Ran::Unknown);
                 }
             }
@@ -676,12 +949,14 @@ impl<L: Link> SerialTarget<L> {
     }
 
     /// Reads until the reply to `seq` is complete (`Some`), or the link
-    /// goes quiet or the timeout passes without it (`None`: ask again).
+    /// goes quiet, the timeout passes without it or a stop is asked for
+    /// (`None`: ask again, or stop).
     fn await_reply(
         &mut self,
         seq: u8,
         timeout: WallDuration,
         frags: &mut Fragments,
+        noise: &mut Noise,
     ) -> io::Result<Option<Response>> {
         let start = WallInstant::now();
         let mut deadline = start + timeout;
@@ -702,10 +977,16 @@ impl<L: Link> SerialTarget<L> {
                 match self.decoder.decode() {
                     Ok(Some(payload)) => {
                         if let Some((s, i, n, data)) = parse_fragment(&payload) {
-                            if s == seq && frags.put(i, n, data) {
+                            if s != seq {
+                                noise.stale += 1;
+                            } else if frags.put(i, n, data) {
                                 match Response::decode(&frags.take(), self.timer) {
                                     Ok((_, r)) => return Ok(Some(r)),
-                                    Err(_) => self.stats.corrupt_frames += 1,
+                                    Err(_) => {
+                                        self.stats.corrupt_frames += 1;
+                                        self.garbled += 1;
+                                        noise.corrupt += 1;
+                                    }
                                 }
                             }
                             continue;
@@ -723,25 +1004,34 @@ impl<L: Link> SerialTarget<L> {
                                 return Ok(Some(r));
                             }
                             Ok((s, r)) if s == seq => return Ok(Some(r)),
-                            Ok(_) => {} // a stale reply to an earlier try
-                            Err(_) => self.stats.corrupt_frames += 1,
+                            // A stale reply to an earlier try, or a reply
+                            // to nothing this host asked.
+                            Ok(_) => noise.stale += 1,
+                            Err(_) => {
+                                self.stats.corrupt_frames += 1;
+                                self.garbled += 1;
+                                noise.corrupt += 1;
+                            }
                         }
                     }
                     Ok(None) => break,
                     Err(_) => {
                         self.stats.corrupt_frames += 1;
+                        self.garbled += 1;
+                        noise.corrupt += 1;
                         quiet_by = Some(WallInstant::now() + quiet);
                     }
                 }
             }
             let now = WallInstant::now();
             let until = quiet_by.map_or(deadline, |q| q.min(deadline));
-            if now >= until {
+            if now >= until || self.opts.stop.requested() {
                 return Ok(None);
             }
-            let n = self.link.recv(&mut buf, until - now)?;
+            let n = self.link.recv(&mut buf, (until - now).min(Stop::SLICE))?;
             if n > 0 {
                 self.heard = true;
+                noise.bytes += n as u64;
                 deadline = deadline.max((WallInstant::now() + gap).min(latest));
             }
             if n > 0 && quiet_by.is_some() {
@@ -751,37 +1041,53 @@ impl<L: Link> SerialTarget<L> {
         }
     }
 
-    /// Reopens a failed link with backoff; the bridge must still be the
-    /// same session, or the run cannot trust the chip's state.
+    /// Reopens a failed link and says HELLO again: a loop of at most
+    /// `reopen_attempts`, with doubling backoff, where a connection that
+    /// opens but fails before the bridge has answered HELLO counts as a
+    /// failed attempt. The bridge must still be the same session holding
+    /// this host's requests, or the run cannot trust the chip's state.
     fn recover(&mut self, e: io::Error) -> Result<(), SerialError> {
         let mut last = e.to_string();
-        let mut wait = self.opts.backoff;
-        for _ in 0..self.opts.reopen_attempts {
-            std::thread::sleep(wait);
-            wait *= 2;
-            match self.link.reopen() {
-                Ok(()) => {
-                    self.stats.reopens += 1;
-                    self.decoder = FrameDecoder::new();
-                    let old = self.hello.session;
-                    let h = self.say_hello()?;
-                    if h.session != old {
-                        return Err(SerialError::Restarted {
-                            link: self.link.name(),
-                            old,
-                            new: h.session,
-                        });
-                    }
-                    return Ok(());
+        // The first attempt at once (a dropped network connection is
+        // usually back at once), then with doubling backoff.
+        let mut wait = WallDuration::ZERO;
+        self.recovering = true;
+        let r = (|| {
+            for _ in 0..self.opts.reopen_attempts {
+                if self.opts.stop.urgent() || self.opts.stop.sleep(wait) {
+                    return Err(self.interrupted());
                 }
-                Err(e) => last = e.to_string(),
+                wait = (wait * 2).max(self.opts.backoff);
+                if let Err(e) = self.link.reopen() {
+                    last = e.to_string();
+                    continue;
+                }
+                self.stats.reopens += 1;
+                self.decoder = FrameDecoder::new();
+                // A delimiter first: whatever part of a frame the bridge
+                // kept from before the drop ends there, not in our HELLO.
+                if let Err(e) = self.link.send(&[0]) {
+                    last = e.to_string();
+                    continue;
+                }
+                match self.say_hello() {
+                    Ok(_) => return Ok(()),
+                    // The link failed again, or the bridge said nothing:
+                    // another attempt.
+                    Err(e @ (SerialError::Io { .. } | SerialError::NoAnswer { .. })) => {
+                        last = e.to_string()
+                    }
+                    Err(e) => return Err(e),
+                }
             }
-        }
-        Err(SerialError::LinkLost {
-            link: self.link.name(),
-            attempts: self.opts.reopen_attempts,
-            last,
-        })
+            Err(SerialError::LinkLost {
+                link: self.link.name(),
+                attempts: self.opts.reopen_attempts,
+                last: last.clone(),
+            })
+        })();
+        self.recovering = false;
+        r
     }
 
     /// The wall time a batch may take on a real-time bridge.
@@ -896,7 +1202,7 @@ impl<L: Link> SerialTarget<L> {
                 chunk[0]
             );
             let extra = self.batch_time(chunk);
-            let asked_again = self.stats.retransmissions;
+            let garbled_before = self.garbled;
             // The capture rides along only on a clean link: on a noisy one
             // (requests shrunk) a longer reply is likelier to need resending.
             let req = if rest.is_empty() && self.request_size >= MAX_REQUEST {
@@ -931,7 +1237,7 @@ impl<L: Link> SerialTarget<L> {
             };
             // Noisy line: smaller requests (and so smaller replies); clean:
             // back up towards the largest.
-            self.request_size = if self.stats.retransmissions > asked_again {
+            self.request_size = if self.garbled > garbled_before {
                 (self.request_size / 2).max(MIN_REQUEST)
             } else {
                 (self.request_size * 2).min(MAX_REQUEST)
@@ -975,6 +1281,42 @@ impl<L: Link> Target for SerialTarget<L> {
     /// (the last run may have grown). Costs nothing when the last batch
     /// brought the rest of the capture back with it.
     fn capture(&mut self) -> Result<Record, TargetError> {
+        Ok(self.counted(Self::fetch_capture)?)
+    }
+
+    fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
+        Ok(self.counted(|t| t.run_batch(ops))?)
+    }
+}
+
+impl<L: Link> SerialTarget<L> {
+    /// Runs `f` unless the link has given up on too many requests already,
+    /// and counts it if it gives up too.
+    fn counted<T>(
+        &mut self,
+        f: impl FnOnce(&mut Self) -> Result<T, SerialError>,
+    ) -> Result<T, SerialError> {
+        if self.opts.stop.requested() {
+            return Err(self.interrupted());
+        }
+        if self.give_ups >= MAX_GIVE_UPS {
+            return Err(SerialError::Exhausted {
+                link: self.link.name(),
+                failures: self.give_ups,
+                last: self.last_give_up.clone(),
+            });
+        }
+        let r = f(self);
+        if let Err(e) = &r {
+            if e.kind() == TargetErrorKind::Link {
+                self.give_ups += 1;
+                self.last_give_up = e.to_string();
+            }
+        }
+        r
+    }
+
+    fn fetch_capture(&mut self) -> Result<Record, SerialError> {
         while !self.captured_current {
             let (runs, pins, moves) = self.capture_from();
             let req = Request::Capture {
@@ -989,15 +1331,11 @@ impl<L: Link> Target for SerialTarget<L> {
                         break;
                     }
                 }
-                other => return Err(self.unexpected("capture", &other).into()),
+                other => return Err(self.unexpected("capture", &other)),
             }
         }
         self.captured_current = self.hello.virtual_time;
         Ok(self.captured.clone())
-    }
-
-    fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
-        Ok(self.run_batch(ops)?)
     }
 }
 
@@ -1026,6 +1364,15 @@ mod tests {
         restart_on_reopen: bool,
         /// How many bytes the bridge sent for each request.
         sent: Vec<usize>,
+        /// Frames that crossed the link so far, both ways.
+        frames: u64,
+        /// The connection drops at this frame boundary: before the frame
+        /// with this index crosses (a request is lost, or a reply cut
+        /// after the frames before it), and the link fails until reopened.
+        cut_at: Option<u64>,
+        broken: bool,
+        /// The bridge hears, but nothing comes back (a stalled server).
+        mute: bool,
     }
 
     impl MemLink {
@@ -1037,7 +1384,20 @@ mod tests {
                 fail_reopens: 0,
                 restart_on_reopen: false,
                 sent: Vec::new(),
+                frames: 0,
+                cut_at: None,
+                broken: false,
+                mute: false,
             }
+        }
+
+        /// Whether the connection drops before the next frame crosses.
+        fn cut_now(&mut self) -> bool {
+            if self.cut_at == Some(self.frames) {
+                self.broken = true;
+            }
+            self.frames += 1;
+            self.broken
         }
 
         fn bridge(session: u32) -> BridgeEngine<EmuBus> {
@@ -1052,13 +1412,32 @@ mod tests {
                 self.fail_sends -= 1;
                 return Err(io::Error::new(io::ErrorKind::BrokenPipe, "unplugged"));
             }
+            let pipe = || io::Error::new(io::ErrorKind::BrokenPipe, "connection dropped");
+            if self.broken || (bytes != [0] && self.cut_now()) {
+                return Err(pipe());
+            }
+            if self.mute {
+                return Ok(());
+            }
             let out = self.server.on_bytes(bytes);
             self.sent.push(out.len());
-            self.pending.extend(out);
+            // The reply's frames, each a boundary the connection may drop at.
+            for f in out.split_inclusive(|b| *b == 0) {
+                if f != [0] && self.cut_now() {
+                    break;
+                }
+                self.pending.extend_from_slice(f);
+            }
             Ok(())
         }
 
         fn recv(&mut self, buf: &mut [u8], _timeout: WallDuration) -> io::Result<usize> {
+            if self.pending.is_empty() && self.broken {
+                return Err(io::Error::new(
+                    io::ErrorKind::ConnectionAborted,
+                    "connection dropped",
+                ));
+            }
             let n = self.pending.len().min(buf.len());
             buf[..n].copy_from_slice(&self.pending[..n]);
             self.pending.drain(..n);
@@ -1071,6 +1450,7 @@ mod tests {
                 return Err(io::Error::new(io::ErrorKind::NotFound, "no such port"));
             }
             self.pending.clear();
+            self.broken = false;
             if self.restart_on_reopen {
                 self.server = Self::bridge(2);
             }
@@ -1091,6 +1471,7 @@ mod tests {
             backoff: WallDuration::from_millis(1),
             quiet: WallDuration::from_millis(1),
             pad: 0,
+            stop: Stop::default(),
         }
     }
 
@@ -1158,6 +1539,135 @@ mod tests {
             // ~1,500 of them, one for the rest (it was 47 at 128 ops each).
             assert_eq!(t.stats.round_trips - before, 2);
         }
+    }
+
+    /// At most once across reconnects (`docs/bridge-protocol.md` section
+    /// 3): the connection drops at every frame boundary of a run in turn,
+    /// requests lost on the way and replies cut after any of their frames,
+    /// and every run sees exactly what a clean run sees. A batch run twice
+    /// would move the chip's clock, the pins or the status.
+    #[test]
+    fn a_connection_dropped_at_any_frame_boundary_changes_no_reply() {
+        use crate::protocol::Direction;
+        use crate::scenario::{Driver, DriverOptions, Init, Move};
+        let run = |link: MemLink| {
+            // Waits long enough that a loaded machine never gives up on a
+            // reply (the link never loses one unless cut), short enough
+            // that asking again for fragments costs little.
+            let opts = SerialOptions {
+                reply_timeout: WallDuration::from_millis(500),
+                min_reply_timeout: WallDuration::from_millis(5),
+                retries: 10,
+                ..quick()
+            };
+            let mut t = SerialTarget::open(link, opts).expect("opens");
+            let mut d = Driver::new(&mut t, DriverOptions::default());
+            d.reset().expect("reset");
+            d.init_and_wait(Init::four_phase()).expect("init");
+            d.start(Move::constant(Direction::Cw, 100, 50_000))
+                .expect("move");
+            let period = d.period(100);
+            // Round trips after the chip reset: none of them gives the
+            // same replies if it runs twice (the chip's clock moves on).
+            let samples: Vec<_> = [40, 300, 7]
+                .into_iter()
+                .map(|n| d.sample_pins(period.scale(13, 10), n).expect("samples"))
+                .collect();
+            drop(d);
+            let pulses = t.execute(&[Op::ReadPulses]).expect("pulses");
+            let capture = t.capture().expect("capture");
+            (samples, pulses, capture, t.link.frames, t.stats.reopens)
+        };
+        let (samples, pulses, capture, frames, reopens) = run(MemLink::new());
+        assert_eq!(reopens, 0);
+        assert!(frames > 20, "precondition: {frames} frames");
+        for cut in 0..frames {
+            let link = MemLink {
+                cut_at: Some(cut),
+                ..MemLink::new()
+            };
+            let (s, p, c, _, reopens) = run(link);
+            assert_eq!(reopens, 1, "cut at frame {cut}");
+            // (Not assert_eq: the samples would fill the screen.)
+            assert!(s == samples, "cut at frame {cut}: the samples differ");
+            assert!(p == pulses, "cut at frame {cut}: the pulses differ");
+            assert!(c == capture, "cut at frame {cut}: the capture differs");
+        }
+    }
+
+    /// A bridge that another host said HELLO to while the link was down
+    /// may have had its chip used: a reconnect that finds it so ends the
+    /// run as a link error, rather than resend a request it may run again.
+    #[test]
+    fn a_reconnect_to_a_bridge_another_host_used_is_not_trusted() {
+        let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+        let other = Request::Hello {
+            version: PROTOCOL_VERSION,
+            host: t.host.wrapping_add(1).max(1),
+        };
+        t.link
+            .server
+            .on_bytes(&frame::encode(&other.encode(1, Timer::NANOS)));
+        t.link.fail_sends = 1;
+        let e = t.execute(&[Op::ReadStatus]).expect_err("displaced");
+        assert_eq!(e.kind, TargetErrorKind::Link);
+        assert!(
+            matches!(
+                e.get_ref().downcast_ref::<SerialError>(),
+                Some(SerialError::Displaced { .. })
+            ),
+            "{e}"
+        );
+    }
+
+    /// Every wait has an end: a bridge that goes silent costs each request
+    /// its tries and one reconnect, and after three requests given up the
+    /// link is not used again, so the rest of a run ends at once.
+    #[test]
+    fn a_link_that_gave_up_three_times_is_not_used_again() {
+        let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+        t.link.mute = true;
+        for n in 1..=MAX_GIVE_UPS {
+            let e = t.execute(&[Op::ReadStatus]).expect_err("silence");
+            assert_eq!(e.kind, TargetErrorKind::Link);
+            let text = e.to_string();
+            assert!(text.contains("no bridge answering"), "{n}: {text}");
+            assert!(text.contains("nothing came back"), "{n}: {text}");
+        }
+        let reopens = t.stats.reopens;
+        let began = WallInstant::now();
+        let e = t.execute(&[Op::ReadStatus]).expect_err("given up");
+        assert!(
+            e.to_string()
+                .contains("the link gave up on 3 requests in this run"),
+            "{e}"
+        );
+        assert_eq!(t.stats.reopens, reopens, "not even a reconnect");
+        assert!(t.capture().is_err());
+        // (A bound, not a speed: nothing at all was waited for.)
+        assert!(began.elapsed() < WallDuration::from_secs(1));
+    }
+
+    /// A stop request ends a wait on a silent link at once, as an
+    /// interruption, not a link failure.
+    #[test]
+    fn a_stop_request_ends_a_wait_as_an_interruption() {
+        let opts = SerialOptions {
+            reply_timeout: WallDuration::from_secs(30),
+            min_reply_timeout: WallDuration::from_secs(30),
+            ..quick()
+        };
+        let stop = opts.stop.clone();
+        let mut t = SerialTarget::open(MemLink::new(), opts).expect("healthy");
+        t.link.mute = true;
+        let asker = std::thread::spawn(move || {
+            std::thread::sleep(WallDuration::from_millis(200));
+            stop.request();
+        });
+        let e = t.execute(&[Op::ReadStatus]).expect_err("stopped");
+        asker.join().expect("asker");
+        assert_eq!(e.kind, TargetErrorKind::Interrupted, "{e}");
+        assert_eq!(t.give_ups, 0, "an interruption is nobody's failure");
     }
 
     #[test]
@@ -1264,6 +1774,7 @@ mod tests {
                         virtual_time: true,
                         firmware: "future".into(),
                         straps: Straps::default(),
+                        resumed: false,
                     });
                     self.0
                         .extend(frame::encode(&hello.encode(seq, Timer::NANOS)));

@@ -15,6 +15,7 @@
 use super::link::Link;
 use super::tcp::TcpLink;
 use super::SerialError;
+use crate::stop::Stop;
 use std::fmt;
 use std::io;
 use std::time::Duration as WallDuration;
@@ -57,6 +58,12 @@ pub struct Telnet {
     rx: Rx,
     /// Replies to the server's option requests, to send.
     pub answers: Vec<u8>,
+    /// The (verb, option) pairs answered already: each is answered once,
+    /// so a server that repeats its requests (an option storm) cannot make
+    /// the client send without end (RFC 1143's rule against loops).
+    answered: std::collections::HashSet<(u8, u8)>,
+    /// Telnet commands read since the last data byte.
+    pub commands_without_data: u64,
 }
 
 impl Default for Telnet {
@@ -64,9 +71,16 @@ impl Default for Telnet {
         Telnet {
             rx: Rx::Data,
             answers: Vec::new(),
+            answered: std::collections::HashSet::new(),
+            commands_without_data: 0,
         }
     }
 }
+
+/// Telnet commands a server may send with no data between them before the
+/// link takes it for an option storm and fails the connection: far more
+/// than any negotiation takes (ser2net's takes a dozen).
+pub const MAX_COMMANDS_WITHOUT_DATA: u64 = 4096;
 
 impl Telnet {
     /// What the client says first: binary both ways, no go-ahead, and the
@@ -96,18 +110,29 @@ impl Telnet {
                 (Rx::Data, IAC) => Rx::Iac,
                 (Rx::Data, b) => {
                     out.push(b);
+                    self.commands_without_data = 0;
                     Rx::Data
                 }
                 (Rx::Iac, IAC) => {
                     out.push(IAC);
+                    self.commands_without_data = 0;
                     Rx::Data
                 }
                 (Rx::Iac, v @ (WILL | WONT | DO | DONT)) => Rx::Verb(v),
-                (Rx::Iac, SB) => Rx::Sub,
+                (Rx::Iac, SB) => {
+                    self.commands_without_data += 1;
+                    Rx::Sub
+                }
                 // NOP, GA and the other one-byte commands.
-                (Rx::Iac, _) => Rx::Data,
+                (Rx::Iac, _) => {
+                    self.commands_without_data += 1;
+                    Rx::Data
+                }
                 (Rx::Verb(v), opt) => {
-                    self.answer(v, opt);
+                    self.commands_without_data += 1;
+                    if self.answered.insert((v, opt)) {
+                        self.answer(v, opt);
+                    }
                     Rx::Data
                 }
                 (Rx::Sub, IAC) => Rx::SubIac,
@@ -180,8 +205,14 @@ impl fmt::Debug for Rfc2217Link {
 
 impl Rfc2217Link {
     pub fn open(addr: &str, baud: u32) -> Result<Rfc2217Link, SerialError> {
+        Self::open_until(addr, baud, Stop::default())
+    }
+
+    /// [`Self::open`], abandoning a connection attempt once `stop` is
+    /// asked for.
+    pub fn open_until(addr: &str, baud: u32, stop: Stop) -> Result<Rfc2217Link, SerialError> {
         let mut link = Rfc2217Link {
-            tcp: TcpLink::open(addr)?,
+            tcp: TcpLink::open_until(addr, stop)?,
             baud,
             telnet: Telnet::default(),
             pending: Vec::new(),
@@ -219,6 +250,14 @@ impl Link for Rfc2217Link {
             let n = self.tcp.recv(&mut raw, timeout)?;
             self.telnet.receive(&raw[..n], &mut self.pending);
             self.flush_answers()?;
+            if self.telnet.commands_without_data > MAX_COMMANDS_WITHOUT_DATA {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidData,
+                    format!(
+                        "the server sent over {MAX_COMMANDS_WITHOUT_DATA} telnet commands and no data (an option storm)"
+                    ),
+                ));
+            }
         }
         let n = self.pending.len().min(buf.len());
         buf[..n].copy_from_slice(&self.pending[..n]);
@@ -239,6 +278,23 @@ impl Link for Rfc2217Link {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A server that repeats its option requests without end is answered
+    /// once per request, and counted, so the link can give up on it.
+    #[test]
+    fn an_option_storm_is_answered_once_and_counted() {
+        let mut t = Telnet::default();
+        let mut out = Vec::new();
+        let storm: Vec<u8> = (0..1000)
+            .flat_map(|_| [IAC, DO, 24, IAC, WILL, 1])
+            .collect();
+        t.receive(&storm, &mut out);
+        assert!(out.is_empty());
+        assert_eq!(t.answers, [IAC, WONT, 24, IAC, DONT, 1]);
+        assert_eq!(t.commands_without_data, 2000);
+        t.receive(b"x", &mut out);
+        assert_eq!((out.as_slice(), t.commands_without_data), (&b"x"[..], 0));
+    }
 
     #[test]
     fn data_0xff_is_doubled_and_read_back_once() {

@@ -12,6 +12,7 @@
 
 use super::link::Link;
 use super::SerialError;
+use crate::stop::Stop;
 use std::fmt;
 use std::io::{self, Read, Write};
 use std::net::{SocketAddr, TcpStream, ToSocketAddrs};
@@ -20,10 +21,16 @@ use std::time::Duration as WallDuration;
 /// How long a connection attempt may take.
 const CONNECT_TIMEOUT: WallDuration = WallDuration::from_secs(5);
 
+/// How long a send may block on a server that does not read (its window
+/// closed): then the connection is taken as failed, and reopened.
+const SEND_TIMEOUT: WallDuration = WallDuration::from_secs(5);
+
 pub struct TcpLink {
     /// `host:port` as given.
     addr: String,
     stream: Option<TcpStream>,
+    /// Asked for, a connection attempt under way is abandoned.
+    stop: Stop,
 }
 
 impl fmt::Debug for TcpLink {
@@ -41,9 +48,16 @@ pub fn parse_tcp(spec: &str) -> Option<String> {
 
 impl TcpLink {
     pub fn open(addr: &str) -> Result<TcpLink, SerialError> {
+        Self::open_until(addr, Stop::default())
+    }
+
+    /// [`Self::open`], abandoning a connection attempt (this one, or a
+    /// reconnect's) once `stop` is asked for.
+    pub fn open_until(addr: &str, stop: Stop) -> Result<TcpLink, SerialError> {
         let mut link = TcpLink {
             addr: addr.to_string(),
             stream: None,
+            stop,
         };
         link.reopen().map_err(|e| SerialError::Io {
             path: link.name(),
@@ -117,9 +131,10 @@ impl Link for TcpLink {
         let addrs: Vec<SocketAddr> = self.addr.to_socket_addrs()?.collect();
         let mut last = io::Error::new(io::ErrorKind::NotFound, "the host has no address");
         for a in addrs {
-            match TcpStream::connect_timeout(&a, CONNECT_TIMEOUT) {
+            match connect(a, &self.stop) {
                 Ok(s) => {
                     s.set_nodelay(true)?;
+                    s.set_write_timeout(Some(SEND_TIMEOUT))?;
                     Self::quick_ack(&s);
                     self.stream = Some(s);
                     return Ok(());
@@ -132,6 +147,33 @@ impl Link for TcpLink {
 
     fn name(&self) -> String {
         format!("tcp://{}", self.addr)
+    }
+}
+
+/// Connects to `addr` within [`CONNECT_TIMEOUT`], or until `stop` is asked
+/// for: the attempt runs on a thread of its own (a blocking connect cannot
+/// be woken), which is left to finish alone when abandoned.
+fn connect(addr: SocketAddr, stop: &Stop) -> io::Result<TcpStream> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(TcpStream::connect_timeout(&addr, CONNECT_TIMEOUT));
+    });
+    loop {
+        if stop.requested() {
+            return Err(io::Error::new(
+                io::ErrorKind::Interrupted,
+                "connection attempt abandoned: a stop was asked for",
+            ));
+        }
+        match rx.recv_timeout(Stop::SLICE) {
+            Ok(r) => return r,
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(io::Error::other(
+                    "the connection attempt ended without a word",
+                ))
+            }
+        }
     }
 }
 
