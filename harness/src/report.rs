@@ -954,7 +954,10 @@ mod tests {
             xml.contains("<error type=\"infrastructure\" message=\"target: link lost\""),
             "{xml}"
         );
-        assert!(xml.contains("<error type=\"harness\" message=\"panicked\""), "{xml}");
+        assert!(
+            xml.contains("<error type=\"harness\" message=\"panicked\""),
+            "{xml}"
+        );
         let record: serde_json::Value =
             serde_json::from_str(&json(&info, &results, &on).expect("json")).expect("JSON");
         assert_eq!(record["scenarios"][0]["error"]["kind"], "infrastructure");
