@@ -54,6 +54,10 @@ pub enum Behaviour {
     AcceptClose,
     /// Answers with random bytes, without end.
     FloodRandom,
+    /// Forwards the first `n` frames of its life, then answers every
+    /// connection with random bytes, without end: a link that turns bad in
+    /// the middle of a run.
+    FloodAfter(u64),
     /// Answers with 0xFF bytes, without end.
     FloodFf,
     /// Answers with one frame that never ends (no delimiter, ever).
@@ -89,6 +93,7 @@ impl Behaviour {
         "stall=400",
         "accept-close",
         "flood-random",
+        "flood-after=300",
         "flood-ff",
         "endless-frame",
         "trickle",
@@ -143,6 +148,7 @@ impl FromStr for Behaviour {
             "stall" => Ok(Behaviour::Stall(n()?)),
             "accept-close" => plain(Behaviour::AcceptClose),
             "flood-random" => plain(Behaviour::FloodRandom),
+            "flood-after" => Ok(Behaviour::FloodAfter(n()?)),
             "flood-ff" => plain(Behaviour::FloodFf),
             "endless-frame" => plain(Behaviour::EndlessFrame),
             "trickle" => plain(Behaviour::Trickle),
@@ -171,6 +177,7 @@ impl fmt::Display for Behaviour {
             Behaviour::Stall(n) => write!(f, "stall={n}"),
             Behaviour::AcceptClose => f.write_str("accept-close"),
             Behaviour::FloodRandom => f.write_str("flood-random"),
+            Behaviour::FloodAfter(n) => write!(f, "flood-after={n}"),
             Behaviour::FloodFf => f.write_str("flood-ff"),
             Behaviour::EndlessFrame => f.write_str("endless-frame"),
             Behaviour::Trickle => f.write_str("trickle"),
@@ -220,6 +227,9 @@ pub struct Stats {
     pub cuts: u64,
     /// Whole frames passed on, both ways.
     pub frames: u64,
+    /// Times the behaviour acted other than by a cut: stalls begun, frames
+    /// sent twice or out of order, floods begun.
+    pub acts: u64,
 }
 
 /// A running chaos proxy; stopped (and its port closed) when dropped.
@@ -258,6 +268,7 @@ impl ChaosProxy {
             rng: StdRng::seed_from_u64(seed),
             stats: Stats::default(),
             conn: Conn::default(),
+            errors: 0,
         };
         let thread = std::thread::Builder::new()
             .name(format!("chaos {behaviour}"))
@@ -393,8 +404,6 @@ struct Conn {
     swapped: Option<(Vec<u8>, Instant)>,
     /// The next trickle byte is due.
     trickle_at: Option<Instant>,
-    /// Error codes answered so far (error-only).
-    errors: u64,
 }
 
 struct Proxy {
@@ -407,7 +416,13 @@ struct Proxy {
     rng: StdRng,
     stats: Stats,
     conn: Conn,
+    /// Error codes answered so far (error-only).
+    errors: u64,
 }
+
+/// Half-open connections kept at most; the oldest is closed past that, so
+/// that a long session does not run out of file descriptors.
+const MAX_ZOMBIES: usize = 64;
 
 /// The telnet commands of an option storm: every option offered and asked
 /// for, again and again.
@@ -514,6 +529,10 @@ impl Proxy {
             }
             if let Behaviour::DropRandomByte(n) = self.behaviour {
                 if self.rng.random_range(0..n) == 0 {
+                    // Part of a request reaches the bridge, then the cut,
+                    // as a serial server forwards what it got.
+                    let part = std::mem::take(&mut self.conn.from_host.current);
+                    self.send_up(&part);
                     self.cut();
                     return;
                 }
@@ -551,6 +570,9 @@ impl Proxy {
     }
 
     fn pass_up(&mut self, frame: Vec<u8>) {
+        if self.flooding() {
+            return;
+        }
         if frame == [0] {
             self.send_up(&frame);
             return;
@@ -560,10 +582,24 @@ impl Proxy {
             return;
         }
         self.send_up(&frame);
+        if let Behaviour::Duplicate(n) = self.behaviour {
+            if self.conn.frames % n == n - 1 {
+                self.stats.acts += 1;
+                self.send_up(&frame);
+            }
+        }
         self.after_frame();
     }
 
+    /// A flood-after proxy past its frames: nothing is forwarded any more.
+    fn flooding(&self) -> bool {
+        matches!(self.behaviour, Behaviour::FloodAfter(n) if self.stats.frames >= n)
+    }
+
     fn pass_down(&mut self, frame: Vec<u8>) {
+        if self.flooding() {
+            return;
+        }
         if frame == [0] {
             self.send_down(&frame);
             return;
@@ -585,12 +621,14 @@ impl Proxy {
                 }
             }
             Behaviour::Duplicate(n) if self.conn.frames % n == n - 1 => {
+                self.stats.acts += 1;
                 self.send_down(&frame);
                 self.send_down(&frame);
             }
             Behaviour::Reorder(n)
                 if self.conn.swapped.is_none() && self.conn.frames % n == n - 1 =>
             {
+                self.stats.acts += 1;
                 self.conn.swapped = Some((frame, Instant::now() + Duration::from_millis(5)));
                 self.after_frame();
                 return;
@@ -621,6 +659,7 @@ impl Proxy {
             }
             Behaviour::Stall(n) => {
                 if self.count(n) {
+                    self.stats.acts += 1;
                     self.conn.stalled_until = Some(Instant::now() + STALL);
                 }
             }
@@ -628,6 +667,9 @@ impl Proxy {
                 if self.count(n) {
                     self.stats.cuts += 1;
                     if let Some(d) = self.down.take() {
+                        if self.zombies.len() >= MAX_ZOMBIES {
+                            self.zombies.remove(0);
+                        }
                         self.zombies.push(d);
                     }
                 }
@@ -648,14 +690,17 @@ impl Proxy {
             Ok(Some(p)) if !p.is_empty() => p[0],
             _ => return,
         };
+        // A bad frame first, which a host must take as noise and ask
+        // again; then the errors that answer a request.
         let codes = [
+            BridgeErrorCode::BadFrame,
             BridgeErrorCode::Malformed,
+            BridgeErrorCode::BadFrame,
             BridgeErrorCode::UnknownOp,
             BridgeErrorCode::Overflow,
-            BridgeErrorCode::BadFrame,
         ];
-        let code = codes[(self.conn.errors % codes.len() as u64) as usize];
-        self.conn.errors += 1;
+        let code = codes[(self.errors % codes.len() as u64) as usize];
+        self.errors += 1;
         let seq = if code == BridgeErrorCode::BadFrame {
             0
         } else {
@@ -675,6 +720,12 @@ impl Proxy {
         }
         match self.behaviour {
             Behaviour::FloodRandom => {
+                let mut b = [0u8; 1024];
+                self.rng.fill(&mut b[..]);
+                self.send_down(&b);
+            }
+            Behaviour::FloodAfter(n) if self.stats.frames >= n => {
+                self.stats.acts = 1;
                 let mut b = [0u8; 1024];
                 self.rng.fill(&mut b[..]);
                 self.send_down(&b);

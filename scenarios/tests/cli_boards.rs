@@ -355,3 +355,23 @@ fn an_unreachable_board_fails_the_run_and_its_record_names_its_address() {
         "{xml}"
     );
 }
+
+/// One bridge named twice would have two hosts drive one chip at once,
+/// each taking the other's HELLO for a takeover: refused before anything
+/// is opened. Several emulators are several chips, and stay allowed.
+#[test]
+fn the_same_bridge_twice_is_refused_before_anything_is_opened() {
+    let out = ppmc(&[
+        "run",
+        "--target",
+        "tcp://127.0.0.1:9",
+        "--target",
+        "tcp://127.0.0.1:9,name=again",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("--target tcp://127.0.0.1:9 given twice"),
+        "{}",
+        text(&out.stderr)
+    );
+}

@@ -102,9 +102,24 @@ fn through(behaviour: &str) -> Outcome {
         o.passed == 96,
         "{behaviour}: exit status and verdicts agree"
     );
+    // The behaviour must have acted, or the run proved nothing.
+    match b {
+        Behaviour::Clean => {}
+        Behaviour::DropEvery(_)
+        | Behaviour::DropAt(_)
+        | Behaviour::DropBothEvery(_)
+        | Behaviour::DropRandomByte(_)
+        | Behaviour::HalfOpen(_)
+        | Behaviour::AcceptClose => assert!(stats.cuts > 0, "{behaviour}: {stats:?}"),
+        Behaviour::Stall(_)
+        | Behaviour::Duplicate(_)
+        | Behaviour::Reorder(_)
+        | Behaviour::FloodAfter(_) => assert!(stats.acts > 0, "{behaviour}: {stats:?}"),
+        _ => assert!(stats.connections > 0, "{behaviour}: {stats:?}"),
+    }
     eprintln!(
-        "| {behaviour} | {} / 96 | 0 | {} | {:.1} s | {} connections, {} cut |",
-        o.passed, o.infrastructure, o.secs, stats.connections, stats.cuts
+        "| {behaviour} | {} / 96 | 0 | {} | {:.1} s | {} connections, {} cut, {} acts |",
+        o.passed, o.infrastructure, o.secs, stats.connections, stats.cuts, stats.acts
     );
     o
 }
@@ -147,6 +162,15 @@ fn a_stalled_or_half_open_connection_is_reconnected() {
     for b in ["stall=400", "half-open=300"] {
         completes(b);
     }
+}
+
+/// A link that turns to noise in the middle of a run: the scenario under
+/// way and the rest are infrastructure errors, none a failure, and the run
+/// ends within its bound (three requests given up at most).
+#[test]
+fn a_link_that_turns_to_noise_mid_run_ends_the_run_without_blaming_the_board() {
+    let o = through("flood-after=300");
+    assert!(o.passed > 0 && o.infrastructure > 0, "{o:?}");
 }
 
 /// Servers that never let a bridge through: the run gives up as an

@@ -346,8 +346,16 @@ impl TargetArgs {
     /// becomes `emu#2`).
     pub fn specs(&self) -> Result<Vec<TargetSpec>, String> {
         let mut specs = Vec::with_capacity(self.targets.len());
+        // Where a bridge is, whatever the options after it.
+        let place = |s: &TargetSpec| s.address.split(',').next().unwrap_or_default().to_string();
         for t in &self.targets {
             let mut spec = TargetSpec::parse(t)?;
+            if spec.address != "emu" && specs.iter().any(|s| place(s) == place(&spec)) {
+                return Err(format!(
+                    "--target {} given twice: a bridge serves one host at a time, and two would drive one chip at once",
+                    place(&spec)
+                ));
+            }
             let mut n = 1;
             let base = spec.label().to_string();
             while specs.iter().any(|s: &TargetSpec| s.label() == spec.label()) {
@@ -463,7 +471,8 @@ impl TargetArgs {
                 self.open_bridge(link, spec, NETWORK_PAD)
             }
             Address::Labgrid(place) => {
-                let link = LabgridLink::open(place).map_err(OpenError::Infrastructure)?;
+                let link = LabgridLink::open_until(place, self.stop.clone())
+                    .map_err(OpenError::Infrastructure)?;
                 self.open_bridge(link, spec, NETWORK_PAD)
             }
         }

@@ -16,6 +16,7 @@ pub struct ChaosProxyArgs {
     to: String,
     /// What the proxy does to the traffic: clean, drop-every=N, drop-at=K,
     /// drop-both-every=N, drop-random-byte=N, stall=N, accept-close,
+    /// flood-after=N,
     /// flood-random, flood-ff, endless-frame, trickle, wrong-seq,
     /// error-only, option-storm, duplicate=N, reorder=N, half-open=N
     /// (N counts frames, or bytes for drop-random-byte).

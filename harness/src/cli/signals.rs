@@ -16,6 +16,10 @@ use crate::stop::Stop;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
+/// Signals this close together are one request (a sender that signals
+/// both the process and its group).
+const SAME_REQUEST: std::time::Duration = std::time::Duration::from_millis(200);
+
 /// Installs the handlers of a command that writes reports; the [`Stop`]
 /// they raise. A thread of its own takes the signals (the handler itself
 /// only wakes it), raises the stop for the first two and ends the process
@@ -30,7 +34,15 @@ pub fn install() -> Stop {
             let _ = std::thread::Builder::new()
                 .name("signals".into())
                 .spawn(move || {
+                    let mut last: Option<std::time::Instant> = None;
                     for _ in signals.forever() {
+                        // GNU timeout sends its signal to ppmc and again to
+                        // its process group: one request, delivered twice.
+                        let now = std::time::Instant::now();
+                        if last.is_some_and(|t| now - t < SAME_REQUEST) {
+                            continue;
+                        }
+                        last = Some(now);
                         if raised.urgent() {
                             std::process::exit(130);
                         }

@@ -14,6 +14,7 @@
 //! `labgrid-client` on the `PATH`, or `PPMC_LABGRID_CLIENT`.
 
 use super::{Link, Rfc2217Link, SerialError, SerialLink, TcpLink};
+use crate::stop::Stop;
 use std::fmt;
 use std::io::{self, BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
@@ -168,8 +169,14 @@ impl LabgridLink {
     /// Asks labgrid where `place`'s serial port is and connects to it.
     /// Every failure is the infrastructure's, and names the place.
     pub fn open(place: Place) -> Result<LabgridLink, String> {
+        Self::open_until(place, Stop::default())
+    }
+
+    /// [`Self::open`], given up (the client's export, a connection
+    /// attempt) once `stop` is asked for.
+    pub fn open_until(place: Place, stop: Stop) -> Result<LabgridLink, String> {
         let who = format!("labgrid:{}", place.name);
-        let (export, found) = export(&place).map_err(|e| format!("{who}: {e}"))?;
+        let (export, found) = export(&place, &stop).map_err(|e| format!("{who}: {e}"))?;
         let inner: Box<dyn Link> = match (&found.host, found.protocol.as_deref()) {
             (None, _) => Box::new(SerialLink::open(&found.port, found.speed).map_err(err)?),
             (Some(host), proto) => {
@@ -181,9 +188,9 @@ impl LabgridLink {
                 let addr = format!("{host}:{}", found.port);
                 match proto {
                     Some("rfc2217") => {
-                        Box::new(Rfc2217Link::open(&addr, found.speed).map_err(err)?)
+                        Box::new(Rfc2217Link::open_until(&addr, found.speed, stop).map_err(err)?)
                     }
-                    Some("raw") => Box::new(TcpLink::open(&addr).map_err(err)?),
+                    Some("raw") => Box::new(TcpLink::open_until(&addr, stop).map_err(err)?),
                     other => {
                         return Err(format!(
                             "{who}: labgrid serves the port as `{}`, which ppmc does not speak (rfc2217 or raw)",
@@ -206,7 +213,7 @@ fn err(e: SerialError) -> String {
 }
 
 /// Runs the client's export and waits for the file it writes.
-fn export(place: &Place) -> Result<(Export, Exported), String> {
+fn export(place: &Place, stop: &Stop) -> Result<(Export, Exported), String> {
     let program = client_program();
     let dir = tempfile::Builder::new()
         .prefix("ppmc-labgrid-")
@@ -250,10 +257,14 @@ fn export(place: &Place) -> Result<(Export, Exported), String> {
     let deadline = WallInstant::now() + EXPORT_TIMEOUT;
     let mut said = Vec::new();
     loop {
+        if stop.requested() {
+            return Err("interrupted by a stop request while labgrid exported the port".into());
+        }
         let left = deadline.saturating_duration_since(WallInstant::now());
-        match rx.recv_timeout(left) {
+        match rx.recv_timeout(left.min(Stop::SLICE)) {
             Ok(line) if line.starts_with("Exported to") => break,
             Ok(line) => said.push(line),
+            Err(mpsc::RecvTimeoutError::Timeout) if !left.is_zero() => {}
             Err(mpsc::RecvTimeoutError::Timeout) => {
                 return Err(format!(
                     "`{program} export` said nothing of the place's port within {} s{}",

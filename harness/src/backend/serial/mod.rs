@@ -285,6 +285,11 @@ const CLEAN_TO_GROW: u32 = 8;
 /// reply stays within [`wire::MAX_REPLY`].
 const REPLY_ENTRIES_BUDGET: usize = 10 * 1024;
 
+/// The most capture records (pulse runs and pin changes) the host takes
+/// from one bridge between chip resets, whatever its HELLO says: a
+/// 16,777,216-step move is a few hundred.
+const MAX_CAPTURE_RECORDS: usize = 4_000_000;
+
 /// Records asked for per capture request.
 const CAPTURE_CHUNK: u16 = 300;
 
@@ -400,6 +405,8 @@ pub struct SerialTarget<L: Link> {
     /// A reconnect is under way: a link error ends the attempt instead of
     /// starting another reconnect.
     recovering: bool,
+    /// The sequence number of the request whose reply is awaited.
+    in_flight: Option<u8>,
     /// Frames that arrived garbled, either way (corrupt frames here,
     /// bad-frame errors from the bridge): what makes the host shrink its
     /// requests and the bridge's reply fragments.
@@ -484,6 +491,7 @@ impl<L: Link> SerialTarget<L> {
             host: host_session(),
             opened: false,
             recovering: false,
+            in_flight: None,
             garbled: 0,
             give_ups: 0,
             last_give_up: String::new(),
@@ -553,6 +561,18 @@ impl<L: Link> SerialTarget<L> {
         };
         let h = match reply {
             Response::Hello(h) if h.version == PROTOCOL_VERSION => h,
+            // Another bridge behind the same address (reflashed, swapped):
+            // the link's doing, not a choice of the user's.
+            Response::Hello(h) if self.opened => {
+                return Err(SerialError::Protocol {
+                    link: self.link.name(),
+                    what: "hello after a reconnect".into(),
+                    detail: format!(
+                        "the bridge now speaks protocol version {}, not {PROTOCOL_VERSION}: another bridge answers",
+                        h.version
+                    ),
+                })
+            }
             Response::Hello(h) => {
                 return Err(SerialError::Version {
                     link: self.link.name(),
@@ -584,7 +604,7 @@ impl<L: Link> SerialTarget<L> {
             Response::Error {
                 code: BridgeErrorCode::Version,
                 detail,
-            } => SerialError::Version {
+            } if !self.opened => SerialError::Version {
                 link: self.link.name(),
                 ours: PROTOCOL_VERSION,
                 theirs: detail
@@ -677,8 +697,10 @@ impl<L: Link> SerialTarget<L> {
         what: &str,
         extra: WallDuration,
     ) -> Result<Response, SerialError> {
-        self.seq = self.seq.wrapping_add(1);
-        let seq = self.seq;
+        let seq = self.next_seq();
+        if !self.recovering {
+            self.in_flight = Some(seq);
+        }
         let payload = req.encode(seq, self.timer);
         let splittable = payload.len() > MIN_REQUEST;
         let full = frame::encode(&payload);
@@ -700,6 +722,12 @@ impl<L: Link> SerialTarget<L> {
         // network connection can die without a word (a half-open TCP
         // connection, a server that stalls).
         let mut reconnected = self.recovering;
+        // Reconnects since the last progress: a server that takes every
+        // connection and drops it again ends the request, not a loop.
+        let mut reconnects = 0;
+        // A probe of `ran` went unanswered: its "no reply" may still come,
+        // after the request was sent again, and would then be stale.
+        let mut probe_lost = false;
         // Attempts in a row that brought nothing new: `silent` ones heard
         // nothing at all (a dead link: `retries` of them end the request),
         // `fruitless` ones at most heard garbage (a live, noisy line: it
@@ -760,6 +788,10 @@ impl<L: Link> SerialTarget<L> {
             }
             attempts += 1;
             if let Err(e) = self.link.send(&next) {
+                reconnects += 1;
+                if reconnects > self.opts.reopen_attempts && !self.recovering {
+                    return Err(self.dropped_again(what, attempts, start, e));
+                }
                 self.link_failed(e)?;
                 next = self.after_reconnect(req, seq, &mut frags, &full);
                 fruitless += 1;
@@ -770,7 +802,7 @@ impl<L: Link> SerialTarget<L> {
             self.stats.round_trips += 1;
             let had = frags.received();
             let budget = (wait + extra).min(give_up_at.saturating_duration_since(sent));
-            match self.await_reply(seq, budget, &mut frags, &mut noise) {
+            match self.await_reply(seq, budget, give_up_at, &mut frags, &mut noise) {
                 Ok(Some(Response::Error {
                     code: BridgeErrorCode::BadFrame,
                     ..
@@ -778,12 +810,20 @@ impl<L: Link> SerialTarget<L> {
                     noise.bad_frames += 1;
                     self.garbled += 1;
                     garbled += 1;
-                    next = full.clone();
+                    // Our RESEND or request was garbled on the way: ask
+                    // again as before, never mixing fragments of two runs.
+                    next = match frags.missing() {
+                        Some(m) => {
+                            frame::encode(&Request::Resend { fragments: m }.encode(seq, self.timer))
+                        }
+                        None => full.clone(),
+                    };
                     if garbled >= 2 && frags.received() == 0 && splittable {
                         // Too long for this line? Only if the bridge never
                         // ran it: a bad-frame error does not say which frame
                         // was bad, so ask before splitting.
-                        match self.ran(seq, &mut frags, &mut noise)? {
+                        match self.ran(seq, give_up_at, &mut frags, &mut noise, &mut probe_lost)? {
+                            Ran::No if probe_lost => {}
                             Ran::No => {
                                 return Err(SerialError::Garbled {
                                     link: self.link.name(),
@@ -818,11 +858,16 @@ impl<L: Link> SerialTarget<L> {
                     }
                 }
                 Err(e) => {
+                    reconnects += 1;
+                    if reconnects > self.opts.reopen_attempts && !self.recovering {
+                        return Err(self.dropped_again(what, attempts, start, e));
+                    }
                     self.link_failed(e)?;
                     next = self.after_reconnect(req, seq, &mut frags, &full);
                 }
             }
             if frags.received() > had {
+                reconnects = 0;
                 fruitless = 0;
                 silent = 0;
                 pause = WallDuration::ZERO;
@@ -855,6 +900,18 @@ impl<L: Link> SerialTarget<L> {
         })
     }
 
+    /// The next sequence number: never 0 (the bridge's own errors carry
+    /// 0), and, while reconnecting, never the request in flight's, so that
+    /// a RESEND for its reply can only find its reply.
+    fn next_seq(&mut self) -> u8 {
+        loop {
+            self.seq = self.seq.wrapping_add(1);
+            if self.seq != 0 && !(self.recovering && self.in_flight == Some(self.seq)) {
+                return self.seq;
+            }
+        }
+    }
+
     /// What to send after a reconnect: the fragments of the reply still
     /// missing (the bridge answers a RESEND from the reply it cached, which
     /// it kept for this host across the reconnect), or the whole request
@@ -879,6 +936,26 @@ impl<L: Link> SerialTarget<L> {
                 *frags = Fragments::default();
                 full.to_vec()
             }
+        }
+    }
+
+    /// A request whose connection kept dropping with no progress between.
+    fn dropped_again(
+        &self,
+        what: &str,
+        tries: u32,
+        start: WallInstant,
+        e: io::Error,
+    ) -> SerialError {
+        SerialError::NoAnswer {
+            link: self.link.name(),
+            what: what.into(),
+            tries,
+            secs: start.elapsed().as_secs_f64(),
+            heard: format!(
+                "the connection dropped {} times with nothing gained between (the last: {e})",
+                self.opts.reopen_attempts + 1
+            ),
         }
     }
 
@@ -908,11 +985,17 @@ impl<L: Link> SerialTarget<L> {
     /// Asks the bridge whether it ran request `seq` (a RESEND of its first
     /// reply fragment): it answers with the cached reply if it did, and with
     /// an error naming the sequence if it did not.
+    ///
+    /// A "no reply" is believed only while no probe of this request has
+    /// gone unanswered (`probe_lost`): a late answer to a lost probe may
+    /// come after the request was sent again and ran.
     fn ran(
         &mut self,
         seq: u8,
+        hard_end: WallInstant,
         frags: &mut Fragments,
         noise: &mut Noise,
+        probe_lost: &mut bool,
     ) -> Result<Ran, SerialError> {
         let probe = frame::encode(&Request::Resend { fragments: vec![0] }.encode(seq, self.timer));
         for _ in 0..=self.opts.retries {
@@ -923,7 +1006,10 @@ impl<L: Link> SerialTarget<L> {
             }
             self.stats.round_trips += 1;
             let before = frags.received();
-            match self.await_reply(seq, self.rtt.timeout(&self.opts), frags, noise) {
+            if WallInstant::now() >= hard_end {
+                return Ok(Ran::Unknown);
+            }
+            match self.await_reply(seq, self.rtt.timeout(&self.opts), hard_end, frags, noise) {
                 Ok(Some(Response::Error {
                     code: BridgeErrorCode::Malformed,
                     detail,
@@ -938,7 +1024,7 @@ impl<L: Link> SerialTarget<L> {
                 Ok(Some(r)) => return Ok(Ran::Yes(r)),
                 Ok(None) if frags.received() > before => return Ok(Ran::Partly),
                 Ok(None) if self.opts.stop.requested() => return Err(self.interrupted()),
-                Ok(None) => {}
+                Ok(None) => *probe_lost = true,
                 Err(e) => {
                     self.link_failed(e)?;
                     return Ok(Ran::Unknown);
@@ -951,18 +1037,20 @@ impl<L: Link> SerialTarget<L> {
     /// Reads until the reply to `seq` is complete (`Some`), or the link
     /// goes quiet, the timeout passes without it or a stop is asked for
     /// (`None`: ask again, or stop).
+    /// It never waits past `hard_end`, the request's own deadline.
     fn await_reply(
         &mut self,
         seq: u8,
         timeout: WallDuration,
+        hard_end: WallInstant,
         frags: &mut Fragments,
         noise: &mut Noise,
     ) -> io::Result<Option<Response>> {
         let start = WallInstant::now();
-        let mut deadline = start + timeout;
+        let mut deadline = (start + timeout).min(hard_end);
         // A reply still arriving is waited for, as long as bytes keep
         // coming (a slow line, a long reply), but not for ever.
-        let latest = start + timeout.max(self.opts.reply_timeout) * 4;
+        let latest = (start + timeout.max(self.opts.reply_timeout) * 4).min(hard_end);
         // The round trip does not change while waiting: the gap allowed
         // between bytes of a reply still arriving, and the quiet after a
         // corrupted frame, are fixed for this wait.
@@ -1327,7 +1415,27 @@ impl<L: Link> SerialTarget<L> {
             };
             match self.request(&req, "capture", WallDuration::ZERO)? {
                 Response::Capture(c) => {
-                    if !self.absorb(c) {
+                    // Every chunk that says there is more must bring some,
+                    // and the capture can hold no more than the bridge said
+                    // its buffer does: a bridge that says `more` for ever
+                    // ends the download.
+                    let brought = c.runs.len() + c.pins.len() + c.moves.len();
+                    let more = self.absorb(c);
+                    let held = self.captured.runs.len() + self.captured.pins.len();
+                    let room = (self.hello.capture_capacity as usize).min(MAX_CAPTURE_RECORDS);
+                    if more && (brought == 0 || held > room) {
+                        return Err(SerialError::Protocol {
+                            link: self.link.name(),
+                            what: "capture".into(),
+                            detail: match brought {
+                                0 => "a chunk that says more records follow brought none".into(),
+                                _ => format!(
+                                    "{held} records and still more, past the {room} its buffer holds"
+                                ),
+                            },
+                        });
+                    }
+                    if !more {
                         break;
                     }
                 }

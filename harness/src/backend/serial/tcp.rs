@@ -15,15 +15,17 @@ use super::SerialError;
 use crate::stop::Stop;
 use std::fmt;
 use std::io::{self, Read, Write};
-use std::net::{SocketAddr, TcpStream, ToSocketAddrs};
+use std::net::{TcpStream, ToSocketAddrs};
 use std::time::Duration as WallDuration;
 
 /// How long a connection attempt may take.
 const CONNECT_TIMEOUT: WallDuration = WallDuration::from_secs(5);
 
 /// How long a send may block on a server that does not read (its window
-/// closed): then the connection is taken as failed, and reopened.
-const SEND_TIMEOUT: WallDuration = WallDuration::from_secs(5);
+/// closed): then the connection is taken as failed, and reopened. A
+/// request is at most a few kilobytes, far less than a socket's buffer, so
+/// only a server that stopped reading makes a send wait at all.
+const SEND_TIMEOUT: WallDuration = WallDuration::from_secs(1);
 
 pub struct TcpLink {
     /// `host:port` as given.
@@ -128,21 +130,12 @@ impl Link for TcpLink {
 
     fn reopen(&mut self) -> io::Result<()> {
         self.stream = None;
-        let addrs: Vec<SocketAddr> = self.addr.to_socket_addrs()?.collect();
-        let mut last = io::Error::new(io::ErrorKind::NotFound, "the host has no address");
-        for a in addrs {
-            match connect(a, &self.stop) {
-                Ok(s) => {
-                    s.set_nodelay(true)?;
-                    s.set_write_timeout(Some(SEND_TIMEOUT))?;
-                    Self::quick_ack(&s);
-                    self.stream = Some(s);
-                    return Ok(());
-                }
-                Err(e) => last = e,
-            }
-        }
-        Err(last)
+        let s = connect(self.addr.clone(), &self.stop)?;
+        s.set_nodelay(true)?;
+        s.set_write_timeout(Some(SEND_TIMEOUT))?;
+        Self::quick_ack(&s);
+        self.stream = Some(s);
+        Ok(())
     }
 
     fn name(&self) -> String {
@@ -150,13 +143,25 @@ impl Link for TcpLink {
     }
 }
 
-/// Connects to `addr` within [`CONNECT_TIMEOUT`], or until `stop` is asked
-/// for: the attempt runs on a thread of its own (a blocking connect cannot
-/// be woken), which is left to finish alone when abandoned.
-fn connect(addr: SocketAddr, stop: &Stop) -> io::Result<TcpStream> {
+/// Resolves `addr` and connects to its first address that answers, each
+/// within [`CONNECT_TIMEOUT`], or until `stop` is asked for: the attempt
+/// (the name lookup included, which can take long) runs on a thread of its
+/// own, since neither can be woken, and is left to finish alone when
+/// abandoned.
+fn connect(addr: String, stop: &Stop) -> io::Result<TcpStream> {
     let (tx, rx) = std::sync::mpsc::channel();
     std::thread::spawn(move || {
-        let _ = tx.send(TcpStream::connect_timeout(&addr, CONNECT_TIMEOUT));
+        let attempt = || {
+            let mut last = io::Error::new(io::ErrorKind::NotFound, "the host has no address");
+            for a in addr.to_socket_addrs()? {
+                match TcpStream::connect_timeout(&a, CONNECT_TIMEOUT) {
+                    Ok(s) => return Ok(s),
+                    Err(e) => last = e,
+                }
+            }
+            Err(last)
+        };
+        let _ = tx.send(attempt());
     });
     loop {
         if stop.requested() {
