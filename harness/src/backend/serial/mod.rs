@@ -841,6 +841,15 @@ impl<L: Link> SerialTarget<L> {
                         }
                     }
                 }
+                // A late answer to a probe that went unanswered: stale, not
+                // this request's reply (a request is never answered so).
+                Ok(Some(Response::Error {
+                    code: BridgeErrorCode::Malformed,
+                    detail,
+                })) if probe_lost && detail.contains("no reply to sequence") => {
+                    noise.stale += 1;
+                    next = full.clone();
+                }
                 Ok(Some(r)) => {
                     // Karn's rule: only an exchange that was not repeated
                     // times the link, and only one with no waits of its own.
@@ -1481,6 +1490,14 @@ mod tests {
         broken: bool,
         /// The bridge hears, but nothing comes back (a stalled server).
         mute: bool,
+        /// Requests sent so far, counted from 1 (LINK and HELLO included).
+        sends: usize,
+        /// These sends arrive garbled (the bridge answers BAD_FRAME).
+        garble: Vec<usize>,
+        /// The replies to these sends are held back, and arrive just before
+        /// the reply to the next send outside them (a slow path).
+        hold: Vec<usize>,
+        held: Vec<u8>,
     }
 
     impl MemLink {
@@ -1496,6 +1513,10 @@ mod tests {
                 cut_at: None,
                 broken: false,
                 mute: false,
+                sends: 0,
+                garble: Vec::new(),
+                hold: Vec::new(),
+                held: Vec::new(),
             }
         }
 
@@ -1527,7 +1548,20 @@ mod tests {
             if self.mute {
                 return Ok(());
             }
-            let out = self.server.on_bytes(bytes);
+            if bytes != [0] {
+                self.sends += 1;
+            }
+            let mut bytes = bytes.to_vec();
+            if self.garble.contains(&self.sends) && bytes.len() > 3 {
+                bytes[2] ^= 0x5A;
+            }
+            let out = self.server.on_bytes(&bytes);
+            if self.hold.contains(&self.sends) {
+                self.held.extend(out);
+                return Ok(());
+            }
+            let held = std::mem::take(&mut self.held);
+            self.pending.extend(held);
             self.sent.push(out.len());
             // The reply's frames, each a boundary the connection may drop at.
             for f in out.split_inclusive(|b| *b == 0) {
@@ -1701,6 +1735,29 @@ mod tests {
             assert!(p == pulses, "cut at frame {cut}: the pulses differ");
             assert!(c == capture, "cut at frame {cut}: the capture differs");
         }
+    }
+
+    /// A "no reply to sequence N" answers a probe of whether the bridge ran
+    /// request N. If the probes go unanswered for a while, and N is then
+    /// sent again and runs, their late answers must not be believed: the
+    /// host would split N and run its ops a second time. Here N arrives
+    /// garbled twice, the first probe too, and the probes' answers come
+    /// only after N was sent again.
+    #[test]
+    fn a_late_answer_to_a_lost_probe_never_runs_a_request_twice() {
+        let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+        let ms = |n| Op::Delay(Duration::from_millis(n));
+        let ops = [ms(5), ms(5), Op::ReadStatus];
+        let before = t.link.server.now();
+        let n = t.link.sends;
+        // N, N again, the first probe: garbled. The probes' answers held.
+        t.link.garble = vec![n + 1, n + 2, n + 3];
+        t.link.hold = (n + 3..=n + 3 + quick().retries as usize).collect();
+        let r = t.execute(&ops);
+        let ran = t.link.server.now().as_nanos() - before.as_nanos();
+        assert_eq!(ran, 10_000_000, "the delays ran once: {r:?}");
+        let r = r.expect("answered from the bridge's cache");
+        assert_eq!(r.len(), 3);
     }
 
     /// A bridge that another host said HELLO to while the link was down
