@@ -14,6 +14,7 @@
 //! `ppmc chaos-proxy` serves it from the command line, for a lab to
 //! qualify its own network and bridge.
 
+use crate::backend::timed_out;
 use ppmc_core::bridge::frame::{self, FrameDecoder};
 use ppmc_core::bridge::wire::{BridgeErrorCode, Response, Timer};
 use rand::rngs::StdRng;
@@ -353,14 +354,7 @@ impl Port {
             Port::Serial(p) => p.read(buf),
         };
         match r {
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
-                ) =>
-            {
-                Ok(0)
-            }
+            Err(e) if timed_out(&e) => Ok(0),
             r => r,
         }
     }
@@ -443,11 +437,7 @@ impl Proxy {
             match d.read(&mut buf) {
                 Ok(0) => self.down = None,
                 Ok(n) => self.took_from_host(&buf[..n]),
-                Err(e)
-                    if matches!(
-                        e.kind(),
-                        io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
-                    ) => {}
+                Err(e) if timed_out(&e) => {}
                 Err(_) => self.down = None,
             }
         }
@@ -513,13 +503,6 @@ impl Proxy {
         if matches!(self.behaviour, Behaviour::DropBothEvery(_)) {
             self.up = None;
         }
-    }
-
-    /// Counts a whole frame; whether the behaviour acts on it now.
-    fn count(&mut self, every: u64) -> bool {
-        self.conn.frames += 1;
-        self.stats.frames += 1;
-        self.conn.frames % every == 0
     }
 
     fn took_from_host(&mut self, bytes: &[u8]) {
@@ -643,41 +626,29 @@ impl Proxy {
         self.after_frame();
     }
 
-    /// What happens at a frame boundary, once the frame has gone on.
+    /// What happens at a frame boundary, once the frame has gone on: it is
+    /// counted, and the behaviours that act every so many frames act.
     fn after_frame(&mut self) {
+        self.conn.frames += 1;
+        self.stats.frames += 1;
+        let frames = self.conn.frames;
         match self.behaviour {
-            Behaviour::DropEvery(n) | Behaviour::DropBothEvery(n) => {
-                if self.count(n) {
-                    self.cut();
-                }
+            Behaviour::DropEvery(n) | Behaviour::DropBothEvery(n) if frames % n == 0 => self.cut(),
+            Behaviour::DropAt(k) if self.stats.frames == k => self.cut(),
+            Behaviour::Stall(n) if frames % n == 0 => {
+                self.stats.acts += 1;
+                self.conn.stalled_until = Some(Instant::now() + STALL);
             }
-            Behaviour::DropAt(k) => {
-                self.count(1);
-                if self.stats.frames == k {
-                    self.cut();
-                }
-            }
-            Behaviour::Stall(n) => {
-                if self.count(n) {
-                    self.stats.acts += 1;
-                    self.conn.stalled_until = Some(Instant::now() + STALL);
-                }
-            }
-            Behaviour::HalfOpen(n) => {
-                if self.count(n) {
-                    self.stats.cuts += 1;
-                    if let Some(d) = self.down.take() {
-                        if self.zombies.len() >= MAX_ZOMBIES {
-                            self.zombies.remove(0);
-                        }
-                        self.zombies.push(d);
+            Behaviour::HalfOpen(n) if frames % n == 0 => {
+                self.stats.cuts += 1;
+                if let Some(d) = self.down.take() {
+                    if self.zombies.len() >= MAX_ZOMBIES {
+                        self.zombies.remove(0);
                     }
+                    self.zombies.push(d);
                 }
             }
-            _ => {
-                self.conn.frames += 1;
-                self.stats.frames += 1;
-            }
+            _ => {}
         }
     }
 

@@ -17,6 +17,7 @@ pub use self::serial::{
     Rfc2217Link, SerialError, SerialLink, SerialOptions, SerialTarget, TcpLink,
 };
 
+pub(crate) use self::serial::timed_out;
 pub use ppmc_core::bus::{Op, Reply};
 
 use crate::protocol::{Record, RecordMark, Straps};

@@ -17,6 +17,15 @@ pub trait Link: Send + fmt::Debug {
     fn name(&self) -> String;
 }
 
+/// A read that ended because its timeout passed (or, on a nonblocking
+/// socket, because nothing was there): nothing arrived, no failure.
+pub(crate) fn timed_out(e: &io::Error) -> bool {
+    matches!(
+        e.kind(),
+        io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
+    )
+}
+
 /// A serial port (USB CDC, UART, or a pseudo-terminal) through `serialport`.
 pub struct SerialLink {
     path: String,
@@ -83,11 +92,7 @@ impl Link for SerialLink {
         match port.read(buf) {
             Ok(0) => Err(io::Error::new(io::ErrorKind::UnexpectedEof, "link closed")),
             Ok(n) => Ok(n),
-            Err(e)
-                if e.kind() == io::ErrorKind::TimedOut || e.kind() == io::ErrorKind::WouldBlock =>
-            {
-                Ok(0)
-            }
+            Err(e) if timed_out(&e) => Ok(0),
             Err(e) => Err(e),
         }
     }

@@ -25,6 +25,7 @@ mod rfc2217;
 mod tcp;
 
 pub use self::labgrid::{parse_labgrid, LabgridLink, Place};
+pub(crate) use self::link::timed_out;
 pub use self::link::{parse_spec, Link, SerialLink};
 pub use self::rfc2217::{parse_rfc2217, Rfc2217Link};
 pub use self::tcp::{parse_tcp, TcpLink};
@@ -761,15 +762,14 @@ impl<L: Link> SerialTarget<L> {
                         last,
                         ..
                     }) => {
-                        return Err(SerialError::NoAnswer {
-                            link: self.link.name(),
-                            what: what.into(),
-                            tries: attempts,
-                            secs: start.elapsed().as_secs_f64(),
-                            heard: format!(
+                        return Err(self.no_answer(
+                            what,
+                            attempts,
+                            start,
+                            format!(
                                 "nothing came back, and {reconnects} attempts to reconnect failed: {last}"
                             ),
-                        })
+                        ))
                     }
                     Err(e) => return Err(e),
                 }
@@ -900,13 +900,19 @@ impl<L: Link> SerialTarget<L> {
                 };
             }
         }
-        Err(SerialError::NoAnswer {
+        Err(self.no_answer(what, attempts, start, noise.to_string()))
+    }
+
+    /// The error of a request given up after `tries` since `start`, and
+    /// what the link brought instead.
+    fn no_answer(&self, what: &str, tries: u32, start: WallInstant, heard: String) -> SerialError {
+        SerialError::NoAnswer {
             link: self.link.name(),
             what: what.into(),
-            tries: attempts,
+            tries,
             secs: start.elapsed().as_secs_f64(),
-            heard: noise.to_string(),
-        })
+            heard,
+        }
     }
 
     /// The next sequence number: never 0 (the bridge's own errors carry
@@ -926,10 +932,11 @@ impl<L: Link> SerialTarget<L> {
     /// it kept for this host across the reconnect), or the whole request
     /// again when none has arrived, which the bridge answers from its cache
     /// if it ran it (section 3: at most once).
-    /// A HELLO or LINK is sent whole again: it changes nothing on the
-    /// chip, and the bridge keeps the reply of only the newest one, the
-    /// reconnect's own HELLO.
-    /// (Its reply may differ from the first: a HELLO's `resumed`.)
+    ///
+    /// A HELLO or LINK is sent whole again, its fragments so far dropped:
+    /// it changes nothing on the chip, the bridge keeps the reply of only
+    /// the newest one (the reconnect's own HELLO), and its new reply may
+    /// differ from the first (a HELLO's `resumed`).
     fn after_reconnect(
         &self,
         req: &Request,
@@ -956,16 +963,18 @@ impl<L: Link> SerialTarget<L> {
         start: WallInstant,
         e: io::Error,
     ) -> SerialError {
-        SerialError::NoAnswer {
-            link: self.link.name(),
-            what: what.into(),
-            tries,
-            secs: start.elapsed().as_secs_f64(),
-            heard: format!(
-                "the connection dropped {} times with nothing gained between (the last: {e})",
-                self.opts.reopen_attempts + 1
-            ),
-        }
+        let heard = format!(
+            "the connection dropped {} times with nothing gained between (the last: {e})",
+            self.opts.reopen_attempts + 1
+        );
+        self.no_answer(what, tries, start, heard)
+    }
+
+    /// Counts a frame that arrived corrupt.
+    fn corrupt(&mut self, noise: &mut Noise) {
+        self.stats.corrupt_frames += 1;
+        self.garbled += 1;
+        noise.corrupt += 1;
     }
 
     /// The error for a stop request.
@@ -1079,11 +1088,7 @@ impl<L: Link> SerialTarget<L> {
                             } else if frags.put(i, n, data) {
                                 match Response::decode(&frags.take(), self.timer) {
                                     Ok((_, r)) => return Ok(Some(r)),
-                                    Err(_) => {
-                                        self.stats.corrupt_frames += 1;
-                                        self.garbled += 1;
-                                        noise.corrupt += 1;
-                                    }
+                                    Err(_) => self.corrupt(noise),
                                 }
                             }
                             continue;
@@ -1104,18 +1109,12 @@ impl<L: Link> SerialTarget<L> {
                             // A stale reply to an earlier try, or a reply
                             // to nothing this host asked.
                             Ok(_) => noise.stale += 1,
-                            Err(_) => {
-                                self.stats.corrupt_frames += 1;
-                                self.garbled += 1;
-                                noise.corrupt += 1;
-                            }
+                            Err(_) => self.corrupt(noise),
                         }
                     }
                     Ok(None) => break,
                     Err(_) => {
-                        self.stats.corrupt_frames += 1;
-                        self.garbled += 1;
-                        noise.corrupt += 1;
+                        self.corrupt(noise);
                         quiet_by = Some(WallInstant::now() + quiet);
                     }
                 }

@@ -10,7 +10,7 @@
 //! and, where the OS has it, asks for quick acknowledgements before every
 //! read (TCP_QUICKACK, which Linux clears again as it goes).
 
-use super::link::Link;
+use super::link::{timed_out, Link};
 use super::SerialError;
 use crate::stop::Stop;
 use std::fmt;
@@ -115,15 +115,7 @@ impl Link for TcpLink {
                 Self::quick_ack(s);
                 Ok(n)
             }
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
-                ) =>
-            {
-                Ok(0)
-            }
-            Err(e) if e.kind() == io::ErrorKind::Interrupted => Ok(0),
+            Err(e) if timed_out(&e) || e.kind() == io::ErrorKind::Interrupted => Ok(0),
             Err(e) => Err(e),
         }
     }
