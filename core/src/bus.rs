@@ -259,6 +259,14 @@ pub trait Bus {
     fn capture_lost(&self) -> bool {
         false
     }
+
+    /// The bridge's own hardware failed (a state machine that never
+    /// finished a bus cycle): what, for the host. Every later request is
+    /// answered with it (`BridgeErrorCode::Hardware`) until the bridge is
+    /// reset; the board is not to blame.
+    fn fault(&self) -> Option<&str> {
+        None
+    }
 }
 
 /// The reference model as a [`Bus`]: ops run in virtual time, and waits

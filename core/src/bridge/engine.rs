@@ -346,7 +346,14 @@ impl<B: Bus> BridgeEngine<B> {
                 detail: format!("{wire_ops} ops in one batch, at most {MAX_BATCH_OPS}"),
             });
         }
-        Ok(ops.iter().map(|op| self.bus.run(*op)).collect())
+        let replies = ops.iter().map(|op| self.bus.run(*op)).collect();
+        match self.bus.fault() {
+            Some(what) => Err(Response::Error {
+                code: BridgeErrorCode::Hardware,
+                detail: what.into(),
+            }),
+            None => Ok(replies),
+        }
     }
 
     /// The records captured since the last reset, if more than the

@@ -180,19 +180,11 @@ impl BusTiming {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::pioregs;
     use crate::programs::bus_player;
-    use crate::sim::{Pins, Sm};
+    use crate::twin::pio::{Inputs, World};
     use std::vec::Vec;
     extern crate std;
-
-    const MAP: Pins = Pins {
-        out_base: 0,
-        out_count: pin::COUNT,
-        in_base: 0,
-        set_base: 0,
-        set_count: 0,
-        jmp_pin: 0,
-    };
 
     /// Cycle by cycle: (levels, dirs) of the OUT pins while `cycle` plays,
     /// the chip driving `chip_byte` whenever RD* and CS* are low; and the
@@ -206,6 +198,9 @@ mod tests {
         play_all(t, &[cycle], sysclk, chip_byte)
     }
 
+    /// The bus player on the RP2350 PIO model, as the firmware configures
+    /// it, fed as the board code feeds it: a step whenever the TX FIFO (4
+    /// deep) has room.
     fn play_all(
         t: &BusTiming,
         cycles: &[Cycle],
@@ -213,25 +208,40 @@ mod tests {
         chip_byte: u8,
     ) -> (Vec<(u64, u64)>, Option<u32>) {
         let program = bus_player();
-        let mut sm = Sm::new(&program, MAP);
-        sm.levels = u64::from(IDLE);
-        sm.dirs = 0x1FFF;
-        for c in cycles {
-            let steps = t.steps(*c, sysclk).expect("fits");
-            sm.tx.extend(steps.words().iter().copied());
-        }
+        let mut w = World::with_program(0, 0, program.words(), 0, &pioregs::bus_player(&program));
+        let all = (1u64 << pin::COUNT) - 1;
+        w.blocks[0].force_pins(all, u64::from(IDLE), all);
+        let mut steps: std::collections::VecDeque<u32> = cycles
+            .iter()
+            .flat_map(|c| t.steps(*c, sysclk).expect("fits").words().to_vec())
+            .collect();
+        let mut chip = Inputs(|_, out: u64, _| {
+            let chip_drives = out >> pin::RD & 1 == 0 && out >> pin::CS & 1 == 0;
+            (if chip_drives { u64::from(chip_byte) } else { 0 }, 0xFF)
+        });
         let mut wave = Vec::new();
+        let mut byte = None;
         // Until the machine waits for the next cycle at `pull`.
         for _ in 0..100_000 {
-            let chip_drives = sm.levels >> pin::RD & 1 == 0 && sm.levels >> pin::CS & 1 == 0;
-            let inputs = if chip_drives { u64::from(chip_byte) } else { 0 };
-            let stalled = sm.step(inputs);
-            wave.push((sm.levels, sm.dirs));
-            if stalled && sm.tx.is_empty() {
+            if !w.blocks[0].tx_full(0) {
+                if let Some(s) = steps.pop_front() {
+                    w.blocks[0].txf_write(0, s);
+                }
+            }
+            w.step(&mut chip);
+            let (out, oe) = w.driven();
+            wave.push((out & all, oe & all));
+            byte = byte.or_else(|| w.pull(0, 0));
+            if w.blocks[0].sm[0].stalled && steps.is_empty() && w.blocks[0].tx_empty(0) {
                 break;
             }
         }
-        (wave, sm.rx.pop_front())
+        assert_eq!(
+            w.blocks[0].fdebug() >> crate::pioregs::fdebug::TXOVER & 1,
+            0,
+            "no step lost"
+        );
+        (wave, byte)
     }
 
     fn bit(v: u64, b: u32) -> bool {

@@ -1,7 +1,10 @@
-//! The parts of the RP2350 bridge firmware that a host can test: the PIO
-//! programs, the bus cycles they play and their timing, and the capture's
-//! timebase. `no_std`; the tests run on the host with a small PIO
-//! interpreter ([`sim`]) that counts every cycle.
+//! The RP2350 bridge's own code, testable on a host: its pin map, PIO
+//! programs and their register configuration, bus cycles as timed steps,
+//! the capture's timebase, the bridge clock, and the board code
+//! ([`board`]) over a thin hardware layer ([`hal`]). The RP2350 image runs
+//! all of it on the chip; the board twin ([`twin`], feature `twin`) runs
+//! the same code on a model of the RP2350's PIO and GPIOs wired to the
+//! reference chip model.
 //!
 //! - [`bus`]: a bus cycle (write command, write data, read status, read
 //!   data) as a few *steps*, each a state of the bus pins held for a number
@@ -9,16 +12,28 @@
 //!   times are [`bus::BusTiming`], configurable, with conservative defaults
 //!   (the datasheet's bus-timing chapter is not in our hands:
 //!   `docs/datasheet-notes.md` N46).
-//! - [`programs::edge_capture`]: a state machine that stamps each rising
+//! - [`programs::edge_counter`]: a state machine that stamps each rising
 //!   edge of one pin (POUT, with DIR) or each change of one pin with a
 //!   counter that ticks every second system clock cycle on every path.
 //! - [`timebase`]: the 31-bit counts the capture pushes, turned into ticks
 //!   since the timebase started.
+//! - [`pioregs`]: the state machines' registers, as values.
+//! - [`clock`]: the bridge's 64-bit cycle clock from the core's cycle
+//!   counter and the always-running timer.
 
 #![no_std]
 
+extern crate alloc;
+#[cfg(any(test, feature = "twin"))]
+extern crate std;
+
+pub mod board;
 pub mod bus;
+pub mod clock;
+pub mod hal;
+pub mod pins;
+pub mod pioregs;
 pub mod programs;
-#[cfg(test)]
-mod sim;
 pub mod timebase;
+#[cfg(any(test, feature = "twin"))]
+pub mod twin;

@@ -1,15 +1,57 @@
-//! The PIO programs of the RP2350 bridge.
+//! The PIO programs of the RP2350 bridge, assembled by the `pio` crate at
+//! compile time, and where each is loaded.
 //!
-//! Each is assembled by the `pio` crate at compile time; the firmware loads
-//! them with embassy-rp, and the tests run them in [`crate::sim`], cycle by
-//! cycle, against the timing they must meet.
+//! Each PIO block holds 32 instruction words, shared by every program
+//! loaded into it (RP2350 datasheet, PIO chapter). The bridge gives each
+//! program a block of its own, at address 0, so that the addresses the
+//! assembler computed are the ones that run:
+//!
+//! | block | program | words | state machines |
+//! |---|---|---|---|
+//! | PIO0 | [`bus_player`] | 9 | SM0 |
+//! | PIO1 | [`edge_counter`]`(true)`: POUT's rising edges with DIR | 11 | SM0 |
+//! | PIO2 | [`edge_counter`]`(false)`: both edges | 21 | SM0-2 (INT*, HOLD, AUX*) |
+//!
+//! (Until issue 28 both counters shared PIO1: 13 + 23 words, which
+//! embassy-rp's `load_program` refuses with a panic at boot.)
 
 use pio::Program;
 
 /// Instructions a PIO block holds.
 pub const SIZE: usize = 32;
 
-/// The bus cycle player (PIO0, one state machine).
+/// A program as loaded at address 0 of its block: its words, its wrap, and
+/// the addresses a state machine may start at.
+#[derive(Debug)]
+pub struct Loaded {
+    pub program: Program<SIZE>,
+    pub wrap_top: u8,
+    pub wrap_bottom: u8,
+    /// Where to start: for the bus player, its `pull`; for an edge
+    /// counter, its loop for a pin that reads high.
+    pub start: u8,
+    /// For an edge counter, its loop for a pin that reads low.
+    pub start_low: u8,
+}
+
+impl Loaded {
+    fn new(program: Program<SIZE>, start: u8, start_low: u8) -> Loaded {
+        Loaded {
+            wrap_top: program.wrap.source,
+            wrap_bottom: program.wrap.target,
+            program,
+            start,
+            start_low,
+        }
+    }
+
+    /// The words loaded, from address 0.
+    pub fn words(&self) -> &[u16] {
+        &self.program.code
+    }
+}
+
+/// The bus cycle player (PIO0, SM0).
 ///
 /// Each word from the TX FIFO is one *step* ([`crate::bus::Step`]): the
 /// directions of D0-D7, then the levels of D0-D7, A0, CS*, DIR (of the
@@ -19,11 +61,12 @@ pub const SIZE: usize = 32;
 /// A sampled byte goes to the RX FIFO. Between cycles the machine waits at
 /// `pull` with the pins as the last step left them.
 ///
-/// Configuration the firmware must give it (and the tests do): OUT pins
-/// GPIO 0-12, IN base GPIO 0, OUT shift right, IN shift left, no autopull,
-/// no autopush, TX FIFO joined (8 steps, a whole cycle, queued at once).
-pub fn bus_player() -> Program<SIZE> {
-    pio::pio_asm!(
+/// Its configuration is [`crate::pioregs::bus_player`]. The FIFOs are not
+/// joined (the RX FIFO takes the bytes read), so the TX FIFO holds 4
+/// steps: the firmware pushes a step only when the FIFO has room
+/// ([`crate::board`]).
+pub fn bus_player() -> Loaded {
+    let p = pio::pio_asm!(
         ".wrap_target",
         "step:",
         "    pull block",
@@ -38,32 +81,33 @@ pub fn bus_player() -> Program<SIZE> {
         "    push block",
         ".wrap",
     )
-    .program
+    .program;
+    Loaded::new(p, 0, 0)
 }
 
-/// Edge capture of one pin, the JMP pin: a rising edge pushes
-/// `level << 31 | count` (with `rising_only`: `DIR << 31 | count`, DIR
-/// being the IN base pin, sampled at the edge), where `count` is the low
-/// 31 bits of a counter X that starts at all ones and counts down once
-/// every two cycles, on every path through the program, so that
-/// [`crate::timebase`] can turn it into time. With `rising_only` false a
-/// falling edge pushes too (the level after the change in bit 31).
+/// An edge counter on the JMP pin.
 ///
-/// State machines of one PIO block enabled by one register write count in
-/// step: their counts are one timebase.
+/// X counts down once every two cycles, on every path through the program,
+/// from all ones (the firmware sets it before starting), so that
+/// [`crate::timebase`] can turn a pushed count into time. A rising edge
+/// pushes `bit << 31 | (X & 0x7FFF_FFFF)`:
 ///
-/// Configuration: JMP pin = the pin, IN base = DIR (POUT capture) or the
-/// pin itself, IN shift left, no autopush; the RX FIFO is drained by DMA
-/// (a full FIFO would stall the counter: the firmware checks the FIFO's
-/// stall flag and reports a capture overrun).
-pub fn edge_capture(rising_only: bool) -> Program<SIZE> {
+/// - `rising_only` (POUT): rising edges only, `bit` being the IN pin (DIR)
+///   sampled at the edge;
+/// - otherwise both edges, `bit` being the level after the change.
+///
+/// Every `jmp x--` goes where it would go if X were not zero: its target
+/// is the next instruction, or the wrap takes it there. At X = 0 a
+/// `jmp x--` does not jump, and a program that fell through into its edge
+/// code there would push an edge that never happened, once every 2^32
+/// ticks (57.3 s at 75 MHz; until issue 28 this one did).
+///
+/// A `push block` stalls the counter while the RX FIFO (8 words, joined)
+/// is full; the firmware sees the stall in FDEBUG.RXSTALL, reports the
+/// capture lost, and restarts the counters.
+pub fn edge_counter(rising_only: bool) -> Loaded {
     if rising_only {
-        pio::pio_asm!(
-            "    mov x, ~null",
-            ".wrap_target",
-            "low:",
-            "    jmp pin rise",
-            "    jmp x-- low",
+        let p = pio::pio_asm!(
             "rise:",
             "    jmp x-- r1",
             "r1:",
@@ -74,22 +118,21 @@ pub fn edge_capture(rising_only: bool) -> Program<SIZE> {
             "    jmp x-- r3",
             "r3:",
             "    push block",
-            "    jmp x-- high",
-            "high:",
-            "    jmp pin still_high",
-            "    jmp x-- low",
             "still_high:",
             "    jmp x-- high",
-            ".wrap",
-        )
-        .program
-    } else {
-        pio::pio_asm!(
-            "    mov x, ~null",
+            "public high:",
+            "    jmp pin still_high",
+            "    jmp x-- low",
             ".wrap_target",
-            "low:",
+            "public low:",
             "    jmp pin rise",
             "    jmp x-- low",
+            ".wrap",
+        );
+        let d = p.public_defines;
+        Loaded::new(p.program, d.high as u8, d.low as u8)
+    } else {
+        let p = pio::pio_asm!(
             "rise:",
             "    jmp x-- r1",
             "r1:",
@@ -103,12 +146,11 @@ pub fn edge_capture(rising_only: bool) -> Program<SIZE> {
             "    jmp x-- r4",
             "r4:",
             "    push block",
-            "    jmp x-- high",
-            "high:",
-            "    jmp pin still_high",
-            "    jmp x-- fall",
             "still_high:",
             "    jmp x-- high",
+            "public high:",
+            "    jmp pin still_high",
+            "    jmp x-- fall",
             "fall:",
             "    set y, 0",
             "    jmp x-- f1",
@@ -121,8 +163,18 @@ pub fn edge_capture(rising_only: bool) -> Program<SIZE> {
             "f3:",
             "    push block",
             "    jmp x-- low",
+            ".wrap_target",
+            "public low:",
+            "    jmp pin rise",
+            "    jmp x-- low",
             ".wrap",
-        )
-        .program
+        );
+        let d = p.public_defines;
+        Loaded::new(p.program, d.high as u8, d.low as u8)
     }
+}
+
+/// What each PIO block is loaded with, in block order.
+pub fn layout() -> [Loaded; 3] {
+    [bus_player(), edge_counter(true), edge_counter(false)]
 }

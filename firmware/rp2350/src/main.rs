@@ -6,9 +6,12 @@
 //!   run.
 //! - Bus cycles played by a PIO state machine from timed steps
 //!   (`ppmc_bridge_fw::bus`), inputs to the chip on GPIO outputs.
-//! - POUT (with DIR), INT*, HOLD and AUX* stamped by PIO edge counters to
-//!   two system clock cycles (13.3 ns at 150 MHz: `timer_hz` 75 MHz);
-//!   S1..S5, AUXO0..3 and DIR sampled by the CPU between ops.
+//! - POUT (with DIR) stamped by a PIO edge counter on PIO1, INT*, HOLD and
+//!   AUX* by three on PIO2, all four started on one cycle, to two system
+//!   clock cycles (13.3 ns at 150 MHz: `timer_hz` 75 MHz); S1..S5,
+//!   AUXO0..3 and DIR sampled by the CPU between ops.
+//! - The board code is `ppmc_bridge_fw::board`, over the hardware layer in
+//!   `hw.rs`: the same code the board twin runs (`firmware/run-twin`).
 //! - Straps: CSEL and VSEL read from their nets at boot; SysClk and an
 //!   external clock given at build time (`PPMC_SYSCLK_HZ`,
 //!   `PPMC_EXT_CLOCK_HZ`), since the bridge cannot see the chip's crystal.
@@ -20,10 +23,8 @@
 
 extern crate alloc;
 
-mod board;
-mod clock;
+mod hw;
 
-use board::{BoardBus, Machines, Sampled, Wiring};
 use core::mem::MaybeUninit;
 use embassy_executor::Spawner;
 use embassy_futures::join::join;
@@ -31,14 +32,15 @@ use embassy_futures::select::{select, Either};
 use embassy_rp::bind_interrupts;
 use embassy_rp::block::ImageDef;
 use embassy_rp::gpio::{Input, Level, Output, Pull};
-use embassy_rp::peripherals::{PIO0, PIO1, USB};
-use embassy_rp::pio::{self, FifoJoin, Pio, PioBatch, ShiftConfig, ShiftDirection};
+use embassy_rp::peripherals::{PIO0, PIO1, PIO2, USB};
+use embassy_rp::pio::{self, Pio};
 use embassy_rp::usb::{Driver, InterruptHandler as UsbIrq};
 use embassy_time::Timer as Delay;
 use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
 use embedded_alloc::LlffHeap as Heap;
+use ppmc_bridge_fw::board::Board;
 use ppmc_bridge_fw::bus::BusTiming;
-use ppmc_bridge_fw::programs;
+use ppmc_bridge_fw::{pins, pioregs, programs};
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::protocol::Straps;
 use static_cell::StaticCell;
@@ -51,6 +53,7 @@ bind_interrupts!(struct Irqs {
     USBCTRL_IRQ => UsbIrq<USB>;
     PIO0_IRQ_0 => pio::InterruptHandler<PIO0>;
     PIO1_IRQ_0 => pio::InterruptHandler<PIO1>;
+    PIO2_IRQ_0 => pio::InterruptHandler<PIO2>;
 });
 
 #[global_allocator]
@@ -63,9 +66,6 @@ const SYSCLK_HZ: u32 = 150_000_000;
 /// Pulse runs plus pin changes the capture holds between chip resets, in
 /// the heap (about 40 bytes each); the suite's busiest scenario needs 367.
 const CAPTURE_RECORDS: u32 = 4096;
-
-/// The loop-back test signal's rate: 10 us between rising edges.
-const SELF_TEST_HZ: u32 = 100_000;
 
 const FIRMWARE: &str = concat!(
     "ppmc-bridge-rp2350 ",
@@ -123,26 +123,69 @@ async fn main(_spawner: Spawner) {
     }
     let p = embassy_rp::init(Default::default());
     let mut core = cortex_m::Peripherals::take().expect("taken once");
-    let clock = clock::Clock::start(&mut core.DCB, &mut core.DWT, SYSCLK_HZ);
+    core.DCB.enable_trace();
+    core.DWT.enable_cycle_counter();
 
-    // The straps: CSEL and VSEL sensed on their nets (open reads high).
+    // The chip's inputs (active low, released: high) and RESET* (high), the
+    // buffers' enables (capture off, drive off): each level is set before
+    // the pin becomes an output (embassy-rp's `Output::new` does so).
+    let _inputs = [
+        Output::new(p.PIN_13, Level::High),
+        Output::new(p.PIN_14, Level::High),
+        Output::new(p.PIN_15, Level::High),
+        Output::new(p.PIN_16, Level::High),
+        Output::new(p.PIN_17, Level::High),
+        Output::new(p.PIN_18, Level::High),
+        Output::new(p.PIN_19, Level::High),
+        Output::new(p.PIN_20, Level::High),
+        Output::new(p.PIN_21, Level::High),
+        Output::new(p.PIN_22, Level::High),
+    ];
+    const _: () = assert!(pins::INPUTS[0] == 13 && pins::INPUTS[9] == 22);
+    let _reset = Output::new(p.PIN_23, Level::High);
+    const _: () = assert!(pins::RESET == 23 && pins::CAPTURE_OE == 24 && pins::DRIVE_EN == 26);
+    let mut capture_oe = Output::new(p.PIN_24, Level::High);
+    let mut drive_en = Output::new(p.PIN_26, Level::Low);
+
+    // The straps: CSEL and VSEL through the capture buffer (open reads
+    // high), read once it is enabled.
+    const _: () = assert!(pins::CSEL == 46 && pins::VSEL == 47);
     let csel = Input::new(p.PIN_46, Pull::Up);
     let vsel = Input::new(p.PIN_47, Pull::Up);
-    let straps = Straps {
-        sysclk_hz: CHIP_SYSCLK_HZ,
-        csel_high: csel.is_high(),
-        vsel_high: vsel.is_high(),
-        ext_clock_hz: (EXT_CLOCK_HZ != 0).then_some(EXT_CLOCK_HZ),
-    };
 
-    // The bus: PIO0 plays steps on GPIO 0-12 (D0-D7, A0, CS*, DIR, RD*, WR*).
+    // Outputs of the chip the CPU samples (input enables on).
+    const _: () = assert!(pins::S[0] == 37 && pins::AUXO[3] == 45);
+    let _sampled = (
+        Input::new(p.PIN_37, Pull::None),
+        Input::new(p.PIN_38, Pull::None),
+        Input::new(p.PIN_39, Pull::None),
+        Input::new(p.PIN_40, Pull::None),
+        Input::new(p.PIN_41, Pull::None),
+        Input::new(p.PIN_42, Pull::None),
+        Input::new(p.PIN_43, Pull::None),
+        Input::new(p.PIN_44, Pull::None),
+        Input::new(p.PIN_45, Pull::None),
+    );
+
+    // The PIO blocks: one program each, at address 0
+    // (ppmc_bridge_fw::programs), configured register by register
+    // (ppmc_bridge_fw::pioregs; hw.rs).
+    let [player, pout_program, pins_program] = programs::layout();
     let Pio {
-        common: mut pio0,
-        sm0: mut bus_sm,
-        ..
+        common: mut pio0, ..
     } = Pio::new(p.PIO0, Irqs);
-    let player = pio0.load_program(&programs::bus_player());
-    let bus_pins = [
+    let Pio {
+        common: mut pio1, ..
+    } = Pio::new(p.PIO1, Irqs);
+    let Pio {
+        common: mut pio2, ..
+    } = Pio::new(p.PIO2, Irqs);
+    hw::load(0, &player);
+    hw::load(1, &pout_program);
+    hw::load(2, &pins_program);
+    // The bus: GPIO 0-12 (D0-D7, A0, CS*, DIR, RD*, WR*) on PIO0.
+    const _: () = assert!(pins::D0 == 0 && pins::WR == 12 && pins::BUS_COUNT == 13);
+    let _bus_pins = [
         pio0.make_pio_pin(p.PIN_0),
         pio0.make_pio_pin(p.PIN_1),
         pio0.make_pio_pin(p.PIN_2),
@@ -157,115 +200,34 @@ async fn main(_spawner: Spawner) {
         pio0.make_pio_pin(p.PIN_11),
         pio0.make_pio_pin(p.PIN_12),
     ];
-    let all: [&pio::Pin<'_, PIO0>; 13] = core::array::from_fn(|i| &bus_pins[i]);
-    let mut cfg = pio::Config::default();
-    cfg.use_program(&player, &[]);
-    cfg.set_out_pins(&all);
-    cfg.set_in_pins(&all[..8]);
-    cfg.shift_out = ShiftConfig {
-        threshold: 32,
-        direction: ShiftDirection::Right,
-        auto_fill: false,
-    };
-    cfg.shift_in = ShiftConfig {
-        threshold: 32,
-        direction: ShiftDirection::Left,
-        auto_fill: false,
-    };
-    cfg.fifo_join = FifoJoin::Duplex;
-    bus_sm.set_config(&cfg);
-    bus_sm.set_pin_dirs(pio::Direction::Out, &all);
-    // Idle: CS*, DIR (towards the chip), RD*, WR* high.
-    bus_sm.set_pins(Level::High, &all[9..]);
-    bus_sm.set_enable(true);
+    // Idle levels (CS*, DIR towards the chip, RD*, WR* high), then
+    // directions, then the player's configuration, then enable.
+    hw::bus_pins(ppmc_bridge_fw::bus::IDLE, 0x1FFF, 0x1FFF);
+    hw::configure(0, 0, &pioregs::bus_player(&player));
+    embassy_rp::pac::PIO0
+        .ctrl()
+        .write_value(embassy_rp::pac::pio::regs::Ctrl(1));
+    // The counters' inputs: GPIO 32-33 on PIO1, 34-36 on PIO2.
+    const _: () = assert!(pins::POUT == 32 && pins::DIR == 33 && pins::AUX == 36);
+    let _capture_pins = (
+        pio1.make_pio_pin(p.PIN_32),
+        pio1.make_pio_pin(p.PIN_33),
+        pio2.make_pio_pin(p.PIN_34),
+        pio2.make_pio_pin(p.PIN_35),
+        pio2.make_pio_pin(p.PIN_36),
+    );
 
-    // The edge counters: PIO1, GPIO 32-36 (POUT, DIR, INT*, HOLD, AUX*).
-    let Pio {
-        common: mut pio1,
-        sm0: mut pout_sm,
-        sm1: mut int_sm,
-        sm2: mut hold_sm,
-        sm3: mut aux_sm,
-        ..
-    } = Pio::new(p.PIO1, Irqs);
-    let rising = pio1.load_program(&programs::edge_capture(true));
-    let both = pio1.load_program(&programs::edge_capture(false));
-    let pout = pio1.make_pio_pin(p.PIN_32);
-    let dir = pio1.make_pio_pin(p.PIN_33);
-    let int = pio1.make_pio_pin(p.PIN_34);
-    let hold = pio1.make_pio_pin(p.PIN_35);
-    let aux = pio1.make_pio_pin(p.PIN_36);
-    let edge_config = |program, jmp: &pio::Pin<'static, PIO1>, input: &pio::Pin<'static, PIO1>| {
-        let mut c = pio::Config::default();
-        c.use_program(program, &[]);
-        c.set_jmp_pin(jmp);
-        c.set_in_pins(&[input]);
-        c.shift_in = ShiftConfig {
-            threshold: 32,
-            direction: ShiftDirection::Left,
-            auto_fill: false,
-        };
-        c.fifo_join = FifoJoin::RxOnly;
-        c
+    // The buffers: the chip's outputs in, then the bridge's out.
+    capture_oe.set_low();
+    drive_en.set_high();
+    Delay::after_micros(10).await;
+    let straps = Straps {
+        sysclk_hz: CHIP_SYSCLK_HZ,
+        csel_high: csel.is_high(),
+        vsel_high: vsel.is_high(),
+        ext_clock_hz: (EXT_CLOCK_HZ != 0).then_some(EXT_CLOCK_HZ),
     };
-    pout_sm.set_config(&edge_config(&rising, &pout, &dir));
-    int_sm.set_config(&edge_config(&both, &int, &int));
-    hold_sm.set_config(&edge_config(&both, &hold, &hold));
-    aux_sm.set_config(&edge_config(&both, &aux, &aux));
-    let mut batch = PioBatch::new();
-    batch.set_enable(&mut pout_sm, true);
-    batch.set_enable(&mut int_sm, true);
-    batch.set_enable(&mut hold_sm, true);
-    batch.set_enable(&mut aux_sm, true);
-    // One register write starts all four counters: one timebase.
-    let started = clock.ticks();
-    batch.execute();
 
-    // The chip's inputs (active low, released: high) and RESET*.
-    let inputs = [
-        Output::new(p.PIN_13, Level::High),
-        Output::new(p.PIN_14, Level::High),
-        Output::new(p.PIN_15, Level::High),
-        Output::new(p.PIN_16, Level::High),
-        Output::new(p.PIN_17, Level::High),
-        Output::new(p.PIN_18, Level::High),
-        Output::new(p.PIN_19, Level::High),
-        Output::new(p.PIN_20, Level::High),
-        Output::new(p.PIN_21, Level::High),
-        Output::new(p.PIN_22, Level::High),
-    ];
-    let reset = Output::new(p.PIN_23, Level::High);
-    // The capture's loop-back test signal: 100 kHz on GPIO 25, always on.
-    // A jumper from GPIO 25 to POUT's capture input (with the chip's POUT
-    // off the net) lets the host check the capture against a known rate
-    // (docs/bridge-hardware.md, bring-up).
-    let mut test_clock = embassy_rp::pwm::Config::default();
-    test_clock.top = (SYSCLK_HZ / SELF_TEST_HZ - 1) as u16;
-    test_clock.compare_b = (SYSCLK_HZ / SELF_TEST_HZ / 2) as u16;
-    let _test_clock = embassy_rp::pwm::Pwm::new_output_b(p.PWM_SLICE4, p.PIN_25, test_clock);
-    let sampled = Sampled {
-        s: [
-            Input::new(p.PIN_37, Pull::None),
-            Input::new(p.PIN_38, Pull::None),
-            Input::new(p.PIN_39, Pull::None),
-            Input::new(p.PIN_40, Pull::None),
-            Input::new(p.PIN_41, Pull::None),
-        ],
-        auxo: [
-            Input::new(p.PIN_42, Pull::None),
-            Input::new(p.PIN_43, Pull::None),
-            Input::new(p.PIN_44, Pull::None),
-            Input::new(p.PIN_45, Pull::None),
-        ],
-    };
-    let machines = Machines {
-        bus: bus_sm,
-        pout: pout_sm,
-        int: int_sm,
-        hold: hold_sm,
-        aux: aux_sm,
-        started,
-    };
     // A step holds 6.9 us at most: a longer time given at build cannot be
     // played, and the board says so in its name instead of starting.
     let (timing, firmware) = if BUS_TIMING.fits(SYSCLK_HZ) {
@@ -273,13 +235,8 @@ async fn main(_spawner: Spawner) {
     } else {
         (BusTiming::DEFAULT, FIRMWARE_DEFAULT_TIMING)
     };
-    let wiring = Wiring {
-        sm: machines,
-        inputs,
-        reset,
-        sampled,
-    };
-    let board = BoardBus::new(clock, SYSCLK_HZ, timing, straps, wiring);
+    let hal = hw::Rp2350::new(SYSCLK_HZ, pout_program, pins_program);
+    let board = Board::new(hal, timing, straps);
     let timer = board.timer();
     let session = embassy_rp::clocks::RoscRng.next_u32();
     let mut engine = BridgeEngine::new(board, session, false, firmware)
@@ -291,7 +248,11 @@ async fn main(_spawner: Spawner) {
     let mut config = embassy_usb::Config::new(0x1209, 0x0001);
     config.manufacturer = Some("ppmc");
     config.product = Some("PPMC-104BFP bus bridge");
-    config.serial_number = None;
+    // The chip's ID: two bridges on one host are told apart
+    // (/dev/serial/by-id).
+    static SERIAL: StaticCell<[u8; 16]> = StaticCell::new();
+    let serial = SERIAL.init(hex16(embassy_rp::otp::get_chipid().unwrap_or(0)));
+    config.serial_number = core::str::from_utf8(serial).ok();
     config.max_power = 100;
     config.max_packet_size_0 = 64;
     static CONFIG_DESC: StaticCell<[u8; 256]> = StaticCell::new();
@@ -336,6 +297,12 @@ async fn main(_spawner: Spawner) {
         }
     };
     join(usb.run(), serve).await;
+}
+
+/// `id` as 16 hexadecimal digits.
+fn hex16(id: u64) -> [u8; 16] {
+    let digits = b"0123456789ABCDEF";
+    core::array::from_fn(|i| digits[(id >> (60 - 4 * i) & 0xF) as usize])
 }
 
 #[panic_handler]

@@ -52,6 +52,9 @@ pub enum BridgeErrorCode {
     Malformed,
     /// 6: the host speaks another protocol version.
     Version,
+    /// 7: the bridge's own hardware failed (a stuck state machine); the
+    /// detail says what. The bridge must be reset.
+    Hardware,
     /// Any other code, kept as received.
     Unknown(u8),
 }
@@ -65,6 +68,7 @@ impl BridgeErrorCode {
             BridgeErrorCode::CaptureOverrun => 4,
             BridgeErrorCode::Malformed => 5,
             BridgeErrorCode::Version => 6,
+            BridgeErrorCode::Hardware => 7,
             BridgeErrorCode::Unknown(c) => c,
         }
     }
@@ -77,6 +81,7 @@ impl BridgeErrorCode {
             4 => BridgeErrorCode::CaptureOverrun,
             5 => BridgeErrorCode::Malformed,
             6 => BridgeErrorCode::Version,
+            7 => BridgeErrorCode::Hardware,
             other => BridgeErrorCode::Unknown(other),
         }
     }
@@ -92,6 +97,7 @@ impl core::fmt::Display for BridgeErrorCode {
             BridgeErrorCode::CaptureOverrun => f.write_str("CAPTURE_OVERRUN"),
             BridgeErrorCode::Malformed => f.write_str("MALFORMED"),
             BridgeErrorCode::Version => f.write_str("VERSION"),
+            BridgeErrorCode::Hardware => f.write_str("HARDWARE"),
             BridgeErrorCode::Unknown(c) => write!(f, "error code {c}"),
         }
     }

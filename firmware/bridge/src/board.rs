@@ -2,13 +2,22 @@
 //! cycles through the PIO step player, inputs on GPIO outputs, outputs
 //! captured by the PIO edge counters and by sampling, the capture kept as
 //! the protocol's record (pulse runs through `EdgeRuns`, move records
-//! through `MoveTracker`). The pin map is docs/bridge-hardware.md's.
+//! through `MoveTracker`). The pin map is [`crate::pins`].
+//!
+//! This is the RP2350 image's board code, over a thin hardware layer
+//! ([`Hal`]): the image runs it on the RP2350, the board twin on the PIO
+//! model ([`crate::twin`]), so that what the twin proves is this code.
+//!
+//! Every wait has a deadline: a state machine that never finishes a bus
+//! cycle makes the bridge report a hardware fault (protocol error
+//! `HARDWARE`), not hang.
 
-use embassy_rp::gpio::{Input, Level, Output};
-use embassy_rp::peripherals::{PIO0, PIO1};
-use embassy_rp::pio::{StateMachine, StateMachineRx};
-use ppmc_bridge_fw::bus::{BusTiming, Cycle};
-use ppmc_bridge_fw::timebase;
+use crate::bus::{BusTiming, Cycle};
+use crate::hal::{Counter, Hal};
+use crate::pins;
+use crate::timebase;
+use alloc::format;
+use alloc::string::String;
 use ppmc_core::bridge::moves::MoveTracker;
 use ppmc_core::bridge::wire::Timer;
 use ppmc_core::bus::{Bus, Op, Reply};
@@ -17,59 +26,18 @@ use ppmc_core::protocol::{
 };
 use ppmc_core::time::{Duration, Instant};
 
-use crate::clock::Clock;
+/// The longest a bus cycle may take before the bridge calls its player
+/// stuck: 1 ms (a cycle of the longest steps takes 35 us at 150 MHz).
+const CYCLE_DEADLINE_US: u64 = 1_000;
 
-/// The chip's input pins, in [`ChipInput::ALL`]'s order: L1*..L4*, ALM*,
-/// CNP*, AUXI0..3, each active low at the chip.
-pub type InputPins = [Output<'static>; 10];
-
-/// Outputs of the chip the CPU samples: S1..S5 and AUXO0..3 (DIR, which
-/// the POUT counter also reads, through the SIO input register).
-pub struct Sampled {
-    pub s: [Input<'static>; 5],
-    pub auxo: [Input<'static>; 4],
-}
-
-/// DIR's GPIO (33), read by the CPU without taking it from the PIO.
-fn dir_level() -> bool {
-    embassy_rp::pac::SIO.gpio_in(1).read() >> (33 - 32) & 1 == 1
-}
-
-/// The PIO state machines: the bus player, and the edge counters of POUT
-/// (with DIR), INT*, HOLD and AUX*, started together.
-pub struct Machines {
-    pub bus: StateMachine<'static, PIO0, 0>,
-    pub pout: StateMachine<'static, PIO1, 0>,
-    pub int: StateMachine<'static, PIO1, 1>,
-    pub hold: StateMachine<'static, PIO1, 2>,
-    pub aux: StateMachine<'static, PIO1, 3>,
-    /// Bridge ticks when the edge counters started.
-    pub started: u64,
-}
-
-impl core::fmt::Debug for Machines {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("Machines")
-            .field("started", &self.started)
-            .finish_non_exhaustive()
-    }
-}
-
-/// What the bridge is wired to: the state machines and the GPIOs.
-pub struct Wiring {
-    pub sm: Machines,
-    pub inputs: InputPins,
-    pub reset: Output<'static>,
-    pub sampled: Sampled,
-}
-
-pub struct BoardBus {
-    clock: Clock,
+pub struct Board<H: Hal> {
+    hal: H,
     sysclk_hz: u32,
     timer: Timer,
     timing: BusTiming,
     straps: Straps,
-    hw: Wiring,
+    /// The cycle the edge counters started on.
+    started: u64,
     /// Bridge ticks at the last chip reset: time zero of the record.
     epoch: u64,
     record: Record,
@@ -85,52 +53,57 @@ pub struct BoardBus {
     switching: bool,
     /// When S1..S5 last went all off or came back from it (ticks).
     last_toggle: u64,
+    /// The bridge's own hardware failed: what.
+    fault: Option<String>,
+    /// Capture overruns since boot (each restarted the counters).
+    pub overruns: u32,
 }
 
 /// Phases that go off and on again within this (ticks at 75 MHz: 1 ms)
 /// are being chopped (stop switching), not switched.
 const CHOP_TICKS: u64 = 75_000;
 
-impl core::fmt::Debug for BoardBus {
+impl<H: Hal> core::fmt::Debug for Board<H> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("BoardBus")
+        f.debug_struct("Board")
             .field("timer", &self.timer)
             .field("straps", &self.straps)
+            .field("started", &self.started)
             .field("epoch", &self.epoch)
             .field("busy", &self.busy)
             .field("lost", &self.lost)
+            .field("fault", &self.fault)
             .finish_non_exhaustive()
     }
 }
 
-fn level(asserted: bool) -> Level {
-    // The chip's inputs are active low.
-    if asserted {
-        Level::Low
-    } else {
-        Level::High
-    }
+fn level(asserted: bool) -> bool {
+    // The chip's inputs are active low: asserted is low.
+    !asserted
 }
 
-impl BoardBus {
-    pub fn new(
-        clock: Clock,
-        sysclk_hz: u32,
-        timing: BusTiming,
-        straps: Straps,
-        hw: Wiring,
-    ) -> BoardBus {
+/// GPIO `g` (32-47) in [`Hal::read_high_pins`]'s word.
+fn high(word: u16, g: u32) -> bool {
+    word >> (g - 32) & 1 == 1
+}
+
+impl<H: Hal> Board<H> {
+    /// The board code over `hal`: starts the edge counters and samples the
+    /// outputs.
+    pub fn new(mut hal: H, timing: BusTiming, straps: Straps) -> Board<H> {
+        let sysclk_hz = hal.sysclk_hz();
         let timer = Timer {
             hz: timebase::timer_hz(sysclk_hz),
         };
-        let epoch = clock.ticks();
-        let mut bus = BoardBus {
-            clock,
+        let started = hal.start_counters();
+        let epoch = hal.cycles() / 2;
+        let mut bus = Board {
+            hal,
             sysclk_hz,
             timer,
             timing,
             straps,
-            hw,
+            started,
             epoch,
             record: Record::default(),
             edges: EdgeRuns::new(timer.edge_tolerance()),
@@ -142,6 +115,8 @@ impl BoardBus {
             lost: false,
             switching: false,
             last_toggle: 0,
+            fault: None,
+            overruns: 0,
         };
         bus.sample(false);
         bus
@@ -152,13 +127,22 @@ impl BoardBus {
         self.timer
     }
 
+    /// The hardware layer (the twin's tests look through it).
+    pub fn hal(&self) -> &H {
+        &self.hal
+    }
+
+    pub fn hal_mut(&mut self) -> &mut H {
+        &mut self.hal
+    }
+
     /// Ticks to the record's time.
     fn at(&self, ticks: u64) -> Instant {
         record_time(self.timer, self.epoch, ticks)
     }
 
     fn now_ticks(&self) -> u64 {
-        self.clock.ticks()
+        self.hal.cycles() / 2
     }
 
     fn deadline(&self, d: Duration) -> u64 {
@@ -169,15 +153,16 @@ impl BoardBus {
     /// changes of the sampled outputs. Called between ops, in every wait,
     /// and while the bridge waits for the host.
     pub fn poll(&mut self) {
-        let now = self.now_ticks().saturating_sub(self.hw.sm.started);
-        let (started, timer, epoch) = (self.hw.sm.started, self.timer, self.epoch);
+        // Ticks of the counters' timebase now: after every word waiting.
+        let now = (self.hal.cycles() - self.started) / 2;
+        let (started, timer, epoch) = (self.started, self.timer, self.epoch);
         // A pushed word's time in the record.
         let place = |w: u32| {
             let e = timebase::place(w, now);
-            (e.bit, record_time(timer, epoch, started + e.at))
+            (e.bit, record_time(timer, epoch, started / 2 + e.at))
         };
         let mut stepped = false;
-        while let Some(w) = self.hw.sm.pout.rx().try_pull() {
+        while let Some(w) = self.hal.capture_pull(Counter::Pout) {
             stepped = true;
             let (bit, at) = place(w);
             let new_move = self
@@ -188,13 +173,31 @@ impl BoardBus {
             self.edges
                 .push(&mut self.record, at, Direction::from_bit(bit), new_move);
         }
-        take_edges(self.hw.sm.int.rx(), Pin::Int, &mut self.record, place);
-        take_edges(self.hw.sm.hold.rx(), Pin::Hold, &mut self.record, place);
-        take_edges(self.hw.sm.aux.rx(), Pin::Aux, &mut self.record, place);
-        self.lost |= self.hw.sm.pout.rx().stalled()
-            | self.hw.sm.int.rx().stalled()
-            | self.hw.sm.hold.rx().stalled()
-            | self.hw.sm.aux.rx().stalled();
+        for (c, pin) in [
+            (Counter::Int, Pin::Int),
+            (Counter::Hold, Pin::Hold),
+            (Counter::Aux, Pin::Aux),
+        ] {
+            while let Some(w) = self.hal.capture_pull(c) {
+                let (high, at) = place(w);
+                // HOLD's level as it is, INT*'s and AUX*'s (active low)
+                // asserted when low.
+                let value = match pin {
+                    Pin::Hold => high,
+                    _ => !high,
+                };
+                self.record.pin(at, pin, u8::from(value));
+            }
+        }
+        if self.hal.capture_stalled() {
+            // A counter stopped counting while its FIFO was full: this
+            // capture has a hole, and every later count would be late by
+            // the stall. The capture is lost until the next chip reset;
+            // the counters start again now, on a fresh timebase.
+            self.lost = true;
+            self.overruns += 1;
+            self.started = self.hal.start_counters();
+        }
         self.sample(stepped);
     }
 
@@ -209,20 +212,15 @@ impl BoardBus {
     /// a millisecond without one as SWITCHING off. (A heuristic of the
     /// firmware, not yet checked on hardware: docs/bridge-hardware.md.)
     fn sample(&mut self, stepped: bool) {
-        let s = self
-            .hw
-            .sampled
-            .s
+        let word = self.hal.read_high_pins();
+        let s = pins::S
             .iter()
-            .fold(0u8, |v, p| v << 1 | u8::from(p.is_high()));
-        let auxo = self
-            .hw
-            .sampled
-            .auxo
+            .fold(0u8, |v, g| v << 1 | u8::from(high(word, *g)));
+        let auxo = pins::AUXO
             .iter()
             .enumerate()
-            .fold(0u8, |v, (i, p)| v | u8::from(p.is_low()) << i);
-        let dir = dir_level();
+            .fold(0u8, |v, (i, g)| v | u8::from(!high(word, *g)) << i);
+        let dir = high(word, pins::DIR);
         let now = self.now_ticks();
         let at = self.at(now);
         if s != self.last_s {
@@ -264,26 +262,61 @@ impl BoardBus {
         }
     }
 
-    /// One bus cycle; the byte read, if a read.
+    /// The bridge's own hardware failed: later ops do nothing, and the
+    /// engine answers `HARDWARE` with `what`.
+    fn fail(&mut self, what: String) {
+        if self.fault.is_none() {
+            self.fault = Some(what);
+        }
+    }
+
+    /// One bus cycle: its time, and the byte read, if a read. Each step is
+    /// written only when the player's TX FIFO has room (4 steps deep; a
+    /// write to a full FIFO is lost), and every wait has a deadline.
     fn cycle(&mut self, c: Cycle) -> (u64, Option<u8>) {
+        if self.fault.is_some() {
+            return (self.now_ticks(), None);
+        }
         let steps = match self.timing.steps(c, self.sysclk_hz) {
             Ok(s) => s,
             // The default timing fits; a board's own is checked at start.
             Err(_) => return (self.now_ticks(), None),
         };
-        cortex_m::interrupt::free(|_| {
-            for w in steps.words() {
-                self.hw.sm.bus.tx().push(*w);
+        let deadline =
+            self.hal.cycles() + CYCLE_DEADLINE_US * u64::from(self.sysclk_hz / 1_000_000);
+        for (i, w) in steps.words().iter().enumerate() {
+            while self.hal.bus_tx_full() {
+                if self.hal.cycles() > deadline {
+                    self.fail(format!(
+                        "the bus player (PIO0 SM0) took no step for 1 ms: step {} of a {c:?} not written",
+                        i + 1
+                    ));
+                    return (self.now_ticks(), None);
+                }
             }
-        });
+            self.hal.bus_push(*w);
+        }
         let byte = match c {
             Cycle::Read { .. } => loop {
-                if let Some(w) = self.hw.sm.bus.rx().try_pull() {
+                if let Some(w) = self.hal.bus_pull() {
                     break Some(w as u8);
+                }
+                if self.hal.cycles() > deadline {
+                    self.fail(format!(
+                        "the bus player (PIO0 SM0) returned no byte for 1 ms after a {c:?}"
+                    ));
+                    return (self.now_ticks(), None);
                 }
             },
             Cycle::Write { .. } => {
-                while !self.hw.sm.bus.tx().empty() {}
+                while !self.hal.bus_tx_empty() {
+                    if self.hal.cycles() > deadline {
+                        self.fail(format!(
+                            "the bus player (PIO0 SM0) did not finish a {c:?} in 1 ms"
+                        ));
+                        return (self.now_ticks(), None);
+                    }
+                }
                 None
             }
         };
@@ -372,12 +405,17 @@ impl BoardBus {
     }
 
     fn reset_chip(&mut self) -> Reply {
-        self.hw.reset.set_low();
+        self.hal.set_reset(false);
         // RESET held low for 100 us, well beyond any chip's minimum.
         let until = self.deadline(Duration::from_micros(100));
-        while self.now_ticks() < until {}
-        self.hw.reset.set_high();
+        while self.now_ticks() < until {
+            self.hal.idle(until * 2);
+        }
+        self.hal.set_reset(true);
         self.poll();
+        // A fresh timebase for the new record: whatever a stall did to the
+        // last one is gone.
+        self.started = self.hal.start_counters();
         self.epoch = self.now_ticks();
         self.record = Record::default();
         self.edges.reset();
@@ -396,26 +434,14 @@ fn record_time(timer: Timer, epoch: u64, ticks: u64) -> Instant {
     Instant::from_nanos(timer.to_nanos(ticks.saturating_sub(epoch)))
 }
 
-/// Records the edges an INT*, HOLD or AUX* counter pushed: HOLD's level as
-/// it is, INT*'s and AUX*'s (active low) asserted when low.
-fn take_edges<const SM: usize>(
-    rx: &mut StateMachineRx<'static, PIO1, SM>,
-    pin: Pin,
-    record: &mut Record,
-    place: impl Fn(u32) -> (bool, Instant),
-) {
-    while let Some(w) = rx.try_pull() {
-        let (high, at) = place(w);
-        let value = match pin {
-            Pin::Hold => high,
-            _ => !high,
-        };
-        record.pin(at, pin, u8::from(value));
-    }
-}
-
-impl Bus for BoardBus {
+impl<H: Hal> Bus for Board<H> {
     fn run(&mut self, op: Op) -> Reply {
+        if self.fault.is_some() {
+            // The engine answers HARDWARE for the whole batch.
+            return Reply::InputSet {
+                at: self.at(self.now_ticks()),
+            };
+        }
         self.poll();
         let reply = match op {
             Op::WriteCommand { byte, wait_ibf } => self.write(true, byte, wait_ibf),
@@ -452,6 +478,7 @@ impl Bus for BoardBus {
                 let until = self.deadline(d);
                 while self.now_ticks() < until {
                     self.poll();
+                    self.hal.idle(until * 2);
                 }
                 Reply::Delayed { at: self.at(until) }
             }
@@ -475,7 +502,7 @@ impl Bus for BoardBus {
             }
             Op::SetInput { input, asserted } => {
                 let i = ChipInput::ALL.iter().position(|x| *x == input).unwrap_or(0);
-                self.hw.inputs[i].set_level(level(asserted));
+                self.hal.set_input(i, level(asserted));
                 Reply::InputSet {
                     at: self.at(self.now_ticks()),
                 }
@@ -506,6 +533,7 @@ impl Bus for BoardBus {
                             count: n,
                         };
                     }
+                    self.hal.idle(deadline * 2);
                 }
             }
             Op::Reset => self.reset_chip(),
@@ -528,5 +556,9 @@ impl Bus for BoardBus {
 
     fn capture_lost(&self) -> bool {
         self.lost
+    }
+
+    fn fault(&self) -> Option<&str> {
+        self.fault.as_deref()
     }
 }

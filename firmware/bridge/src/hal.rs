@@ -1,0 +1,68 @@
+//! The thin hardware layer under the bridge's board code ([`crate::board`]):
+//! what the board code asks of the RP2350. The RP2350 image implements it
+//! with embassy-rp and the PAC (`firmware/rp2350/src/hw.rs`); the board
+//! twin implements it with the PIO model ([`crate::twin`]). Everything
+//! above it, the same code, runs on both.
+
+/// One of the four edge counters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Counter {
+    /// POUT's rising edges, with DIR.
+    Pout,
+    /// INT*, HOLD and AUX*: both edges, with the new level.
+    Int,
+    Hold,
+    Aux,
+}
+
+impl Counter {
+    pub const ALL: [Counter; 4] = [Counter::Pout, Counter::Int, Counter::Hold, Counter::Aux];
+}
+
+pub trait Hal {
+    /// The system clock's frequency.
+    fn sysclk_hz(&self) -> u32;
+
+    /// System clock cycles since boot, from a clock that keeps counting
+    /// while the core sleeps.
+    fn cycles(&self) -> u64;
+
+    /// FSTAT.TXFULL of the bus player.
+    fn bus_tx_full(&mut self) -> bool;
+
+    /// Writes one step to the bus player's TX FIFO. The board code calls it
+    /// only when the FIFO has room: a write to a full FIFO is lost.
+    fn bus_push(&mut self, word: u32);
+
+    /// FSTAT.TXEMPTY of the bus player.
+    fn bus_tx_empty(&mut self) -> bool;
+
+    /// A byte the bus player read, if one is waiting.
+    fn bus_pull(&mut self) -> Option<u32>;
+
+    /// A word counter `c` pushed, if one is waiting.
+    fn capture_pull(&mut self, c: Counter) -> Option<u32>;
+
+    /// Whether any counter stalled on a full RX FIFO since the last call
+    /// (FDEBUG.RXSTALL, cleared by the call): its count stopped meanwhile.
+    fn capture_stalled(&mut self) -> bool;
+
+    /// Stops the four counters, empties their FIFOs, sets their counts to
+    /// all ones and their start by each pin's level, and starts them on
+    /// one cycle; that cycle.
+    fn start_counters(&mut self) -> u64;
+
+    /// Drives the chip's input `i` (`pins::INPUTS` order) to `high`.
+    fn set_input(&mut self, i: usize, high: bool);
+
+    /// Drives RESET* to `high`.
+    fn set_reset(&mut self, high: bool);
+
+    /// The levels of GPIO 32-47, bit 0 being GPIO 32.
+    fn read_high_pins(&mut self) -> u16;
+
+    /// Nothing to do before cycle `until` but drain the capture: a real
+    /// bridge carries on; the twin may skip time to the next thing that
+    /// could fill a FIFO.
+    fn idle(&mut self, _until: u64) {}
+}

@@ -1,0 +1,58 @@
+//! The bridge's pin map, by RP2350B GPIO number: the one place it is
+//! written down. The RP2350 image, the board twin, `docs/bridge-hardware.md`
+//! and the schematic in `hardware/` (checked by a test against this module)
+//! all follow it.
+
+/// D0-D7 of the chip's bus, through the 74LVC8T245's A side (GPIO 0-7).
+pub const D0: u32 = 0;
+/// A0 (high: the command register on a write, status on a read).
+pub const A0: u32 = 8;
+/// CS*.
+pub const CS: u32 = 9;
+/// DIR of the 74LVC8T245 (high: bridge to chip).
+pub const SHIFT_DIR: u32 = 10;
+/// RD*.
+pub const RD: u32 = 11;
+/// WR*.
+pub const WR: u32 = 12;
+/// The bus player's OUT pins: GPIO 0-12.
+pub const BUS_COUNT: u32 = 13;
+
+/// The chip's inputs, in `ppmc_core::protocol::Input::ALL`'s order:
+/// L1*..L4*, ALM*, CNP*, AUXI0..3 (GPIO 13-22), through the 74HCT244s.
+pub const INPUTS: [u32; 10] = [13, 14, 15, 16, 17, 18, 19, 20, 21, 22];
+/// RESET* of the chip, through a 74HCT244.
+pub const RESET: u32 = 23;
+/// OE* of the 74LVC245s that bring the chip's outputs in (pulled up: the
+/// chip's outputs are cut off until the firmware pulls it low). High
+/// during the self-test, so that the test generator drives the capture
+/// inputs instead of the chip.
+pub const CAPTURE_OE: u32 = 24;
+/// The self-test generator: through 1 kOhm onto the capture inputs of POUT
+/// and INT* (the bridge side of the 74LVC245), which it drives only while
+/// [`CAPTURE_OE`] is high.
+pub const TEST_GEN: u32 = 25;
+/// Enables the 74HCT244s' outputs towards the chip (through an N-MOSFET on
+/// their OE*, pulled down at this pin): low while the bridge boots or is
+/// unpowered, when pull-ups and pull-downs on the chip side hold RESET*
+/// low and L1*..L4*, ALM*, CNP* released.
+pub const DRIVE_EN: u32 = 26;
+
+/// POUT, stamped on its rising edges with DIR.
+pub const POUT: u32 = 32;
+/// DIR, read with each POUT edge (and sampled).
+pub const DIR: u32 = 33;
+/// INT*, stamped on both edges.
+pub const INT: u32 = 34;
+/// HOLD, stamped on both edges.
+pub const HOLD: u32 = 35;
+/// AUX*, stamped on both edges.
+pub const AUX: u32 = 36;
+/// S1..S5, sampled (GPIO 37-41).
+pub const S: [u32; 5] = [37, 38, 39, 40, 41];
+/// AUXO0..3, sampled (GPIO 42-45).
+pub const AUXO: [u32; 4] = [42, 43, 44, 45];
+/// The CSEL and VSEL straps, sensed at boot through the 74LVC245's spare
+/// channels (GPIO 46 and 47 are ADC pins and not 5 V tolerant).
+pub const CSEL: u32 = 46;
+pub const VSEL: u32 = 47;

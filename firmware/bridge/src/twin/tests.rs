@@ -1,0 +1,409 @@
+//! The board code on the twin, held to the RP2350's rules, and the image's
+//! defects before issue 28, each reproduced (in the model, on the old
+//! program or configuration) and each shown fixed.
+
+use super::pio::{Inputs, World};
+use super::*;
+use crate::pins;
+use ppmc_core::bus::{Bus, EmuBus, Op, Reply};
+use ppmc_core::protocol::Status;
+use ppmc_core::time::Duration;
+use std::string::ToString;
+use std::vec;
+use std::vec::Vec;
+
+fn twin() -> TwinBoard {
+    board(Straps::default(), ModelConfig::default()).expect("the twin boots")
+}
+
+/// docs/examples/accel-1000-steps.ppmc, as ops: initialization, then 1,000
+/// steps CW with accel/decel (Section 3-2).
+fn accel_move(steps: u32) -> Vec<Op> {
+    let wait = Some(Duration::from_millis(10));
+    let wc = |byte| Op::WriteCommand {
+        byte,
+        wait_ibf: wait,
+    };
+    let wd = |byte| Op::WriteData {
+        byte,
+        wait_ibf: wait,
+    };
+    let n = steps - 1;
+    vec![
+        Op::Reset,
+        wc(0x02),
+        wd(100),
+        wd(20),
+        wd(100),
+        wd(0),
+        Op::Delay(Duration::from_millis(200)),
+        wc(0x43),
+        wd(n as u8),
+        wd((n >> 8) as u8),
+        wd((n >> 16) as u8),
+        Op::AwaitStatus {
+            mask: Status::BUSY,
+            value: Status::BUSY,
+            timeout: Duration::from_millis(1),
+        },
+        Op::AwaitStatus {
+            mask: Status::BUSY,
+            value: 0,
+            timeout: Duration::from_secs(2),
+        },
+        Op::ReadPulses,
+    ]
+}
+
+fn run(bus: &mut impl Bus, ops: &[Op]) -> Vec<Reply> {
+    ops.iter().map(|op| bus.run(*op)).collect()
+}
+
+/// The pulse times of the last move, in ns.
+fn pulse_times(bus: &impl Bus) -> Vec<u64> {
+    bus.record()
+        .runs
+        .iter()
+        .flat_map(|r| {
+            let n = u64::from(r.count.saturating_sub(1)).max(1);
+            (0..u64::from(r.count)).map(move |i| r.start.as_nanos() + r.span.as_nanos() * i / n)
+        })
+        .collect()
+}
+
+#[test]
+fn a_move_on_the_twin_is_the_models_move_to_the_timers_tick() {
+    // Section 3-2, through the board code, the PIO model and the chip.
+    let ops = accel_move(1000);
+    let mut emu = EmuBus::new(Straps::default(), ModelConfig::default()).expect("model");
+    let want = run(&mut emu, &ops);
+    let mut b = twin();
+    let got = run(&mut b, &ops);
+    assert_eq!(b.fault(), None);
+    assert!(!b.capture_lost());
+    // The same status and pulse summary.
+    assert!(
+        matches!(got[0], Reply::ResetDone { .. }),
+        "reset: {:?}",
+        got[0]
+    );
+    let summary = |r: &Reply| match r {
+        Reply::Pulses { summary, .. } => (summary.count, summary.cw, summary.ccw),
+        other => panic!("not a pulse summary: {other:?}"),
+    };
+    assert_eq!(summary(&got[13]), summary(&want[13]));
+    assert_eq!(summary(&got[13]).0, 1000);
+    // Every interval as the model's, to two timer ticks (26.7 ns) and the
+    // cycles between the bus write and the chip taking it.
+    let (t, e) = (pulse_times(&b), pulse_times(&emu));
+    assert_eq!(t.len(), e.len());
+    let offset = t[0] as i64 - e[0] as i64;
+    for (i, (a, m)) in t.iter().zip(&e).enumerate() {
+        let err = *a as i64 - *m as i64 - offset;
+        assert!(
+            err.abs() <= 27,
+            "pulse {i}: {a} ns on the twin, {m} ns in the model"
+        );
+    }
+    let hw = b.hal();
+    assert_eq!(hw.chip.contention, 0, "nobody drove against the shifter");
+    assert_eq!(hw.chip.floating, 0, "no buffered line floated");
+    for blk in &hw.world.blocks {
+        assert_eq!(
+            blk.fdebug() >> pioregs::fdebug::TXOVER & 0xF,
+            0,
+            "no step lost"
+        );
+    }
+}
+
+#[test]
+fn the_board_code_never_writes_a_full_fifo_whatever_the_cpus_pace() {
+    // Defect 4: every step written only when the TX FIFO has room, with
+    // the CPU at random paces.
+    for seed in 1..6u64 {
+        let mut b = crate::board::Board::new(
+            Twin::new(Straps::default(), ModelConfig::default())
+                .expect("boots")
+                .with_gaps(seed, 40 * seed),
+            BusTiming::DEFAULT,
+            Straps::default(),
+        );
+        let ops = accel_move(20);
+        let got = run(&mut b, &ops);
+        assert!(matches!(got[13], Reply::Pulses { summary, .. } if summary.count == 20));
+        let hw = b.hal();
+        assert_eq!(
+            hw.world.blocks[0].fdebug() >> pioregs::fdebug::TXOVER & 1,
+            0
+        );
+        assert_eq!(hw.chip.contention, 0, "seed {seed}");
+    }
+}
+
+#[test]
+fn a_stuck_bus_player_is_a_hardware_fault_within_its_deadline() {
+    // Defect 7: a state machine that never finishes a cycle.
+    let mut b = twin();
+    b.run(Op::Reset);
+    b.hal_mut().stop_bus_player();
+    let before = b.hal().world.cycle;
+    b.run(Op::ReadStatus);
+    let waited = b.hal().world.cycle - before;
+    let fault = b.fault().expect("a hardware fault").to_string();
+    assert!(fault.contains("bus player"), "{fault}");
+    assert!(
+        waited < 2 * SYSCLK_HZ as u64 / 1000,
+        "gave up within 2 ms: {waited} cycles"
+    );
+}
+
+#[test]
+fn a_minute_of_idle_records_no_phantom_edge() {
+    // Defect 3: the counters pass X = 0 (every 2^32 ticks, 57.3 s) with no
+    // edge recorded. 61 s of virtual time.
+    let mut b = twin();
+    b.run(Op::Reset);
+    b.run(Op::Delay(Duration::from_secs(61)));
+    b.run(Op::ReadStatus);
+    assert!(b.record().runs.is_empty(), "{:?}", b.record().runs);
+    assert!(
+        b.record().pins.iter().all(|p| !matches!(
+            p.pin,
+            ppmc_core::protocol::Pin::Int
+                | ppmc_core::protocol::Pin::Hold
+                | ppmc_core::protocol::Pin::Aux
+        )),
+        "{:?}",
+        b.record().pins
+    );
+    assert!(!b.capture_lost());
+    // The counters did pass zero.
+    assert!(b.hal().world.cycle > 2 * (1u64 << 32));
+}
+
+#[test]
+fn an_overrun_is_reported_and_the_next_capture_is_on_time() {
+    // Defect 8: a CPU that does not drain the capture while 1,000 pulses
+    // come 42 us apart: the POUT counter stalls on its full FIFO.
+    let mut b = twin();
+    b.hal_mut().idle_step = 150 * 5_000; // looks every 5 ms
+    let mut ops = accel_move(1000);
+    ops.insert(12, Op::Delay(Duration::from_millis(100)));
+    run(&mut b, &ops);
+    assert!(b.capture_lost(), "the overrun is reported");
+    assert!(b.overruns >= 1);
+    // Then the next capture, drained as usual, is on time.
+    b.hal_mut().idle_step = 150;
+    let ops = accel_move(1000);
+    run(&mut b, &ops);
+    assert!(!b.capture_lost());
+    let mut emu = EmuBus::new(Straps::default(), ModelConfig::default()).expect("model");
+    run(&mut emu, &ops);
+    let (t, e) = (pulse_times(&b), pulse_times(&emu));
+    assert_eq!(t.len(), 1000);
+    let offset = t[0] as i64 - e[0] as i64;
+    assert!(
+        offset.abs() < 20_000,
+        "first pulse {offset} ns off the model's"
+    );
+    for (a, m) in t.iter().zip(&e) {
+        assert!((*a as i64 - *m as i64 - offset).abs() <= 27);
+    }
+}
+
+/// The image before issue 28, kept to show the model catches its defects.
+mod before {
+    use pio::Program;
+
+    /// PIO1 held both counters: 13 + 23 words.
+    pub fn rising() -> Program<32> {
+        pio::pio_asm!(
+            "    mov x, ~null",
+            ".wrap_target",
+            "low:",
+            "    jmp pin rise",
+            "    jmp x-- low",
+            "rise:",
+            "    jmp x-- r1",
+            "r1:",
+            "    in pins, 1",
+            "    jmp x-- r2",
+            "r2:",
+            "    in x, 31",
+            "    jmp x-- r3",
+            "r3:",
+            "    push block",
+            "    jmp x-- high",
+            "high:",
+            "    jmp pin still_high",
+            "    jmp x-- low",
+            "still_high:",
+            "    jmp x-- high",
+            ".wrap",
+        )
+        .program
+    }
+
+    pub fn both() -> Program<32> {
+        pio::pio_asm!(
+            "    mov x, ~null",
+            ".wrap_target",
+            "low:",
+            "    jmp pin rise",
+            "    jmp x-- low",
+            "rise:",
+            "    jmp x-- r1",
+            "r1:",
+            "    set y, 1",
+            "    jmp x-- r2",
+            "r2:",
+            "    in y, 1",
+            "    jmp x-- r3",
+            "r3:",
+            "    in x, 31",
+            "    jmp x-- r4",
+            "r4:",
+            "    push block",
+            "    jmp x-- high",
+            "high:",
+            "    jmp pin still_high",
+            "    jmp x-- fall",
+            "still_high:",
+            "    jmp x-- high",
+            "fall:",
+            "    set y, 0",
+            "    jmp x-- f1",
+            "f1:",
+            "    in y, 1",
+            "    jmp x-- f2",
+            "f2:",
+            "    in x, 31",
+            "    jmp x-- f3",
+            "f3:",
+            "    push block",
+            "    jmp x-- low",
+            ".wrap",
+        )
+        .program
+    }
+}
+
+#[test]
+fn defect_1_two_counters_do_not_fit_one_block_and_the_layout_does() {
+    let mut w = World::new();
+    let (r, b) = (before::rising(), before::both());
+    w.blocks[1].load(&r.code, 0).expect("13 words fit");
+    // embassy-rp's load_program would place it after the first: 13 + 23.
+    let err = w.blocks[1].load(&b.code, r.code.len() as u8);
+    assert!(err.is_err(), "36 words in a 32-word block");
+    let mut w = World::new();
+    for (i, p) in programs::layout().iter().enumerate() {
+        w.blocks[i]
+            .load(p.words(), 0)
+            .expect("one program per block fits");
+        assert!(w.blocks[i].words_used() <= 32);
+    }
+}
+
+/// Pulses on GPIO 32 for a counter configured by `regs`: words pushed.
+fn count_pulses_on_pout(regs: &pioregs::SmRegs, words: &[u16]) -> usize {
+    let mut w = World::with_program(1, 16, words, 0, regs);
+    let mut pushed = 0;
+    let mut outside = Inputs(|c: u64, _, _| {
+        let high = c % 200 > 100;
+        (u64::from(high) << pins::POUT, 1 << pins::POUT | 1 << 16)
+    });
+    for _ in 0..2_000 {
+        w.step(&mut outside);
+        while w.pull(1, 0).is_some() {
+            pushed += 1;
+        }
+    }
+    pushed
+}
+
+#[test]
+fn defect_2_the_jmp_pin_is_relative_to_gpiobase() {
+    let p = programs::edge_counter(true);
+    let ours = pioregs::pout_counter(&p, false);
+    assert_eq!(
+        count_pulses_on_pout(&ours, p.words()),
+        10,
+        "ten pulses on GPIO 32"
+    );
+    // embassy-rp 0.10 writes the GPIO number raw into the 5-bit field:
+    // 32 & 31 = 0, which with GPIOBASE 16 is GPIO 16.
+    let mut embassy = ours;
+    embassy.execctrl &= !(0x1F << pioregs::execctrl::JMP_PIN);
+    embassy.execctrl |= (pins::POUT & 0x1F) << pioregs::execctrl::JMP_PIN;
+    assert_eq!(
+        count_pulses_on_pout(&embassy, p.words()),
+        0,
+        "it watched GPIO 16"
+    );
+}
+
+/// Words pushed by a counter started with X at `x`, no edge at all, over
+/// `cycles`.
+fn idle_pushes(words: &[u16], regs: &pioregs::SmRegs, x: u32, cycles: u64) -> usize {
+    let mut regs = *regs;
+    regs.x = x;
+    let mut w = World::with_program(1, 16, words, 0, &regs);
+    // X as a long run leaves it (`set x` takes 5 bits only).
+    w.blocks[1].sm[0].set_x(x);
+    let mut n = 0;
+    let mut outside = Inputs(|_, _, _| (0, 1 << pins::POUT | 0xFFFF << 16));
+    for _ in 0..cycles {
+        w.step(&mut outside);
+        while w.pull(1, 0).is_some() {
+            n += 1;
+        }
+    }
+    n
+}
+
+#[test]
+fn defect_3_passing_x_zero_pushes_nothing() {
+    let p = programs::edge_counter(true);
+    let regs = pioregs::pout_counter(&p, false);
+    assert_eq!(idle_pushes(p.words(), &regs, 20, 200), 0);
+    let b = programs::edge_counter(false);
+    let regs_b = pioregs::pin_counters(&b, [false; 3])[0];
+    assert_eq!(idle_pushes(b.words(), &regs_b, 20, 200), 0);
+    // The old program, started in its low loop, falls into its edge code.
+    let old = before::rising();
+    let mut old_regs = regs;
+    old_regs.execctrl = regs.execctrl & !(0x1F << 7 | 0x1F << 12)
+        | u32::from(old.wrap.source) << 12
+        | u32::from(old.wrap.target) << 7;
+    old_regs.start = 1;
+    assert!(
+        idle_pushes(&old.code, &old_regs, 20, 200) > 0,
+        "a phantom edge"
+    );
+}
+
+#[test]
+fn defect_4_writing_a_cycle_without_looking_loses_steps() {
+    // The image pushed every step of a cycle without looking at TXFULL; a
+    // read right after a write finds the FIFO (4 deep) busy.
+    let p = programs::bus_player();
+    let mut w = World::with_program(0, 0, p.words(), 0, &pioregs::bus_player(&p));
+    let t = BusTiming::DEFAULT;
+    let mut outside = Inputs(|_, _, _| (0, 0));
+    for c in [
+        crate::bus::Cycle::Write { a0: true, byte: 1 },
+        crate::bus::Cycle::Read { a0: true },
+    ] {
+        for s in t.steps(c, SYSCLK_HZ).expect("fits").words() {
+            w.blocks[0].txf_write(0, *s);
+        }
+        w.step(&mut outside);
+    }
+    assert_ne!(
+        w.blocks[0].fdebug() >> pioregs::fdebug::TXOVER & 1,
+        0,
+        "steps were lost (FDEBUG.TXOVER)"
+    );
+}

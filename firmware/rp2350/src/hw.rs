@@ -1,0 +1,223 @@
+//! The RP2350's side of the bridge's hardware layer ([`Hal`]): the PIO
+//! blocks written register by register from `ppmc_bridge_fw::pioregs`
+//! (the values the board twin runs), GPIOs through the SIO, and the clock
+//! from the cycle counter and the always-running timer
+//! (`ppmc_bridge_fw::clock`).
+//!
+//! The PIO state machines are configured through the PAC, not embassy-rp's
+//! `Config`: embassy-rp 0.10 writes the JMP pin unrelative to GPIOBASE
+//! (embassy-rs/embassy#5498), which would have the edge counters of PIO1
+//! and PIO2 watch GPIO 16-20. embassy-rp still claims the pins (FUNCSEL,
+//! input enable) and owns the blocks.
+
+use core::cell::RefCell;
+use cortex_m::peripheral::DWT;
+use embassy_rp::pac;
+use embassy_rp::pac::pio::regs::{
+    Ctrl, Fdebug, SmClkdiv, SmExecctrl, SmInstr, SmPinctrl, SmShiftctrl,
+};
+use ppmc_bridge_fw::clock::Clock;
+use ppmc_bridge_fw::hal::{Counter, Hal};
+use ppmc_bridge_fw::pins;
+use ppmc_bridge_fw::pioregs::{self, fdebug, shiftctrl, SmRegs, START_COUNTERS, STOP_COUNTERS};
+use ppmc_bridge_fw::programs::Loaded;
+
+/// The three PIO blocks, by index.
+fn pio(b: usize) -> pac::pio::Pio {
+    match b {
+        0 => pac::PIO0,
+        1 => pac::PIO1,
+        _ => pac::PIO2,
+    }
+}
+
+/// Loads `p` at address 0 of block `b` and sets its GPIOBASE. Each block
+/// holds one program (`ppmc_bridge_fw::programs`), so nothing else is
+/// there.
+pub fn load(b: usize, p: &Loaded) {
+    let block = pio(b);
+    for (i, w) in p.words().iter().enumerate() {
+        block
+            .instr_mem(i)
+            .write_value(pac::pio::regs::InstrMem(u32::from(*w)));
+    }
+    block
+        .gpiobase()
+        .write_value(pac::pio::regs::Gpiobase(pioregs::block::GPIOBASE[b]));
+}
+
+/// Writes the registers of state machine `s` of block `b`, then forces its
+/// start instructions. The state machine must be disabled.
+pub fn configure(b: usize, s: usize, regs: &SmRegs) {
+    let sm = pio(b).sm(s);
+    sm.clkdiv().write_value(SmClkdiv(regs.clkdiv));
+    sm.execctrl().write_value(SmExecctrl(regs.execctrl));
+    // FJOIN flipped, then as wanted: both FIFOs flushed.
+    sm.shiftctrl()
+        .write_value(SmShiftctrl(regs.shiftctrl ^ 1 << shiftctrl::FJOIN_RX));
+    sm.shiftctrl().write_value(SmShiftctrl(regs.shiftctrl));
+    sm.pinctrl().write_value(SmPinctrl(regs.pinctrl));
+    for w in regs.start_instructions() {
+        sm.instr().write_value(SmInstr(u32::from(w)));
+    }
+}
+
+/// Sets the levels, then the directions, of `mask` (GPIO 0-12) on PIO0
+/// SM0 with forced `set` instructions, five pins at a time.
+pub fn bus_pins(levels: u32, dirs: u32, mask: u32) {
+    let sm = pio(0).sm(0);
+    let saved = sm.pinctrl().read();
+    for (value, pindirs) in [(levels, false), (dirs, true)] {
+        let mut g = 0;
+        while g < 13 {
+            let n = (13 - g).min(5);
+            let chunk = (value >> g) & ((1 << n) - 1);
+            let m = (mask >> g) & ((1 << n) - 1);
+            if m != 0 {
+                sm.pinctrl().write_value(SmPinctrl(
+                    g << pioregs::pinctrl::SET_BASE | n << pioregs::pinctrl::SET_COUNT,
+                ));
+                // set pins / set pindirs, data = the chunk.
+                let dest = if pindirs { 0b100 } else { 0b000 };
+                sm.instr()
+                    .write_value(SmInstr(0b111 << 13 | dest << 5 | chunk));
+            }
+            g += n;
+        }
+    }
+    sm.pinctrl().write_value(saved);
+}
+
+/// The RP2350's PIO, SIO and clock as the board code's hardware layer.
+pub struct Rp2350 {
+    sysclk_hz: u32,
+    clock: RefCell<Clock>,
+    counters: [Loaded; 2],
+}
+
+impl core::fmt::Debug for Rp2350 {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Rp2350")
+            .field("sysclk_hz", &self.sysclk_hz)
+            .finish_non_exhaustive()
+    }
+}
+
+fn now_us() -> u64 {
+    embassy_time::Instant::now().as_micros()
+}
+
+impl Rp2350 {
+    /// The hardware layer, with the cycle counter running (`start`) and
+    /// the counters' programs (PIO1's and PIO2's) loaded.
+    pub fn new(sysclk_hz: u32, pout: Loaded, pins_: Loaded) -> Rp2350 {
+        Rp2350 {
+            sysclk_hz,
+            clock: RefCell::new(Clock::new(sysclk_hz, DWT::cycle_count(), now_us(), 0)),
+            counters: [pout, pins_],
+        }
+    }
+
+    fn sio_set(g: u32, high: bool) {
+        let bank = (g / 32) as usize;
+        let bit = 1 << (g % 32);
+        if high {
+            pac::SIO.gpio_out(bank).value_set().write_value(bit);
+        } else {
+            pac::SIO.gpio_out(bank).value_clr().write_value(bit);
+        }
+    }
+
+    fn counter(c: Counter) -> (usize, usize) {
+        match c {
+            Counter::Pout => (pioregs::block::POUT, 0),
+            Counter::Int => (pioregs::block::PINS, 0),
+            Counter::Hold => (pioregs::block::PINS, 1),
+            Counter::Aux => (pioregs::block::PINS, 2),
+        }
+    }
+}
+
+impl Hal for Rp2350 {
+    fn sysclk_hz(&self) -> u32 {
+        self.sysclk_hz
+    }
+
+    fn cycles(&self) -> u64 {
+        let (fine, us) = cortex_m::interrupt::free(|_| (DWT::cycle_count(), now_us()));
+        self.clock.borrow_mut().update(fine, us)
+    }
+
+    fn bus_tx_full(&mut self) -> bool {
+        pio(0).fstat().read().txfull() & 1 != 0
+    }
+
+    fn bus_push(&mut self, word: u32) {
+        pio(0).txf(0).write_value(word);
+    }
+
+    fn bus_tx_empty(&mut self) -> bool {
+        pio(0).fstat().read().txempty() & 1 != 0
+    }
+
+    fn bus_pull(&mut self) -> Option<u32> {
+        (pio(0).fstat().read().rxempty() & 1 == 0).then(|| pio(0).rxf(0).read())
+    }
+
+    fn capture_pull(&mut self, c: Counter) -> Option<u32> {
+        let (b, s) = Self::counter(c);
+        (pio(b).fstat().read().rxempty() >> s & 1 == 0).then(|| pio(b).rxf(s).read())
+    }
+
+    fn capture_stalled(&mut self) -> bool {
+        let pout = 1 << fdebug::RXSTALL;
+        let others = 0b0111 << fdebug::RXSTALL;
+        let stalled =
+            pio(1).fdebug().read().0 & pout != 0 || pio(2).fdebug().read().0 & others != 0;
+        pio(1).fdebug().write_value(Fdebug(pout));
+        pio(2).fdebug().write_value(Fdebug(others));
+        stalled
+    }
+
+    fn start_counters(&mut self) -> u64 {
+        pio(1).ctrl().write_value(Ctrl(STOP_COUNTERS));
+        let high = |g: u32| pac::SIO.gpio_in((g / 32) as usize).read() >> (g % 32) & 1 == 1;
+        let pout = pioregs::pout_counter(&self.counters[0], high(pins::POUT));
+        let others = pioregs::pin_counters(
+            &self.counters[1],
+            [pins::INT, pins::HOLD, pins::AUX].map(high),
+        );
+        configure(1, 0, &pout);
+        for (s, regs) in others.iter().enumerate() {
+            configure(2, s, regs);
+        }
+        // Restart the state machines' internal state (ISR, delay), stopped.
+        pio(1)
+            .ctrl()
+            .write_value(Ctrl(1 << pioregs::ctrl::SM_RESTART));
+        pio(2)
+            .ctrl()
+            .write_value(Ctrl(0b0111 << pioregs::ctrl::SM_RESTART));
+        pio(1).fdebug().write_value(Fdebug(1 << fdebug::RXSTALL));
+        pio(2)
+            .fdebug()
+            .write_value(Fdebug(0b0111 << fdebug::RXSTALL));
+        let at = cortex_m::interrupt::free(|_| {
+            pio(1).ctrl().write_value(Ctrl(START_COUNTERS));
+            self.cycles()
+        });
+        at
+    }
+
+    fn set_input(&mut self, i: usize, high: bool) {
+        Self::sio_set(pins::INPUTS[i], high);
+    }
+
+    fn set_reset(&mut self, high: bool) {
+        Self::sio_set(pins::RESET, high);
+    }
+
+    fn read_high_pins(&mut self) -> u16 {
+        (pac::SIO.gpio_in(1).read() & 0xFFFF) as u16
+    }
+}
