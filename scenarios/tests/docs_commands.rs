@@ -38,7 +38,7 @@ const FILES: [&str; 12] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 19] = [
+const ELSEWHERE: [(&str, &str); 20] = [
     (
         "timeout -s INT 5 ppmc run",
         "in scenarios/tests/cli_signals.rs (timeout -s INT during the long move on a real-time bridge, ten times)",
@@ -74,6 +74,10 @@ const ELSEWHERE: [(&str, &str); 19] = [
     ),
     ("firmware/build", "in .ci/run (the firmware step)"),
     (
+        "firmware/run-twin",
+        "in harness/tests/firmware_twin.rs (started, scenarios run through it, stopped)",
+    ),
+    (
         "firmware/run-qemu",
         "in harness/tests/firmware_qemu.rs (started, the whole suite run through it, stopped)",
     ),
@@ -87,7 +91,7 @@ const ELSEWHERE: [(&str, &str); 19] = [
     ),
     (
         "cargo +nightly fuzz run",
-        "in .ci/run (the fuzz step runs every target so, 45 s each)",
+        "in .ci/run (the fuzz step runs every target so, 30 s each)",
     ),
     (
         "mkdir -p ../target/fuzz-corpus",

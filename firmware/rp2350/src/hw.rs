@@ -202,11 +202,10 @@ impl Hal for Rp2350 {
         pio(2)
             .fdebug()
             .write_value(Fdebug(0b0111 << fdebug::RXSTALL));
-        let at = cortex_m::interrupt::free(|_| {
+        cortex_m::interrupt::free(|_| {
             pio(1).ctrl().write_value(Ctrl(START_COUNTERS));
             self.cycles()
-        });
-        at
+        })
     }
 
     fn set_input(&mut self, i: usize, high: bool) {

@@ -217,6 +217,10 @@ async fn main(_spawner: Spawner) {
         pio2.make_pio_pin(p.PIN_36),
     );
 
+    // TEST_GEN (GPIO 25) stays an input while the capture buffers are on
+    // (docs/bridge-hardware.md); the self-test that drives it is to come.
+    const _: () = assert!(pins::TEST_GEN == 25);
+
     // The buffers: the chip's outputs in, then the bridge's out.
     capture_oe.set_low();
     drive_en.set_high();

@@ -895,10 +895,10 @@ impl World {
         let mut turns = room / period;
         for &(b, s, k, dx) in &loops {
             let per = u64::from(dx) * (period / k);
-            if per > 0 {
-                // Every `jmp x--` skipped must see X non-zero.
-                let x = u64::from(self.blocks[b].sm[s].core.x);
-                turns = turns.min(x.saturating_sub(1) / per);
+            // Every `jmp x--` skipped must see X non-zero.
+            let x = u64::from(self.blocks[b].sm[s].core.x);
+            if let Some(t) = x.saturating_sub(1).checked_div(per) {
+                turns = turns.min(t);
             }
         }
         if turns == 0 {

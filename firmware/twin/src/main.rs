@@ -1,0 +1,237 @@
+//! `ppmc-twin`, run by `firmware/run-twin`: the RP2350 bridge's board code
+//! (`ppmc_bridge_fw::board`) on the board twin (a model of the RP2350's PIO
+//! blocks and GPIOs wired pin by pin to the reference chip model), behind
+//! the same `BridgeEngine` the image runs, serving the bridge protocol on a
+//! pseudo-terminal as `ppmc bridge-sim` and `firmware/run-qemu` do.
+//!
+//! Time is virtual: it passes as the twin simulates, cycle by cycle where
+//! anything happens, so runs are repeatable.
+
+use ppmc_bridge_fw::twin;
+use ppmc_core::bridge::engine::BridgeEngine;
+use ppmc_core::emu::{faults, ModelConfig};
+use ppmc_core::protocol::Straps;
+use std::ffi::CStr;
+use std::io::{self, Write};
+use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+const HELP: &str = "\
+ppmc-twin: the RP2350 bridge's board code on a twin of the RP2350, served on a pseudo-terminal
+
+usage: firmware/run-twin [options]
+
+  --clock-mhz MHZ      the chip's SysClk strap, 1 to 40 (fractions allowed); default 16
+  --csel high|low      default high
+  --vsel high|low      default high
+  --chip-fault NAME    a fault of the catalogue (ppmc fault-matrix --list),
+                       swap-error-A-B or status-stuck-0xNN; repeat to combine
+  --link PATH          also make PATH a symbolic link to the pty (removed on exit)
+  -h, --help           this text
+
+It prints `run-twin: serving on /dev/pts/N` once it serves, and stops on
+SIGINT or SIGTERM.";
+
+static STOP: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(_: libc::c_int) {
+    STOP.store(true, Ordering::Relaxed);
+}
+
+struct Options {
+    straps: Straps,
+    model: ModelConfig,
+    link: Option<PathBuf>,
+}
+
+fn parse(args: &[String]) -> Result<Option<Options>, String> {
+    let mut straps = Straps::default();
+    let mut model = ModelConfig::default();
+    let mut link = None;
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        let mut value = || {
+            it.next()
+                .cloned()
+                .ok_or_else(|| format!("{a} needs a value"))
+        };
+        match a.as_str() {
+            "-h" | "--help" => return Ok(None),
+            "--clock-mhz" => {
+                let v = value()?;
+                let mhz: f64 = v
+                    .parse()
+                    .map_err(|_| format!("--clock-mhz `{v}` is not a number"))?;
+                let hz = (mhz * 1e6).round();
+                if !(1e6..=40e6).contains(&hz) {
+                    return Err(format!("--clock-mhz `{v}`: 1 to 40"));
+                }
+                straps.sysclk_hz = hz as u32;
+            }
+            "--csel" | "--vsel" => {
+                let v = value()?;
+                let high = match v.as_str() {
+                    "high" => true,
+                    "low" => false,
+                    _ => return Err(format!("{a} `{v}`: high or low")),
+                };
+                if a == "--csel" {
+                    straps.csel_high = high;
+                } else {
+                    straps.vsel_high = high;
+                }
+            }
+            "--chip-fault" => {
+                let v = value()?;
+                faults::apply_named(&v, &mut model).map_err(|e| format!("--chip-fault: {e}"))?;
+            }
+            "--link" => link = Some(PathBuf::from(value()?)),
+            other => return Err(format!("unknown option `{other}` (--help lists them)")),
+        }
+    }
+    Ok(Some(Options {
+        straps,
+        model,
+        link,
+    }))
+}
+
+/// A pseudo-terminal in raw mode: the master, and the slave's path.
+fn open_pty() -> io::Result<(OwnedFd, String)> {
+    let mut master: libc::c_int = -1;
+    let mut slave: libc::c_int = -1;
+    // SAFETY: openpty writes two descriptors; the name, termios and
+    // window size are optional and null here.
+    let rc = unsafe {
+        libc::openpty(
+            &mut master,
+            &mut slave,
+            std::ptr::null_mut(),
+            std::ptr::null(),
+            std::ptr::null(),
+        )
+    };
+    if rc != 0 {
+        return Err(io::Error::last_os_error());
+    }
+    // SAFETY: both are open descriptors openpty just gave us.
+    let (master, slave) = unsafe { (OwnedFd::from_raw_fd(master), OwnedFd::from_raw_fd(slave)) };
+    // SAFETY: a zeroed termios is filled by tcgetattr before use.
+    let mut t: libc::termios = unsafe { std::mem::zeroed() };
+    // SAFETY: valid descriptor and pointer.
+    unsafe {
+        if libc::tcgetattr(slave.as_raw_fd(), &mut t) == 0 {
+            libc::cfmakeraw(&mut t);
+            libc::tcsetattr(slave.as_raw_fd(), libc::TCSANOW, &t);
+        }
+    }
+    // SAFETY: ptsname_r writes a NUL-terminated name into the buffer.
+    let mut name = [0 as libc::c_char; 128];
+    let rc = unsafe { libc::ptsname_r(master.as_raw_fd(), name.as_mut_ptr(), name.len()) };
+    if rc != 0 {
+        return Err(io::Error::from_raw_os_error(rc));
+    }
+    // SAFETY: NUL-terminated by ptsname_r.
+    let path = unsafe { CStr::from_ptr(name.as_ptr()) }
+        .to_string_lossy()
+        .into_owned();
+    // The slave stays open here too, so that a host closing it does not
+    // leave the master reading EIO; dropping it would.
+    std::mem::forget(slave);
+    Ok((master, path))
+}
+
+/// Waits up to 50 ms for the master to be readable.
+fn readable(fd: std::os::fd::RawFd) -> bool {
+    let mut p = libc::pollfd {
+        fd,
+        events: libc::POLLIN,
+        revents: 0,
+    };
+    // SAFETY: one valid pollfd.
+    let n = unsafe { libc::poll(&mut p, 1, 50) };
+    n > 0 && p.revents & libc::POLLIN != 0
+}
+
+fn serve(o: Options) -> Result<(), String> {
+    let board = twin::board(o.straps, o.model).map_err(|e| format!("the twin cannot boot: {e}"))?;
+    let timer = board.timer();
+    let session = std::process::id() ^ 0x7717_0000;
+    let firmware = concat!(
+        "ppmc-bridge-twin ",
+        env!("CARGO_PKG_VERSION"),
+        " (the RP2350 board code on a twin of the RP2350)"
+    );
+    let mut engine = BridgeEngine::new(board, session, true, firmware)
+        .with_timer(timer)
+        .with_capture_capacity(4096);
+    let (master, path) = open_pty().map_err(|e| format!("no pseudo-terminal: {e}"))?;
+    if let Some(link) = &o.link {
+        let _ = std::fs::remove_file(link);
+        std::os::unix::fs::symlink(&path, link)
+            .map_err(|e| format!("--link {}: {e}", link.display()))?;
+    }
+    println!("run-twin: serving on {path}");
+    let _ = io::stdout().flush();
+    let mut file = std::fs::File::from(master);
+    let mut buf = [0u8; 4096];
+    let result = loop {
+        if STOP.load(Ordering::Relaxed) {
+            break Ok(());
+        }
+        if !readable(file.as_raw_fd()) {
+            continue;
+        }
+        let n = match io::Read::read(&mut file, &mut buf) {
+            Ok(n) => n,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(_) => {
+                std::thread::sleep(std::time::Duration::from_millis(20));
+                continue;
+            }
+        };
+        let reply = engine.on_bytes(&buf[..n]);
+        if let Err(e) = file.write_all(&reply).and_then(|_| file.flush()) {
+            break Err(format!("writing to {path}: {e}"));
+        }
+    };
+    if let Some(link) = &o.link {
+        let _ = std::fs::remove_file(link);
+    }
+    result
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let o = match parse(&args) {
+        Ok(Some(o)) => o,
+        Ok(None) => {
+            println!("{HELP}");
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("run-twin: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    // SAFETY: the handler only stores to an atomic.
+    unsafe {
+        libc::signal(
+            libc::SIGINT,
+            on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
+        );
+        libc::signal(
+            libc::SIGTERM,
+            on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
+        );
+    }
+    match serve(o) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("run-twin: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
