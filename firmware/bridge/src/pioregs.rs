@@ -12,6 +12,7 @@
 //! GPIOBASE = 16 a `jmp pin` on GPIO 32 tests GPIO 16. Every pin field
 //! here is relative to the block's window, the JMP pin included.
 
+use crate::hal::Counter;
 use crate::pins;
 #[cfg(test)]
 use crate::programs;
@@ -213,17 +214,37 @@ pub fn pin_counters(p: &Loaded, levels: [bool; 3]) -> [SmRegs; 3] {
     ]
 }
 
+/// Where each edge counter runs: (block, state machine).
+pub const fn counter_sm(c: Counter) -> (usize, usize) {
+    match c {
+        Counter::Pout => (block::POUT, 0),
+        Counter::Int => (block::PINS, 0),
+        Counter::Hold => (block::PINS, 1),
+        Counter::Aux => (block::PINS, 2),
+    }
+}
+
+/// The state machines of each block that are edge counters, as a mask.
+pub const COUNTERS: [u32; 3] = [0, 0b0001, 0b0111];
+
+/// The CTRL value that restarts (SM_RESTART) the counters of block `b`,
+/// leaving every state machine of it disabled.
+pub const fn restart_counters(b: usize) -> u32 {
+    COUNTERS[b] << ctrl::SM_RESTART
+}
+
 /// The CTRL value written to the POUT block (PIO1) that enables its SM0
 /// and, in the same write, SM0-2 of the next block (PIO2): the four
 /// counters start on one clock cycle, one timebase.
-pub const START_COUNTERS: u32 = 0b0001 << ctrl::SM_ENABLE
-    | 0b0001 << ctrl::CLKDIV_RESTART
-    | 0b0111 << ctrl::NEXT_PIO_MASK
+pub const START_COUNTERS: u32 = COUNTERS[block::POUT] << ctrl::SM_ENABLE
+    | COUNTERS[block::POUT] << ctrl::CLKDIV_RESTART
+    | COUNTERS[block::PINS] << ctrl::NEXT_PIO_MASK
     | 1 << ctrl::NEXTPREV_SM_ENABLE
     | 1 << ctrl::NEXTPREV_CLKDIV_RESTART;
 
 /// The CTRL value written to PIO1 that stops the four counters at once.
-pub const STOP_COUNTERS: u32 = 0b0111 << ctrl::NEXT_PIO_MASK | 1 << ctrl::NEXTPREV_SM_DISABLE;
+pub const STOP_COUNTERS: u32 =
+    COUNTERS[block::PINS] << ctrl::NEXT_PIO_MASK | 1 << ctrl::NEXTPREV_SM_DISABLE;
 
 #[cfg(test)]
 mod tests {

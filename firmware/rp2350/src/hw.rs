@@ -127,15 +127,6 @@ impl Rp2350 {
             pac::SIO.gpio_out(bank).value_clr().write_value(bit);
         }
     }
-
-    fn counter(c: Counter) -> (usize, usize) {
-        match c {
-            Counter::Pout => (pioregs::block::POUT, 0),
-            Counter::Int => (pioregs::block::PINS, 0),
-            Counter::Hold => (pioregs::block::PINS, 1),
-            Counter::Aux => (pioregs::block::PINS, 2),
-        }
-    }
 }
 
 impl Hal for Rp2350 {
@@ -165,7 +156,7 @@ impl Hal for Rp2350 {
     }
 
     fn capture_pull(&mut self, c: Counter) -> Option<u32> {
-        let (b, s) = Self::counter(c);
+        let (b, s) = pioregs::counter_sm(c);
         (pio(b).fstat().read().rxempty() >> s & 1 == 0).then(|| pio(b).rxf(s).read())
     }
 

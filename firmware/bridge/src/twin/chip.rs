@@ -55,7 +55,8 @@ pub struct ChipSide {
     /// ends.
     rises: VecDeque<u64>,
     pout_until: u64,
-    /// What the chip drives onto GPIO 32-47, as levels.
+    /// What the chip's outputs other than POUT, and the straps, drive onto
+    /// GPIO 32-47, as levels: taken from the model whenever it changed.
     outputs: u64,
     /// Cycles (settles) on which both sides drove one side of the shifter.
     pub contention: u64,
@@ -94,7 +95,7 @@ impl ChipSide {
             writes: 0,
             reads: 0,
         };
-        c.outputs = c.pin_levels(0);
+        c.outputs = c.pin_levels();
         c
     }
 
@@ -151,7 +152,7 @@ impl ChipSide {
             }
         }
         self.due = self.next_due(cycle);
-        self.outputs = self.pin_levels(cycle);
+        self.outputs = self.pin_levels();
     }
 
     fn next_due(&self, cycle: u64) -> u64 {
@@ -168,13 +169,12 @@ impl ChipSide {
             .unwrap_or(u64::MAX)
     }
 
-    /// The levels of GPIO 32-47 the chip's outputs and straps give.
-    fn pin_levels(&self, cycle: u64) -> u64 {
+    /// The levels of GPIO 33-47 the chip's outputs (POUT aside) and
+    /// straps give.
+    fn pin_levels(&self) -> u64 {
         let p = self.model.pins();
         let mut v = 0u64;
         let mut set = |g: u32, high: bool| v |= u64::from(high) << g;
-        let pout = cycle < self.pout_until;
-        set(pins::POUT, pout);
         set(pins::DIR, p.dir == Direction::Ccw);
         set(pins::INT, !p.int);
         set(pins::HOLD, p.hold);
@@ -200,7 +200,7 @@ impl ChipSide {
         self.pout_until = 0;
         self.driving = None;
         self.due = self.next_due(cycle);
-        self.outputs = self.pin_levels(cycle);
+        self.outputs = self.pin_levels();
     }
 }
 
@@ -306,8 +306,6 @@ impl Outside for ChipSide {
                 }
             }
         }
-        self.outputs = self.pin_levels(cycle);
-
         // What the outside drives onto the RP2350's pins.
         let mut levels = 0u64;
         let mut driven = 0u64;
@@ -321,7 +319,8 @@ impl Outside for ChipSide {
         let capture_on = bit(oe, pins::CAPTURE_OE) && !bit(out, pins::CAPTURE_OE);
         let chip_nets: u64 = (0x3FFF << pins::POUT) | 1 << pins::CSEL | 1 << pins::VSEL;
         if capture_on {
-            levels |= self.outputs & chip_nets;
+            let pout = u64::from(cycle < self.pout_until) << pins::POUT;
+            levels |= (self.outputs | pout) & chip_nets;
             driven |= chip_nets;
         } else if bit(oe, pins::TEST_GEN) {
             let g = bit(out, pins::TEST_GEN);

@@ -133,15 +133,6 @@ impl Twin {
         self.world.run_until(until, &mut self.chip);
     }
 
-    fn counter(c: Counter) -> (usize, usize) {
-        match c {
-            Counter::Pout => (block::POUT, 0),
-            Counter::Int => (block::PINS, 0),
-            Counter::Hold => (block::PINS, 1),
-            Counter::Aux => (block::PINS, 2),
-        }
-    }
-
     /// Stops the bus player, as a stuck state machine would (a test of the
     /// board code's deadlines).
     pub fn stop_bus_player(&mut self) {
@@ -181,19 +172,19 @@ impl Hal for Twin {
 
     fn capture_pull(&mut self, c: Counter) -> Option<u32> {
         self.spend(self.cpu_cycles);
-        let (b, s) = Self::counter(c);
+        let (b, s) = pioregs::counter_sm(c);
         let b = &mut self.world.blocks[b];
         (b.rx_level(s) > 0).then(|| b.rxf_read(s)).flatten()
     }
 
     fn capture_stalled(&mut self) -> bool {
         self.spend(self.cpu_cycles);
-        let pout = 1 << fdebug::RXSTALL;
-        let pins_ = 0b0111 << fdebug::RXSTALL;
-        let stalled = self.world.blocks[block::POUT].fdebug() & pout != 0
-            || self.world.blocks[block::PINS].fdebug() & pins_ != 0;
-        self.world.blocks[block::POUT].clear_fdebug(pout);
-        self.world.blocks[block::PINS].clear_fdebug(pins_);
+        let mut stalled = false;
+        for b in [block::POUT, block::PINS] {
+            let mask = pioregs::COUNTERS[b] << fdebug::RXSTALL;
+            stalled |= self.world.blocks[b].fdebug() & mask != 0;
+            self.world.blocks[b].clear_fdebug(mask);
+        }
         stalled
     }
 
@@ -222,8 +213,11 @@ impl Hal for Twin {
                 .configure(s, &regs)
                 .unwrap_or_else(|e| panic!("the counters' configuration: {e:?}"));
         }
-        self.world.blocks[block::POUT].clear_fdebug(1 << fdebug::RXSTALL);
-        self.world.blocks[block::PINS].clear_fdebug(0b0111 << fdebug::RXSTALL);
+        for b in [block::POUT, block::PINS] {
+            // Internal state cleared, as the image does; then the stalls.
+            self.world.write_ctrl(b, pioregs::restart_counters(b));
+            self.world.blocks[b].clear_fdebug(pioregs::COUNTERS[b] << fdebug::RXSTALL);
+        }
         self.spend(self.cpu_cycles);
         self.world.write_ctrl(block::POUT, START_COUNTERS);
         self.world.cycle

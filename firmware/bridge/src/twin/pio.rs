@@ -123,28 +123,25 @@ impl Sm {
         reg >> at & ((1 << bits) - 1)
     }
 
-    fn tx_depth(&self) -> usize {
+    /// (TX, RX) FIFO depths from the join bits: 4 + 4, or 8 + 0.
+    fn depths(&self) -> (usize, usize) {
         match (
             self.shiftctrl >> shiftctrl::FJOIN_TX & 1,
             self.shiftctrl >> shiftctrl::FJOIN_RX & 1,
         ) {
-            (1, 0) => 8,
-            (0, 1) => 0,
-            (0, 0) => 4,
-            _ => 0,
+            (0, 0) => (4, 4),
+            (1, 0) => (8, 0),
+            (0, 1) => (0, 8),
+            _ => (0, 0),
         }
     }
 
+    fn tx_depth(&self) -> usize {
+        self.depths().0
+    }
+
     fn rx_depth(&self) -> usize {
-        match (
-            self.shiftctrl >> shiftctrl::FJOIN_TX & 1,
-            self.shiftctrl >> shiftctrl::FJOIN_RX & 1,
-        ) {
-            (0, 1) => 8,
-            (1, 0) => 0,
-            (0, 0) => 4,
-            _ => 0,
-        }
+        self.depths().1
     }
 
     fn wrap_top(&self) -> u8 {
@@ -424,28 +421,8 @@ impl Block {
         let mut stall = false;
         match ins.operands {
             InstructionOperands::JMP { condition, address } => {
-                let c = &mut self.sm[s].core;
-                let take = match condition {
-                    JmpCondition::Always => true,
-                    JmpCondition::XIsZero => c.x == 0,
-                    JmpCondition::XDecNonZero => {
-                        let t = c.x != 0;
-                        c.x = c.x.wrapping_sub(1);
-                        t
-                    }
-                    JmpCondition::YIsZero => c.y == 0,
-                    JmpCondition::YDecNonZero => {
-                        let t = c.y != 0;
-                        c.y = c.y.wrapping_sub(1);
-                        t
-                    }
-                    JmpCondition::XNotEqualY => c.x != c.y,
-                    JmpCondition::PinHigh => jmp_level,
-                    JmpCondition::OutputShiftRegisterNotEmpty => {
-                        c.osr_count < Self::thresh(shiftctrl, shiftctrl::PULL_THRESH)
-                    }
-                };
-                if take {
+                let pull_thresh = Self::thresh(shiftctrl, shiftctrl::PULL_THRESH);
+                if jump(&mut self.sm[s].core, condition, jmp_level, pull_thresh) {
                     next = address;
                 }
             }
@@ -667,21 +644,18 @@ impl Block {
                 let InstructionOperands::JMP { condition, address } = ins.operands else {
                     return None;
                 };
-                let take = match condition {
-                    JmpCondition::Always => true,
-                    JmpCondition::XDecNonZero => {
-                        let t = c.x != 0;
-                        if !t {
-                            // The loop's exit: not a loop to skip.
-                            return None;
-                        }
-                        c.x = c.x.wrapping_sub(1);
-                        t
-                    }
-                    JmpCondition::PinHigh => seen >> self.gpio(sm.jmp_pin()) & 1 == 1,
-                    JmpCondition::YIsZero => c.y == 0,
+                match condition {
+                    // The loop's exit: not a loop to skip.
+                    JmpCondition::XDecNonZero if c.x == 0 => return None,
+                    JmpCondition::Always
+                    | JmpCondition::XDecNonZero
+                    | JmpCondition::PinHigh
+                    | JmpCondition::YIsZero => {}
+                    // X read otherwise, Y changed, the OSR: not pure.
                     _ => return None,
-                };
+                }
+                let level = seen >> self.gpio(sm.jmp_pin()) & 1 == 1;
+                let take = jump(&mut c, condition, level, 32);
                 c.pc = if take { address } else { sm.next_pc(c.pc) };
                 c.delay = ins.delay;
             }
@@ -690,6 +664,29 @@ impl Block {
             }
         }
         None
+    }
+}
+
+/// Whether a `jmp` on `condition` jumps, the JMP pin reading `jmp_level`:
+/// `x--` and `y--` test, then decrement (wrapping from 0).
+fn jump(c: &mut Core, condition: JmpCondition, jmp_level: bool, pull_thresh: u32) -> bool {
+    match condition {
+        JmpCondition::Always => true,
+        JmpCondition::XIsZero => c.x == 0,
+        JmpCondition::XDecNonZero => {
+            let t = c.x != 0;
+            c.x = c.x.wrapping_sub(1);
+            t
+        }
+        JmpCondition::YIsZero => c.y == 0,
+        JmpCondition::YDecNonZero => {
+            let t = c.y != 0;
+            c.y = c.y.wrapping_sub(1);
+            t
+        }
+        JmpCondition::XNotEqualY => c.x != c.y,
+        JmpCondition::PinHigh => jmp_level,
+        JmpCondition::OutputShiftRegisterNotEmpty => c.osr_count < pull_thresh,
     }
 }
 
