@@ -9,19 +9,11 @@
 
 mod common;
 
-use ppmc::backend::{SerialLink, SerialOptions, SerialTarget};
+use common::served::{only_error_3_fails, Served};
 use ppmc::runner::run_suite;
 use ppmc::scenario::{DriverOptions, Verdict};
-use std::io::{BufRead, BufReader};
-use std::os::unix::process::CommandExt;
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc;
-use std::time::Duration;
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+use std::path::Path;
+use std::process::{Command, Stdio};
 
 /// Whether this machine can build and run the firmware; in CI it must.
 fn available() -> bool {
@@ -41,93 +33,12 @@ fn available() -> bool {
     qemu && rust
 }
 
-/// `firmware/run-qemu` in its own process group, stopped with SIGTERM (so
-/// that it stops QEMU and removes its link) when dropped.
-struct VirtualBoard {
-    child: Child,
-    link: PathBuf,
-    _dir: tempfile::TempDir,
-}
-
-impl VirtualBoard {
-    fn start(args: &[&str]) -> VirtualBoard {
-        let dir = tempfile::tempdir().expect("scratch dir");
-        let link = dir.path().join("bridge");
-        let mut child = Command::new(repo().join("firmware/run-qemu"))
-            .arg("--link")
-            .arg(&link)
-            .args(args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .process_group(0)
-            .spawn()
-            .expect("run-qemu starts");
-        let stdout = child.stdout.take().expect("piped");
-        let (tx, rx) = mpsc::channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(stdout).lines() {
-                if tx.send(line.unwrap_or_default()).is_err() {
-                    break;
-                }
-            }
-        });
-        // Building the image the first time takes a minute or two.
-        let first = rx
-            .recv_timeout(Duration::from_secs(400))
-            .expect("run-qemu says where it serves within the time limit");
-        let mut board = VirtualBoard {
-            child,
-            link,
-            _dir: dir,
-        };
-        assert!(
-            first.starts_with("run-qemu: serving on /dev/"),
-            "unexpected first line `{first}`"
-        );
-        assert!(board.link.exists(), "the link is there");
-        assert!(board.child.try_wait().expect("wait").is_none());
-        board
-    }
-
-    fn target(&self) -> SerialTarget<SerialLink> {
-        let path = self.link.to_str().expect("utf-8 path");
-        SerialTarget::open(
-            SerialLink::open(path, 115_200).expect("the pty opens"),
-            SerialOptions::default(),
-        )
-        .expect("the firmware answers HELLO")
-    }
-}
-
-impl Drop for VirtualBoard {
-    fn drop(&mut self) {
-        // The whole group: run-qemu and the QEMU it started.
-        let group = format!("-{}", self.child.id());
-        let signal = |sig: &str| {
-            let _ = Command::new("kill")
-                .args([sig, "--", &group])
-                .stderr(Stdio::null())
-                .status();
-        };
-        signal("-TERM");
-        let deadline = std::time::Instant::now() + Duration::from_secs(10);
-        while self.child.try_wait().ok().flatten().is_none() {
-            if std::time::Instant::now() > deadline {
-                signal("-KILL");
-                let _ = self.child.wait();
-                break;
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-    }
-}
-
 #[test]
 fn the_whole_suite_through_the_firmware_equals_the_in_process_run() {
     if !available() {
         return;
     }
-    let board = VirtualBoard::start(&[]);
+    let board = Served::start("run-qemu", &[]);
     let mut t = board.target();
     let hello = t.hello().clone();
     assert!(
@@ -170,20 +81,13 @@ fn a_chip_fault_in_the_virtual_chip_is_caught_and_straps_come_from_the_board() {
     if !available() {
         return;
     }
-    let board = VirtualBoard::start(&["--chip-fault", "swap-error-3-4", "--clock-mhz", "12"]);
+    let board = Served::start(
+        "run-qemu",
+        &["--chip-fault", "swap-error-3-4", "--clock-mhz", "12"],
+    );
     let mut t = board.target();
     assert_eq!(t.hello().straps.sysclk_hz, 12_000_000);
-    let errors: Vec<_> = ppmc_scenarios::all()
-        .into_iter()
-        .filter(|s| s.has_tag("error"))
-        .collect();
-    let results = run_suite(&mut t, &errors, 1, DriverOptions::default(), |_| {});
-    let failed: Vec<&str> = results
-        .iter()
-        .filter(|r| matches!(r.verdict, Verdict::Failed(_)))
-        .map(|r| r.name)
-        .collect();
-    assert_eq!(failed, ["e3_data_without_a_command"], "{results:#?}");
+    only_error_3_fails(&mut t);
 }
 
 /// At most once across reconnects, in the firmware: the connection to the
@@ -195,7 +99,7 @@ fn a_connection_cut_at_every_frame_boundary_changes_no_verdict_on_the_firmware()
     if !available() {
         return;
     }
-    let board = VirtualBoard::start(&[]);
+    let board = Served::start("run-qemu", &[]);
     let path = board.link.to_str().expect("utf-8 path").to_string();
     let frames = common::drop_at_every_frame(
         ppmc::chaos::Upstream::Serial(path),

@@ -5,6 +5,8 @@
 
 #![allow(dead_code)] // each test file uses a different part of the helper
 
+pub mod served;
+
 use ppmc::backend::{EmuTarget, Op, Reply, Target};
 use ppmc::emu::{Chip, ModelConfig};
 use ppmc::protocol::{
