@@ -23,6 +23,10 @@ pub mod execctrl {
     pub const WRAP_BOTTOM: u32 = 7;
     pub const WRAP_TOP: u32 = 12;
     pub const JMP_PIN: u32 = 24;
+    /// 1: side-set writes pin directions, not levels.
+    pub const SIDE_PINDIR: u32 = 29;
+    /// 1: the side-set's top bit enables it (`.side_set n opt`).
+    pub const SIDE_EN: u32 = 30;
 }
 
 /// SMx_SHIFTCTRL fields.
@@ -86,6 +90,10 @@ pub struct SmRegs {
     pub start: u8,
     /// X at start (a forced `mov x, ~null` for the edge counters).
     pub x: u32,
+    /// The side-set value the forced instructions carry, for a program
+    /// with a side-set ([`Loaded::side`]): the state machine decodes them
+    /// with its side-set configuration, as it does its program.
+    pub side: Option<u8>,
 }
 
 impl SmRegs {
@@ -113,13 +121,19 @@ impl SmRegs {
             condition: JmpCondition::Always,
             address: self.start,
         };
+        let count = (self.pinctrl >> pinctrl::SIDESET_COUNT & 0b111) as u8;
+        let side_set = SideSet::new(
+            false,
+            count,
+            self.execctrl >> execctrl::SIDE_PINDIR & 1 == 1,
+        );
         [set_x, jmp].map(|operands| {
             Instruction {
                 operands,
                 delay: 0,
-                side_set: None,
+                side_set: self.side.filter(|_| count > 0),
             }
-            .encode(SideSet::default())
+            .encode(side_set)
         })
     }
 }
@@ -166,18 +180,25 @@ pub mod block {
 /// The bus player (PIO0, SM0) running `p` ([`programs::bus_player`]): OUT
 /// pins GPIO 0-12, IN base GPIO 0 (D0-D7), OUT shift right, IN shift left,
 /// no autopull or autopush, FIFOs not joined (it pushes the bytes it
-/// reads): 4 steps queue in the TX FIFO.
+/// reads): 4 steps queue in the TX FIFO. Its side-set (to directions,
+/// not optional) covers A0, CS*, DIR, RD* and WR*: GPIO 8-12.
 pub fn bus_player(p: &Loaded) -> SmRegs {
     let base = block::GPIOBASE[block::BUS];
+    let side = p.program.side_set;
     SmRegs {
         clkdiv: CLKDIV_1,
-        execctrl: wrap(p),
+        execctrl: wrap(p)
+            | u32::from(side.pindirs()) << execctrl::SIDE_PINDIR
+            | u32::from(side.optional()) << execctrl::SIDE_EN,
         shiftctrl: 1 << shiftctrl::OUT_SHIFTDIR | 8 << shiftctrl::IN_COUNT,
         pinctrl: idx(pins::D0, base) << pinctrl::OUT_BASE
             | pins::BUS_COUNT << pinctrl::OUT_COUNT
-            | idx(pins::D0, base) << pinctrl::IN_BASE,
+            | idx(pins::D0, base) << pinctrl::IN_BASE
+            | idx(pins::A0, base) << pinctrl::SIDESET_BASE
+            | u32::from(side.bits()) << pinctrl::SIDESET_COUNT,
         start: p.start,
         x: 0,
+        side: p.side,
     }
 }
 
@@ -193,6 +214,7 @@ fn counter(p: &Loaded, block: usize, pin: u32, input: u32, high: bool) -> SmRegs
         pinctrl: idx(input, base) << pinctrl::IN_BASE,
         start: if high { p.start } else { p.start_low },
         x: u32::MAX,
+        side: p.side,
     }
 }
 
@@ -292,6 +314,9 @@ mod tests {
         assert!(s.out_shiftdir() && !s.in_shiftdir() && !s.fjoin_rx() && !s.fjoin_tx());
         let p = SmPinctrl(player.pinctrl);
         assert_eq!((p.out_base(), p.out_count(), p.in_base()), (0, 13, 0));
+        assert_eq!((p.sideset_base(), p.sideset_count()), (8, 5), "A0..WR*");
+        let e = SmExecctrl(player.execctrl);
+        assert!(e.side_pindir() && !e.side_en());
         let p = SmPinctrl(pout.pinctrl);
         assert_eq!(p.in_base(), 17);
         let c = Ctrl(START_COUNTERS);

@@ -32,16 +32,20 @@ pub struct Loaded {
     pub start: u8,
     /// For an edge counter, its loop for a pin that reads low.
     pub start_low: u8,
+    /// The side-set value every instruction of the program carries, when
+    /// it has a side-set: instructions the CPU forces must carry it too.
+    pub side: Option<u8>,
 }
 
 impl Loaded {
-    fn new(program: Program<SIZE>, start: u8, start_low: u8) -> Loaded {
+    fn new(program: Program<SIZE>, start: u8, start_low: u8, side: Option<u8>) -> Loaded {
         Loaded {
             wrap_top: program.wrap.source,
             wrap_bottom: program.wrap.target,
             program,
             start,
             start_low,
+            side,
         }
     }
 
@@ -65,25 +69,40 @@ impl Loaded {
 /// joined (the RX FIFO takes the bytes read), so the TX FIFO holds 4
 /// steps: the firmware pushes a step only when the FIFO has room
 /// ([`crate::board`]).
+///
+/// `out pindirs, 8` writes all 13 OUT pins' directions: the 8 bits shifted
+/// out, and zeroes above them (RP2350 datasheet 11.4.5.2, "the remainder
+/// are zeroes", and 11.5.6, the mapping "continues for PINCTRL_OUT_COUNT
+/// bits"). Alone it would leave A0, CS*, DIR, RD* and WR* undriven from
+/// the first step on (until issue 28 it did; pioemu showed it). So every
+/// instruction side-sets those five pins' directions to driven
+/// ([`PLAYER_SIDE`], side-set to PINDIRS at A0): a side-set takes
+/// precedence over an OUT to the same pins on the same cycle (11.5.6), and
+/// takes effect even while `pull` stalls. It costs no cycle; the price is
+/// the delay field, which side-set takes whole (the program uses none).
 pub fn bus_player() -> Loaded {
     let p = pio::pio_asm!(
+        ".side_set 5 pindirs",
         ".wrap_target",
         "step:",
-        "    pull block",
-        "    out pindirs, 8",
-        "    out pins, 13",
-        "    out y, 1",
-        "    out x, 10",
+        "    pull block         side 0b11111",
+        "    out pindirs, 8     side 0b11111",
+        "    out pins, 13       side 0b11111",
+        "    out y, 1           side 0b11111",
+        "    out x, 10          side 0b11111",
         "hold:",
-        "    jmp x-- hold",
-        "    jmp !y step",
-        "    in pins, 8",
-        "    push block",
+        "    jmp x-- hold       side 0b11111",
+        "    jmp !y step        side 0b11111",
+        "    in pins, 8         side 0b11111",
+        "    push block         side 0b11111",
         ".wrap",
     )
     .program;
-    Loaded::new(p, 0, 0)
+    Loaded::new(p, 0, 0, Some(PLAYER_SIDE))
 }
+
+/// The bus player's side-set: A0, CS*, DIR, RD* and WR* driven.
+pub const PLAYER_SIDE: u8 = 0b11111;
 
 /// An edge counter on the JMP pin.
 ///
@@ -130,7 +149,7 @@ pub fn edge_counter(rising_only: bool) -> Loaded {
             ".wrap",
         );
         let d = p.public_defines;
-        Loaded::new(p.program, d.high as u8, d.low as u8)
+        Loaded::new(p.program, d.high as u8, d.low as u8, None)
     } else {
         let p = pio::pio_asm!(
             "rise:",
@@ -170,11 +189,84 @@ pub fn edge_counter(rising_only: bool) -> Loaded {
             ".wrap",
         );
         let d = p.public_defines;
-        Loaded::new(p.program, d.high as u8, d.low as u8)
+        Loaded::new(p.program, d.high as u8, d.low as u8, None)
     }
 }
 
 /// What each PIO block is loaded with, in block order.
 pub fn layout() -> [Loaded; 3] {
     [bus_player(), edge_counter(true), edge_counter(false)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bus::{BusTiming, Cycle, IDLE};
+    use crate::pioregs;
+    use crate::twin::pio::{Inputs, World};
+    use std::vec::Vec;
+
+    /// The output enables of A0, CS*, DIR, RD* and WR* on each cycle of a
+    /// write and a read played by `p`, configured and fed as the firmware
+    /// does it.
+    fn control_enables(p: &Loaded) -> Vec<u32> {
+        let mut w = World::with_program(0, 0, p.words(), 0, &pioregs::bus_player(p));
+        let all = (1u64 << 13) - 1;
+        w.blocks[0].force_pins(all, u64::from(IDLE), all);
+        let mut steps: std::collections::VecDeque<u32> =
+            [Cycle::Write { a0: true, byte: 1 }, Cycle::Read { a0: true }]
+                .iter()
+                .flat_map(|c| {
+                    let s = BusTiming::DEFAULT.steps(*c, 150_000_000).expect("fits");
+                    s.words().to_vec()
+                })
+                .collect();
+        let mut outside = Inputs(|_, _, _| (0, 0xFF));
+        let mut enables = Vec::new();
+        while !(steps.is_empty() && w.blocks[0].tx_empty(0) && w.blocks[0].sm[0].stalled) {
+            if !w.blocks[0].tx_full(0) {
+                if let Some(s) = steps.pop_front() {
+                    w.blocks[0].txf_write(0, s);
+                }
+            }
+            w.step(&mut outside);
+            enables.push((w.driven().1 >> 8 & 0x1F) as u32);
+        }
+        enables
+    }
+
+    #[test]
+    fn defect_out_pindirs_released_the_strobes_and_the_side_set_keeps_them_driven() {
+        // The player until issue 28: `out pindirs, 8` writes zeroes to the
+        // directions of the five OUT pins above D0-D7 (RP2350 datasheet
+        // 11.4.5.2, 11.5.6), which nothing set again.
+        let old = pio::pio_asm!(
+            ".wrap_target",
+            "step:",
+            "    pull block",
+            "    out pindirs, 8",
+            "    out pins, 13",
+            "    out y, 1",
+            "    out x, 10",
+            "hold:",
+            "    jmp x-- hold",
+            "    jmp !y step",
+            "    in pins, 8",
+            "    push block",
+            ".wrap",
+        )
+        .program;
+        let old = control_enables(&Loaded::new(old, 0, 0, None));
+        assert_eq!(old[0], 0b11111, "driven until the first `out pindirs`");
+        assert!(
+            old[1..].iter().all(|e| *e == 0),
+            "A0..WR* undriven from then on"
+        );
+        let ours = control_enables(&bus_player());
+        assert!(ours.len() > 100);
+        assert!(
+            ours.iter().all(|e| *e == 0b11111),
+            "A0..WR* driven on every cycle"
+        );
+    }
 }

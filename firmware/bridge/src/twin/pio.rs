@@ -13,11 +13,15 @@
 //! - inputs pass a 2-flip-flop synchroniser: a state machine sees a pin's
 //!   level of two cycles before;
 //! - `jmp x--` tests X, then decrements it, wrapping from 0 to all ones;
+//! - an OUT to PINS or PINDIRS writes all OUT_COUNT pins, zeroes above the
+//!   bits shifted out; a side-set (to pins or, with SIDE_PINDIR, to
+//!   directions) takes precedence over them on the same cycle, and takes
+//!   effect even when its instruction stalls;
 //! - one CTRL write enables state machines of a block and, through
 //!   NEXT_PIO_MASK, of the next block, on the same cycle.
 //!
 //! The instructions are decoded by the `pio` crate. What the bridge does
-//! not use (side-set, autopush and autopull, IRQs, the RX FIFO as
+//! not use (optional side-set, autopush and autopull, IRQs, the RX FIFO as
 //! registers, clock dividers other than 1) is refused when configured,
 //! not modelled approximately.
 //!
@@ -156,6 +160,14 @@ impl Sm {
         Self::field(self.execctrl, execctrl::JMP_PIN, 5)
     }
 
+    /// The side-set configuration instructions are decoded with
+    /// (PINCTRL.SIDESET_COUNT, EXECCTRL.SIDE_PINDIR).
+    fn side_set(&self) -> SideSet {
+        let count = Self::field(self.pinctrl, pinctrl::SIDESET_COUNT, 3) as u8;
+        let pindirs = Self::field(self.execctrl, execctrl::SIDE_PINDIR, 1) == 1;
+        SideSet::new(false, count, pindirs)
+    }
+
     fn in_base(&self) -> u32 {
         Self::field(self.pinctrl, pinctrl::IN_BASE, 5)
     }
@@ -165,6 +177,16 @@ impl Sm {
             0 => 32,
             n => n,
         }
+    }
+
+    /// Side-set pins: (base, count, to directions).
+    fn side_pins(&self) -> (u32, u32, bool) {
+        let ss = self.side_set();
+        (
+            Self::field(self.pinctrl, pinctrl::SIDESET_BASE, 5),
+            u32::from(ss.bits()),
+            ss.pindirs(),
+        )
     }
 
     fn next_pc(&self, pc: u8) -> u8 {
@@ -258,11 +280,12 @@ impl Block {
             )));
         }
         let side = Sm::field(regs.pinctrl, pinctrl::SIDESET_COUNT, 3);
+        let side_en = Sm::field(regs.execctrl, execctrl::SIDE_EN, 1);
         let auto = regs.shiftctrl & (1 << shiftctrl::AUTOPUSH | 1 << shiftctrl::AUTOPULL);
         let rx_as_regs = regs.shiftctrl & (0b11 << 14);
-        if side != 0 || auto != 0 || rx_as_regs != 0 {
+        if side > 5 || side_en != 0 || auto != 0 || rx_as_regs != 0 {
             return Err(Unsupported(
-                "side-set, autopush/autopull or RX FIFO registers".into(),
+                "optional side-set, autopush/autopull or RX FIFO registers".into(),
             ));
         }
         let sm = &mut self.sm[s];
@@ -284,7 +307,7 @@ impl Block {
     pub fn exec(&mut self, s: usize, word: u16, seen: u64) {
         let pc = self.sm[s].core.pc;
         let jumps = matches!(
-            Instruction::decode(word, SideSet::default()).map(|i| i.operands),
+            Instruction::decode(word, self.sm[s].side_set()).map(|i| i.operands),
             Some(InstructionOperands::JMP { .. })
         );
         self.run_instr(s, word, seen, true);
@@ -395,7 +418,7 @@ impl Block {
     /// Executes `word` on `s`: its effects, the next PC and the delay, or
     /// a stall (nothing changes, the same instruction runs next cycle).
     fn run_instr(&mut self, s: usize, word: u16, seen: u64, forced: bool) {
-        let ins = Instruction::decode(word, SideSet::default()).unwrap_or_else(|| {
+        let ins = Instruction::decode(word, self.sm[s].side_set()).unwrap_or_else(|| {
             panic!(
                 "PIO{} SM{s}: word {word:#06x} is not an instruction",
                 self.index
@@ -488,11 +511,12 @@ impl Block {
                     c.osr << n
                 };
                 c.osr_count = (c.osr_count + n).min(32);
+                // A 32-bit value, the bits shifted out and zeroes above
+                // them, goes to all OUT_COUNT pins (11.4.5.2, 11.5.6):
+                // `out pindirs, 8` with 13 OUT pins makes the top 5 inputs.
                 match destination {
-                    OutDestination::PINS => self.write_window(out_base, n.min(out_count), v, false),
-                    OutDestination::PINDIRS => {
-                        self.write_window(out_base, n.min(out_count), v, true)
-                    }
+                    OutDestination::PINS => self.write_window(out_base, out_count, v, false),
+                    OutDestination::PINDIRS => self.write_window(out_base, out_count, v, true),
                     OutDestination::X => self.sm[s].core.x = v,
                     OutDestination::Y => self.sm[s].core.y = v,
                     OutDestination::NULL => {}
@@ -594,6 +618,11 @@ impl Block {
             }
             other => panic!("PIO{} SM{s}: {other:?} is not modelled", self.index),
         }
+        // The side-set, over any OUT or SET to the same pins, stalled or not.
+        if let Some(v) = ins.side_set {
+            let (base, count, dirs) = self.sm[s].side_pins();
+            self.write_window(base, count, u32::from(v), dirs);
+        }
         let sm = &mut self.sm[s];
         sm.stalled = stall;
         if stall {
@@ -603,6 +632,14 @@ impl Block {
         if !forced {
             sm.core.delay = ins.delay;
         }
+    }
+
+    /// Whether side-setting `v` on state machine `s` leaves its pins as
+    /// they are.
+    fn side_set_holds(&self, s: usize, v: u8) -> bool {
+        let (base, count, dirs) = self.sm[s].side_pins();
+        let reg = if dirs { self.oe } else { self.out };
+        (0..count).all(|i| reg >> self.gpio(base + i) & 1 == u64::from(v >> i & 1))
     }
 
     fn thresh(shiftctrl: u32, at: u32) -> u32 {
@@ -624,7 +661,7 @@ impl Block {
         if sm.stalled && sm.core.delay == 0 {
             // A stall on a FIFO lasts until the CPU acts, if it still holds.
             let word = self.instr[usize::from(sm.core.pc)];
-            let ins = Instruction::decode(word, SideSet::default())?;
+            let ins = Instruction::decode(word, sm.side_set())?;
             return match ins.operands {
                 InstructionOperands::PULL { block: true, .. } if sm.tx.is_empty() => Some((1, 0)),
                 InstructionOperands::PUSH { block: true, .. } if sm.rx.len() >= sm.rx_depth() => {
@@ -640,10 +677,16 @@ impl Block {
                 c.delay -= 1;
             } else {
                 let word = self.instr[usize::from(c.pc)];
-                let ins = Instruction::decode(word, SideSet::default())?;
+                let ins = Instruction::decode(word, sm.side_set())?;
                 let InstructionOperands::JMP { condition, address } = ins.operands else {
                     return None;
                 };
+                // A side-set that would change a pin: not a loop to skip.
+                if let Some(v) = ins.side_set {
+                    if !self.side_set_holds(s, v) {
+                        return None;
+                    }
+                }
                 match condition {
                     // The loop's exit: not a loop to skip.
                     JmpCondition::XDecNonZero if c.x == 0 => return None,
