@@ -244,6 +244,14 @@ pub trait Bus {
     /// Runs one op on the bus's own clock and says how it ended.
     fn run(&mut self, op: Op) -> Reply;
 
+    /// The op that follows the one about to run in the same batch, if any.
+    /// A [`Op::Delay`] is the time from the moment of the op before it to
+    /// the moment of the op after it; on the reference model ops take no
+    /// time, but a bridge's bus cycles do (a write's moment is WR*'s rise,
+    /// after its setup and strobe), so a bridge ends a delay early by the
+    /// time the next op takes to reach its moment.
+    fn next_op(&mut self, _next: Option<Op>) {}
+
     /// Everything captured on the output side since the last reset.
     fn record(&self) -> &Record;
 

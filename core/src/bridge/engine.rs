@@ -346,7 +346,14 @@ impl<B: Bus> BridgeEngine<B> {
                 detail: format!("{wire_ops} ops in one batch, at most {MAX_BATCH_OPS}"),
             });
         }
-        let replies = ops.iter().map(|op| self.bus.run(*op)).collect();
+        let replies = ops
+            .iter()
+            .enumerate()
+            .map(|(i, op)| {
+                self.bus.next_op(ops.get(i + 1).copied());
+                self.bus.run(*op)
+            })
+            .collect();
         match self.bus.fault() {
             Some(what) => Err(Response::Error {
                 code: BridgeErrorCode::Hardware,

@@ -36,6 +36,7 @@ enum Tentative {
     Init {
         before: Option<(Winding, OutputLogic)>,
         was_initialized: bool,
+        was_switching: bool,
     },
 }
 
@@ -49,6 +50,8 @@ pub struct MoveTracker {
     winding: Option<(Winding, OutputLogic)>,
     /// An initialization the chip accepted since reset or software reset.
     initialized: bool,
+    /// Whether the last accepted initialization asked for stop switching.
+    switching: bool,
     /// BUSY as the last status read showed it.
     busy: bool,
     tentative: Option<Tentative>,
@@ -63,6 +66,13 @@ impl MoveTracker {
     /// energized pattern), once an initialization has set it.
     pub fn logic(&self) -> Option<OutputLogic> {
         self.winding.map(|(_, l)| l)
+    }
+
+    /// Whether the last initialization the chip accepted asked it to chop
+    /// the excitation outputs while stopped (Section 3-2, bit 5); never
+    /// between a reset and the first initialization.
+    pub fn stop_switching(&self) -> bool {
+        self.initialized && self.switching
     }
 
     /// A chip reset: nothing is known any more.
@@ -118,7 +128,9 @@ impl MoveTracker {
                     self.tentative = Some(Tentative::Init {
                         before: self.winding,
                         was_initialized: self.initialized,
+                        was_switching: self.switching,
                     });
+                    self.switching = c.stop_switching;
                     if self.winding.is_none() {
                         let w = Winding {
                             motor: c.motor,
@@ -176,9 +188,11 @@ impl MoveTracker {
             Tentative::Init {
                 before,
                 was_initialized,
+                was_switching,
             } => {
                 self.winding = before;
                 self.initialized = was_initialized;
+                self.switching = was_switching;
             }
         }
     }
@@ -220,6 +234,10 @@ impl<B: Bus> Tracked<B> {
 }
 
 impl<B: Bus> Bus for Tracked<B> {
+    fn next_op(&mut self, next: Option<Op>) {
+        self.inner.next_op(next);
+    }
+
     fn run(&mut self, op: Op) -> Reply {
         // The pattern at the write: sampled just before it, which on the
         // reference model is the same instant.
@@ -283,5 +301,38 @@ impl<B: Bus> Bus for Tracked<B> {
 
     fn capture_lost(&self) -> bool {
         self.inner.capture_lost()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An initialization (4-phase, RL 100, RH 20, PA 100) with code `code`,
+    /// then the status the chip answers.
+    fn init(t: &mut MoveTracker, rec: &mut Record, code: u8, status: u8) {
+        t.on_write(rec, true, code, Instant::ZERO, 0);
+        for b in [0x64, 0x14, 0x64, 0x00] {
+            t.on_write(rec, false, b, Instant::ZERO, 0);
+        }
+        t.on_status(rec, Status(status));
+    }
+
+    /// Section 3-2, bit 5 of the initialization code: stop switching as the
+    /// last accepted initialization asked, never before the first one.
+    #[test]
+    fn stop_switching_follows_the_last_accepted_initialization() {
+        let (mut t, mut rec) = (MoveTracker::new(), Record::default());
+        assert!(!t.stop_switching(), "none before the first initialization");
+        init(&mut t, &mut rec, 0x22, 0);
+        assert!(t.stop_switching());
+        // Refused (error flag): the one before still holds.
+        init(&mut t, &mut rec, 0x02, Status::ERROR);
+        assert!(t.stop_switching());
+        init(&mut t, &mut rec, 0x02, 0);
+        assert!(!t.stop_switching());
+        init(&mut t, &mut rec, 0x22, 0);
+        t.reset();
+        assert!(!t.stop_switching(), "a reset forgets it");
     }
 }

@@ -119,6 +119,10 @@ impl<B: Bus> Timed<B> {
 }
 
 impl<B: Bus> Bus for Timed<B> {
+    fn next_op(&mut self, next: Option<Op>) {
+        self.inner.next_op(next);
+    }
+
     fn run(&mut self, op: Op) -> Reply {
         let reply = self.inner.run(op);
         if op == Op::Reset {

@@ -12,23 +12,31 @@
 //! cycle makes the bridge report a hardware fault (protocol error
 //! `HARDWARE`), not hang.
 
-use crate::bus::{BusTiming, Cycle};
+use crate::bus::{self, BusTiming, Cycle};
 use crate::hal::{Counter, Hal};
 use crate::pins;
 use crate::timebase;
 use alloc::format;
 use alloc::string::String;
+use alloc::vec::Vec;
 use ppmc_core::bridge::moves::MoveTracker;
 use ppmc_core::bridge::wire::Timer;
 use ppmc_core::bus::{Bus, Op, Reply};
 use ppmc_core::protocol::{
-    Direction, EdgeRuns, Input as ChipInput, OutputLogic, Pin, Pins, Record, Status, Straps,
+    Direction, EdgeRuns, Input as ChipInput, OutputLogic, Pin, PinEvent, Pins, Record, Status,
+    Straps,
 };
 use ppmc_core::time::{Duration, Instant};
 
 /// The longest a bus cycle may take before the bridge calls its player
 /// stuck: 1 ms (a cycle of the longest steps takes 35 us at 150 MHz).
 const CYCLE_DEADLINE_US: u64 = 1_000;
+
+/// An edge counter has pushed its word within this many ticks of the edge
+/// (16 system clock cycles: the 2-cycle input synchroniser, a pass of the
+/// counter's loop, the push), so a drain that starts after a tick has
+/// every edge from before it, less this.
+const SETTLE_TICKS: u64 = 8;
 
 pub struct Board<H: Hal> {
     hal: H,
@@ -41,6 +49,41 @@ pub struct Board<H: Hal> {
     /// Bridge ticks at the last chip reset: time zero of the record.
     epoch: u64,
     record: Record,
+    /// Pin changes not yet in the record, in time order: the record keeps
+    /// them in time order, and they come from several sources (the edge
+    /// counters, the sampled outputs, BUSY in status reads) at different
+    /// delays. Each poll moves those no source can precede any more.
+    pending: Vec<PinEvent>,
+    /// Ticks of the last sample of the outputs the CPU reads, and of the
+    /// last POUT edge taken.
+    last_sample: u64,
+    last_pulse: u64,
+    /// The cycle the bus player will be back at its `pull` with every step
+    /// written so far played, as the board code predicts from the steps'
+    /// lengths: when the next cycle's steps start, unless they come later.
+    player_free: u64,
+    /// The moment of the last op (ticks): a write's WR* rise, a read's RD*
+    /// fall, an input's change, the pulse an `AwaitPulses` waited for, a
+    /// delay's end. A delay counts from it.
+    moment: u64,
+    /// The op after the one running, in its batch ([`Bus::next_op`]).
+    next: Option<Op>,
+    /// A delay that ended early for the op after it: when it ended, and
+    /// that op's kind.
+    after_delay: Option<(u64, Lag)>,
+    /// How long the last poll took (ticks).
+    poll_ticks: u64,
+    /// Status reads the last wait for a flag took.
+    wait_reads: u32,
+    /// How long each kind of op took from a delay's end to its moment, as
+    /// last measured (ticks; 0 until measured).
+    lags: [u64; Lag::COUNT],
+    /// RD*'s fall at the last status read (ticks).
+    last_status: u64,
+    /// The sampled outputs (masked) as last seen, and the last tick they
+    /// were seen so.
+    last_word: u16,
+    unchanged: u64,
     edges: EdgeRuns,
     tracker: MoveTracker,
     /// Last sampled S1..S5 levels, AUXO levels and DIR, for changes.
@@ -77,6 +120,55 @@ impl<H: Hal> core::fmt::Debug for Board<H> {
     }
 }
 
+/// S1..S5, AUXO0..3 and DIR in [`Hal::read_high_pins`]'s word: the
+/// outputs the CPU samples.
+const SAMPLED: u16 = {
+    let mut m = 1 << (pins::DIR - 32);
+    let mut i = 0;
+    while i < 5 {
+        m |= 1 << (pins::S[i] - 32);
+        i += 1;
+    }
+    let mut i = 0;
+    while i < 4 {
+        m |= 1 << (pins::AUXO[i] - 32);
+        i += 1;
+    }
+    m
+};
+
+/// The kinds of op a delay may end early for ([`Bus::next_op`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Lag {
+    /// A write that waits for IBF = 0 (a status read first).
+    WriteAfterIbf,
+    Write,
+    /// A read that waits for OBF = 1.
+    ReadAfterObf,
+    Read,
+    Input,
+}
+
+impl Lag {
+    const COUNT: usize = 5;
+
+    fn of(op: Op) -> Option<Lag> {
+        Some(match op {
+            Op::WriteCommand { wait_ibf, .. } | Op::WriteData { wait_ibf, .. } => {
+                if wait_ibf.is_some() {
+                    Lag::WriteAfterIbf
+                } else {
+                    Lag::Write
+                }
+            }
+            Op::ReadData { wait_obf: Some(_) } => Lag::ReadAfterObf,
+            Op::ReadData { wait_obf: None } | Op::ReadStatus => Lag::Read,
+            Op::SetInput { .. } => Lag::Input,
+            _ => return None,
+        })
+    }
+}
+
 fn level(asserted: bool) -> bool {
     // The chip's inputs are active low: asserted is low.
     !asserted
@@ -106,6 +198,19 @@ impl<H: Hal> Board<H> {
             started,
             epoch,
             record: Record::default(),
+            pending: Vec::new(),
+            last_sample: 0,
+            last_pulse: 0,
+            player_free: 0,
+            moment: epoch,
+            next: None,
+            after_delay: None,
+            wait_reads: 0,
+            poll_ticks: 0,
+            lags: [0; Lag::COUNT],
+            last_status: epoch,
+            last_word: 0,
+            unchanged: epoch,
             edges: EdgeRuns::new(timer.edge_tolerance()),
             tracker: MoveTracker::new(),
             last_s: 0,
@@ -118,7 +223,10 @@ impl<H: Hal> Board<H> {
             fault: None,
             overruns: 0,
         };
-        bus.sample(false);
+        let word = bus.hal.read_high_pins() & SAMPLED;
+        let now = bus.now_ticks();
+        bus.sample(word, bus.at(now), now, false);
+        bus.last_word = word;
         bus
     }
 
@@ -136,6 +244,11 @@ impl<H: Hal> Board<H> {
         &mut self.hal
     }
 
+    /// The record's time of system clock cycle `cycle`.
+    pub fn time_of_cycle(&self, cycle: u64) -> Instant {
+        self.at(cycle / 2)
+    }
+
     /// Ticks to the record's time.
     fn at(&self, ticks: u64) -> Instant {
         record_time(self.timer, self.epoch, ticks)
@@ -149,27 +262,54 @@ impl<H: Hal> Board<H> {
         self.now_ticks() + self.timer.to_ticks(d.as_nanos())
     }
 
-    /// Takes what the capture holds: edge words from the PIO counters and
-    /// changes of the sampled outputs. Called between ops, in every wait,
-    /// and while the bridge waits for the host.
+    /// Takes what the capture holds: the outputs the CPU samples, then the
+    /// edge words from the PIO counters (an edge from before the sample is
+    /// in its FIFO by then), and moves into the record the pin changes no
+    /// source can precede any more. Called between ops, in every wait, and
+    /// while the bridge waits for the host.
     pub fn poll(&mut self) {
-        // Ticks of the counters' timebase now: after every word waiting.
-        let now = (self.hal.cycles() - self.started) / 2;
-        let (started, timer, epoch) = (self.started, self.timer, self.epoch);
-        // A pushed word's time in the record.
-        let place = |w: u32| {
-            let e = timebase::place(w, now);
-            (e.bit, record_time(timer, epoch, started / 2 + e.at))
+        let started = self.now_ticks();
+        self.poll_inner();
+        self.poll_ticks = self.now_ticks() - started;
+    }
+
+    fn poll_inner(&mut self) {
+        let word = self.hal.read_high_pins() & SAMPLED;
+        let sampled = self.now_ticks();
+        let before = core::mem::replace(&mut self.last_sample, sampled);
+        // A change happened after the outputs were last seen unchanged and
+        // by now: stamped halfway (within half a pass of the loop that
+        // watched them).
+        let since = core::mem::replace(&mut self.unchanged, sampled);
+        let changed = self.at(since + sampled.saturating_sub(since) / 2);
+        self.last_word = word;
+        self.drain();
+        // A change of S1..S5 is a step when a POUT edge came since the
+        // last sample (or just before it, its word then still on its way).
+        let stepped = self.last_pulse + SETTLE_TICKS >= before;
+        self.sample(word, changed, sampled, stepped);
+        let horizon = self.at(sampled.saturating_sub(SETTLE_TICKS));
+        let n = self.pending.partition_point(|p| p.at <= horizon);
+        self.record.pins.extend(self.pending.drain(..n));
+    }
+
+    /// The edge counters' words, each placed in time by the clock read
+    /// after it was taken from its FIFO (so at or after its edge).
+    fn drain(&mut self) {
+        let (timer, epoch) = (self.timer, self.epoch);
+        let ticks = |hal: &H, started: u64, w: u32| {
+            let e = timebase::place(w, (hal.cycles() - started) / 2);
+            (e.bit, started / 2 + e.at)
         };
-        let mut stepped = false;
         while let Some(w) = self.hal.capture_pull(Counter::Pout) {
-            stepped = true;
-            let (bit, at) = place(w);
+            let (bit, t) = ticks(&self.hal, self.started, w);
+            self.last_pulse = self.last_pulse.max(t);
             let new_move = self
                 .record
                 .moves
                 .last()
                 .is_some_and(|m| m.first_run == self.record.runs.len());
+            let at = record_time(timer, epoch, t);
             self.edges
                 .push(&mut self.record, at, Direction::from_bit(bit), new_move);
         }
@@ -179,14 +319,14 @@ impl<H: Hal> Board<H> {
             (Counter::Aux, Pin::Aux),
         ] {
             while let Some(w) = self.hal.capture_pull(c) {
-                let (high, at) = place(w);
+                let (high, t) = ticks(&self.hal, self.started, w);
                 // HOLD's level as it is, INT*'s and AUX*'s (active low)
                 // asserted when low.
                 let value = match pin {
                     Pin::Hold => high,
                     _ => !high,
                 };
-                self.record.pin(at, pin, u8::from(value));
+                self.pin(record_time(timer, epoch, t), pin, u8::from(value));
             }
         }
         if self.hal.capture_stalled() {
@@ -198,7 +338,13 @@ impl<H: Hal> Board<H> {
             self.overruns += 1;
             self.started = self.hal.start_counters();
         }
-        self.sample(stepped);
+    }
+
+    /// A pin change, kept in time order until [`Board::poll`] moves it to
+    /// the record.
+    fn pin(&mut self, at: Instant, pin: Pin, value: u8) {
+        let i = self.pending.partition_point(|p| p.at <= at);
+        self.pending.insert(i, PinEvent { at, pin, value });
     }
 
     /// Records changes of the outputs the CPU samples.
@@ -211,8 +357,7 @@ impl<H: Hal> Board<H> {
     /// stopped: toggles closer than 1 ms are recorded as SWITCHING on, and
     /// a millisecond without one as SWITCHING off. (A heuristic of the
     /// firmware, not yet checked on hardware: docs/bridge-hardware.md.)
-    fn sample(&mut self, stepped: bool) {
-        let word = self.hal.read_high_pins();
+    fn sample(&mut self, word: u16, at: Instant, now: u64, stepped: bool) {
         let s = pins::S
             .iter()
             .fold(0u8, |v, g| v << 1 | u8::from(high(word, *g)));
@@ -221,12 +366,14 @@ impl<H: Hal> Board<H> {
             .enumerate()
             .fold(0u8, |v, (i, g)| v | u8::from(!high(word, *g)) << i);
         let dir = high(word, pins::DIR);
-        let now = self.now_ticks();
-        let at = self.at(now);
         if s != self.last_s {
             let (was, is) = (self.energized(self.last_s), self.energized(s));
             let toggle = was == 0 || is == 0;
-            let chopping = toggle && now.saturating_sub(self.last_toggle) < CHOP_TICKS;
+            // Only an initialization that asked for it makes the chip
+            // chop (Section 3-2, bit 5), never before the first one.
+            let chopping = toggle
+                && self.tracker.stop_switching()
+                && now.saturating_sub(self.last_toggle) < CHOP_TICKS;
             if toggle {
                 self.last_toggle = now;
             }
@@ -234,22 +381,22 @@ impl<H: Hal> Board<H> {
             if chopping {
                 if !self.switching {
                     self.switching = true;
-                    self.record.pin(at, Pin::Switching, 1);
+                    self.pin(at, Pin::Switching, 1);
                 }
             } else if !stepped {
-                self.record.pin(at, Pin::Phases, is);
+                self.pin(at, Pin::Phases, is);
             }
         } else if self.switching && now.saturating_sub(self.last_toggle) >= CHOP_TICKS {
             self.switching = false;
-            self.record.pin(at, Pin::Switching, 0);
+            self.pin(at, Pin::Switching, 0);
         }
         if auxo != self.last_auxo {
             self.last_auxo = auxo;
-            self.record.pin(at, Pin::Auxo, auxo);
+            self.pin(at, Pin::Auxo, auxo);
         }
         if dir != self.last_dir {
             self.last_dir = dir;
-            self.record.pin(at, Pin::Dir, u8::from(dir));
+            self.pin(at, Pin::Dir, u8::from(dir));
         }
     }
 
@@ -270,9 +417,17 @@ impl<H: Hal> Board<H> {
         }
     }
 
-    /// One bus cycle: its time, and the byte read, if a read. Each step is
-    /// written only when the player's TX FIFO has room (4 steps deep; a
-    /// write to a full FIFO is lost), and every wait has a deadline.
+    /// One bus cycle: its moment (ticks: WR*'s rise, RD*'s fall), and the
+    /// byte read, if a read. Each step is written only when the player's TX
+    /// FIFO has room (4 steps deep; a write to a full FIFO is lost), and
+    /// every wait has a deadline.
+    ///
+    /// The moment is predicted, not observed: the player takes a step at
+    /// its `pull` when both the step is in the FIFO and the step before has
+    /// played, and every step lasts what its word says, so the cycle each
+    /// step starts on follows from the cycle each word went in. (Watching
+    /// the FIFO empty would be late by the hold step and the CPU's loop:
+    /// more than Table 3-3's tolerances allow.)
     fn cycle(&mut self, c: Cycle) -> (u64, Option<u8>) {
         if self.fault.is_some() {
             return (self.now_ticks(), None);
@@ -284,6 +439,7 @@ impl<H: Hal> Board<H> {
         };
         let deadline =
             self.hal.cycles() + CYCLE_DEADLINE_US * u64::from(self.sysclk_hz / 1_000_000);
+        let mut moment = self.hal.cycles();
         for (i, w) in steps.words().iter().enumerate() {
             while self.hal.bus_tx_full() {
                 if self.hal.cycles() > deadline {
@@ -294,8 +450,14 @@ impl<H: Hal> Board<H> {
                     return (self.now_ticks(), None);
                 }
             }
-            self.hal.bus_push(*w);
+            let pushed = self.hal.bus_push(*w);
+            let pull = self.player_free.max(pushed + 1);
+            if i == c.moment_step() {
+                moment = pull + u64::from(bus::PINS_AT);
+            }
+            self.player_free = pull + u64::from(bus::step_cycles(*w));
         }
+        self.moment = moment / 2;
         let byte = match c {
             Cycle::Read { .. } => loop {
                 if let Some(w) = self.hal.bus_pull() {
@@ -320,17 +482,22 @@ impl<H: Hal> Board<H> {
                 None
             }
         };
-        (self.now_ticks(), byte)
+        (moment / 2, byte)
     }
 
     fn read_status(&mut self) -> (u64, Status) {
         let (t, b) = self.cycle(Cycle::Read { a0: true });
         let status = Status(b.unwrap_or(0));
         self.tracker.on_status(&mut self.record, status);
+        let prev = core::mem::replace(&mut self.last_status, t);
         if status.busy() != self.busy {
             self.busy = status.busy();
-            let at = self.at(t);
-            self.record.pin(at, Pin::Busy, u8::from(self.busy));
+            // BUSY changed between the last read and this one: halfway,
+            // when the reads are close (a wait's loop); else at this one.
+            let gap = t.saturating_sub(prev);
+            let close = gap <= self.timer.to_ticks(2_000);
+            let at = self.at(if close { prev + gap / 2 } else { t });
+            self.pin(at, Pin::Busy, u8::from(self.busy));
         }
         (t, status)
     }
@@ -344,7 +511,9 @@ impl<H: Hal> Board<H> {
         deadline: u64,
     ) -> Result<(u64, Status), (u64, Status)> {
         let start = self.now_ticks();
+        self.wait_reads = 0;
         loop {
+            self.wait_reads += 1;
             let (t, s) = self.read_status();
             if s.0 & mask == value {
                 return Ok((t - start.min(t), s));
@@ -394,22 +563,113 @@ impl<H: Hal> Board<H> {
         }
     }
 
-    /// The level of a PIO-captured pin: its last recorded change.
+    /// The level of a PIO-captured pin: its last change.
     fn sm_level(&self, pin: Pin) -> bool {
-        self.record
-            .pins
+        self.pending
             .iter()
             .rev()
+            .chain(self.record.pins.iter().rev())
             .find(|p| p.pin == pin)
             .is_some_and(|p| p.value == 1)
     }
 
+    /// How long an op of kind `k` takes from a delay's end to its moment
+    /// (ticks): as last measured, or until then its bus cycles' length
+    /// alone.
+    fn lag(&self, k: Lag) -> u64 {
+        let measured = self.lags[k as usize];
+        if measured > 0 {
+            return measured;
+        }
+        let cycles = |c: Cycle, to_moment: bool| -> u64 {
+            let Ok(steps) = self.timing.steps(c, self.sysclk_hz) else {
+                return 0;
+            };
+            let words = steps.words();
+            let n = if to_moment {
+                c.moment_step()
+            } else {
+                words.len()
+            };
+            let sum: u64 = words[..n]
+                .iter()
+                .map(|w| u64::from(bus::step_cycles(*w)))
+                .sum();
+            sum + if to_moment {
+                u64::from(bus::PINS_AT)
+            } else {
+                0
+            }
+        };
+        let read = Cycle::Read { a0: true };
+        let write = Cycle::Write { a0: true, byte: 0 };
+        let c = match k {
+            Lag::WriteAfterIbf => cycles(read, false) + cycles(write, true),
+            Lag::Write => cycles(write, true),
+            Lag::ReadAfterObf => cycles(read, false) + cycles(read, true),
+            Lag::Read => cycles(read, true),
+            Lag::Input => 0,
+        };
+        c / 2
+    }
+
+    /// `Op::Delay`: until `d` after the last op's moment, less the time the
+    /// next op takes to reach its own ([`Bus::next_op`]).
+    fn delay(&mut self, d: Duration) -> Reply {
+        let target = self.moment + self.timer.to_ticks(d.as_nanos());
+        let kind = self.next.and_then(Lag::of);
+        let until = target.saturating_sub(kind.map_or(0, |k| self.lag(k)));
+        loop {
+            let now = self.now_ticks();
+            if now >= until {
+                break;
+            }
+            // No poll that would end past `until`: the capture waits in
+            // its FIFOs until the next op's poll.
+            if now + self.poll_ticks < until {
+                self.poll();
+            }
+            self.idle(until);
+        }
+        let end = self.now_ticks();
+        self.after_delay = kind.map(|k| (end, k));
+        self.moment = target.max(end);
+        Reply::Delayed {
+            at: self.at(self.moment),
+        }
+    }
+
+    /// Lets the hardware idle until tick `until` or a change of the
+    /// outputs it watches.
+    fn idle(&mut self, until: u64) {
+        let seen = self.hal.idle(until * 2) / 2;
+        self.unchanged = self.unchanged.max(seen);
+    }
+
+    /// The time of pulse `n` (from 1) of the last move, if it came.
+    fn pulse_time(&self, n: u64) -> Option<Instant> {
+        let first = self.record.moves.last()?.first_run;
+        let mut left = n.checked_sub(1)?;
+        for r in &self.record.runs[first..] {
+            let c = u64::from(r.count);
+            if left < c {
+                return Some(r.at(left as u32));
+            }
+            left -= c;
+        }
+        None
+    }
+
     fn reset_chip(&mut self) -> Reply {
         self.hal.set_reset(false);
+        // The inputs start over too (`Op::Reset`): all released.
+        for i in 0..pins::INPUTS.len() {
+            self.hal.set_input(i, level(false));
+        }
         // RESET held low for 100 us, well beyond any chip's minimum.
         let until = self.deadline(Duration::from_micros(100));
         while self.now_ticks() < until {
-            self.hal.idle(until * 2);
+            self.idle(until);
         }
         self.hal.set_reset(true);
         self.poll();
@@ -417,7 +677,10 @@ impl<H: Hal> Board<H> {
         // last one is gone.
         self.started = self.hal.start_counters();
         self.epoch = self.now_ticks();
+        self.moment = self.epoch;
         self.record = Record::default();
+        self.pending.clear();
+        self.last_pulse = 0;
         self.edges.reset();
         self.tracker.reset();
         self.lost = false;
@@ -442,7 +705,11 @@ impl<H: Hal> Bus for Board<H> {
                 at: self.at(self.now_ticks()),
             };
         }
-        self.poll();
+        // Right after a delay that ended early for this op, nothing comes
+        // between: the delay's loop has just drained the capture.
+        if self.after_delay.is_none() {
+            self.poll();
+        }
         let reply = match op {
             Op::WriteCommand { byte, wait_ibf } => self.write(true, byte, wait_ibf),
             Op::WriteData { byte, wait_ibf } => self.write(false, byte, wait_ibf),
@@ -474,14 +741,7 @@ impl<H: Hal> Bus for Board<H> {
                     waited,
                 }
             }
-            Op::Delay(d) => {
-                let until = self.deadline(d);
-                while self.now_ticks() < until {
-                    self.poll();
-                    self.hal.idle(until * 2);
-                }
-                Reply::Delayed { at: self.at(until) }
-            }
+            Op::Delay(d) => self.delay(d),
             Op::AwaitStatus {
                 mask,
                 value,
@@ -503,8 +763,9 @@ impl<H: Hal> Bus for Board<H> {
             Op::SetInput { input, asserted } => {
                 let i = ChipInput::ALL.iter().position(|x| *x == input).unwrap_or(0);
                 self.hal.set_input(i, level(asserted));
+                self.moment = self.now_ticks();
                 Reply::InputSet {
-                    at: self.at(self.now_ticks()),
+                    at: self.at(self.moment),
                 }
             }
             Op::ReadPins => {
@@ -525,7 +786,11 @@ impl<H: Hal> Bus for Board<H> {
                     let n = self.record.last_move_pulses().count;
                     let t = self.now_ticks();
                     if n >= count {
-                        break Reply::PulsesReached { at: self.at(t) };
+                        // The moment is the pulse's own, not when the
+                        // capture brought it: a delay counts from it.
+                        let at = self.pulse_time(count).unwrap_or(self.at(t));
+                        self.moment = self.epoch + self.timer.to_ticks(at.as_nanos());
+                        break Reply::PulsesReached { at };
                     }
                     if t >= deadline {
                         break Reply::PulsesTimedOut {
@@ -533,13 +798,30 @@ impl<H: Hal> Bus for Board<H> {
                             count: n,
                         };
                     }
-                    self.hal.idle(deadline * 2);
+                    self.idle(deadline);
                 }
             }
             Op::Reset => self.reset_chip(),
         };
+        if matches!(op, Op::Delay(_)) && self.after_delay.is_some() {
+            return reply;
+        }
         self.poll();
+        // The first op after a delay that ended early for it: how long it
+        // took to its moment, for the next such delay (only when it did
+        // not wait on the chip).
+        if let Some((end, kind)) = self.after_delay.take() {
+            let waited =
+                matches!(kind, Lag::WriteAfterIbf | Lag::ReadAfterObf) && self.wait_reads > 1;
+            if Lag::of(op) == Some(kind) && !waited && self.moment > end {
+                self.lags[kind as usize] = self.moment - end;
+            }
+        }
         reply
+    }
+
+    fn next_op(&mut self, next: Option<Op>) {
+        self.next = next;
     }
 
     fn record(&self) -> &Record {

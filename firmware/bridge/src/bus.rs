@@ -117,6 +117,35 @@ impl Steps {
     }
 }
 
+/// Cycles from a step's `pull` to the cycle its pins show: `pull`,
+/// `out pindirs`, `out pins`.
+pub const PINS_AT: u32 = 2;
+
+/// How many system clock cycles the step `word` lasts, from its `pull` to
+/// the next: `x + 7`, or `x + 9` when it samples.
+pub fn step_cycles(word: u32) -> u32 {
+    let sampled = word >> 21 & 1 == 1;
+    (word >> 22 & MAX_COUNT)
+        + if sampled {
+            STEP_CYCLES_SAMPLED
+        } else {
+            STEP_CYCLES
+        }
+}
+
+impl Cycle {
+    /// The step whose pins make the cycle's moment: for a write, the hold
+    /// step, on whose first cycle WR* rises and the chip takes the byte;
+    /// for a read, the strobe step, on whose first cycle RD* falls and the
+    /// chip answers (Section 3-1).
+    pub fn moment_step(self) -> usize {
+        match self {
+            Cycle::Write { .. } => 2,
+            Cycle::Read { .. } => 1,
+        }
+    }
+}
+
 /// One step's word: D0-D7 directions (1 = driven), the 13 pin levels,
 /// sample, count.
 pub fn step(dirs: u8, pins: u32, sample: bool, count: u32) -> u32 {

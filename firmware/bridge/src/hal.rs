@@ -30,9 +30,10 @@ pub trait Hal {
     /// FSTAT.TXFULL of the bus player.
     fn bus_tx_full(&mut self) -> bool;
 
-    /// Writes one step to the bus player's TX FIFO. The board code calls it
-    /// only when the FIFO has room: a write to a full FIFO is lost.
-    fn bus_push(&mut self, word: u32);
+    /// Writes one step to the bus player's TX FIFO; the cycle the word went
+    /// in, as closely as the implementation can tell. The board code calls
+    /// it only when the FIFO has room: a write to a full FIFO is lost.
+    fn bus_push(&mut self, word: u32) -> u64;
 
     /// FSTAT.TXEMPTY of the bus player.
     fn bus_tx_empty(&mut self) -> bool;
@@ -61,8 +62,10 @@ pub trait Hal {
     /// The levels of GPIO 32-47, bit 0 being GPIO 32.
     fn read_high_pins(&mut self) -> u16;
 
-    /// Nothing to do before cycle `until` but drain the capture: a real
-    /// bridge carries on; the twin may skip time to the next thing that
-    /// could fill a FIFO.
-    fn idle(&mut self, _until: u64) {}
+    /// Nothing to do before cycle `until` but watch the outputs: returns
+    /// at `until`, or soon after a sampled output (S1..S5, AUXO, DIR)
+    /// changes or a capture FIFO takes a word, whichever comes first; and
+    /// the last cycle it saw the sampled outputs as they were when called,
+    /// so that a change is stamped within a pass of a short loop.
+    fn idle(&mut self, until: u64) -> u64;
 }

@@ -143,8 +143,12 @@ impl Hal for Rp2350 {
         pio(0).fstat().read().txfull() & 1 != 0
     }
 
-    fn bus_push(&mut self, word: u32) {
+    fn bus_push(&mut self, word: u32) -> u64 {
         pio(0).txf(0).write_value(word);
+        // The cycle of the write: the clock now, less the cycles since.
+        let after = DWT::cycle_count();
+        let now = self.cycles();
+        now - u64::from(DWT::cycle_count().wrapping_sub(after))
     }
 
     fn bus_tx_empty(&mut self) -> bool {
@@ -210,4 +214,48 @@ impl Hal for Rp2350 {
     fn read_high_pins(&mut self) -> u16 {
         (pac::SIO.gpio_in(1).read() & 0xFFFF) as u16
     }
+
+    fn idle(&mut self, until: u64) -> u64 {
+        // A tight loop on the sampled outputs and the capture FIFOs' empty
+        // flags: a change is seen within a pass (some 20 cycles), and the
+        // slower clock is read only every 64 passes (well under 1 us). The
+        // cycle counter's raw value marks the last pass that saw nothing.
+        let sampled = SAMPLED_MASK;
+        let seen = pac::SIO.gpio_in(1).read() & sampled;
+        let counters = |b: usize| pio(b).fstat().read().rxempty();
+        let mut quiet = DWT::cycle_count();
+        loop {
+            for _ in 0..64 {
+                if pac::SIO.gpio_in(1).read() & sampled != seen
+                    || counters(1) & 1 == 0
+                    || counters(2) & 0b0111 != 0b0111
+                {
+                    let now = self.cycles();
+                    return now - u64::from(DWT::cycle_count().wrapping_sub(quiet));
+                }
+                quiet = DWT::cycle_count();
+            }
+            let now = self.cycles();
+            if now >= until {
+                return now;
+            }
+        }
+    }
 }
+
+/// S1..S5, AUXO0..3 and DIR in GPIO_HI_IN: the outputs the board code
+/// samples.
+const SAMPLED_MASK: u32 = {
+    let mut m = 1 << (pins::DIR - 32);
+    let mut i = 0;
+    while i < 5 {
+        m |= 1 << (pins::S[i] - 32);
+        i += 1;
+    }
+    let mut i = 0;
+    while i < 4 {
+        m |= 1 << (pins::AUXO[i] - 32);
+        i += 1;
+    }
+    m
+};

@@ -173,6 +173,20 @@ fn serve(o: Options) -> Result<(), String> {
         std::os::unix::fs::symlink(&path, link)
             .map_err(|e| format!("--link {}: {e}", link.display()))?;
     }
+    // A signal during a long op (the twin runs every cycle of it) must not
+    // wait for the op to end: a second later, this thread stops the twin.
+    let link = o.link.clone();
+    std::thread::spawn(move || loop {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        if STOP.load(Ordering::Relaxed) {
+            std::thread::sleep(std::time::Duration::from_secs(1));
+            if let Some(link) = &link {
+                let _ = std::fs::remove_file(link);
+            }
+            eprintln!("run-twin: stopped in the middle of an op");
+            std::process::exit(0);
+        }
+    });
     println!("run-twin: serving on {path}");
     let _ = io::stdout().flush();
     let mut file = std::fs::File::from(master);

@@ -62,9 +62,12 @@ pub struct ChipSide {
     pub contention: u64,
     /// Settles on which a buffered line was left floating.
     pub floating: u64,
-    /// Bus writes and reads the chip took.
+    /// Bus writes and reads the chip took, and the cycle of the last of
+    /// each (WR*'s rise, RD*'s fall).
     pub writes: u64,
     pub reads: u64,
+    pub last_write: u64,
+    pub last_read: u64,
 }
 
 fn bit(v: u64, g: u32) -> bool {
@@ -94,6 +97,8 @@ impl ChipSide {
             floating: 0,
             writes: 0,
             reads: 0,
+            last_write: 0,
+            last_read: 0,
         };
         c.outputs = c.pin_levels();
         c
@@ -199,6 +204,9 @@ impl ChipSide {
         self.rises.clear();
         self.pout_until = 0;
         self.driving = None;
+        // The fresh model's inputs are released: levels on its pins that
+        // say otherwise are applied again from the next cycle.
+        self.inputs_high = 0x3FF;
         self.due = self.next_due(cycle);
         self.outputs = self.pin_levels();
     }
@@ -276,6 +284,7 @@ impl Outside for ChipSide {
                     self.model.write_data(byte);
                 }
                 self.writes += 1;
+                self.last_write = cycle;
                 self.harvest(cycle);
             }
             if self.rd && !rd && !cs {
@@ -287,6 +296,7 @@ impl Outside for ChipSide {
                 };
                 self.driving = Some(byte);
                 self.reads += 1;
+                self.last_read = cycle;
                 self.harvest(cycle);
             }
         }

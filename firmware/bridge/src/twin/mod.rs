@@ -44,7 +44,8 @@ pub struct Twin {
     pub cpu_cycles: u64,
     /// Random extra cycles per call: (state, at most).
     gaps: Option<(u64, u64)>,
-    /// Longest a call to [`Hal::idle`] lets time run unpolled, in cycles.
+    /// Cycles a pass of [`Hal::idle`]'s loop takes (read the pins and the
+    /// capture FIFOs' levels, compare): how late after a change it returns.
     pub idle_step: u64,
 }
 
@@ -60,7 +61,7 @@ impl Twin {
             layout: programs::layout(),
             cpu_cycles: CPU_CYCLES,
             gaps: None,
-            idle_step: 150,
+            idle_step: 2 * CPU_CYCLES,
         };
         t.boot().map_err(|e| format!("{e:?}"))?;
         Ok(t)
@@ -154,9 +155,10 @@ impl Hal for Twin {
         self.world.blocks[block::BUS].tx_full(0)
     }
 
-    fn bus_push(&mut self, word: u32) {
+    fn bus_push(&mut self, word: u32) -> u64 {
         self.spend(self.cpu_cycles);
         self.world.blocks[block::BUS].txf_write(0, word);
+        self.world.cycle
     }
 
     fn bus_tx_empty(&mut self) -> bool {
@@ -242,14 +244,22 @@ impl Hal for Twin {
         (self.world.pads() >> 32) as u16
     }
 
-    fn idle(&mut self, until: u64) {
-        // The CPU looks again `idle_step` cycles after the next thing the
-        // outside does (a POUT edge, a pin change), or at `until`.
+    fn idle(&mut self, until: u64) -> u64 {
+        // The CPU's loop looks every `idle_step` cycles: it sees the next
+        // thing the outside does (a POUT edge, a pin change) on its first
+        // pass after, and the pass before saw nothing yet. Or it is `until`.
         use pio::Outside;
         let now = self.world.cycle;
+        let step = self.idle_step.max(1);
         let next = self.chip.next_change(now).unwrap_or(u64::MAX);
-        let to = until.min(next.saturating_add(self.idle_step)).max(now + 1);
+        let seen = now.saturating_add(next.saturating_sub(now).div_ceil(step).saturating_mul(step));
+        let to = until.min(seen).max(now + 1);
         self.world.run_until(to, &mut self.chip);
+        if to == seen {
+            to - step
+        } else {
+            to
+        }
     }
 }
 

@@ -194,7 +194,7 @@ fn an_overrun_is_reported_and_the_next_capture_is_on_time() {
     assert!(b.capture_lost(), "the overrun is reported");
     assert!(b.overruns >= 1);
     // Then the next capture, drained as usual, is on time.
-    b.hal_mut().idle_step = 150;
+    b.hal_mut().idle_step = 2 * CPU_CYCLES;
     let ops = accel_move(1000);
     run(&mut b, &ops);
     assert!(!b.capture_lost());
@@ -406,4 +406,107 @@ fn defect_4_writing_a_cycle_without_looking_loses_steps() {
         0,
         "steps were lost (FDEBUG.TXOVER)"
     );
+}
+
+#[test]
+fn a_write_is_stamped_at_wr_rising_and_a_read_at_rd_falling() {
+    // Section 3-1: the chip takes a byte on WR*'s rising edge and answers
+    // a read from RD*'s falling edge. The board code stamps each cycle at
+    // that moment, predicted from the steps it wrote, within a tick (two
+    // cycles) of where the chip saw it: also when the CPU is slow between
+    // steps and the player waits for them.
+    for gaps in [None, Some((0x9E37_79B9_7F4A_7C15, 400))] {
+        let mut hw = Twin::new(Straps::default(), ModelConfig::default()).expect("boots");
+        if let Some((seed, max)) = gaps {
+            hw = hw.with_gaps(seed, max);
+        }
+        let mut b = crate::board::Board::new(hw, BusTiming::DEFAULT, Straps::default());
+        b.run(Op::Reset);
+        let tick = Duration::from_nanos(1_000_000_000 / crate::timebase::timer_hz(SYSCLK_HZ));
+        for i in 0..200u32 {
+            let (reply, seen) = if i % 3 == 0 {
+                let r = b.run(Op::ReadStatus);
+                (r, b.hal().chip.last_read)
+            } else {
+                let r = b.run(Op::WriteData {
+                    byte: i as u8,
+                    wait_ibf: None,
+                });
+                (r, b.hal().chip.last_write)
+            };
+            let at = match reply {
+                Reply::Written { at, .. } | Reply::Status { at, .. } => at,
+                other => panic!("{other:?}"),
+            };
+            let chip = b.time_of_cycle(seen);
+            let off = at.as_nanos().abs_diff(chip.as_nanos());
+            assert!(
+                off <= tick.as_nanos(),
+                "op {i} (gaps {gaps:?}): stamped {at}, the chip saw it at {chip}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_delay_counts_from_the_last_ops_moment_and_the_next_op_acts_on_time() {
+    // A script's delay is the time from one op's moment to the next's
+    // (`Bus::next_op`): after the pulse `AwaitPulses` waited for, the input
+    // changes, or the command is written (WR* rising), `d` later, as on
+    // the reference model, within a few ticks; not late by the capture's
+    // delay or the write's own bus cycles.
+    let d = Duration::from_nanos(25_600);
+    for write in [false, true] {
+        let mut b = twin();
+        let mut ops = accel_move(5_000);
+        ops.truncate(ops.len() - 3);
+        let engine_like = |b: &mut TwinBoard, ops: &[Op]| -> Vec<Reply> {
+            (0..ops.len())
+                .map(|i| {
+                    b.next_op(ops.get(i + 1).copied());
+                    b.run(ops[i])
+                })
+                .collect()
+        };
+        engine_like(&mut b, &ops);
+        let trigger = if write {
+            Op::WriteCommand {
+                byte: 0x08,
+                wait_ibf: Some(Duration::from_millis(1)),
+            }
+        } else {
+            Op::SetInput {
+                input: ppmc_core::protocol::Input::L3,
+                asserted: true,
+            }
+        };
+        // Twice: the second delay knows how long the op took the first time.
+        for n in [100, 200] {
+            let replies = engine_like(
+                &mut b,
+                &[
+                    Op::AwaitPulses {
+                        count: n,
+                        timeout: Duration::from_secs(1),
+                    },
+                    Op::Delay(d),
+                    trigger,
+                ],
+            );
+            let pulse = match replies[0] {
+                Reply::PulsesReached { at } => at,
+                ref r => panic!("{r:?}"),
+            };
+            let acted = match replies[2] {
+                Reply::Written { at, .. } => b.time_of_cycle(b.hal().chip.last_write).max(at),
+                Reply::InputSet { at } => at,
+                ref r => panic!("{r:?}"),
+            };
+            let late = acted.as_nanos() as i64 - (pulse + d).as_nanos() as i64;
+            assert!(
+                late.abs() <= 100,
+                "write {write}, pulse {n}: acted {late} ns off ({pulse} + {d} vs {acted})"
+            );
+        }
+    }
 }
