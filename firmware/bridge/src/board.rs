@@ -147,10 +147,12 @@ enum Lag {
     ReadAfterObf,
     Read,
     Input,
+    /// A pin sample.
+    Pins,
 }
 
 impl Lag {
-    const COUNT: usize = 5;
+    const COUNT: usize = 6;
 
     fn of(op: Op) -> Option<Lag> {
         Some(match op {
@@ -164,6 +166,7 @@ impl Lag {
             Op::ReadData { wait_obf: Some(_) } => Lag::ReadAfterObf,
             Op::ReadData { wait_obf: None } | Op::ReadStatus => Lag::Read,
             Op::SetInput { .. } => Lag::Input,
+            Op::ReadPins => Lag::Pins,
             _ => return None,
         })
     }
@@ -608,7 +611,7 @@ impl<H: Hal> Board<H> {
             Lag::Write => cycles(write, true),
             Lag::ReadAfterObf => cycles(read, false) + cycles(read, true),
             Lag::Read => cycles(read, true),
-            Lag::Input => 0,
+            Lag::Input | Lag::Pins => 0,
         };
         c / 2
     }
@@ -769,9 +772,21 @@ impl<H: Hal> Bus for Board<H> {
                 }
             }
             Op::ReadPins => {
+                let aimed = self.moment;
                 let pins = self.pins();
+                let read = self.last_sample;
+                // Read where the delay before it aimed, to a tick or two:
+                // stamped there, so that regular samples stay on their grid
+                // (one SAMPLES entry on the wire, as on the model).
+                let on_grid = read.abs_diff(aimed) <= 2;
+                if let Some((end, Lag::Pins)) = self.after_delay.take() {
+                    if read > end {
+                        self.lags[Lag::Pins as usize] = read - end;
+                    }
+                }
+                self.moment = if on_grid { aimed } else { read };
                 Reply::Pins {
-                    at: self.at(self.now_ticks()),
+                    at: self.at(self.moment),
                     pins,
                 }
             }

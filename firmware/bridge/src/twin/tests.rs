@@ -510,3 +510,35 @@ fn a_delay_counts_from_the_last_ops_moment_and_the_next_op_acts_on_time() {
         }
     }
 }
+
+#[test]
+fn regular_pin_samples_stay_on_their_grid() {
+    // `ReadPins, Delay(step)` pairs: each sample is read where its delay
+    // aimed and stamped there, so that the bridge sends them as one
+    // SAMPLES entry, as the reference model's are.
+    let mut b = twin();
+    let mut ops = accel_move(50);
+    ops.truncate(7);
+    let step = Duration::from_micros(10);
+    for _ in 0..40 {
+        ops.extend([Op::ReadPins, Op::Delay(step)]);
+    }
+    let replies: Vec<Reply> = (0..ops.len())
+        .map(|i| {
+            b.next_op(ops.get(i + 1).copied());
+            b.run(ops[i])
+        })
+        .collect();
+    let times: Vec<u64> = replies
+        .iter()
+        .filter_map(|r| match r {
+            Reply::Pins { at, .. } => Some(at.as_nanos()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(times.len(), 40);
+    // The first sample calibrates; from the second on, every step is `step`.
+    for w in times[1..].windows(2) {
+        assert_eq!(w[1] - w[0], step.as_nanos(), "{times:?}");
+    }
+}
