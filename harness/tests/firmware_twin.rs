@@ -5,17 +5,36 @@
 //! (firmware/README.md). These tests go through it as a host goes
 //! through a board.
 //!
-//! The whole suite does not yet pass through the twin (issue 28 is open on
-//! it): these tests run the scenarios it passes, and a chip fault.
+//! The whole suite (`--skip-tag long`) passes through it with the
+//! emulator's verdicts, but for the scenarios in [`NOT_YET`], each with
+//! why (issue 28 is open on them).
 
 mod common;
 
 use common::served::{only_error_3_fails, Served};
+use ppmc::backend::EmuTarget;
 use ppmc::runner::run_suite;
 use ppmc::scenario::{DriverOptions, Verdict};
+use ppmc_core::emu::ModelConfig;
+use ppmc_core::protocol::Straps;
+
+/// Scenarios the twin does not yet judge as the emulator does, and why.
+const NOT_YET: [(&str, &str); 3] = [
+    (
+        "s3_5_1_default_switching_chops_the_phases",
+        "pin samples 250 ns apart: the board code reads them about 0.6 us apart, \
+         off their grid, and the reply outgrows the protocol's limit (OVERFLOW)",
+    ),
+    ("s3_5_1_switching_parameters", "the same sampling"),
+    (
+        "s3_3_4_longest_triangle_first_pout",
+        "seconds of status polling, simulated cycle by cycle: the twin answers \
+         later than the host waits",
+    ),
+];
 
 #[test]
-fn the_board_code_on_the_twin_passes_the_errors_and_a_move() {
+fn the_suite_passes_through_the_board_code_on_the_twin_with_the_emulators_verdicts() {
     let twin = Served::start("run-twin", &[]);
     let mut t = twin.target();
     let hello = t.hello().clone();
@@ -27,17 +46,20 @@ fn the_board_code_on_the_twin_passes_the_errors_and_a_move() {
     assert_eq!(hello.timer_hz, 75_000_000, "the PIO counters' timebase");
     let chosen: Vec<_> = ppmc_scenarios::all()
         .into_iter()
-        .filter(|s| {
-            s.has_tag("error")
-                || s.name == "s3_1_1_status_is_idle_after_reset"
-                || s.name == "s3_2_2_ramp_runs_from_rl_to_rh"
-        })
+        .filter(|s| !s.has_tag("long") && !NOT_YET.iter().any(|(n, _)| *n == s.name))
         .collect();
-    assert!(chosen.len() > 5);
-    let results = run_suite(&mut t, &chosen, 1, DriverOptions::default(), |_| {});
-    for r in &results {
-        assert_eq!(r.verdict, Verdict::Passed, "{}: {:?}", r.name, r.verdict);
-    }
+    assert!(chosen.len() > 80, "{}", chosen.len());
+    let mut emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+    let want = run_suite(&mut emu, &chosen, 1, DriverOptions::default(), |_| {});
+    let got = run_suite(&mut t, &chosen, 1, DriverOptions::default(), |_| {});
+    let differ: Vec<String> = want
+        .iter()
+        .zip(&got)
+        .filter(|(w, g)| w.verdict != g.verdict)
+        .map(|(w, g)| format!("{}: emulator {:?}, twin {:?}", w.name, w.verdict, g.verdict))
+        .collect();
+    assert!(differ.is_empty(), "{}", differ.join("\n"));
+    assert!(got.iter().all(|r| r.verdict == Verdict::Passed));
     drop(t);
     let link = twin.link.clone();
     drop(twin);

@@ -506,7 +506,10 @@ impl<H: Hal> Board<H> {
     }
 
     /// Polls the status register until `status & mask == value`, at most
-    /// until `deadline`; the ticks waited, or the last status.
+    /// until `deadline`; the ticks waited, or the last status. The flag
+    /// changed between the last two reads: when they are close (the loop's
+    /// pass), the wait is taken to end halfway, the best estimate of the
+    /// chip's own moment.
     fn wait_status(
         &mut self,
         mask: u8,
@@ -515,12 +518,18 @@ impl<H: Hal> Board<H> {
     ) -> Result<(u64, Status), (u64, Status)> {
         let start = self.now_ticks();
         self.wait_reads = 0;
+        let mut prev = None;
         loop {
             self.wait_reads += 1;
             let (t, s) = self.read_status();
             if s.0 & mask == value {
-                return Ok((t - start.min(t), s));
+                let end = match prev {
+                    Some(p) if t - p <= self.timer.to_ticks(2_000) => p + (t - p) / 2,
+                    _ => t,
+                };
+                return Ok((end.saturating_sub(start), s));
             }
+            prev = Some(t);
             if t >= deadline {
                 return Err((t, s));
             }
@@ -750,10 +759,11 @@ impl<H: Hal> Bus for Board<H> {
                 value,
                 timeout,
             } => {
+                let start = self.now_ticks();
                 let deadline = self.deadline(timeout);
                 match self.wait_status(mask, value & mask, deadline) {
                     Ok((w, status)) => Reply::Awaited {
-                        at: self.at(self.now_ticks()),
+                        at: self.at(start + w),
                         waited: Duration::from_nanos(self.timer.to_nanos(w)),
                         status,
                     },
