@@ -19,19 +19,12 @@ use ppmc_core::emu::ModelConfig;
 use ppmc_core::protocol::Straps;
 
 /// Scenarios the twin does not yet judge as the emulator does, and why.
-const NOT_YET: [(&str, &str); 3] = [
-    (
-        "s3_5_1_default_switching_chops_the_phases",
-        "pin samples 250 ns apart: the board code reads them about 0.6 us apart, \
-         off their grid, and the reply outgrows the protocol's limit (OVERFLOW)",
-    ),
-    ("s3_5_1_switching_parameters", "the same sampling"),
-    (
-        "s3_3_4_longest_triangle_first_pout",
-        "seconds of status polling, simulated cycle by cycle: the twin answers \
-         later than the host waits",
-    ),
-];
+const NOT_YET: [(&str, &str); 1] = [(
+    "s3_3_4_longest_triangle_first_pout",
+    "1.3 s of a move with the board code polling status, simulated cycle \
+     by cycle: the twin answers after about a minute, later than the host \
+     waits (it passes with `--link-timeout 600s`)",
+)];
 
 #[test]
 fn the_suite_passes_through_the_board_code_on_the_twin_with_the_emulators_verdicts() {

@@ -275,6 +275,11 @@ impl Board {
         self.chip.poll_at()
     }
 
+    /// [`Chip::next_pin_change`].
+    pub fn next_pin_change(&self) -> Option<Instant> {
+        self.chip.next_pin_change()
+    }
+
     pub fn advance_to(&mut self, until: Instant) {
         self.chip.advance_to(until);
         self.take_in();
@@ -391,5 +396,41 @@ mod tests {
         // Section 3-3-2: ALM stops a move; this chip never sees it.
         assert!(!board.chip().inputs().contains(Input::Alm));
         assert!(board.chip().inputs().contains(Input::L1));
+    }
+}
+
+#[cfg(test)]
+mod chop_tests {
+    use super::*;
+    use crate::time::Duration;
+
+    /// Section 3-5-1: with stop switching, the phases go on and off by
+    /// themselves; `next_pin_change` says when, so that a harness that
+    /// follows the pins in time (the board twin) sees every edge.
+    #[test]
+    fn next_pin_change_names_every_chop_edge() {
+        let mut b = Board::new(Straps::default(), ModelConfig::default()).expect("model");
+        // 4-phase, stop switching (bit 5), RL 100, RH 20, PA 4.
+        b.write_command(0x22);
+        for byte in [100, 20, 4, 0] {
+            b.advance_to(b.chip().now() + Duration::from_micros(10));
+            b.write_data(byte);
+        }
+        b.advance_to(b.chip().now() + Duration::from_millis(40));
+        assert!(b.next_pin_change().is_some(), "chopping");
+        let mut edges = 0;
+        let mut last = b.pins().phases;
+        for _ in 0..6 {
+            let t = b.next_pin_change().expect("still chopping");
+            // Just before: unchanged; at it: changed.
+            b.advance_to(t - Duration::from_nanos(1));
+            assert_eq!(b.pins().phases, last, "no edge before {t}");
+            b.advance_to(t);
+            let now = b.pins().phases;
+            assert_ne!(now, last, "an edge at {t}");
+            last = now;
+            edges += 1;
+        }
+        assert_eq!(edges, 6);
     }
 }

@@ -38,6 +38,15 @@ const CYCLE_DEADLINE_US: u64 = 1_000;
 /// every edge from before it, less this.
 const SETTLE_TICKS: u64 = 8;
 
+/// What the code between a delay's end and the next op's moment may take,
+/// beyond the op's bus cycles, so that the op can aim its moment at the
+/// delay's end ([`Board::lead`]).
+const CPU_LEAD_US: u64 = 2;
+
+/// The step an aimed cycle starts with: the bus left idle for 47 cycles,
+/// time enough for the CPU to write the wait step after it.
+const ANCHOR: u32 = bus::step(0xFF, bus::IDLE, false, 40);
+
 pub struct Board<H: Hal> {
     hal: H,
     sysclk_hz: u32,
@@ -68,16 +77,14 @@ pub struct Board<H: Hal> {
     moment: u64,
     /// The op after the one running, in its batch ([`Bus::next_op`]).
     next: Option<Op>,
-    /// A delay that ended early for the op after it: when it ended, and
-    /// that op's kind.
-    after_delay: Option<(u64, Lag)>,
+    /// Where a delay that ended early aims the next op's moment (ticks).
+    aim: Option<u64>,
+    /// The op running ends its batch; the last batch has ended (the core
+    /// may sleep before the next: the clock is set right first).
+    ends_batch: bool,
+    batch_done: bool,
     /// How long the last poll took (ticks).
     poll_ticks: u64,
-    /// Status reads the last wait for a flag took.
-    wait_reads: u32,
-    /// How long each kind of op took from a delay's end to its moment, as
-    /// last measured (ticks; 0 until measured).
-    lags: [u64; Lag::COUNT],
     /// RD*'s fall at the last status read (ticks).
     last_status: u64,
     /// The sampled outputs (masked) as last seen, and the last tick they
@@ -137,7 +144,8 @@ const SAMPLED: u16 = {
     m
 };
 
-/// The kinds of op a delay may end early for ([`Bus::next_op`]).
+/// The kinds of op a delay ends early for ([`Bus::next_op`]), to aim
+/// their moment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Lag {
     /// A write that waits for IBF = 0 (a status read first).
@@ -152,8 +160,6 @@ enum Lag {
 }
 
 impl Lag {
-    const COUNT: usize = 6;
-
     fn of(op: Op) -> Option<Lag> {
         Some(match op {
             Op::WriteCommand { wait_ibf, .. } | Op::WriteData { wait_ibf, .. } => {
@@ -175,6 +181,19 @@ impl Lag {
 fn level(asserted: bool) -> bool {
     // The chip's inputs are active low: asserted is low.
     !asserted
+}
+
+/// S1..S5 (S1 in bit 4), AUXO0..3 asserted (bit i: AUXOi) and DIR, from
+/// [`Hal::read_high_pins`]'s word.
+fn sampled_levels(word: u16) -> (u8, u8, bool) {
+    let s = pins::S
+        .iter()
+        .fold(0u8, |v, g| v << 1 | u8::from(high(word, *g)));
+    let auxo = pins::AUXO
+        .iter()
+        .enumerate()
+        .fold(0u8, |v, (i, g)| v | u8::from(!high(word, *g)) << i);
+    (s, auxo, high(word, pins::DIR))
 }
 
 /// GPIO `g` (32-47) in [`Hal::read_high_pins`]'s word.
@@ -207,10 +226,10 @@ impl<H: Hal> Board<H> {
             player_free: 0,
             moment: epoch,
             next: None,
-            after_delay: None,
-            wait_reads: 0,
+            aim: None,
             poll_ticks: 0,
-            lags: [0; Lag::COUNT],
+            ends_batch: true,
+            batch_done: true,
             last_status: epoch,
             last_word: 0,
             unchanged: epoch,
@@ -271,6 +290,13 @@ impl<H: Hal> Board<H> {
     /// source can precede any more. Called between ops, in every wait, and
     /// while the bridge waits for the host.
     pub fn poll(&mut self) {
+        // Called between requests, when the core may have slept.
+        self.hal.resync();
+        self.refresh();
+    }
+
+    /// [`Board::poll`] within an op.
+    fn refresh(&mut self) {
         let started = self.now_ticks();
         self.poll_inner();
         self.poll_ticks = self.now_ticks() - started;
@@ -361,14 +387,7 @@ impl<H: Hal> Board<H> {
     /// a millisecond without one as SWITCHING off. (A heuristic of the
     /// firmware, not yet checked on hardware: docs/bridge-hardware.md.)
     fn sample(&mut self, word: u16, at: Instant, now: u64, stepped: bool) {
-        let s = pins::S
-            .iter()
-            .fold(0u8, |v, g| v << 1 | u8::from(high(word, *g)));
-        let auxo = pins::AUXO
-            .iter()
-            .enumerate()
-            .fold(0u8, |v, (i, g)| v | u8::from(!high(word, *g)) << i);
-        let dir = high(word, pins::DIR);
+        let (s, auxo, dir) = sampled_levels(word);
         if s != self.last_s {
             let (was, is) = (self.energized(self.last_s), self.energized(s));
             let toggle = was == 0 || is == 0;
@@ -431,7 +450,7 @@ impl<H: Hal> Board<H> {
     /// step starts on follows from the cycle each word went in. (Watching
     /// the FIFO empty would be late by the hold step and the CPU's loop:
     /// more than Table 3-3's tolerances allow.)
-    fn cycle(&mut self, c: Cycle) -> (u64, Option<u8>) {
+    fn cycle(&mut self, c: Cycle, aim: Option<u64>) -> (u64, Option<u8>) {
         if self.fault.is_some() {
             return (self.now_ticks(), None);
         }
@@ -443,22 +462,39 @@ impl<H: Hal> Board<H> {
         let deadline =
             self.hal.cycles() + CYCLE_DEADLINE_US * u64::from(self.sysclk_hz / 1_000_000);
         let mut moment = self.hal.cycles();
-        for (i, w) in steps.words().iter().enumerate() {
-            while self.hal.bus_tx_full() {
-                if self.hal.cycles() > deadline {
-                    self.fail(format!(
-                        "the bus player (PIO0 SM0) took no step for 1 ms: step {} of a {c:?} not written",
-                        i + 1
-                    ));
+        if let Some(t) = aim {
+            // The cycle's moment at tick `t`: an anchor step, whose start
+            // its push tells, then a wait step timed from it.
+            let goal = t * 2;
+            let before: u64 = steps.words()[..c.moment_step()]
+                .iter()
+                .map(|w| u64::from(bus::step_cycles(*w)))
+                .sum::<u64>()
+                + u64::from(bus::PINS_AT);
+            let anchor = u64::from(bus::step_cycles(ANCHOR));
+            let fits = anchor + u64::from(bus::MAX_COUNT + bus::STEP_CYCLES) + before;
+            while self.hal.cycles() + fits < goal {}
+            let Some(pull) = self.push_step(ANCHOR, deadline, c) else {
+                return (self.now_ticks(), None);
+            };
+            let waited = pull + anchor + u64::from(bus::STEP_CYCLES) + before;
+            if goal >= waited {
+                let count = (goal - waited).min(u64::from(bus::MAX_COUNT)) as u32;
+                if self
+                    .push_step(bus::step(0xFF, bus::IDLE, false, count), deadline, c)
+                    .is_none()
+                {
                     return (self.now_ticks(), None);
                 }
             }
-            let pushed = self.hal.bus_push(*w);
-            let pull = self.player_free.max(pushed + 1);
+        }
+        for (i, w) in steps.words().iter().enumerate() {
+            let Some(pull) = self.push_step(*w, deadline, c) else {
+                return (self.now_ticks(), None);
+            };
             if i == c.moment_step() {
                 moment = pull + u64::from(bus::PINS_AT);
             }
-            self.player_free = pull + u64::from(bus::step_cycles(*w));
         }
         self.moment = moment / 2;
         let byte = match c {
@@ -488,8 +524,26 @@ impl<H: Hal> Board<H> {
         (moment / 2, byte)
     }
 
-    fn read_status(&mut self) -> (u64, Status) {
-        let (t, b) = self.cycle(Cycle::Read { a0: true });
+    /// Writes step `w` when the player's TX FIFO has room; the cycle the
+    /// player will take it on (its `pull`), predicted. `None` when the
+    /// player took no step for the cycle's deadline: a hardware fault.
+    fn push_step(&mut self, w: u32, deadline: u64, c: Cycle) -> Option<u64> {
+        while self.hal.bus_tx_full() {
+            if self.hal.cycles() > deadline {
+                self.fail(format!(
+                    "the bus player (PIO0 SM0) took no step for 1 ms: a step of a {c:?} not written"
+                ));
+                return None;
+            }
+        }
+        let pushed = self.hal.bus_push(w);
+        let pull = self.player_free.max(pushed + 1);
+        self.player_free = pull + u64::from(bus::step_cycles(w));
+        Some(pull)
+    }
+
+    fn read_status(&mut self, aim: Option<u64>) -> (u64, Status) {
+        let (t, b) = self.cycle(Cycle::Read { a0: true }, aim);
         let status = Status(b.unwrap_or(0));
         self.tracker.on_status(&mut self.record, status);
         let prev = core::mem::replace(&mut self.last_status, t);
@@ -517,11 +571,9 @@ impl<H: Hal> Board<H> {
         deadline: u64,
     ) -> Result<(u64, Status), (u64, Status)> {
         let start = self.now_ticks();
-        self.wait_reads = 0;
         let mut prev = None;
         loop {
-            self.wait_reads += 1;
-            let (t, s) = self.read_status();
+            let (t, s) = self.read_status(None);
             if s.0 & mask == value {
                 let end = match prev {
                     Some(p) if t - p <= self.timer.to_ticks(2_000) => p + (t - p) / 2,
@@ -533,7 +585,7 @@ impl<H: Hal> Board<H> {
             if t >= deadline {
                 return Err((t, s));
             }
-            self.poll();
+            self.refresh();
         }
     }
 
@@ -552,16 +604,17 @@ impl<H: Hal> Board<H> {
             }
         }
         let phases = self.energized(self.last_s);
-        let (t, _) = self.cycle(Cycle::Write { a0: command, byte });
+        let aim = self.aim;
+        let (t, _) = self.cycle(Cycle::Write { a0: command, byte }, aim);
         let at = self.at(t);
-        self.poll();
+        self.refresh();
         self.tracker
             .on_write(&mut self.record, command, byte, at, phases);
         Reply::Written { at, waited }
     }
 
     fn pins(&mut self) -> Pins {
-        self.poll();
+        self.refresh();
         let phases = self.energized(self.last_s);
         Pins {
             int: self.sm_level(Pin::Int),
@@ -571,6 +624,21 @@ impl<H: Hal> Board<H> {
             phases,
             phase_levels: self.last_s,
             dir: Direction::from_bit(self.last_dir),
+            busy: self.busy,
+        }
+    }
+
+    /// The pins as GPIO 32-47 show them in `word`, read just now.
+    fn pins_from(&self, word: u16) -> Pins {
+        let (s, auxo, dir) = sampled_levels(word);
+        Pins {
+            int: !high(word, pins::INT),
+            hold: high(word, pins::HOLD),
+            aux: !high(word, pins::AUX),
+            auxo,
+            phases: self.energized(s),
+            phase_levels: s,
+            dir: Direction::from_bit(dir),
             busy: self.busy,
         }
     }
@@ -585,14 +653,10 @@ impl<H: Hal> Board<H> {
             .is_some_and(|p| p.value == 1)
     }
 
-    /// How long an op of kind `k` takes from a delay's end to its moment
-    /// (ticks): as last measured, or until then its bus cycles' length
-    /// alone.
-    fn lag(&self, k: Lag) -> u64 {
-        let measured = self.lags[k as usize];
-        if measured > 0 {
-            return measured;
-        }
+    /// How long before its moment an op of kind `k` must start (ticks):
+    /// its bus cycles before the moment (a status read first, for one that
+    /// waits on a flag), and [`CPU_LEAD_US`] for the code between.
+    fn lead(&self, k: Lag) -> u64 {
         let cycles = |c: Cycle, to_moment: bool| -> u64 {
             let Ok(steps) = self.timing.steps(c, self.sysclk_hz) else {
                 return 0;
@@ -615,22 +679,26 @@ impl<H: Hal> Board<H> {
         };
         let read = Cycle::Read { a0: true };
         let write = Cycle::Write { a0: true, byte: 0 };
+        let anchor = u64::from(bus::step_cycles(ANCHOR));
         let c = match k {
-            Lag::WriteAfterIbf => cycles(read, false) + cycles(write, true),
-            Lag::Write => cycles(write, true),
-            Lag::ReadAfterObf => cycles(read, false) + cycles(read, true),
-            Lag::Read => cycles(read, true),
+            Lag::WriteAfterIbf => cycles(read, false) + anchor + cycles(write, true),
+            Lag::Write => anchor + cycles(write, true),
+            Lag::ReadAfterObf => cycles(read, false) + anchor + cycles(read, true),
+            Lag::Read => anchor + cycles(read, true),
             Lag::Input | Lag::Pins => 0,
         };
-        c / 2
+        c / 2 + self.timer.to_ticks(CPU_LEAD_US * 1_000)
     }
 
-    /// `Op::Delay`: until `d` after the last op's moment, less the time the
-    /// next op takes to reach its own ([`Bus::next_op`]).
+    /// `Op::Delay`: until `d` after the last op's moment. When the next op
+    /// is one with a moment ([`Bus::next_op`]), the delay ends early by
+    /// that op's [`Board::lead`], and the op aims its moment at the delay's
+    /// end: a bus cycle through a wait step in the player, to the cycle; an
+    /// input or a pin sample by spinning on the clock.
     fn delay(&mut self, d: Duration) -> Reply {
         let target = self.moment + self.timer.to_ticks(d.as_nanos());
         let kind = self.next.and_then(Lag::of);
-        let until = target.saturating_sub(kind.map_or(0, |k| self.lag(k)));
+        let until = target.saturating_sub(kind.map_or(0, |k| self.lead(k)));
         loop {
             let now = self.now_ticks();
             if now >= until {
@@ -639,16 +707,22 @@ impl<H: Hal> Board<H> {
             // No poll that would end past `until`: the capture waits in
             // its FIFOs until the next op's poll.
             if now + self.poll_ticks < until {
-                self.poll();
+                self.refresh();
             }
             self.idle(until);
         }
         let end = self.now_ticks();
-        self.after_delay = kind.map(|k| (end, k));
+        // Late (the CPU took longer than `d`): the next op acts now.
+        self.aim = kind.map(|_| target.max(end));
         self.moment = target.max(end);
         Reply::Delayed {
             at: self.at(self.moment),
         }
+    }
+
+    /// Spins on the clock until tick `t`.
+    fn spin_until(&mut self, t: u64) {
+        while self.now_ticks() < t {}
     }
 
     /// Lets the hardware idle until tick `until` or a change of the
@@ -684,7 +758,7 @@ impl<H: Hal> Board<H> {
             self.idle(until);
         }
         self.hal.set_reset(true);
-        self.poll();
+        self.refresh();
         // A fresh timebase for the new record: whatever a stall did to the
         // last one is gone.
         self.started = self.hal.start_counters();
@@ -717,16 +791,28 @@ impl<H: Hal> Bus for Board<H> {
                 at: self.at(self.now_ticks()),
             };
         }
-        // Right after a delay that ended early for this op, nothing comes
-        // between: the delay's loop has just drained the capture.
-        if self.after_delay.is_none() {
-            self.poll();
+        // The core may have slept since the batch before (between
+        // requests, in the executor's `wfe`), never within one.
+        if self.batch_done {
+            self.hal.resync();
+            self.batch_done = false;
+        }
+        // The capture is drained between ops, but for those aimed at a
+        // moment: an op right after a delay that ended early for it, and a
+        // delay that will end early for the next (its loop drains the
+        // capture while there is time). A tight run of pin samples so
+        // drains nothing; a FIFO that fills meanwhile stalls its counter,
+        // and the next drain reports the capture lost (CAPTURE_OVERRUN).
+        let aimed = self.aim.is_some();
+        let aiming = matches!(op, Op::Delay(_)) && self.next.and_then(Lag::of).is_some();
+        if !aimed && !aiming {
+            self.refresh();
         }
         let reply = match op {
             Op::WriteCommand { byte, wait_ibf } => self.write(true, byte, wait_ibf),
             Op::WriteData { byte, wait_ibf } => self.write(false, byte, wait_ibf),
             Op::ReadStatus => {
-                let (t, status) = self.read_status();
+                let (t, status) = self.read_status(self.aim);
                 Reply::Status {
                     at: self.at(t),
                     status,
@@ -746,7 +832,8 @@ impl<H: Hal> Bus for Board<H> {
                         }
                     }
                 }
-                let (t, b) = self.cycle(Cycle::Read { a0: false });
+                let aim = self.aim;
+                let (t, b) = self.cycle(Cycle::Read { a0: false }, aim);
                 Reply::Data {
                     at: self.at(t),
                     byte: b.unwrap_or(0),
@@ -775,31 +862,39 @@ impl<H: Hal> Bus for Board<H> {
             }
             Op::SetInput { input, asserted } => {
                 let i = ChipInput::ALL.iter().position(|x| *x == input).unwrap_or(0);
+                if let Some(t) = self.aim {
+                    self.spin_until(t);
+                }
                 self.hal.set_input(i, level(asserted));
                 self.moment = self.now_ticks();
                 Reply::InputSet {
                     at: self.at(self.moment),
                 }
             }
-            Op::ReadPins => {
-                let aimed = self.moment;
-                let pins = self.pins();
-                let read = self.last_sample;
-                // Read where the delay before it aimed, to a tick or two:
-                // stamped there, so that regular samples stay on their grid
-                // (one SAMPLES entry on the wire, as on the model).
-                let on_grid = read.abs_diff(aimed) <= 2;
-                if let Some((end, Lag::Pins)) = self.after_delay.take() {
-                    if read > end {
-                        self.lags[Lag::Pins as usize] = read - end;
+            Op::ReadPins => match self.aim {
+                Some(t) => {
+                    // Read where the delay before it aimed, the cycles of a
+                    // GPIO read after the clock said so: stamped there, so
+                    // that regular samples stay on their grid (one SAMPLES
+                    // entry on the wire, as on the model). No poll: the
+                    // capture waits in its FIFOs (a tight sampling loop).
+                    self.spin_until(t);
+                    let word = self.hal.read_high_pins();
+                    self.moment = t;
+                    Reply::Pins {
+                        at: self.at(t),
+                        pins: self.pins_from(word),
                     }
                 }
-                self.moment = if on_grid { aimed } else { read };
-                Reply::Pins {
-                    at: self.at(self.moment),
-                    pins,
+                None => {
+                    let pins = self.pins();
+                    self.moment = self.last_sample;
+                    Reply::Pins {
+                        at: self.at(self.moment),
+                        pins,
+                    }
                 }
-            }
+            },
             Op::ReadPulses => Reply::Pulses {
                 at: self.at(self.now_ticks()),
                 summary: self.record.last_move_pulses(),
@@ -807,7 +902,7 @@ impl<H: Hal> Bus for Board<H> {
             Op::AwaitPulses { count, timeout } => {
                 let deadline = self.deadline(timeout);
                 loop {
-                    self.poll();
+                    self.refresh();
                     let n = self.record.last_move_pulses().count;
                     let t = self.now_ticks();
                     if n >= count {
@@ -828,25 +923,21 @@ impl<H: Hal> Bus for Board<H> {
             }
             Op::Reset => self.reset_chip(),
         };
-        if matches!(op, Op::Delay(_)) && self.after_delay.is_some() {
+        if matches!(op, Op::Delay(_)) && self.aim.is_some() {
             return reply;
         }
-        self.poll();
-        // The first op after a delay that ended early for it: how long it
-        // took to its moment, for the next such delay (only when it did
-        // not wait on the chip).
-        if let Some((end, kind)) = self.after_delay.take() {
-            let waited =
-                matches!(kind, Lag::WriteAfterIbf | Lag::ReadAfterObf) && self.wait_reads > 1;
-            if Lag::of(op) == Some(kind) && !waited && self.moment > end {
-                self.lags[kind as usize] = self.moment - end;
-            }
+        if !(aimed && op == Op::ReadPins) || self.ends_batch {
+            self.refresh();
         }
+        self.batch_done |= self.ends_batch;
+        self.aim = None;
         reply
     }
 
     fn next_op(&mut self, next: Option<Op>) {
         self.next = next;
+        // The op about to run ends its batch.
+        self.ends_batch = next.is_none();
     }
 
     fn record(&self) -> &Record {

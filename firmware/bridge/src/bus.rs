@@ -148,8 +148,8 @@ impl Cycle {
 
 /// One step's word: D0-D7 directions (1 = driven), the 13 pin levels,
 /// sample, count.
-pub fn step(dirs: u8, pins: u32, sample: bool, count: u32) -> u32 {
-    u32::from(dirs) | (pins & 0x1FFF) << 8 | u32::from(sample) << 21 | (count & MAX_COUNT) << 22
+pub const fn step(dirs: u8, pins: u32, sample: bool, count: u32) -> u32 {
+    dirs as u32 | (pins & 0x1FFF) << 8 | (sample as u32) << 21 | (count & MAX_COUNT) << 22
 }
 
 /// The idle bus: strobes and CS* high, shifter towards the chip, D0-D7

@@ -59,6 +59,14 @@ impl Clock {
         self.cycles
     }
 
+    /// Cycles now from the cycle counter alone (`fine`), if it cannot have
+    /// wrapped since the last [`Clock::update`] (2^30 cycles: 7 s at
+    /// 150 MHz): exact unless the core slept since.
+    pub fn extend(&self, fine: u32) -> Option<u64> {
+        let d = fine.wrapping_sub(self.last_fine);
+        (d < 1 << 30).then_some(self.cycles + u64::from(d))
+    }
+
     /// The last reading's cycles.
     pub fn cycles(&self) -> u64 {
         self.cycles

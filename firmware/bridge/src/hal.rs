@@ -23,9 +23,15 @@ pub trait Hal {
     /// The system clock's frequency.
     fn sysclk_hz(&self) -> u32;
 
-    /// System clock cycles since boot, from a clock that keeps counting
-    /// while the core sleeps.
+    /// System clock cycles since boot: cheap (the RP2350 image extends the
+    /// core's cycle counter), and exact as long as the core has not slept
+    /// since the last [`Hal::resync`].
     fn cycles(&self) -> u64;
+
+    /// Sets the clock right again from a source that keeps counting while
+    /// the core sleeps (the 1 MHz timer): the board code calls it at every
+    /// op and whenever it polls between requests.
+    fn resync(&mut self);
 
     /// FSTAT.TXFULL of the bus player.
     fn bus_tx_full(&mut self) -> bool;

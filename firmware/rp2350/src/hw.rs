@@ -108,6 +108,13 @@ fn now_us() -> u64 {
 }
 
 impl Rp2350 {
+    /// Reads the cycle counter and the timer together and sets the clock
+    /// by them (`ppmc_bridge_fw::clock`).
+    fn update(&self) -> u64 {
+        let (fine, us) = cortex_m::interrupt::free(|_| (DWT::cycle_count(), now_us()));
+        self.clock.borrow_mut().update(fine, us)
+    }
+
     /// The hardware layer, with the cycle counter running (`start`) and
     /// the counters' programs (PIO1's and PIO2's) loaded.
     pub fn new(sysclk_hz: u32, pout: Loaded, pins_: Loaded) -> Rp2350 {
@@ -135,8 +142,14 @@ impl Hal for Rp2350 {
     }
 
     fn cycles(&self) -> u64 {
-        let (fine, us) = cortex_m::interrupt::free(|_| (DWT::cycle_count(), now_us()));
-        self.clock.borrow_mut().update(fine, us)
+        if let Some(c) = self.clock.borrow().extend(DWT::cycle_count()) {
+            return c;
+        }
+        self.update()
+    }
+
+    fn resync(&mut self) {
+        self.update();
     }
 
     fn bus_tx_full(&mut self) -> bool {

@@ -380,6 +380,13 @@ impl Chip {
         }
     }
 
+    /// When the output pins next change by themselves with no event of the
+    /// model's (stop switching's chopping, Section 3-5-1): the first such
+    /// time after now, if any. For a harness that follows the pins in time.
+    pub fn next_pin_change(&self) -> Option<Instant> {
+        self.next_chop(self.now)
+    }
+
     /// Pulses output so far by the move in progress (or the last move).
     pub fn move_pulses(&self) -> u64 {
         match &self.motion {

@@ -493,6 +493,22 @@ impl Chip {
         }
     }
 
+    /// The first time after `t` at which stop switching turns the phases on
+    /// or off ([`Chip::energized`]'s next edge), while it chops.
+    pub(super) fn next_chop(&self, t: Instant) -> Option<Instant> {
+        let since = self.switching_since?;
+        let (on, off) = (self.switch_on.as_nanos(), self.switch_off.as_nanos());
+        let cycle = (on + off).max(1);
+        let elapsed = t.saturating_since(since).as_nanos();
+        let start = elapsed - elapsed % cycle;
+        let next = if elapsed % cycle < on {
+            start + on
+        } else {
+            start + cycle
+        };
+        Some(since + Duration::from_nanos(next))
+    }
+
     /// Pin levels of S1..S5 for an energized pattern (Section 3-2-1).
     pub(super) fn levels(&self, energized: u8) -> u8 {
         match self.logic {

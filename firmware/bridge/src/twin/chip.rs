@@ -166,7 +166,9 @@ impl ChipSide {
             .predict_pulse(self.model.move_pulses() + 1)
             .map(|t| self.cycle_of(t));
         let poll = self.model.poll_at().map(|t| self.cycle_of(t));
-        [pulse, poll]
+        // Stop switching chops S1..S5 with no event of the model's.
+        let chop = self.model.next_pin_change().map(|t| self.cycle_of(t));
+        [pulse, poll, chop]
             .into_iter()
             .flatten()
             .map(|c| c.max(cycle + 1))

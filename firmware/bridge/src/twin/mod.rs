@@ -34,6 +34,15 @@ pub const SYSCLK_HZ: u32 = 150_000_000;
 /// register access and the loop around it.
 pub const CPU_CYCLES: u64 = 12;
 
+/// Cycles a reading of the bridge's clock costs the RP2350 image
+/// (`Hal::cycles`: the cycle counter, extended): some 6.
+pub const CLOCK_CYCLES: u64 = 6;
+
+/// Cycles setting the clock right costs (`Hal::resync`: interrupts off,
+/// the cycle counter, the 1 MHz timer's two words, the clock's 64-bit
+/// arithmetic): some 64.
+pub const RESYNC_CYCLES: u64 = 64;
+
 /// The twin's hardware: the RP2350's PIO and GPIOs, the board around it.
 #[derive(Debug)]
 pub struct Twin {
@@ -44,6 +53,9 @@ pub struct Twin {
     pub cpu_cycles: u64,
     /// Random extra cycles per call: (state, at most).
     gaps: Option<(u64, u64)>,
+    /// Clock readings not yet paid for: the world runs them off at the next
+    /// call that spends.
+    owed: core::cell::Cell<u64>,
     /// Cycles a pass of [`Hal::idle`]'s loop takes (read the pins and the
     /// capture FIFOs' levels, compare): how late after a change it returns.
     pub idle_step: u64,
@@ -62,6 +74,7 @@ impl Twin {
             cpu_cycles: CPU_CYCLES,
             gaps: None,
             idle_step: 2 * CPU_CYCLES,
+            owed: core::cell::Cell::new(0),
         };
         t.boot().map_err(|e| format!("{e:?}"))?;
         Ok(t)
@@ -121,7 +134,7 @@ impl Twin {
 
     /// Spends `n` CPU cycles (plus a gap, if any): the hardware runs.
     fn spend(&mut self, n: u64) {
-        let mut n = n;
+        let mut n = n + self.owed.take();
         if let Some((s, max)) = self.gaps.as_mut() {
             *s ^= *s << 13;
             *s ^= *s >> 7;
@@ -147,7 +160,14 @@ impl Hal for Twin {
     }
 
     fn cycles(&self) -> u64 {
-        self.world.cycle
+        // The reading costs its cycles; it says the time at its end.
+        let owed = self.owed.get() + CLOCK_CYCLES;
+        self.owed.set(owed);
+        self.world.cycle + owed
+    }
+
+    fn resync(&mut self) {
+        self.spend(RESYNC_CYCLES);
     }
 
     fn bus_tx_full(&mut self) -> bool {
@@ -249,6 +269,7 @@ impl Hal for Twin {
         // thing the outside does (a POUT edge, a pin change) on its first
         // pass after, and the pass before saw nothing yet. Or it is `until`.
         use pio::Outside;
+        self.spend(0);
         let now = self.world.cycle;
         let step = self.idle_step.max(1);
         let next = self.chip.next_change(now).unwrap_or(u64::MAX);

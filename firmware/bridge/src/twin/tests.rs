@@ -202,9 +202,12 @@ fn an_overrun_is_reported_and_the_next_capture_is_on_time() {
     run(&mut emu, &ops);
     let (t, e) = (pulse_times(&b), pulse_times(&emu));
     assert_eq!(t.len(), 1000);
+    // The model's bus cycles take no time; the twin's, and its status
+    // polling for IBF between the command's bytes, some microseconds each:
+    // a stalled counter would put it milliseconds off.
     let offset = t[0] as i64 - e[0] as i64;
     assert!(
-        offset.abs() < 20_000,
+        offset.abs() < 50_000,
         "first pulse {offset} ns off the model's"
     );
     for (a, m) in t.iter().zip(&e) {
@@ -451,10 +454,11 @@ fn a_write_is_stamped_at_wr_rising_and_a_read_at_rd_falling() {
 #[test]
 fn a_delay_counts_from_the_last_ops_moment_and_the_next_op_acts_on_time() {
     // A script's delay is the time from one op's moment to the next's
-    // (`Bus::next_op`): after the pulse `AwaitPulses` waited for, the input
-    // changes, or the command is written (WR* rising), `d` later, as on
-    // the reference model, within a few ticks; not late by the capture's
-    // delay or the write's own bus cycles.
+    // (`Bus::next_op`): after the pulse `AwaitPulses` waited for, the
+    // command is written (WR* rising) `d` later, as on the reference model,
+    // to a tick; an input changes within the last pass of a spin on the
+    // clock and a GPIO write. Not late by the capture's delay or the
+    // write's own bus cycles (a microsecond, before issue 28's twin).
     let d = Duration::from_nanos(25_600);
     for write in [false, true] {
         let mut b = twin();
@@ -503,8 +507,9 @@ fn a_delay_counts_from_the_last_ops_moment_and_the_next_op_acts_on_time() {
                 ref r => panic!("{r:?}"),
             };
             let late = acted.as_nanos() as i64 - (pulse + d).as_nanos() as i64;
+            let within = if write { 27 } else { 150 };
             assert!(
-                late.abs() <= 100,
+                (0..=within).contains(&late),
                 "write {write}, pulse {n}: acted {late} ns off ({pulse} + {d} vs {acted})"
             );
         }
@@ -519,7 +524,8 @@ fn regular_pin_samples_stay_on_their_grid() {
     let mut b = twin();
     let mut ops = accel_move(50);
     ops.truncate(7);
-    let step = Duration::from_micros(10);
+    // 250 ns apart, as the stop-switching scenarios sample (Section 3-5-1).
+    let step = Duration::from_nanos(250);
     for _ in 0..40 {
         ops.extend([Op::ReadPins, Op::Delay(step)]);
     }
@@ -537,8 +543,10 @@ fn regular_pin_samples_stay_on_their_grid() {
         })
         .collect();
     assert_eq!(times.len(), 40);
-    // The first sample calibrates; from the second on, every step is `step`.
-    for w in times[1..].windows(2) {
-        assert_eq!(w[1] - w[0], step.as_nanos(), "{times:?}");
+    // Every step is `step` in the bridge's ticks (19 of 13.3 ns).
+    let timer = b.timer();
+    let ticks: Vec<u64> = times.iter().map(|t| timer.to_ticks(*t)).collect();
+    for w in ticks.windows(2) {
+        assert_eq!(w[1] - w[0], timer.to_ticks(step.as_nanos()), "{times:?}");
     }
 }
