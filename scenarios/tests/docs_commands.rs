@@ -38,7 +38,7 @@ const FILES: [&str; 12] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 21] = [
+const ELSEWHERE: [(&str, &str); 22] = [
     (
         "timeout -s INT 5 ppmc run",
         "in scenarios/tests/cli_signals.rs (timeout -s INT during the long move on a real-time bridge, ten times)",
@@ -80,6 +80,10 @@ const ELSEWHERE: [(&str, &str); 21] = [
     (
         "firmware/run-qemu",
         "in harness/tests/firmware_qemu.rs (started, the whole suite run through it, stopped)",
+    ),
+    (
+        "cargo run -q --release --locked --manifest-path firmware/Cargo.toml -p ppmc-bridge-fw --features twin --example capture_margin",
+        "in .ci/run (the firmware step: the twin's capture margin)",
     ),
     (
         "firmware/pioemu/run",

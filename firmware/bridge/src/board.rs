@@ -83,6 +83,8 @@ pub struct Board<H: Hal> {
     /// may sleep before the next: the clock is set right first).
     ends_batch: bool,
     batch_done: bool,
+    /// Pin samples taken without a poll around them.
+    samples: u32,
     /// How long the last poll took (ticks).
     poll_ticks: u64,
     /// RD*'s fall at the last status read (ticks).
@@ -228,6 +230,7 @@ impl<H: Hal> Board<H> {
             next: None,
             aim: None,
             poll_ticks: 0,
+            samples: 0,
             ends_batch: true,
             batch_done: true,
             last_status: epoch,
@@ -881,6 +884,13 @@ impl<H: Hal> Bus for Board<H> {
                     self.spin_until(t);
                     let word = self.hal.read_high_pins();
                     self.moment = t;
+                    // Every 8th sample, a look at the capture's FIFOs:
+                    // drained when a quarter full, at the cost of that
+                    // sample's place on the grid.
+                    self.samples += 1;
+                    if self.samples.is_multiple_of(8) && self.hal.capture_level() >= 2 {
+                        self.refresh();
+                    }
                     Reply::Pins {
                         at: self.at(t),
                         pins: self.pins_from(word),

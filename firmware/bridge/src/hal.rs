@@ -50,6 +50,9 @@ pub trait Hal {
     /// A word counter `c` pushed, if one is waiting.
     fn capture_pull(&mut self, c: Counter) -> Option<u32>;
 
+    /// The most words any counter's RX FIFO holds now (FLEVEL).
+    fn capture_level(&mut self) -> usize;
+
     /// Whether any counter stalled on a full RX FIFO since the last call
     /// (FDEBUG.RXSTALL, cleared by the call): its count stopped meanwhile.
     fn capture_stalled(&mut self) -> bool;

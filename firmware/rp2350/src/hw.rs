@@ -177,6 +177,18 @@ impl Hal for Rp2350 {
         (pio(b).fstat().read().rxempty() >> s & 1 == 0).then(|| pio(b).rxf(s).read())
     }
 
+    fn capture_level(&mut self) -> usize {
+        // FLEVEL: 4 bits of RX level a state machine, at bit 8 * s + 4.
+        let rx = |b: usize, s: usize| (pio(b).flevel().read().0 >> (8 * s + 4) & 0xF) as usize;
+        let (pb, ps) = pioregs::counter_sm(Counter::Pout);
+        let mut most = rx(pb, ps);
+        for c in [Counter::Int, Counter::Hold, Counter::Aux] {
+            let (b, s) = pioregs::counter_sm(c);
+            most = most.max(rx(b, s));
+        }
+        most
+    }
+
     fn capture_stalled(&mut self) -> bool {
         let pout = 1 << fdebug::RXSTALL;
         let others = 0b0111 << fdebug::RXSTALL;

@@ -43,6 +43,29 @@ pub const CLOCK_CYCLES: u64 = 6;
 /// arithmetic): some 64.
 pub const RESYNC_CYCLES: u64 = 64;
 
+/// How often the board code looked into the POUT counter's RX FIFO, and
+/// how full it found it: the capture's margin.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Drains {
+    /// The most words the FIFO held when the board code looked.
+    pub fullest: usize,
+    /// The longest time between two looks that found words, in cycles.
+    pub longest_gap: u64,
+    last: Option<u64>,
+}
+
+impl Drains {
+    fn look(&mut self, cycle: u64, level: usize) {
+        self.fullest = self.fullest.max(level);
+        if let Some(last) = self.last {
+            if level > 0 {
+                self.longest_gap = self.longest_gap.max(cycle - last);
+            }
+        }
+        self.last = Some(cycle);
+    }
+}
+
 /// The twin's hardware: the RP2350's PIO and GPIOs, the board around it.
 #[derive(Debug)]
 pub struct Twin {
@@ -53,6 +76,8 @@ pub struct Twin {
     pub cpu_cycles: u64,
     /// Random extra cycles per call: (state, at most).
     gaps: Option<(u64, u64)>,
+    /// How the board code drained the POUT counter's FIFO.
+    pub drains: Drains,
     /// Clock readings not yet paid for: the world runs them off at the next
     /// call that spends.
     owed: core::cell::Cell<u64>,
@@ -75,6 +100,7 @@ impl Twin {
             gaps: None,
             idle_step: 2 * CPU_CYCLES,
             owed: core::cell::Cell::new(0),
+            drains: Drains::default(),
         };
         t.boot().map_err(|e| format!("{e:?}"))?;
         Ok(t)
@@ -195,8 +221,25 @@ impl Hal for Twin {
     fn capture_pull(&mut self, c: Counter) -> Option<u32> {
         self.spend(self.cpu_cycles);
         let (b, s) = pioregs::counter_sm(c);
+        let cycle = self.world.cycle;
         let b = &mut self.world.blocks[b];
-        (b.rx_level(s) > 0).then(|| b.rxf_read(s)).flatten()
+        let level = b.rx_level(s);
+        if c == Counter::Pout {
+            self.drains.look(cycle, level);
+        }
+        (level > 0).then(|| b.rxf_read(s)).flatten()
+    }
+
+    fn capture_level(&mut self) -> usize {
+        self.spend(self.cpu_cycles);
+        Counter::ALL
+            .iter()
+            .map(|c| {
+                let (b, s) = pioregs::counter_sm(*c);
+                self.world.blocks[b].rx_level(s)
+            })
+            .max()
+            .unwrap_or(0)
     }
 
     fn capture_stalled(&mut self) -> bool {
@@ -282,6 +325,111 @@ impl Hal for Twin {
             to
         }
     }
+}
+
+/// The capture's margin at the chip's fastest pulse rate, measured on the
+/// twin ([`capture_margin`]).
+#[derive(Debug, Clone, Copy)]
+pub struct CaptureMargin {
+    pub sysclk_hz: u32,
+    pub pulses: u64,
+    /// The move's pulse interval at its top speed.
+    pub interval_ns: u64,
+    /// Words the POUT counter's RX FIFO holds, and the most it held when
+    /// the board code looked.
+    pub depth: usize,
+    pub fullest: usize,
+    /// The longest time between two looks that found words.
+    pub longest_gap_ns: u64,
+    pub lost: bool,
+}
+
+impl CaptureMargin {
+    /// How many times over the FIFO could have held what came between two
+    /// looks: its depth in pulse intervals, over the longest gap.
+    pub fn margin(&self) -> f64 {
+        (self.depth as u64 * self.interval_ns) as f64 / self.longest_gap_ns.max(1) as f64
+    }
+}
+
+/// Runs a 5,000-pulse move in POUT mode at RH = 12 on a chip at SysClk
+/// 40 MHz (CSEL high): 10.4 us a pulse, 96 kpps, the fastest under the
+/// speed limit of 40 kpps x SysClk / 16 = 100 kpps (Section 3-2), while
+/// the board code waits for BUSY = 0 as a scenario does; and says how the
+/// board code kept up with the POUT counter's FIFO.
+pub fn capture_margin() -> Result<CaptureMargin, String> {
+    use ppmc_core::bus::{Bus, Op};
+    use ppmc_core::protocol::Status;
+    use ppmc_core::time::Duration;
+    let (straps, mut ops) = fastest_move();
+    let mut b = board(straps, ModelConfig::default())?;
+    ops.push(Op::AwaitStatus {
+        mask: Status::BUSY,
+        value: Status::BUSY,
+        timeout: Duration::from_millis(5),
+    });
+    ops.push(Op::AwaitStatus {
+        mask: Status::BUSY,
+        value: 0,
+        timeout: Duration::from_secs(2),
+    });
+    for op in &ops {
+        b.run(*op);
+    }
+    let pulses = b.record().last_move_pulses().count;
+    let (blk, s) = pioregs::counter_sm(Counter::Pout);
+    let hw = b.hal();
+    let tclock = straps
+        .tclock(ppmc_core::protocol::ClockSource::Internal)
+        .ok_or("no internal clock")?;
+    Ok(CaptureMargin {
+        sysclk_hz: SYSCLK_HZ,
+        pulses,
+        interval_ns: straps.pulse_interval(12, tclock).as_nanos(),
+        depth: hw.world.blocks[blk].rx_capacity(s),
+        fullest: hw.drains.fullest,
+        longest_gap_ns: hw.drains.longest_gap * 1_000_000_000 / u64::from(SYSCLK_HZ),
+        lost: b.capture_lost(),
+    })
+}
+
+/// [`capture_margin`]'s chip (SysClk 40 MHz) and ops, up to the move's
+/// last byte: a reset, an initialization (RL 100, RH 12, PA 100), 100 ms,
+/// 5,000 pulses with accel/decel in POUT mode.
+pub fn fastest_move() -> (Straps, std::vec::Vec<ppmc_core::bus::Op>) {
+    use ppmc_core::bus::Op;
+    use ppmc_core::time::Duration;
+    let straps = Straps {
+        sysclk_hz: 40_000_000,
+        ..Straps::default()
+    };
+    let wait = Some(Duration::from_millis(10));
+    let n: u32 = 5_000 - 1;
+    let mut ops = std::vec![
+        Op::Reset,
+        Op::WriteCommand {
+            byte: 0x02,
+            wait_ibf: wait
+        }
+    ];
+    for byte in [100, 12, 100, 0] {
+        ops.push(Op::WriteData {
+            byte,
+            wait_ibf: wait,
+        });
+    }
+    ops.push(Op::Delay(Duration::from_millis(100)));
+    ops.push(Op::WriteCommand {
+        byte: 0xC3,
+        wait_ibf: wait,
+    });
+    for byte in [n as u8, (n >> 8) as u8, (n >> 16) as u8] {
+        ops.push(Op::WriteData {
+            byte,
+            wait_ibf: wait,
+        });
+    }
+    (straps, ops)
 }
 
 /// The board code on the twin: what `firmware/run-twin` serves.

@@ -355,6 +355,11 @@ impl Block {
     }
 
     /// Words waiting in the RX FIFO of `s` (FLEVEL).
+    /// How many words state machine `s`'s RX FIFO holds (by its join).
+    pub fn rx_capacity(&self, s: usize) -> usize {
+        self.sm[s].rx_depth()
+    }
+
     pub fn rx_level(&self, s: usize) -> usize {
         self.sm[s].rx.len()
     }

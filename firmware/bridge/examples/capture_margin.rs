@@ -1,0 +1,33 @@
+//! The capture's margin at the chip's fastest pulse rate, measured on the
+//! board twin (docs/performance.md):
+//!
+//! ```sh
+//! cd firmware && cargo run -q --release --locked -p ppmc-bridge-fw --features twin --example capture_margin
+//! ```
+
+fn main() -> std::process::ExitCode {
+    let m = match ppmc_bridge_fw::twin::capture_margin() {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("capture_margin: {e}");
+            return std::process::ExitCode::FAILURE;
+        }
+    };
+    println!(
+        "RP2350 at {} MHz, chip at 40 MHz: {} pulses {} ns apart ({:.0} kpps)",
+        m.sysclk_hz / 1_000_000,
+        m.pulses,
+        m.interval_ns,
+        1e6 / m.interval_ns as f64
+    );
+    println!(
+        "POUT FIFO: {} words deep, at most {} waiting when drained; longest gap between drains {} ns",
+        m.depth, m.fullest, m.longest_gap_ns
+    );
+    println!(
+        "margin: {:.1}x (FIFO depth in pulse intervals over the longest gap); capture lost: {}",
+        m.margin(),
+        m.lost
+    );
+    std::process::ExitCode::SUCCESS
+}
