@@ -300,6 +300,7 @@ impl<H: Hal> Board<H> {
 
     /// [`Board::poll`] within an op.
     fn refresh(&mut self) {
+        self.hal.keepalive();
         let started = self.now_ticks();
         self.poll_inner();
         self.poll_ticks = self.now_ticks() - started;

@@ -71,6 +71,10 @@ pub trait Hal {
     /// The levels of GPIO 32-47, bit 0 being GPIO 32.
     fn read_high_pins(&mut self) -> u16;
 
+    /// The board code is alive: feeds the watchdog (the RP2350 image). Called
+    /// from every loop of the board code that may last.
+    fn keepalive(&mut self) {}
+
     /// Nothing to do before cycle `until` but watch the outputs: returns
     /// at `until`, or soon after a sampled output (S1..S5, AUXO, DIR)
     /// changes or a capture FIFO takes a word, whichever comes first; and

@@ -107,6 +107,10 @@ fn now_us() -> u64 {
     embassy_time::Instant::now().as_micros()
 }
 
+/// The watchdog's period: the board code feeds it from every loop
+/// (`Hal::keepalive`), so only a loop that stopped lets it fire.
+pub const WATCHDOG_MS: u64 = 1_000;
+
 impl Rp2350 {
     /// Reads the cycle counter and the timer together and sets the clock
     /// by them (`ppmc_bridge_fw::clock`).
@@ -240,6 +244,13 @@ impl Hal for Rp2350 {
         (pac::SIO.gpio_in(1).read() & 0xFFFF) as u16
     }
 
+    fn keepalive(&mut self) {
+        // As embassy-rp's `Watchdog::feed`: the count, in microseconds.
+        pac::WATCHDOG
+            .load()
+            .write_value(pac::watchdog::regs::Load(WATCHDOG_MS as u32 * 1_000));
+    }
+
     fn idle(&mut self, until: u64) -> u64 {
         // A tight loop on the sampled outputs and the capture FIFOs' empty
         // flags: a change is seen within a pass (some 20 cycles), and the
@@ -260,6 +271,7 @@ impl Hal for Rp2350 {
                 }
                 quiet = DWT::cycle_count();
             }
+            self.keepalive();
             let now = self.cycles();
             if now >= until {
                 return now;

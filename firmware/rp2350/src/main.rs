@@ -11,7 +11,12 @@
 //!   clock cycles (13.3 ns at 150 MHz: `timer_hz` 75 MHz); S1..S5,
 //!   AUXO0..3 and DIR sampled by the CPU between ops.
 //! - The board code is `ppmc_bridge_fw::board`, over the hardware layer in
-//!   `hw.rs`: the same code the board twin runs (`firmware/run-twin`).
+//!   `hw.rs`: the same code the board twin runs (`firmware/run-twin`). It
+//!   runs with the protocol engine on core 1, so that its long ops (a
+//!   delay, a wait for a status or for pulses, seconds long) never keep
+//!   core 0's USB stack from answering the host; bytes cross between the
+//!   cores through two pipes. A watchdog restarts the bridge if core 1's
+//!   loop stops.
 //! - Straps: CSEL and VSEL read from their nets at boot; SysClk and an
 //!   external clock given at build time (`PPMC_SYSCLK_HZ`,
 //!   `PPMC_EXT_CLOCK_HZ`), since the bridge cannot see the chip's crystal.
@@ -32,10 +37,15 @@ use embassy_futures::select::{select, Either};
 use embassy_rp::bind_interrupts;
 use embassy_rp::block::ImageDef;
 use embassy_rp::gpio::{Input, Level, Output, Pull};
+use embassy_rp::multicore::{spawn_core1, Stack};
 use embassy_rp::peripherals::{PIO0, PIO1, PIO2, USB};
 use embassy_rp::pio::{self, Pio};
 use embassy_rp::usb::{Driver, InterruptHandler as UsbIrq};
+use embassy_rp::watchdog::Watchdog;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::pipe::Pipe;
 use embassy_time::Timer as Delay;
+use embassy_time::{with_timeout, Duration};
 use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
 use embedded_alloc::LlffHeap as Heap;
 use ppmc_bridge_fw::board::Board;
@@ -55,6 +65,18 @@ bind_interrupts!(struct Irqs {
     PIO1_IRQ_0 => pio::InterruptHandler<PIO1>;
     PIO2_IRQ_0 => pio::InterruptHandler<PIO2>;
 });
+
+/// Bytes from the host to the engine on core 1, and its replies back.
+static FROM_HOST: Pipe<CriticalSectionRawMutex, 512> = Pipe::new();
+static TO_HOST: Pipe<CriticalSectionRawMutex, 2048> = Pipe::new();
+
+/// How long the host may leave a reply packet unread before the bridge
+/// takes it as gone (and waits for the next connection).
+const WRITE_DEADLINE: Duration = Duration::from_millis(500);
+
+/// Core 1's stack: the engine, the board code and a batch's replies live
+/// on the heap; this holds their frames.
+static CORE1_STACK: StaticCell<Stack<32768>> = StaticCell::new();
 
 #[global_allocator]
 static HEAP: Heap = Heap::empty();
@@ -239,13 +261,49 @@ async fn main(_spawner: Spawner) {
     } else {
         (BusTiming::DEFAULT, FIRMWARE_DEFAULT_TIMING)
     };
-    let hal = hw::Rp2350::new(SYSCLK_HZ, pout_program, pins_program);
-    let board = Board::new(hal, timing, straps);
-    let timer = board.timer();
+    // HELLO_REPLY's firmware text says when the last reset was a panic,
+    // and where: the host prints it with every run's identity.
+    let firmware: alloc::string::String = match last_panic() {
+        Some(at) => alloc::format!("{firmware}; restarted after a panic at {at}"),
+        None => firmware.into(),
+    };
+    // The engine on core 1, with its own cycle counter (each core has
+    // one: the clock the board code reads is core 1's). It feeds the
+    // watchdog from every loop of the board code (`Hal::keepalive`).
+    let mut watchdog = Watchdog::new(p.WATCHDOG);
+    watchdog.start(Duration::from_millis(hw::WATCHDOG_MS));
     let session = embassy_rp::clocks::RoscRng.next_u32();
-    let mut engine = BridgeEngine::new(board, session, false, firmware)
-        .with_timer(timer)
-        .with_capture_capacity(CAPTURE_RECORDS);
+    spawn_core1(p.CORE1, CORE1_STACK.init(Stack::new()), move || {
+        // SAFETY: core 1's own DCB and DWT, set up once here.
+        let mut core1 = unsafe { cortex_m::Peripherals::steal() };
+        core1.DCB.enable_trace();
+        core1.DWT.enable_cycle_counter();
+        let hal = hw::Rp2350::new(SYSCLK_HZ, pout_program, pins_program);
+        let board = Board::new(hal, timing, straps);
+        let timer = board.timer();
+        let mut engine = BridgeEngine::new(board, session, false, firmware)
+            .with_timer(timer)
+            .with_capture_capacity(CAPTURE_RECORDS);
+        let mut buf = [0u8; 64];
+        loop {
+            match FROM_HOST.try_read(&mut buf) {
+                Ok(n) => {
+                    let reply = engine.on_bytes(&buf[..n]);
+                    let mut rest = &reply[..];
+                    while !rest.is_empty() {
+                        match TO_HOST.try_write(rest) {
+                            Ok(k) => rest = &rest[k..],
+                            // Core 0 sends as the host reads: the capture
+                            // keeps draining meanwhile.
+                            Err(_) => engine.bus_mut().poll(),
+                        }
+                    }
+                }
+                // Between requests the capture keeps draining.
+                Err(_) => engine.bus_mut().poll(),
+            }
+        }
+    });
 
     // USB CDC ACM.
     let driver = Driver::new(p.USB, Irqs);
@@ -275,27 +333,23 @@ async fn main(_spawner: Spawner) {
     let mut usb = builder.build();
 
     let serve = async {
-        let mut buf = [0u8; 64];
+        let (mut rx, mut tx) = ([0u8; 64], [0u8; 64]);
         loop {
             class.wait_connection().await;
             'connected: loop {
-                // Between requests the capture keeps draining.
-                match select(class.read_packet(&mut buf), Delay::after_micros(50)).await {
-                    Either::First(Ok(n)) => {
-                        let reply = engine.on_bytes(&buf[..n]);
-                        for chunk in reply.chunks(64) {
-                            if class.write_packet(chunk).await.is_err() {
-                                break 'connected;
-                            }
-                            engine.bus_mut().poll();
+                match select(class.read_packet(&mut rx), TO_HOST.read(&mut tx)).await {
+                    Either::First(Ok(n)) => FROM_HOST.write_all(&rx[..n]).await,
+                    Either::First(Err(_)) => break 'connected,
+                    Either::Second(n) => {
+                        let sent = with_timeout(WRITE_DEADLINE, class.write_packet(&tx[..n])).await;
+                        if !matches!(sent, Ok(Ok(()))) {
+                            break 'connected;
                         }
-                        if !reply.is_empty() && reply.len().is_multiple_of(64) {
+                        if n == 64 && TO_HOST.is_empty() {
                             // A full last packet: end the transfer.
-                            let _ = class.write_packet(&[]).await;
+                            let _ = with_timeout(WRITE_DEADLINE, class.write_packet(&[])).await;
                         }
                     }
-                    Either::First(Err(_)) => break 'connected,
-                    Either::Second(()) => engine.bus_mut().poll(),
                 }
             }
         }
@@ -309,10 +363,60 @@ fn hex16(id: u64) -> [u8; 16] {
     core::array::from_fn(|i| digits[(id >> (60 - 4 * i) & 0xF) as usize])
 }
 
+/// A panic record in the watchdog's scratch registers, which a watchdog
+/// reset keeps: SCRATCH0 says one is there, SCRATCH1 has the line, and
+/// SCRATCH2-7 the first 24 bytes of the source file's name.
+const PANIC_MAGIC: u32 = 0x5050_4d43; // "PPMC"
+
+/// The panic record the last reset left, if any, as text; cleared.
+fn last_panic() -> Option<alloc::string::String> {
+    let wd = embassy_rp::pac::WATCHDOG;
+    if wd.scratch0().read() != PANIC_MAGIC {
+        return None;
+    }
+    wd.scratch0().write_value(0);
+    let line = wd.scratch1().read();
+    let words = [
+        wd.scratch2().read(),
+        wd.scratch3().read(),
+        wd.scratch4().read(),
+        wd.scratch5().read(),
+        wd.scratch6().read(),
+        wd.scratch7().read(),
+    ];
+    let bytes: alloc::vec::Vec<u8> = words
+        .iter()
+        .flat_map(|w| w.to_le_bytes())
+        .take_while(|b| *b != 0)
+        .collect();
+    let file = core::str::from_utf8(&bytes).unwrap_or("?");
+    Some(alloc::format!("{file}:{line}"))
+}
+
 #[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    // The host sees the bridge go silent, and its health check fails.
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    // Kept across the reset for HELLO to report (`last_panic`), then the
+    // watchdog restarts the bridge: the host sees it come back, not a
+    // bridge gone silent.
     cortex_m::interrupt::disable();
+    let wd = embassy_rp::pac::WATCHDOG;
+    let (file, line) = info.location().map_or(("?", 0), |l| {
+        (l.file().rsplit('/').next().unwrap_or("?"), l.line())
+    });
+    let mut name = [0u8; 24];
+    for (d, s) in name.iter_mut().zip(file.bytes()) {
+        *d = s;
+    }
+    let word = |i: usize| u32::from_le_bytes([name[i], name[i + 1], name[i + 2], name[i + 3]]);
+    wd.scratch1().write_value(line);
+    wd.scratch2().write_value(word(0));
+    wd.scratch3().write_value(word(4));
+    wd.scratch4().write_value(word(8));
+    wd.scratch5().write_value(word(12));
+    wd.scratch6().write_value(word(16));
+    wd.scratch7().write_value(word(20));
+    wd.scratch0().write_value(PANIC_MAGIC);
+    wd.ctrl().modify(|w| w.set_trigger(true));
     loop {
         cortex_m::asm::wfi();
     }
