@@ -2,6 +2,9 @@
 //! written down. The RP2350 image, the board twin, `docs/bridge-hardware.md`
 //! and the schematic in `hardware/` (checked by a test against this module)
 //! all follow it.
+//!
+//! GPIO 28-31 are free. GPIO 47 is left to the PGA2350's PSRAM, whose chip
+//! select it is ([`VSEL`]).
 
 /// D0-D7 of the chip's bus, through the 74LVC8T245's A side (GPIO 0-7).
 pub const D0: u32 = 0;
@@ -52,7 +55,13 @@ pub const AUX: u32 = 36;
 pub const S: [u32; 5] = [37, 38, 39, 40, 41];
 /// AUXO0..3, sampled (GPIO 42-45).
 pub const AUXO: [u32; 4] = [42, 43, 44, 45];
-/// The CSEL and VSEL straps, sensed at boot through the 74LVC245's spare
-/// channels (GPIO 46 and 47 are ADC pins and not 5 V tolerant).
+/// The CSEL strap, sensed at boot through a spare channel of the
+/// 74LVC245 (GPIO 46 is an ADC pin of the RP2350B, not 5 V tolerant).
 pub const CSEL: u32 = 46;
-pub const VSEL: u32 = 47;
+/// The VSEL strap, sensed at boot through the 74LVC245's other spare
+/// channel. Not on GPIO 47: the PGA2350 wires GPIO 47 to its PSRAM's chip
+/// select (the RP2350's QMI CS1n), and a strap there would select the
+/// PSRAM while the RP2350 reads its flash. GPIO 27 is a digital pin (the
+/// RP2350B's ADC pins are 40-47) in GPIO bank 0: the image reads it from
+/// SIO GPIO_IN, not GPIO_HI_IN.
+pub const VSEL: u32 = 27;

@@ -839,6 +839,35 @@ fn every_gpio_of_the_pin_map_reaches_its_signal_on_the_chip_header() {
     report("the pin map against the schematic", problems);
 }
 
+/// GPIO 47 is the PGA2350's PSRAM chip select (the Pico SDK's
+/// `boards/pimoroni_pga2350.h`: `PIMORONI_PGA2350_PSRAM_CS_PIN 47`). A
+/// signal from the chip's board on it would select the PSRAM while the
+/// RP2350 reads its flash on the same QSPI lines: the pin map leaves it
+/// free, and the schematic leaves it unconnected.
+#[test]
+fn gpio_47_the_modules_psram_select_is_left_free() {
+    const PSRAM_CS: u32 = 47;
+    let mut problems = Vec::new();
+    for (name, g) in gpios() {
+        if g == PSRAM_CS {
+            problems.push(format!(
+                "{name} is on GPIO {g}, the PGA2350's PSRAM chip select"
+            ));
+        }
+    }
+    let nl = load();
+    let module = nl.only("PGA2350").expect("one PGA2350");
+    let pin = nl
+        .pin(module, &format!("GP{PSRAM_CS}"))
+        .expect("the module has GP47");
+    if let Ok(net) = nl.net(&pin) {
+        problems.push(format!(
+            "GPIO {PSRAM_CS}, the PGA2350's PSRAM chip select, is on net {net:?}"
+        ));
+    }
+    report("GPIO 47, the PSRAM's chip select", problems);
+}
+
 #[test]
 fn the_control_pins_reach_their_parts() {
     let nl = load();

@@ -170,10 +170,12 @@ async fn main(_spawner: Spawner) {
     let mut drive_en = Output::new(p.PIN_26, Level::Low);
 
     // The straps: CSEL and VSEL through the capture buffer (open reads
-    // high), read once it is enabled.
-    const _: () = assert!(pins::CSEL == 46 && pins::VSEL == 47);
+    // high), read once it is enabled. CSEL is in GPIO bank 1, VSEL in bank
+    // 0 (embassy-rp reads each from its own SIO GPIO_IN bank). GPIO 47,
+    // the PGA2350's PSRAM chip select, is left alone.
+    const _: () = assert!(pins::CSEL == 46 && pins::VSEL == 27);
     let csel = Input::new(p.PIN_46, Pull::Up);
-    let vsel = Input::new(p.PIN_47, Pull::Up);
+    let vsel = Input::new(p.PIN_27, Pull::Up);
 
     // Outputs of the chip the CPU samples (input enables on).
     const _: () = assert!(pins::S[0] == 37 && pins::AUXO[3] == 45);
