@@ -110,6 +110,8 @@ fn now_us() -> u64 {
 /// The watchdog's period: the board code feeds it from every loop
 /// (`Hal::keepalive`), so only a loop that stopped lets it fire.
 pub const WATCHDOG_MS: u64 = 1_000;
+// LOAD holds 24 bits of microseconds.
+const _: () = assert!(WATCHDOG_MS * 1_000 <= 0xFF_FFFF);
 
 impl Rp2350 {
     /// Reads the cycle counter and the timer together and sets the clock
@@ -253,28 +255,32 @@ impl Hal for Rp2350 {
 
     fn idle(&mut self, until: u64) -> u64 {
         // A tight loop on the sampled outputs and the capture FIFOs' empty
-        // flags: a change is seen within a pass (some 20 cycles), and the
-        // slower clock is read only every 64 passes (well under 1 us). The
-        // cycle counter's raw value marks the last pass that saw nothing.
+        // flags: a change is seen within a pass (some 20 cycles). The cycle
+        // counter's raw value marks the last pass that saw nothing.
         let sampled = SAMPLED_MASK;
         let seen = pac::SIO.gpio_in(1).read() & sampled;
         let counters = |b: usize| pio(b).fstat().read().rxempty();
-        let mut quiet = DWT::cycle_count();
+        let start = DWT::cycle_count();
+        // The cycles to `until`, counted on the raw cycle counter every
+        // pass (a pass is some 20 cycles: the end is met to within one).
+        let budget = until.saturating_sub(self.cycles()).min(1 << 30) as u32;
+        let mut quiet = start;
+        let mut passes: u32 = 0;
         loop {
-            for _ in 0..64 {
-                if pac::SIO.gpio_in(1).read() & sampled != seen
-                    || counters(1) & 1 == 0
-                    || counters(2) & 0b0111 != 0b0111
-                {
-                    let now = self.cycles();
-                    return now - u64::from(DWT::cycle_count().wrapping_sub(quiet));
-                }
-                quiet = DWT::cycle_count();
+            if pac::SIO.gpio_in(1).read() & sampled != seen
+                || counters(1) & 1 == 0
+                || counters(2) & 0b0111 != 0b0111
+            {
+                let now = self.cycles();
+                return now - u64::from(DWT::cycle_count().wrapping_sub(quiet));
             }
-            self.keepalive();
-            let now = self.cycles();
-            if now >= until {
-                return now;
+            quiet = DWT::cycle_count();
+            if quiet.wrapping_sub(start) >= budget {
+                return self.cycles();
+            }
+            passes = passes.wrapping_add(1);
+            if passes.is_multiple_of(4096) {
+                self.keepalive();
             }
         }
     }

@@ -340,7 +340,24 @@ async fn main(_spawner: Spawner) {
             class.wait_connection().await;
             'connected: loop {
                 match select(class.read_packet(&mut rx), TO_HOST.read(&mut tx)).await {
-                    Either::First(Ok(n)) => FROM_HOST.write_all(&rx[..n]).await,
+                    Either::First(Ok(n)) => {
+                        // Core 1 may be sending a long reply while the host
+                        // sends on: replies keep going out while the bytes
+                        // wait for room, or neither core would move again.
+                        let mut rest = &rx[..n];
+                        while !rest.is_empty() {
+                            match select(FROM_HOST.write(rest), TO_HOST.read(&mut tx)).await {
+                                Either::First(k) => rest = &rest[k..],
+                                Either::Second(m) => {
+                                    let sent =
+                                        with_timeout(WRITE_DEADLINE, class.write_packet(&tx[..m])).await;
+                                    if !matches!(sent, Ok(Ok(()))) {
+                                        break 'connected;
+                                    }
+                                }
+                            }
+                        }
+                    }
                     Either::First(Err(_)) => break 'connected,
                     Either::Second(n) => {
                         let sent = with_timeout(WRITE_DEADLINE, class.write_packet(&tx[..n])).await;
@@ -366,8 +383,9 @@ fn hex16(id: u64) -> [u8; 16] {
 }
 
 /// A panic record in the watchdog's scratch registers, which a watchdog
-/// reset keeps: SCRATCH0 says one is there, SCRATCH1 has the line, and
-/// SCRATCH2-7 the first 24 bytes of the source file's name.
+/// reset keeps (the bootrom and the SDK use SCRATCH4-7: left alone):
+/// SCRATCH0 says one is there, SCRATCH1 has the line, SCRATCH2-3 the
+/// first 8 bytes of the source file's name (or "hardfault" and the PC).
 const PANIC_MAGIC: u32 = 0x5050_4d43; // "PPMC"
 
 /// The panic record the last reset left, if any, as text; cleared.
@@ -378,21 +396,49 @@ fn last_panic() -> Option<alloc::string::String> {
     }
     wd.scratch0().write_value(0);
     let line = wd.scratch1().read();
-    let words = [
-        wd.scratch2().read(),
-        wd.scratch3().read(),
-        wd.scratch4().read(),
-        wd.scratch5().read(),
-        wd.scratch6().read(),
-        wd.scratch7().read(),
-    ];
-    let bytes: alloc::vec::Vec<u8> = words
+    let bytes: alloc::vec::Vec<u8> = [wd.scratch2().read(), wd.scratch3().read()]
         .iter()
         .flat_map(|w| w.to_le_bytes())
         .take_while(|b| *b != 0)
         .collect();
     let file = core::str::from_utf8(&bytes).unwrap_or("?");
+    if file == "hardfaul" {
+        return Some(alloc::format!("a hard fault at pc {line:#010x}"));
+    }
     Some(alloc::format!("{file}:{line}"))
+}
+
+/// Keeps a record (`last_panic`) and resets the chip by its watchdog, set
+/// up here in full (embassy-rp's `trigger_reset` does the same): a panic
+/// before the watchdog was started would otherwise reset nothing.
+fn record_and_reset(name: &[u8], line: u32) -> ! {
+    cortex_m::interrupt::disable();
+    let wd = embassy_rp::pac::WATCHDOG;
+    let mut n = [0u8; 8];
+    for (d, s) in n.iter_mut().zip(name) {
+        *d = *s;
+    }
+    wd.scratch1().write_value(line);
+    wd.scratch2().write_value(u32::from_le_bytes([n[0], n[1], n[2], n[3]]));
+    wd.scratch3().write_value(u32::from_le_bytes([n[4], n[5], n[6], n[7]]));
+    wd.scratch0().write_value(PANIC_MAGIC);
+    // Every stage up to the processors (PSM WDSEL, as embassy-rp writes it).
+    embassy_rp::pac::PSM
+        .wdsel()
+        .write_value(embassy_rp::pac::psm::regs::Wdsel(0x0001_fffc));
+    wd.ctrl().modify(|w| {
+        w.set_enable(true);
+        w.set_trigger(true);
+    });
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+#[cortex_m_rt::exception]
+unsafe fn HardFault(ef: &cortex_m_rt::ExceptionFrame) -> ! {
+    // The faulting PC in the line's place (`last_panic` shows it so).
+    record_and_reset(b"hardfault", ef.pc())
 }
 
 #[panic_handler]
@@ -400,26 +446,8 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     // Kept across the reset for HELLO to report (`last_panic`), then the
     // watchdog restarts the bridge: the host sees it come back, not a
     // bridge gone silent.
-    cortex_m::interrupt::disable();
-    let wd = embassy_rp::pac::WATCHDOG;
-    let (file, line) = info.location().map_or(("?", 0), |l| {
-        (l.file().rsplit('/').next().unwrap_or("?"), l.line())
-    });
-    let mut name = [0u8; 24];
-    for (d, s) in name.iter_mut().zip(file.bytes()) {
-        *d = s;
-    }
-    let word = |i: usize| u32::from_le_bytes([name[i], name[i + 1], name[i + 2], name[i + 3]]);
-    wd.scratch1().write_value(line);
-    wd.scratch2().write_value(word(0));
-    wd.scratch3().write_value(word(4));
-    wd.scratch4().write_value(word(8));
-    wd.scratch5().write_value(word(12));
-    wd.scratch6().write_value(word(16));
-    wd.scratch7().write_value(word(20));
-    wd.scratch0().write_value(PANIC_MAGIC);
-    wd.ctrl().modify(|w| w.set_trigger(true));
-    loop {
-        cortex_m::asm::wfi();
-    }
+    let (file, line) = info
+        .location()
+        .map_or(("?", 0), |l| (l.file().rsplit('/').next().unwrap_or("?"), l.line()));
+    record_and_reset(file.as_bytes(), line)
 }
