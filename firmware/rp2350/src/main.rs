@@ -350,7 +350,8 @@ async fn main(_spawner: Spawner) {
                                 Either::First(k) => rest = &rest[k..],
                                 Either::Second(m) => {
                                     let sent =
-                                        with_timeout(WRITE_DEADLINE, class.write_packet(&tx[..m])).await;
+                                        with_timeout(WRITE_DEADLINE, class.write_packet(&tx[..m]))
+                                            .await;
                                     if !matches!(sent, Ok(Ok(()))) {
                                         break 'connected;
                                     }
@@ -419,8 +420,10 @@ fn record_and_reset(name: &[u8], line: u32) -> ! {
         *d = *s;
     }
     wd.scratch1().write_value(line);
-    wd.scratch2().write_value(u32::from_le_bytes([n[0], n[1], n[2], n[3]]));
-    wd.scratch3().write_value(u32::from_le_bytes([n[4], n[5], n[6], n[7]]));
+    wd.scratch2()
+        .write_value(u32::from_le_bytes([n[0], n[1], n[2], n[3]]));
+    wd.scratch3()
+        .write_value(u32::from_le_bytes([n[4], n[5], n[6], n[7]]));
     wd.scratch0().write_value(PANIC_MAGIC);
     // Every stage up to the processors (PSM WDSEL, as embassy-rp writes it).
     embassy_rp::pac::PSM
@@ -446,8 +449,8 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     // Kept across the reset for HELLO to report (`last_panic`), then the
     // watchdog restarts the bridge: the host sees it come back, not a
     // bridge gone silent.
-    let (file, line) = info
-        .location()
-        .map_or(("?", 0), |l| (l.file().rsplit('/').next().unwrap_or("?"), l.line()));
+    let (file, line) = info.location().map_or(("?", 0), |l| {
+        (l.file().rsplit('/').next().unwrap_or("?"), l.line())
+    });
     record_and_reset(file.as_bytes(), line)
 }
