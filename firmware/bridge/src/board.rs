@@ -43,6 +43,9 @@ const SETTLE_TICKS: u64 = 8;
 /// delay's end ([`Board::lead`]).
 const CPU_LEAD_US: u64 = 2;
 
+/// Time enough for a look at the capture FIFOs' levels (ticks: 32 cycles).
+const LOOK_TICKS: u64 = 16;
+
 /// The step an aimed cycle starts with: the bus left idle for 47 cycles,
 /// time enough for the CPU to write the wait step after it.
 const ANCHOR: u32 = bus::step(0xFF, bus::IDLE, false, 40);
@@ -882,18 +885,26 @@ impl<H: Hal> Bus for Board<H> {
                     // that regular samples stay on their grid (one SAMPLES
                     // entry on the wire, as on the model). No poll: the
                     // capture waits in its FIFOs (a tight sampling loop).
+                    // Every 8th sample, a look at the capture's FIFOs, when
+                    // there is time before the sample; every 64th, in any
+                    // case. Drained when a quarter full, at the cost of
+                    // that sample's place on the grid.
+                    self.samples += 1;
+                    let look = self.samples.is_multiple_of(8)
+                        && (self.now_ticks() + LOOK_TICKS < t || self.samples.is_multiple_of(64));
+                    let mut late = false;
+                    if look {
+                        if self.hal.capture_level() >= 2 {
+                            self.refresh();
+                        }
+                        // Past the sample's time: stamped when read.
+                        late = self.now_ticks() > t;
+                    }
                     self.spin_until(t);
                     let word = self.hal.read_high_pins();
-                    self.moment = t;
-                    // Every 8th sample, a look at the capture's FIFOs:
-                    // drained when a quarter full, at the cost of that
-                    // sample's place on the grid.
-                    self.samples += 1;
-                    if self.samples.is_multiple_of(8) && self.hal.capture_level() >= 2 {
-                        self.refresh();
-                    }
+                    self.moment = if late { self.now_ticks() } else { t };
                     Reply::Pins {
-                        at: self.at(t),
+                        at: self.at(self.moment),
                         pins: self.pins_from(word),
                     }
                 }
