@@ -11,6 +11,7 @@
 //! input enable) and owns the blocks.
 
 use core::cell::RefCell;
+use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::peripheral::DWT;
 use embassy_rp::pac;
 use embassy_rp::pac::pio::regs::{
@@ -93,7 +94,13 @@ pub struct Rp2350 {
     sysclk_hz: u32,
     clock: RefCell<Clock>,
     counters: [Loaded; 2],
+    /// Core 0's heartbeat as last seen, and when (cycles).
+    beat: (u32, u64),
 }
+
+/// Core 0's heartbeat: it counts up every 100 ms while core 0's executor
+/// runs (`main.rs`); core 1 feeds the watchdog only while it moves.
+pub static HEARTBEAT: AtomicU32 = AtomicU32::new(0);
 
 impl core::fmt::Debug for Rp2350 {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -128,6 +135,7 @@ impl Rp2350 {
             sysclk_hz,
             clock: RefCell::new(Clock::new(sysclk_hz, DWT::cycle_count(), now_us(), 0)),
             counters: [pout, pins_],
+            beat: (HEARTBEAT.load(Ordering::Relaxed), 0),
         }
     }
 
@@ -247,6 +255,18 @@ impl Hal for Rp2350 {
     }
 
     fn keepalive(&mut self) {
+        // Fed only while core 0 is alive too: its heartbeat moved within
+        // half the watchdog's period. A core that stopped, either, lets the
+        // watchdog restart the bridge.
+        let beat = HEARTBEAT.load(Ordering::Relaxed);
+        let now = self.cycles();
+        if beat != self.beat.0 {
+            self.beat = (beat, now);
+        }
+        let half = WATCHDOG_MS / 2 * u64::from(self.sysclk_hz / 1_000);
+        if now.saturating_sub(self.beat.1) > half {
+            return;
+        }
         // As embassy-rp's `Watchdog::feed`: the count, in microseconds.
         pac::WATCHDOG
             .load()

@@ -32,7 +32,7 @@ mod hw;
 
 use core::mem::MaybeUninit;
 use embassy_executor::Spawner;
-use embassy_futures::join::join;
+use embassy_futures::join::join3;
 use embassy_futures::select::{select, Either};
 use embassy_rp::bind_interrupts;
 use embassy_rp::block::ImageDef;
@@ -374,7 +374,14 @@ async fn main(_spawner: Spawner) {
             }
         }
     };
-    join(usb.run(), serve).await;
+    // Core 0's heartbeat, for core 1's watchdog feeding (hw.rs).
+    let heartbeat = async {
+        loop {
+            Delay::after_millis(100).await;
+            hw::HEARTBEAT.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
+        }
+    };
+    join3(usb.run(), serve, heartbeat).await;
 }
 
 /// `id` as 16 hexadecimal digits.
