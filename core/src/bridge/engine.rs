@@ -14,14 +14,13 @@
 
 use super::frame::{self, FrameDecoder, FrameError};
 use super::wire::{
-    self, fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response, Timer, WireError,
-    MAX_BATCH_OPS, MAX_REPLY, PROTOCOL_VERSION,
+    self, capture_bytes, fragment, BridgeErrorCode, CaptureChunk, Hello, Incoming, ReplyWriter,
+    Request, Response, Timer, WireError, WireOp, MAX_BATCH_OPS, MAX_REPLY, PROTOCOL_VERSION,
 };
-use crate::bus::{Bus, Op, Reply};
+use crate::bus::{Bus, Op};
 use crate::time::{Duration, Instant};
 use alloc::format;
 use alloc::string::{String, ToString};
-use alloc::vec;
 use alloc::vec::Vec;
 
 /// Records per capture chunk, sized so that a reply fits in 255 fragments.
@@ -36,6 +35,20 @@ struct Answered {
     frames: Vec<Vec<u8>>,
 }
 
+/// Encodes `frames` onto `out`, which grows once for them.
+fn put_frames<F: AsRef<[u8]>>(out: &mut Vec<u8>, frames: &[F]) {
+    // COBS adds a byte in 254 and one more; then the check and the
+    // delimiter.
+    let len = |f: &F| {
+        let body = f.as_ref().len() + frame::CHECK_LEN;
+        body + body / 254 + 2
+    };
+    out.reserve(frames.iter().map(len).sum());
+    for f in frames {
+        out.extend(frame::encode(f.as_ref()));
+    }
+}
+
 /// A bridge in front of a chip.
 #[derive(Debug)]
 pub struct BridgeEngine<B> {
@@ -46,9 +59,9 @@ pub struct BridgeEngine<B> {
     session: u32,
     timer: Timer,
     virtual_time: bool,
-    /// Pulse runs plus pin changes the capture buffer holds (as announced
-    /// in HELLO_REPLY); beyond it the capture is overrun until the next
-    /// chip reset.
+    /// Records (pulse runs, pin changes and move records) the capture
+    /// buffer holds (as announced in HELLO_REPLY); beyond it the capture
+    /// is overrun until the next chip reset.
     capture_capacity: u32,
     /// The host session of the last HELLO (0: none yet).
     host: u32,
@@ -89,9 +102,13 @@ impl<B: Bus> BridgeEngine<B> {
         }
     }
 
-    /// A bridge whose capture buffer holds `records` pulse runs plus pin
-    /// changes: past that, capture requests answer CAPTURE_OVERRUN until
-    /// the next chip reset, as a board with a small buffer would.
+    /// A bridge whose capture buffer holds `records` records (pulse runs,
+    /// pin changes and move records): past that, capture requests answer
+    /// CAPTURE_OVERRUN until the next chip reset, as a board with a small
+    /// buffer would, and a batch stops before its next op (a chip reset
+    /// excepted) with the same answer, so that the capture outgrows its
+    /// buffer by at most what one op adds: a bridge sizes its buffer by
+    /// its memory (firmware/README.md).
     pub fn with_capture_capacity(mut self, records: u32) -> Self {
         self.capture_capacity = records;
         self
@@ -117,9 +134,7 @@ impl<B: Bus> BridgeEngine<B> {
             match self.decoder.decode() {
                 Ok(Some(payload)) => {
                     self.frames += 1;
-                    for f in self.on_payload(&payload) {
-                        out.extend(frame::encode(&f));
-                    }
+                    self.on_payload(&payload, &mut out);
                 }
                 Ok(None) => break,
                 Err(e) => {
@@ -154,7 +169,7 @@ impl<B: Bus> BridgeEngine<B> {
         self.bus.run(Op::Delay(d));
     }
 
-    /// The frames answering one request payload.
+    /// The frames answering one request payload, encoded onto `out`.
     ///
     /// The at-most-once rule (`docs/bridge-protocol.md` section 3): a
     /// payload byte for byte the same as the last request's, or as the last
@@ -163,37 +178,49 @@ impl<B: Bus> BridgeEngine<B> {
     /// host that reconnects, says HELLO with its own host session again and
     /// resends the request whose reply it lost gets that reply; a HELLO
     /// with another host session (another host) clears the cache.
-    fn on_payload(&mut self, payload: &[u8]) -> Vec<Vec<u8>> {
+    fn on_payload(&mut self, payload: &[u8], out: &mut Vec<u8>) {
         for cached in [&self.control, &self.last].into_iter().flatten() {
             if cached.payload == payload {
-                return cached.frames.clone();
+                return put_frames(out, &cached.frames);
             }
         }
         let seq = payload.first().copied().unwrap_or(0);
-        let decoded = Request::decode(payload, self.timer);
-        if let Ok((s, Request::Resend { fragments })) = &decoded {
+        // A batch's SAMPLE ops stay whole: memory does not grow with them.
+        let decoded = Incoming::decode(payload, self.timer);
+        if let Ok((s, Incoming::Other(Request::Resend { fragments }))) = &decoded {
             // Only for the request answered last, or the one before a
             // HELLO or LINK.
             let answered = [&self.control, &self.last]
                 .into_iter()
                 .flatten()
                 .find(|a| a.payload.first() == Some(s));
-            return match answered {
+            let frames: Vec<&[u8]> = match answered {
                 Some(a) => fragments
                     .iter()
-                    .filter_map(|i| a.frames.get(usize::from(*i)).cloned())
+                    .filter_map(|i| a.frames.get(usize::from(*i)).map(Vec::as_slice))
                     .collect(),
-                None => vec![Response::Error {
-                    code: BridgeErrorCode::Malformed,
-                    detail: format!("no reply to sequence {s} to resend"),
+                None => {
+                    let e = Response::Error {
+                        code: BridgeErrorCode::Malformed,
+                        detail: format!("no reply to sequence {s} to resend"),
+                    };
+                    return put_frames(out, &[e.encode(seq, self.timer)]);
                 }
-                .encode(seq, self.timer)],
             };
+            return put_frames(out, &frames);
         }
         let control = matches!(
             decoded,
-            Ok((_, Request::Hello { .. } | Request::Link { .. }))
+            Ok((
+                _,
+                Incoming::Other(Request::Hello { .. } | Request::Link { .. })
+            ))
         );
+        if !control {
+            // Replaced by this request's answer: free while it runs.
+            self.last = None;
+            self.control = None;
+        }
         let mut reply = match decoded {
             Ok((_, req)) => self.respond(seq, req),
             Err(e) => Response::Error {
@@ -208,65 +235,80 @@ impl<B: Bus> BridgeEngine<B> {
             .encode(seq, self.timer),
         };
         if reply.len() > MAX_REPLY {
-            // Never a truncated reply: the host asked for too much at once.
-            reply = Response::Error {
-                code: BridgeErrorCode::Overflow,
-                detail: format!(
-                    "the reply takes {} bytes, more than {MAX_REPLY}; send fewer ops",
-                    reply.len()
-                ),
-            }
-            .encode(seq, self.timer);
+            reply = self.overflow(seq, reply.len());
         }
         let frames = fragment(&reply, self.fragment);
+        drop(reply);
+        put_frames(out, &frames);
         let answered = Some(Answered {
             payload: payload.to_vec(),
-            frames: frames.clone(),
+            frames,
         });
         if control {
             self.control = answered;
         } else {
             self.last = answered;
-            self.control = None;
         }
-        frames
+    }
+
+    /// Never a truncated reply: the host asked for too much at once.
+    fn overflow(&self, seq: u8, len: usize) -> Vec<u8> {
+        Response::Error {
+            code: BridgeErrorCode::Overflow,
+            detail: format!("the reply takes {len} bytes, more than {MAX_REPLY}; send fewer ops"),
+        }
+        .encode(seq, self.timer)
     }
 
     /// The encoded response to `req`.
-    fn respond(&mut self, seq: u8, req: Request) -> Vec<u8> {
+    fn respond(&mut self, seq: u8, req: Incoming) -> Vec<u8> {
         match req {
-            Request::BatchCapture {
+            Incoming::Batch(ops) => {
+                let mut replies = ReplyWriter::new(seq, false, self.timer, MAX_REPLY);
+                match self.run_ops(&ops, &mut replies) {
+                    Err(e) => e.encode(seq, self.timer),
+                    Ok(()) => replies
+                        .finish()
+                        .unwrap_or_else(|len| self.overflow(seq, len)),
+                }
+            }
+            Incoming::BatchCapture {
                 ops,
                 runs,
                 pins,
                 moves,
                 max,
-            } => match self.run_ops(&ops) {
-                Err(e) => e.encode(seq, self.timer),
-                // The ops ran, but what they left is not all there.
-                Ok(_) if let Some(held) = self.overrun() => {
-                    self.overrun_error(held).encode(seq, self.timer)
-                }
-                Ok(replies) => {
-                    // The capture takes what room the replies leave.
-                    let mut max = max;
-                    let mut r = Response::BatchCapture {
-                        replies,
-                        capture: self.chunk(runs, pins, moves, max),
-                    };
-                    loop {
-                        let bytes = r.encode(seq, self.timer);
-                        if max <= 1 || bytes.len() <= MAX_REPLY {
-                            break bytes;
-                        }
-                        max /= 2;
-                        if let Response::BatchCapture { capture, .. } = &mut r {
-                            *capture = self.chunk(runs, pins, moves, max);
-                        }
+            } => {
+                let mut replies = ReplyWriter::new(seq, true, self.timer, MAX_REPLY);
+                match self.run_ops(&ops, &mut replies) {
+                    Err(e) => e.encode(seq, self.timer),
+                    // The ops ran, but what they left is not all there.
+                    Ok(()) if let Some(held) = self.overrun() => {
+                        self.overrun_error(held).encode(seq, self.timer)
                     }
+                    Ok(()) => match replies.finish() {
+                        Ok(mut bytes) => {
+                            // The capture takes what room the replies leave.
+                            let mut max = max;
+                            loop {
+                                let chunk = self.chunk(runs, pins, moves, max);
+                                let capture = capture_bytes(&chunk, self.timer);
+                                if max <= 1 || bytes.len() + capture.len() <= MAX_REPLY {
+                                    bytes.extend_from_slice(&capture);
+                                    break bytes;
+                                }
+                                max /= 2;
+                            }
+                        }
+                        // Too long with the least capture too.
+                        Err(len) => {
+                            let chunk = self.chunk(runs, pins, moves, 1);
+                            self.overflow(seq, len + capture_bytes(&chunk, self.timer).len())
+                        }
+                    },
                 }
-            },
-            req => self.handle(req).encode(seq, self.timer),
+            }
+            Incoming::Other(req) => self.handle(req).encode(seq, self.timer),
         }
     }
 
@@ -289,9 +331,9 @@ impl<B: Bus> BridgeEngine<B> {
                 firmware: self.firmware.clone(),
                 straps: self.bus.straps(),
             }),
-            Request::Batch(ops) => match self.run_ops(&ops) {
-                Ok(replies) => Response::Batch(replies),
-                Err(e) => e,
+            Request::Batch(_) => Response::Error {
+                code: BridgeErrorCode::Malformed,
+                detail: "batch handled before dispatch".into(),
             },
             Request::Resend { .. } => Response::Error {
                 code: BridgeErrorCode::Malformed,
@@ -336,38 +378,50 @@ impl<B: Bus> BridgeEngine<B> {
         resumed
     }
 
-    /// Runs a batch's ops within the batch limit; the error response
-    /// otherwise.
-    fn run_ops(&mut self, ops: &[Op]) -> Result<Vec<Reply>, Response> {
-        let wire_ops = wire::wire_ops(ops).len();
-        if wire_ops > usize::from(MAX_BATCH_OPS) {
+    /// Runs a batch's ops within the batch limit, their replies into
+    /// `replies`; the error response otherwise. A batch stops before an op
+    /// (a chip reset excepted, which empties the capture) once the capture
+    /// holds more than its buffer: the capture then outgrows its buffer by
+    /// at most what one op adds, whatever the batch asks for.
+    fn run_ops(&mut self, ops: &[WireOp], replies: &mut ReplyWriter) -> Result<(), Response> {
+        if ops.len() > usize::from(MAX_BATCH_OPS) {
             return Err(Response::Error {
                 code: BridgeErrorCode::Overflow,
-                detail: format!("{wire_ops} ops in one batch, at most {MAX_BATCH_OPS}"),
+                detail: format!("{} ops in one batch, at most {MAX_BATCH_OPS}", ops.len()),
             });
         }
-        let replies = ops
-            .iter()
-            .enumerate()
-            .map(|(i, op)| {
-                self.bus.next_op(ops.get(i + 1).copied());
-                self.bus.run(*op)
-            })
-            .collect();
-        match self.bus.fault() {
-            Some(what) => Err(Response::Error {
+        let mut full = None;
+        let mut ops = WireOp::ops(ops).peekable();
+        while let Some(op) = ops.next() {
+            let held = self.held();
+            if op != Op::Reset && held > self.capture_capacity as usize {
+                full = Some(held);
+                break;
+            }
+            self.bus.next_op(ops.peek().copied());
+            replies.push(self.bus.run(op));
+        }
+        match (self.bus.fault(), full) {
+            (Some(what), _) => Err(Response::Error {
                 code: BridgeErrorCode::Hardware,
                 detail: what.into(),
             }),
-            None => Ok(replies),
+            (None, Some(held)) => Err(self.overrun_error(held)),
+            (None, None) => Ok(()),
         }
+    }
+
+    /// The records captured since the last reset: pulse runs, pin changes
+    /// and move records.
+    fn held(&self) -> usize {
+        let rec = self.bus.record();
+        rec.runs.len() + rec.pins.len() + rec.moves.len()
     }
 
     /// The records captured since the last reset, if more than the
     /// capture buffer holds.
     fn overrun(&self) -> Option<usize> {
-        let rec = self.bus.record();
-        let held = rec.runs.len() + rec.pins.len();
+        let held = self.held();
         (held > self.capture_capacity as usize || self.bus.capture_lost()).then_some(held)
     }
 
@@ -416,7 +470,7 @@ impl<B: Bus> BridgeEngine<B> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bus::EmuBus;
+    use crate::bus::{EmuBus, Reply};
     use crate::emu::ModelConfig;
     use crate::protocol::Straps;
     use alloc::vec;
@@ -836,16 +890,100 @@ mod tests {
         let mut s = server();
         ask(&mut s, 1, &Request::Batch(init));
         let r = ask(&mut s, 2, &Request::Batch(ops));
+        // The length said is the whole reply's, though the bridge kept no
+        // more of it than fits.
+        let says = format!("the reply takes {len} bytes");
         assert!(
             matches!(
                 &r,
                 Response::Error {
                     code: BridgeErrorCode::Overflow,
                     detail,
-                } if detail.contains("send fewer ops")
+                } if detail.contains("send fewer ops") && detail.contains(&says)
             ),
             "{r:?}"
         );
+    }
+
+    /// A single step (0x4A), waited out: a move record, a pulse run and
+    /// pin changes (BUSY, HOLD).
+    fn single_step() -> [Op; 2] {
+        [
+            Op::WriteCommand {
+                byte: 0x4A,
+                wait_ibf: Some(Duration::from_secs(1)),
+            },
+            Op::Delay(Duration::from_millis(5)),
+        ]
+    }
+
+    #[test]
+    fn a_batch_stops_at_a_full_capture_and_a_chip_reset_starts_it_again() {
+        let mut s = server().with_capture_capacity(20);
+        ask(&mut s, 1, &Request::Batch(init_ops()));
+        let held = |s: &BridgeEngine<EmuBus>| {
+            let r = s.bus().record();
+            (r.runs.len(), r.pins.len(), r.moves.len())
+        };
+        let (runs, pins, moves) = held(&s);
+        assert!(runs + pins + moves < 20, "precondition");
+        // Thirty steps in one batch: far more than the buffer holds.
+        let steps: Vec<Op> = (0..30).flat_map(|_| single_step()).collect();
+        let r = ask(&mut s, 2, &Request::Batch(steps));
+        assert!(
+            matches!(
+                &r,
+                Response::Error {
+                    code: BridgeErrorCode::CaptureOverrun,
+                    detail,
+                } if detail.contains("the buffer holds 20")
+            ),
+            "{r:?}"
+        );
+        // It stopped at the op after the one that filled it: the capture
+        // holds at most one op's records more than the buffer (a step's
+        // wait adds its run and pin changes), moves counted.
+        let (runs, pins, moves) = held(&s);
+        assert!(moves < 30, "the batch stopped: {moves} moves");
+        assert!(
+            runs + pins + moves > 20 && runs + pins + moves <= 20 + 6,
+            "{runs} runs, {pins} pin changes, {moves} moves"
+        );
+        // A batch without a reset does not run; the capture is overrun.
+        let more = ask(&mut s, 3, &Request::Batch(single_step().to_vec()));
+        assert!(matches!(
+            more,
+            Response::Error {
+                code: BridgeErrorCode::CaptureOverrun,
+                ..
+            }
+        ));
+        assert_eq!(held(&s), (runs, pins, moves), "nothing ran");
+        let capture = Request::Capture {
+            runs: 0,
+            pins: 0,
+            moves: 0,
+            max: 60,
+        };
+        assert!(matches!(
+            ask(&mut s, 4, &capture),
+            Response::Error {
+                code: BridgeErrorCode::CaptureOverrun,
+                ..
+            }
+        ));
+        // A chip reset runs, and empties the capture.
+        let mut ops = vec![Op::Reset];
+        ops.extend(init_ops());
+        ops.extend(single_step());
+        let Response::Batch(replies) = ask(&mut s, 5, &Request::Batch(ops.clone())) else {
+            panic!("the batch with a reset runs");
+        };
+        assert_eq!(replies.len(), ops.len());
+        let Response::Capture(c) = ask(&mut s, 6, &capture) else {
+            panic!("the capture is whole again");
+        };
+        assert_eq!(c.moves.len(), 1);
     }
 
     #[test]

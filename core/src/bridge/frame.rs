@@ -23,7 +23,7 @@ use crc::{Crc, Table, CRC_32_ISCSI};
 const CRC32C: Crc<u32, Table<16>> = Crc::<u32, Table<16>>::new(&CRC_32_ISCSI);
 
 /// Bytes of the check appended to every payload.
-const CHECK_LEN: usize = 4;
+pub(crate) const CHECK_LEN: usize = 4;
 
 /// Largest payload a frame may carry (before CRC and COBS).
 pub const MAX_PAYLOAD: usize = 4096;

@@ -20,6 +20,8 @@
 //! - [`pioregs`]: the state machines' registers, as values.
 //! - [`clock`]: the bridge's 64-bit cycle clock from the core's cycle
 //!   counter and the always-running timer.
+//! - [`limits`]: the heap and the capture capacity every image keeps (the
+//!   QEMU board's too), and why the capture fills before the heap.
 
 #![no_std]
 
@@ -31,6 +33,7 @@ pub mod board;
 pub mod bus;
 pub mod clock;
 pub mod hal;
+pub mod limits;
 pub mod pins;
 pub mod pioregs;
 pub mod programs;

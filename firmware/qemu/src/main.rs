@@ -25,20 +25,27 @@ use config::BootConfig;
 use core::mem::MaybeUninit;
 use cortex_m_rt::entry;
 use embedded_alloc::LlffHeap as Heap;
+use ppmc_bridge_fw::limits::{CAPTURE_RECORDS, HEAP_BYTES};
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::bus::EmuBus;
 
 #[global_allocator]
 static HEAP: Heap = Heap::empty();
 
-/// Heap for the model, its capture and the engine's buffers: most of the
-/// board's 4 MiB of data RAM.
-const HEAP_SIZE: usize = 3 * 1024 * 1024;
+/// The RP2350 board's heap, with its capture capacity
+/// (`ppmc_bridge_fw::limits`, one source for every image): this board
+/// keeps the board's limits, so that it shows what the board does when the
+/// capture or the heap fills. The heap holds the model, its capture and
+/// the engine's buffers; the model takes a few KB of it, within what
+/// `limits::CHIP_BYTES` allows the board code on the board. Beyond the
+/// heap this image needs only what the board's does: statics, and its
+/// stack (cortex-m-rt's, from the top of RAM down), which has the rest of
+/// the 4 MiB where the board's stacks share what its 512 KiB leave.
+const HEAP_SIZE: usize = HEAP_BYTES;
 
-/// Pulse runs plus pin changes the capture holds between chip resets: what
-/// the heap holds with room to spare (about 40 bytes each); past it the
-/// board answers CAPTURE_OVERRUN instead of running out of memory.
-const CAPTURE_RECORDS: u32 = 50_000;
+/// Bytes handed to the engine at a time: the board gets the host's bytes in
+/// USB packets of 64, and the engine answers each piece as it comes.
+const PIECE: usize = 64;
 
 /// What HELLO_REPLY says this bridge runs.
 const FIRMWARE: &str = concat!(
@@ -69,8 +76,10 @@ fn main() -> ! {
     loop {
         incoming.clear();
         uart.read_available(&mut incoming);
-        let reply = engine.on_bytes(&incoming);
-        uart.write_all(&reply);
+        for piece in incoming.chunks(PIECE) {
+            let reply = engine.on_bytes(piece);
+            uart.write_all(&reply);
+        }
     }
 }
 

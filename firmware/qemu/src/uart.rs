@@ -62,7 +62,8 @@ impl Uart {
     }
 
     /// Appends the bytes waiting now to `out`, sleeping until there is at
-    /// least one.
+    /// least one; at most until `out` is full (its capacity: the rest wait
+    /// in QEMU, so that a host that never pauses costs no more memory).
     pub fn read_available(&mut self, out: &mut Vec<u8>) {
         while read(STATE) & STATE_RX_FULL == 0 {
             cortex_m::asm::wfi();
@@ -72,7 +73,7 @@ impl Uart {
         // A short look for more: QEMU hands the next byte over as soon as
         // the last one is read.
         let mut idle = 0;
-        while idle < 64 {
+        while idle < 64 && out.len() < out.capacity() {
             if read(STATE) & STATE_RX_FULL != 0 {
                 out.push(read(DATA) as u8);
                 idle = 0;

@@ -50,7 +50,7 @@ use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
 use embedded_alloc::LlffHeap as Heap;
 use ppmc_bridge_fw::board::Board;
 use ppmc_bridge_fw::bus::BusTiming;
-use ppmc_bridge_fw::{pins, pioregs, programs};
+use ppmc_bridge_fw::{limits, pins, pioregs, programs};
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::protocol::Straps;
 use static_cell::StaticCell;
@@ -80,14 +80,13 @@ static CORE1_STACK: StaticCell<Stack<32768>> = StaticCell::new();
 
 #[global_allocator]
 static HEAP: Heap = Heap::empty();
-const HEAP_SIZE: usize = 256 * 1024;
+/// The heap, for the capture and the engine's buffers: with the capture's
+/// capacity, `ppmc_bridge_fw::limits`, which the QEMU board keeps too and
+/// which has the arithmetic by which the capture fills before the heap.
+const HEAP_SIZE: usize = limits::HEAP_BYTES;
 
 /// The system clock embassy-rp sets up by default.
 const SYSCLK_HZ: u32 = 150_000_000;
-
-/// Pulse runs plus pin changes the capture holds between chip resets, in
-/// the heap (about 40 bytes each); the suite's busiest scenario needs 367.
-const CAPTURE_RECORDS: u32 = 4096;
 
 const FIRMWARE: &str = concat!(
     "ppmc-bridge-rp2350 ",
@@ -285,7 +284,7 @@ async fn main(_spawner: Spawner) {
         let timer = board.timer();
         let mut engine = BridgeEngine::new(board, session, false, firmware)
             .with_timer(timer)
-            .with_capture_capacity(CAPTURE_RECORDS);
+            .with_capture_capacity(limits::CAPTURE_RECORDS);
         let mut buf = [0u8; 64];
         loop {
             match FROM_HOST.try_read(&mut buf) {

@@ -166,7 +166,7 @@ fn serve(o: Options) -> Result<(), String> {
     );
     let mut engine = BridgeEngine::new(board, session, true, firmware)
         .with_timer(timer)
-        .with_capture_capacity(4096);
+        .with_capture_capacity(ppmc_bridge_fw::limits::CAPTURE_RECORDS);
     let (master, path) = open_pty().map_err(|e| format!("no pseudo-terminal: {e}"))?;
     if let Some(link) = &o.link {
         let _ = std::fs::remove_file(link);

@@ -132,8 +132,8 @@ pub struct BridgeOptions {
     /// Hold each reply until the wall clock has caught up with the
     /// emulator's virtual time, and announce real time in HELLO_REPLY.
     pub realtime: bool,
-    /// Pulse runs plus pin changes the capture buffer holds (see
-    /// [`BridgeEngine::with_capture_capacity`]).
+    /// Records (pulse runs, pin changes and move records) the capture
+    /// buffer holds (see [`BridgeEngine::with_capture_capacity`]).
     pub capture_capacity: u32,
     /// A bridge timer of this rate, not locked to the chip's clock (see
     /// [`timed_engine`]); `None`: a nanosecond timer in step with the chip.

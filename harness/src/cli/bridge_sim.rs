@@ -21,10 +21,10 @@ pub struct BridgeSimArgs {
     /// virtual time (to behave like a real board's timing).
     #[arg(long)]
     realtime: bool,
-    /// Pulse runs plus pin changes the bridge's capture buffer holds; past
-    /// that, capture requests answer CAPTURE_OVERRUN until the next chip
-    /// reset (to try a host against a board with a small buffer). Default:
-    /// unlimited.
+    /// Records (pulse runs, pin changes and move records) the bridge's
+    /// capture buffer holds; past that, capture requests and batches answer
+    /// CAPTURE_OVERRUN until the next chip reset (to try a host against a
+    /// board with a small buffer). Default: unlimited.
     #[arg(long, value_name = "N", default_value_t = u32::MAX, hide_default_value = true)]
     capture_capacity: u32,
     /// Give the bridge a timer of HZ that is not locked to the chip's clock,

@@ -297,11 +297,13 @@ pub enum WireError {
 
 mod bytes;
 mod capture;
+mod lean;
 mod ops;
 
 pub use self::bytes::Timer;
 use self::bytes::{R, W};
 use self::capture::{get_capture, put_capture};
+pub use self::lean::{capture_bytes, Incoming, ReplyWriter, WireOp};
 use self::ops::{get_ops, get_replies, put_ops, put_replies};
 pub use self::ops::{
     wire_op_len, wire_ops, worst_reply_len, MAX_BATCH_OPS, MAX_REPLY_ENTRY, MAX_SAMPLES,

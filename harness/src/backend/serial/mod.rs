@@ -1404,7 +1404,11 @@ impl<L: Link> SerialTarget<L> {
         }
         let r = f(self);
         if let Err(e) = &r {
-            if e.kind() == TargetErrorKind::Link {
+            // A capture overrun is an answer, not a request given up: the
+            // bridge works, and the chip reset of the next scenario empties
+            // its capture.
+            if e.kind() == TargetErrorKind::Link && !matches!(e, SerialError::CaptureOverrun { .. })
+            {
                 self.give_ups += 1;
                 self.last_give_up = e.to_string();
             }
@@ -1782,6 +1786,48 @@ mod tests {
             ),
             "{e}"
         );
+    }
+
+    /// A bridge whose capture overran answers so until a chip reset: each
+    /// answer is the scenario's error, not a request given up, however
+    /// many scenarios in a row overrun.
+    #[test]
+    fn capture_overruns_do_not_use_up_the_link() {
+        let mut link = MemLink::new();
+        link.server = MemLink::bridge(1).with_capture_capacity(3);
+        let mut t = SerialTarget::open(link, quick()).expect("healthy");
+        // Initialization (RL 100, RH 20, PA 100) and a single step: more
+        // than 3 records.
+        let wait_ibf = Some(Duration::from_secs(1));
+        let mut ops = vec![Op::WriteCommand {
+            byte: 0x06,
+            wait_ibf: None,
+        }];
+        ops.extend([100, 20, 100, 0].map(|byte| Op::WriteData { byte, wait_ibf }));
+        ops.push(Op::Delay(Duration::from_millis(200)));
+        ops.push(Op::WriteCommand {
+            byte: 0x4A,
+            wait_ibf,
+        });
+        ops.push(Op::Delay(Duration::from_millis(5)));
+        for n in 0..2 * MAX_GIVE_UPS {
+            let mut batch = vec![Op::Reset];
+            batch.extend(ops.iter().copied());
+            let e = t
+                .execute(&batch)
+                .and_then(|_| t.capture())
+                .expect_err("the capture overran");
+            assert!(
+                matches!(
+                    e.get_ref().downcast_ref::<SerialError>(),
+                    Some(SerialError::CaptureOverrun { .. })
+                ),
+                "{n}: {e}"
+            );
+        }
+        assert_eq!(t.give_ups, 0);
+        t.execute(&[Op::Reset, Op::ReadStatus])
+            .expect("the link is still used");
     }
 
     /// Every wait has an end: a bridge that goes silent costs each request
