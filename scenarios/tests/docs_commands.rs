@@ -82,7 +82,7 @@ const ELSEWHERE: [(&str, &str); 22] = [
         "in harness/tests/firmware_qemu.rs (started, the whole suite run through it, stopped)",
     ),
     (
-        "cargo run -q --release --locked --manifest-path firmware/Cargo.toml -p ppmc-bridge-fw --features twin --example capture_margin",
+        "cargo run --release --locked --manifest-path firmware/Cargo.toml -p ppmc-bridge-fw --features twin --example capture_margin",
         "in .ci/run (the firmware step: the twin's capture margin)",
     ),
     (
