@@ -82,9 +82,9 @@ pub struct Board<H: Hal> {
     next: Option<Op>,
     /// Where a delay that ended early aims the next op's moment (ticks).
     aim: Option<u64>,
-    /// The op running ends its batch; the last batch has ended (the core
-    /// may sleep before the next: the clock is set right first).
-    ends_batch: bool,
+    /// The last batch has ended (the core may sleep before the next: the
+    /// clock is set right first). The op running ends its batch when
+    /// `next` is `None`.
     batch_done: bool,
     /// Pin samples taken without a poll around them.
     samples: u32,
@@ -131,23 +131,6 @@ impl<H: Hal> core::fmt::Debug for Board<H> {
             .finish_non_exhaustive()
     }
 }
-
-/// S1..S5, AUXO0..3 and DIR in [`Hal::read_high_pins`]'s word: the
-/// outputs the CPU samples.
-const SAMPLED: u16 = {
-    let mut m = 1 << (pins::DIR - 32);
-    let mut i = 0;
-    while i < 5 {
-        m |= 1 << (pins::S[i] - 32);
-        i += 1;
-    }
-    let mut i = 0;
-    while i < 4 {
-        m |= 1 << (pins::AUXO[i] - 32);
-        i += 1;
-    }
-    m
-};
 
 /// The kinds of op a delay ends early for ([`Bus::next_op`]), to aim
 /// their moment.
@@ -234,7 +217,6 @@ impl<H: Hal> Board<H> {
             aim: None,
             poll_ticks: 0,
             samples: 0,
-            ends_batch: true,
             batch_done: true,
             last_status: epoch,
             last_word: 0,
@@ -251,7 +233,7 @@ impl<H: Hal> Board<H> {
             fault: None,
             overruns: 0,
         };
-        let word = bus.hal.read_high_pins() & SAMPLED;
+        let word = bus.hal.read_high_pins() & pins::SAMPLED_HIGH;
         let now = bus.now_ticks();
         bus.sample(word, bus.at(now), now, false);
         bus.last_word = word;
@@ -310,7 +292,7 @@ impl<H: Hal> Board<H> {
     }
 
     fn poll_inner(&mut self) {
-        let word = self.hal.read_high_pins() & SAMPLED;
+        let word = self.hal.read_high_pins() & pins::SAMPLED_HIGH;
         let sampled = self.now_ticks();
         let before = core::mem::replace(&mut self.last_sample, sampled);
         // A change happened after the outputs were last seen unchanged and
@@ -948,18 +930,17 @@ impl<H: Hal> Bus for Board<H> {
         if matches!(op, Op::Delay(_)) && self.aim.is_some() {
             return reply;
         }
-        if !(aimed && op == Op::ReadPins) || self.ends_batch {
+        let ends_batch = self.next.is_none();
+        if !(aimed && op == Op::ReadPins) || ends_batch {
             self.refresh();
         }
-        self.batch_done |= self.ends_batch;
+        self.batch_done |= ends_batch;
         self.aim = None;
         reply
     }
 
     fn next_op(&mut self, next: Option<Op>) {
         self.next = next;
-        // The op about to run ends its batch.
-        self.ends_batch = next.is_none();
     }
 
     fn record(&self) -> &Record {

@@ -65,3 +65,21 @@ pub const CSEL: u32 = 46;
 /// RP2350B's ADC pins are 40-47) in GPIO bank 0: the image reads it from
 /// SIO GPIO_IN, not GPIO_HI_IN.
 pub const VSEL: u32 = 27;
+
+/// S1..S5, AUXO0..3 and DIR, the outputs the CPU samples, as bits of
+/// GPIO 32-47 (bit 0: GPIO 32; the board code's `Hal::read_high_pins`, the
+/// image's GPIO_HI_IN).
+pub const SAMPLED_HIGH: u16 = {
+    let mut m = 1 << (DIR - 32);
+    let mut i = 0;
+    while i < S.len() {
+        m |= 1 << (S[i] - 32);
+        i += 1;
+    }
+    let mut i = 0;
+    while i < AUXO.len() {
+        m |= 1 << (AUXO[i] - 32);
+        i += 1;
+    }
+    m
+};

@@ -277,7 +277,7 @@ impl Hal for Rp2350 {
         // A tight loop on the sampled outputs and the capture FIFOs' empty
         // flags: a change is seen within a pass (some 20 cycles). The cycle
         // counter's raw value marks the last pass that saw nothing.
-        let sampled = SAMPLED_MASK;
+        let sampled = u32::from(pins::SAMPLED_HIGH);
         let seen = pac::SIO.gpio_in(1).read() & sampled;
         let counters = |b: usize| pio(b).fstat().read().rxempty();
         let start = DWT::cycle_count();
@@ -305,20 +305,3 @@ impl Hal for Rp2350 {
         }
     }
 }
-
-/// S1..S5, AUXO0..3 and DIR in GPIO_HI_IN: the outputs the board code
-/// samples.
-const SAMPLED_MASK: u32 = {
-    let mut m = 1 << (pins::DIR - 32);
-    let mut i = 0;
-    while i < 5 {
-        m |= 1 << (pins::S[i] - 32);
-        i += 1;
-    }
-    let mut i = 0;
-    while i < 4 {
-        m |= 1 << (pins::AUXO[i] - 32);
-        i += 1;
-    }
-    m
-};

@@ -397,14 +397,31 @@ pub fn capture_margin() -> Result<CaptureMargin, String> {
 /// last byte: a reset, an initialization (RL 100, RH 12, PA 100), 100 ms,
 /// 5,000 pulses with accel/decel in POUT mode.
 pub fn fastest_move() -> (Straps, std::vec::Vec<ppmc_core::bus::Op>) {
-    use ppmc_core::bus::Op;
     use ppmc_core::time::Duration;
     let straps = Straps {
         sysclk_hz: 40_000_000,
         ..Straps::default()
     };
+    (
+        straps,
+        init_and_move(12, Duration::from_millis(100), 0xC3, 5_000),
+    )
+}
+
+/// Ops: a reset; an initialization (4-phase, RL 100, RH `rh`, PA 100);
+/// `settle`; the accel/decel move `command` (0x43 CW, 0xC3 in POUT mode)
+/// of `steps` pulses, up to its last byte. Every write waits for IBF = 0,
+/// at most 10 ms.
+pub fn init_and_move(
+    rh: u8,
+    settle: ppmc_core::time::Duration,
+    command: u8,
+    steps: u32,
+) -> std::vec::Vec<ppmc_core::bus::Op> {
+    use ppmc_core::bus::Op;
+    use ppmc_core::time::Duration;
     let wait = Some(Duration::from_millis(10));
-    let n: u32 = 5_000 - 1;
+    let n = steps - 1;
     let mut ops = std::vec![
         Op::Reset,
         Op::WriteCommand {
@@ -412,15 +429,15 @@ pub fn fastest_move() -> (Straps, std::vec::Vec<ppmc_core::bus::Op>) {
             wait_ibf: wait
         }
     ];
-    for byte in [100, 12, 100, 0] {
+    for byte in [100, rh, 100, 0] {
         ops.push(Op::WriteData {
             byte,
             wait_ibf: wait,
         });
     }
-    ops.push(Op::Delay(Duration::from_millis(100)));
+    ops.push(Op::Delay(settle));
     ops.push(Op::WriteCommand {
-        byte: 0xC3,
+        byte: command,
         wait_ibf: wait,
     });
     for byte in [n as u8, (n >> 8) as u8, (n >> 16) as u8] {
@@ -429,7 +446,7 @@ pub fn fastest_move() -> (Straps, std::vec::Vec<ppmc_core::bus::Op>) {
             wait_ibf: wait,
         });
     }
-    (straps, ops)
+    ops
 }
 
 /// The board code on the twin: what `firmware/run-twin` serves.

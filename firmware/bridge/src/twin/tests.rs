@@ -9,7 +9,6 @@ use ppmc_core::bus::{Bus, EmuBus, Op, Reply};
 use ppmc_core::protocol::Status;
 use ppmc_core::time::Duration;
 use std::string::ToString;
-use std::vec;
 use std::vec::Vec;
 
 fn twin() -> TwinBoard {
@@ -19,28 +18,8 @@ fn twin() -> TwinBoard {
 /// docs/examples/accel-1000-steps.ppmc, as ops: initialization, then 1,000
 /// steps CW with accel/decel (Section 3-2).
 fn accel_move(steps: u32) -> Vec<Op> {
-    let wait = Some(Duration::from_millis(10));
-    let wc = |byte| Op::WriteCommand {
-        byte,
-        wait_ibf: wait,
-    };
-    let wd = |byte| Op::WriteData {
-        byte,
-        wait_ibf: wait,
-    };
-    let n = steps - 1;
-    vec![
-        Op::Reset,
-        wc(0x02),
-        wd(100),
-        wd(20),
-        wd(100),
-        wd(0),
-        Op::Delay(Duration::from_millis(200)),
-        wc(0x43),
-        wd(n as u8),
-        wd((n >> 8) as u8),
-        wd((n >> 16) as u8),
+    let mut ops = init_and_move(20, Duration::from_millis(200), 0x43, steps);
+    ops.extend([
         Op::AwaitStatus {
             mask: Status::BUSY,
             value: Status::BUSY,
@@ -52,7 +31,8 @@ fn accel_move(steps: u32) -> Vec<Op> {
             timeout: Duration::from_secs(2),
         },
         Op::ReadPulses,
-    ]
+    ]);
+    ops
 }
 
 fn run(bus: &mut impl Bus, ops: &[Op]) -> Vec<Reply> {
