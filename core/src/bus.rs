@@ -14,6 +14,7 @@
 use crate::emu::{Board, Chip, ChipError, ModelConfig};
 use crate::protocol::{Flag, Input, Pins, PulseSummary, Record, RecordMark, Status, Straps};
 use crate::time::{Duration, Instant};
+use alloc::string::String;
 
 /// One bus-level operation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -275,6 +276,49 @@ pub trait Bus {
     fn fault(&self) -> Option<&str> {
         None
     }
+
+    /// Runs a bridge's self-test of its capture ([`SelfTestPlan`]): its
+    /// own pulse generator drives the capture inputs of POUT and INT* with
+    /// the chip's outputs cut off, and the capture records what it saw
+    /// from a fresh start (as after [`Op::Reset`], which the chip also
+    /// gets). What the generator was asked is in the reply; what it did,
+    /// the capture says. A bus with no generator (the reference model)
+    /// says why not.
+    fn self_test(&mut self, _plan: &SelfTestPlan) -> Result<SelfTestReply, String> {
+        Err("this bridge has no self-test generator".into())
+    }
+}
+
+/// What a bridge's self-test generates: `bursts` bursts of `count`
+/// pulses, each high for `high` then low for `low`, and `gap` of low
+/// between one burst's last pulse and the next burst. The bridge rounds
+/// each time to its own resolution and says what it used
+/// ([`SelfTestReply`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SelfTestPlan {
+    pub count: u32,
+    pub high: Duration,
+    pub low: Duration,
+    pub bursts: u16,
+    pub gap: Duration,
+}
+
+impl SelfTestPlan {
+    /// From the first rise of a burst to its last pulse's end.
+    pub fn burst_length(&self, high: Duration, low: Duration) -> Duration {
+        (high + low).saturating_mul(u64::from(self.count))
+    }
+}
+
+/// A self-test's schedule as the bridge ran it: when each burst's first
+/// pulse rose on the bridge's clock (the record's time, from the fresh
+/// start), and the high and low times it generated, rounded to its
+/// resolution.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SelfTestReply {
+    pub starts: alloc::vec::Vec<Instant>,
+    pub high: Duration,
+    pub low: Duration,
 }
 
 /// The reference model as a [`Bus`]: ops run in virtual time, and waits

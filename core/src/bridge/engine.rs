@@ -352,6 +352,21 @@ impl<B: Bus> BridgeEngine<B> {
                 code: BridgeErrorCode::Malformed,
                 detail: "batch-capture handled before dispatch".into(),
             },
+            Request::SelfTest(plan) => {
+                if let Some(what) = self.bus.fault() {
+                    return Response::Error {
+                        code: BridgeErrorCode::Hardware,
+                        detail: what.into(),
+                    };
+                }
+                match self.bus.self_test(&plan) {
+                    Ok(reply) => Response::SelfTest(reply),
+                    Err(detail) => Response::Error {
+                        code: BridgeErrorCode::UnknownOp,
+                        detail,
+                    },
+                }
+            }
             Request::Link { fragment, pad } => {
                 self.fragment =
                     usize::from(fragment).clamp(wire::MIN_FRAGMENT_DATA, wire::FRAGMENT_DATA);
@@ -609,6 +624,28 @@ mod tests {
         );
         let again = s.on_bytes(&frame::encode(&hello.encode(8, Timer::NANOS)));
         assert_eq!(again.len(), plain.len());
+    }
+
+    #[test]
+    fn a_bridge_without_a_generator_refuses_the_self_test_and_goes_on() {
+        use crate::bus::SelfTestPlan;
+        let mut s = server();
+        let plan = SelfTestPlan {
+            count: 10,
+            high: Duration::from_micros(5),
+            low: Duration::from_micros(5),
+            bursts: 1,
+            gap: Duration::ZERO,
+        };
+        match ask(&mut s, 3, &Request::SelfTest(plan)) {
+            Response::Error {
+                code: BridgeErrorCode::UnknownOp,
+                detail,
+            } => assert!(detail.contains("no self-test generator"), "{detail}"),
+            other => panic!("{other:?}"),
+        }
+        let after = ask(&mut s, 4, &Request::Batch(vec![Op::ReadStatus]));
+        assert!(matches!(after, Response::Batch(r) if r.len() == 1));
     }
 
     #[test]

@@ -300,7 +300,31 @@ fn main() {
         tx: vec![],
     });
 
-    let traces: Vec<String> = [bus_run, pout_run]
+    // The self-test generator at address 0 (the image relocates it after
+    // the bus player; `programs` tests the relocation): two bursts, the
+    // second written while the first plays, so the machine goes straight
+    // on; then a third after it waited at `pull`.
+    let gen = programs::test_gen();
+    let burst = |count, high, low| programs::test_gen_words(count, high, low).expect("makeable");
+    let mut gen_tx: Vec<(usize, u32)> = burst(4, 5, 7).iter().map(|w| (0, *w)).collect();
+    gen_tx.extend(burst(3, 3, 4).iter().map(|w| (10, *w)));
+    gen_tx.extend(burst(2, 9, 6).iter().map(|w| (200, *w)));
+    let tg = 1u32 << ppmc_bridge_fw::pins::TEST_GEN;
+    let quiet = |_: usize| (0, 0);
+    let gen_run = Run {
+        name: "test_gen",
+        block: block::BUS,
+        sm: pioregs::TEST_GEN_SM,
+        program: &gen,
+        regs: pioregs::test_gen(&gen),
+        x: None,
+        pins: Some((0, tg)),
+        cycles: 300,
+        outside: &quiet,
+        tx: gen_tx,
+    };
+
+    let traces: Vec<String> = [bus_run, pout_run, gen_run]
         .into_iter()
         .chain(pin_runs)
         .map(|r| trace(&r))

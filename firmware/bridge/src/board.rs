@@ -15,13 +15,14 @@
 use crate::bus::{self, BusTiming, Cycle};
 use crate::hal::{Counter, Hal};
 use crate::pins;
-use crate::timebase;
+use crate::programs::{self, TEST_GEN_LEAD};
+use crate::{limits, timebase};
 use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
 use ppmc_core::bridge::moves::MoveTracker;
 use ppmc_core::bridge::wire::Timer;
-use ppmc_core::bus::{Bus, Op, Reply};
+use ppmc_core::bus::{Bus, Op, Reply, SelfTestPlan, SelfTestReply};
 use ppmc_core::protocol::{
     Direction, EdgeRuns, Input as ChipInput, OutputLogic, Pin, PinEvent, Pins, Record, Status,
     Straps,
@@ -42,6 +43,17 @@ const SETTLE_TICKS: u64 = 8;
 /// beyond the op's bus cycles, so that the op can aim its moment at the
 /// delay's end ([`Board::lead`]).
 const CPU_LEAD_US: u64 = 2;
+
+/// The most records the board code keeps between chip resets: the
+/// capture's capacity and what one op may add beyond it
+/// ([`limits::OP_RECORDS`]). Past it, edges and pin changes are dropped,
+/// and the engine answers CAPTURE_OVERRUN (the record holds more than the
+/// capacity): a chip that pulses without end cannot exhaust the heap.
+const MOST_RECORDS: usize = limits::CAPTURE_RECORDS as usize + limits::OP_RECORDS;
+
+/// The longest self-test the board runs in one request (cycles at most
+/// 2^40: two hours at 150 MHz; the host asks for far less).
+const SELF_TEST_MOST_CYCLES: u64 = 1 << 40;
 
 /// Time enough for a look at the capture FIFOs' levels (ticks: 32 cycles).
 const LOOK_TICKS: u64 = 16;
@@ -320,6 +332,9 @@ impl<H: Hal> Board<H> {
             (e.bit, started / 2 + e.at)
         };
         while let Some(w) = self.hal.capture_pull(Counter::Pout) {
+            if !self.room() {
+                continue;
+            }
             let (bit, t) = ticks(&self.hal, self.started, w);
             self.last_pulse = self.last_pulse.max(t);
             let new_move = self
@@ -361,8 +376,88 @@ impl<H: Hal> Board<H> {
     /// A pin change, kept in time order until [`Board::poll`] moves it to
     /// the record.
     fn pin(&mut self, at: Instant, pin: Pin, value: u8) {
+        if !self.room() {
+            return;
+        }
         let i = self.pending.partition_point(|p| p.at <= at);
         self.pending.insert(i, PinEvent { at, pin, value });
+    }
+
+    /// Whether the record (and the changes on their way to it) has room
+    /// for another record ([`MOST_RECORDS`]).
+    fn room(&self) -> bool {
+        let r = &self.record;
+        r.runs.len() + r.pins.len() + r.moves.len() + self.pending.len() < MOST_RECORDS
+    }
+
+    /// Drains the capture until tick `t`.
+    fn drain_until(&mut self, t: u64) {
+        while self.now_ticks() < t {
+            self.refresh();
+            self.idle(t);
+        }
+    }
+
+    /// The self-test ([`Bus::self_test`]): the generator connected to the
+    /// capture inputs of POUT and INT* (the chip's outputs cut off), a
+    /// chip reset (a fresh record and timebase, started with the
+    /// generator's level), the bursts, each started when the last one and
+    /// its gap have passed, the capture drained throughout; then the
+    /// inputs given back to the chip. Each burst's first rise is predicted
+    /// from the cycle the generator was enabled on
+    /// ([`programs::TEST_GEN_LEAD`]): what the capture says about it is
+    /// the capture's offset.
+    fn run_self_test(&mut self, plan: &SelfTestPlan) -> Result<SelfTestReply, String> {
+        // Ticks are two cycles: times in whole ticks keep every edge on
+        // the counters' grid.
+        let cycles = |d: Duration| 2 * self.timer.to_ticks(d.as_nanos());
+        let (high, low, gap) = (cycles(plan.high), cycles(plan.low), cycles(plan.gap));
+        let words = programs::test_gen_words(plan.count, high, low).ok_or_else(|| {
+            format!(
+                "the generator cannot make pulses {} high and {} low: each must be at least {} and at most 2^32 cycles",
+                plan.high,
+                plan.low,
+                Duration::from_nanos(self.timer.to_nanos(2))
+            )
+        })?;
+        let burst = (high + low).saturating_mul(u64::from(plan.count));
+        let total = (burst + gap).saturating_mul(u64::from(plan.bursts));
+        if total > SELF_TEST_MOST_CYCLES {
+            return Err(format!(
+                "a self-test of {} bursts of {} pulses takes longer than the bridge allows in one request",
+                plan.bursts, plan.count
+            ));
+        }
+        self.hal.resync();
+        self.hal.gen_connect(true);
+        self.reset_chip();
+        let mut starts = Vec::with_capacity(usize::from(plan.bursts));
+        // The first burst a little after the reset (the counters started).
+        let mut next = self.hal.cycles() + u64::from(self.sysclk_hz / 500_000);
+        for _ in 0..plan.bursts {
+            self.drain_until(next / 2);
+            let enabled = self.hal.gen_start(words);
+            let first = enabled + TEST_GEN_LEAD;
+            starts.push(self.time_of_cycle(first));
+            let end = first + burst;
+            self.drain_until(end.div_ceil(2) + SETTLE_TICKS);
+            self.hal.gen_stop();
+            next = end + gap;
+        }
+        // Every edge of the last burst into the record, then the chip's
+        // outputs back.
+        let settled = self.now_ticks() + 2 * SETTLE_TICKS;
+        self.drain_until(settled);
+        self.refresh();
+        self.hal.gen_connect(false);
+        self.moment = self.now_ticks();
+        self.batch_done = true;
+        let dur = |c: u64| Duration::from_nanos(self.timer.to_nanos(c / 2));
+        Ok(SelfTestReply {
+            starts,
+            high: dur(high),
+            low: dur(low),
+        })
     }
 
     /// Records changes of the outputs the CPU samples.
@@ -961,5 +1056,9 @@ impl<H: Hal> Bus for Board<H> {
 
     fn fault(&self) -> Option<&str> {
         self.fault.as_deref()
+    }
+
+    fn self_test(&mut self, plan: &SelfTestPlan) -> Result<SelfTestReply, String> {
+        self.run_self_test(plan)
     }
 }

@@ -71,6 +71,20 @@ pub trait Hal {
     /// The levels of GPIO 32-47, bit 0 being GPIO 32.
     fn read_high_pins(&mut self) -> u16;
 
+    /// Gives the capture inputs of POUT and INT* to the self-test
+    /// generator (`on`: CAPTURE_OE* high, the chip's outputs cut off,
+    /// then TEST_GEN driven low), or back to the chip (TEST_GEN released,
+    /// then CAPTURE_OE* low).
+    fn gen_connect(&mut self, on: bool);
+
+    /// Starts a burst of the generator (`programs::test_gen`): stops and
+    /// restarts its state machine, writes `words` into its TX FIFO, and
+    /// enables it; the cycle it was enabled on.
+    fn gen_start(&mut self, words: [u32; 3]) -> u64;
+
+    /// Stops the generator (TEST_GEN keeps its level: low after a burst).
+    fn gen_stop(&mut self);
+
     /// The board code is alive: feeds the watchdog (the RP2350 image). Called
     /// from every loop of the board code that may last.
     fn keepalive(&mut self) {}

@@ -66,8 +66,9 @@ pub const MOVE_BYTES: usize = 32;
 /// pulses, makes 469 runs in the model.
 ///
 /// A chip that pulses at random intervals would make a run of every pulse,
-/// without end within one op: the board code's capture has no limit of
-/// its own yet (firmware/README.md).
+/// without end within one op: the board code stops recording at
+/// [`CAPTURE_RECORDS`] + `OP_RECORDS` (`board.rs`), and the engine answers
+/// CAPTURE_OVERRUN.
 pub const OP_RECORDS: usize = 2 * 254 + 2 + 1 + 16;
 
 /// What the bridge engine (`ppmc_core::bridge::engine`) holds at its worst

@@ -202,6 +202,40 @@ pub fn bus_player(p: &Loaded) -> SmRegs {
     }
 }
 
+/// The self-test generator (PIO0, SM1) running `p` ([`programs::test_gen`],
+/// relocated to its origin): SET pin TEST_GEN, FIFOs not joined (a
+/// burst's three words fit the TX FIFO's four), no side-set.
+pub fn test_gen(p: &Loaded) -> SmRegs {
+    let base = block::GPIOBASE[block::BUS];
+    SmRegs {
+        clkdiv: CLKDIV_1,
+        execctrl: wrap(p),
+        shiftctrl: 1 << shiftctrl::OUT_SHIFTDIR,
+        pinctrl: idx(pins::TEST_GEN, base) << pinctrl::SET_BASE | 1 << pinctrl::SET_COUNT,
+        start: p.start,
+        x: 0,
+        side: p.side,
+    }
+}
+
+/// The generator's state machine in PIO0.
+pub const TEST_GEN_SM: usize = 1;
+
+/// PIO0's CTRL with the bus player (SM0) running and the generator
+/// stopped and restarted (its ISR, OSR counters and delay cleared).
+pub const TEST_GEN_STOP: u32 = 1 << ctrl::SM_ENABLE | 1 << (TEST_GEN_SM as u32 + ctrl::SM_RESTART);
+
+/// PIO0's CTRL with both the bus player and the generator running.
+pub const TEST_GEN_RUN: u32 = (1 | 1 << TEST_GEN_SM) << ctrl::SM_ENABLE;
+
+/// A `set pins` (or `set pindirs`) of `value`, with no delay or side-set:
+/// what the CPU forces on the generator's state machine to drive or
+/// release TEST_GEN.
+pub const fn force_set(pindirs: bool, value: u8) -> u16 {
+    let dest: u16 = if pindirs { 0b100 } else { 0b000 };
+    0b111 << 13 | dest << 5 | (value as u16 & 0x1F)
+}
+
 /// An edge counter running `p`: JMP pin `pin`, IN base `input` (one pin),
 /// RX FIFO joined (8 words), counting from all ones, started in the loop
 /// for the level `pin` has (`high`), so that starting is not an edge.

@@ -9,6 +9,7 @@
 //! | block | program | words | state machines |
 //! |---|---|---|---|
 //! | PIO0 | [`bus_player`] | 9 | SM0 |
+//! | PIO0, at 9 | [`test_gen`]: the self-test's pulses on TEST_GEN | 12 | SM1 |
 //! | PIO1 | [`edge_counter`]`(true)`: POUT's rising edges with DIR | 11 | SM0 |
 //! | PIO2 | [`edge_counter`]`(false)`: both edges | 21 | SM0-2 (INT*, HOLD, AUX*) |
 //!
@@ -193,9 +194,89 @@ pub fn edge_counter(rising_only: bool) -> Loaded {
     }
 }
 
-/// What each PIO block is loaded with, in block order.
+/// What each PIO block is loaded with, in block order, at address 0. PIO0
+/// also holds [`test_gen`], at [`test_gen_origin`].
 pub fn layout() -> [Loaded; 3] {
     [bus_player(), edge_counter(true), edge_counter(false)]
+}
+
+/// The self-test generator (PIO0, SM1): `count` pulses on TEST_GEN, each
+/// high for `high` cycles and low for `low`, from three TX FIFO words
+/// ([`test_gen_words`]); then it waits at its first `pull` for the next
+/// burst, the pin low.
+///
+/// From the cycle it is enabled with the three words in its FIFO, its
+/// first `set pins, 1` runs on cycle [`TEST_GEN_LEAD`] - 1, so the pin is
+/// high from cycle [`TEST_GEN_LEAD`] on; each pulse is `high` cycles high
+/// (`set`, `mov`, X + 1 times `jmp x--`) and `low` low (the same, and the
+/// `jmp y--`), whatever the count: the board code predicts every edge
+/// from the cycle it enabled the machine on.
+///
+/// Assembled for address 0; [`test_gen_origin`] relocates it.
+pub fn test_gen() -> Loaded {
+    let p = pio::pio_asm!(
+        ".wrap_target",
+        "    pull block",
+        "    out y, 32",
+        "    pull block",
+        "    mov isr, osr",
+        "    pull block",
+        "pulse:",
+        "    set pins, 1",
+        "    mov x, osr",
+        "high:",
+        "    jmp x-- high",
+        "    set pins, 0",
+        "    mov x, isr",
+        "low:",
+        "    jmp x-- low",
+        "    jmp y-- pulse",
+        ".wrap",
+    )
+    .program;
+    Loaded::new(p, 0, 0, None)
+}
+
+/// Cycles from enabling [`test_gen`] to its pin's first rise.
+pub const TEST_GEN_LEAD: u64 = 6;
+
+/// The shortest high and low times [`test_gen`] makes (cycles).
+pub const TEST_GEN_MIN: (u64, u64) = (3, 4);
+
+/// The three TX FIFO words of a burst of `count` pulses, `high` and `low`
+/// cycles each; `None` if [`test_gen`] cannot make them (count 0, times
+/// under [`TEST_GEN_MIN`] or over 2^32 cycles).
+pub fn test_gen_words(count: u32, high: u64, low: u64) -> Option<[u32; 3]> {
+    let n = count.checked_sub(1)?;
+    let h = u32::try_from(high.checked_sub(TEST_GEN_MIN.0)?).ok()?;
+    let l = u32::try_from(low.checked_sub(TEST_GEN_MIN.1)?).ok()?;
+    Some([n, l, h])
+}
+
+/// Where [`test_gen`] is loaded in PIO0: after the bus player.
+pub fn test_gen_origin() -> u8 {
+    bus_player().words().len() as u8
+}
+
+/// `p`, assembled for address 0, relocated to `origin`: its jumps' targets, its wrap and its start
+/// addresses moved by `origin`, as embassy-rp's `load_program` relocates.
+pub fn relocate(p: Loaded, origin: u8) -> Loaded {
+    let mut program = p.program;
+    for w in program.code.iter_mut() {
+        // JMP: opcode 000 in bits 15-13, the address in bits 4-0.
+        if *w >> 13 == 0 {
+            *w = (*w & !0x1F) | ((*w & 0x1F) + u16::from(origin)) & 0x1F;
+        }
+    }
+    program.origin = Some(origin);
+    Loaded {
+        program,
+        wrap_top: p.wrap_top + origin,
+        wrap_bottom: p.wrap_bottom + origin,
+        start: p.start + origin,
+        start_low: p.start_low + origin,
+        side: p.side,
+    }
 }
 
 #[cfg(test)]
@@ -233,6 +314,78 @@ mod tests {
             enables.push((w.driven().1 >> 8 & 0x1F) as u32);
         }
         enables
+    }
+
+    #[test]
+    fn relocating_moves_the_jumps_wrap_and_start_and_nothing_else() {
+        let at0 = test_gen();
+        let moved = relocate(test_gen(), 9);
+        assert_eq!(at0.words().len(), moved.words().len());
+        let mut jumps = 0;
+        for (a, b) in at0.words().iter().zip(moved.words()) {
+            if a >> 13 == 0 {
+                jumps += 1;
+                assert_eq!((a & !0x1F, (a & 0x1F) + 9), (b & !0x1F, b & 0x1F));
+            } else {
+                assert_eq!(a, b);
+            }
+        }
+        assert_eq!(jumps, 3, "jmp x-- high, jmp x-- low, jmp y-- pulse");
+        assert_eq!(
+            (moved.wrap_top, moved.wrap_bottom, moved.start),
+            (at0.wrap_top + 9, at0.wrap_bottom + 9, 9)
+        );
+    }
+
+    #[test]
+    fn the_generator_makes_each_pulse_as_asked_from_its_lead_on() {
+        // Two bursts, counted cycle by cycle on the PIO model at its origin
+        // in PIO0: rises at TEST_GEN_LEAD + k x (high + low), each high
+        // for `high` cycles.
+        use crate::pins;
+        let origin = test_gen_origin();
+        let gen = relocate(test_gen(), origin);
+        let regs = pioregs::test_gen(&gen);
+        let mut w = World::new();
+        w.blocks[0].load(gen.words(), origin).expect("fits");
+        w.blocks[0].configure(1, &regs).expect("modelled");
+        for g in 0..48 {
+            w.func[g] = crate::twin::pio::Func::Pio(0);
+        }
+        let mut outside = Inputs(|_, _, _| (0, 0));
+        w.blocks[0].exec(1, pioregs::force_set(true, 1), 0);
+        for (count, high, low) in [(3u32, 3u64, 4u64), (5, 10, 12)] {
+            let words = test_gen_words(count, high, low).expect("makeable");
+            for word in words {
+                w.blocks[0].txf_write(1, word);
+            }
+            w.write_ctrl(0, pioregs::TEST_GEN_RUN);
+            let enabled = w.cycle;
+            let mut rises = Vec::new();
+            let mut last = false;
+            let mut high_for = Vec::new();
+            let mut since = 0;
+            for _ in 0..(TEST_GEN_LEAD + u64::from(count) * (high + low) + 20) {
+                w.step(&mut outside);
+                let level = w.pads() >> pins::TEST_GEN & 1 == 1;
+                if level && !last {
+                    rises.push(w.cycle - enabled);
+                    since = w.cycle;
+                }
+                if !level && last {
+                    high_for.push(w.cycle - since);
+                }
+                last = level;
+            }
+            let want: Vec<u64> = (0..u64::from(count))
+                .map(|k| TEST_GEN_LEAD + k * (high + low))
+                .collect();
+            assert_eq!(rises, want, "{count} pulses of {high} + {low} cycles");
+            assert!(high_for.iter().all(|h| *h == high), "{high_for:?}");
+            w.write_ctrl(0, pioregs::TEST_GEN_STOP);
+        }
+        assert_eq!(test_gen_words(1, 2, 4), None, "high under 3 cycles");
+        assert_eq!(test_gen_words(0, 3, 4), None, "no pulse");
     }
 
     #[test]

@@ -32,14 +32,15 @@ fn pio(b: usize) -> pac::pio::Pio {
     }
 }
 
-/// Loads `p` at address 0 of block `b` and sets its GPIOBASE. Each block
-/// holds one program (`ppmc_bridge_fw::programs`), so nothing else is
-/// there.
-pub fn load(b: usize, p: &Loaded) {
+/// Loads `p` at address `origin` of block `b` (already relocated there)
+/// and sets the block's GPIOBASE. Each block holds one program at 0, and
+/// PIO0 the self-test's generator after it (`ppmc_bridge_fw::programs`),
+/// so nothing else is there.
+pub fn load(b: usize, p: &Loaded, origin: u8) {
     let block = pio(b);
     for (i, w) in p.words().iter().enumerate() {
         block
-            .instr_mem(i)
+            .instr_mem(usize::from(origin) + i)
             .write_value(pac::pio::regs::InstrMem(u32::from(*w)));
     }
     block
@@ -94,6 +95,8 @@ pub struct Rp2350 {
     sysclk_hz: u32,
     clock: RefCell<Clock>,
     counters: [Loaded; 2],
+    /// The self-test generator, as loaded in PIO0.
+    gen: Loaded,
     /// Core 0's heartbeat as last seen, and when (cycles).
     beat: (u32, u64),
 }
@@ -130,11 +133,12 @@ impl Rp2350 {
 
     /// The hardware layer, with the cycle counter running (`start`) and
     /// the counters' programs (PIO1's and PIO2's) loaded.
-    pub fn new(sysclk_hz: u32, pout: Loaded, pins_: Loaded) -> Rp2350 {
+    pub fn new(sysclk_hz: u32, pout: Loaded, pins_: Loaded, gen: Loaded) -> Rp2350 {
         Rp2350 {
             sysclk_hz,
             clock: RefCell::new(Clock::new(sysclk_hz, DWT::cycle_count(), now_us(), 0)),
             counters: [pout, pins_],
+            gen,
             beat: (HEARTBEAT.load(Ordering::Relaxed), 0),
         }
     }
@@ -240,6 +244,41 @@ impl Hal for Rp2350 {
             pio(1).ctrl().write_value(Ctrl(START_COUNTERS));
             self.cycles()
         })
+    }
+
+    fn gen_connect(&mut self, on: bool) {
+        let sm = pio(0).sm(pioregs::TEST_GEN_SM);
+        let force = |w: u16| sm.instr().write_value(SmInstr(u32::from(w)));
+        if on {
+            // The chip's outputs off the capture inputs first, then
+            // TEST_GEN driven low (docs/bridge-hardware.md).
+            Self::sio_set(pins::CAPTURE_OE, true);
+            force(pioregs::force_set(false, 0));
+            force(pioregs::force_set(true, 1));
+        } else {
+            force(pioregs::force_set(true, 0));
+            Self::sio_set(pins::CAPTURE_OE, false);
+        }
+    }
+
+    fn gen_start(&mut self, words: [u32; 3]) -> u64 {
+        let s = pioregs::TEST_GEN_SM;
+        pio(0).ctrl().write_value(Ctrl(pioregs::TEST_GEN_STOP));
+        configure(0, s, &pioregs::test_gen(&self.gen));
+        for w in words {
+            pio(0).txf(s).write_value(w);
+        }
+        cortex_m::interrupt::free(|_| {
+            pio(0).ctrl().write_value(Ctrl(pioregs::TEST_GEN_RUN));
+            // The cycle of the write: the clock now, less the cycles since.
+            let after = DWT::cycle_count();
+            let now = self.cycles();
+            now - u64::from(DWT::cycle_count().wrapping_sub(after))
+        })
+    }
+
+    fn gen_stop(&mut self) {
+        pio(0).ctrl().write_value(Ctrl(pioregs::TEST_GEN_STOP));
     }
 
     fn set_input(&mut self, i: usize, high: bool) {

@@ -203,9 +203,11 @@ async fn main(_spawner: Spawner) {
     let Pio {
         common: mut pio2, ..
     } = Pio::new(p.PIO2, Irqs);
-    hw::load(0, &player);
-    hw::load(1, &pout_program);
-    hw::load(2, &pins_program);
+    let gen = programs::relocate(programs::test_gen(), programs::test_gen_origin());
+    hw::load(0, &player, 0);
+    hw::load(0, &gen, programs::test_gen_origin());
+    hw::load(1, &pout_program, 0);
+    hw::load(2, &pins_program, 0);
     // The bus: GPIO 0-12 (D0-D7, A0, CS*, DIR, RD*, WR*) on PIO0.
     const _: () = assert!(pins::D0 == 0 && pins::WR == 12 && pins::BUS_COUNT == 13);
     let _bus_pins = [
@@ -240,9 +242,13 @@ async fn main(_spawner: Spawner) {
         pio2.make_pio_pin(p.PIN_36),
     );
 
-    // TEST_GEN (GPIO 25) stays an input while the capture buffers are on
-    // (docs/bridge-hardware.md); the self-test that drives it is to come.
+    // TEST_GEN (GPIO 25): PIO0's, undriven (SM1's direction stays 0)
+    // except in the self-test, which drives it only while the capture
+    // buffers are off (docs/bridge-hardware.md). The generator waits,
+    // stopped, configured.
     const _: () = assert!(pins::TEST_GEN == 25);
+    let _test_gen = pio0.make_pio_pin(p.PIN_25);
+    hw::configure(0, pioregs::TEST_GEN_SM, &pioregs::test_gen(&gen));
 
     // The buffers: the chip's outputs in, then the bridge's out.
     capture_oe.set_low();
@@ -279,7 +285,7 @@ async fn main(_spawner: Spawner) {
         let mut core1 = unsafe { cortex_m::Peripherals::steal() };
         core1.DCB.enable_trace();
         core1.DWT.enable_cycle_counter();
-        let hal = hw::Rp2350::new(SYSCLK_HZ, pout_program, pins_program);
+        let hal = hw::Rp2350::new(SYSCLK_HZ, pout_program, pins_program, gen);
         let board = Board::new(hal, timing, straps);
         let timer = board.timer();
         let mut engine = BridgeEngine::new(board, session, false, firmware)

@@ -6,7 +6,7 @@
 //! [`Request::decode`] and [`Response::decode`] check every length and
 //! value and never panic; `docs/bridge-protocol.md` is the specification.
 
-use crate::bus::{Op, Reply};
+use crate::bus::{Op, Reply, SelfTestPlan, SelfTestReply};
 use crate::protocol::capture::MoveStart;
 use crate::protocol::{
     Direction, Input, MoveKind, Pin, PinEvent, Pins, PulseRun, PulseSummary, Status, Straps,
@@ -28,12 +28,14 @@ pub mod kind {
     pub const RESEND: u8 = 0x04;
     pub const BATCH_CAPTURE: u8 = 0x05;
     pub const LINK: u8 = 0x06;
+    pub const SELF_TEST: u8 = 0x07;
     pub const HELLO_REPLY: u8 = 0x81;
     pub const BATCH_REPLY: u8 = 0x82;
     pub const CAPTURE_REPLY: u8 = 0x83;
     pub const FRAGMENT: u8 = 0x84;
     pub const BATCH_CAPTURE_REPLY: u8 = 0x85;
     pub const LINK_REPLY: u8 = 0x86;
+    pub const SELF_TEST_REPLY: u8 = 0x87;
     pub const ERROR: u8 = 0xFF;
 }
 
@@ -171,6 +173,10 @@ pub enum Request {
     /// so that a serial server in between that holds a partial buffer
     /// (ser2net's `chardelay`) sends each reply at once.
     Link { fragment: u8, pad: u16 },
+    /// The bridge's self-test of its capture ([`SelfTestPlan`]): a chip
+    /// reset, the generator's bursts, and the capture of them from the
+    /// reset on, fetched with CAPTURE as usual.
+    SelfTest(SelfTestPlan),
 }
 
 /// Largest response payload sent as one frame; longer ones go as
@@ -260,6 +266,7 @@ pub enum Response {
         fragment: u8,
         pad: u16,
     },
+    SelfTest(SelfTestReply),
 }
 
 impl Response {
@@ -272,6 +279,7 @@ impl Response {
             Response::BatchCapture { .. } => "BATCH_CAPTURE_REPLY",
             Response::Error { .. } => "ERROR",
             Response::Link { .. } => "LINK_REPLY",
+            Response::SelfTest(_) => "SELF_TEST_REPLY",
         }
     }
 }
@@ -412,6 +420,14 @@ impl Request {
                 w.u8(*fragment);
                 w.u16(*pad);
             }
+            Request::SelfTest(p) => {
+                w.u8(kind::SELF_TEST);
+                w.u32(p.count);
+                w.dur(p.high);
+                w.dur(p.low);
+                w.u16(p.bursts);
+                w.dur(p.gap);
+            }
             Request::Resend { fragments } => {
                 w.u8(kind::RESEND);
                 w.u8(fragments.len().min(255) as u8);
@@ -467,6 +483,34 @@ impl Request {
                     fragments: r.take(n)?.to_vec(),
                 }
             }
+            kind::SELF_TEST => {
+                let at = r.at;
+                let count = r.u32()?;
+                if count == 0 {
+                    return Err(WireError::BadValue {
+                        at,
+                        field: "self-test pulse count",
+                        value: 0,
+                    });
+                }
+                let (high, low) = (r.dur()?, r.dur()?);
+                let at = r.at;
+                let bursts = r.u16()?;
+                if bursts == 0 {
+                    return Err(WireError::BadValue {
+                        at,
+                        field: "self-test burst count",
+                        value: 0,
+                    });
+                }
+                Request::SelfTest(SelfTestPlan {
+                    count,
+                    high,
+                    low,
+                    bursts,
+                    gap: r.dur()?,
+                })
+            }
             k => return Err(WireError::UnknownKind(k)),
         };
         r.end()?;
@@ -518,6 +562,16 @@ impl Response {
                 w.u8(*fragment);
                 w.u16(*pad);
             }
+            Response::SelfTest(t) => {
+                w.u8(kind::SELF_TEST_REPLY);
+                w.dur(t.high);
+                w.dur(t.low);
+                let n = t.starts.len().min(usize::from(u16::MAX));
+                w.u16(n as u16);
+                for at in &t.starts[..n] {
+                    w.time(*at);
+                }
+            }
         }
         w.0
     }
@@ -565,6 +619,15 @@ impl Response {
                 fragment: r.u8()?,
                 pad: r.u16()?,
             },
+            kind::SELF_TEST_REPLY => {
+                let (high, low) = (r.dur()?, r.dur()?);
+                let n = r.count(8)?;
+                let mut starts = Vec::with_capacity(n);
+                for _ in 0..n {
+                    starts.push(r.time()?);
+                }
+                Response::SelfTest(SelfTestReply { starts, high, low })
+            }
             k => return Err(WireError::UnknownKind(k)),
         };
         r.end()?;
@@ -948,6 +1011,43 @@ mod tests {
             fragments: vec![0, 2],
         };
         assert_eq!(Request::decode(&r.encode(4, T), T), Ok((4, r)));
+        // SELF_TEST, in a bridge's ticks (75 MHz), and its reply.
+        let t = Timer { hz: 75_000_000 };
+        let plan = SelfTestPlan {
+            count: 100,
+            high: Duration::from_nanos(5_000),
+            low: Duration::from_nanos(5_000),
+            bursts: 3,
+            gap: Duration::from_micros(200),
+        };
+        let st = Request::SelfTest(plan);
+        assert_eq!(Request::decode(&st.encode(7, t), t), Ok((7, st)));
+        let zero = Request::SelfTest(SelfTestPlan { count: 0, ..plan });
+        assert!(matches!(
+            Request::decode(&zero.encode(7, t), t),
+            Err(WireError::BadValue {
+                field: "self-test pulse count",
+                ..
+            })
+        ));
+        let none = Request::SelfTest(SelfTestPlan { bursts: 0, ..plan });
+        assert!(Request::decode(&none.encode(7, t), t).is_err());
+        let done = Response::SelfTest(SelfTestReply {
+            starts: vec![Instant::from_nanos(120), Instant::from_nanos(1_200_040)],
+            high: Duration::from_nanos(5_000),
+            low: Duration::from_nanos(5_000),
+        });
+        assert_eq!(Response::decode(&done.encode(7, t), t), Ok((7, done)));
+        // A count of starts the bytes cannot hold is refused, not allocated.
+        let mut lying = Response::SelfTest(SelfTestReply {
+            starts: vec![],
+            high: Duration::ZERO,
+            low: Duration::ZERO,
+        })
+        .encode(7, t);
+        let n = lying.len();
+        lying[n - 2..].copy_from_slice(&u16::MAX.to_le_bytes());
+        assert!(Response::decode(&lying, t).is_err());
         let c = Request::Capture {
             runs: 1,
             pins: 2,

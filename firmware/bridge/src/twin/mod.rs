@@ -72,6 +72,8 @@ pub struct Twin {
     pub world: World,
     pub chip: ChipSide,
     layout: [Loaded; 3],
+    /// The self-test generator, as loaded in PIO0.
+    gen: Loaded,
     /// Cycles each call costs.
     pub cpu_cycles: u64,
     /// Random extra cycles per call: (state, at most).
@@ -96,6 +98,7 @@ impl Twin {
             world: World::new(),
             chip: ChipSide::new(model, SYSCLK_HZ),
             layout: programs::layout(),
+            gen: programs::relocate(programs::test_gen(), programs::test_gen_origin()),
             cpu_cycles: CPU_CYCLES,
             gaps: None,
             idle_step: 2 * CPU_CYCLES,
@@ -122,6 +125,16 @@ impl Twin {
                 .load(p.words(), 0)
                 .map_err(|e| std::boxed::Box::new(e) as _)?;
         }
+        // The generator after the bus player in PIO0, stopped, TEST_GEN
+        // given to PIO0 and undriven (SM1's direction 0) until the self-test.
+        w.blocks[0]
+            .load(self.gen.words(), programs::test_gen_origin())
+            .map_err(|e| std::boxed::Box::new(e) as _)?;
+        w.blocks[0]
+            .configure(pioregs::TEST_GEN_SM, &pioregs::test_gen(&self.gen))
+            .map_err(|e| std::boxed::Box::new(e) as _)?;
+        w.blocks[0].force_pins(1 << pins::TEST_GEN, 0, 0);
+        w.func[pins::TEST_GEN as usize] = Func::Pio(0);
         // SIO outputs: levels first, then directions (issue 28): the chip's
         // inputs released, RESET* high, the buffers off until all is set.
         let mut sio_pins: u64 = 1 << pins::RESET | 1 << pins::CAPTURE_OE | 1 << pins::DRIVE_EN;
@@ -288,6 +301,52 @@ impl Hal for Twin {
         self.world.cycle
     }
 
+    fn gen_connect(&mut self, on: bool) {
+        let g = pioregs::TEST_GEN_SM;
+        self.spend(self.cpu_cycles);
+        if on {
+            self.world.sio_out |= 1 << pins::CAPTURE_OE;
+            self.world.cpu_wrote(&mut self.chip);
+            self.spend(self.cpu_cycles);
+            let seen = self.world.seen();
+            self.world.blocks[0].exec(g, pioregs::force_set(false, 0), seen);
+            self.world.blocks[0].exec(g, pioregs::force_set(true, 1), seen);
+        } else {
+            let seen = self.world.seen();
+            self.world.blocks[0].exec(g, pioregs::force_set(true, 0), seen);
+            self.world.cpu_wrote(&mut self.chip);
+            self.spend(self.cpu_cycles);
+            self.world.sio_out &= !(1 << pins::CAPTURE_OE);
+        }
+        self.world.cpu_wrote(&mut self.chip);
+    }
+
+    fn gen_start(&mut self, words: [u32; 3]) -> u64 {
+        let g = pioregs::TEST_GEN_SM;
+        self.spend(self.cpu_cycles);
+        self.world.write_ctrl(0, pioregs::TEST_GEN_STOP);
+        let regs = pioregs::test_gen(&self.gen);
+        // FJOIN flipped and back: the FIFOs flushed, as the image does.
+        let blk = &mut self.world.blocks[0];
+        blk.write_shiftctrl(g, regs.shiftctrl ^ 1 << pioregs::shiftctrl::FJOIN_RX);
+        blk.write_shiftctrl(g, regs.shiftctrl);
+        self.world.blocks[0]
+            .configure(g, &regs)
+            .unwrap_or_else(|e| panic!("the generator's configuration: {e:?}"));
+        for w in words {
+            self.spend(self.cpu_cycles);
+            self.world.blocks[0].txf_write(g, w);
+        }
+        self.spend(self.cpu_cycles);
+        self.world.write_ctrl(0, pioregs::TEST_GEN_RUN);
+        self.world.cycle
+    }
+
+    fn gen_stop(&mut self) {
+        self.spend(self.cpu_cycles);
+        self.world.write_ctrl(0, pioregs::TEST_GEN_STOP);
+    }
+
     fn set_input(&mut self, i: usize, high: bool) {
         self.spend(self.cpu_cycles);
         let g = pins::INPUTS[i];
@@ -318,6 +377,25 @@ impl Hal for Twin {
         let next = self.chip.next_change(now).unwrap_or(u64::MAX);
         let seen = now.saturating_add(next.saturating_sub(now).div_ceil(step).saturating_mul(step));
         let to = until.min(seen).max(now + 1);
+        if self.world.blocks[0].sm[pioregs::TEST_GEN_SM].enabled {
+            // The self-test generator's edges are the PIO's, not the
+            // chip's: the loop sees them as a capture FIFO's word, pass
+            // by pass.
+            let mut at = now;
+            while at < to {
+                let next = (at + step).min(to);
+                self.world.run_until(next, &mut self.chip);
+                let words = Counter::ALL.iter().any(|c| {
+                    let (b, s) = pioregs::counter_sm(*c);
+                    self.world.blocks[b].rx_level(s) > 0
+                });
+                if words {
+                    return at;
+                }
+                at = next;
+            }
+            return to;
+        }
         self.world.run_until(to, &mut self.chip);
         if to == seen {
             to - step

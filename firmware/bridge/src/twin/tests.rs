@@ -5,7 +5,7 @@
 use super::pio::{Inputs, World};
 use super::*;
 use crate::pins;
-use ppmc_core::bus::{Bus, EmuBus, Op, Reply};
+use ppmc_core::bus::{Bus, EmuBus, Op, Reply, SelfTestPlan};
 use ppmc_core::protocol::Status;
 use ppmc_core::time::Duration;
 use std::string::ToString;
@@ -287,6 +287,12 @@ fn defect_1_two_counters_do_not_fit_one_block_and_the_layout_does() {
             .expect("one program per block fits");
         assert!(w.blocks[i].words_used() <= 32);
     }
+    // The self-test's generator after the bus player in PIO0.
+    let gen = programs::relocate(programs::test_gen(), programs::test_gen_origin());
+    w.blocks[0]
+        .load(gen.words(), programs::test_gen_origin())
+        .expect("the bus player and the generator share PIO0");
+    assert_eq!(w.blocks[0].words_used(), 21);
 }
 
 /// Pulses on GPIO 32 for a counter configured by `regs`: words pushed.
@@ -567,4 +573,116 @@ fn pins_sampled_every_250_ns_through_a_fast_move_lose_no_pulse() {
     }
     assert!(!b.capture_lost());
     assert_eq!(b.record().last_move_pulses().count, 5_000);
+}
+
+fn self_test_plan(count: u32, high_ns: u64, low_ns: u64, bursts: u16) -> SelfTestPlan {
+    SelfTestPlan {
+        count,
+        high: Duration::from_nanos(high_ns),
+        low: Duration::from_nanos(low_ns),
+        bursts,
+        gap: Duration::from_micros(50),
+    }
+}
+
+/// INT*'s changes in the record, in ns, with their values.
+fn int_changes(bus: &impl Bus) -> Vec<(u64, u8)> {
+    bus.record()
+        .pins
+        .iter()
+        .filter(|p| p.pin == ppmc_core::protocol::Pin::Int)
+        .map(|p| (p.at.as_nanos(), p.value))
+        .collect()
+}
+
+#[test]
+fn the_self_test_generator_is_captured_on_pout_and_int_where_the_board_code_said() {
+    // Issue 28, item 7: TEST_GEN through 1 kOhm onto the capture inputs of
+    // POUT and INT*, with CAPTURE_OE* high (the chip's outputs cut off).
+    // Two bursts of 100 pulses at 100 kpps, the chip's fastest rate.
+    let mut b = twin();
+    let plan = self_test_plan(100, 5_000, 5_000, 2);
+    let reply = b.self_test(&plan).expect("the board has a generator");
+    assert_eq!(reply.starts.len(), 2);
+    assert_eq!(
+        (reply.high.as_nanos(), reply.low.as_nanos()),
+        (5_000, 5_000)
+    );
+    assert!(!b.capture_lost());
+    let period = 10_000;
+    let want: Vec<u64> = reply
+        .starts
+        .iter()
+        .flat_map(|s| (0..100).map(move |k| s.as_nanos() + k * period))
+        .collect();
+    let got = pulse_times(&b);
+    assert_eq!(got.len(), want.len(), "every pulse captured, no other");
+    let offsets: Vec<i64> = got
+        .iter()
+        .zip(&want)
+        .map(|(g, w)| *g as i64 - *w as i64)
+        .collect();
+    let lo = offsets.iter().min().expect("pulses");
+    let hi = offsets.iter().max().expect("pulses");
+    // The counters see an edge after the 2-cycle synchroniser and a pass of
+    // their loop: a few cycles late, the same few every time.
+    assert!(
+        (0..=60).contains(lo) && hi - lo <= 14,
+        "offsets {lo}..{hi} ns"
+    );
+    // INT* follows TEST_GEN (asserted, 1, while it is low): a rise
+    // releases it, a fall asserts it, each at its predicted time.
+    let int = int_changes(&b);
+    let window = |t: u64| t >= want[0] - 100 && t <= want[want.len() - 1] + period;
+    let int: Vec<(u64, u8)> = int.into_iter().filter(|(t, _)| window(*t)).collect();
+    assert_eq!(int.len(), 400, "both edges of every pulse");
+    for (i, (t, v)) in int.iter().enumerate() {
+        let rise = want[i / 2];
+        let (edge, value) = if i % 2 == 0 {
+            (rise, 0)
+        } else {
+            (rise + 5_000, 1)
+        };
+        assert_eq!(*v, value, "change {i}");
+        let d = *t as i64 - edge as i64;
+        assert!((0..=60).contains(&d), "change {i}: {d} ns from its edge");
+    }
+    // The chip has its outputs back: a move after it is captured as ever.
+    let replies = run(&mut b, &accel_move(100));
+    assert!(matches!(replies.last(), Some(Reply::Pulses { summary, .. }) if summary.count == 100));
+}
+
+#[test]
+fn a_self_test_beyond_the_captures_limit_is_reported_and_the_next_is_on_time() {
+    // 2,000 pulses 107 ns apart (9.4 MHz): INT*'s counter pushes two words
+    // a pulse, and 4,000 changes are more than the capture holds. The
+    // capture must say it lost some, never hand over a short one.
+    let mut b = twin();
+    let fast = self_test_plan(2_000, 53, 53, 1);
+    b.self_test(&fast).expect("runs");
+    let held = b.record().runs.len() + b.record().pins.len();
+    assert!(
+        b.capture_lost() || held > crate::limits::CAPTURE_RECORDS as usize,
+        "an overrun: lost {}, {held} records",
+        b.capture_lost()
+    );
+    let most = crate::limits::CAPTURE_RECORDS as usize + crate::limits::OP_RECORDS;
+    assert!(held <= most, "{held} records: the board code stops at {most}");
+    // The next self-test starts afresh and is on time.
+    let slow = self_test_plan(20, 10_000, 40_000, 1);
+    let reply = b.self_test(&slow).expect("runs");
+    assert!(!b.capture_lost());
+    let got = pulse_times(&b);
+    assert_eq!(got.len(), 20);
+    let d = got[0] as i64 - reply.starts[0].as_nanos() as i64;
+    assert!((0..=60).contains(&d), "first pulse {d} ns from its start");
+}
+
+#[test]
+fn a_self_test_the_generator_cannot_make_is_refused_with_its_limits() {
+    let mut b = twin();
+    let e = b
+        .self_test(&self_test_plan(10, 5, 5, 1))
+        .expect_err("too short");
+    assert!(e.contains("at least"), "{e}");
 }
