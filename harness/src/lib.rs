@@ -23,6 +23,7 @@ pub mod golden;
 pub mod report;
 pub mod runner;
 pub mod scenario;
+pub mod selftest;
 pub mod soak;
 pub mod stop;
 pub mod trace;

@@ -124,7 +124,11 @@ const ELSEWHERE: [(&str, &str); 22] = [
 /// local stand-in: `(text in the command, where)`. Those "in
 /// scenarios/tests/labgrid/place.sh" must appear in that script as written
 /// (with `"$ppmc"` for `ppmc`).
-const PPMC_ELSEWHERE: [(&str, &str); 3] = [
+const PPMC_ELSEWHERE: [(&str, &str); 4] = [
+    (
+        "selftest --target serial:",
+        "in scenarios/tests/cli_selftest.rs (against the board twin: a bridge-sim has no generator)",
+    ),
     (
         "127.0.0.1:4000",
         "in scenarios/tests/cli_chaos.rs (the chaos proxy in front of a bridge-sim, a suite run through it)",

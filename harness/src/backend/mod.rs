@@ -18,10 +18,19 @@ pub use self::serial::{
 };
 
 pub(crate) use self::serial::timed_out;
-pub use ppmc_core::bus::{Op, Reply};
+pub use ppmc_core::bus::{Op, Reply, SelfTestPlan, SelfTestReply};
 
 use crate::protocol::{Record, RecordMark, Straps};
 use std::fmt;
+
+/// A bridge's self-test as it ran: what the bridge says it generated, and
+/// what its capture recorded from the chip reset on, or why it has no
+/// capture to give (a capture overrun, in the bridge's words).
+#[derive(Debug, Clone)]
+pub struct SelfTestRun {
+    pub reply: SelfTestReply,
+    pub capture: Result<Record, String>,
+}
 
 /// What kind of failure a target error is, so that generic code can tell a
 /// broken link from a misbehaving device (embedded-hal's `ErrorKind` idea).
@@ -150,6 +159,18 @@ pub trait Target: Send {
     fn forget_capture_before(&mut self, mark: RecordMark) -> RecordMark {
         let _ = mark;
         RecordMark::default()
+    }
+
+    /// Runs a bus bridge's self-test of its capture (`ppmc selftest`,
+    /// [`SelfTestPlan`]): the chip is reset, and the bridge's own generator
+    /// drives its capture inputs of POUT and INT*. The default, for a
+    /// target with no bridge (the emulator), refuses.
+    fn self_test(&mut self, plan: &SelfTestPlan) -> Result<SelfTestRun, TargetError> {
+        let _ = plan;
+        Err(TargetError::new(
+            TargetErrorKind::Unsupported,
+            "this target has no bus bridge to self-test: give a board's --target",
+        ))
     }
 
     /// Runs one op.

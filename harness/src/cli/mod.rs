@@ -18,6 +18,7 @@ mod list;
 mod progress;
 mod record;
 mod run;
+mod selftest;
 mod signals;
 
 use crate::scenario::Scenario;
@@ -78,6 +79,14 @@ enum Command {
     /// how fast. Exit status 0 when every fault is caught and the clean
     /// board by nothing, 1 otherwise.
     FaultMatrix(fault_matrix::MatrixArgs),
+    /// Test a bus bridge's capture with its own pulse generator, no jumper
+    /// and no chip output needed: POUT's and INT*'s capture inputs, driven
+    /// at the chip's slowest and fastest rates, in bursts, and beyond what
+    /// the capture keeps; prints each check's measured timestamp offset and
+    /// jitter. The first step of a new bridge's bring-up
+    /// (docs/bridge-hardware.md). Exit status 0 when every check passes, 1
+    /// when one fails or the bridge cannot be reached, 2 on bad usage.
+    Selftest(selftest::SelftestArgs),
     /// Serve a misbehaving TCP proxy in front of a bridge (dropped
     /// connections, floods, stalls, wrong replies), to check that a link
     /// that fails never turns into a verdict on the board. Prints where it
@@ -112,6 +121,7 @@ pub fn main(suite: Vec<Scenario>) -> ExitCode {
         Command::Fuzz(args) => fuzz::run(args),
         Command::FaultMatrix(args) => fault_matrix::run(args, suite),
         Command::ChaosProxy(args) => chaos_proxy::run(args),
+        Command::Selftest(args) => selftest::run(args),
     };
     match done {
         Ok(()) => ExitCode::SUCCESS,

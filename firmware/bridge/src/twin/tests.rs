@@ -686,3 +686,4 @@ fn a_self_test_the_generator_cannot_make_is_refused_with_its_limits() {
         .expect_err("too short");
     assert!(e.contains("at least"), "{e}");
 }
+

@@ -30,7 +30,9 @@ pub use self::link::{parse_spec, Link, SerialLink};
 pub use self::rfc2217::{parse_rfc2217, Rfc2217Link};
 pub use self::tcp::{parse_tcp, TcpLink};
 
-use super::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
+use super::{
+    Op, Reply, SelfTestPlan, SelfTestRun, Target, TargetError, TargetErrorKind, TargetInfo,
+};
 use crate::protocol::Record;
 use crate::protocol::Straps;
 use crate::stop::Stop;
@@ -95,8 +97,15 @@ pub enum SerialError {
         attempts: u32,
         last: String,
     },
-    #[error("{link}: the bridge restarted (session {old:08x} -> {new:08x}); the chip's state is unknown")]
-    Restarted { link: String, old: u32, new: u32 },
+    #[error("{link}: the bridge restarted (session {old:08x} -> {new:08x}){}; the chip's state is unknown", why.as_ref().map(|w| format!(" after {w}")).unwrap_or_default())]
+    Restarted {
+        link: String,
+        old: u32,
+        new: u32,
+        /// What the bridge says restarted it, from its new HELLO (the RP2350
+        /// image's panic record: `a panic at board.rs:123`).
+        why: Option<String>,
+    },
     /// After a reconnect the bridge no longer held this host's cached
     /// request: another host said HELLO to it while the link was down, and
     /// may have used the chip.
@@ -444,6 +453,14 @@ impl std::fmt::Display for Noise {
     }
 }
 
+/// What a bridge's firmware text says restarted it: the RP2350 image ends
+/// it in `; restarted after a panic at FILE:LINE` after a panic or a hard
+/// fault (its panic record, kept across the watchdog's reset).
+pub fn restart_cause(firmware: &str) -> Option<String> {
+    let (_, cause) = firmware.rsplit_once("restarted after ")?;
+    Some(cause.trim().to_string())
+}
+
 /// A host session: a number no other host is likely to pick, never 0.
 fn host_session() -> u32 {
     use std::hash::{BuildHasher, Hash, Hasher};
@@ -589,6 +606,7 @@ impl<L: Link> SerialTarget<L> {
                     link: self.link.name(),
                     old: self.hello.session,
                     new: h.session,
+                    why: restart_cause(&h.firmware),
                 });
             }
             if !h.resumed {
@@ -1383,6 +1401,10 @@ impl<L: Link> Target for SerialTarget<L> {
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
         Ok(self.counted(|t| t.run_batch(ops))?)
     }
+
+    fn self_test(&mut self, plan: &SelfTestPlan) -> Result<SelfTestRun, TargetError> {
+        Ok(self.counted(|t| t.run_self_test(plan))?)
+    }
 }
 
 impl<L: Link> SerialTarget<L> {
@@ -1414,6 +1436,32 @@ impl<L: Link> SerialTarget<L> {
             }
         }
         r
+    }
+
+    /// SELF_TEST, then the capture it made: the bridge resets its chip
+    /// first, so the capture and the bridge's clock start afresh.
+    fn run_self_test(&mut self, plan: &SelfTestPlan) -> Result<SelfTestRun, SerialError> {
+        self.captured = Record::default();
+        self.captured_current = false;
+        self.clock = Instant::ZERO;
+        let extra = if self.hello.virtual_time {
+            WallDuration::ZERO
+        } else {
+            let burst = (plan.high + plan.low).saturating_mul(u64::from(plan.count)) + plan.gap;
+            // The chip reset (100 us) and the bursts, each with its gap.
+            let total = burst.saturating_mul(u64::from(plan.bursts)).as_nanos() + 1_000_000;
+            WallDuration::from_nanos(total)
+        };
+        let reply = match self.request(&Request::SelfTest(*plan), "self-test", extra)? {
+            Response::SelfTest(r) => r,
+            other => return Err(self.unexpected("self-test", &other)),
+        };
+        let capture = match self.fetch_capture() {
+            Ok(r) => Ok(r),
+            Err(SerialError::CaptureOverrun { detail, .. }) => Err(detail),
+            Err(e) => return Err(e),
+        };
+        Ok(SelfTestRun { reply, capture })
     }
 
     fn fetch_capture(&mut self) -> Result<Record, SerialError> {
@@ -1482,6 +1530,9 @@ mod tests {
         fail_sends: u32,
         fail_reopens: u32,
         restart_on_reopen: bool,
+        /// The bridge restarts at the next reopen with this firmware text
+        /// (a panic record in it).
+        panic_on_reopen: Option<String>,
         /// How many bytes the bridge sent for each request.
         sent: Vec<usize>,
         /// Frames that crossed the link so far, both ways.
@@ -1511,6 +1562,7 @@ mod tests {
                 fail_sends: 0,
                 fail_reopens: 0,
                 restart_on_reopen: false,
+                panic_on_reopen: None,
                 sent: Vec::new(),
                 frames: 0,
                 cut_at: None,
@@ -1598,6 +1650,10 @@ mod tests {
             self.broken = false;
             if self.restart_on_reopen {
                 self.server = Self::bridge(2);
+            }
+            if let Some(firmware) = self.panic_on_reopen.take() {
+                let bus = EmuBus::new(Straps::default(), ModelConfig::default()).expect("emu");
+                self.server = BridgeEngine::new(bus, 3, true, firmware);
             }
             Ok(())
         }
@@ -1937,6 +1993,27 @@ mod tests {
             "{}",
             e.to_string()
         );
+    }
+
+    /// Issue 28, item 6: the RP2350 image keeps a panic's place across the
+    /// watchdog's reset and says it in HELLO; a run that loses its bridge
+    /// to a panic ends in an infrastructure error naming it.
+    #[test]
+    fn a_bridge_that_panicked_is_an_infrastructure_error_naming_the_panic() {
+        let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+        t.link.fail_sends = 1;
+        t.link.panic_on_reopen = Some(
+            "ppmc-bridge-rp2350 0.1.0; restarted after a panic at bridge/src/board.rs:442".into(),
+        );
+        let e = t.execute(&[Op::ReadStatus]).expect_err("restarted");
+        assert_eq!(e.kind, TargetErrorKind::Link, "not the board's failure");
+        assert!(
+            e.to_string().contains(
+                "the bridge restarted (session 00000001 -> 00000003) after a panic at bridge/src/board.rs:442"
+            ),
+            "{e}"
+        );
+        assert_eq!(restart_cause("ppmc-bridge-rp2350 0.1.0"), None);
     }
 
     /// A bridge that reboots while the port stays open (a UART bridge, a
