@@ -143,6 +143,33 @@ impl Rp2350 {
         }
     }
 
+    /// The cycle of the register write just before the call: the clock
+    /// now, less the cycles since. The counters' start and the
+    /// generator's are stamped alike, so that what the self-test measures
+    /// between them is the capture's, not a difference in stamping.
+    fn stamp(&self) -> u64 {
+        let after = DWT::cycle_count();
+        let now = self.cycles();
+        now - u64::from(DWT::cycle_count().wrapping_sub(after))
+    }
+
+    /// Pull-ups on the capture inputs the self-test leaves undriven (DIR,
+    /// HOLD, AUX*, S1..S5, AUXO0..3) while the 74LVC245s' outputs are
+    /// off, so that they hold still (RP2350-E9: a floating input pad
+    /// drifts; a pull-up still holds it); off again after.
+    fn hold_undriven(on: bool) {
+        let undriven = [pins::DIR, pins::HOLD, pins::AUX]
+            .into_iter()
+            .chain(pins::S)
+            .chain(pins::AUXO);
+        for g in undriven {
+            pac::PADS_BANK0.gpio(g as usize).modify(|w| {
+                w.set_pue(on);
+                w.set_pde(false);
+            });
+        }
+    }
+
     fn sio_set(g: u32, high: bool) {
         let bank = (g / 32) as usize;
         let bit = 1 << (g % 32);
@@ -242,7 +269,7 @@ impl Hal for Rp2350 {
             .write_value(Fdebug(0b0111 << fdebug::RXSTALL));
         cortex_m::interrupt::free(|_| {
             pio(1).ctrl().write_value(Ctrl(START_COUNTERS));
-            self.cycles()
+            self.stamp()
         })
     }
 
@@ -252,12 +279,14 @@ impl Hal for Rp2350 {
         if on {
             // The chip's outputs off the capture inputs first, then
             // TEST_GEN driven low (docs/bridge-hardware.md).
+            Self::hold_undriven(true);
             Self::sio_set(pins::CAPTURE_OE, true);
             force(pioregs::force_set(false, 0));
             force(pioregs::force_set(true, 1));
         } else {
             force(pioregs::force_set(true, 0));
             Self::sio_set(pins::CAPTURE_OE, false);
+            Self::hold_undriven(false);
         }
     }
 
@@ -270,10 +299,7 @@ impl Hal for Rp2350 {
         }
         cortex_m::interrupt::free(|_| {
             pio(0).ctrl().write_value(Ctrl(pioregs::TEST_GEN_RUN));
-            // The cycle of the write: the clock now, less the cycles since.
-            let after = DWT::cycle_count();
-            let now = self.cycles();
-            now - u64::from(DWT::cycle_count().wrapping_sub(after))
+            self.stamp()
         })
     }
 

@@ -21,6 +21,11 @@
 //!   external clock given at build time (`PPMC_SYSCLK_HZ`,
 //!   `PPMC_EXT_CLOCK_HZ`), since the bridge cannot see the chip's crystal.
 //!
+//! - A debug log over RTT (defmt): boot, the last panic, USB connections,
+//!   capture overruns and hardware faults, read with a debug probe
+//!   (`probe-rs attach`, firmware/README.md). Nothing is logged inside an
+//!   op: a log line costs a few microseconds with interrupts off.
+//!
 //! What has run where: firmware/README.md.
 
 #![no_std]
@@ -31,6 +36,7 @@ extern crate alloc;
 mod hw;
 
 use core::mem::MaybeUninit;
+use defmt_rtt as _;
 use embassy_executor::Spawner;
 use embassy_futures::join::join3;
 use embassy_futures::select::{select, Either};
@@ -270,10 +276,21 @@ async fn main(_spawner: Spawner) {
     };
     // HELLO_REPLY's firmware text says when the last reset was a panic,
     // and where: the host prints it with every run's identity.
-    let firmware: alloc::string::String = match last_panic() {
+    let panicked = last_panic();
+    let firmware: alloc::string::String = match &panicked {
         Some(at) => alloc::format!("{firmware}; restarted after a panic at {at}"),
         None => firmware.into(),
     };
+    defmt::info!(
+        "{=str}: chip SysClk {=u32} Hz, CSEL {=bool}, VSEL {=bool}",
+        firmware.as_str(),
+        straps.sysclk_hz,
+        straps.csel_high,
+        straps.vsel_high
+    );
+    if let Some(at) = &panicked {
+        defmt::warn!("restarted after a panic at {=str}", at.as_str());
+    }
     // The engine on core 1, with its own cycle counter (each core has
     // one: the clock the board code reads is core 1's). It feeds the
     // watchdog from every loop of the board code (`Hal::keepalive`).
@@ -292,7 +309,21 @@ async fn main(_spawner: Spawner) {
             .with_timer(timer)
             .with_capture_capacity(limits::CAPTURE_RECORDS);
         let mut buf = [0u8; 64];
+        // What the log has said about the board code so far.
+        let (mut overruns, mut faulted) = (0u32, false);
         loop {
+            let board = engine.bus();
+            if board.overruns != overruns {
+                overruns = board.overruns;
+                defmt::warn!(
+                    "capture overrun ({=u32} since boot): the counters restarted",
+                    overruns
+                );
+            }
+            if let (Some(what), false) = (ppmc_core::bus::Bus::fault(board), faulted) {
+                faulted = true;
+                defmt::error!("hardware fault: {=str}", what);
+            }
             match FROM_HOST.try_read(&mut buf) {
                 Ok(n) => {
                     let reply = engine.on_bytes(&buf[..n]);
@@ -343,6 +374,7 @@ async fn main(_spawner: Spawner) {
         let (mut rx, mut tx) = ([0u8; 64], [0u8; 64]);
         loop {
             class.wait_connection().await;
+            defmt::info!("USB: the host opened the port");
             'connected: loop {
                 match select(class.read_packet(&mut rx), TO_HOST.read(&mut tx)).await {
                     Either::First(Ok(n)) => {
@@ -377,6 +409,10 @@ async fn main(_spawner: Spawner) {
                     }
                 }
             }
+            defmt::info!(
+                "USB: the host closed the port, or stopped reading for {=u64} ms",
+                WRITE_DEADLINE.as_millis()
+            );
         }
     };
     // Core 0's heartbeat, for core 1's watchdog feeding (hw.rs).
@@ -426,6 +462,7 @@ fn last_panic() -> Option<alloc::string::String> {
 /// before the watchdog was started would otherwise reset nothing.
 fn record_and_reset(name: &[u8], line: u32) -> ! {
     cortex_m::interrupt::disable();
+    defmt::error!("panic at {=[u8]:a}:{=u32}; restarting", name, line);
     let wd = embassy_rp::pac::WATCHDOG;
     let mut n = [0u8; 8];
     for (d, s) in n.iter_mut().zip(name) {

@@ -667,7 +667,10 @@ fn a_self_test_beyond_the_captures_limit_is_reported_and_the_next_is_on_time() {
         b.capture_lost()
     );
     let most = crate::limits::CAPTURE_RECORDS as usize + crate::limits::OP_RECORDS;
-    assert!(held <= most, "{held} records: the board code stops at {most}");
+    assert!(
+        held <= most,
+        "{held} records: the board code stops at {most}"
+    );
     // The next self-test starts afresh and is on time.
     let slow = self_test_plan(20, 10_000, 40_000, 1);
     let reply = b.self_test(&slow).expect("runs");
@@ -686,4 +689,3 @@ fn a_self_test_the_generator_cannot_make_is_refused_with_its_limits() {
         .expect_err("too short");
     assert!(e.contains("at least"), "{e}");
 }
-
