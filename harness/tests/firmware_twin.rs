@@ -6,8 +6,8 @@
 //! through a board.
 //!
 //! The whole suite (`--skip-tag long`) passes through it with the
-//! emulator's verdicts, but for the scenarios in [`NOT_YET`], each with
-//! why (issue 28 is open on them).
+//! emulator's verdicts: the scenarios in [`SLOW`] in a test of their own,
+//! with a host patient enough for the twin's pace.
 
 mod common;
 
@@ -18,12 +18,13 @@ use ppmc::scenario::{DriverOptions, Verdict};
 use ppmc_core::emu::ModelConfig;
 use ppmc_core::protocol::Straps;
 
-/// Scenarios the twin does not yet judge as the emulator does, and why.
-const NOT_YET: [(&str, &str); 1] = [(
+/// Scenarios the twin takes far longer over than a board, and why: each
+/// runs in [`slow_scenarios_pass_through_the_twin_given_a_patient_host`].
+const SLOW: [(&str, &str); 1] = [(
     "s3_3_4_longest_triangle_first_pout",
     "1.3 s of a move with the board code polling status, simulated cycle \
-     by cycle: the twin answers after about a minute, later than the host \
-     waits (it passes with `--link-timeout 600s`)",
+     by cycle: the twin answers after about a minute, later than a host \
+     waits for a board (`--link-timeout 600s --link-retries 40` waits)",
 )];
 
 #[test]
@@ -39,7 +40,7 @@ fn the_suite_passes_through_the_board_code_on_the_twin_with_the_emulators_verdic
     assert_eq!(hello.timer_hz, 75_000_000, "the PIO counters' timebase");
     let chosen: Vec<_> = ppmc_scenarios::all()
         .into_iter()
-        .filter(|s| !s.has_tag("long") && !NOT_YET.iter().any(|(n, _)| *n == s.name))
+        .filter(|s| !s.has_tag("long") && !SLOW.iter().any(|(n, _)| *n == s.name))
         .collect();
     assert!(chosen.len() > 80, "{}", chosen.len());
     let mut emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
@@ -57,6 +58,28 @@ fn the_suite_passes_through_the_board_code_on_the_twin_with_the_emulators_verdic
     let link = twin.link.clone();
     drop(twin);
     assert!(!link.exists(), "run-twin removes its link when stopped");
+}
+
+#[test]
+fn slow_scenarios_pass_through_the_twin_given_a_patient_host() {
+    let twin = Served::start("run-twin", &[]);
+    let mut t = twin.target_with(ppmc::backend::SerialOptions {
+        reply_timeout: std::time::Duration::from_secs(600),
+        retries: 40,
+        ..ppmc::backend::SerialOptions::default()
+    });
+    let chosen: Vec<_> = ppmc_scenarios::all()
+        .into_iter()
+        .filter(|s| SLOW.iter().any(|(n, _)| *n == s.name))
+        .collect();
+    assert_eq!(chosen.len(), SLOW.len(), "every slow scenario is in the suite");
+    let mut emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+    let want = run_suite(&mut emu, &chosen, 1, DriverOptions::default(), |_| {});
+    let got = run_suite(&mut t, &chosen, 1, DriverOptions::default(), |_| {});
+    for (w, g) in want.iter().zip(&got) {
+        assert_eq!(w.verdict, g.verdict, "{}: {:?}", w.name, g);
+        assert_eq!(g.verdict, Verdict::Passed, "{}", g.name);
+    }
 }
 
 #[test]

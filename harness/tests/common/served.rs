@@ -64,10 +64,15 @@ impl Served {
 
     /// A serial target on the link, past HELLO.
     pub fn target(&self) -> SerialTarget<SerialLink> {
+        self.target_with(SerialOptions::default())
+    }
+
+    /// [`Served::target`] with `opts`.
+    pub fn target_with(&self, opts: SerialOptions) -> SerialTarget<SerialLink> {
         let path = self.link.to_str().expect("utf-8 path");
         SerialTarget::open(
             SerialLink::open(path, 115_200).expect("the pty opens"),
-            SerialOptions::default(),
+            opts,
         )
         .expect("the bridge answers HELLO")
     }
