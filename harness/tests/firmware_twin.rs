@@ -72,7 +72,11 @@ fn slow_scenarios_pass_through_the_twin_given_a_patient_host() {
         .into_iter()
         .filter(|s| SLOW.iter().any(|(n, _)| *n == s.name))
         .collect();
-    assert_eq!(chosen.len(), SLOW.len(), "every slow scenario is in the suite");
+    assert_eq!(
+        chosen.len(),
+        SLOW.len(),
+        "every slow scenario is in the suite"
+    );
     let mut emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
     let want = run_suite(&mut emu, &chosen, 1, DriverOptions::default(), |_| {});
     let got = run_suite(&mut t, &chosen, 1, DriverOptions::default(), |_| {});

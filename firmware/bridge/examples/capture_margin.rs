@@ -21,11 +21,11 @@ fn main() -> std::process::ExitCode {
         1e6 / m.interval_ns as f64
     );
     println!(
-        "POUT FIFO: {} words deep, at most {} waiting when drained; longest gap between drains {} ns",
+        "POUT ring: {} words deep (its DMA ring), at most {} waiting when drained; longest gap between drains {} ns",
         m.depth, m.fullest, m.longest_gap_ns
     );
     println!(
-        "margin: {:.1}x (FIFO depth in pulse intervals over the longest gap); capture lost: {}",
+        "margin: {:.1}x (ring depth in pulse intervals over the longest gap); capture lost: {}",
         m.margin(),
         m.lost
     );

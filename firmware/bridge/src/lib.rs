@@ -17,6 +17,8 @@
 //!   counter that ticks every second system clock cycle on every path.
 //! - [`timebase`]: the 31-bit counts the capture pushes, turned into ticks
 //!   since the timebase started.
+//! - [`ring`]: the DMA rings the counters' words go to, and how the CPU
+//!   reads them and tells a ring the DMA came round on.
 //! - [`pioregs`]: the state machines' registers, as values.
 //! - [`clock`]: the bridge's 64-bit cycle clock from the core's cycle
 //!   counter and the always-running timer.
@@ -37,6 +39,7 @@ pub mod limits;
 pub mod pins;
 pub mod pioregs;
 pub mod programs;
+pub mod ring;
 pub mod timebase;
 #[cfg(any(test, feature = "twin"))]
 pub mod twin;

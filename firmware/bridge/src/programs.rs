@@ -122,9 +122,20 @@ pub const PLAYER_SIDE: u8 = 0b11111;
 /// code there would push an edge that never happened, once every 2^32
 /// ticks (57.3 s at 75 MHz; until issue 28 this one did).
 ///
-/// A `push block` stalls the counter while the RX FIFO (8 words, joined)
-/// is full; the firmware sees the stall in FDEBUG.RXSTALL, reports the
-/// capture lost, and restarts the counters.
+/// A DMA channel moves each pushed word into a ring in RAM the cycle
+/// after ([`crate::ring`]), so the RX FIFO (8 words, joined) does not fill
+/// and `push block` does not stall; should it ever (the DMA held off the
+/// bus), the firmware sees the stall in FDEBUG.RXSTALL, reports the
+/// capture lost, and restarts the counters, as it does for a ring the DMA
+/// came round on before the CPU read it.
+///
+/// After an edge a program runs its push path before it looks at the pin
+/// again: a change that comes sooner is not seen, and nothing says so.
+/// On the twin, POUT's counter sees pulses and gaps of 8 cycles; the
+/// both-edge counter misses changes 8 cycles apart and sees them 18
+/// apart (`changes_shorter_than_the_both_edge_counters_path_are_missed_and_the_selftests_are_not`).
+/// The chip's outputs change microseconds apart; `ppmc selftest` makes no
+/// level shorter than 18 cycles.
 pub fn edge_counter(rising_only: bool) -> Loaded {
     if rising_only {
         let p = pio::pio_asm!(

@@ -10,7 +10,7 @@
 //! and PIO2 watch GPIO 16-20. embassy-rp still claims the pins (FUNCSEL,
 //! input enable) and owns the blocks.
 
-use core::cell::RefCell;
+use core::cell::{RefCell, UnsafeCell};
 use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::peripheral::DWT;
 use embassy_rp::pac;
@@ -22,6 +22,7 @@ use ppmc_bridge_fw::hal::{Counter, Hal};
 use ppmc_bridge_fw::pins;
 use ppmc_bridge_fw::pioregs::{self, fdebug, shiftctrl, SmRegs, START_COUNTERS, STOP_COUNTERS};
 use ppmc_bridge_fw::programs::Loaded;
+use ppmc_bridge_fw::ring::{Lapped, Reader, RING_BITS, RING_WORDS};
 
 /// The three PIO blocks, by index.
 fn pio(b: usize) -> pac::pio::Pio {
@@ -90,6 +91,62 @@ pub fn bus_pins(levels: u32, dirs: u32, mask: u32) {
     sm.pinctrl().write_value(saved);
 }
 
+/// A ring a DMA channel writes a counter's words into
+/// (`ppmc_bridge_fw::ring`), aligned to its size as `RING_SIZE` needs.
+#[repr(C, align(1024))]
+struct Ring(UnsafeCell<[u32; RING_WORDS]>);
+
+// SAFETY: the DMA writes a ring and only core 1's board code reads it,
+// with volatile reads of whole words (`Rp2350::word`).
+unsafe impl Sync for Ring {}
+
+const _: () = assert!(core::mem::align_of::<Ring>() == RING_WORDS * 4);
+
+static RINGS: [Ring; 4] = [const { Ring(UnsafeCell::new([0; RING_WORDS])) }; 4];
+
+/// The DMA channel of each counter (`Counter::ALL` order); main.rs claims
+/// channels 0-3 from embassy-rp so that nothing else takes them.
+const fn dma_channel(c: Counter) -> usize {
+    match c {
+        Counter::Pout => 0,
+        Counter::Int => 1,
+        Counter::Hold => 2,
+        Counter::Aux => 3,
+    }
+}
+
+/// Starts the four DMA channels, each moving its counter's RX FIFO into
+/// its ring for ever (TRANS_COUNT mode ENDLESS, the write address wrapped
+/// at the ring's 1 KiB), paced by the FIFO's DREQ (RP2350 datasheet, DMA
+/// chapter). The counters need not run: a channel waits for its DREQ.
+pub fn start_rings() {
+    use pac::dma::vals::{DataSize, TransCountMode, TreqSel};
+    for c in Counter::ALL {
+        let (b, s) = pioregs::counter_sm(c);
+        let n = dma_channel(c);
+        let ch = pac::DMA.ch(n);
+        ch.read_addr().write_value(pio(b).rxf(s).as_ptr() as u32);
+        ch.write_addr().write_value(RINGS[n].0.get() as u32);
+        ch.trans_count().write(|w| {
+            w.set_mode(TransCountMode::ENDLESS);
+            w.set_count(1);
+        });
+        // PIO1's RX FIFO 0 is DREQ 12, PIO2's RX FIFO s is 20 + s.
+        let dreq = if b == 1 { 12 } else { 20 } + s as u8;
+        ch.ctrl_trig().write(|w| {
+            w.set_data_size(DataSize::SIZE_WORD);
+            w.set_incr_read(false);
+            w.set_incr_write(true);
+            w.set_ring_size(RING_BITS);
+            w.set_ring_sel(true);
+            w.set_chain_to(n as u8);
+            w.set_treq_sel(TreqSel::from_bits(dreq));
+            w.set_irq_quiet(true);
+            w.set_en(true);
+        });
+    }
+}
+
 /// The RP2350's PIO, SIO and clock as the board code's hardware layer.
 pub struct Rp2350 {
     sysclk_hz: u32,
@@ -99,6 +156,10 @@ pub struct Rp2350 {
     gen: Loaded,
     /// Core 0's heartbeat as last seen, and when (cycles).
     beat: (u32, u64),
+    /// The CPU's side of each counter's ring, and whether one was lapped
+    /// since the last look.
+    readers: [Reader; 4],
+    lapped: bool,
 }
 
 /// Core 0's heartbeat: it counts up every 100 ms while core 0's executor
@@ -140,7 +201,25 @@ impl Rp2350 {
             counters: [pout, pins_],
             gen,
             beat: (HEARTBEAT.load(Ordering::Relaxed), 0),
+            readers: [Reader::default(); 4],
+            lapped: false,
         }
+    }
+
+    /// Where counter `c`'s DMA channel writes next, as a ring index.
+    fn write_index(c: Counter) -> usize {
+        let n = dma_channel(c);
+        let base = RINGS[n].0.get() as u32;
+        let at = pac::DMA.ch(n).write_addr().read();
+        (at.wrapping_sub(base) / 4) as usize % RING_WORDS
+    }
+
+    /// Word `i` of counter `c`'s ring, as the DMA left it.
+    fn word(c: Counter, i: usize) -> u32 {
+        let ring = RINGS[dma_channel(c)].0.get() as *const u32;
+        // SAFETY: `i` is below RING_WORDS (the reader's indices are), and
+        // a whole aligned word is read at once, whatever the DMA does.
+        unsafe { core::ptr::read_volatile(ring.add(i % RING_WORDS)) }
     }
 
     /// The cycle of the register write just before the call: the clock
@@ -218,27 +297,35 @@ impl Hal for Rp2350 {
     }
 
     fn capture_pull(&mut self, c: Counter) -> Option<u32> {
-        let (b, s) = pioregs::counter_sm(c);
-        (pio(b).fstat().read().rxempty() >> s & 1 == 0).then(|| pio(b).rxf(s).read())
+        let write = Self::write_index(c);
+        let reader = &mut self.readers[dma_channel(c)];
+        match reader.next(|i| Self::word(c, i), write) {
+            Ok(w) => w,
+            Err(Lapped) => {
+                self.lapped = true;
+                *reader = Reader::at(write);
+                None
+            }
+        }
     }
 
     fn capture_level(&mut self) -> usize {
-        // FLEVEL: 4 bits of RX level a state machine, at bit 8 * s + 4.
-        let rx = |b: usize, s: usize| (pio(b).flevel().read().0 >> (8 * s + 4) & 0xF) as usize;
-        let (pb, ps) = pioregs::counter_sm(Counter::Pout);
-        let mut most = rx(pb, ps);
-        for c in [Counter::Int, Counter::Hold, Counter::Aux] {
-            let (b, s) = pioregs::counter_sm(c);
-            most = most.max(rx(b, s));
-        }
-        most
+        Counter::ALL
+            .iter()
+            .map(|c| self.readers[dma_channel(*c)].level(Self::write_index(*c)))
+            .max()
+            .unwrap_or(0)
     }
 
     fn capture_stalled(&mut self) -> bool {
+        // A ring the DMA came round on, or (should the DMA ever fall
+        // behind) a counter that stalled on its full FIFO.
+        let lapped = core::mem::take(&mut self.lapped);
         let pout = 1 << fdebug::RXSTALL;
         let others = 0b0111 << fdebug::RXSTALL;
-        let stalled =
-            pio(1).fdebug().read().0 & pout != 0 || pio(2).fdebug().read().0 & others != 0;
+        let stalled = lapped
+            || pio(1).fdebug().read().0 & pout != 0
+            || pio(2).fdebug().read().0 & others != 0;
         pio(1).fdebug().write_value(Fdebug(pout));
         pio(2).fdebug().write_value(Fdebug(others));
         stalled
@@ -267,10 +354,17 @@ impl Hal for Rp2350 {
         pio(2)
             .fdebug()
             .write_value(Fdebug(0b0111 << fdebug::RXSTALL));
-        cortex_m::interrupt::free(|_| {
+        let started = cortex_m::interrupt::free(|_| {
             pio(1).ctrl().write_value(Ctrl(START_COUNTERS));
             self.stamp()
-        })
+        });
+        // What the rings held is from before: read from where each DMA
+        // channel writes next.
+        for c in Counter::ALL {
+            self.readers[dma_channel(c)] = Reader::at(Self::write_index(c));
+        }
+        self.lapped = false;
+        started
     }
 
     fn gen_connect(&mut self, on: bool) {
@@ -344,7 +438,9 @@ impl Hal for Rp2350 {
         // counter's raw value marks the last pass that saw nothing.
         let sampled = u32::from(pins::SAMPLED_HIGH);
         let seen = pac::SIO.gpio_in(1).read() & sampled;
-        let counters = |b: usize| pio(b).fstat().read().rxempty();
+        // A word in a ring moves its channel's write address.
+        let writes = || Counter::ALL.map(|c| pac::DMA.ch(dma_channel(c)).write_addr().read());
+        let at_start = writes();
         let start = DWT::cycle_count();
         // The cycles to `until`, counted on the raw cycle counter every
         // pass (a pass is some 20 cycles: the end is met to within one).
@@ -352,10 +448,7 @@ impl Hal for Rp2350 {
         let mut quiet = start;
         let mut passes: u32 = 0;
         loop {
-            if pac::SIO.gpio_in(1).read() & sampled != seen
-                || counters(1) & 1 == 0
-                || counters(2) & 0b0111 != 0b0111
-            {
+            if pac::SIO.gpio_in(1).read() & sampled != seen || writes() != at_start {
                 let now = self.cycles();
                 return now - u64::from(DWT::cycle_count().wrapping_sub(quiet));
             }

@@ -240,6 +240,10 @@ async fn main(_spawner: Spawner) {
         .write_value(embassy_rp::pac::pio::regs::Ctrl(1));
     // The counters' inputs: GPIO 32-33 on PIO1, 34-36 on PIO2.
     const _: () = assert!(pins::POUT == 32 && pins::DIR == 33 && pins::AUX == 36);
+    // The capture's DMA rings: channels 0-3, one a counter (hw.rs),
+    // claimed here so that nothing else in embassy-rp takes them.
+    let _ring_channels = (p.DMA_CH0, p.DMA_CH1, p.DMA_CH2, p.DMA_CH3);
+    hw::start_rings();
     let _capture_pins = (
         pio1.make_pio_pin(p.PIN_32),
         pio1.make_pio_pin(p.PIN_33),

@@ -20,6 +20,7 @@ use crate::hal::{Counter, Hal};
 use crate::pins;
 use crate::pioregs::{self, block, fdebug, START_COUNTERS, STOP_COUNTERS};
 use crate::programs::{self, Loaded};
+use crate::ring::{Lapped, Reader, RING_WORDS};
 use chip::ChipSide;
 use pio::{Func, World};
 use ppmc_core::emu::{Board as Model, ModelConfig};
@@ -43,11 +44,11 @@ pub const CLOCK_CYCLES: u64 = 6;
 /// arithmetic): some 64.
 pub const RESYNC_CYCLES: u64 = 64;
 
-/// How often the board code looked into the POUT counter's RX FIFO, and
+/// How often the board code looked into the POUT counter's DMA ring, and
 /// how full it found it: the capture's margin.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Drains {
-    /// The most words the FIFO held when the board code looked.
+    /// The most words the ring held when the board code looked.
     pub fullest: usize,
     /// The longest time between two looks that found words, in cycles.
     pub longest_gap: u64,
@@ -78,8 +79,12 @@ pub struct Twin {
     pub cpu_cycles: u64,
     /// Random extra cycles per call: (state, at most).
     gaps: Option<(u64, u64)>,
-    /// How the board code drained the POUT counter's FIFO.
+    /// How the board code drained the POUT counter's ring.
     pub drains: Drains,
+    /// The CPU's side of each counter's DMA ring ([`Counter::ALL`]
+    /// order), and whether one was lapped since the last look.
+    readers: [Reader; 4],
+    lapped: bool,
     /// Clock readings not yet paid for: the world runs them off at the next
     /// call that spends.
     owed: core::cell::Cell<u64>,
@@ -104,6 +109,8 @@ impl Twin {
             idle_step: 2 * CPU_CYCLES,
             owed: core::cell::Cell::new(0),
             drains: Drains::default(),
+            readers: [Reader::default(); 4],
+            lapped: false,
         };
         t.boot().map_err(|e| format!("{e:?}"))?;
         Ok(t)
@@ -135,6 +142,16 @@ impl Twin {
             .map_err(|e| std::boxed::Box::new(e) as _)?;
         w.blocks[0].force_pins(1 << pins::TEST_GEN, 0, 0);
         w.func[pins::TEST_GEN as usize] = Func::Pio(0);
+        // A DMA channel a counter, into its ring (the image's `hw::rings`).
+        for c in Counter::ALL {
+            let (block, sm) = pioregs::counter_sm(c);
+            w.dma.push(pio::RingDma {
+                block,
+                sm,
+                ring: std::vec![0; RING_WORDS],
+                write: 0,
+            });
+        }
         // SIO outputs: levels first, then directions (issue 28): the chip's
         // inputs released, RESET* high, the buffers off until all is set.
         let mut sio_pins: u64 = 1 << pins::RESET | 1 << pins::CAPTURE_OE | 1 << pins::DRIVE_EN;
@@ -233,31 +250,36 @@ impl Hal for Twin {
 
     fn capture_pull(&mut self, c: Counter) -> Option<u32> {
         self.spend(self.cpu_cycles);
-        let (b, s) = pioregs::counter_sm(c);
+        let i = counter_index(c);
         let cycle = self.world.cycle;
-        let b = &mut self.world.blocks[b];
-        let level = b.rx_level(s);
+        let d = &self.world.dma[i];
+        let reader = &mut self.readers[i];
         if c == Counter::Pout {
-            self.drains.look(cycle, level);
+            self.drains.look(cycle, reader.level(d.write));
         }
-        (level > 0).then(|| b.rxf_read(s)).flatten()
+        match reader.next(|k| d.ring[k], d.write) {
+            Ok(w) => w,
+            Err(Lapped) => {
+                self.lapped = true;
+                *reader = Reader::at(d.write);
+                None
+            }
+        }
     }
 
     fn capture_level(&mut self) -> usize {
         self.spend(self.cpu_cycles);
-        Counter::ALL
+        self.readers
             .iter()
-            .map(|c| {
-                let (b, s) = pioregs::counter_sm(*c);
-                self.world.blocks[b].rx_level(s)
-            })
+            .zip(&self.world.dma)
+            .map(|(r, d)| r.level(d.write))
             .max()
             .unwrap_or(0)
     }
 
     fn capture_stalled(&mut self) -> bool {
         self.spend(self.cpu_cycles);
-        let mut stalled = false;
+        let mut stalled = core::mem::take(&mut self.lapped);
         for b in [block::POUT, block::PINS] {
             let mask = pioregs::COUNTERS[b] << fdebug::RXSTALL;
             stalled |= self.world.blocks[b].fdebug() & mask != 0;
@@ -298,7 +320,14 @@ impl Hal for Twin {
         }
         self.spend(self.cpu_cycles);
         self.world.write_ctrl(block::POUT, START_COUNTERS);
-        self.world.cycle
+        let started = self.world.cycle;
+        // What the rings held is from before: read from where each DMA
+        // channel writes next.
+        for (r, d) in self.readers.iter_mut().zip(&self.world.dma) {
+            *r = Reader::at(d.write);
+        }
+        self.lapped = false;
+        started
     }
 
     fn gen_connect(&mut self, on: bool) {
@@ -379,16 +408,16 @@ impl Hal for Twin {
         let to = until.min(seen).max(now + 1);
         if self.world.blocks[0].sm[pioregs::TEST_GEN_SM].enabled {
             // The self-test generator's edges are the PIO's, not the
-            // chip's: the loop sees them as a capture FIFO's word, pass
-            // by pass.
+            // chip's: the loop sees them as a ring's word, pass by pass.
             let mut at = now;
             while at < to {
                 let next = (at + step).min(to);
                 self.world.run_until(next, &mut self.chip);
-                let words = Counter::ALL.iter().any(|c| {
-                    let (b, s) = pioregs::counter_sm(*c);
-                    self.world.blocks[b].rx_level(s) > 0
-                });
+                let words = self
+                    .readers
+                    .iter()
+                    .zip(&self.world.dma)
+                    .any(|(r, d)| r.level(d.write) > 0);
                 if words {
                     return at;
                 }
@@ -405,6 +434,11 @@ impl Hal for Twin {
     }
 }
 
+/// Where counter `c`'s DMA channel and reader are.
+fn counter_index(c: Counter) -> usize {
+    Counter::ALL.iter().position(|x| *x == c).unwrap_or(0)
+}
+
 /// The capture's margin at the chip's fastest pulse rate, measured on the
 /// twin ([`capture_margin`]).
 #[derive(Debug, Clone, Copy)]
@@ -413,7 +447,7 @@ pub struct CaptureMargin {
     pub pulses: u64,
     /// The move's pulse interval at its top speed.
     pub interval_ns: u64,
-    /// Words the POUT counter's RX FIFO holds, and the most it held when
+    /// Words the POUT counter's DMA ring holds, and the most it held when
     /// the board code looked.
     pub depth: usize,
     pub fullest: usize,
@@ -423,7 +457,7 @@ pub struct CaptureMargin {
 }
 
 impl CaptureMargin {
-    /// How many times over the FIFO could have held what came between two
+    /// How many times over the ring could have held what came between two
     /// looks: its depth in pulse intervals, over the longest gap.
     pub fn margin(&self) -> f64 {
         (self.depth as u64 * self.interval_ns) as f64 / self.longest_gap_ns.max(1) as f64
@@ -434,7 +468,7 @@ impl CaptureMargin {
 /// 40 MHz (CSEL high): 10.4 us a pulse, 96 kpps, the fastest under the
 /// speed limit of 40 kpps x SysClk / 16 = 100 kpps (Section 3-2), while
 /// the board code waits for BUSY = 0 as a scenario does; and says how the
-/// board code kept up with the POUT counter's FIFO.
+/// board code kept up with the POUT counter's ring.
 pub fn capture_margin() -> Result<CaptureMargin, String> {
     use ppmc_core::bus::{Bus, Op};
     use ppmc_core::protocol::Status;
@@ -455,7 +489,6 @@ pub fn capture_margin() -> Result<CaptureMargin, String> {
         b.run(*op);
     }
     let pulses = b.record().last_move_pulses().count;
-    let (blk, s) = pioregs::counter_sm(Counter::Pout);
     let hw = b.hal();
     let tclock = straps
         .tclock(ppmc_core::protocol::ClockSource::Internal)
@@ -464,7 +497,7 @@ pub fn capture_margin() -> Result<CaptureMargin, String> {
         sysclk_hz: SYSCLK_HZ,
         pulses,
         interval_ns: straps.pulse_interval(12, tclock).as_nanos(),
-        depth: hw.world.blocks[blk].rx_capacity(s),
+        depth: RING_WORDS,
         fullest: hw.drains.fullest,
         longest_gap_ns: hw.drains.longest_gap * 1_000_000_000 / u64::from(SYSCLK_HZ),
         lost: b.capture_lost(),

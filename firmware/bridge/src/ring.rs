@@ -1,0 +1,129 @@
+//! The capture's DMA rings: a DMA channel per edge counter moves each word
+//! the counter pushes from its RX FIFO into a ring in RAM, endlessly
+//! (RP2350 datasheet, DMA chapter: `TRANS_COUNT` mode ENDLESS, the write
+//! address wrapped by `RING_SIZE`), so that the counter never waits on a
+//! full FIFO and the CPU drains at its leisure, up to a ring's worth.
+//!
+//! The CPU sees where the DMA writes next (its `WRITE_ADDR`) and keeps
+//! where it reads next. A ring the DMA came round on before the CPU read
+//! it is told by the word the CPU read last: the DMA overwrote it on its
+//! way round ([`Reader::next`]). Two words of a counter are never equal
+//! (each carries a count that only goes down, through 2^31 ticks), so an
+//! overwritten word always differs.
+
+/// Words a ring holds: 1 KiB, aligned to its size as `RING_SIZE` needs.
+pub const RING_WORDS: usize = 256;
+
+/// `RING_SIZE` of the DMA channel: log2 of a ring's bytes.
+pub const RING_BITS: u8 = 10;
+const _: () = assert!(1 << RING_BITS == RING_WORDS * 4);
+
+/// The DMA came round the ring past words the CPU had not read: the
+/// capture lost some.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Lapped;
+
+/// The CPU's side of a ring.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Reader {
+    /// The next word to read.
+    read: usize,
+    /// The word read last, as it was.
+    last: Option<u32>,
+}
+
+impl Reader {
+    /// Reads from where the DMA writes next, `write`: what the ring holds
+    /// is dropped.
+    pub fn at(write: usize) -> Reader {
+        Reader {
+            read: write % RING_WORDS,
+            last: None,
+        }
+    }
+
+    /// Words written and not yet read (a full ring reads as empty: the
+    /// next [`Reader::next`] tells them apart).
+    pub fn level(&self, write: usize) -> usize {
+        (write % RING_WORDS + RING_WORDS - self.read) % RING_WORDS
+    }
+
+    /// The next word, `word(i)` reading the ring's word `i`, `write` being
+    /// where the DMA writes next; `None` when every word written is read.
+    pub fn next(
+        &mut self,
+        word: impl Fn(usize) -> u32,
+        write: usize,
+    ) -> Result<Option<u32>, Lapped> {
+        // The word read last is where it was, or the DMA came round.
+        if let Some(last) = self.last {
+            if word((self.read + RING_WORDS - 1) % RING_WORDS) != last {
+                return Err(Lapped);
+            }
+        }
+        if self.read == write % RING_WORDS {
+            return Ok(None);
+        }
+        let w = word(self.read);
+        self.read = (self.read + 1) % RING_WORDS;
+        self.last = Some(w);
+        Ok(Some(w))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::vec::Vec;
+
+    /// A DMA writing words `from..to` (each word its own number, as
+    /// counts never repeat) into `ring`; where it writes next.
+    fn dma(ring: &mut [u32; RING_WORDS], from: u32, to: u32) -> usize {
+        for w in from..to {
+            ring[w as usize % RING_WORDS] = w;
+        }
+        to as usize % RING_WORDS
+    }
+
+    #[test]
+    fn every_word_is_read_once_in_order_across_the_wrap() {
+        let mut ring = [0u32; RING_WORDS];
+        let mut r = Reader::at(0);
+        let mut got = Vec::new();
+        let mut at = 0;
+        for chunk in [10u32, 200, 255, 1, 0, 256 - 1, 37] {
+            let write = dma(&mut ring, at, at + chunk);
+            at += chunk;
+            assert_eq!(r.level(write), chunk as usize % RING_WORDS);
+            while let Some(w) = r.next(|i| ring[i], write).expect("never lapped") {
+                got.push(w);
+            }
+        }
+        assert_eq!(got, (0..at).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn a_ring_the_dma_came_round_on_is_told_whatever_the_lap() {
+        for extra in [1u32, 5, RING_WORDS as u32, 3 * RING_WORDS as u32 + 7] {
+            let mut ring = [0u32; RING_WORDS];
+            let mut r = Reader::at(0);
+            let write = dma(&mut ring, 0, 3);
+            assert_eq!(r.next(|i| ring[i], write), Ok(Some(0)));
+            // The DMA writes a whole ring and more before the CPU looks.
+            let write = dma(&mut ring, 3, RING_WORDS as u32 + extra);
+            assert_eq!(
+                r.next(|i| ring[i], write),
+                Err(Lapped),
+                "{extra} over a ring"
+            );
+        }
+        // Exactly a ring's worth unread is told too (the ring cannot say
+        // full from empty): a word early, never late.
+        let mut ring = [0u32; RING_WORDS];
+        let mut r = Reader::at(0);
+        let write = dma(&mut ring, 0, 1);
+        assert_eq!(r.next(|i| ring[i], write), Ok(Some(0)));
+        let write = dma(&mut ring, 1, 1 + RING_WORDS as u32);
+        assert_eq!(r.next(|i| ring[i], write), Err(Lapped));
+    }
+}
