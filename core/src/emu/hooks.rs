@@ -1,7 +1,8 @@
 //! Deliberate faults inside the reference model, for checking that the
 //! suite, the golden comparison and the fuzzers catch a bad board. A clean
 //! chip has none ([`Faults::default`]). The named catalogue that sets them
-//! lives in the harness (`ppmc::faults`).
+//! is [`crate::emu::faults`] (the harness re-exports it as `ppmc::faults`,
+//! and the QEMU board's virtual chip takes the same names).
 //!
 //! Only faults that need the model's insides are here: its firmware's
 //! decisions (what a register read clears, what the mask gates, how a stop
