@@ -8,9 +8,14 @@
 //! There are no vectors (libsigrok's VCD reader loads a file with a vector
 //! as zero samples, without a word), and a value is written only when it
 //! changes, with a timestamp only where something changes. Timescale 1 ns,
-//! the trace's own resolution. POUT is drawn as a pulse of 1 us, or half
-//! the period when pulses come faster. The file is written as a stream, so
-//! a 16-million-pulse trace costs time but not memory.
+//! the trace's own resolution. The initial values are at `#0`, and a last,
+//! empty timestamp marks the trace's end (its last event: a bus access, a
+//! measurement), so that a viewer shows the whole trace. POUT is drawn as a
+//! pulse of 1 us, or half the period when pulses come faster: the trace
+//! records rising edges only, and the file's header says so, since a viewer
+//! that samples coarser than the width drawn loses pulses. The file is
+//! written as a stream, so a 16-million-pulse trace costs time but not
+//! memory.
 
 use crate::protocol::{Direction, Pin, Winding};
 use crate::time::{Duration, Instant};
@@ -63,6 +68,7 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
         "ppmc trace of {} (section {})",
         trace.scenario, trace.section
     ))?;
+    w.comment(POUT_WIDTH_NOTE)?;
     w.timescale(1, TimescaleUnit::NS)?;
     w.add_module("ppmc")?;
     let mut ids = Vec::with_capacity(SIGNALS.len());
@@ -71,6 +77,7 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
     }
     w.upscope()?;
     w.enddefinitions()?;
+    w.timestamp(0)?;
     w.begin(vcd::SimulationCommand::Dumpvars)?;
     for id in &ids {
         w.change_scalar(*id, Value::V0)?;
@@ -144,8 +151,21 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
     if let Some(f) = pending_fall.take() {
         state.set(f, POUT, false)?;
     }
+    // The trace's end, where nothing changes.
+    let end = trace
+        .events
+        .iter()
+        .map(|e| e.at.as_nanos())
+        .max()
+        .unwrap_or(0);
+    if end > state.last_time {
+        state.w.timestamp(end)?;
+    }
     state.w.flush()
 }
+
+/// The header's word on how POUT is drawn.
+pub const POUT_WIDTH_NOTE: &str = "pout: the trace records each pulse's rising edge; each is drawn 1 us wide (half the period when pulses come faster). A viewer sampling coarser than that width loses pulses: count them at the trace's timescale (1 ns).";
 
 struct Emitter<W: Write> {
     w: vcd::Writer<W>,
@@ -215,6 +235,7 @@ events
 426.000us pin busy 0
 426.000us pin int 1
 500.000us pin auxo 0b0101
+600.000us rs 0x00
 end
 ";
 
@@ -234,19 +255,22 @@ end
         let mut last_s = (0, 0);
         let mut dir_high = false;
         let mut auxo_seen = [false; 4];
-        // Every value written is a change, and every timestamp has one.
+        // Every value written is a change, and every timestamp has one but
+        // the last, the trace's end. The initial values are at #0.
         let mut values = std::collections::HashMap::new();
         let mut changes_since_timestamp = 1;
+        let mut stamps = Vec::new();
         for cmd in parser {
             let cmd = cmd.expect("VCD body parses");
             match cmd {
                 Command::Timestamp(t) => {
                     assert!(
-                        changes_since_timestamp > 0,
+                        changes_since_timestamp > 0 || stamps == [0],
                         "an empty timestamp before #{t}"
                     );
                     changes_since_timestamp = 0;
                     now = t;
+                    stamps.push(t);
                 }
                 Command::ChangeScalar(i, v) => {
                     changes_since_timestamp += 1;
@@ -273,6 +297,18 @@ end
                 _ => {}
             }
         }
+        assert_eq!(stamps.first(), Some(&0), "the initial values at #0");
+        assert_eq!(changes_since_timestamp, 0, "a last, empty timestamp");
+        assert_eq!(now, 600_000, "the trace's end: its last event");
+        let text = String::from_utf8(buf.clone()).expect("utf-8");
+        assert!(
+            text.contains(POUT_WIDTH_NOTE),
+            "the header says how POUT is drawn"
+        );
+        assert!(
+            text.contains("$enddefinitions $end\n#0\n$dumpvars"),
+            "{text}"
+        );
         assert_eq!(rises, vec![300_000, 350_000, 400_000]);
         assert_eq!(
             busy_changes,
