@@ -685,10 +685,29 @@ impl<'t> Driver<'t> {
         Ok(s.count)
     }
 
-    /// Expects the shortest and longest interval of the most recent move
-    /// (deferred, as [`Driver::expect_pulses`]).
+    /// Expects the shortest interval of the most recent move to be `min`
+    /// and the longest to be `max`, each exactly (but for the capture's
+    /// own bound on a bridge whose timer is not locked to the chip):
+    /// a check of a ramp's ends, not a band. For "every interval within
+    /// 1 % of 1 ms", [`Driver::expect_intervals_within`]. Deferred, as
+    /// [`Driver::expect_pulses`].
     pub fn expect_intervals(&mut self, min: Duration, max: Duration) -> Outcome {
         self.enqueue(Vec::new(), Some(Check::Intervals { min, max }))
+    }
+
+    /// Expects every interval of the most recent move within `percent` of
+    /// `nominal` (and the capture's own bound, on a bridge whose timer is
+    /// not locked to the chip): `d.expect_intervals_within(us(1_000),
+    /// 1.0)` passes intervals of 990 to 1,010 us. Deferred, as
+    /// [`Driver::expect_pulses`].
+    pub fn expect_intervals_within(&mut self, nominal: Duration, percent: f64) -> Outcome {
+        // To the nanosecond, never wider than asked.
+        let tol = (nominal.as_nanos() as f64 * percent.abs() / 100.0).floor() as u64;
+        let tolerance = Duration::from_nanos(tol);
+        self.enqueue(
+            Vec::new(),
+            Some(Check::IntervalsWithin { nominal, tolerance }),
+        )
     }
 
     /// Expects no pulse of the most recent move after `t` (deferred, as

@@ -79,6 +79,12 @@ pub(super) enum Check {
         min: Duration,
         max: Duration,
     },
+    /// Every interval of the most recent move within `tolerance` of
+    /// `nominal`.
+    IntervalsWithin {
+        nominal: Duration,
+        tolerance: Duration,
+    },
     /// No pulse of the most recent move after this time.
     NoPulsesAfter(Instant),
     /// No pulse of the most recent move later than this after the last
@@ -229,6 +235,22 @@ impl Driver<'_> {
         ops.extend_from_slice(extra);
         let mut began = self.now;
         if ops.is_empty() {
+            // Only checks of the capture, queued after the last flush (a
+            // scenario that reads a value, then checks the move): judged on
+            // the capture as it stands. They were once dropped unjudged
+            // here, and a wrong one passed.
+            if groups.iter().any(|g| g.check.is_some()) {
+                let record = self
+                    .target
+                    .capture()
+                    .map_err(|e| Stop::Error(HarnessError::target(&e)))?;
+                self.capture = Some(record);
+                for g in &groups {
+                    if let Some(c) = &g.check {
+                        self.judge_check(c, &[], began)?;
+                    }
+                }
+            }
             return Ok((began, Vec::new()));
         }
         let mut replies = self.send_then(&ops, capture)?;
@@ -616,6 +638,22 @@ impl Driver<'_> {
                     ));
                 }
             }
+            Check::IntervalsWithin { nominal, tolerance } => {
+                // A band around the nominal interval, widened by what the
+                // capture cannot tell.
+                let band = tolerance + s.interval_bound;
+                let lo = Duration::from_nanos(nominal.as_nanos().saturating_sub(band.as_nanos()));
+                let hi = nominal + band;
+                let inside = |g: Option<Duration>| g.is_some_and(|g| g >= lo && g <= hi);
+                if !(inside(s.min_interval) && inside(s.max_interval)) {
+                    return Err(fail(
+                        "every pulse interval",
+                        format!("within {nominal} ± {band} ({lo} to {hi})"),
+                        format!("from {} to {}", opt(s.min_interval), opt(s.max_interval)),
+                        s.first.unwrap_or(at),
+                    ));
+                }
+            }
             Check::NoPulsesAfter(t) => no_pulses_after(rec, t)?,
             Check::NoPulsesAfterTrigger(margin) => {
                 let t = self.need("a stop or an input edge", self.trigger)?;
@@ -652,6 +690,7 @@ impl Check {
             self,
             Check::Pulses { .. }
                 | Check::Intervals { .. }
+                | Check::IntervalsWithin { .. }
                 | Check::NoPulsesAfter(_)
                 | Check::NoPulsesAfterTrigger(_)
         )
@@ -787,6 +826,45 @@ mod tests {
         let f = failure(d.flush());
         assert_eq!(f.expected, ErrorCode::NotInitialized.to_string(), "{f}");
         assert!(f.got.contains("error 3"), "{f}");
+    }
+
+    #[test]
+    fn intervals_within_a_percent_of_nominal_pass_and_two_percent_off_fail() {
+        // Section 3-3-5: a constant move at rate 50 (four-phase, internal
+        // clock, reference straps) pulses at one interval; a band of 1 %
+        // around it passes, the same band around an interval 2 % longer
+        // fails and says both.
+        let mut t = Counting::new();
+        let mut d = Driver::new(&mut t, DriverOptions::default());
+        d.reset().expect("queued");
+        d.init_and_wait(Init::four_phase()).expect("init");
+        d.run(Move::constant(Direction::Cw, 50, 100)).expect("runs");
+        let period = d.period(50);
+        d.expect_intervals_within(period, 1.0)
+            .expect("on the nominal");
+        d.flush().expect("within 1 %");
+        let off = Duration::from_nanos(period.as_nanos() * 102 / 100);
+        d.expect_intervals_within(off, 1.0).expect("queued");
+        let f = failure(d.flush());
+        assert_eq!(f.expectation, "every pulse interval", "{f}");
+        assert!(f.expected.starts_with(&format!("within {off} ± ")), "{f}");
+        assert_eq!(f.got, format!("from {period} to {period}"), "{f}");
+    }
+
+    #[test]
+    fn a_capture_check_queued_alone_after_a_flush_is_judged() {
+        // A check of the capture with nothing queued before it: it once
+        // went unjudged, and this wrong one passed.
+        let mut t = Counting::new();
+        let mut d = Driver::new(&mut t, DriverOptions::default());
+        d.reset().expect("queued");
+        d.init_and_wait(Init::four_phase()).expect("init");
+        d.run(Move::constant(Direction::Cw, 50, 100)).expect("runs");
+        d.flush().expect("runs");
+        d.expect_intervals(Duration::from_nanos(1), Duration::from_nanos(2))
+            .expect("queued");
+        let f = failure(d.finish());
+        assert_eq!(f.expectation, "pulse intervals (min, max)", "{f}");
     }
 
     /// A driver right after the tenth pulse of a 100-step constant move
