@@ -22,7 +22,7 @@ use ppmc_bridge_fw::hal::{Counter, Hal};
 use ppmc_bridge_fw::pins;
 use ppmc_bridge_fw::pioregs::{self, fdebug, shiftctrl, SmRegs, START_COUNTERS, STOP_COUNTERS};
 use ppmc_bridge_fw::programs::Loaded;
-use ppmc_bridge_fw::ring::{Lapped, Reader, RING_BITS, RING_WORDS};
+use ppmc_bridge_fw::ring::{Lapped, Reader, CANARY, RING_BITS, RING_WORDS};
 
 /// The three PIO blocks, by index.
 fn pio(b: usize) -> pac::pio::Pio {
@@ -116,9 +116,12 @@ const fn dma_channel(c: Counter) -> usize {
 }
 
 /// Starts the four DMA channels, each moving its counter's RX FIFO into
-/// its ring for ever (TRANS_COUNT mode ENDLESS, the write address wrapped
-/// at the ring's 1 KiB), paced by the FIFO's DREQ (RP2350 datasheet, DMA
-/// chapter). The counters need not run: a channel waits for its DREQ.
+/// its ring for ever, paced by the FIFO's DREQ (RP2350 datasheet, DMA
+/// chapter): the write address wrapped at the ring's 1 KiB, and a ring's
+/// worth of transfers at a time, the channel re-triggering itself at the
+/// end of each (TRANS_COUNT mode TRIGGER_SELF), so that the count says
+/// where the next word goes (`Rp2350::write_index`). The counters need
+/// not run: a channel waits for its DREQ.
 pub fn start_rings() {
     use pac::dma::vals::{DataSize, TransCountMode, TreqSel};
     for c in Counter::ALL {
@@ -128,8 +131,8 @@ pub fn start_rings() {
         ch.read_addr().write_value(pio(b).rxf(s).as_ptr() as u32);
         ch.write_addr().write_value(RINGS[n].0.get() as u32);
         ch.trans_count().write(|w| {
-            w.set_mode(TransCountMode::ENDLESS);
-            w.set_count(1);
+            w.set_mode(TransCountMode::TRIGGER_SELF);
+            w.set_count(RING_WORDS as u32);
         });
         // PIO1's RX FIFO 0 is DREQ 12, PIO2's RX FIFO s is 20 + s.
         let dreq = if b == 1 { 12 } else { 20 } + s as u8;
@@ -206,12 +209,31 @@ impl Rp2350 {
         }
     }
 
-    /// Where counter `c`'s DMA channel writes next, as a ring index.
+    /// Where counter `c`'s DMA channel writes next, as a ring index: from
+    /// its transfer count, which moves as each write completes (its
+    /// WRITE_ADDR, with the ring's wrap, may run ahead of the data:
+    /// `ppmc_bridge_fw::ring`).
     fn write_index(c: Counter) -> usize {
-        let n = dma_channel(c);
-        let base = RINGS[n].0.get() as u32;
-        let at = pac::DMA.ch(n).write_addr().read();
-        (at.wrapping_sub(base) / 4) as usize % RING_WORDS
+        let left = pac::DMA.ch(dma_channel(c)).trans_count().read().count() as usize;
+        (RING_WORDS - left.min(RING_WORDS)) % RING_WORDS
+    }
+
+    /// Reader `i` from where its channel writes next, the canary where it
+    /// wrote last (`ppmc_bridge_fw::ring::Reader::at`).
+    fn restart_reader(&mut self, c: Counter) {
+        let write = Self::write_index(c);
+        let ring = RINGS[dma_channel(c)].0.get() as *mut u32;
+        // SAFETY: the slot is inside the ring; the DMA writes the slot at
+        // `write` next, not this one.
+        unsafe { core::ptr::write_volatile(ring.add(Reader::canary_slot(write)), CANARY) };
+        self.readers[dma_channel(c)] = Reader::at(write);
+    }
+
+    /// Whether any ring holds words the CPU has not read.
+    fn rings_hold_words(&self) -> bool {
+        Counter::ALL
+            .iter()
+            .any(|c| self.readers[dma_channel(*c)].level(Self::write_index(*c)) > 0)
     }
 
     /// Word `i` of counter `c`'s ring, as the DMA left it.
@@ -303,7 +325,7 @@ impl Hal for Rp2350 {
             Ok(w) => w,
             Err(Lapped) => {
                 self.lapped = true;
-                *reader = Reader::at(write);
+                self.restart_reader(c);
                 None
             }
         }
@@ -321,9 +343,19 @@ impl Hal for Rp2350 {
         // A ring the DMA came round on, or (should the DMA ever fall
         // behind) a counter that stalled on its full FIFO.
         let lapped = core::mem::take(&mut self.lapped);
+        // A channel a bus error halted (CTRL_TRIG.AHB_ERROR) moves nothing
+        // more: re-armed, and the capture lost (the counters restart).
+        let halted = Counter::ALL.iter().any(|c| {
+            let ctrl = pac::DMA.ch(dma_channel(*c)).ctrl_trig().read();
+            ctrl.ahb_error() || !ctrl.en()
+        });
+        if halted {
+            start_rings();
+        }
         let pout = 1 << fdebug::RXSTALL;
         let others = 0b0111 << fdebug::RXSTALL;
         let stalled = lapped
+            || halted
             || pio(1).fdebug().read().0 & pout != 0
             || pio(2).fdebug().read().0 & others != 0;
         pio(1).fdebug().write_value(Fdebug(pout));
@@ -333,6 +365,19 @@ impl Hal for Rp2350 {
 
     fn start_counters(&mut self) -> u64 {
         pio(1).ctrl().write_value(Ctrl(STOP_COUNTERS));
+        // Stopped, the counters push nothing more; the DMA takes what is
+        // in their FIFOs within some cycles (bounded: a channel a bus error
+        // halted never would). Flushing a FIFO the DMA still counts on
+        // would put channel and FIFO out of step (datasheet 12.6.4.2).
+        let pout_sm = 1u32;
+        let others = 0b0111u32;
+        for _ in 0..1_000 {
+            let empty1 = pio(1).fstat().read().rxempty() as u32 & pout_sm == pout_sm;
+            let empty2 = pio(2).fstat().read().rxempty() as u32 & others == others;
+            if empty1 && empty2 {
+                break;
+            }
+        }
         let high = |g: u32| pac::SIO.gpio_in((g / 32) as usize).read() >> (g % 32) & 1 == 1;
         let pout = pioregs::pout_counter(&self.counters[0], high(pins::POUT));
         let others = pioregs::pin_counters(
@@ -354,17 +399,24 @@ impl Hal for Rp2350 {
         pio(2)
             .fdebug()
             .write_value(Fdebug(0b0111 << fdebug::RXSTALL));
-        let started = cortex_m::interrupt::free(|_| {
-            pio(1).ctrl().write_value(Ctrl(START_COUNTERS));
-            self.stamp()
-        });
-        // What the rings held is from before: read from where each DMA
-        // channel writes next.
+        // Each channel's DREQ count cleared (the FIFOs are empty): the
+        // handshake starts afresh with the counters.
         for c in Counter::ALL {
-            self.readers[dma_channel(c)] = Reader::at(Self::write_index(c));
+            pac::DMA
+                .ch(dma_channel(c))
+                .dbg_ctdreq()
+                .write_value(pac::dma::regs::DbgCtdreq(0));
+        }
+        // What the rings held is from before: read from where each DMA
+        // channel writes next, before the first edge can come.
+        for c in Counter::ALL {
+            self.restart_reader(c);
         }
         self.lapped = false;
-        started
+        cortex_m::interrupt::free(|_| {
+            pio(1).ctrl().write_value(Ctrl(START_COUNTERS));
+            self.stamp()
+        })
     }
 
     fn gen_connect(&mut self, on: bool) {
@@ -433,14 +485,11 @@ impl Hal for Rp2350 {
     }
 
     fn idle(&mut self, until: u64) -> u64 {
-        // A tight loop on the sampled outputs and the capture FIFOs' empty
-        // flags: a change is seen within a pass (some 20 cycles). The cycle
+        // A tight loop on the sampled outputs and the rings: a change, or
+        // a word not yet read, is seen within a pass (some 40 cycles). The cycle
         // counter's raw value marks the last pass that saw nothing.
         let sampled = u32::from(pins::SAMPLED_HIGH);
         let seen = pac::SIO.gpio_in(1).read() & sampled;
-        // A word in a ring moves its channel's write address.
-        let writes = || Counter::ALL.map(|c| pac::DMA.ch(dma_channel(c)).write_addr().read());
-        let at_start = writes();
         let start = DWT::cycle_count();
         // The cycles to `until`, counted on the raw cycle counter every
         // pass (a pass is some 20 cycles: the end is met to within one).
@@ -448,7 +497,7 @@ impl Hal for Rp2350 {
         let mut quiet = start;
         let mut passes: u32 = 0;
         loop {
-            if pac::SIO.gpio_in(1).read() & sampled != seen || writes() != at_start {
+            if pac::SIO.gpio_in(1).read() & sampled != seen || self.rings_hold_words() {
                 let now = self.cycles();
                 return now - u64::from(DWT::cycle_count().wrapping_sub(quiet));
             }

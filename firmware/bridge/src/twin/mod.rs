@@ -20,7 +20,7 @@ use crate::hal::{Counter, Hal};
 use crate::pins;
 use crate::pioregs::{self, block, fdebug, START_COUNTERS, STOP_COUNTERS};
 use crate::programs::{self, Loaded};
-use crate::ring::{Lapped, Reader, RING_WORDS};
+use crate::ring::{Lapped, Reader, CANARY, RING_WORDS};
 use chip::ChipSide;
 use pio::{Func, World};
 use ppmc_core::emu::{Board as Model, ModelConfig};
@@ -210,6 +210,16 @@ impl Twin {
     }
 }
 
+impl Twin {
+    /// Reader `i` from where its DMA channel writes next, with the canary
+    /// where it wrote last (`ring::Reader::at`).
+    fn restart_reader(&mut self, i: usize) {
+        let d = &mut self.world.dma[i];
+        d.ring[Reader::canary_slot(d.write)] = CANARY;
+        self.readers[i] = Reader::at(d.write);
+    }
+}
+
 impl Hal for Twin {
     fn sysclk_hz(&self) -> u32 {
         SYSCLK_HZ
@@ -261,7 +271,7 @@ impl Hal for Twin {
             Ok(w) => w,
             Err(Lapped) => {
                 self.lapped = true;
-                *reader = Reader::at(d.write);
+                self.restart_reader(i);
                 None
             }
         }
@@ -318,16 +328,16 @@ impl Hal for Twin {
             self.world.write_ctrl(b, pioregs::restart_counters(b));
             self.world.blocks[b].clear_fdebug(pioregs::COUNTERS[b] << fdebug::RXSTALL);
         }
-        self.spend(self.cpu_cycles);
-        self.world.write_ctrl(block::POUT, START_COUNTERS);
-        let started = self.world.cycle;
         // What the rings held is from before: read from where each DMA
-        // channel writes next.
-        for (r, d) in self.readers.iter_mut().zip(&self.world.dma) {
-            *r = Reader::at(d.write);
+        // channel writes next, set before the counters start, as the image
+        // does.
+        for i in 0..self.readers.len() {
+            self.restart_reader(i);
         }
         self.lapped = false;
-        started
+        self.spend(self.cpu_cycles);
+        self.world.write_ctrl(block::POUT, START_COUNTERS);
+        self.world.cycle
     }
 
     fn gen_connect(&mut self, on: bool) {
