@@ -63,11 +63,28 @@ fn bit(b: bool) -> Value {
 
 /// Writes `trace` as VCD to `out`.
 pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
+    export_window(trace, None, out)
+}
+
+/// Writes the part of `trace` from `window.0` to `window.1` as VCD to
+/// `out` (the whole trace with `None`): the signals' values at the
+/// window's start come first, at its start time, and only what changes
+/// within it follows, so that a failure an hour into a long move costs a
+/// small file. Pulses outside the window are skipped by arithmetic, not
+/// one by one.
+pub fn export_window(
+    trace: &Trace,
+    window: Option<(Instant, Instant)>,
+    out: impl Write,
+) -> io::Result<()> {
     let mut w = vcd::Writer::new(io::BufWriter::new(out));
     w.comment(&format!(
         "ppmc trace of {} (section {})",
         trace.scenario, trace.section
     ))?;
+    if let Some((from, to)) = window {
+        w.comment(&format!("the trace from {from} to {to} only"))?;
+    }
     w.comment(POUT_WIDTH_NOTE)?;
     w.timescale(1, TimescaleUnit::NS)?;
     w.add_module("ppmc")?;
@@ -77,19 +94,19 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
     }
     w.upscope()?;
     w.enddefinitions()?;
-    w.timestamp(0)?;
-    w.begin(vcd::SimulationCommand::Dumpvars)?;
-    for id in &ids {
-        w.change_scalar(*id, Value::V0)?;
-    }
-    w.end()?;
-
+    let (from, to) = window.unwrap_or((Instant::ZERO, Instant::from_nanos(u64::MAX)));
     let mut state = Emitter {
         w,
         ids,
         values: [false; SIGNALS.len()],
         last_time: 0,
+        from: from.as_nanos(),
+        to: to.as_nanos(),
+        started: false,
     };
+    if from == Instant::ZERO {
+        state.start()?;
+    }
     let mut winding: Option<Winding> = None;
     let mut phase: u32 = 0;
     // Falling edge of the last POUT, not yet written.
@@ -115,7 +132,18 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
                 } else {
                     Duration::from_micros(1)
                 };
-                for i in 0..*count {
+                // The pulses in the window (and the one whose fall may
+                // cross into it): the phases advance over the rest at once.
+                let early = Instant::from_nanos(from.as_nanos().saturating_sub(width.as_nanos()));
+                let first_in = first_at_or_after(&run, *count, early);
+                let late = Instant::from_nanos(to.as_nanos().saturating_add(1));
+                let past = first_at_or_after(&run, *count, late);
+                if first_in > 0 {
+                    if let Some(wd) = winding {
+                        phase = wd.advance(phase, *dir, u64::from(first_in));
+                    }
+                }
+                for i in first_in..past.max(first_in) {
                     let t = run.at(i);
                     state.flush_before(&mut pending_fall, t)?;
                     state.set(t, POUT, true)?;
@@ -124,6 +152,11 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
                         state.set_bits(t, S1, 5, wd.pattern(phase))?;
                     }
                     pending_fall = Some(t + width.max(Duration::from_nanos(1)));
+                }
+                if past < *count {
+                    if let Some(wd) = winding {
+                        phase = wd.advance(phase, *dir, u64::from(*count - past.max(first_in)));
+                    }
                 }
             }
             EventKind::Pin { pin, value } => {
@@ -151,17 +184,35 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
     if let Some(f) = pending_fall.take() {
         state.set(f, POUT, false)?;
     }
-    // The trace's end, where nothing changes.
+    // The trace's end (or the window's), where nothing changes.
     let end = trace
         .events
         .iter()
         .map(|e| e.at.as_nanos())
         .max()
         .unwrap_or(0);
+    let end = end.min(state.to).max(state.from);
+    if !state.started {
+        state.start()?;
+    }
     if end > state.last_time {
         state.w.timestamp(end)?;
     }
     state.w.flush()
+}
+
+/// The first pulse of `run` (of `count`) at or after `t`: `count` if none.
+fn first_at_or_after(run: &crate::protocol::PulseRun, count: u32, t: Instant) -> u32 {
+    let (mut lo, mut hi) = (0u32, count);
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if run.at(mid) < t {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
 }
 
 /// The header's word on how POUT is drawn.
@@ -172,8 +223,15 @@ struct Emitter<W: Write> {
     ids: Vec<IdCode>,
     /// Every wire's value as last written.
     values: [bool; SIGNALS.len()],
-    /// The last timestamp written (0 is the `$dumpvars` block's).
+    /// The last timestamp written (the window's start is the `$dumpvars`
+    /// block's).
     last_time: u64,
+    /// The window, in ns: changes before `from` only set the values the
+    /// `$dumpvars` block starts with; changes after `to` are not written.
+    from: u64,
+    to: u64,
+    /// The `$dumpvars` block is written.
+    started: bool,
 }
 
 impl<W: Write> Emitter<W> {
@@ -188,12 +246,34 @@ impl<W: Write> Emitter<W> {
         Ok(())
     }
 
+    /// The window's start: every wire's value as it stands, at its time.
+    fn start(&mut self) -> io::Result<()> {
+        self.started = true;
+        self.last_time = self.from;
+        self.w.timestamp(self.from)?;
+        self.w.begin(vcd::SimulationCommand::Dumpvars)?;
+        for (id, v) in self.ids.iter().zip(self.values) {
+            self.w.change_scalar(*id, bit(v))?;
+        }
+        self.w.end()
+    }
+
     /// Sets wire `i` at `at`: writes nothing unless its value changes.
     fn set(&mut self, at: Instant, i: usize, v: bool) -> io::Result<()> {
         if self.values[i] == v {
             return Ok(());
         }
         let t = at.as_nanos();
+        if t < self.from {
+            self.values[i] = v;
+            return Ok(());
+        }
+        if t > self.to {
+            return Ok(());
+        }
+        if !self.started {
+            self.start()?;
+        }
         if t > self.last_time {
             self.w.timestamp(t)?;
             self.last_time = t;
@@ -238,6 +318,95 @@ events
 600.000us rs 0x00
 end
 ";
+
+    /// Rising POUT edges and the last value of each wire, from a VCD.
+    fn rises_and_last(buf: &[u8]) -> (Vec<u64>, std::collections::BTreeMap<String, bool>) {
+        let mut parser = Parser::new(buf);
+        let header = parser.parse_header().expect("VCD header parses");
+        let names: std::collections::HashMap<IdCode, String> = SIGNALS
+            .iter()
+            .map(|n| {
+                (
+                    header.find_var(&["ppmc", n]).expect("declared").code,
+                    n.to_string(),
+                )
+            })
+            .collect();
+        let (mut now, mut rises, mut last) = (0, Vec::new(), std::collections::BTreeMap::new());
+        for cmd in parser {
+            match cmd.expect("VCD body parses") {
+                Command::Timestamp(t) => now = t,
+                Command::ChangeScalar(i, v) => {
+                    let name = names[&i].clone();
+                    if name == "pout" && v == Value::V1 {
+                        rises.push(now);
+                    }
+                    last.insert(name, v == Value::V1);
+                }
+                _ => {}
+            }
+        }
+        (rises, last)
+    }
+
+    const LONG: &str = "ppmc-trace 1
+scenario long
+section 3-3-3
+target emu
+detail sysclk_hz 16000000
+detail csel high
+detail vsel high
+detail ext_clock_hz none
+events
+0.000us reset
+100.000us move accel-decel cw steps=16777216 pout=0 winding=4ph-2 phase=0
+1000.000us pulses cw n=16777216 dt=10.000us
+167773150.000us rs 0x00
+end
+";
+
+    #[test]
+    fn a_window_of_a_long_move_is_small_and_has_the_pulses_and_phases_of_the_whole() {
+        // Issue 29: a failure in the 16,777,216-step move once wrote a VCD
+        // of some 650 MB. A millisecond around a time five seconds in: its
+        // hundred pulses, each where the whole trace has it.
+        let trace = Trace::parse(LONG).expect("valid");
+        let (from, to) = (
+            Instant::from_nanos(5_001_000_000),
+            Instant::from_nanos(5_002_000_000),
+        );
+        let mut buf = Vec::new();
+        export_window(&trace, Some((from, to)), &mut buf).expect("export");
+        assert!(buf.len() < 20_000, "{} bytes", buf.len());
+        let (rises, _) = rises_and_last(&buf);
+        let want: Vec<u64> = (0..16_777_216u64)
+            .map(|k| 1_000_000 + 10_000 * k)
+            .skip_while(|t| *t + 1_000 < from.as_nanos())
+            .take_while(|t| *t <= to.as_nanos())
+            .collect();
+        assert_eq!(rises, want);
+        // The phases at a window's end are the whole trace's at that time:
+        // a short move, whole and in a window that ends with it.
+        let short = LONG.replace("16777216", "1003");
+        let trace = Trace::parse(&short).expect("valid");
+        let mut whole = Vec::new();
+        export(&trace, &mut whole).expect("export");
+        let mut part = Vec::new();
+        let end = Instant::from_nanos(1_000_000 + 10_000 * 1_002 + 5_000);
+        export_window(
+            &trace,
+            Some((Instant::from_nanos(9_000_000), end)),
+            &mut part,
+        )
+        .expect("export");
+        let (whole_rises, whole_last) = rises_and_last(&whole);
+        let (part_rises, part_last) = rises_and_last(&part);
+        assert_eq!(whole_rises.len(), 1003);
+        assert_eq!(part_rises, whole_rises[800..].to_vec());
+        for s in ["s1", "s2", "s3", "s4", "s5", "dir"] {
+            assert_eq!(part_last[s], whole_last[s], "{s} at the end");
+        }
+    }
 
     #[test]
     fn export_parses_back_with_every_pulse_and_pin() {

@@ -50,6 +50,7 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             junit: None,
             json: None,
             artifacts: None,
+            artifacts_window: super::run::Window::All,
             board_rev: None,
             each: false,
             repeat: 1,

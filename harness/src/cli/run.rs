@@ -40,8 +40,16 @@ pub struct RunArgs {
     #[arg(long, value_name = "FILE")]
     pub(super) json: Option<PathBuf>,
     /// Keep the trace and VCD of every scenario that did not pass here.
+    /// The VCD shows `--artifacts-window` either side of the failure.
     #[arg(long, value_name = "DIR")]
     pub(super) artifacts: Option<PathBuf>,
+    /// How much of a failed scenario's waveform `--artifacts` writes:
+    /// this long before and after the failure (e.g. 10ms), or `all` for
+    /// the whole trace (a failure in the 16,777,216-step move makes a VCD
+    /// of some 650 MB). A scenario that ended in an error has no failure
+    /// time: its VCD is whole.
+    #[arg(long, value_name = "DURATION|all", default_value = "10ms", value_parser = parse_window)]
+    pub(super) artifacts_window: Window,
     /// Board revision label for the reports (a target's own `,rev=`
     /// overrides it).
     #[arg(long)]
@@ -126,17 +134,47 @@ fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) {
     }
 }
 
+/// How much of a failed scenario's waveform to keep.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Window {
+    All,
+    Around(crate::time::Duration),
+}
+
+fn parse_window(s: &str) -> Result<Window, String> {
+    if s == "all" {
+        return Ok(Window::All);
+    }
+    super::args::parse_duration(s).map(Window::Around)
+}
+
 /// Saves `r`'s trace and VCD in `dir`, adding each file written to `saved`
-/// (for the reports to point at).
-fn save_artifacts(dir: &Path, r: &ScenarioResult, saved: &mut Vec<String>) -> Result<(), String> {
+/// (for the reports to point at). The VCD covers `window` either side of
+/// the failure, when there is one.
+fn save_artifacts(
+    dir: &Path,
+    r: &ScenarioResult,
+    window: Window,
+    saved: &mut Vec<String>,
+) -> Result<(), String> {
     let Some(trace) = &r.trace else { return Ok(()) };
     let text = trace.render();
     let tpath = dir.join(format!("{}.trace", r.name));
     files::write(&tpath, text.as_bytes()).map_err(|e| e.to_string())?;
     saved.push(tpath.display().to_string());
     let vpath = dir.join(format!("{}.vcd", r.name));
-    files::write_with(&vpath, |w| crate::vcd_export::export(trace, w))
-        .map_err(|e| e.to_string())?;
+    let around = match (&r.verdict, window) {
+        (Verdict::Failed(f), Window::Around(d)) => {
+            let from =
+                crate::time::Instant::from_nanos(f.at.as_nanos().saturating_sub(d.as_nanos()));
+            Some((from, f.at + d))
+        }
+        _ => None,
+    };
+    files::write_with(&vpath, |w| {
+        crate::vcd_export::export_window(trace, around, w)
+    })
+    .map_err(|e| e.to_string())?;
     saved.push(vpath.display().to_string());
     Ok(())
 }
@@ -388,7 +426,8 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
                     Spread::Share => dir.clone(),
                 };
                 let mut saved = saved.borrow_mut();
-                if let Err(e) = save_artifacts(&dir, r, saved.entry(slot).or_default()) {
+                let window = args.artifacts_window;
+                if let Err(e) = save_artifacts(&dir, r, window, saved.entry(slot).or_default()) {
                     problems.push(e);
                 }
             }
