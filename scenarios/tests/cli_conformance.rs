@@ -90,6 +90,63 @@ fn scaled_copy(tag: &str, num: u64, den: u64) -> tempfile::TempDir {
 }
 
 #[test]
+fn compare_traces_writes_junit_and_json_as_run_does_and_names_a_missing_trace() {
+    // Issue 29: `compare --traces` had no reports, other verdict words
+    // than `run`, and a trace missing from the compared set was reported
+    // as a missing golden file.
+    let three_dir = scaled_copy("three-reports", 103, 100);
+    let three = three_dir.path();
+    fs::remove_file(three.join("e0_undefined_command_code.snap")).ok();
+    let out_dir = scratch("compare-reports");
+    let (junit, json) = (out_dir.path().join("c.xml"), out_dir.path().join("c.json"));
+    let out = ppmc(&[
+        "compare",
+        s(&golden_dir()),
+        "--traces",
+        s(three),
+        "--filter",
+        "e0_undefined_command_code",
+        "--junit",
+        s(&junit),
+        "--json",
+        s(&json),
+    ]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}{}", text(&out.stderr));
+    assert!(
+        stdout.contains("ERROR    e0_undefined_command_code"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains(&format!("no trace of this scenario in {}", three.display())),
+        "{stdout}"
+    );
+    let out = ppmc(&[
+        "compare",
+        s(&golden_dir()),
+        "--traces",
+        s(three),
+        "--filter",
+        "s3_3_5_constant_speed_100_steps",
+        "--junit",
+        s(&junit),
+        "--json",
+        s(&json),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stdout));
+    let xml = fs::read_to_string(&junit).expect("JUnit written");
+    assert!(
+        xml.contains(r#"<testcase name="s3_3_5_constant_speed_100_steps""#)
+            && xml.contains(r#"<failure type="device""#),
+        "{xml}"
+    );
+    let record: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&json).expect("JSON written")).expect("JSON");
+    common::check_record(&common::run_record_schema(), &record);
+    assert_eq!(record["summary"]["failed"], 1, "{record}");
+}
+
+#[test]
 fn compare_passes_half_a_percent_and_fails_three_percent() {
     let half_dir = scaled_copy("half", 1005, 1000);
     let half = half_dir.path();
@@ -103,10 +160,13 @@ fn compare_passes_half_a_percent_and_fails_three_percent() {
     assert_eq!(out.status.code(), Some(1));
     let stdout = text(&out.stdout);
     assert!(
-        stdout.contains("DIVERGE  s3_3_5_constant_speed_100_steps"),
+        stdout.contains("FAIL     s3_3_5_constant_speed_100_steps (section 3-3-5)"),
         "{stdout}"
     );
-    assert!(stdout.contains("first divergence at "), "{stdout}");
+    assert!(
+        stdout.contains("golden trace: first divergence in "),
+        "{stdout}"
+    );
     assert!(stdout.contains("(allowed "), "{stdout}");
     // Loosen the tolerances and 3 % passes.
     let out = ppmc(&[
@@ -326,7 +386,7 @@ fn compare_counts_an_unusable_file_as_an_error_not_a_failure() {
     let stdout = text(&out.stdout);
     assert_eq!(out.status.code(), Some(1), "{stdout}");
     assert!(
-        stdout.contains("BAD FILE e0_motor_type_code_00"),
+        stdout.contains("ERROR    e0_motor_type_code_00"),
         "{stdout}"
     );
     assert!(stdout.contains("not UTF-8 text"), "{stdout}");

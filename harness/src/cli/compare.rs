@@ -2,11 +2,12 @@
 
 use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
 use crate::cli::{usage, CliError};
-use crate::compare::compare;
-use crate::golden::{self};
-use crate::scenario::Scenario;
+use crate::golden::{self, GoldenError};
+use crate::report::{self, BoardInfo, RunInfo};
+use crate::scenario::{HarnessError, Scenario, ScenarioResult, Verdict};
+use crate::time::Duration;
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Which scenarios to take.
 #[derive(Debug, Args)]
@@ -23,6 +24,14 @@ pub struct CompareArgs {
     target: TargetArgs,
     #[command(flatten)]
     tolerance: ToleranceArgs,
+    /// Write a JUnit XML report: a test case per scenario, a divergence a
+    /// failure, an unusable file an error (as `ppmc run` writes them).
+    #[arg(long, value_name = "FILE")]
+    junit: Option<PathBuf>,
+    /// Write a JSON run record (docs/run-record.schema.json, as `ppmc run`
+    /// writes it; the compared trace set stands as the board).
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
 }
 
 pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
@@ -47,8 +56,8 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             target: args.target,
             golden: Some(args.golden),
             tolerance: args.tolerance,
-            junit: None,
-            json: None,
+            junit: args.junit,
+            json: args.json,
             artifacts: None,
             artifacts_window: super::run::Window::All,
             board_rev: None,
@@ -64,36 +73,93 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             dir.display()
         )));
     }
-    // A trace that diverges fails; a file that cannot be used (missing,
-    // unreadable, corrupt, at other straps) is an error of its own: the
-    // file is at fault, not the board.
-    let (mut ok, mut bad, mut errors) = (0usize, 0usize, 0usize);
+    // A trace that diverges fails, as in `ppmc run --golden`; a file that
+    // cannot be used (missing, unreadable, corrupt, at other straps) is an
+    // error of its own: the file is at fault, not the board.
+    let started = std::time::Instant::now();
+    let mut info = RunInfo::new(
+        vec![BoardInfo {
+            name: dir.display().to_string(),
+            target: format!("traces:{}", dir.display()),
+            target_details: Default::default(),
+            board_rev: None,
+            bridge_firmware: None,
+            error: None,
+        }],
+        "one",
+    );
+    info.options = crate::report::RunOptions {
+        repeat: 1,
+        golden: Some(args.golden.display().to_string()),
+        marginal_pct: 0.0,
+        latency_tol_pct: tol.latency_bp as f64 / 100.0,
+        interval_tol_pct: tol.interval_bp as f64 / 100.0,
+        time_floor_ns: tol.floor.as_nanos(),
+        ..Default::default()
+    };
+    args.select.describe(&mut info.options);
+    let mut results = Vec::with_capacity(scenarios.len());
     for s in &scenarios {
-        // Traces at other straps than the golden's are refused by name.
-        let pair = golden::load(dir, s.name)
-            .and_then(|t| golden::load_for(&args.golden, s.name, &t.straps).map(|g| (g, t)));
-        let line = match pair {
-            Ok((g, t)) => match compare(&g, &t, &tol) {
-                Ok(()) => {
-                    ok += 1;
-                    format!("MATCH    {}", s.name)
-                }
-                Err(d) => {
-                    bad += 1;
-                    format!("DIVERGE  {}\n         first divergence {d}", s.name)
-                }
-            },
-            Err(e) => {
-                errors += 1;
-                format!("BAD FILE {}\n         {e}", s.name)
-            }
+        let mut r = ScenarioResult {
+            name: s.name,
+            section: s.section,
+            tags: s.tags,
+            verdict: Verdict::Passed,
+            measurements: Vec::new(),
+            trace: None,
+            elapsed: Duration::ZERO,
+            wall: std::time::Duration::ZERO,
         };
-        outln!("{line}");
+        match golden::load(dir, s.name) {
+            Ok(t) => {
+                r.elapsed = Duration::from_nanos(t.events.last().map_or(0, |e| e.at.as_nanos()));
+                r.trace = Some(t);
+                super::run::check_golden(&mut r, &args.golden, &tol);
+                r.trace = None;
+            }
+            Err(GoldenError::Missing { path }) => {
+                r.verdict = Verdict::Error(HarnessError::Golden(missing(dir, &path)));
+            }
+            Err(e) => r.verdict = Verdict::Error(HarnessError::Golden(e.to_string())),
+        }
+        outln!("{}", super::run::verdict_line(&r, None));
+        results.push(r);
     }
+    info.wall_s = started.elapsed().as_secs_f64();
+    let on = vec![Some(0); results.len()];
+    let mut problems = Vec::new();
+    if let Some(p) = &args.junit {
+        if let Err(e) = super::run::write_report(p, report::junit(&info, &results, &[], &on)) {
+            problems.push(e);
+        }
+    }
+    if let Some(p) = &args.json {
+        if let Err(e) = super::run::write_report(p, report::json(&info, &results, &on)) {
+            problems.push(e);
+        }
+    }
+    let count = |f: fn(&Verdict) -> bool| results.iter().filter(|r| f(&r.verdict)).count();
+    let ok = count(|v| v.ok());
+    let bad = count(|v| matches!(v, Verdict::Failed(_)));
+    let errors = count(|v| matches!(v, Verdict::Error(_)));
     outln!("compare: {ok} passed, {bad} failed, {errors} errors");
+    if let Some(p) = problems.first() {
+        return Err(CliError::Failed(p.clone()));
+    }
     if bad + errors == 0 {
         Ok(())
     } else {
         Err(CliError::Verdict)
     }
+}
+
+/// The error of a scenario the compared set has no trace of: the
+/// recording's gap, not the golden set's.
+fn missing(dir: &Path, path: &Path) -> String {
+    format!(
+        "{}: no trace of this scenario in {} (record it there with `ppmc record --out {}`)",
+        path.display(),
+        dir.display(),
+        dir.display()
+    )
 }

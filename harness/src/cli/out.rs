@@ -77,11 +77,11 @@ pub fn verdict_word(word: &str, width: usize) -> String {
         return padded;
     }
     let code = match word {
-        "PASS" | "SAME" => "32",      // green
-        "MARGINAL" => "33",           // yellow
-        "FAIL" | "DIVERGE" => "1;31", // bold red
-        "ERROR" => "1;35",            // bold magenta
-        _ => "2",                     // dim: not run
+        "PASS" | "SAME" => "32", // green
+        "MARGINAL" => "33",      // yellow
+        "FAIL" => "1;31",        // bold red
+        "ERROR" => "1;35",       // bold magenta
+        _ => "2",                // dim: not run
     };
     format!("\x1b[{code}m{word}\x1b[0m{}", &padded[word.len()..])
 }

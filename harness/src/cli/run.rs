@@ -72,7 +72,7 @@ pub struct RunArgs {
     pub(super) marginal: f64,
 }
 
-fn verdict_line(r: &ScenarioResult, board: Option<&str>) -> String {
+pub(super) fn verdict_line(r: &ScenarioResult, board: Option<&str>) -> String {
     let tag = match r.verdict {
         Verdict::Passed => "PASS",
         Verdict::Marginal => "MARGINAL",
@@ -99,7 +99,7 @@ fn verdict_line(r: &ScenarioResult, board: Option<&str>) -> String {
 
 /// Applies the golden comparison to a result: a divergence or an unusable
 /// golden file fails the scenario (never the process).
-fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) {
+pub(super) fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) {
     if !r.verdict.ok() {
         return;
     }
@@ -179,7 +179,10 @@ fn save_artifacts(
     Ok(())
 }
 
-fn write_report(path: &Path, text: Result<String, report::ReportError>) -> Result<(), String> {
+pub(super) fn write_report(
+    path: &Path,
+    text: Result<String, report::ReportError>,
+) -> Result<(), String> {
     let text = text.map_err(|e| format!("{}: {e}", path.display()))?;
     files::write_report(path, text.as_bytes()).map_err(|e| e.to_string())
 }
