@@ -8,6 +8,7 @@
 
 use super::board::BoardFaults;
 use super::hooks::Faults;
+use crate::protocol::timing::{figure, Figure, TimingId, TimingRow, TABLE_3_3};
 use crate::time::Duration;
 
 /// Shape of the acceleration ramp from the start-up rate RL to the high
@@ -92,37 +93,62 @@ pub struct ModelConfig {
 }
 
 impl Default for ModelConfig {
+    /// Every Table 3-3 figure from [`TABLE_3_3`], once
+    /// ([`ModelConfig::from_table`]); the rest as `docs/datasheet-notes.md`
+    /// says.
     fn default() -> Self {
+        Self::from_table(TABLE_3_3).expect("Table 3-3 prints every figure the model takes")
+    }
+}
+
+impl ModelConfig {
+    /// The default model with the Table 3-3 figures of `table`: a row
+    /// corrected in [`TABLE_3_3`] moves the model (and the faults, which
+    /// scale these) with it; `None` if `table` lacks a figure the model
+    /// takes. The latencies Table 3-3 does not print, or prints only as a
+    /// band the model picks a point in, are given here, each with its
+    /// note.
+    pub fn from_table(table: &[TimingRow]) -> Option<ModelConfig> {
+        use Figure::{Max, Min, Typ};
+        use TimingId::*;
+        let t = |id, f| figure(table, id, f);
         let us = Duration::from_micros;
-        ModelConfig {
+        Some(ModelConfig {
+            // Not in Table 3-3, or a point the model picks inside a band it
+            // prints (docs/datasheet-notes.md): N11 (byte pickup, OBF), N19
+            // (BUSY's rise, inside the BusyRise band), N18 (single step's
+            // POUT), N22 (the remaining-pulse calculation, inside the
+            // AbnormalTermination bound), N39 (stop switching).
             byte_pickup: us(6),
             obf_ready: us(20),
             obf_next: us(10),
             busy_rise: us(60),
-            init_outputs: us(44),
-            init_time_min: us(16_500),
-            init_time_max: us(162_800),
-            accel_first_pout: us(200),
-            accel_first_pout_triangle_max: us(1_100),
-            constant_first_pout: us(194),
             single_step_pout: us(86),
-            single_step_done: us(112),
-            decel_stop: us(17),
-            hs_limit_accel: us(12),
-            hs_limit_cruise: us(17),
             remaining_calc: us(180),
-            interrupt_delay: us(26),
-            next_command: us(156),
-            hold_on: us(3_400),
-            aux_switch: us(14),
-            aux_output: us(14),
-            excitation_off: us(18),
             switching_on: us(65),
             switching_off: Duration::from_nanos(108_750),
+            init_outputs: t(InitOutputsSet, Typ)?,
+            init_time_min: t(InitProcessing, Min)?,
+            init_time_max: t(InitProcessing, Max)?,
+            accel_first_pout: t(AccelFirstPout, Min)?,
+            accel_first_pout_triangle_max: t(AccelFirstPout, Max)?,
+            constant_first_pout: t(ConstantFirstPout, Typ)?,
+            single_step_done: t(SingleStep, Typ)?,
+            decel_stop: t(DecelStopProcessing, Typ)?,
+            hs_limit_accel: t(HighSpeedLimitAccel, Typ)?,
+            hs_limit_cruise: t(HighSpeedLimitCruise, Typ)?,
+            interrupt_delay: t(InterruptOutput, Typ)?,
+            next_command: t(NextCommand, Typ)?,
+            hold_on: t(HoldOn, Typ)?,
+            // AUX ON and OFF print the same figure; AUXO's data takes it
+            // too (notes N11).
+            aux_switch: t(AuxOn, Typ)?,
+            aux_output: t(AuxOn, Typ)?,
+            excitation_off: t(ExcitationOff, Typ)?,
             accel_curve: AccelCurve::LinearSpeed,
             faults: Faults::default(),
             board: BoardFaults::default(),
-        }
+        })
     }
 }
 
@@ -220,6 +246,48 @@ impl ModelConfig {
 mod tests {
     use super::*;
     use alloc::string::ToString;
+
+    #[test]
+    fn every_table_3_3_figure_the_model_takes_moves_it_and_no_other() {
+        // Issue 29: Table 3-3 written once. Each figure bumped by 1 us in a
+        // copy of the table moves the model's defaults, but for the bands
+        // the model only places a point in or that only judge a target.
+        use crate::protocol::timing::{Figure, TimingId};
+        let base = ModelConfig::from_table(TABLE_3_3).expect("every figure");
+        assert_eq!(base, ModelConfig::default());
+        let mut unused = alloc::vec::Vec::new();
+        for (i, row) in TABLE_3_3.iter().enumerate() {
+            for f in [Figure::Min, Figure::Typ, Figure::Max] {
+                let Some(v) = row.figure(f) else { continue };
+                let mut table = TABLE_3_3.to_vec();
+                let bumped = Some(v + Duration::from_micros(1));
+                match f {
+                    Figure::Min => table[i].min = bumped,
+                    Figure::Typ => table[i].typ = bumped,
+                    Figure::Max => table[i].max = bumped,
+                }
+                let moved = ModelConfig::from_table(&table).expect("every figure");
+                if moved == base {
+                    unused.push((row.id, f));
+                }
+            }
+        }
+        assert_eq!(
+            unused,
+            [
+                // Judged only: the bound of a stop's BUSY fall (N22), the
+                // band BUSY rises in (N19), AUX OFF's figure (AUX ON's).
+                (TimingId::AbnormalTermination, Figure::Max),
+                (TimingId::AuxOff, Figure::Typ),
+                (TimingId::BusyRise, Figure::Min),
+                (TimingId::BusyRise, Figure::Max),
+            ]
+        );
+        // A table that lacks a figure the model takes gives no model.
+        let mut table = TABLE_3_3.to_vec();
+        table.retain(|r| r.id != TimingId::NextCommand);
+        assert_eq!(ModelConfig::from_table(&table), None);
+    }
 
     #[test]
     fn default_config_is_valid() {

@@ -26,6 +26,32 @@ pub struct TimingRow {
     pub max: Option<Duration>,
 }
 
+/// A figure of a row: the min, typ or max column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Figure {
+    Min,
+    Typ,
+    Max,
+}
+
+impl TimingRow {
+    /// The row's figure `f`, if the datasheet prints one.
+    pub fn figure(&self, f: Figure) -> Option<Duration> {
+        match f {
+            Figure::Min => self.min,
+            Figure::Typ => self.typ,
+            Figure::Max => self.max,
+        }
+    }
+}
+
+/// Figure `f` of row `id` in `table` ([`TABLE_3_3`], or a copy of it with
+/// a row corrected): what the model's defaults take
+/// (`crate::emu::ModelConfig::from_table`).
+pub fn figure(table: &[TimingRow], id: TimingId, f: Figure) -> Option<Duration> {
+    table.iter().find(|r| r.id == id)?.figure(f)
+}
+
 /// Names for the rows of Table 3-3.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum TimingId {
