@@ -99,7 +99,7 @@ const ELSEWHERE: [(&str, &str); 22] = [
     ),
     (
         "cargo +nightly fuzz run",
-        "in .ci/run (the fuzz step runs every target so, 30 s each)",
+        "in .ci/run (the fuzz step runs every target so, 20 s each)",
     ),
     (
         "mkdir -p ../target/fuzz-corpus",
