@@ -17,6 +17,8 @@
 //!   counter that ticks every second system clock cycle on every path.
 //! - [`timebase`]: the 31-bit counts the capture pushes, turned into ticks
 //!   since the timebase started.
+//! - [`usb`]: core 0's loop between the USB port and the engine's pipes,
+//!   with a deadline on every packet written.
 //! - [`ring`]: the DMA rings the counters' words go to, and how the CPU
 //!   reads them and tells a ring the DMA came round on.
 //! - [`pioregs`]: the state machines' registers, as values.
@@ -43,3 +45,4 @@ pub mod ring;
 pub mod timebase;
 #[cfg(any(test, feature = "twin"))]
 pub mod twin;
+pub mod usb;

@@ -39,7 +39,6 @@ use core::mem::MaybeUninit;
 use defmt_rtt as _;
 use embassy_executor::Spawner;
 use embassy_futures::join::join3;
-use embassy_futures::select::{select, Either};
 use embassy_rp::bind_interrupts;
 use embassy_rp::block::ImageDef;
 use embassy_rp::gpio::{Input, Level, Output, Pull};
@@ -56,7 +55,7 @@ use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
 use embedded_alloc::LlffHeap as Heap;
 use ppmc_bridge_fw::board::Board;
 use ppmc_bridge_fw::bus::BusTiming;
-use ppmc_bridge_fw::{limits, pins, pioregs, programs};
+use ppmc_bridge_fw::{limits, pins, pioregs, programs, usb};
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::protocol::Straps;
 use static_cell::StaticCell;
@@ -371,48 +370,18 @@ async fn main(_spawner: Spawner) {
         &mut [],
         CONTROL_BUF.init([0; 64]),
     );
-    let mut class = CdcAcmClass::new(&mut builder, STATE.init(State::new()), 64);
+    let class = CdcAcmClass::new(&mut builder, STATE.init(State::new()), 64);
     let mut usb = builder.build();
 
+    // Core 0 only moves bytes between the port and core 1's pipes, every
+    // packet written with a deadline (ppmc_bridge_fw::usb, tested on the
+    // host against the loop it replaced: defect 6).
     let serve = async {
-        let (mut rx, mut tx) = ([0u8; 64], [0u8; 64]);
+        let mut cdc = Cdc(class);
         loop {
-            class.wait_connection().await;
+            cdc.0.wait_connection().await;
             defmt::info!("USB: the host opened the port");
-            'connected: loop {
-                match select(class.read_packet(&mut rx), TO_HOST.read(&mut tx)).await {
-                    Either::First(Ok(n)) => {
-                        // Core 1 may be sending a long reply while the host
-                        // sends on: replies keep going out while the bytes
-                        // wait for room, or neither core would move again.
-                        let mut rest = &rx[..n];
-                        while !rest.is_empty() {
-                            match select(FROM_HOST.write(rest), TO_HOST.read(&mut tx)).await {
-                                Either::First(k) => rest = &rest[k..],
-                                Either::Second(m) => {
-                                    let sent =
-                                        with_timeout(WRITE_DEADLINE, class.write_packet(&tx[..m]))
-                                            .await;
-                                    if !matches!(sent, Ok(Ok(()))) {
-                                        break 'connected;
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    Either::First(Err(_)) => break 'connected,
-                    Either::Second(n) => {
-                        let sent = with_timeout(WRITE_DEADLINE, class.write_packet(&tx[..n])).await;
-                        if !matches!(sent, Ok(Ok(()))) {
-                            break 'connected;
-                        }
-                        if n == 64 && TO_HOST.is_empty() {
-                            // A full last packet: end the transfer.
-                            let _ = with_timeout(WRITE_DEADLINE, class.write_packet(&[])).await;
-                        }
-                    }
-                }
-            }
+            usb::serve_connection(&mut cdc, &CorePipes, &WriteDeadline).await;
             defmt::info!(
                 "USB: the host closed the port, or stopped reading for {=u64} ms",
                 WRITE_DEADLINE.as_millis()
@@ -427,6 +396,45 @@ async fn main(_spawner: Spawner) {
         }
     };
     join3(usb.run(), serve, heartbeat).await;
+}
+
+/// The CDC ACM class as `usb::Packets`.
+struct Cdc<'d>(CdcAcmClass<'d, Driver<'d, USB>>);
+
+impl usb::Packets for Cdc<'_> {
+    async fn read_packet(&mut self, buf: &mut [u8]) -> Result<usize, ()> {
+        self.0.read_packet(buf).await.map_err(drop)
+    }
+
+    async fn write_packet(&mut self, data: &[u8]) -> Result<(), ()> {
+        self.0.write_packet(data).await.map_err(drop)
+    }
+}
+
+/// The pipes between the cores as `usb::Pipes`.
+struct CorePipes;
+
+impl usb::Pipes for CorePipes {
+    async fn to_engine(&self, data: &[u8]) -> usize {
+        FROM_HOST.write(data).await
+    }
+
+    async fn replies(&self, buf: &mut [u8]) -> usize {
+        TO_HOST.read(buf).await
+    }
+
+    fn replies_empty(&self) -> bool {
+        TO_HOST.is_empty()
+    }
+}
+
+/// [`WRITE_DEADLINE`] as `usb::Deadline`.
+struct WriteDeadline;
+
+impl usb::Deadline for WriteDeadline {
+    async fn within<F: core::future::Future>(&self, f: F) -> Option<F::Output> {
+        with_timeout(WRITE_DEADLINE, f).await.ok()
+    }
 }
 
 /// `id` as 16 hexadecimal digits.
