@@ -304,9 +304,10 @@ pub struct SelfTestPlan {
 }
 
 impl SelfTestPlan {
-    /// From the first rise of a burst to its last pulse's end.
-    pub fn burst_length(&self, high: Duration, low: Duration) -> Duration {
-        (high + low).saturating_mul(u64::from(self.count))
+    /// How long the generator runs: every burst, each followed by its gap.
+    pub fn length(&self) -> Duration {
+        let burst = (self.high + self.low).saturating_mul(u64::from(self.count)) + self.gap;
+        burst.saturating_mul(u64::from(self.bursts))
     }
 }
 

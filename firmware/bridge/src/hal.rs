@@ -17,6 +17,16 @@ pub enum Counter {
 
 impl Counter {
     pub const ALL: [Counter; 4] = [Counter::Pout, Counter::Int, Counter::Hold, Counter::Aux];
+
+    /// Its place in [`Counter::ALL`]: its DMA channel and ring reader.
+    pub const fn index(self) -> usize {
+        match self {
+            Counter::Pout => 0,
+            Counter::Int => 1,
+            Counter::Hold => 2,
+            Counter::Aux => 3,
+        }
+    }
 }
 
 pub trait Hal {

@@ -104,15 +104,11 @@ const _: () = assert!(core::mem::align_of::<Ring>() == RING_WORDS * 4);
 
 static RINGS: [Ring; 4] = [const { Ring(UnsafeCell::new([0; RING_WORDS])) }; 4];
 
-/// The DMA channel of each counter (`Counter::ALL` order); main.rs claims
-/// channels 0-3 from embassy-rp so that nothing else takes them.
+/// The DMA channel of each counter: its place in `Counter::ALL` (channels
+/// 0-3); main.rs claims them from embassy-rp so that nothing else takes
+/// them.
 const fn dma_channel(c: Counter) -> usize {
-    match c {
-        Counter::Pout => 0,
-        Counter::Int => 1,
-        Counter::Hold => 2,
-        Counter::Aux => 3,
-    }
+    c.index()
 }
 
 /// Starts the four DMA channels, each moving its counter's RX FIFO into
@@ -304,10 +300,7 @@ impl Hal for Rp2350 {
 
     fn bus_push(&mut self, word: u32) -> u64 {
         pio(0).txf(0).write_value(word);
-        // The cycle of the write: the clock now, less the cycles since.
-        let after = DWT::cycle_count();
-        let now = self.cycles();
-        now - u64::from(DWT::cycle_count().wrapping_sub(after))
+        self.stamp()
     }
 
     fn bus_tx_empty(&mut self) -> bool {

@@ -260,7 +260,7 @@ impl Hal for Twin {
 
     fn capture_pull(&mut self, c: Counter) -> Option<u32> {
         self.spend(self.cpu_cycles);
-        let i = counter_index(c);
+        let i = c.index();
         let cycle = self.world.cycle;
         let d = &self.world.dma[i];
         let reader = &mut self.readers[i];
@@ -442,11 +442,6 @@ impl Hal for Twin {
             to
         }
     }
-}
-
-/// Where counter `c`'s DMA channel and reader are.
-fn counter_index(c: Counter) -> usize {
-    Counter::ALL.iter().position(|x| *x == c).unwrap_or(0)
 }
 
 /// The capture's margin at the chip's fastest pulse rate, measured on the

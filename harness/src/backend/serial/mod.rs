@@ -1447,10 +1447,8 @@ impl<L: Link> SerialTarget<L> {
         let extra = if self.hello.virtual_time {
             WallDuration::ZERO
         } else {
-            let burst = (plan.high + plan.low).saturating_mul(u64::from(plan.count)) + plan.gap;
             // The chip reset (100 us) and the bursts, each with its gap.
-            let total = burst.saturating_mul(u64::from(plan.bursts)).as_nanos() + 1_000_000;
-            WallDuration::from_nanos(total)
+            WallDuration::from_nanos(plan.length().as_nanos().saturating_add(1_000_000))
         };
         let reply = match self.request(&Request::SelfTest(*plan), "self-test", extra)? {
             Response::SelfTest(r) => r,
