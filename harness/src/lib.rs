@@ -4,11 +4,14 @@
 //! The std half of ppmc: everything that needs an operating system, on top
 //! of the portable `ppmc-core` (re-exported here as [`time`], [`protocol`],
 //! [`emu`] and [`bus`]). Layers, each depending only on the ones before it:
-//! [`backend`] (one bus abstraction, many backends: the emulator, a serial
-//! bridge) and [`bridge::sim`] ← [`scenario`] (the scenario API) ←
-//! [`runner`], [`trace`], [`golden`], [`compare`], [`report`],
-//! [`console`] ← [`fuzzing`], [`fault_matrix`] ← [`cli`] (the command
-//! line). `ARCHITECTURE.md` at the repository root is the map.
+//! [`stop`], [`files`] ← [`backend`] (targets: a [`backend::TargetSpec`]
+//! opened into the emulator or a bridge over a byte link), [`trace`],
+//! [`vcd_export`], [`bridge::sim`] ← [`scenario`] (the scenario API) ←
+//! [`runner`] (one target or a [`runner::Farm`] of boards), [`golden`],
+//! [`compare`], [`selftest`], [`console`], [`chaos`] ← [`report`],
+//! [`soak`] ← [`fuzzing`] ← [`fault_matrix`] ← [`cli`] (the command line:
+//! arguments in, results printed, nothing else). `ARCHITECTURE.md` at the
+//! repository root is the map.
 
 pub mod backend;
 pub mod bridge;

@@ -1,8 +1,11 @@
 //! Running a suite: choosing scenarios, running them one after another on
-//! a target, and keeping going when one fails or errors.
+//! a target, and keeping going when one fails or errors; on several boards
+//! at once ([`run_on_boards`], [`stream_on_boards`]), opened together as a
+//! [`Farm`], which keeps the boards it could not reach out of the verdict.
 
-use crate::backend::{Op, Target};
+use crate::backend::{self, Op, OpenError, OpenOptions, Target, TargetInfo, TargetSpec};
 use crate::scenario::{run_scenario, DriverOptions, NotRun, Scenario, ScenarioResult, Verdict};
+use crate::stop::Stop;
 use crate::time::Duration;
 
 /// Which scenarios a run takes.
@@ -368,6 +371,200 @@ pub fn stream_on_boards(
         }
     }
 }
+
+/// The boards of a run on several targets, opened: those reached, and why
+/// the others were not. A board that cannot be reached takes no part: its
+/// scenarios are "not run", blamed on the infrastructure, never failed.
+pub struct Farm {
+    specs: Vec<TargetSpec>,
+    /// The targets reached, and for each, its spec's index.
+    targets: Vec<Box<dyn Target>>,
+    reached: Vec<usize>,
+    /// The specs not reached (their index) and why.
+    unreached: Vec<(usize, OpenError)>,
+    stop: Stop,
+}
+
+impl Farm {
+    /// Opens every spec at once (a farm's boards each take a while to
+    /// answer). Every spec is [`checked`](backend::check) first: one the
+    /// user got wrong is an [`OpenError::Invalid`] before any board is
+    /// touched. A board that cannot be reached is kept as unreached.
+    pub fn open(specs: Vec<TargetSpec>, opts: &OpenOptions) -> Result<Farm, OpenError> {
+        for spec in &specs {
+            backend::check(spec, opts)?;
+        }
+        let opened: Vec<Result<Box<dyn Target>, OpenError>> = std::thread::scope(|scope| {
+            let handles: Vec<_> = specs
+                .iter()
+                .map(|spec| scope.spawn(|| backend::open(spec, opts)))
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| {
+                    h.join().unwrap_or_else(|_| {
+                        Err(OpenError::Infrastructure(
+                            "opening the target panicked".into(),
+                        ))
+                    })
+                })
+                .collect()
+        });
+        let mut farm = Farm {
+            specs: Vec::new(),
+            targets: Vec::new(),
+            reached: Vec::new(),
+            unreached: Vec::new(),
+            stop: opts.stop.clone(),
+        };
+        for (b, opened) in opened.into_iter().enumerate() {
+            match opened {
+                Ok(t) => {
+                    farm.targets.push(t);
+                    farm.reached.push(b);
+                }
+                Err(e @ OpenError::Invalid(_)) => return Err(e),
+                Err(e) => farm.unreached.push((b, e)),
+            }
+        }
+        farm.specs = specs;
+        Ok(farm)
+    }
+
+    /// The specs, in the order given: board `b` of the results is `specs()[b]`.
+    pub fn specs(&self) -> &[TargetSpec] {
+        &self.specs
+    }
+
+    /// Board `b`: what its target says of itself, or why it was not reached.
+    pub fn board(&self, b: usize) -> Result<TargetInfo, &OpenError> {
+        match self.reached.iter().position(|r| *r == b) {
+            Some(t) => Ok(self.targets[t].info()),
+            None => Err(self
+                .unreached
+                .iter()
+                .find(|(u, _)| *u == b)
+                .map(|(_, e)| e)
+                .unwrap_or(&NOT_OPENED)),
+        }
+    }
+
+    /// The boards not reached (their index) and why.
+    pub fn unreached(&self) -> &[(usize, OpenError)] {
+        &self.unreached
+    }
+
+    /// Whether no board at all could be reached.
+    pub fn reached_none(&self) -> bool {
+        self.targets.is_empty()
+    }
+
+    /// Why no board could be reached: the one reason, or each board's.
+    pub fn unreached_reason(&self) -> String {
+        match self.unreached.as_slice() {
+            [(_, e)] => e.to_string(),
+            all => format!(
+                "infrastructure error: no board could be reached: {}",
+                all.iter()
+                    .map(|(b, e)| format!("{}: {e}", self.specs[*b].label()))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        }
+    }
+
+    /// [`stream_on_boards`] on the boards reached, with boards numbered
+    /// as the specs are. The scenarios of a board not reached are "not
+    /// run" (interrupted if a stop was asked for while the boards were
+    /// opened): with [`Spread::Each`] its own, after the others' slots;
+    /// when no board was reached, the selection once (per board with
+    /// `Each`). Those go to `keep` only.
+    #[allow(clippy::too_many_arguments)]
+    pub fn stream(
+        &mut self,
+        scenarios: &[Scenario],
+        repeat: usize,
+        opts: DriverOptions,
+        spread: Spread,
+        stop: impl Fn() -> bool + Sync,
+        mut on_result: impl FnMut(usize, Option<usize>, &mut ScenarioResult),
+        mut keep: impl FnMut(BoardResult),
+    ) {
+        let interrupted = self.stop.requested();
+        let not_reached = |s: &Scenario, why: &str| match interrupted {
+            true => not_run(s, NotRun::Interrupted),
+            false => not_run(s, NotRun::Unreachable(why.to_string())),
+        };
+        if self.targets.is_empty() {
+            let why = self.unreached_reason();
+            let each_board: Vec<Option<usize>> = match spread {
+                Spread::Each => (0..self.specs.len()).map(Some).collect(),
+                Spread::Share => vec![(self.specs.len() == 1).then_some(0)],
+            };
+            let mut slot = 0;
+            for board in each_board {
+                for s in scenarios {
+                    let result = not_reached(s, &why);
+                    keep(BoardResult {
+                        board,
+                        slot,
+                        result,
+                    });
+                    slot += 1;
+                }
+            }
+            return;
+        }
+        let reached = &self.reached;
+        stream_on_boards(
+            &mut self.targets,
+            scenarios,
+            repeat,
+            opts,
+            spread,
+            stop,
+            |slot, t, r| on_result(slot, t.map(|t| reached[t]), r),
+            |mut r| {
+                r.board = r.board.map(|t| reached[t]);
+                keep(r)
+            },
+        );
+        // With `Each`, a board that could not be reached runs nothing: its
+        // slots come after the boards reached.
+        if spread == Spread::Each {
+            let per_queue = scenarios.len() * repeat;
+            let interrupted = self.stop.requested();
+            for (k, (b, e)) in self.unreached.iter().enumerate() {
+                let first = per_queue * (self.targets.len() + k);
+                for (i, s) in (0..repeat).flat_map(|_| scenarios).enumerate() {
+                    let result = match interrupted {
+                        true => not_run(s, NotRun::Interrupted),
+                        false => not_run(s, NotRun::Unreachable(e.to_string())),
+                    };
+                    keep(BoardResult {
+                        board: Some(*b),
+                        slot: first + i,
+                        result,
+                    });
+                }
+            }
+        }
+    }
+}
+
+impl std::fmt::Debug for Farm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Farm")
+            .field("specs", &self.specs)
+            .field("reached", &self.reached)
+            .field("unreached", &self.unreached)
+            .finish_non_exhaustive()
+    }
+}
+
+/// What [`Farm::board`] says of a board it has no record of (an index
+/// past the specs).
+static NOT_OPENED: OpenError = OpenError::Infrastructure(String::new());
 
 #[cfg(test)]
 mod tests {

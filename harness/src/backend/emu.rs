@@ -1,7 +1,7 @@
 //! The emulator as a target: the reference model's [`EmuBus`] behind the
 //! [`Target`] trait.
 
-use super::{Op, Reply, Target, TargetError, TargetInfo};
+use super::target::{Op, Reply, Target, TargetError, TargetInfo};
 use crate::emu::{Chip, ChipError, ModelConfig};
 use crate::protocol::{Record, RecordMark, Straps};
 use ppmc_core::bus::{Bus, EmuBus};

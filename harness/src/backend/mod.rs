@@ -1,186 +1,61 @@
 //! One bus abstraction, many backends.
 //!
-//! Everything that drives a chip (the console, later the scenario runner
-//! and the fuzzer) talks to a [`Target`] through batches of [`Op`]s. A batch
-//! runs back to back on the target's own clock and comes back as one
-//! [`Reply`] per op, each stamped with the target's time. On the emulator a
-//! batch costs nothing; on a board behind the serial bus bridge it costs one
-//! round trip, which is why waiting (for IBF, OBF, BUSY) is an op the target
-//! performs, never a host-side polling loop.
+//! Everything that drives a chip (the console, the scenario runner, the
+//! fuzzer) talks to a [`Target`] through batches of [`Op`]s. A batch runs
+//! back to back on the target's own clock and comes back as one [`Reply`]
+//! per op, each stamped with the target's time. On the emulator a batch
+//! costs nothing; on a board behind the serial bus bridge it costs one
+//! round trip, which is why waiting (for IBF, OBF, BUSY) is an op the
+//! target performs, never a host-side polling loop.
+//!
+//! A target is named by a [`TargetSpec`] (`emu`, `serial:/dev/ttyACM0`,
+//! `tcp://host:port`, `rfc2217://host:port`, `labgrid:place`, each with
+//! options of that board alone) and opened by [`open`], which checks a
+//! board's health and its straps on the way:
+//!
+//! ```
+//! # use ppmc::chaos::{Behaviour, ChaosProxy, Upstream};
+//! # use ppmc::bridge::sim::{LinkFaults, PtyBridge};
+//! # use ppmc::{emu::ModelConfig, protocol::Straps};
+//! # let bridge = PtyBridge::start(ppmc::bus::EmuBus::new(Straps::default(), ModelConfig::default())?, LinkFaults::default())?;
+//! # let server = ChaosProxy::start("127.0.0.1:0", Upstream::Serial(bridge.path().into()), Behaviour::Clean, 0)?;
+//! # let port = server.addr().port();
+//! use ppmc::backend::{open, OpenOptions, Op, TargetSpec};
+//!
+//! // A bridge's serial port served on the lab network (ser2net in raw
+//! // mode), labelled for the reports.
+//! let spec: TargetSpec = format!("tcp://127.0.0.1:{port},name=bench-1").parse()?;
+//! let mut board = open(&spec, &OpenOptions::default())?;
+//! let status = board.execute_one(Op::ReadStatus)?;
+//! println!("{}: {status}", spec.label());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! A new way to reach a bridge is a [`Link`] under `link/` and a
+//! [`LinkKind`]; the protocol, retries, reconnects and verdicts come with
+//! [`SerialTarget`].
 
 mod emu;
+pub mod link;
+mod open;
 mod serial;
+mod spec;
+mod target;
 
 pub use self::emu::EmuTarget;
+pub use self::link::labgrid::{parse_labgrid, LabgridLink, Place};
+pub use self::link::rfc2217::{parse_rfc2217, Rfc2217Link};
+pub use self::link::serial::{parse_spec, SerialLink};
+pub use self::link::tcp::{parse_tcp, TcpLink};
+pub use self::link::Link;
+pub use self::open::{check, open, OpenError, OpenOptions};
 pub use self::serial::{
-    parse_labgrid, parse_rfc2217, parse_spec, parse_tcp, LabgridLink, Link, LinkStats, Place,
-    Rfc2217Link, SerialError, SerialLink, SerialOptions, SerialTarget, TcpLink,
+    restart_cause, LinkStats, SerialError, SerialOptions, SerialTarget, MAX_GIVE_UPS,
+};
+pub use self::spec::{Address, LinkKind, SpecError, StrapOptions, TargetSpec};
+pub use self::target::{
+    Op, Reply, SelfTestPlan, SelfTestReply, SelfTestRun, Target, TargetError, TargetErrorKind,
+    TargetInfo,
 };
 
-pub(crate) use self::serial::timed_out;
-pub use ppmc_core::bus::{Op, Reply, SelfTestPlan, SelfTestReply};
-
-use crate::protocol::{Record, RecordMark, Straps};
-use std::fmt;
-
-/// A bridge's self-test as it ran: what the bridge says it generated, and
-/// what its capture recorded from the chip reset on, or why it has no
-/// capture to give (a capture overrun, in the bridge's words).
-#[derive(Debug, Clone)]
-pub struct SelfTestRun {
-    pub reply: SelfTestReply,
-    pub capture: Result<Record, String>,
-}
-
-/// What kind of failure a target error is, so that generic code can tell a
-/// broken link from a misbehaving device (embedded-hal's `ErrorKind` idea).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum TargetErrorKind {
-    /// The connection to the target failed: port gone, no answer, corrupt
-    /// frames. Not the device's fault.
-    Link,
-    /// The target refused the request (unsupported op, bad argument).
-    Unsupported,
-    /// Anything else inside the harness.
-    Other,
-    /// A stop was asked for (SIGINT, SIGTERM) while the target was busy:
-    /// nobody's fault, and no verdict.
-    Interrupted,
-}
-
-/// A failure to run a batch on a target: its [`TargetErrorKind`] for
-/// generic code, and the backend's own error, kept whole. As with
-/// `std::io::Error`, it displays as that error, [`TargetError::get_ref`]
-/// gives it back (to downcast to, say, a `SerialError`), and
-/// [`std::error::Error::source`] continues its chain.
-#[derive(Debug)]
-pub struct TargetError {
-    pub kind: TargetErrorKind,
-    inner: Box<dyn std::error::Error + Send + Sync>,
-}
-
-impl TargetError {
-    /// An error of `kind` caused by `inner` (a backend's error, or a
-    /// sentence: a `String` converts).
-    pub fn new(
-        kind: TargetErrorKind,
-        inner: impl Into<Box<dyn std::error::Error + Send + Sync>>,
-    ) -> TargetError {
-        TargetError {
-            kind,
-            inner: inner.into(),
-        }
-    }
-
-    /// The backend's error.
-    pub fn get_ref(&self) -> &(dyn std::error::Error + Send + Sync + 'static) {
-        &*self.inner
-    }
-}
-
-impl fmt::Display for TargetError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.inner.fmt(f)
-    }
-}
-
-impl std::error::Error for TargetError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        self.inner.source()
-    }
-}
-
-/// What a target says about itself, for traces and reports.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct TargetInfo {
-    /// `emu`, or `serial:/dev/ttyACM0`.
-    pub name: String,
-    /// How the chip is strapped: the emulator's options, or what the
-    /// bridge reports of its board.
-    pub straps: Straps,
-    /// Other facts, `key value`: the bridge's firmware and protocol.
-    pub extra: Vec<(String, String)>,
-}
-
-impl TargetInfo {
-    /// The straps' fields, then the other facts: how traces and reports
-    /// list them.
-    pub fn details(&self) -> Vec<(String, String)> {
-        self.straps
-            .fields()
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .chain(self.extra.iter().cloned())
-            .collect()
-    }
-}
-
-/// A chip the harness can drive.
-pub trait Target: Send {
-    fn info(&self) -> TargetInfo;
-
-    /// How the chip is strapped; scenarios derive rates, waits and timing
-    /// bands from it.
-    fn straps(&self) -> Straps {
-        self.info().straps
-    }
-
-    /// Everything captured on the output side since the last reset: pulse
-    /// runs with the target's timestamps, pin changes, move starts.
-    fn capture(&mut self) -> Result<Record, TargetError>;
-
-    /// Runs `ops` back to back and returns one reply per op, in order.
-    fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError>;
-
-    /// Runs `ops`, then returns the capture too: one round trip on a board
-    /// where a caller needs both.
-    fn execute_then_capture(&mut self, ops: &[Op]) -> Result<(Vec<Reply>, Record), TargetError> {
-        let replies = self.execute(ops)?;
-        Ok((replies, self.capture()?))
-    }
-
-    /// [`Target::execute_then_capture`] with the capture from `from` on
-    /// ([`Record::since`]): what a caller that has the rest needs, without
-    /// copying the whole record on every call.
-    fn execute_then_capture_since(
-        &mut self,
-        ops: &[Op],
-        from: RecordMark,
-    ) -> Result<(Vec<Reply>, Record), TargetError> {
-        let (replies, capture) = self.execute_then_capture(ops)?;
-        Ok((replies, capture.since(from)))
-    }
-
-    /// Lets the target drop its capture before `mark` (a mark of
-    /// [`Target::capture`]), which the caller has done with: what it
-    /// dropped, from which later marks count down. A long differential run
-    /// so keeps a window, not its whole history. A target may keep
-    /// everything (the default drops nothing) or less than asked.
-    fn forget_capture_before(&mut self, mark: RecordMark) -> RecordMark {
-        let _ = mark;
-        RecordMark::default()
-    }
-
-    /// Runs a bus bridge's self-test of its capture (`ppmc selftest`,
-    /// [`SelfTestPlan`]): the chip is reset, and the bridge's own generator
-    /// drives its capture inputs of POUT and INT*. The default, for a
-    /// target with no bridge (the emulator), refuses.
-    fn self_test(&mut self, plan: &SelfTestPlan) -> Result<SelfTestRun, TargetError> {
-        let _ = plan;
-        Err(TargetError::new(
-            TargetErrorKind::Unsupported,
-            "this target has no bus bridge to self-test: give a board's --target",
-        ))
-    }
-
-    /// Runs one op.
-    fn execute_one(&mut self, op: Op) -> Result<Reply, TargetError> {
-        let mut replies = self.execute(std::slice::from_ref(&op))?;
-        replies.pop().ok_or_else(|| {
-            TargetError::new(
-                TargetErrorKind::Other,
-                format!("target returned no reply to `{op}`"),
-            )
-        })
-    }
-}
+pub(crate) use self::link::timed_out;

@@ -1,14 +1,13 @@
 //! `ppmc run`: the conformance suite on a target, graded, with reports.
 
-use super::args::{OpenError, SelectArgs, TargetArgs, ToleranceArgs};
+use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
 use super::progress::Progress;
-use crate::backend::Target;
 use crate::cli::{usage, CliError};
 use crate::compare::{compare, Tolerances};
 use crate::files;
 use crate::golden::{self};
 use crate::report::{self, BoardInfo, Listing, RunInfo, RunOptions, Tally};
-use crate::runner::{stream_on_boards, Spread};
+use crate::runner::{Farm, Spread};
 use crate::scenario::{
     DriverOptions, Failure, Grading, HarnessError, NotRun, Scenario, ScenarioResult, Verdict,
 };
@@ -278,89 +277,45 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         }
     }
     let specs = args.target.specs().map_err(usage)?;
-    for spec in &specs {
-        args.target.check(spec)?;
-    }
-    let spread = match args.each && specs.len() > 1 {
+    let several_specs = specs.len();
+    let spread = match args.each && several_specs > 1 {
         true => Spread::Each,
         false => Spread::Share,
     };
-    // Every board at once: a farm's boards each take a while to answer.
-    let opened: Vec<Result<Box<dyn Target>, OpenError>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = specs
-            .iter()
-            .map(|spec| scope.spawn(|| args.target.open_spec(spec)))
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| {
-                h.join().unwrap_or_else(|_| {
-                    Err(OpenError::Infrastructure(
-                        "opening the target panicked".into(),
-                    ))
-                })
-            })
-            .collect()
-    });
-    let mut boards = Vec::new();
-    let mut targets: Vec<Box<dyn Target>> = Vec::new();
-    // For each target opened, its board.
-    let mut reached = Vec::new();
-    let mut unreached = Vec::new();
-    for (b, (spec, opened)) in specs.iter().zip(opened).enumerate() {
-        let rev = spec.rev.clone().or_else(|| args.board_rev.clone());
-        let name = spec.label().to_string();
-        match opened {
-            Ok(t) => {
-                boards.push(BoardInfo::new(name, &t.info(), rev));
-                targets.push(t);
-                reached.push(b);
+    let mut farm = Farm::open(specs, &args.target.open_options())?;
+    let boards = farm
+        .specs()
+        .iter()
+        .enumerate()
+        .map(|(b, spec)| {
+            let rev = spec.rev.clone().or_else(|| args.board_rev.clone());
+            let name = spec.label().to_string();
+            match farm.board(b) {
+                Ok(t) => BoardInfo::new(name, &t, rev),
+                Err(e) => BoardInfo::unreached(name, spec.address.clone(), rev, e.to_string()),
             }
-            Err(OpenError::Usage(m)) => return Err(usage(m)),
-            Err(e @ OpenError::Infrastructure(_)) => {
-                boards.push(BoardInfo::unreached(
-                    name,
-                    spec.address.clone(),
-                    rev,
-                    e.to_string(),
-                ));
-                unreached.push((b, e));
-            }
-        }
-    }
-    let mut info = RunInfo::new(boards, spread.name(specs.len()));
+        })
+        .collect();
+    let mut info = RunInfo::new(boards, spread.name(several_specs));
     info.options = args.options(&tol);
-    // A stop asked for while the targets were opened leaves every scenario
-    // interrupted, not blamed on a target.
-    let not_reached = |s: &Scenario, why: &str| match stop.requested() {
-        true => crate::runner::not_run(s, NotRun::Interrupted),
-        false => crate::runner::not_run(s, NotRun::Unreachable(why.to_string())),
-    };
-    if targets.is_empty() {
+    if farm.reached_none() {
         // Nothing ran: say so in the reports too, so CI shows an
         // infrastructure problem rather than a bad board.
-        let why = match unreached.as_slice() {
-            [(_, e)] => e.to_string(),
-            all => format!(
-                "infrastructure error: no board could be reached: {}",
-                all.iter()
-                    .map(|(b, e)| format!("{}: {e}", info.boards[*b].name))
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            ),
-        };
+        let why = farm.unreached_reason();
         let mut results = Vec::new();
         let mut on = Vec::new();
-        let each_board: Vec<Option<usize>> = match spread {
-            Spread::Each => (0..specs.len()).map(Some).collect(),
-            Spread::Share => vec![(specs.len() == 1).then_some(0)],
-        };
-        for board in each_board {
-            for s in &scenarios {
-                results.push(not_reached(s, &why));
-                on.push(board);
-            }
-        }
+        farm.stream(
+            &scenarios,
+            1,
+            DriverOptions::default(),
+            spread,
+            || true,
+            |_, _, _| {},
+            |r| {
+                results.push(r.result);
+                on.push(r.board);
+            },
+        );
         let _ = args
             .junit
             .as_ref()
@@ -379,7 +334,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 .to_string(),
         ));
     }
-    for (b, e) in &unreached {
+    for (b, e) in farm.unreached() {
         errln!(
             "ppmc: board {} takes no part in the run: {e}",
             info.boards[*b].name
@@ -394,7 +349,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     };
     let repeat = args.repeat as usize;
     let runs = match spread {
-        Spread::Each => targets.len(),
+        Spread::Each => several_specs - farm.unreached().len(),
         Spread::Share => 1,
     };
     let progress = Progress::new(scenarios.len() * repeat * runs);
@@ -406,20 +361,19 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let mut soak = Soak::new(scenarios.len(), repeat);
     let stopped = || stop.requested() || super::out::stdout_closed();
     let several = info.boards.len() > 1;
-    let board_name = |t: Option<usize>| info.board_name(t.map(|t| reached[t])).to_string();
-    stream_on_boards(
-        &mut targets,
+    let board_name = |b: Option<usize>| info.board_name(b).to_string();
+    farm.stream(
         &scenarios,
         repeat,
         opts,
         spread,
         stopped,
-        |slot, t, r| {
+        |slot, b, r| {
             if let Some(dir) = &args.golden {
                 check_golden(r, dir, &tol);
             }
             progress.step(r.name);
-            let name = board_name(t);
+            let name = board_name(b);
             if !matches!(r.verdict, Verdict::NotRun(NotRun::Interrupted)) {
                 progress.line(&verdict_line(r, several.then_some(name.as_str())));
             }
@@ -438,7 +392,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             r.trace = None;
         },
         |r| {
-            let board = r.board.map(|t| reached[t]);
+            let board = r.board;
             let files = saved.borrow_mut().remove(&r.slot).unwrap_or_default();
             soak.add(r, board, files);
         },
@@ -446,22 +400,6 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     progress.finish();
     let interrupted = stopped();
     info.wall_s = started.elapsed().as_secs_f64();
-    // With --each, a board that could not be reached runs nothing: its
-    // slots come after the boards reached.
-    if spread == Spread::Each {
-        let per_queue = scenarios.len() * repeat;
-        for (k, (b, e)) in unreached.iter().enumerate() {
-            let first = per_queue * (targets.len() + k);
-            for (i, s) in (0..repeat).flat_map(|_| &scenarios).enumerate() {
-                let r = crate::runner::BoardResult {
-                    board: None,
-                    slot: first + i,
-                    result: not_reached(s, &e.to_string()),
-                };
-                soak.add(r, Some(*b), Vec::new());
-            }
-        }
-    }
     let tally = soak.tally();
     let unlisted = soak.unlisted();
     let board_tallies: Vec<Tally> = (0..info.boards.len())
@@ -507,14 +445,14 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     }
     if interrupted {
         Err(CliError::Interrupted)
-    } else if !unreached.is_empty() {
+    } else if !farm.unreached().is_empty() {
         // A board that took no part is an infrastructure error however well
         // the others did: CI must see that the farm is not whole.
         Err(CliError::Infrastructure(format!(
             "{} of {} boards could not be reached and took no part in the run: {}",
-            unreached.len(),
+            farm.unreached().len(),
             info.boards.len(),
-            unreached
+            farm.unreached()
                 .iter()
                 .map(|(b, _)| {
                     let board = &info.boards[*b];

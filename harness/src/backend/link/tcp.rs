@@ -10,8 +10,8 @@
 //! and, where the OS has it, asks for quick acknowledgements before every
 //! read (TCP_QUICKACK, which Linux clears again as it goes).
 
-use super::link::{timed_out, Link};
-use super::SerialError;
+use super::{timed_out, Link};
+use crate::backend::serial::SerialError;
 use crate::stop::Stop;
 use std::fmt;
 use std::io::{self, Read, Write};

@@ -1,30 +1,11 @@
-//! The byte link to a bridge: the [`Link`] trait, a serial port behind it
-//! ([`SerialLink`]), and `serial:<path>[,baud=N]` target specs.
+//! A serial port (USB CDC, a UART, a pseudo-terminal) as a [`Link`], and
+//! `serial:<path>[,baud=N]` addresses.
 
-use super::SerialError;
+use super::{timed_out, Link};
+use crate::backend::serial::SerialError;
 use std::fmt;
 use std::io::{self, Read, Write};
 use std::time::Duration as WallDuration;
-
-/// A byte link to a bridge.
-pub trait Link: Send + fmt::Debug {
-    fn send(&mut self, bytes: &[u8]) -> io::Result<()>;
-    /// Reads what arrives within `timeout`; `Ok(0)` when nothing did.
-    fn recv(&mut self, buf: &mut [u8], timeout: WallDuration) -> io::Result<usize>;
-    /// Opens the link again after it failed.
-    fn reopen(&mut self) -> io::Result<()>;
-    /// What to call the link in messages: `serial:/dev/ttyACM0`.
-    fn name(&self) -> String;
-}
-
-/// A read that ended because its timeout passed (or, on a nonblocking
-/// socket, because nothing was there): nothing arrived, no failure.
-pub(crate) fn timed_out(e: &io::Error) -> bool {
-    matches!(
-        e.kind(),
-        io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
-    )
-}
 
 /// A serial port (USB CDC, UART, or a pseudo-terminal) through `serialport`.
 pub struct SerialLink {
@@ -135,4 +116,41 @@ pub fn parse_spec(spec: &str) -> Option<(String, u32)> {
         }
     }
     Some((path, baud))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_busy_or_forbidden_port_says_another_program_may_hold_it() {
+        // (A real second open cannot be refused here: CI runs as root, and
+        // root passes the exclusive lock serialport takes on the port.)
+        for e in [
+            io::Error::from_raw_os_error(16), // EBUSY
+            io::Error::new(io::ErrorKind::ResourceBusy, "busy"),
+            io::Error::new(io::ErrorKind::PermissionDenied, "denied"),
+        ] {
+            let msg = open_error("/dev/ttyACM0", e).to_string();
+            assert!(msg.starts_with("/dev/ttyACM0: port busy"), "{msg}");
+            assert!(msg.contains("another program"), "{msg}");
+        }
+        let missing = open_error("/dev/ttyACM9", io::ErrorKind::NotFound.into());
+        assert!(missing.to_string().contains("no such serial port"));
+    }
+
+    #[test]
+    fn specs_parse() {
+        assert_eq!(
+            parse_spec("serial:/dev/ttyACM0"),
+            Some(("/dev/ttyACM0".into(), 115_200))
+        );
+        assert_eq!(
+            parse_spec("serial:/dev/pts/3,baud=921600"),
+            Some(("/dev/pts/3".into(), 921_600))
+        );
+        assert_eq!(parse_spec("serial:"), None);
+        assert_eq!(parse_spec("serial:/x,speed=1"), None);
+        assert_eq!(parse_spec("emu"), None);
+    }
 }

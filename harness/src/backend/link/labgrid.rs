@@ -13,7 +13,11 @@
 //! `LG_PROXY`) in the environment reach it unchanged. The client program is
 //! `labgrid-client` on the `PATH`, or `PPMC_LABGRID_CLIENT`.
 
-use super::{Link, Rfc2217Link, SerialError, SerialLink, TcpLink};
+use super::rfc2217::Rfc2217Link;
+use super::serial::SerialLink;
+use super::tcp::TcpLink;
+use super::Link;
+use crate::backend::serial::SerialError;
 use crate::stop::Stop;
 use std::fmt;
 use std::io::{self, BufRead, BufReader};

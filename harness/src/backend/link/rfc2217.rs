@@ -12,9 +12,9 @@
 //! terminal or USB CDC the settings change nothing, and the link layer's
 //! health check says whether the bridge is there.
 
-use super::link::Link;
 use super::tcp::TcpLink;
-use super::SerialError;
+use super::Link;
+use crate::backend::serial::SerialError;
 use crate::stop::Stop;
 use std::fmt;
 use std::io;

@@ -1,0 +1,127 @@
+//! Why talking to a bridge failed: [`SerialError`], its kind, and what a
+//! restarted bridge says restarted it.
+
+use crate::backend::target::{TargetError, TargetErrorKind};
+use crate::time::Instant;
+use ppmc_core::bridge::wire::BridgeErrorCode;
+use std::io;
+
+/// Why talking to a bridge failed.
+#[derive(Debug, thiserror::Error)]
+pub enum SerialError {
+    #[error("{path}: no such serial port (is the bridge plugged in?)")]
+    PortMissing { path: String },
+    #[error("{path}: port busy or not accessible ({detail}); is another program using it?")]
+    PortBusy { path: String, detail: String },
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: io::Error,
+    },
+    #[error("{link}: no bridge answering: no valid reply to {what} after {tries} tries in {secs:.1} s ({heard})")]
+    NoAnswer {
+        link: String,
+        what: String,
+        tries: u32,
+        /// Wall time spent on the request.
+        secs: f64,
+        /// What the link brought instead: nothing, noise, replies to other
+        /// requests, errors.
+        heard: String,
+    },
+    #[error("{link}: bridge speaks protocol version {theirs}, this ppmc speaks {ours}")]
+    Version {
+        link: String,
+        ours: u16,
+        theirs: u16,
+    },
+    #[error("{link}: the bridge answered {code} to {what}: {detail}")]
+    Bridge {
+        link: String,
+        what: String,
+        code: BridgeErrorCode,
+        detail: String,
+    },
+    #[error("{link}: the bridge's capture buffer overran; pulses were lost ({detail})")]
+    CaptureOverrun { link: String, detail: String },
+    #[error("{link}: unexpected reply to {what}: {detail}")]
+    Protocol {
+        link: String,
+        what: String,
+        detail: String,
+    },
+    #[error("{link}: link lost and not back after {attempts} reopen attempts ({last})")]
+    LinkLost {
+        link: String,
+        attempts: u32,
+        last: String,
+    },
+    #[error("{link}: the bridge restarted (session {old:08x} -> {new:08x}){}; the chip's state is unknown", why.as_ref().map(|w| format!(" after {w}")).unwrap_or_default())]
+    Restarted {
+        link: String,
+        old: u32,
+        new: u32,
+        /// What the bridge says restarted it, from its new HELLO (the RP2350
+        /// image's panic record: `a panic at board.rs:123`).
+        why: Option<String>,
+    },
+    /// After a reconnect the bridge no longer held this host's cached
+    /// request: another host said HELLO to it while the link was down, and
+    /// may have used the chip.
+    #[error("{link}: after reconnecting, the bridge no longer holds this host's requests (another host used it while the link was down); the chip's state is unknown")]
+    Displaced { link: String },
+    /// The link gave up on too many requests in this run to be trusted
+    /// with another.
+    #[error("{link}: the link gave up on {failures} requests in this run, and is not used for more (the last: {last})")]
+    Exhausted {
+        link: String,
+        failures: u32,
+        last: String,
+    },
+    /// A stop was asked for (SIGINT, SIGTERM) while waiting on the link.
+    #[error("{link}: interrupted by a stop request")]
+    Interrupted { link: String },
+    /// A reply came back timed before an earlier one, with no chip reset
+    /// in between: the bridge restarted behind the open port (a watchdog,
+    /// a brown-out) and the chip's state was lost with it.
+    #[error("{link}: the bridge's clock went back from {was} to {now} without a chip reset: the bridge restarted behind the open port and the chip's state is unknown")]
+    ClockWentBack {
+        link: String,
+        was: Instant,
+        now: Instant,
+    },
+    #[error("{link}: health check failed: {detail}")]
+    Unhealthy { link: String, detail: String },
+    /// A request of `len` bytes kept arriving garbled; the bridge has not
+    /// run it. Batches are then sent in smaller requests.
+    #[error("{link}: a {len}-byte request keeps arriving garbled")]
+    Garbled { link: String, len: usize },
+}
+
+impl SerialError {
+    pub fn kind(&self) -> TargetErrorKind {
+        match self {
+            SerialError::Version { .. } => TargetErrorKind::Unsupported,
+            SerialError::Interrupted { .. } => TargetErrorKind::Interrupted,
+            // An error or a reply of the wrong kind to a well-formed
+            // request is the bridge's or the link's doing (a firmware bug,
+            // something else answering on the port), never the chip's.
+            _ => TargetErrorKind::Link,
+        }
+    }
+}
+
+impl From<SerialError> for TargetError {
+    fn from(e: SerialError) -> Self {
+        TargetError::new(e.kind(), e)
+    }
+}
+
+/// What a bridge's firmware text says restarted it: the RP2350 image ends
+/// it in `; restarted after a panic at FILE:LINE` after a panic or a hard
+/// fault (its panic record, kept across the watchdog's reset).
+pub fn restart_cause(firmware: &str) -> Option<String> {
+    let (_, cause) = firmware.rsplit_once("restarted after ")?;
+    Some(cause.trim().to_string())
+}

@@ -1,0 +1,342 @@
+//! [`SerialTarget`]: the bridge session (HELLO, the health check, the
+//! straps its chip reports) and the [`Target`] it is.
+
+use super::error::*;
+use super::options::*;
+use crate::backend::link::Link;
+use crate::backend::target::{
+    Op, Reply, SelfTestPlan, SelfTestRun, Target, TargetError, TargetErrorKind, TargetInfo,
+};
+use crate::protocol::Record;
+use crate::protocol::Straps;
+use crate::time::Instant;
+use ppmc_core::bridge::frame::FrameDecoder;
+use ppmc_core::bridge::wire::{
+    BridgeErrorCode, Hello, Request, Response, Timer, FRAGMENT_DATA, MIN_FRAGMENT_DATA,
+    PROTOCOL_VERSION,
+};
+use std::time::{Duration as WallDuration, Instant as WallInstant};
+
+/// What the link has cost so far (for reports and `docs/performance.md`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LinkStats {
+    pub round_trips: u64,
+    pub retransmissions: u64,
+    pub corrupt_frames: u64,
+    pub reopens: u64,
+}
+
+/// A chip behind a bus bridge.
+#[derive(Debug)]
+pub struct SerialTarget<L: Link> {
+    pub(super) link: L,
+    pub(super) decoder: FrameDecoder,
+    pub(super) seq: u8,
+    pub(super) hello: Hello,
+    pub(super) timer: Timer,
+    pub(super) opts: SerialOptions,
+    /// The capture fetched so far (since the last chip reset).
+    pub(super) captured: Record,
+    /// `captured` is the whole capture as of now: the last request brought
+    /// the rest of it back, and the bridge's chip has not moved on since
+    /// (it runs in virtual time, so nothing happens between requests).
+    pub(super) captured_current: bool,
+    /// The link's measured round-trip time.
+    pub(super) rtt: RoundTrip,
+    /// Whether the last [`Self::await_reply`] received any byte at all.
+    pub(super) heard: bool,
+    /// Data bytes per reply fragment in force on the bridge (LINK), and
+    /// the size wanted: halved after a request whose reply needed asking
+    /// again, doubled back after [`CLEAN_TO_GROW`] clean ones.
+    pub(super) fragment: u8,
+    pub(super) want_fragment: u8,
+    /// The reply padding in force on the bridge (LINK).
+    pub(super) pad: u16,
+    /// Clean requests in a row.
+    pub(super) clean: u32,
+    /// The bridge answers LINK (one that refuses it keeps 48-byte
+    /// fragments, and is not asked again).
+    pub(super) link_ok: bool,
+    /// The latest bridge time seen since the last chip reset: a reply
+    /// timed before it means the bridge restarted.
+    pub(super) clock: Instant,
+    /// The request size in force: halved when a request needed asking
+    /// again, doubled back after clean ones.
+    pub(super) request_size: usize,
+    /// This host's session, said in every HELLO (never 0): the bridge
+    /// keeps its cached request across a reconnect for it.
+    pub(super) host: u32,
+    /// The target is open: the bridge's session is known, and a HELLO
+    /// after a reconnect must find it, and this host's requests, again.
+    pub(super) opened: bool,
+    /// A reconnect is under way: a link error ends the attempt instead of
+    /// starting another reconnect.
+    pub(super) recovering: bool,
+    /// The sequence number of the request whose reply is awaited.
+    pub(super) in_flight: Option<u8>,
+    /// Frames that arrived garbled, either way (corrupt frames here,
+    /// bad-frame errors from the bridge): what makes the host shrink its
+    /// requests and the bridge's reply fragments.
+    pub(super) garbled: u64,
+    /// Requests given up so far, and the last reason.
+    pub(super) give_ups: u32,
+    pub(super) last_give_up: String,
+    pub stats: LinkStats,
+}
+
+/// A host session: a number no other host is likely to pick, never 0.
+pub(super) fn host_session() -> u32 {
+    use std::hash::{BuildHasher, Hash, Hasher};
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    std::process::id().hash(&mut h);
+    std::time::SystemTime::now().hash(&mut h);
+    WallInstant::now().hash(&mut h);
+    let x = h.finish();
+    ((x >> 32) as u32 ^ x as u32).max(1)
+}
+
+impl<L: Link> SerialTarget<L> {
+    /// Says hello, then checks the board's health: a chip reset, and the
+    /// status register reading 0x00 after it.
+    pub fn open(link: L, opts: SerialOptions) -> Result<Self, SerialError> {
+        let mut t = SerialTarget {
+            link,
+            decoder: FrameDecoder::new(),
+            seq: 0,
+            hello: Hello {
+                version: PROTOCOL_VERSION,
+                session: 0,
+                timer_hz: Timer::NANOS.hz,
+                max_batch_ops: 1,
+                max_payload: 64,
+                capture_capacity: 0,
+                inputs_wired: 0,
+                virtual_time: false,
+                firmware: String::new(),
+                straps: Straps::default(),
+                resumed: false,
+            },
+            timer: Timer::NANOS,
+            opts,
+            captured: Record::default(),
+            captured_current: false,
+            clock: Instant::ZERO,
+            rtt: RoundTrip::default(),
+            heard: false,
+            fragment: FRAGMENT_DATA as u8,
+            want_fragment: FRAGMENT_DATA as u8,
+            pad: 0,
+            clean: 0,
+            link_ok: true,
+            request_size: MAX_REQUEST,
+            host: host_session(),
+            opened: false,
+            recovering: false,
+            in_flight: None,
+            garbled: 0,
+            give_ups: 0,
+            last_give_up: String::new(),
+            stats: LinkStats::default(),
+        };
+        t.hello = t.say_hello()?;
+        t.timer = Timer {
+            hz: t.hello.timer_hz,
+        };
+        // Always: a bridge keeps its LINK settings across hosts, and the
+        // last one may have asked for padding this link does not want.
+        if t.link_ok {
+            t.set_link(t.fragment, t.opts.pad)?;
+        }
+        // From here on a reconnect must find this session again.
+        t.opened = true;
+        let replies = t
+            .run_batch(&[Op::Reset, Op::ReadStatus])
+            .map_err(|e| match e {
+                e @ SerialError::Interrupted { .. } => e,
+                e => SerialError::Unhealthy {
+                    link: t.link.name(),
+                    detail: e.to_string(),
+                },
+            })?;
+        match replies.get(1) {
+            Some(Reply::Status { status, .. }) if status.0 == 0 => Ok(t),
+            Some(Reply::Status { status, .. }) => Err(SerialError::Unhealthy {
+                link: t.link.name(),
+                detail: format!(
+                    "after a chip reset the status register reads 0x{:02X}, not 0x00",
+                    status.0
+                ),
+            }),
+            other => Err(SerialError::Unhealthy {
+                link: t.link.name(),
+                detail: match other {
+                    Some(r) => format!("the status read after a chip reset got `{r}`"),
+                    None => "no reply to the status read after a chip reset".into(),
+                },
+            }),
+        }
+    }
+
+    pub fn hello(&self) -> &Hello {
+        &self.hello
+    }
+
+    /// Says HELLO with this host's session and checks the version. Once the
+    /// target is open, the bridge must be the same session, and must have
+    /// kept this host's cached request (`resumed`): otherwise what the
+    /// chip did while the link was down is unknown.
+    pub(super) fn say_hello(&mut self) -> Result<Hello, SerialError> {
+        let hello = Request::Hello {
+            version: PROTOCOL_VERSION,
+            host: self.host,
+        };
+        let reply = match self.request(&hello, "hello", WallDuration::ZERO) {
+            // A line too noisy for the hello reply's 48-byte fragments:
+            // ask for the smallest and say hello again (not while
+            // reconnecting, where a silent bridge is told by the loop).
+            Err(SerialError::NoAnswer { .. }) if self.link_ok && !self.recovering => {
+                self.want_fragment = MIN_FRAGMENT_DATA as u8;
+                self.request(&hello, "hello", WallDuration::ZERO)?
+            }
+            other => other?,
+        };
+        let h = match reply {
+            Response::Hello(h) if h.version == PROTOCOL_VERSION => h,
+            // Another bridge behind the same address (reflashed, swapped):
+            // the link's doing, not a choice of the user's.
+            Response::Hello(h) if self.opened => {
+                return Err(SerialError::Protocol {
+                    link: self.link.name(),
+                    what: "hello after a reconnect".into(),
+                    detail: format!(
+                        "the bridge now speaks protocol version {}, not {PROTOCOL_VERSION}: another bridge answers",
+                        h.version
+                    ),
+                })
+            }
+            Response::Hello(h) => {
+                return Err(SerialError::Version {
+                    link: self.link.name(),
+                    ours: PROTOCOL_VERSION,
+                    theirs: h.version,
+                })
+            }
+            other => return Err(self.unexpected("hello", &other)),
+        };
+        if self.opened {
+            if h.session != self.hello.session {
+                return Err(SerialError::Restarted {
+                    link: self.link.name(),
+                    old: self.hello.session,
+                    new: h.session,
+                    why: restart_cause(&h.firmware),
+                });
+            }
+            if !h.resumed {
+                return Err(SerialError::Displaced {
+                    link: self.link.name(),
+                });
+            }
+        }
+        Ok(h)
+    }
+
+    pub(super) fn unexpected(&self, what: &str, r: &Response) -> SerialError {
+        match r {
+            Response::Error {
+                code: BridgeErrorCode::Version,
+                detail,
+            } if !self.opened => SerialError::Version {
+                link: self.link.name(),
+                ours: PROTOCOL_VERSION,
+                theirs: detail
+                    .split_whitespace()
+                    .find_map(|w| w.parse().ok())
+                    .unwrap_or(0),
+            },
+            Response::Error {
+                code: BridgeErrorCode::CaptureOverrun,
+                detail,
+            } => SerialError::CaptureOverrun {
+                link: self.link.name(),
+                detail: detail.clone(),
+            },
+            Response::Error { code, detail } => SerialError::Bridge {
+                link: self.link.name(),
+                what: what.into(),
+                code: *code,
+                detail: detail.clone(),
+            },
+            other => SerialError::Protocol {
+                link: self.link.name(),
+                what: what.into(),
+                detail: format!("a {} message", other.name()),
+            },
+        }
+    }
+}
+
+impl<L: Link> Target for SerialTarget<L> {
+    fn info(&self) -> TargetInfo {
+        TargetInfo {
+            name: self.link.name(),
+            straps: self.hello.straps,
+            extra: vec![
+                ("bridge_firmware".into(), self.hello.firmware.clone()),
+                ("bridge_protocol".into(), self.hello.version.to_string()),
+            ],
+        }
+    }
+
+    fn straps(&self) -> Straps {
+        self.hello.straps
+    }
+
+    /// Fetches what the bridge captured since the last fetch: new pin
+    /// changes and moves, and the pulse runs from the last one known on
+    /// (the last run may have grown). Costs nothing when the last batch
+    /// brought the rest of the capture back with it.
+    fn capture(&mut self) -> Result<Record, TargetError> {
+        Ok(self.counted(Self::fetch_capture)?)
+    }
+
+    fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
+        Ok(self.counted(|t| t.run_batch(ops))?)
+    }
+
+    fn self_test(&mut self, plan: &SelfTestPlan) -> Result<SelfTestRun, TargetError> {
+        Ok(self.counted(|t| t.run_self_test(plan))?)
+    }
+}
+
+impl<L: Link> SerialTarget<L> {
+    /// Runs `f` unless the link has given up on too many requests already,
+    /// and counts it if it gives up too.
+    pub(super) fn counted<T>(
+        &mut self,
+        f: impl FnOnce(&mut Self) -> Result<T, SerialError>,
+    ) -> Result<T, SerialError> {
+        if self.opts.stop.requested() {
+            return Err(self.interrupted());
+        }
+        if self.give_ups >= MAX_GIVE_UPS {
+            return Err(SerialError::Exhausted {
+                link: self.link.name(),
+                failures: self.give_ups,
+                last: self.last_give_up.clone(),
+            });
+        }
+        let r = f(self);
+        if let Err(e) = &r {
+            // A capture overrun is an answer, not a request given up: the
+            // bridge works, and the chip reset of the next scenario empties
+            // its capture.
+            if e.kind() == TargetErrorKind::Link && !matches!(e, SerialError::CaptureOverrun { .. })
+            {
+                self.give_ups += 1;
+                self.last_give_up = e.to_string();
+            }
+        }
+        r
+    }
+}

@@ -1,0 +1,522 @@
+//! What names a target: a [`TargetSpec`] (`emu`, or a bridge's address in
+//! one of the forms of [`LinkKind`], then options of that board alone),
+//! read into an [`Address`], and the strap options ([`StrapOptions`]) a
+//! user may give for a board.
+//!
+//! The grammar, one string per board:
+//!
+//! ```text
+//! emu | serial:<path>[,baud=N] | tcp://<host>:<port>
+//!     | rfc2217://<host>:<port>[,baud=N] | labgrid:<place>[,port=NAME]
+//! then any of: ,name=LABEL ,rev=LABEL ,pad=BYTES
+//!              ,clock-mhz=MHZ ,csel=high|low ,vsel=high|low ,ext-clock-khz=KHZ
+//! ```
+
+use super::link::labgrid::{parse_labgrid, Place};
+use super::link::rfc2217::parse_rfc2217;
+use super::link::serial::parse_spec;
+use super::link::tcp::parse_tcp;
+use crate::protocol::{Straps, StrapsError};
+use std::fmt;
+use std::str::FromStr;
+
+/// The ways a bridge is reached: the registry of address forms. Adding a
+/// link kind is a variant here (the compiler then asks for its prefix,
+/// its form, whether it crosses a network, and how [`super::open`] opens
+/// it) and its [`super::Link`] under `link/`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum LinkKind {
+    /// A serial port: USB CDC, a UART, a pseudo-terminal.
+    Serial,
+    /// A raw TCP byte stream (ser2net in raw mode, socat).
+    Tcp,
+    /// Telnet with RFC 2217 (ser2net's telnet(rfc2217), labgrid's exporter).
+    Rfc2217,
+    /// The serial port of a labgrid place the user has acquired.
+    Labgrid,
+}
+
+impl LinkKind {
+    /// Every kind, in the order the usage messages list them.
+    pub const ALL: [LinkKind; 4] = [
+        LinkKind::Serial,
+        LinkKind::Tcp,
+        LinkKind::Rfc2217,
+        LinkKind::Labgrid,
+    ];
+
+    /// What an address of this kind starts with.
+    pub fn prefix(self) -> &'static str {
+        match self {
+            LinkKind::Serial => "serial:",
+            LinkKind::Tcp => "tcp://",
+            LinkKind::Rfc2217 => "rfc2217://",
+            LinkKind::Labgrid => "labgrid:",
+        }
+    }
+
+    /// The address form, as the usage messages write it.
+    pub fn form(self) -> &'static str {
+        match self {
+            LinkKind::Serial => "serial:<path>[,baud=N]",
+            LinkKind::Tcp => "tcp://<host>:<port>",
+            LinkKind::Rfc2217 => "rfc2217://<host>:<port>[,baud=N]",
+            LinkKind::Labgrid => "labgrid:<place>",
+        }
+    }
+
+    /// The reply padding asked for when a spec gives none (`pad=`). A
+    /// serial server on the way (ser2net, labgrid's exporter) holds a
+    /// partly filled 64-byte buffer for a millisecond or more; a reply
+    /// padded to fill it goes at once (`docs/bridge-protocol.md`, LINK).
+    /// On a serial port the padding would only cost time.
+    pub fn default_pad(self) -> u16 {
+        match self {
+            LinkKind::Serial => 0,
+            LinkKind::Tcp | LinkKind::Rfc2217 | LinkKind::Labgrid => 64,
+        }
+    }
+}
+
+/// Where a target's chip is, as its backend takes it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Address {
+    /// The reference emulator, in process.
+    Emu,
+    Serial {
+        path: String,
+        baud: u32,
+    },
+    /// `host:port`.
+    Tcp(String),
+    Rfc2217 {
+        addr: String,
+        baud: u32,
+    },
+    Labgrid(Place),
+}
+
+impl Address {
+    /// The link a bridge at this address is reached over; `None` for the
+    /// emulator.
+    pub fn kind(&self) -> Option<LinkKind> {
+        match self {
+            Address::Emu => None,
+            Address::Serial { .. } => Some(LinkKind::Serial),
+            Address::Tcp(_) => Some(LinkKind::Tcp),
+            Address::Rfc2217 { .. } => Some(LinkKind::Rfc2217),
+            Address::Labgrid(_) => Some(LinkKind::Labgrid),
+        }
+    }
+}
+
+/// A target spec or strap option that does not read: the user's typing,
+/// said in words that name the form to write.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SpecError(pub String);
+
+impl fmt::Display for SpecError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for SpecError {}
+
+impl From<SpecError> for String {
+    fn from(e: SpecError) -> String {
+        e.0
+    }
+}
+
+/// Strap options given by the user: on the command line (for every
+/// board) or in a spec (for that board). On the emulator they are the
+/// straps (the defaults filling in); on a board the bridge reports them,
+/// and those given must agree.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StrapOptions {
+    /// System clock in MHz (`clock-mhz=`, `--clock-mhz`).
+    pub clock_mhz: Option<f64>,
+    /// CSEL strap high (`csel=high`).
+    pub csel_high: Option<bool>,
+    /// VSEL strap high (`vsel=high`).
+    pub vsel_high: Option<bool>,
+    /// Frequency on the CLOCK pin in kHz (`ext-clock-khz=`).
+    pub ext_clock_khz: Option<f64>,
+}
+
+/// `value` Hz (the flag's `shown` value) as a whole number of hertz.
+fn hz(value: f64, flag: &str, shown: f64) -> Result<u32, SpecError> {
+    let v = value.round();
+    if v.is_finite() && v >= 1.0 && v <= f64::from(u32::MAX) {
+        Ok(v as u32)
+    } else {
+        Err(SpecError(format!(
+            "{flag} {shown} is not a usable frequency"
+        )))
+    }
+}
+
+impl StrapOptions {
+    /// These options, with `under`'s where these give none.
+    pub fn over(self, under: StrapOptions) -> StrapOptions {
+        StrapOptions {
+            clock_mhz: self.clock_mhz.or(under.clock_mhz),
+            csel_high: self.csel_high.or(under.csel_high),
+            vsel_high: self.vsel_high.or(under.vsel_high),
+            ext_clock_khz: self.ext_clock_khz.or(under.ext_clock_khz),
+        }
+    }
+
+    /// The straps: those given, the emulator's defaults for the rest.
+    pub fn straps(&self) -> Result<Straps, SpecError> {
+        let d = Straps::default();
+        let straps = Straps {
+            sysclk_hz: match self.clock_mhz {
+                Some(mhz) => hz(mhz * 1e6, "--clock-mhz", mhz)?,
+                None => d.sysclk_hz,
+            },
+            csel_high: self.csel_high.unwrap_or(d.csel_high),
+            vsel_high: self.vsel_high.unwrap_or(d.vsel_high),
+            ext_clock_hz: self
+                .ext_clock_khz
+                .map(|k| hz(k * 1e3, "--ext-clock-khz", k))
+                .transpose()?,
+        };
+        straps.validate().map_err(|e| {
+            SpecError(match e {
+                StrapsError::SysClk(_) => format!(
+                    "--clock-mhz {}: the system clock must be 1 to 40 MHz",
+                    self.clock_mhz.unwrap_or(16.0)
+                ),
+                StrapsError::ExtClock { max, .. } => format!(
+                    "--ext-clock-khz {}: the external clock must be 1 kHz to SysClk/16 ({} kHz here)",
+                    self.ext_clock_khz.unwrap_or(0.0),
+                    f64::from(max) / 1e3
+                ),
+            })
+        })?;
+        Ok(straps)
+    }
+
+    /// The straps given that disagree with `reported` (what a bridge says
+    /// its chip is strapped to), each as `--flag: the bridge reports X,
+    /// given Y`.
+    pub fn disagreements(&self, reported: &Straps) -> Result<Vec<String>, SpecError> {
+        let given = self.straps()?;
+        let mhz = |hz: u32| (f64::from(hz) / 1e6).to_string();
+        let level = |high| if high { "high" } else { "low" }.to_string();
+        let khz =
+            |h: Option<u32>| h.map_or("none".to_string(), |h| (f64::from(h) / 1e3).to_string());
+        // Each strap given: its flag, the bridge's value and the given
+        // one, as the user writes them.
+        let straps = [
+            (
+                self.clock_mhz.is_some(),
+                "--clock-mhz",
+                mhz(reported.sysclk_hz),
+                mhz(given.sysclk_hz),
+            ),
+            (
+                self.csel_high.is_some(),
+                "--csel",
+                level(reported.csel_high),
+                level(given.csel_high),
+            ),
+            (
+                self.vsel_high.is_some(),
+                "--vsel",
+                level(reported.vsel_high),
+                level(given.vsel_high),
+            ),
+            (
+                self.ext_clock_khz.is_some(),
+                "--ext-clock-khz",
+                khz(reported.ext_clock_hz),
+                khz(given.ext_clock_hz),
+            ),
+        ];
+        Ok(straps
+            .into_iter()
+            .filter(|(set, _, bridge, given)| *set && bridge != given)
+            .map(|(_, flag, bridge, given)| {
+                format!("{flag}: the bridge reports {bridge}, given {given}")
+            })
+            .collect())
+    }
+}
+
+/// One target: where its chip is, and the options of that board alone.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TargetSpec {
+    /// The target as its backend takes it, board options removed:
+    /// `serial:/dev/ttyACM0,baud=115200`.
+    pub address: String,
+    /// What the reports call the board (`name=`); default: the address.
+    pub name: Option<String>,
+    /// The board revision label (`rev=`).
+    pub rev: Option<String>,
+    /// Reply padding to ask the bridge for (`pad=`); default: the link
+    /// kind's ([`LinkKind::default_pad`]).
+    pub pad: Option<u16>,
+    /// The board's own strap options (`clock-mhz=`, `csel=`, ...), over
+    /// those given for every board.
+    pub straps: StrapOptions,
+}
+
+impl FromStr for TargetSpec {
+    type Err = SpecError;
+
+    fn from_str(s: &str) -> Result<TargetSpec, SpecError> {
+        TargetSpec::parse(s)
+    }
+}
+
+impl TargetSpec {
+    /// Splits `spec` into its address and the board's own options
+    /// (`name=`, `rev=`, `pad=`, `clock-mhz=`, `csel=`, `vsel=`,
+    /// `ext-clock-khz=`); other `key=value` parts (`baud=`) stay with the
+    /// address. The address itself is read by [`TargetSpec::resolve`].
+    pub fn parse(spec: &str) -> Result<TargetSpec, SpecError> {
+        let mut parts = spec.split(',');
+        let mut address = parts.next().unwrap_or_default().to_string();
+        let mut t = TargetSpec {
+            address: String::new(),
+            name: None,
+            rev: None,
+            pad: None,
+            straps: StrapOptions::default(),
+        };
+        let bad = |what: &str| SpecError(format!("--target `{spec}`: {what}"));
+        let number = |k: &str, v: &str| {
+            v.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| bad(&format!("{k}={v} is not a number")))
+        };
+        let level = |k: &str, v: &str| match v {
+            "high" => Ok(true),
+            "low" => Ok(false),
+            _ => Err(bad(&format!("{k}={v}: write high or low"))),
+        };
+        let text = |k: &str, v: &str| {
+            if v.is_empty() {
+                Err(bad(&format!("{k}= needs a value")))
+            } else {
+                Ok(v.to_string())
+            }
+        };
+        for part in parts {
+            let (k, v) = part.split_once('=').unwrap_or((part, ""));
+            match k {
+                "name" => t.name = Some(text(k, v)?),
+                "rev" => t.rev = Some(text(k, v)?),
+                "pad" => {
+                    t.pad = Some(
+                        v.parse::<u16>()
+                            .ok()
+                            .filter(|p| *p <= ppmc_core::bridge::wire::MAX_PAD)
+                            .ok_or_else(|| bad(&format!("pad={v}: give 0 to 512 bytes")))?,
+                    )
+                }
+                "clock-mhz" => t.straps.clock_mhz = Some(number(k, v)?),
+                "ext-clock-khz" => t.straps.ext_clock_khz = Some(number(k, v)?),
+                "csel" => t.straps.csel_high = Some(level(k, v)?),
+                "vsel" => t.straps.vsel_high = Some(level(k, v)?),
+                _ => {
+                    address.push(',');
+                    address.push_str(part);
+                }
+            }
+        }
+        t.address = address;
+        Ok(t)
+    }
+
+    /// Every spec of a run on several boards, parsed, with unique labels
+    /// (a second `emu` becomes `emu#2`). One bridge named twice is refused:
+    /// a bridge serves one host at a time, and two would drive one chip.
+    pub fn parse_all<S: AsRef<str>>(specs: &[S]) -> Result<Vec<TargetSpec>, SpecError> {
+        let mut out: Vec<TargetSpec> = Vec::with_capacity(specs.len());
+        // Where a bridge is, whatever the options after it.
+        let place = |s: &TargetSpec| s.address.split(',').next().unwrap_or_default().to_string();
+        for t in specs {
+            let mut spec = TargetSpec::parse(t.as_ref())?;
+            if spec.address != "emu" && out.iter().any(|s| place(s) == place(&spec)) {
+                return Err(SpecError(format!(
+                    "--target {} given twice: a bridge serves one host at a time, and two would drive one chip at once",
+                    place(&spec)
+                )));
+            }
+            let mut n = 1;
+            let base = spec.label().to_string();
+            while out.iter().any(|s| s.label() == spec.label()) {
+                n += 1;
+                spec.name = Some(format!("{base}#{n}"));
+            }
+            out.push(spec);
+        }
+        Ok(out)
+    }
+
+    /// What the reports call this board.
+    pub fn label(&self) -> &str {
+        self.name.as_deref().unwrap_or(&self.address)
+    }
+
+    /// The address read as its backend takes it; an error naming the form
+    /// to write when it does not read.
+    pub fn resolve(&self) -> Result<Address, SpecError> {
+        let a = self.address.as_str();
+        if a == "emu" {
+            return Ok(Address::Emu);
+        }
+        let Some(kind) = LinkKind::ALL
+            .into_iter()
+            .find(|k| a.starts_with(k.prefix()))
+        else {
+            let mut forms = String::from("`emu`");
+            for (i, k) in LinkKind::ALL.iter().enumerate() {
+                let last = i + 1 == LinkKind::ALL.len();
+                forms.push_str(if last { " or " } else { ", " });
+                forms.push_str(&format!("`{}`", k.form()));
+            }
+            return Err(SpecError(format!("unknown target `{a}`: use {forms}")));
+        };
+        let v6 = " (an IPv6 address in brackets: [::1])";
+        let bad = |hint: &str| SpecError(format!("bad target `{a}`: write {}{hint}", kind.form()));
+        match kind {
+            LinkKind::Serial => parse_spec(a)
+                .map(|(path, baud)| Address::Serial { path, baud })
+                .ok_or_else(|| bad("")),
+            LinkKind::Tcp => parse_tcp(a)
+                .filter(|addr| host_and_port(addr))
+                .map(Address::Tcp)
+                .ok_or_else(|| bad(v6)),
+            LinkKind::Rfc2217 => parse_rfc2217(a)
+                .filter(|(addr, _)| host_and_port(addr))
+                .map(|(addr, baud)| Address::Rfc2217 { addr, baud })
+                .ok_or_else(|| bad(v6)),
+            LinkKind::Labgrid => parse_labgrid(a)
+                .map(Address::Labgrid)
+                .ok_or_else(|| bad("")),
+        }
+    }
+}
+
+/// Whether `addr` reads as `host:port` that a connection can be tried to:
+/// a port from 1 to 65535 after a host name, an IPv4 address or an IPv6
+/// address in brackets (`[::1]:4321`). Anything else (`[::1`, `::1:4321`,
+/// a space in the name) is the user's typing, refused before any
+/// connection, never a network failure.
+fn host_and_port(addr: &str) -> bool {
+    let Some((host, port)) = addr.rsplit_once(':') else {
+        return false;
+    };
+    let port_ok = port.parse::<u16>().is_ok_and(|p| p != 0);
+    let host_ok = match host.strip_prefix('[') {
+        Some(v6) => v6
+            .strip_suffix(']')
+            .is_some_and(|v6| v6.parse::<std::net::Ipv6Addr>().is_ok()),
+        None => {
+            !host.is_empty()
+                && host
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '.' | '_'))
+        }
+    };
+    port_ok && host_ok
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn network_addresses_are_host_and_port_or_the_users_mistake() {
+        for good in [
+            "bench1.lab:4321",
+            "127.0.0.1:2001",
+            "[::1]:4321",
+            "[fe80::1]:1",
+            "rig_1:65535",
+        ] {
+            assert!(host_and_port(good), "{good}");
+        }
+        for bad in [
+            "[::1",
+            "[::1]",
+            "[::1:4321",
+            "::1:4321",
+            "[nothost]:4321",
+            "host:0",
+            "host:65536",
+            ":4321",
+            "host name:4321",
+            "host",
+        ] {
+            assert!(!host_and_port(bad), "{bad}");
+        }
+        let spec = |t: &str| TargetSpec::parse(t).expect("splits");
+        for t in ["tcp://[::1", "tcp://[::1:4321", "rfc2217://[::1,baud=9600"] {
+            let e = spec(t).resolve().expect_err("refused").0;
+            assert!(e.contains("an IPv6 address in brackets"), "{t}: {e}");
+        }
+        assert_eq!(
+            spec("tcp://[::1]:4321").resolve(),
+            Ok(Address::Tcp("[::1]:4321".into()))
+        );
+        assert!(matches!(
+            spec("rfc2217://[::1]:4321,baud=9600").resolve(),
+            Ok(Address::Rfc2217 { baud: 9600, .. })
+        ));
+    }
+
+    #[test]
+    fn every_link_kind_is_in_the_usage_message_and_resolves_to_itself() {
+        let e = TargetSpec::parse("usb:0")
+            .expect("reads")
+            .resolve()
+            .expect_err("refused")
+            .0;
+        assert_eq!(
+            e,
+            "unknown target `usb:0`: use `emu`, `serial:<path>[,baud=N]`, `tcp://<host>:<port>`, `rfc2217://<host>:<port>[,baud=N]` or `labgrid:<place>`"
+        );
+        for (text, kind) in [
+            ("serial:/dev/ttyACM0", LinkKind::Serial),
+            ("tcp://bench1:4321", LinkKind::Tcp),
+            ("rfc2217://bench1:4321", LinkKind::Rfc2217),
+            ("labgrid:rig-3", LinkKind::Labgrid),
+        ] {
+            let a = TargetSpec::parse(text)
+                .expect("reads")
+                .resolve()
+                .expect("reads");
+            assert_eq!(a.kind(), Some(kind), "{text}");
+            assert!(text.starts_with(kind.prefix()));
+        }
+        assert_eq!(
+            TargetSpec::parse("emu").expect("reads").resolve(),
+            Ok(Address::Emu)
+        );
+    }
+
+    #[test]
+    fn board_options_leave_the_address_and_labels_are_unique() {
+        let s: TargetSpec = "serial:/dev/ttyACM0,baud=9600,name=b1,rev=B,pad=32,csel=low"
+            .parse()
+            .expect("reads");
+        assert_eq!(s.address, "serial:/dev/ttyACM0,baud=9600");
+        assert_eq!(
+            (s.label(), s.rev.as_deref(), s.pad),
+            ("b1", Some("B"), Some(32))
+        );
+        assert_eq!(s.straps.csel_high, Some(false));
+        let all = TargetSpec::parse_all(&["emu", "emu", "emu,name=emu#2"]).expect("reads");
+        let labels: Vec<&str> = all.iter().map(TargetSpec::label).collect();
+        assert_eq!(labels, ["emu", "emu#2", "emu#2#2"]);
+        let twice = TargetSpec::parse_all(&["tcp://a:1", "tcp://a:1,name=x"]).expect_err("refused");
+        assert!(twice.0.contains("given twice"), "{twice}");
+    }
+}
