@@ -66,7 +66,9 @@ fn named_paths(text: &str) -> Vec<String> {
     text.split('`')
         .skip(1)
         .step_by(2)
-        .filter(|w| !w.contains(' ') && !w.contains("::") && !w.contains("://") && !w.starts_with('-'))
+        .filter(|w| {
+            !w.contains(' ') && !w.contains("::") && !w.contains("://") && !w.starts_with('-')
+        })
         .filter(|w| {
             w.contains('/')
                 || [".rs", ".md", ".toml", ".json", ".sh", ".py"]

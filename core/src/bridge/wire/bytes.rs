@@ -1,7 +1,11 @@
 //! Little-endian writing and checked reading of message fields, with
 //! times converted to and from the bridge timer's ticks.
 
-use super::*;
+use super::message::*;
+use crate::protocol::{Direction, Input};
+use crate::time::{Duration, Instant};
+use alloc::string::String;
+use alloc::vec::Vec;
 
 /// Converts between nanoseconds and ticks of a timer running at `hz`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,7 +1,10 @@
 //! Capture records on the wire: pulse runs, pin changes and move starts.
 
 use super::bytes::{R, W};
-use super::*;
+use super::message::*;
+use crate::protocol::capture::MoveStart;
+use crate::protocol::{MoveKind, Pin, PinEvent, PulseRun, Winding};
+use crate::time::Duration;
 
 pub(super) fn pin_code(p: Pin) -> u8 {
     Pin::ALL.iter().position(|x| *x == p).unwrap_or(0) as u8

@@ -12,10 +12,15 @@
 //! into its SAMPLES entry on the fly: the same bytes as
 //! [`Response::encode`], in memory bounded by [`MAX_REPLY`].
 
-use super::bytes::{R, W};
+use super::bytes::{Timer, R, W};
 use super::capture::{put_capture, RUN_BYTES};
+use super::message::*;
 use super::ops::{get_op, op, put_pins, put_reply, rep, SAMPLES_HEAD, SAMPLES_RUN};
-use super::*;
+use crate::bus::{Op, Reply};
+use crate::protocol::Pins;
+use crate::time::{Duration, Instant};
+use alloc::vec;
+use alloc::vec::Vec;
 
 /// One op of a batch as it travels: a plain op, or a SAMPLE op that stands
 /// for `pairs` `(ReadPins, Delay(step))` pairs.
@@ -331,6 +336,7 @@ pub fn capture_bytes(c: &CaptureChunk, timer: Timer) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::protocol::{Direction, Status};
     use proptest::prelude::*;
 
     fn pins(b: u8) -> Pins {

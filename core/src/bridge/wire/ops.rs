@@ -2,8 +2,12 @@
 //! entries, SAMPLE ops and their run-length SAMPLES replies, and the
 //! worst-case sizes a host packs requests by.
 
-use super::bytes::{R, W};
-use super::*;
+use super::bytes::{Timer, R, W};
+use super::message::*;
+use crate::bus::{Op, Reply};
+use crate::protocol::{Direction, Pins, PulseSummary, Status};
+use crate::time::Instant;
+use alloc::vec::Vec;
 
 /// Op codes inside a batch.
 pub(super) mod op {
@@ -39,9 +43,6 @@ pub(super) mod rep {
     pub const RESET_DONE: u8 = 0x0E;
     pub const SAMPLES: u8 = 0x0F;
 }
-
-/// Most pin samples one SAMPLE op (or one SAMPLES reply entry) stands for.
-pub const MAX_SAMPLES: usize = 512;
 
 /// The largest reply entry of a plain op on the wire (PULSES).
 pub const MAX_REPLY_ENTRY: usize = 73;

@@ -41,7 +41,7 @@ pub struct SerialOptions {
     /// 0 for none.
     pub pad: u16,
     /// Asked for, every wait on the link ends within [`Stop::SLICE`] with
-    /// [`SerialError::Interrupted`].
+    /// [`SerialError::Interrupted`](super::SerialError::Interrupted).
     pub stop: Stop,
 }
 
