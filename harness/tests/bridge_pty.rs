@@ -5,7 +5,7 @@ mod common;
 
 use ppmc::backend::{EmuTarget, SerialError, SerialLink, SerialOptions, SerialTarget};
 use ppmc::bridge::sim::{LinkFaults, PtyBridge};
-use ppmc::emu::{BoardFaults, ModelConfig};
+use ppmc::emu::{WiringFaults, ModelConfig};
 use ppmc::protocol::Straps;
 use ppmc::runner::run_suite;
 use ppmc::scenario::{DriverOptions, ScenarioResult, Verdict};
@@ -177,9 +177,9 @@ fn an_unhealthy_board_is_refused_at_open() {
     let sim = Sim::start(
         LinkFaults::default(),
         ModelConfig {
-            board: BoardFaults {
+            board: WiringFaults {
                 status_stuck_high: 0x08,
-                ..BoardFaults::default()
+                ..WiringFaults::default()
             },
             ..ModelConfig::default()
         },

@@ -21,16 +21,16 @@ fn replay(target: &str, body: fn(&[u8])) -> usize {
 /// on one whose outputs are miswired (the board keeps a record of its own).
 #[test]
 fn a_reset_checker_runs_as_a_fresh_one() {
-    use ppmc::emu::{BoardFaults, ModelConfig};
+    use ppmc::emu::{WiringFaults, ModelConfig};
     use ppmc::fuzzing::{bus, oracle::Checker};
     let inputs = common::fuzz_inputs("bus_bytes");
     assert!(inputs.len() > 50, "the corpus is there");
     for cfg in [
         ModelConfig::default(),
         ModelConfig {
-            board: BoardFaults {
+            board: WiringFaults {
                 dir_inverted: true,
-                ..BoardFaults::default()
+                ..WiringFaults::default()
             },
             ..ModelConfig::default()
         },

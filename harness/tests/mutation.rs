@@ -5,7 +5,7 @@
 
 use ppmc::backend::EmuTarget;
 use ppmc::compare::{compare, Tolerances};
-use ppmc::emu::{BoardFaults, Faults, ModelConfig};
+use ppmc::emu::{ModelConfig, ModelFaults, WiringFaults};
 use ppmc::protocol::{ErrorCode, Straps};
 use ppmc::runner::run_suite;
 use ppmc::scenario::{DriverOptions, Failure, ScenarioResult, Verdict};
@@ -92,9 +92,9 @@ fn mutants() -> Vec<(String, ModelConfig)> {
     v.push((
         "last pulse dropped".into(),
         ModelConfig {
-            faults: Faults {
+            faults: ModelFaults {
                 drop_last_pulse: true,
-                ..Faults::default()
+                ..ModelFaults::default()
             },
             ..ModelConfig::default()
         },
@@ -102,9 +102,9 @@ fn mutants() -> Vec<(String, ModelConfig)> {
     v.push((
         "status bit 3 stuck high".into(),
         ModelConfig {
-            board: BoardFaults {
+            board: WiringFaults {
                 status_stuck_high: 0x08,
-                ..BoardFaults::default()
+                ..WiringFaults::default()
             },
             ..ModelConfig::default()
         },
@@ -114,9 +114,9 @@ fn mutants() -> Vec<(String, ModelConfig)> {
         v.push((
             format!("error {} reported as {}", e.number(), other.number()),
             ModelConfig {
-                board: BoardFaults {
+                board: WiringFaults {
                     swap_error: Some((e, other)),
-                    ..BoardFaults::default()
+                    ..WiringFaults::default()
                 },
                 ..ModelConfig::default()
             },
@@ -212,9 +212,9 @@ fn latency_five_percent_off_fails_its_scenario_with_the_divergence() {
 #[test]
 fn a_dropped_pulse_fails_with_the_pulse_count() {
     let cfg = ModelConfig {
-        faults: Faults {
+        faults: ModelFaults {
             drop_last_pulse: true,
-            ..Faults::default()
+            ..ModelFaults::default()
         },
         ..ModelConfig::default()
     };
@@ -230,9 +230,9 @@ fn a_dropped_pulse_fails_with_the_pulse_count() {
 #[test]
 fn a_different_error_code_fails_with_expected_and_got() {
     let cfg = ModelConfig {
-        board: BoardFaults {
+        board: WiringFaults {
             swap_error: Some((ErrorCode::TooManyParameters, ErrorCode::AccelPulsesTooMany)),
-            ..BoardFaults::default()
+            ..WiringFaults::default()
         },
         ..ModelConfig::default()
     };

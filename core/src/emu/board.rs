@@ -15,7 +15,7 @@ use crate::time::Instant;
 /// register read (by the host, and by a bridge waiting on a flag), and its
 /// pin wiring, seen by the chip (inputs) or by whatever captures its outputs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct BoardFaults {
+pub struct WiringFaults {
     /// Status register bits that read 1 whatever the chip says (a data bus
     /// line stuck high).
     pub status_stuck_high: u8,
@@ -34,7 +34,7 @@ pub struct BoardFaults {
     pub auxo_reversed: bool,
 }
 
-impl BoardFaults {
+impl WiringFaults {
     /// The status byte as the host reads it through this board.
     pub fn status(&self, s: Status) -> Status {
         let mut b = s.0;
@@ -101,13 +101,13 @@ impl BoardFaults {
 }
 
 /// The reference model as a host reaches it through a board with the
-/// [`BoardFaults`] of [`ModelConfig::board`]: every status read, every input
+/// [`WiringFaults`] of [`ModelConfig::board`]: every status read, every input
 /// and every output passes the board. The chip's own state is
 /// [`Board::chip`].
 #[derive(Debug, Clone)]
 pub struct Board {
     chip: Chip,
-    faults: BoardFaults,
+    faults: WiringFaults,
     /// The chip's record as seen at the connector, kept only when an output
     /// line is miswired (the chip's own record is the board's otherwise).
     seen: Option<Seen>,
@@ -124,7 +124,7 @@ struct Seen {
 }
 
 impl Seen {
-    fn take_in(&mut self, chip: &Record, f: &BoardFaults) {
+    fn take_in(&mut self, chip: &Record, f: &WiringFaults) {
         // The last run taken in may have grown since.
         let from = self.runs.saturating_sub(1);
         self.record.runs.truncate(from);
@@ -300,24 +300,24 @@ mod tests {
             false,
             StatusField::Error(ErrorCode::NotInitialized),
         );
-        let bus = BoardFaults {
+        let bus = WiringFaults {
             status_stuck_high: 0x08,
             swap_error: Some((ErrorCode::NotInitialized, ErrorCode::TooManyParameters)),
-            ..BoardFaults::default()
+            ..WiringFaults::default()
         };
         // Diagram 3-1: error flag bit 7, number in bits 6-4; bit 3 stuck.
         assert_eq!(bus.status(error2).0, 0x80 | 3 << 4 | 0x08);
         let idle = Status::new(false, false, false, StatusField::ParamsRemaining(0));
         assert_eq!(bus.status(idle).0, 0x08);
-        assert_eq!(BoardFaults::default().status(error2), error2);
+        assert_eq!(WiringFaults::default().status(error2), error2);
     }
 
-    fn miswired() -> BoardFaults {
-        BoardFaults {
+    fn miswired() -> WiringFaults {
+        WiringFaults {
             dir_inverted: true,
             hold_stuck_off: true,
             auxo_reversed: true,
-            ..BoardFaults::default()
+            ..WiringFaults::default()
         }
     }
 
@@ -384,9 +384,9 @@ mod tests {
         let mut inputs_cut = InputSet::default();
         inputs_cut.set(Input::Alm, true);
         let cfg = ModelConfig {
-            board: BoardFaults {
+            board: WiringFaults {
                 inputs_cut,
-                ..BoardFaults::default()
+                ..WiringFaults::default()
             },
             ..ModelConfig::default()
         };

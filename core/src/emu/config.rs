@@ -6,8 +6,8 @@
 //! it gives a range; `docs/datasheet-notes.md` says where each default comes
 //! from.
 
-use super::board::BoardFaults;
-use super::hooks::Faults;
+use super::board::WiringFaults;
+use super::hooks::ModelFaults;
 use crate::protocol::timing::{figure, Figure, TimingId, TimingRow, TABLE_3_3};
 use crate::time::Duration;
 
@@ -86,10 +86,10 @@ pub struct ModelConfig {
     /// Shape of the acceleration ramp.
     pub accel_curve: AccelCurve,
     /// Deliberate faults inside the model; none by default.
-    pub faults: Faults,
+    pub faults: ModelFaults,
     /// Deliberate faults on the board's data bus, applied around the model
     /// by [`super::Board`]; none by default.
-    pub board: BoardFaults,
+    pub board: WiringFaults,
 }
 
 impl Default for ModelConfig {
@@ -146,8 +146,8 @@ impl ModelConfig {
             aux_output: t(AuxOn, Typ)?,
             excitation_off: t(ExcitationOff, Typ)?,
             accel_curve: AccelCurve::LinearSpeed,
-            faults: Faults::default(),
-            board: BoardFaults::default(),
+            faults: ModelFaults::default(),
+            board: WiringFaults::default(),
         })
     }
 }

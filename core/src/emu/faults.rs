@@ -6,6 +6,15 @@
 //! NAME`, `ppmc fault-matrix` and the QEMU bridge firmware's virtual chip
 //! (`firmware/run-qemu --chip-fault NAME`) use those names. `docs/detection.md` shows
 //! which check catches which.
+//!
+//! A [`NamedFault`] is one of three kinds, by where it acts:
+//! - a **timing** fault, most of them: a latency of
+//!   [`ModelConfig`] moved out of its Table 3-3 band;
+//! - a **wiring** fault of the board around the chip
+//!   ([`super::WiringFaults`]: a data bus line, an input wire, an output
+//!   line), outside the model;
+//! - a **model** fault ([`super::ModelFaults`], the hooks): the chip's
+//!   firmware deciding wrongly, which needs the model's insides.
 
 use crate::emu::ModelConfig;
 use crate::protocol::timing::{figure, Figure, TimingId, TABLE_3_3};
@@ -16,7 +25,7 @@ use alloc::vec::Vec;
 
 /// One named fault of the catalogue.
 #[derive(Debug, Clone, Copy)]
-pub struct BoardFault {
+pub struct NamedFault {
     /// Stable name, as given to `--chip-fault`.
     pub name: &'static str,
     /// What the faulty board does, in a user's words.
@@ -26,7 +35,7 @@ pub struct BoardFault {
     apply: fn(&mut ModelConfig),
 }
 
-impl BoardFault {
+impl NamedFault {
     /// Puts the fault into a model configuration.
     pub fn apply(&self, cfg: &mut ModelConfig) {
         (self.apply)(cfg)
@@ -47,7 +56,7 @@ fn pct(d: Duration, percent: u64) -> Duration {
 
 macro_rules! fault {
     ($name:literal, $section:literal, $what:literal, |$c:ident| $body:expr) => {
-        BoardFault {
+        NamedFault {
             name: $name,
             what: $what,
             section: $section,
@@ -57,7 +66,7 @@ macro_rules! fault {
 }
 
 /// Every named board fault.
-pub const CATALOGUE: &[BoardFault] = &[
+pub const CATALOGUE: &[NamedFault] = &[
     fault!(
         "busy-rise-early",
         "Table 3-3",
@@ -230,7 +239,7 @@ pub const CATALOGUE: &[BoardFault] = &[
 ];
 
 /// The catalogue entry called `name`.
-pub fn find(name: &str) -> Option<&'static BoardFault> {
+pub fn find(name: &str) -> Option<&'static NamedFault> {
     CATALOGUE.iter().find(|f| f.name == name)
 }
 

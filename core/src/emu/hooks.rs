@@ -1,19 +1,19 @@
 //! Deliberate faults inside the reference model, for checking that the
 //! suite, the golden comparison and the fuzzers catch a bad board. A clean
-//! chip has none ([`Faults::default`]). The named catalogue that sets them
+//! chip has none ([`ModelFaults::default`]). The named catalogue that sets them
 //! is [`crate::emu::faults`] (the harness re-exports it as `ppmc::faults`,
 //! and the QEMU board's virtual chip takes the same names).
 //!
 //! Only faults that need the model's insides are here: its firmware's
 //! decisions (what a register read clears, what the mask gates, how a stop
 //! decelerates) and which pulse of a move is its last. Faults of the board's
-//! wiring, which the model need not know, are [`super::BoardFaults`].
+//! wiring, which the model need not know, are [`super::WiringFaults`].
 
 /// Behaviour switches the model consults. Timing faults need none: they
 /// are latencies moved out of their Table 3-3 band in
 /// [`super::ModelConfig`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Faults {
+pub struct ModelFaults {
     /// The last pulse of every move is lost on the POUT wire (the chip
     /// counts it as output).
     pub drop_last_pulse: bool,

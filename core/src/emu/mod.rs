@@ -8,7 +8,7 @@ pub mod faults;
 pub mod hooks;
 mod motion;
 
-pub use board::{Board, BoardFaults};
+pub use board::{Board, WiringFaults};
 pub use chip::{Chip, ChipError, PA_MAX, PA_MIN};
 pub use config::{AccelCurve, ConfigError, ModelConfig};
-pub use hooks::Faults;
+pub use hooks::ModelFaults;

@@ -282,7 +282,7 @@ mod tests {
     use super::*;
     use crate::backend::EmuTarget;
     use crate::console;
-    use crate::emu::BoardFaults;
+    use crate::emu::WiringFaults;
     use crate::protocol::Straps;
     use crate::time::Duration;
     use bus::BusOp::*;
@@ -333,9 +333,9 @@ mod tests {
     fn a_reproducer_names_the_break_and_marks_its_op() {
         let data = bus::encode(&sample());
         let cfg = ModelConfig {
-            board: BoardFaults {
+            board: WiringFaults {
                 status_stuck_high: 0x08,
-                ..BoardFaults::default()
+                ..WiringFaults::default()
             },
             ..ModelConfig::default()
         };

@@ -816,7 +816,7 @@ fn record_breaks(rec: &Record) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emu::{BoardFaults, Chip};
+    use crate::emu::{WiringFaults, Chip};
     use crate::fuzzing::bus::BusOp::*;
     use crate::time::Duration;
 
@@ -871,9 +871,9 @@ mod tests {
     #[test]
     fn a_stuck_status_bit_is_caught() {
         let cfg = ModelConfig {
-            board: BoardFaults {
+            board: WiringFaults {
                 status_stuck_high: 0x08,
-                ..BoardFaults::default()
+                ..WiringFaults::default()
             },
             ..ModelConfig::default()
         };
@@ -886,9 +886,9 @@ mod tests {
     #[test]
     fn parameter_counts_beyond_four_are_caught() {
         let cfg = ModelConfig {
-            board: BoardFaults {
+            board: WiringFaults {
                 status_stuck_high: 0x50,
-                ..BoardFaults::default()
+                ..WiringFaults::default()
             },
             ..ModelConfig::default()
         };
