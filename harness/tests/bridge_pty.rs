@@ -5,7 +5,7 @@ mod common;
 
 use ppmc::backend::{EmuTarget, SerialError, SerialLink, SerialOptions, SerialTarget};
 use ppmc::bridge::sim::{LinkFaults, PtyBridge};
-use ppmc::emu::{WiringFaults, ModelConfig};
+use ppmc::emu::{ModelConfig, WiringFaults};
 use ppmc::protocol::Straps;
 use ppmc::runner::run_suite;
 use ppmc::scenario::{DriverOptions, ScenarioResult, Verdict};

@@ -21,7 +21,7 @@ fn replay(target: &str, body: fn(&[u8])) -> usize {
 /// on one whose outputs are miswired (the board keeps a record of its own).
 #[test]
 fn a_reset_checker_runs_as_a_fresh_one() {
-    use ppmc::emu::{WiringFaults, ModelConfig};
+    use ppmc::emu::{ModelConfig, WiringFaults};
     use ppmc::fuzzing::{bus, oracle::Checker};
     let inputs = common::fuzz_inputs("bus_bytes");
     assert!(inputs.len() > 50, "the corpus is there");

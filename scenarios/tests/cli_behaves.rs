@@ -138,3 +138,42 @@ fn verdicts_are_coloured_only_when_asked() {
         text(&coloured.stdout)
     );
 }
+
+/// Issue 29: `bridge-sim --help` listed the client's options (`--target`,
+/// `--link-timeout`, `--link-retries`), which mean nothing to a server.
+/// It takes the chip's straps and ramp only; the commands that drive a
+/// target take all of them.
+#[test]
+fn bridge_sim_takes_the_chips_options_and_no_clients() {
+    let help = |cmd: &str| {
+        let out = ppmc(&[cmd, "--help"]);
+        assert!(out.status.success(), "{cmd} --help");
+        text(&out.stdout)
+    };
+    let sim = help("bridge-sim");
+    for client in ["--target", "--link-timeout", "--link-retries"] {
+        let listed = sim.lines().any(|l| l.trim_start().starts_with(client));
+        assert!(!listed, "bridge-sim --help lists {client}");
+    }
+    for chip in [
+        "--clock-mhz",
+        "--csel",
+        "--vsel",
+        "--ext-clock-khz",
+        "--accel-curve",
+    ] {
+        assert!(sim.contains(chip), "bridge-sim --help lacks {chip}");
+    }
+    for cmd in ["run", "record", "console", "selftest"] {
+        let h = help(cmd);
+        for flag in ["--target", "--link-timeout", "--clock-mhz", "--accel-curve"] {
+            assert!(h.contains(flag), "{cmd} --help lacks {flag}");
+        }
+    }
+    let out = ppmc(&["bridge-sim", "--target", "emu"]);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "an unknown option is a usage error"
+    );
+}

@@ -38,7 +38,7 @@ const FILES: [&str; 12] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 22] = [
+const ELSEWHERE: [(&str, &str); 27] = [
     (
         "timeout -s INT 5 ppmc run",
         "in scenarios/tests/cli_signals.rs (timeout -s INT during the long move on a real-time bridge, ten times)",
@@ -54,6 +54,17 @@ const ELSEWHERE: [(&str, &str); 22] = [
     (
         "labgrid-client",
         "in scenarios/tests/labgrid/place.sh (against a local coordinator)",
+    ),
+    (
+        "unshare -rn bash",
+        "in scenarios/tests/cli_labgrid.rs, which runs scenarios/tests/labgrid/place.sh so (unshare -n, as root)",
+    ),
+    ("ip link set lo up", "in scenarios/tests/labgrid/place.sh"),
+    ("ip addr add", "in scenarios/tests/labgrid/place.sh"),
+    ("labgrid-coordinator", "in scenarios/tests/labgrid/place.sh"),
+    (
+        "labgrid-exporter -c 127.0.0.1",
+        "in scenarios/tests/labgrid/place.sh",
     ),
     (
         "labgrid-exporter",

@@ -30,6 +30,28 @@ pub struct TargetArgs {
     /// them.
     #[arg(long = "target", value_name = "TARGET", default_value = "emu")]
     targets: Vec<String>,
+    #[command(flatten)]
+    chip: ChipArgs,
+    /// On a board: how long to wait at most for a reply (beyond the time
+    /// the batch's own waits take), e.g. 1s, 250ms. The host waits less on
+    /// a link it has measured to be fast, and backs off up to this.
+    #[arg(long, value_name = "DURATION", default_value = "1s", value_parser = parse_duration)]
+    link_timeout: Duration,
+    /// On a board: attempts in a row that hear nothing before a request is
+    /// given up as a link error (ten times as many that hear only garbage:
+    /// a noisy line is alive).
+    #[arg(long, value_name = "N", default_value_t = 10)]
+    link_retries: u32,
+    /// Asked for (a signal), opening a target and every wait on its link
+    /// end early.
+    #[arg(skip)]
+    pub(super) stop: Stop,
+}
+
+/// The chip itself: how its board is strapped, and the emulator's ramp.
+/// On a board, the bridge reports the straps and those given must agree.
+#[derive(Debug, Args)]
+pub struct ChipArgs {
     /// System clock in MHz, 1 to 40 (fractions allowed, e.g. 12.288).
     /// Default: 16 on the emulator; on a board, what its bridge reports
     /// (given, it must agree).
@@ -48,23 +70,38 @@ pub struct TargetArgs {
     /// emulator; on a board, the bridge's.
     #[arg(long, value_name = "KHZ")]
     ext_clock_khz: Option<f64>,
-    /// On a board: how long to wait at most for a reply (beyond the time
-    /// the batch's own waits take), e.g. 1s, 250ms. The host waits less on
-    /// a link it has measured to be fast, and backs off up to this.
-    #[arg(long, value_name = "DURATION", default_value = "1s", value_parser = parse_duration)]
-    link_timeout: Duration,
-    /// On a board: attempts in a row that hear nothing before a request is
-    /// given up as a link error (ten times as many that hear only garbage:
-    /// a noisy line is alive).
-    #[arg(long, value_name = "N", default_value_t = 10)]
-    link_retries: u32,
     /// Shape of the acceleration ramp (the datasheet's chapter 1 is not available).
     #[arg(long, value_enum, default_value_t = Curve::LinearSpeed)]
     accel_curve: Curve,
-    /// Asked for (a signal), opening a target and every wait on its link
-    /// end early.
-    #[arg(skip)]
-    pub(super) stop: Stop,
+}
+
+impl ChipArgs {
+    /// The strap options given.
+    fn strap_options(&self) -> StrapOptions {
+        let level = |l: Option<Level>| l.map(|l| l == Level::High);
+        StrapOptions {
+            clock_mhz: self.clock_mhz,
+            csel_high: level(self.csel),
+            vsel_high: level(self.vsel),
+            ext_clock_khz: self.ext_clock_khz,
+        }
+    }
+
+    /// The straps given, the emulator's defaults for the rest.
+    pub fn straps(&self) -> Result<Straps, String> {
+        self.strap_options().straps().map_err(String::from)
+    }
+
+    /// The emulator's model: the default, with the ramp chosen.
+    pub fn model(&self) -> ModelConfig {
+        ModelConfig {
+            accel_curve: match self.accel_curve {
+                Curve::LinearSpeed => AccelCurve::LinearSpeed,
+                Curve::LinearRate => AccelCurve::LinearRate,
+            },
+            ..ModelConfig::default()
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -103,14 +140,8 @@ impl TargetArgs {
 
     /// What the flags say for every target.
     pub fn open_options(&self) -> OpenOptions {
-        let level = |l: Option<Level>| l.map(|l| l == Level::High);
         OpenOptions {
-            straps: StrapOptions {
-                clock_mhz: self.clock_mhz,
-                csel_high: level(self.csel),
-                vsel_high: level(self.vsel),
-                ext_clock_khz: self.ext_clock_khz,
-            },
+            straps: self.chip.strap_options(),
             model: self.model(),
             link_timeout: std::time::Duration::from_nanos(self.link_timeout.as_nanos()),
             link_retries: self.link_retries,
@@ -134,14 +165,9 @@ impl TargetArgs {
             .map_or_else(|| self.targets.join(" "), |s| s.address)
     }
 
+    /// The emulator's model ([`ChipArgs::model`]).
     pub fn model(&self) -> ModelConfig {
-        ModelConfig {
-            accel_curve: match self.accel_curve {
-                Curve::LinearSpeed => AccelCurve::LinearSpeed,
-                Curve::LinearRate => AccelCurve::LinearRate,
-            },
-            ..ModelConfig::default()
-        }
+        self.chip.model()
     }
 
     /// Opens the single target ([`backend::open`]).

@@ -1,7 +1,7 @@
 //! `ppmc bridge-sim`: the bridge protocol on a pseudo-terminal, with the
 //! emulator behind it.
 
-use super::args::TargetArgs;
+use super::args::ChipArgs;
 use crate::backend::EmuTarget;
 use crate::cli::{usage, CliError};
 use clap::Args;
@@ -10,8 +10,10 @@ use std::path::{Path, PathBuf};
 
 #[derive(Debug, Args)]
 pub struct BridgeSimArgs {
+    /// The emulated chip behind the bridge: its straps (which HELLO
+    /// reports to the host) and its ramp.
     #[command(flatten)]
-    target: TargetArgs,
+    chip: ChipArgs,
     /// Also make PATH a symbolic link to the pty, removed on exit, SIGINT
     /// and SIGTERM. An existing PATH is replaced only when it is a stale
     /// link of an earlier bridge-sim (to a pseudo-terminal that is gone).
@@ -87,16 +89,11 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
             )));
         }
     }
-    if args.target.name() != "emu" {
-        return Err(usage(
-            "bridge-sim serves the emulator; --target must be emu",
-        ));
-    }
-    let straps = match args.target.straps() {
+    let straps = match args.chip.straps() {
         Ok(s) => s,
         Err(e) => return Err(usage(e)),
     };
-    let mut model = args.target.model();
+    let mut model = args.chip.model();
     if let Err(e) = crate::faults::apply_all(&args.chip_faults, &mut model) {
         return Err(usage(format!("--chip-fault: {e}")));
     }

@@ -816,7 +816,7 @@ fn record_breaks(rec: &Record) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emu::{WiringFaults, Chip};
+    use crate::emu::{Chip, WiringFaults};
     use crate::fuzzing::bus::BusOp::*;
     use crate::time::Duration;
 

@@ -19,6 +19,9 @@ cleanup() {
 }
 trap cleanup EXIT
 trap 'exit 143' TERM INT
+# The farm's files and logs, as docs/board-farm.md ("Try it on one
+# machine") writes them: in the folder it runs in.
+cd "$dir"
 
 # Only loopback exists here. ser2net 4 refuses to listen on a host with no
 # address but 127.0.0.1 ("Unable to find a valid name"), so loopback gets a
@@ -30,7 +33,7 @@ ip addr add 10.254.0.1/32 dev lo
 pids+=($!)
 "$ppmc" bridge-sim --link "$dir/pty2" > "$dir/bridge-sim2.log" 2>&1 &
 pids+=($!)
-labgrid-coordinator -l 127.0.0.1:20408 > "$dir/coordinator.log" 2>&1 &
+labgrid-coordinator -l 127.0.0.1:20408 > coordinator.log 2>&1 &
 pids+=($!)
 for _ in $(seq 100); do [ -L "$dir/pty" ] && [ -L "$dir/pty2" ] && break; sleep 0.1; done
 cat > "$dir/exporter.yaml" <<YAML
@@ -48,8 +51,7 @@ for _ in $(seq 150); do
     (exec 3<>/dev/tcp/127.0.0.1/20408) 2>/dev/null && break
     sleep 0.2
 done
-labgrid-exporter -c 127.0.0.1:20408 --hostname 127.0.0.1 -n bench1 "$dir/exporter.yaml" \
-    > "$dir/exporter.log" 2>&1 &
+labgrid-exporter -c 127.0.0.1:20408 --hostname 127.0.0.1 -n bench1 exporter.yaml > exporter.log 2>&1 &
 pids+=($!)
 for _ in $(seq 150); do
     [ "$(labgrid-client resources 2>/dev/null | grep -c '^bench1/bridge2\?/')" = 2 ] && break
@@ -66,7 +68,6 @@ esac
 labgrid-client -p rig1 create
 labgrid-client -p rig1 add-match 'bench1/bridge/*'
 
-cd "$dir"
 "$ppmc" run --target labgrid:rig1 > unacquired.out 2> unacquired.err
 echo "MARK unacquired-exit $?"
 
