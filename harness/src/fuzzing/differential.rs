@@ -352,7 +352,10 @@ pub fn minimize(
 }
 
 /// The reproducer: a console script of the actions, headed by how to
-/// replay it and what departed.
+/// replay it and what departed. After each action it reads the status,
+/// the output pins and the pulses of the latest move (`rs`, `pins`,
+/// `pulses`), so that the two replays print what a departure is made of
+/// (a read byte, a pin, a pulse count or interval) and their diff shows it.
 pub fn script(acts: &[Action], d: &Departure, seed: u64, target: &str) -> String {
     let mut out = String::new();
     let _ = writeln!(
@@ -371,6 +374,8 @@ pub fn script(acts: &[Action], d: &Departure, seed: u64, target: &str) -> String
             let _ = writeln!(out, "{st}");
         }
         let _ = writeln!(out, "rs");
+        let _ = writeln!(out, "pins");
+        let _ = writeln!(out, "pulses");
     }
     out
 }
@@ -465,5 +470,50 @@ mod tests {
         let text = script(&small, &d2, seed, "emu");
         assert!(text.contains(&format!("seed {seed}")));
         assert!(console::parse_script(&text).is_ok(), "{text}");
+    }
+
+    /// Issue 29: the reproducer said "diff the two", but printed no pulse
+    /// or pin, so a departure in the pulses made an empty diff. Replayed
+    /// on the clean model and on the faulty board, as the header says, its
+    /// outputs now differ where the departure is.
+    #[test]
+    fn the_reproducers_two_replays_differ_where_the_boards_do() {
+        let faulty = || faults::find("drop-last-pulse").expect("fault").model();
+        let mut t = emu(faulty());
+        let s = DiffSettings::default();
+        let (seed, acts, d) = (0..40)
+            .find_map(|seed| {
+                let acts: Vec<Action> = program(seed).take(300).collect();
+                run(&mut t, acts.iter().cloned(), &s, |_| true)
+                    .expect("runs")
+                    .map(|d| (seed, acts, d))
+            })
+            .expect("some seed of 40 finds the lost pulse");
+        let (small, d) = match minimize(&mut t, &acts, &s, 300).expect("runs") {
+            (small, Some(d2)) => (small, d2),
+            (_, None) => (acts, d),
+        };
+        let text = script(&small, &d, seed, "emu");
+        let lines = console::parse_script(&text).expect("the reproducer parses");
+        let replay = |cfg: ModelConfig| {
+            let mut out = Vec::new();
+            let opts = console::ConsoleOptions::default();
+            console::run(&mut emu(cfg), &lines, &opts, &mut out).expect("replays");
+            String::from_utf8(out).expect("text")
+        };
+        let (clean, board) = (replay(ModelConfig::default()), replay(faulty()));
+        let differ: Vec<(&str, &str)> = clean
+            .lines()
+            .zip(board.lines())
+            .filter(|(a, b)| a != b)
+            .collect();
+        assert!(
+            !differ.is_empty(),
+            "the two replays print the same:\n{clean}"
+        );
+        assert!(
+            differ.iter().any(|(a, _)| a.starts_with("pulses")),
+            "{differ:?}"
+        );
     }
 }
