@@ -1,6 +1,6 @@
 //! A bridge keeps the capture's move records itself, from the bytes it
 //! writes, the status it reads and the phase pattern it sees
-//! (`ppmc_core::bridge::moves`, docs/bridge-protocol.md section 7). Here
+//! (`ppmc_core::bridge::move_tracker`, docs/bridge-protocol.md section 7). Here
 //! the whole suite runs with the reference model's own records replaced by
 //! the tracker's: every trace must come out the same, event for event
 //! (every move's time, kind, direction, steps, winding and phase), and so
@@ -10,7 +10,7 @@
 mod common;
 
 use ppmc::backend::{Op, Reply, Target, TargetError, TargetInfo};
-use ppmc::bridge::moves::Tracked;
+use ppmc::bridge::move_tracker::Tracked;
 use ppmc::bus::{Bus, EmuBus};
 use ppmc::emu::ModelConfig;
 use ppmc::protocol::{Record, Straps};

@@ -7,11 +7,11 @@
 //! turns requests and responses into payloads and back, and [`engine`] is
 //! the bridge's request executor over any [`crate::bus::Bus`]; [`timed`]
 //! captures a bus's outputs again with a bridge timer's resolution;
-//! [`moves`] keeps a capture's move records from the bus traffic, as a
+//! [`move_tracker`] keeps a capture's move records from the bus traffic, as a
 //! bridge firmware must.
 
 pub mod engine;
 pub mod frame;
-pub mod moves;
+pub mod move_tracker;
 pub mod timed;
 pub mod wire;

@@ -20,7 +20,7 @@ use crate::{limits, timebase};
 use alloc::format;
 use alloc::string::String;
 use alloc::vec::Vec;
-use ppmc_core::bridge::moves::MoveTracker;
+use ppmc_core::bridge::move_tracker::MoveTracker;
 use ppmc_core::bridge::wire::Timer;
 use ppmc_core::bus::{Bus, Op, Reply, SelfTestPlan, SelfTestReply};
 use ppmc_core::protocol::{
