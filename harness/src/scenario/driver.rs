@@ -5,9 +5,10 @@
 //! The author API lives here; how steps are batched and judged is in
 //! [`super::queue`], the Table 3-3 measurements in [`super::measure`].
 
+use super::builders::{Init, Move};
 use super::grade::{Grade, Grading, Measurement};
-use super::queue::{fail, Check, Done, Group, Role, Step};
-use super::{HarnessError, Init, Move, Outcome, Stop};
+use super::outcome::{fail, HarnessError, Outcome, Stop};
+use super::queue::{Check, Done, Group, Role, Step};
 use crate::backend::{Op, Reply, Target};
 use crate::protocol::{
     ClockSource, Direction, ErrorCode, Flag, Input, Pins, Record, Register, Status, Straps,

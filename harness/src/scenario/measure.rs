@@ -3,8 +3,7 @@
 
 use super::driver::Driver;
 use super::grade::Grade;
-use super::queue::fail;
-use super::{Failure, HarnessError, Outcome, Stop};
+use super::outcome::{fail, Failure, HarnessError, Outcome, Stop};
 use crate::protocol::{Flag, Pin, Register, TimingId};
 use crate::time::{Duration, Instant, Limit};
 

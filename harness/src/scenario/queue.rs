@@ -6,7 +6,7 @@
 //! or on the capture as it stood where they were queued.
 
 use super::driver::Driver;
-use super::{Failure, HarnessError, Outcome, Stop};
+use super::outcome::{fail, HarnessError, Outcome, Stop};
 use crate::backend::{Op, Reply};
 use crate::protocol::{Direction, ErrorCode, Flag, Input, Pins, Record, Status, StatusField};
 use crate::time::{Duration, Instant};
@@ -119,20 +119,6 @@ pub(super) struct Group {
 
 /// Most groups the driver queues before it sends them anyway.
 const MAX_QUEUED: usize = 64;
-
-pub(super) fn fail(
-    expectation: impl Into<String>,
-    expected: impl ToString,
-    got: impl ToString,
-    at: Instant,
-) -> Stop {
-    Stop::Failed(Failure {
-        expectation: expectation.into(),
-        expected: expected.to_string(),
-        got: got.to_string(),
-        at,
-    })
-}
 
 impl Driver<'_> {
     /// Runs ops on the target; with `capture`, also fetches the capture
@@ -742,7 +728,7 @@ mod tests {
     use crate::backend::{EmuTarget, Target, TargetError, TargetErrorKind, TargetInfo};
     use crate::emu::ModelConfig;
     use crate::protocol::Straps;
-    use crate::scenario::{DriverOptions, Init, Move};
+    use crate::scenario::{DriverOptions, Failure, Init, Move};
 
     /// The emulator, counting round trips and the ops in each.
     #[derive(Debug)]
