@@ -6,13 +6,15 @@
 //! its [`ScenarioResult`]: the verdict, the graded measurements and the
 //! trace.
 
+mod batch;
 mod builders;
+mod check;
 pub mod driver;
 pub mod grade;
 mod measure;
 mod outcome;
-mod queue;
 mod run;
+mod steps;
 mod verdict;
 
 pub use builders::{Init, Move};

@@ -91,3 +91,13 @@ pub(super) fn fail(
         at,
     })
 }
+
+/// The time `t` a measurement starts from, or a scenario bug if the
+/// scenario has not done `what` that sets it.
+pub(super) fn need(what: &str, t: Option<Instant>) -> Outcome<Instant> {
+    t.ok_or_else(|| {
+        Stop::Error(HarnessError::Scenario(format!(
+            "scenario bug: measuring needs {what}, which this scenario has not done"
+        )))
+    })
+}
