@@ -10,7 +10,7 @@
 use super::batch::{Batch, Limits};
 use super::builders::{Init, Move};
 use super::check::Check;
-use super::grade::{Grade, Grading, Measurement};
+use super::grade::{Grade, Measurement};
 use super::outcome::{fail, HarnessError, Outcome, Stop};
 use super::steps::{Done, Role, Step};
 use crate::backend::{Op, Reply, Target};
@@ -21,70 +21,9 @@ use crate::protocol::{
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, Event};
 
-/// A value [`Driver::check`] compares, as a failure report shows it to a
-/// person: `true`, `42`, `0x3F` for a register byte, `120.000us`, `none`.
-pub trait Shown {
-    fn shown(&self) -> String;
-}
-
-macro_rules! shown_as_text {
-    ($($t:ty),*) => {$(
-        impl Shown for $t {
-            fn shown(&self) -> String {
-                self.to_string()
-            }
-        }
-    )*};
-}
-
-shown_as_text!(bool, u16, u32, u64, usize, i32, i64, Instant, Duration, String, &str);
-
-impl Shown for u8 {
-    fn shown(&self) -> String {
-        format!("0x{self:02X}")
-    }
-}
-
-impl<T: Shown> Shown for Option<T> {
-    fn shown(&self) -> String {
-        match self {
-            Some(v) => v.shown(),
-            None => "none".into(),
-        }
-    }
-}
-
-/// Timeouts and limits of a [`Driver`], given for the reference board
-/// (16 MHz, CSEL high): the driver stretches each for a slower board
-/// ([`Straps::stretch`]), so a scenario's limits hold at every clock the
-/// straps allow.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct DriverOptions {
-    /// Flowchart writes wait at most this long for IBF = 0.
-    pub ibf_timeout: Duration,
-    /// Flowchart reads wait at most this long for OBF = 1.
-    pub obf_timeout: Duration,
-    /// An operation command must raise BUSY within this.
-    pub busy_timeout: Duration,
-    /// [`Driver::wait_idle`] waits at most this long for BUSY = 0.
-    pub idle_timeout: Duration,
-    /// Virtual time one scenario may use before it is stopped as an error.
-    pub budget: Duration,
-    pub grading: Grading,
-}
-
-impl Default for DriverOptions {
-    fn default() -> Self {
-        DriverOptions {
-            ibf_timeout: Duration::from_secs(1),
-            obf_timeout: Duration::from_millis(100),
-            busy_timeout: Duration::from_millis(5),
-            idle_timeout: Duration::from_secs(60),
-            budget: Duration::from_secs(120),
-            grading: Grading::default(),
-        }
-    }
-}
+// Defined beside the driver, and public here as they always were.
+pub use super::options::DriverOptions;
+pub use super::outcome::Shown;
 
 /// Drives one scenario on a target and records what it saw.
 pub struct Driver<'t> {

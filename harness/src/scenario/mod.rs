@@ -12,14 +12,16 @@ mod check;
 pub mod driver;
 pub mod grade;
 mod measure;
+mod options;
 mod outcome;
 mod run;
 mod steps;
 mod verdict;
 
 pub use builders::{Init, Move};
-pub use driver::{Driver, DriverOptions};
+pub use driver::Driver;
 pub use grade::{Grade, Grading, Measurement};
+pub use options::DriverOptions;
 pub use outcome::{Failure, HarnessError, Outcome, Stop};
 /// Declares a scenario where it is written; see the `ppmc-macros` crate.
 pub use ppmc_macros::scenario;

@@ -1,5 +1,6 @@
 //! What a scenario body returns and why it stops: [`Outcome`], [`Stop`],
-//! the device's [`Failure`] and the harness's [`HarnessError`].
+//! the device's [`Failure`] (with [`Shown`], how a value appears in one)
+//! and the harness's [`HarnessError`].
 
 use crate::backend::{TargetError, TargetErrorKind};
 use crate::time::{Duration, Instant};
@@ -74,6 +75,40 @@ impl fmt::Display for Failure {
             "at {}: {}: expected {}, got {}",
             self.at, self.expectation, self.expected, self.got
         )
+    }
+}
+
+/// A value [`Driver::check`](super::driver::Driver::check) compares, as a
+/// failure report shows it to a person: `true`, `42`, `0x3F` for a
+/// register byte, `120.000us`, `none`.
+pub trait Shown {
+    fn shown(&self) -> String;
+}
+
+macro_rules! shown_as_text {
+    ($($t:ty),*) => {$(
+        impl Shown for $t {
+            fn shown(&self) -> String {
+                self.to_string()
+            }
+        }
+    )*};
+}
+
+shown_as_text!(bool, u16, u32, u64, usize, i32, i64, Instant, Duration, String, &str);
+
+impl Shown for u8 {
+    fn shown(&self) -> String {
+        format!("0x{self:02X}")
+    }
+}
+
+impl<T: Shown> Shown for Option<T> {
+    fn shown(&self) -> String {
+        match self {
+            Some(v) => v.shown(),
+            None => "none".into(),
+        }
     }
 }
 

@@ -1,8 +1,9 @@
 //! One conformance scenario ([`Scenario`]) and how it runs on a target
 //! from a hardware reset ([`run_scenario`]).
 
-use super::driver::{Driver, DriverOptions};
+use super::driver::Driver;
 use super::grade::Grade;
+use super::options::DriverOptions;
 use super::outcome::{HarnessError, Outcome, Stop};
 use super::verdict::{NotRun, ScenarioResult, Verdict};
 use crate::backend::{Target, TargetErrorKind};
