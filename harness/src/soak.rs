@@ -8,7 +8,7 @@
 //! and each measurement's count, minimum, mean, maximum and worst grade.
 //! What is held grows with the suite and the cap, never with the passes.
 
-use crate::report::Tally;
+use crate::report::tally::Tally;
 use crate::runner::BoardResult;
 use crate::scenario::{Grade, NotRun, ScenarioResult, Verdict};
 use crate::time::Duration;

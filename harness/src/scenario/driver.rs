@@ -2,110 +2,45 @@
 //! [`Target`], a raw layer to break the protocol on purpose, and
 //! expectations that stop the scenario at the first thing that went wrong.
 //!
-//! The author API lives here; how steps are batched and judged is in
-//! [`super::queue`], the Table 3-3 measurements in [`super::measure`].
+//! The author API lives here. The driver owns a `Batch`, which queues
+//! its steps into round trips and judges them (`batch.rs`, with the steps
+//! in `steps.rs` and the deferred checks in `check.rs`); the Table 3-3
+//! measurements are in `measure.rs`.
 
-use super::grade::{Grade, Grading, Measurement};
-use super::queue::{fail, Check, Done, Group, Role, Step};
-use super::{HarnessError, Init, Move, Outcome, Stop};
+use super::batch::{Batch, Limits};
+use super::builders::{Init, Move};
+use super::check::Check;
+use super::grade::{Grade, Measurement};
+use super::outcome::{fail, HarnessError, Outcome, Stop};
+use super::steps::{Done, Role, Step};
 use crate::backend::{Op, Reply, Target};
 use crate::protocol::{
     ClockSource, Direction, ErrorCode, Flag, Input, Pins, Record, Register, Status, Straps,
     TimingId,
 };
 use crate::time::{Duration, Instant};
-use crate::trace::{BusEvent, Event, EventKind};
+use crate::trace::{BusEvent, Event};
 
-/// A value [`Driver::check`] compares, as a failure report shows it to a
-/// person: `true`, `42`, `0x3F` for a register byte, `120.000us`, `none`.
-pub trait Shown {
-    fn shown(&self) -> String;
-}
-
-macro_rules! shown_as_text {
-    ($($t:ty),*) => {$(
-        impl Shown for $t {
-            fn shown(&self) -> String {
-                self.to_string()
-            }
-        }
-    )*};
-}
-
-shown_as_text!(bool, u16, u32, u64, usize, i32, i64, Instant, Duration, String, &str);
-
-impl Shown for u8 {
-    fn shown(&self) -> String {
-        format!("0x{self:02X}")
-    }
-}
-
-impl<T: Shown> Shown for Option<T> {
-    fn shown(&self) -> String {
-        match self {
-            Some(v) => v.shown(),
-            None => "none".into(),
-        }
-    }
-}
-
-/// Timeouts and limits of a [`Driver`], given for the reference board
-/// (16 MHz, CSEL high): the driver stretches each for a slower board
-/// ([`Straps::stretch`]), so a scenario's limits hold at every clock the
-/// straps allow.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct DriverOptions {
-    /// Flowchart writes wait at most this long for IBF = 0.
-    pub ibf_timeout: Duration,
-    /// Flowchart reads wait at most this long for OBF = 1.
-    pub obf_timeout: Duration,
-    /// An operation command must raise BUSY within this.
-    pub busy_timeout: Duration,
-    /// [`Driver::wait_idle`] waits at most this long for BUSY = 0.
-    pub idle_timeout: Duration,
-    /// Virtual time one scenario may use before it is stopped as an error.
-    pub budget: Duration,
-    pub grading: Grading,
-}
-
-impl Default for DriverOptions {
-    fn default() -> Self {
-        DriverOptions {
-            ibf_timeout: Duration::from_secs(1),
-            obf_timeout: Duration::from_millis(100),
-            busy_timeout: Duration::from_millis(5),
-            idle_timeout: Duration::from_secs(60),
-            budget: Duration::from_secs(120),
-            grading: Grading::default(),
-        }
-    }
-}
+// Defined beside the driver, and public here as they always were.
+pub use super::options::DriverOptions;
+pub use super::outcome::Shown;
 
 /// Drives one scenario on a target and records what it saw.
 pub struct Driver<'t> {
-    pub(super) target: &'t mut dyn Target,
+    /// The target, the steps queued for it, and what came back: the bus
+    /// log, the clock, the times measurements start from, the capture.
+    pub(super) batch: Batch<'t>,
     pub(super) opts: DriverOptions,
-    pub(super) bus: Vec<Event>,
     pub(super) measurements: Vec<Measurement>,
-    pub(super) now: Instant,
-    /// Final write of the most recent operation command.
-    pub(super) anchor: Option<Instant>,
-    /// Final write of the most recent initialization.
-    pub(super) init_write: Option<Instant>,
     pub(super) init: Option<Init>,
-    /// The most recent stop write, input edge or auxiliary command write.
-    pub(super) trigger: Option<Instant>,
-    pub(super) capture: Option<Record>,
     pub(super) straps: Straps,
-    /// Steps not yet sent (see [`Driver::flush`]).
-    pub(super) queue: Vec<Group>,
 }
 
 impl std::fmt::Debug for Driver<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Driver")
-            .field("now", &self.now)
-            .field("anchor", &self.anchor)
+            .field("now", &self.batch.clock())
+            .field("anchor", &self.batch.anchor())
             .finish_non_exhaustive()
     }
 }
@@ -121,25 +56,23 @@ impl<'t> Driver<'t> {
             budget: straps.stretch(opts.budget),
             ..opts
         };
+        let limits = Limits {
+            ibf_timeout: opts.ibf_timeout,
+            obf_timeout: opts.obf_timeout,
+            budget: opts.budget,
+        };
         Driver {
             straps,
-            target,
+            batch: Batch::new(target, limits),
             opts,
-            bus: Vec::new(),
             measurements: Vec::new(),
-            now: Instant::ZERO,
-            anchor: None,
-            init_write: None,
             init: None,
-            trigger: None,
-            capture: None,
-            queue: Vec::new(),
         }
     }
 
     /// The bus events and measurements recorded so far.
     pub(crate) fn into_parts(self) -> (Vec<Event>, Vec<Measurement>) {
-        (self.bus, self.measurements)
+        (self.batch.into_bus(), self.measurements)
     }
 
     pub fn measurements(&self) -> &[Measurement] {
@@ -185,12 +118,47 @@ impl<'t> Driver<'t> {
     /// The target's clock, once everything queued has run.
     pub fn now(&mut self) -> Outcome<Instant> {
         self.flush()?;
-        Ok(self.now)
+        Ok(self.batch.clock())
     }
 
     /// The clock as of the last op sent (for reports).
     pub(crate) fn clock(&self) -> Instant {
-        self.now
+        self.batch.clock()
+    }
+
+    /// Sends everything queued as one batch, then logs and judges the
+    /// replies in order, stopping at the first failure. Ops queued after a
+    /// failing one have run on the target too; the verdict and the failure
+    /// are those of the first failing step.
+    pub fn flush(&mut self) -> Outcome {
+        self.batch.flush()
+    }
+
+    /// Flushes what is queued at the end of a scenario, fetching the
+    /// capture in the same round trip.
+    pub fn finish(&mut self) -> Outcome {
+        self.batch.finish()
+    }
+
+    /// Steps that play no role for the measurements.
+    fn plain(steps: impl IntoIterator<Item = Step>) -> Vec<(Step, Role)> {
+        steps.into_iter().map(|s| (s, Role::Plain)).collect()
+    }
+
+    /// Queues a write of the command (`command`) or data register, after
+    /// IBF = 0 if `wait`.
+    fn write(&mut self, byte: u8, command: bool, wait: bool, role: Role) -> Outcome {
+        self.batch.enqueue(
+            vec![(
+                Step::Write {
+                    byte,
+                    command,
+                    wait,
+                },
+                role,
+            )],
+            None,
+        )
     }
 
     // ----- raw layer -------------------------------------------------------
@@ -198,25 +166,20 @@ impl<'t> Driver<'t> {
     /// Runs ops on the target (after everything queued); a target failure
     /// stops the scenario as an error (not the device's fault).
     pub fn exec(&mut self, ops: &[Op]) -> Outcome<Vec<Reply>> {
-        Ok(self.flush_with(ops, false)?.1)
+        Ok(self.batch.flush_with(ops, false)?.1)
     }
 
     /// Puts a bus transaction into the scenario's trace: for code that
     /// runs raw ops with [`Driver::exec`] and wants them shown.
     pub fn log_bus(&mut self, at: Instant, e: BusEvent) {
-        self.bus.push(Event {
-            at,
-            kind: EventKind::Bus(e),
-        });
+        self.batch.log_bus(at, e);
     }
 
     /// Hardware reset; every scenario starts with one.
     pub fn reset(&mut self) -> Outcome {
-        self.anchor = None;
-        self.init_write = None;
+        self.batch.forget_marks();
         self.init = None;
-        self.trigger = None;
-        self.enqueue(Self::plain([Step::Reset]), None)
+        self.batch.enqueue(Self::plain([Step::Reset]), None)
     }
 
     /// Flowchart write of the command register (waits for IBF = 0).
@@ -241,7 +204,7 @@ impl<'t> Driver<'t> {
 
     /// Reads the status register.
     pub fn status(&mut self) -> Outcome<Status> {
-        match self.step(Step::Status)? {
+        match self.batch.step(Step::Status)? {
             Done::Status(s) => Ok(s),
             _ => Err(Stop::Error(HarnessError::Reply(
                 "status read answered otherwise".into(),
@@ -251,7 +214,7 @@ impl<'t> Driver<'t> {
 
     /// Flowchart read of the data register (waits for OBF = 1).
     pub fn read_data(&mut self) -> Outcome<u8> {
-        match self.step(Step::ReadData)? {
+        match self.batch.step(Step::ReadData)? {
             Done::Byte(b) => Ok(b),
             _ => Err(Stop::Error(HarnessError::Reply(
                 "data read answered otherwise".into(),
@@ -268,7 +231,7 @@ impl<'t> Driver<'t> {
         value: bool,
         timeout: Duration,
     ) -> Outcome<Option<Duration>> {
-        match self.step(Step::Await {
+        match self.batch.step(Step::Await {
             flag,
             value,
             timeout,
@@ -286,7 +249,7 @@ impl<'t> Driver<'t> {
     /// one).
     pub fn expect_flag(&mut self, flag: Flag, value: bool, timeout: Duration) -> Outcome {
         let timeout = self.straps.stretch(timeout);
-        self.enqueue(
+        self.batch.enqueue(
             Self::plain([Step::Await {
                 flag,
                 value,
@@ -337,26 +300,28 @@ impl<'t> Driver<'t> {
 
     /// Lets time pass.
     pub fn wait(&mut self, d: Duration) -> Outcome {
-        self.enqueue(Self::plain([Step::Delay(d)]), None)
+        self.batch.enqueue(Self::plain([Step::Delay(d)]), None)
     }
 
     /// Drives an input (`on` = asserted, pin low). An assertion counts as
     /// the trigger for latency measurements.
     pub fn set(&mut self, input: Input, on: bool) -> Outcome {
         let role = if on { Role::Trigger } else { Role::Plain };
-        self.enqueue(vec![(Step::Set { input, on }, role)], None)
+        self.batch
+            .enqueue(vec![(Step::Set { input, on }, role)], None)
     }
 
     /// Waits until the move in progress has output `n` pulses; the next op
     /// acts right after that pulse, on the target's clock.
     pub fn after_pulses(&mut self, n: u64) -> Outcome {
         let timeout = self.opts.idle_timeout;
-        self.enqueue(Self::plain([Step::AwaitPulses { count: n, timeout }]), None)
+        self.batch
+            .enqueue(Self::plain([Step::AwaitPulses { count: n, timeout }]), None)
     }
 
     /// The output pins now.
     pub fn pins(&mut self) -> Outcome<Pins> {
-        match self.step(Step::Pins)? {
+        match self.batch.step(Step::Pins)? {
             Done::Pins(p) => Ok(p),
             _ => Err(Stop::Error(HarnessError::Reply(
                 "pins read answered otherwise".into(),
@@ -405,7 +370,7 @@ impl<'t> Driver<'t> {
                 .find(|w| w[0].1 == level && w[1].1 != level)
                 .map(|w| (w[1].0.saturating_since(w[0].0), w[1].0))
         };
-        let now = self.now;
+        let now = self.batch.clock();
         for (name, level, want) in [("switching_on", true, on), ("switching_off", false, off)] {
             let Some((got, at)) = stretch(level) else {
                 return Err(fail(
@@ -438,17 +403,7 @@ impl<'t> Driver<'t> {
     /// The capture since reset (fetched once per change, after everything
     /// queued has run).
     pub fn capture(&mut self) -> Outcome<&Record> {
-        self.flush_then(true)?;
-        if self.capture.is_none() {
-            let c = self
-                .target
-                .capture()
-                .map_err(|e| Stop::Error(HarnessError::Capture(format!("target capture: {e}"))))?;
-            self.capture = Some(c);
-        }
-        self.capture
-            .as_ref()
-            .ok_or_else(|| Stop::Error(HarnessError::Capture("capture unavailable".into())))
+        self.batch.capture()
     }
 
     // ----- flowchart helpers ---------------------------------------------
@@ -457,7 +412,7 @@ impl<'t> Driver<'t> {
     /// before an operation command.
     pub fn wait_ready(&mut self) -> Outcome {
         let steps = Self::plain(self.ready_steps());
-        self.enqueue(steps, None)
+        self.batch.enqueue(steps, None)
     }
 
     /// The initialization flowchart (Diagram 3-3). Later writes wait for
@@ -470,7 +425,7 @@ impl<'t> Driver<'t> {
             Role::InitWrite,
         ));
         self.init = Some(init);
-        self.enqueue(steps, None)
+        self.batch.enqueue(steps, None)
     }
 
     /// Initialization, then waiting out its processing time (Table 3-3 max
@@ -502,7 +457,7 @@ impl<'t> Driver<'t> {
                 must: true,
             },
         ]));
-        self.enqueue(steps, None)
+        self.batch.enqueue(steps, None)
     }
 
     /// Issues a move's command and data without waiting for BUSY (for
@@ -510,7 +465,7 @@ impl<'t> Driver<'t> {
     pub fn issue(&mut self, m: Move) -> Outcome {
         let mut steps = Self::plain(self.ready_steps());
         steps.extend(Self::command_steps(m.code(), &m.params(), Role::Anchor));
-        self.enqueue(steps, None)
+        self.batch.enqueue(steps, None)
     }
 
     /// Issues a move and waits for it to end.
@@ -562,6 +517,7 @@ impl<'t> Driver<'t> {
             .map(|(s, _)| s)
             .collect();
         Ok(self
+            .batch
             .steps(&steps)?
             .into_iter()
             .filter_map(|d| match d {
@@ -593,7 +549,12 @@ impl<'t> Driver<'t> {
     pub fn check<T: PartialEq + Shown>(&mut self, what: &str, expected: T, got: T) -> Outcome {
         self.flush()?;
         if expected != got {
-            return Err(fail(what, expected.shown(), got.shown(), self.now));
+            return Err(fail(
+                what,
+                expected.shown(),
+                got.shown(),
+                self.batch.clock(),
+            ));
         }
         Ok(())
     }
@@ -601,24 +562,24 @@ impl<'t> Driver<'t> {
     /// Expects the error flag with `code` (Table 3-2).
     pub fn expect_error(&mut self, code: ErrorCode) -> Outcome {
         let steps = self.settled_status_steps();
-        self.enqueue(steps, Some(Check::Error(code)))
+        self.batch.enqueue(steps, Some(Check::Error(code)))
     }
 
     /// Expects no error flag.
     pub fn expect_no_error(&mut self) -> Outcome {
         let steps = self.settled_status_steps();
-        self.enqueue(steps, Some(Check::NoError))
+        self.batch.enqueue(steps, Some(Check::NoError))
     }
 
     /// Expects status bits 6-4 to count `n` parameter bytes still wanted.
     pub fn expect_params_remaining(&mut self, n: u8) -> Outcome {
         let steps = self.settled_status_steps();
-        self.enqueue(steps, Some(Check::Params(n)))
+        self.batch.enqueue(steps, Some(Check::Params(n)))
     }
 
     /// Expects `status & mask == value`.
     pub fn expect_status(&mut self, mask: u8, value: u8) -> Outcome {
-        self.enqueue(
+        self.batch.enqueue(
             Self::plain([Step::Status]),
             Some(Check::StatusMask { mask, value }),
         )
@@ -626,7 +587,7 @@ impl<'t> Driver<'t> {
 
     fn expect_register(&mut self, reg: Register, what: &'static str, expected: &[u8]) -> Outcome {
         let steps = self.register_steps(reg);
-        self.enqueue(
+        self.batch.enqueue(
             steps,
             Some(Check::Bytes {
                 what,
@@ -667,12 +628,13 @@ impl<'t> Driver<'t> {
     /// judged on the capture as it stands now (deferred: no round trip of
     /// its own on a board).
     pub fn expect_pulses(&mut self, n: u64, dir: Direction) -> Outcome {
-        self.enqueue(Vec::new(), Some(Check::Pulses { n, dir }))
+        self.batch
+            .enqueue(Vec::new(), Some(Check::Pulses { n, dir }))
     }
 
     /// Expects the most recent move's pulse count within `lo..=hi`.
     pub fn expect_pulses_between(&mut self, lo: u64, hi: u64) -> Outcome<u64> {
-        let now = self.now;
+        let now = self.batch.clock();
         let s = self.capture()?.last_move_pulses();
         if s.count < lo || s.count > hi {
             return Err(fail(
@@ -692,7 +654,8 @@ impl<'t> Driver<'t> {
     /// 1 % of 1 ms", [`Driver::expect_intervals_within`]. Deferred, as
     /// [`Driver::expect_pulses`].
     pub fn expect_intervals(&mut self, min: Duration, max: Duration) -> Outcome {
-        self.enqueue(Vec::new(), Some(Check::Intervals { min, max }))
+        self.batch
+            .enqueue(Vec::new(), Some(Check::Intervals { min, max }))
     }
 
     /// Expects every interval of the most recent move within `percent` of
@@ -704,7 +667,7 @@ impl<'t> Driver<'t> {
         // To the nanosecond, never wider than asked.
         let tol = (nominal.as_nanos() as f64 * percent.abs() / 100.0).floor() as u64;
         let tolerance = Duration::from_nanos(tol);
-        self.enqueue(
+        self.batch.enqueue(
             Vec::new(),
             Some(Check::IntervalsWithin { nominal, tolerance }),
         )
@@ -713,7 +676,8 @@ impl<'t> Driver<'t> {
     /// Expects no pulse of the most recent move after `t` (deferred, as
     /// [`Driver::expect_pulses`]).
     pub fn expect_no_pulses_after(&mut self, t: Instant) -> Outcome {
-        self.enqueue(Vec::new(), Some(Check::NoPulsesAfter(t)))
+        self.batch
+            .enqueue(Vec::new(), Some(Check::NoPulsesAfter(t)))
     }
 
     /// Expects no pulse of the most recent move later than `margin` after
@@ -722,12 +686,14 @@ impl<'t> Driver<'t> {
     pub fn expect_no_pulses_after_trigger(&mut self, margin: Duration) -> Outcome {
         // The chip's reaction is a firmware time: longer on a slower clock.
         let margin = self.fw(margin).max(margin);
-        self.enqueue(Vec::new(), Some(Check::NoPulsesAfterTrigger(margin)))
+        self.batch
+            .enqueue(Vec::new(), Some(Check::NoPulsesAfterTrigger(margin)))
     }
 
     /// Expects the energized phases (S1 in bit 4).
     pub fn expect_phases(&mut self, pattern: u8) -> Outcome {
-        self.enqueue(Self::plain([Step::Pins]), Some(Check::Phases(pattern)))
+        self.batch
+            .enqueue(Self::plain([Step::Pins]), Some(Check::Phases(pattern)))
     }
 
     /// Expects output pins: each `Some` is checked.
@@ -738,7 +704,7 @@ impl<'t> Driver<'t> {
         aux: Option<bool>,
         auxo: Option<u8>,
     ) -> Outcome {
-        self.enqueue(
+        self.batch.enqueue(
             Self::plain([Step::Pins]),
             Some(Check::Pins {
                 int,

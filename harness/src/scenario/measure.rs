@@ -3,8 +3,7 @@
 
 use super::driver::Driver;
 use super::grade::Grade;
-use super::queue::fail;
-use super::{Failure, HarnessError, Outcome, Stop};
+use super::outcome::{fail, need, Failure, HarnessError, Outcome, Stop};
 use crate::protocol::{Flag, Pin, Register, TimingId};
 use crate::time::{Duration, Instant, Limit};
 
@@ -39,22 +38,14 @@ impl Driver<'_> {
             .map(|e| e.at))
     }
 
-    /// [`Driver::need`] of a time set by a queued step: flushes first.
+    /// [`need`] of a time set by a queued step: flushes first.
     fn flushed(&mut self, what: &str, t: fn(&Self) -> Option<Instant>) -> Outcome<Instant> {
         self.flush()?;
-        self.need(what, t(self))
-    }
-
-    pub(super) fn need(&self, what: &str, t: Option<Instant>) -> Outcome<Instant> {
-        t.ok_or_else(|| {
-            Stop::Error(HarnessError::Scenario(format!(
-                "scenario bug: measuring needs {what}, which this scenario has not done"
-            )))
-        })
+        need(what, t(self))
     }
 
     fn last_move_pulse_times(&mut self) -> Outcome<(Instant, Instant)> {
-        let now = self.now;
+        let now = self.batch.clock();
         let s = self.capture()?.last_move_pulses();
         match (s.first, s.last) {
             (Some(a), Some(b)) => Ok((a, b)),
@@ -67,16 +58,16 @@ impl Driver<'_> {
     pub fn expect_latency(&mut self, id: TimingId) -> Outcome<Duration> {
         let (from, to) = match id {
             TimingId::BusyRise => {
-                let a = self.flushed("an operation command", |d| d.anchor)?;
+                let a = self.flushed("an operation command", |d| d.batch.anchor())?;
                 (a, self.pin_after(Pin::Busy, Some(1), a)?)
             }
             TimingId::AccelFirstPout | TimingId::ConstantFirstPout => {
-                let a = self.flushed("an operation command", |d| d.anchor)?;
+                let a = self.flushed("an operation command", |d| d.batch.anchor())?;
                 let (first, _) = self.last_move_pulse_times()?;
                 (a, Some(first))
             }
             TimingId::SingleStep => {
-                let a = self.flushed("an operation command", |d| d.anchor)?;
+                let a = self.flushed("an operation command", |d| d.batch.anchor())?;
                 (a, self.pin_after(Pin::Busy, Some(0), a)?)
             }
             TimingId::InterruptOutput => {
@@ -88,23 +79,23 @@ impl Driver<'_> {
                 (last, self.pin_after(Pin::Hold, Some(1), last)?)
             }
             TimingId::AbnormalTermination => {
-                let t = self.flushed("a stop or limit", |d| d.trigger)?;
+                let t = self.flushed("a stop or limit", |d| d.batch.trigger())?;
                 (t, self.pin_after(Pin::Busy, Some(0), t)?)
             }
             TimingId::AuxOn => {
-                let t = self.flushed("an AUX ON command", |d| d.trigger)?;
+                let t = self.flushed("an AUX ON command", |d| d.batch.trigger())?;
                 (t, self.pin_after(Pin::Aux, Some(1), t)?)
             }
             TimingId::AuxOff => {
-                let t = self.flushed("an AUX OFF command", |d| d.trigger)?;
+                let t = self.flushed("an AUX OFF command", |d| d.batch.trigger())?;
                 (t, self.pin_after(Pin::Aux, Some(0), t)?)
             }
             TimingId::ExcitationOff => {
-                let t = self.flushed("a software reset", |d| d.trigger)?;
+                let t = self.flushed("a software reset", |d| d.batch.trigger())?;
                 (t, self.pin_after(Pin::Phases, Some(0), t)?)
             }
             TimingId::InitOutputsSet => {
-                let t = self.flushed("an initialization", |d| d.init_write)?;
+                let t = self.flushed("an initialization", |d| d.batch.init_write())?;
                 (t, self.pin_after(Pin::Phases, None, t)?)
             }
             TimingId::InitProcessing => return self.measure_init_processing(),
@@ -113,7 +104,7 @@ impl Driver<'_> {
             | TimingId::HighSpeedLimitAccel
             | TimingId::HighSpeedLimitCruise => return self.expect_decel_start(id),
         };
-        let now = self.now;
+        let now = self.batch.clock();
         let to = to.ok_or_else(|| {
             fail(
                 format!("{} (Table 3-3): the event it ends with", id.name()),
@@ -135,9 +126,9 @@ impl Driver<'_> {
         self.expect_flag(Flag::Ibf, false, timeout)?;
         self.raw_command(Register::InputSignals.code())?;
         self.expect_flag(Flag::Ibf, false, timeout)?;
-        let t = self.flushed("an initialization", |d| d.init_write)?;
-        let value = self.now.saturating_since(t);
-        let at = self.now;
+        let t = self.flushed("an initialization", |d| d.batch.init_write())?;
+        let value = self.batch.clock().saturating_since(t);
+        let at = self.batch.clock();
         self.drain_probe()?;
         self.record_measure(TimingId::InitProcessing, value, at)?;
         Ok(value)
@@ -153,8 +144,8 @@ impl Driver<'_> {
         // The move had ended before the command: its last pulse is in the
         // capture fetched with the batch.
         let (_, last) = self.last_move_pulse_times()?;
-        let value = self.now.saturating_since(last);
-        let at = self.now;
+        let value = self.batch.clock().saturating_since(last);
+        let at = self.batch.clock();
         self.drain_probe()?;
         self.record_measure(TimingId::NextCommand, value, at)?;
         Ok(value)
@@ -181,7 +172,9 @@ impl Driver<'_> {
             ))
         })?;
         self.wait_idle()?;
-        let t = self.flushed("a decelerating stop or high-speed limit", |d| d.trigger)?;
+        let t = self.flushed("a decelerating stop or high-speed limit", |d| {
+            d.batch.trigger()
+        })?;
         let rec = self.capture()?;
         let from = rec.moves.last().map_or(0, |m| m.first_run);
         let times: Vec<Instant> = rec.runs[from..]
@@ -205,7 +198,10 @@ impl Driver<'_> {
                 .map_or(n, |i| i as u64)
         };
         let (j_lo, j_hi) = (first_after(lo), first_after(hi));
-        let start_time = times.get(j1 as usize).copied().unwrap_or(self.now);
+        let start_time = times
+            .get(j1 as usize)
+            .copied()
+            .unwrap_or(self.batch.clock());
         if j1 < j_lo || j1 > j_hi {
             return Err(Stop::Failed(Failure {
                 expectation: format!(

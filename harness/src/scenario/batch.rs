@@ -1,145 +1,136 @@
-//! How a driver's steps reach the target: steps that need no reply yet
-//! are queued, sent in one batch with the next step whose result the
-//! scenario must see, and judged in order when the replies come back, so
-//! that a scenario on a board costs a round trip per point where it looks,
-//! not one per call. Deferred checks are judged on their group's replies,
-//! or on the capture as it stood where they were queued.
+//! How a driver's steps reach the target: a [`Batch`] queues the steps
+//! that need no reply yet, sends them in one batch with the next step
+//! whose result the scenario must see, and judges the replies in order
+//! when they come back, so that a scenario on a board costs a round trip
+//! per point where it looks, not one per call. Deferred checks are judged
+//! on their group's replies, or on the capture as it stood where they
+//! were queued.
 
-use super::driver::Driver;
-use super::{Failure, HarnessError, Outcome, Stop};
-use crate::backend::{Op, Reply};
-use crate::protocol::{Direction, ErrorCode, Flag, Input, Pins, Record, Status, StatusField};
+use super::check::Check;
+use super::outcome::{fail, HarnessError, Outcome, Stop};
+use super::steps::{Done, Role, Step};
+use crate::backend::{Op, Reply, Target};
+use crate::protocol::Record;
 use crate::time::{Duration, Instant};
-use crate::trace::{BusEvent, EventKind};
-
-/// One step: an op and how its reply is judged.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Step {
-    Write {
-        byte: u8,
-        command: bool,
-        wait: bool,
-    },
-    Status,
-    ReadData,
-    /// `must`: a timeout fails the scenario.
-    Await {
-        flag: Flag,
-        value: bool,
-        timeout: Duration,
-        must: bool,
-    },
-    Delay(Duration),
-    Set {
-        input: Input,
-        on: bool,
-    },
-    AwaitPulses {
-        count: u64,
-        timeout: Duration,
-    },
-    Reset,
-    Pins,
-}
-
-/// What a step gave back.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Done {
-    At,
-    Status(Status),
-    Byte(u8),
-    Waited(Option<Duration>),
-    Pins(Pins),
-}
-
-/// What the driver remembers of a step once it has run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Role {
-    Plain,
-    /// The final byte of an initialization.
-    InitWrite,
-    /// The final byte of an operation command: the anchor of measurements.
-    Anchor,
-    /// A stop, an input edge or an auxiliary command: the trigger of
-    /// latency measurements.
-    Trigger,
-}
-
-/// A deferred expectation, judged on the replies of its group, or on the
-/// capture as it stood where the check was queued.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub(super) enum Check {
-    /// The most recent move output `n` pulses, all in `dir`.
-    Pulses {
-        n: u64,
-        dir: Direction,
-    },
-    /// The shortest and longest interval of the most recent move.
-    Intervals {
-        min: Duration,
-        max: Duration,
-    },
-    /// Every interval of the most recent move within `tolerance` of
-    /// `nominal`.
-    IntervalsWithin {
-        nominal: Duration,
-        tolerance: Duration,
-    },
-    /// No pulse of the most recent move after this time.
-    NoPulsesAfter(Instant),
-    /// No pulse of the most recent move later than this after the last
-    /// trigger.
-    NoPulsesAfterTrigger(Duration),
-    Bytes {
-        what: &'static str,
-        expected: Vec<u8>,
-    },
-    Error(ErrorCode),
-    NoError,
-    Params(u8),
-    StatusMask {
-        mask: u8,
-        value: u8,
-    },
-    Phases(u8),
-    Pins {
-        int: Option<bool>,
-        hold: Option<bool>,
-        aux: Option<bool>,
-        auxo: Option<u8>,
-    },
-}
+use crate::trace::{BusEvent, Event, EventKind};
 
 /// Steps queued to go to the target together, and what to check of them.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub(super) struct Group {
-    pub(super) steps: Vec<(Step, Role)>,
-    pub(super) check: Option<Check>,
+struct Group {
+    steps: Vec<(Step, Role)>,
+    check: Option<Check>,
 }
 
-/// Most groups the driver queues before it sends them anyway.
+/// Most groups a batch queues before it sends them anyway.
 const MAX_QUEUED: usize = 64;
 
-pub(super) fn fail(
-    expectation: impl Into<String>,
-    expected: impl ToString,
-    got: impl ToString,
-    at: Instant,
-) -> Stop {
-    Stop::Failed(Failure {
-        expectation: expectation.into(),
-        expected: expected.to_string(),
-        got: got.to_string(),
-        at,
-    })
+/// What a batch takes of the driver's options, stretched for the board.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Limits {
+    /// Flowchart writes wait at most this long for IBF = 0.
+    pub(super) ibf_timeout: Duration,
+    /// Flowchart reads wait at most this long for OBF = 1.
+    pub(super) obf_timeout: Duration,
+    /// Virtual time the scenario may use before it is stopped as an error.
+    pub(super) budget: Duration,
 }
 
-impl Driver<'_> {
+/// A driver's way to its target: the steps queued and not yet sent, and
+/// what came back of those sent: the bus transactions for the trace, the
+/// target's clock, the times measurements start from, and the capture.
+pub(super) struct Batch<'t> {
+    target: &'t mut dyn Target,
+    limits: Limits,
+    /// Steps not yet sent (see [`Batch::flush`]).
+    queue: Vec<Group>,
+    bus: Vec<Event>,
+    now: Instant,
+    /// Final write of the most recent operation command.
+    anchor: Option<Instant>,
+    /// Final write of the most recent initialization.
+    init_write: Option<Instant>,
+    /// The most recent stop write, input edge or auxiliary command write.
+    trigger: Option<Instant>,
+    capture: Option<Record>,
+}
+
+impl<'t> Batch<'t> {
+    pub(super) fn new(target: &'t mut dyn Target, limits: Limits) -> Self {
+        Batch {
+            target,
+            limits,
+            queue: Vec::new(),
+            bus: Vec::new(),
+            now: Instant::ZERO,
+            anchor: None,
+            init_write: None,
+            trigger: None,
+            capture: None,
+        }
+    }
+
+    /// The target's clock as of the last op sent.
+    pub(super) fn clock(&self) -> Instant {
+        self.now
+    }
+
+    /// Final write of the most recent operation command, once sent.
+    pub(super) fn anchor(&self) -> Option<Instant> {
+        self.anchor
+    }
+
+    /// Final write of the most recent initialization, once sent.
+    pub(super) fn init_write(&self) -> Option<Instant> {
+        self.init_write
+    }
+
+    /// The most recent stop write, input edge or auxiliary command write,
+    /// once sent.
+    pub(super) fn trigger(&self) -> Option<Instant> {
+        self.trigger
+    }
+
+    /// Forgets the times measurements start from (at a reset).
+    pub(super) fn forget_marks(&mut self) {
+        self.anchor = None;
+        self.init_write = None;
+        self.trigger = None;
+    }
+
+    /// The bus events logged so far.
+    pub(super) fn into_bus(self) -> Vec<Event> {
+        self.bus
+    }
+
+    /// Puts a bus transaction into the scenario's trace.
+    pub(super) fn log_bus(&mut self, at: Instant, e: BusEvent) {
+        self.bus.push(Event {
+            at,
+            kind: EventKind::Bus(e),
+        });
+    }
+
+    /// The capture since reset (fetched once per change, after everything
+    /// queued has run).
+    pub(super) fn capture(&mut self) -> Outcome<&Record> {
+        self.flush_then(true)?;
+        if self.capture.is_none() {
+            let c = self
+                .target
+                .capture()
+                .map_err(|e| Stop::Error(HarnessError::Capture(format!("target capture: {e}"))))?;
+            self.capture = Some(c);
+        }
+        self.capture
+            .as_ref()
+            .ok_or_else(|| Stop::Error(HarnessError::Capture("capture unavailable".into())))
+    }
+
     /// Runs ops on the target; with `capture`, also fetches the capture
     /// after them (one round trip less on a board).
-    pub(super) fn send_then(&mut self, ops: &[Op], capture: bool) -> Outcome<Vec<Reply>> {
-        if self.now.as_nanos() > self.opts.budget.as_nanos() {
-            return Err(Stop::Error(HarnessError::Budget(self.opts.budget)));
+    fn send_then(&mut self, ops: &[Op], capture: bool) -> Outcome<Vec<Reply>> {
+        if self.now.as_nanos() > self.limits.budget.as_nanos() {
+            return Err(Stop::Error(HarnessError::Budget(self.limits.budget)));
         }
         let (replies, record) = if capture {
             let (replies, record) = self
@@ -168,7 +159,7 @@ impl Driver<'_> {
         Ok(replies)
     }
 
-    pub(super) fn unexpected(&self, op: &str, reply: &Reply) -> Stop {
+    fn unexpected(&self, op: &str, reply: &Reply) -> Stop {
         Stop::Error(HarnessError::Reply(format!(
             "target answered `{reply}` to {op}"
         )))
@@ -185,27 +176,23 @@ impl Driver<'_> {
         Ok(())
     }
 
-    pub(super) fn plain(steps: impl IntoIterator<Item = Step>) -> Vec<(Step, Role)> {
-        steps.into_iter().map(|s| (s, Role::Plain)).collect()
-    }
-
     /// Sends everything queued as one batch, then logs and judges the
     /// replies in order, stopping at the first failure. Ops queued after a
     /// failing one have run on the target too; the verdict and the failure
     /// are those of the first failing step.
-    pub fn flush(&mut self) -> Outcome {
+    pub(super) fn flush(&mut self) -> Outcome {
         self.flush_then(false)
     }
 
     /// Flushes what is queued at the end of a scenario, fetching the
     /// capture in the same round trip.
-    pub fn finish(&mut self) -> Outcome {
+    pub(super) fn finish(&mut self) -> Outcome {
         self.flush_then(true)
     }
 
-    /// [`Driver::flush`]; with `capture`, the capture after the batch comes
+    /// [`Batch::flush`]; with `capture`, the capture after the batch comes
     /// back with it.
-    pub(super) fn flush_then(&mut self, capture: bool) -> Outcome {
+    fn flush_then(&mut self, capture: bool) -> Outcome {
         if self.queue.is_empty() {
             return Ok(());
         }
@@ -213,7 +200,7 @@ impl Driver<'_> {
     }
 
     /// Sends everything queued and then `extra` as one batch (one round trip
-    /// on a board), judges the queued groups as [`Driver::flush`] does, and
+    /// on a board), judges the queued groups as [`Batch::flush`] does, and
     /// returns when `extra` began (the end of the last queued op) and the
     /// replies to `extra`. With `capture`, the capture after the batch comes
     /// back with it.
@@ -302,14 +289,14 @@ impl Driver<'_> {
     }
 
     /// The op a step sends.
-    pub(super) fn step_op(&self, step: Step) -> Op {
+    fn step_op(&self, step: Step) -> Op {
         match step {
             Step::Write {
                 byte,
                 command,
                 wait,
             } => {
-                let wait_ibf = wait.then_some(self.opts.ibf_timeout);
+                let wait_ibf = wait.then_some(self.limits.ibf_timeout);
                 if command {
                     Op::WriteCommand { byte, wait_ibf }
                 } else {
@@ -318,7 +305,7 @@ impl Driver<'_> {
             }
             Step::Status => Op::ReadStatus,
             Step::ReadData => Op::ReadData {
-                wait_obf: Some(self.opts.obf_timeout),
+                wait_obf: Some(self.limits.obf_timeout),
             },
             Step::Await {
                 flag,
@@ -339,7 +326,7 @@ impl Driver<'_> {
 
     /// Logs a step's reply and judges it. `began` is when the step started
     /// (the end of the step before it).
-    pub(super) fn judge(&mut self, step: Step, reply: Reply, began: Instant) -> Outcome<Done> {
+    fn judge(&mut self, step: Step, reply: Reply, began: Instant) -> Outcome<Done> {
         match (step, reply) {
             (
                 Step::Write {
@@ -362,7 +349,7 @@ impl Driver<'_> {
                 self.log_bus(at, BusEvent::WriteTimedOut { command, byte });
                 Err(fail(
                     format!("IBF = 0 before writing 0x{byte:02X} (flowchart)"),
-                    format!("IBF = 0 within {}", self.opts.ibf_timeout),
+                    format!("IBF = 0 within {}", self.limits.ibf_timeout),
                     format!("status 0x{:02X}", status.0),
                     at,
                 ))
@@ -385,7 +372,7 @@ impl Driver<'_> {
                 self.log_bus(at, BusEvent::ReadTimedOut);
                 Err(fail(
                     "OBF = 1 before reading (flowchart)",
-                    format!("OBF = 1 within {}", self.opts.obf_timeout),
+                    format!("OBF = 1 within {}", self.limits.obf_timeout),
                     format!("status 0x{:02X}", status.0),
                     at,
                 ))
@@ -477,7 +464,7 @@ impl Driver<'_> {
 
     /// Judges a deferred expectation on the results of its group; `at` is
     /// when the group's last step ended.
-    pub(super) fn judge_check(&self, c: &Check, done: &[Done], at: Instant) -> Outcome {
+    fn judge_check(&self, c: &Check, done: &[Done], at: Instant) -> Outcome {
         if c.on_capture() {
             let mut rec = self
                 .capture
@@ -500,240 +487,10 @@ impl Driver<'_> {
             if !wrote_at_cut {
                 rec.moves.retain(|m| m.at < at);
             }
-            return self.judge_capture(c, &rec, at);
+            return c.judge_capture(&rec, at, self.trigger);
         }
-        let status = done.iter().rev().find_map(|d| match d {
-            Done::Status(s) => Some(*s),
-            _ => None,
-        });
-        let pins = done.iter().rev().find_map(|d| match d {
-            Done::Pins(p) => Some(*p),
-            _ => None,
-        });
-        match (c, status, pins) {
-            (Check::Bytes { what, expected }, _, _) => {
-                let got: Vec<u8> = done
-                    .iter()
-                    .filter_map(|d| match d {
-                        Done::Byte(b) => Some(*b),
-                        _ => None,
-                    })
-                    .collect();
-                if &got != expected {
-                    return Err(fail(*what, hex(expected), hex(&got), at));
-                }
-            }
-            (Check::Error(code), Some(s), _) => {
-                if s.error() != Some(*code) {
-                    return Err(fail(
-                        "status error (Table 3-2)",
-                        code,
-                        describe_status(s),
-                        at,
-                    ));
-                }
-            }
-            (Check::NoError, Some(s), _) => {
-                if s.error_flag() {
-                    return Err(fail("no error", "error flag 0", describe_status(s), at));
-                }
-            }
-            (Check::Params(n), Some(s), _) => {
-                if s.field() != StatusField::ParamsRemaining(*n) {
-                    return Err(fail(
-                        "parameter count (status bits 6-4)",
-                        format!("{n} remaining"),
-                        describe_status(s),
-                        at,
-                    ));
-                }
-            }
-            (Check::StatusMask { mask, value }, Some(s), _) => {
-                if s.0 & mask != value & mask {
-                    return Err(fail(
-                        format!("status & 0x{mask:02X}"),
-                        format!("0x{:02X}", value & mask),
-                        format!("0x{:02X}", s.0 & mask),
-                        at,
-                    ));
-                }
-            }
-            (Check::Phases(pattern), _, Some(p)) => {
-                if p.phases != *pattern {
-                    return Err(fail(
-                        "energized phases S1..S5",
-                        format!("0b{pattern:05b}"),
-                        format!("0b{:05b}", p.phases),
-                        at,
-                    ));
-                }
-            }
-            (
-                Check::Pins {
-                    int,
-                    hold,
-                    aux,
-                    auxo,
-                },
-                _,
-                Some(p),
-            ) => {
-                let checks = [
-                    ("INT*", int.map(u8::from), u8::from(p.int)),
-                    ("HOLD", hold.map(u8::from), u8::from(p.hold)),
-                    ("AUX*", aux.map(u8::from), u8::from(p.aux)),
-                    ("AUXO0..3", *auxo, p.auxo),
-                ];
-                for (name, want, got) in checks {
-                    if let Some(w) = want {
-                        if w != got {
-                            return Err(fail(format!("{name} asserted"), w, got, at));
-                        }
-                    }
-                }
-            }
-            (c, _, _) => {
-                return Err(Stop::Error(HarnessError::Scenario(format!(
-                    "scenario bug: check {c:?} has no reply to judge"
-                ))))
-            }
-        }
-        Ok(())
+        c.judge_results(done, at)
     }
-
-    /// Judges a check of the capture `rec`, cut at `at` where the check
-    /// was queued.
-    pub(super) fn judge_capture(&self, c: &Check, rec: &Record, at: Instant) -> Outcome {
-        let s = rec.last_move_pulses();
-        match *c {
-            Check::Pulses { n, dir } => {
-                let got = if dir == Direction::Cw { s.cw } else { s.ccw };
-                if s.count != n || got != n {
-                    return Err(fail(
-                        format!("pulses {}", dir.name()),
-                        n,
-                        format!("{} ({} cw, {} ccw)", s.count, s.cw, s.ccw),
-                        s.last.unwrap_or(at),
-                    ));
-                }
-            }
-            Check::Intervals { min, max } => {
-                // Exact, but for what the capture cannot tell (the jitter
-                // bound of a bridge whose timer is not locked to the chip).
-                let bound = s.interval_bound;
-                let near = |got: Option<Duration>, want: Duration| {
-                    got.is_some_and(|g| g.abs_diff(want) <= bound)
-                };
-                if !(near(s.min_interval, min) && near(s.max_interval, max)) {
-                    let expected = if bound == Duration::ZERO {
-                        format!("({min}, {max})")
-                    } else {
-                        format!("({min}, {max}), each within {bound} (the capture's bound)")
-                    };
-                    return Err(fail(
-                        "pulse intervals (min, max)",
-                        expected,
-                        format!("({}, {})", opt(s.min_interval), opt(s.max_interval)),
-                        s.first.unwrap_or(at),
-                    ));
-                }
-            }
-            Check::IntervalsWithin { nominal, tolerance } => {
-                // A band around the nominal interval, widened by what the
-                // capture cannot tell.
-                let band = tolerance + s.interval_bound;
-                let lo = Duration::from_nanos(nominal.as_nanos().saturating_sub(band.as_nanos()));
-                let hi = nominal + band;
-                let inside = |g: Option<Duration>| g.is_some_and(|g| g >= lo && g <= hi);
-                if !(inside(s.min_interval) && inside(s.max_interval)) {
-                    return Err(fail(
-                        "every pulse interval",
-                        format!("within {nominal} ± {band} ({lo} to {hi})"),
-                        format!("from {} to {}", opt(s.min_interval), opt(s.max_interval)),
-                        s.first.unwrap_or(at),
-                    ));
-                }
-            }
-            Check::NoPulsesAfter(t) => no_pulses_after(rec, t)?,
-            Check::NoPulsesAfterTrigger(margin) => {
-                let t = self.need("a stop or an input edge", self.trigger)?;
-                no_pulses_after(rec, t + margin)?;
-            }
-            _ => {
-                return Err(Stop::Error(HarnessError::Scenario(format!(
-                    "scenario bug: check {c:?} is not one of the capture"
-                ))))
-            }
-        }
-        Ok(())
-    }
-
-    pub(super) fn write(&mut self, byte: u8, command: bool, wait: bool, role: Role) -> Outcome {
-        self.enqueue(
-            vec![(
-                Step::Write {
-                    byte,
-                    command,
-                    wait,
-                },
-                role,
-            )],
-            None,
-        )
-    }
-}
-
-impl Check {
-    /// Whether the check is judged on the capture rather than on replies.
-    pub(super) fn on_capture(&self) -> bool {
-        matches!(
-            self,
-            Check::Pulses { .. }
-                | Check::Intervals { .. }
-                | Check::IntervalsWithin { .. }
-                | Check::NoPulsesAfter(_)
-                | Check::NoPulsesAfterTrigger(_)
-        )
-    }
-}
-
-/// Fails if the most recent move of `rec` has a pulse after `t`.
-pub(super) fn no_pulses_after(rec: &Record, t: Instant) -> Outcome {
-    let from = rec.moves.last().map_or(0, |m| m.first_run);
-    let (mut late, mut first) = (0u64, None);
-    for r in rec.runs.get(from..).unwrap_or_default() {
-        let count = u64::from(r.count);
-        // Pulses of the run at or before `t`.
-        let on_time = r.count_until(t);
-        if on_time < r.count {
-            first.get_or_insert(r.at(on_time));
-            late += count - u64::from(on_time);
-        }
-    }
-    match first {
-        Some(first) => Err(fail(format!("no pulse after {t}"), 0, late, first)),
-        None => Ok(()),
-    }
-}
-
-pub(super) fn describe_status(s: Status) -> String {
-    match s.field() {
-        StatusField::Error(e) => format!("0x{:02X} ({e})", s.0),
-        StatusField::ParamsRemaining(n) => {
-            format!("0x{:02X} (no error, {n} parameters wanted)", s.0)
-        }
-    }
-}
-
-pub(super) fn hex(b: &[u8]) -> String {
-    b.iter()
-        .map(|x| format!("0x{x:02X}"))
-        .collect::<Vec<_>>()
-        .join(" ")
-}
-
-pub(super) fn opt(d: Option<Duration>) -> String {
-    d.map_or("-".into(), |d| d.to_string())
 }
 
 #[cfg(test)]
@@ -742,7 +499,8 @@ mod tests {
     use crate::backend::{EmuTarget, Target, TargetError, TargetErrorKind, TargetInfo};
     use crate::emu::ModelConfig;
     use crate::protocol::Straps;
-    use crate::scenario::{DriverOptions, Init, Move};
+    use crate::protocol::{Direction, ErrorCode};
+    use crate::scenario::{Driver, DriverOptions, Failure, Init, Move};
 
     /// The emulator, counting round trips and the ops in each.
     #[derive(Debug)]

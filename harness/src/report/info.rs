@@ -1,0 +1,153 @@
+//! Facts about a run that every report carries: [`RunInfo`], its boards
+//! ([`BoardInfo`]) and the options it was made with ([`RunOptions`]).
+
+use crate::backend::TargetInfo;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::SystemTime;
+
+/// The selection and settings a run was made with, for the record.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct RunOptions {
+    pub filter: Option<String>,
+    pub tags: Vec<String>,
+    pub skip_tags: Vec<String>,
+    /// `I/N`, when the run is one shard of the suite.
+    pub shard: Option<String>,
+    pub repeat: u32,
+    /// The golden directory compared against, if any.
+    pub golden: Option<String>,
+    /// Width of the MARGINAL zone, percent of each limit.
+    pub marginal_pct: f64,
+    /// The golden comparison's tolerances.
+    pub latency_tol_pct: f64,
+    pub interval_tol_pct: f64,
+    pub time_floor_ns: u64,
+}
+
+/// A board of a run: what the reports call it and what is known of it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BoardInfo {
+    /// The board's label: the `--target` given, or its `name=`.
+    pub name: String,
+    /// The target as reached: `serial:/dev/ttyACM0`, or
+    /// `labgrid:rig1 (rfc2217://lab:2001)`.
+    pub target: String,
+    pub target_details: BTreeMap<String, String>,
+    /// The board revision label (`rev=` or `--board-rev`).
+    pub board_rev: Option<String>,
+    /// The bus bridge's firmware version, when the target is a board.
+    pub bridge_firmware: Option<String>,
+    /// Why the board took no part in the run, or left it early.
+    pub error: Option<String>,
+}
+
+impl BoardInfo {
+    pub fn new(name: String, target: &TargetInfo, board_rev: Option<String>) -> BoardInfo {
+        let bridge_firmware = target
+            .extra
+            .iter()
+            .find(|(k, _)| k == "bridge_firmware")
+            .map(|(_, v)| v.clone());
+        BoardInfo {
+            name,
+            target: target.name.clone(),
+            target_details: target.details().into_iter().collect(),
+            board_rev,
+            bridge_firmware,
+            error: None,
+        }
+    }
+
+    /// A board that could not be reached: nothing is known of it but its
+    /// name, the address it was tried at (`target`) and why.
+    pub fn unreached(
+        name: String,
+        target: String,
+        board_rev: Option<String>,
+        why: String,
+    ) -> BoardInfo {
+        BoardInfo {
+            target,
+            name,
+            target_details: BTreeMap::new(),
+            board_rev,
+            bridge_firmware: None,
+            error: Some(why),
+        }
+    }
+}
+
+/// Facts about a run that every report carries.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunInfo {
+    pub harness_version: String,
+    pub git_revision: String,
+    /// The boards, in the order of `--target`; results name them by index.
+    pub boards: Vec<BoardInfo>,
+    /// `one` (a single board), `share` (each scenario on one of several
+    /// boards) or `each` (every scenario on every board).
+    pub spread: &'static str,
+    /// When the run started, UTC, RFC 3339.
+    pub started: String,
+    /// Wall-clock duration of the whole run, seconds.
+    pub wall_s: f64,
+    /// The machine the harness ran on.
+    pub host: String,
+    pub options: RunOptions,
+}
+
+impl RunInfo {
+    pub fn new(boards: Vec<BoardInfo>, spread: &'static str) -> RunInfo {
+        RunInfo {
+            harness_version: crate::VERSION.to_string(),
+            git_revision: crate::GIT_REV.to_string(),
+            boards,
+            spread,
+            started: rfc3339(SystemTime::now()),
+            wall_s: 0.0,
+            host: hostname(),
+            options: RunOptions::default(),
+        }
+    }
+
+    /// The label of board `b`, or `(none)` for a result no board took.
+    pub fn board_name(&self, b: Option<usize>) -> &str {
+        b.and_then(|b| self.boards.get(b))
+            .map_or("(none)", |b| b.name.as_str())
+    }
+}
+
+/// The machine's name, as far as it can be learned without privileges.
+fn hostname() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|h| h.trim().to_string())
+        .filter(|h| !h.is_empty())
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// `t` as `YYYY-MM-DDTHH:MM:SSZ` (UTC).
+pub fn rfc3339(t: SystemTime) -> String {
+    let secs = t
+        .duration_since(SystemTime::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let (days, rem) = (secs / 86_400, secs % 86_400);
+    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
+    let z = days as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1_460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3_600,
+        rem % 3_600 / 60,
+        rem % 60
+    )
+}

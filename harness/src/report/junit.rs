@@ -1,0 +1,442 @@
+//! JUnit XML for CI systems (see [`junit`]).
+
+use super::info::{BoardInfo, RunInfo};
+use super::listing::{error_kind, Listing, ReportError};
+use crate::scenario::{Grade, NotRun, ScenarioResult, Verdict};
+use crate::soak::Repeated;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// JUnit XML for CI systems, valid under the Jenkins xunit schema
+/// (`junit-10.xsd`) and read by GitLab and junitparser: one test case per
+/// scenario run (classname = datasheet section; names made unique under
+/// `--repeat` with ` [pass K]`), `time` in wall seconds with the device's
+/// virtual time as a suite property per case; a failure or error carries
+/// its explanation in `message` and as its text; infrastructure problems
+/// (target unreachable or lost) are errors, an interrupted run's leftovers
+/// are skipped; the files saved for each result (`attachments`, in the
+/// results' order; missing entries mean none) are `[[ATTACHMENT|path]]`
+/// lines in `system-out`.
+///
+/// `boards` gives each result's board (an index into `info.boards`). A run
+/// on one board is one test suite with the board's facts as properties
+/// (`target`, `board_rev`, `target.*`). A run shared by several boards is
+/// one test suite too: each board's facts are `board.<name>.*` properties,
+/// and each test case names its board in a `board_of.<case>` property and a
+/// `board:` line of its `system-out`. A run with `--each` is one test suite
+/// per board, named after it.
+pub fn junit(
+    info: &RunInfo,
+    results: &[ScenarioResult],
+    attachments: &[Vec<String>],
+    boards: &[Option<usize>],
+) -> Result<String, ReportError> {
+    junit_listing(info, &Listing::all(results, attachments, boards))
+}
+
+/// A test case: a result, or a scenario's repeated runs.
+enum Case<'a> {
+    One(usize),
+    Many(&'a Repeated),
+}
+
+/// The child element a test case's verdict gives it, if any: failure,
+/// error or skipped, with its type and message.
+fn verdict_element(v: &Verdict) -> Option<(&'static str, &'static str, String)> {
+    match v {
+        Verdict::Passed | Verdict::Marginal => None,
+        Verdict::Failed(f) => Some(("failure", "device", f.to_string())),
+        Verdict::Error(e) => Some(("error", error_kind(e), e.to_string())),
+        Verdict::NotRun(NotRun::Interrupted) => {
+            Some(("skipped", "interrupted", NotRun::Interrupted.to_string()))
+        }
+        Verdict::NotRun(why) => Some(("error", "infrastructure", why.to_string())),
+    }
+}
+
+/// The element of a scenario's repeated runs: a failure or error when runs
+/// that did not pass were counted past the listing's cap.
+fn repeated_element(r: &Repeated) -> Option<(&'static str, &'static str, String)> {
+    let t = &r.tally;
+    let past = format!(
+        "past the first {} results after the first pass that did not pass, which are listed one by one",
+        crate::soak::MAX_LISTED
+    );
+    let lost = t.not_run - r.interrupted;
+    if t.failed > 0 {
+        Some((
+            "failure",
+            "device",
+            format!("{} runs failed {past}", t.failed),
+        ))
+    } else if t.errors > 0 {
+        Some((
+            "error",
+            "harness",
+            format!("{} runs were errors {past}", t.errors),
+        ))
+    } else if lost > 0 {
+        Some((
+            "error",
+            "infrastructure",
+            format!("{lost} runs were not run {past}"),
+        ))
+    } else {
+        None
+    }
+}
+
+/// [`junit`] of what `listing` lists: each listed result a test case (named
+/// ` [pass K]` when the run repeats), and each scenario's repeated runs one
+/// test case, ` [passes A-B]` (with ` on <board>` in a suite several
+/// boards share), whose `system-out` gives their counts and each
+/// measurement's range, `time` their wall time and `device_time` their
+/// virtual time, summed.
+pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> {
+    let results = l.results;
+    let repeats = info.options.repeat > 1 && !l.passes.is_empty();
+    let in_board = |b: Option<usize>| {
+        (0..results.len())
+            .filter(move |&i| l.board_of(i) == b)
+            .map(Case::One)
+    };
+    let many_in = |b: Option<usize>| {
+        l.repeated
+            .iter()
+            .filter(move |r| r.board == b)
+            .map(Case::Many)
+    };
+    // The suites: their board (when they have one) and their cases.
+    let groups: Vec<(Option<usize>, Vec<Case>)> = if info.spread == "each" {
+        (0..info.boards.len())
+            .map(|b| (Some(b), in_board(Some(b)).chain(many_in(Some(b))).collect()))
+            .collect()
+    } else {
+        let board = (info.boards.len() == 1).then_some(0);
+        let cases = (0..results.len())
+            .map(Case::One)
+            .chain(l.repeated.iter().map(Case::Many))
+            .collect();
+        vec![(board, cases)]
+    };
+    let element = |c: &Case| match c {
+        Case::One(i) => verdict_element(&results[*i].verdict),
+        Case::Many(r) => repeated_element(r),
+    };
+    let kind_count = |cases: &[Case], tag: &str| {
+        cases
+            .iter()
+            .filter(|c| element(c).is_some_and(|(t, _, _)| t == tag))
+            .count()
+    };
+    let all: usize = groups.iter().map(|(_, c)| c.len()).sum();
+    let (failures, errors): (usize, usize) = groups.iter().fold((0, 0), |(f, e), (_, c)| {
+        (f + kind_count(c, "failure"), e + kind_count(c, "error"))
+    });
+    let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    let _ = writeln!(
+        x,
+        "<testsuites name=\"ppmc\" tests=\"{all}\" failures=\"{failures}\" errors=\"{errors}\" time=\"{:.6}\">",
+        info.wall_s
+    );
+    for (board, cases) in groups {
+        let shared = board.is_none() && info.boards.len() > 1;
+        let one_names = unique_names(
+            &cases
+                .iter()
+                .filter_map(|c| match c {
+                    Case::One(i) => Some(&results[*i]),
+                    Case::Many(_) => None,
+                })
+                .collect::<Vec<_>>(),
+        );
+        let mut ones = one_names.into_iter();
+        let names: Vec<String> = cases
+            .iter()
+            .map(|c| match c {
+                Case::One(i) => {
+                    let n = ones.next().unwrap_or_default();
+                    match l.passes.get(*i) {
+                        Some(p) if repeats => format!("{} [pass {p}]", results[*i].name),
+                        _ => n,
+                    }
+                }
+                Case::Many(r) => {
+                    let mut n = format!("{} [passes {}-{}]", r.name, r.first_pass, r.last_pass);
+                    if shared {
+                        n.push_str(&format!(" on {}", info.board_name(r.board)));
+                    }
+                    n
+                }
+            })
+            .collect();
+        let wall: f64 = cases
+            .iter()
+            .map(|c| match c {
+                Case::One(i) => results[*i].wall.as_secs_f64(),
+                Case::Many(r) => r.wall.as_secs_f64(),
+            })
+            .sum();
+        let mut suite_name = "ppmc-conformance".to_string();
+        if let Some(shard) = &info.options.shard {
+            suite_name.push_str(&format!(" shard {shard}"));
+        }
+        if info.spread == "each" {
+            suite_name.push_str(&format!(" on {}", info.board_name(board)));
+        }
+        let _ = writeln!(
+            x,
+            "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" skipped=\"{}\" \
+             time=\"{wall:.6}\" timestamp=\"{}\" hostname=\"{}\">",
+            esc(&suite_name),
+            cases.len(),
+            kind_count(&cases, "failure"),
+            kind_count(&cases, "error"),
+            kind_count(&cases, "skipped"),
+            esc(&info.started),
+            esc(&info.host)
+        );
+        x.push_str("    <properties>\n");
+        let mut props: Vec<(String, String)> = vec![
+            ("harness_version".into(), info.harness_version.clone()),
+            ("git_revision".into(), info.git_revision.clone()),
+        ];
+        match board {
+            Some(b) => props.extend(board_props("", &info.boards[b])),
+            None => {
+                for b in &info.boards {
+                    props.extend(board_props(&format!("board.{}.", b.name), b));
+                }
+                props.extend(cases.iter().zip(&names).map(|(c, n)| {
+                    let b = match c {
+                        Case::One(i) => l.board_of(*i),
+                        Case::Many(r) => r.board,
+                    };
+                    (format!("board_of.{n}"), info.board_name(b).to_string())
+                }));
+            }
+        }
+        props.extend(cases.iter().zip(&names).map(|(c, n)| {
+            let elapsed = match c {
+                Case::One(i) => results[*i].elapsed,
+                Case::Many(r) => r.elapsed,
+            };
+            (
+                format!("device_time.{n}"),
+                format!("{:.9}", elapsed.as_nanos() as f64 / 1e9),
+            )
+        }));
+        for (k, v) in props {
+            let _ = writeln!(
+                x,
+                "      <property name=\"{}\" value=\"{}\"/>",
+                esc(&k),
+                esc(&v)
+            );
+        }
+        x.push_str("    </properties>\n");
+        for (c, name) in cases.iter().zip(&names) {
+            match c {
+                Case::One(i) => {
+                    let shared = board.is_none().then(|| info.board_name(l.board_of(*i)));
+                    testcase(&mut x, &results[*i], name, l.attachments.get(*i), shared);
+                }
+                Case::Many(r) => {
+                    let shared = board.is_none().then(|| info.board_name(r.board));
+                    repeated_case(&mut x, r, name, shared);
+                }
+            }
+        }
+        x.push_str("  </testsuite>\n");
+    }
+    x.push_str("</testsuites>\n");
+    Ok(x)
+}
+
+/// One `<testcase>` for a scenario's repeated runs.
+fn repeated_case(x: &mut String, r: &Repeated, name: &str, board: Option<&str>) {
+    let t = &r.tally;
+    let mut out = Vec::new();
+    if let Some(b) = board {
+        out.push(format!("board: {b}"));
+    }
+    out.push(format!(
+        "repeated: {} runs of passes {}-{} not listed one by one: {} passed, {} marginal, {} failed, {} errors, {} not run ({} interrupted)",
+        r.runs(),
+        r.first_pass,
+        r.last_pass,
+        t.passed,
+        t.marginal,
+        t.failed,
+        t.errors,
+        t.not_run,
+        r.interrupted
+    ));
+    out.extend(r.measurements.iter().map(|m| {
+        format!(
+            "{}: {} runs, min {}, mean {}, max {}, worst {}",
+            m.name,
+            m.count,
+            m.min,
+            m.mean(),
+            m.max,
+            m.worst.name()
+        )
+    }));
+    let _ = writeln!(
+        x,
+        "    <testcase name=\"{}\" classname=\"section {}\" time=\"{:.6}\">",
+        esc(name),
+        esc(r.section),
+        r.wall.as_secs_f64()
+    );
+    if let Some((tag, kind, message)) = repeated_element(r) {
+        let _ = writeln!(
+            x,
+            "      <{tag} type=\"{kind}\" message=\"{}\">{}</{tag}>",
+            esc(&message),
+            esc_text(&message)
+        );
+    }
+    let _ = writeln!(
+        x,
+        "      <system-out>{}</system-out>",
+        esc_text(&out.join("\n"))
+    );
+    x.push_str("    </testcase>\n");
+}
+
+/// A board's facts as suite properties, their names prefixed by `prefix`.
+fn board_props(prefix: &str, b: &BoardInfo) -> Vec<(String, String)> {
+    let mut props = vec![
+        (format!("{prefix}target"), b.target.clone()),
+        (
+            format!("{prefix}board_rev"),
+            b.board_rev.clone().unwrap_or_default(),
+        ),
+        (
+            format!("{prefix}bridge_firmware"),
+            b.bridge_firmware.clone().unwrap_or_default(),
+        ),
+    ];
+    if let Some(e) = &b.error {
+        props.push((format!("{prefix}error"), e.clone()));
+    }
+    props.extend(
+        b.target_details
+            .iter()
+            .map(|(k, v)| (format!("{prefix}target.{k}"), v.clone())),
+    );
+    props
+}
+
+/// One `<testcase>`; `board` names the board when the suite is shared.
+fn testcase(
+    x: &mut String,
+    r: &ScenarioResult,
+    name: &str,
+    attachments: Option<&Vec<String>>,
+    board: Option<&str>,
+) {
+    let _ = write!(
+        x,
+        "    <testcase name=\"{}\" classname=\"section {}\" time=\"{:.6}\"",
+        esc(name),
+        esc(r.section),
+        r.wall.as_secs_f64()
+    );
+    let mut body = String::new();
+    if let Some((tag, kind, message)) = verdict_element(&r.verdict) {
+        let _ = writeln!(
+            body,
+            "      <{tag} type=\"{kind}\" message=\"{}\">{}</{tag}>",
+            esc(&message),
+            esc_text(&message)
+        );
+    }
+    let mut out: Vec<String> = Vec::new();
+    if let Some(b) = board {
+        out.push(format!("board: {b}"));
+    }
+    if r.verdict == Verdict::Marginal {
+        let near: Vec<String> = r
+            .measurements
+            .iter()
+            .filter(|m| m.grade == Grade::Marginal)
+            .map(|m| m.to_string())
+            .collect();
+        out.push(format!("MARGINAL: {}", near.join("; ")));
+    }
+    out.extend(
+        attachments
+            .into_iter()
+            .flatten()
+            .map(|p| format!("[[ATTACHMENT|{p}]]")),
+    );
+    if !out.is_empty() {
+        let _ = writeln!(
+            body,
+            "      <system-out>{}</system-out>",
+            esc_text(&out.join("\n"))
+        );
+    }
+    if body.is_empty() {
+        x.push_str("/>\n");
+    } else {
+        x.push_str(">\n");
+        x.push_str(&body);
+        x.push_str("    </testcase>\n");
+    }
+}
+
+/// Test case names, with ` [pass K]` when a scenario ran more than once.
+fn unique_names(results: &[&ScenarioResult]) -> Vec<String> {
+    let mut runs: BTreeMap<&str, usize> = BTreeMap::new();
+    for r in results {
+        *runs.entry(r.name).or_default() += 1;
+    }
+    let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
+    results
+        .iter()
+        .map(|r| {
+            let k = seen.entry(r.name).or_default();
+            *k += 1;
+            if runs[r.name] > 1 {
+                format!("{} [pass {k}]", r.name)
+            } else {
+                r.name.to_string()
+            }
+        })
+        .collect()
+}
+
+/// Text as an XML attribute value (a newline kept as `&#10;`).
+fn esc(s: &str) -> String {
+    escape(s, true)
+}
+
+/// Text as XML element content (newlines as they are).
+fn esc_text(s: &str) -> String {
+    escape(s, false)
+}
+
+/// Characters XML 1.0 cannot carry at all (most control characters)
+/// become `?`.
+fn escape(s: &str, attribute: bool) -> String {
+    let mut o = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '\n' if !attribute => o.push('\n'),
+            '&' => o.push_str("&amp;"),
+            '<' => o.push_str("&lt;"),
+            '>' => o.push_str("&gt;"),
+            '"' => o.push_str("&quot;"),
+            '\'' => o.push_str("&apos;"),
+            '\n' => o.push_str("&#10;"),
+            '\t' | '\r' => o.push(' '),
+            c if (c as u32) < 0x20 || c == '\u{FFFE}' || c == '\u{FFFF}' => o.push('?'),
+            c => o.push(c),
+        }
+    }
+    o
+}
