@@ -341,58 +341,7 @@ pub fn to_op(stmt: Stmt, opts: &ConsoleOptions) -> Op {
 /// (`None` for statements that touch no register or pin: `wait`, `pins`,
 /// `pulses`, `now`).
 pub fn bus_event(stmt: Stmt, reply: &Reply) -> Option<BusEvent> {
-    Some(match (stmt, *reply) {
-        (Stmt::WriteCommand { byte, wait }, Reply::Written { waited, .. }) => {
-            BusEvent::WriteCommand {
-                byte,
-                waited: wait.then_some(waited),
-            }
-        }
-        (Stmt::WriteData { byte, wait }, Reply::Written { waited, .. }) => BusEvent::WriteData {
-            byte,
-            waited: wait.then_some(waited),
-        },
-        (Stmt::WriteCommand { byte, .. }, Reply::WriteTimedOut { .. }) => BusEvent::WriteTimedOut {
-            command: true,
-            byte,
-        },
-        (Stmt::WriteData { byte, .. }, Reply::WriteTimedOut { .. }) => BusEvent::WriteTimedOut {
-            command: false,
-            byte,
-        },
-        (Stmt::ReadStatus, Reply::Status { status, .. }) => BusEvent::ReadStatus(status.0),
-        (Stmt::ReadData { wait }, Reply::Data { byte, waited, .. }) => BusEvent::ReadData {
-            byte,
-            waited: wait.then_some(waited),
-        },
-        (Stmt::ReadData { .. }, Reply::ReadTimedOut { .. }) => BusEvent::ReadTimedOut,
-        (Stmt::Await { flag, value, .. }, Reply::Awaited { waited, status, .. }) => {
-            BusEvent::Await {
-                flag,
-                value,
-                waited: Some(waited),
-                status: status.0,
-            }
-        }
-        (Stmt::Await { flag, value, .. }, Reply::AwaitTimedOut { status, .. }) => BusEvent::Await {
-            flag,
-            value,
-            waited: None,
-            status: status.0,
-        },
-        (Stmt::Set { input, asserted }, Reply::InputSet { .. }) => {
-            BusEvent::SetInput { input, asserted }
-        }
-        (Stmt::AwaitPulse { count, .. }, Reply::PulsesReached { .. }) => BusEvent::AwaitPulses {
-            count,
-            reached: true,
-        },
-        (Stmt::AwaitPulse { count, .. }, Reply::PulsesTimedOut { .. }) => BusEvent::AwaitPulses {
-            count,
-            reached: false,
-        },
-        _ => return None,
-    })
+    BusEvent::of(&to_op(stmt, &ConsoleOptions::default()), reply)
 }
 
 fn opt_time<T: fmt::Display>(t: Option<T>) -> String {

@@ -25,6 +25,7 @@
 //! golden file may start with insta's `---` front matter, which is skipped.
 //! [`Trace::parse`] reads back exactly what [`Trace::render`] writes.
 
+use crate::backend::{Op, Reply};
 use crate::protocol::{
     Direction, Flag, Input, MoveKind, Pin, PulseRun, Record, StrapFieldError, Straps, Winding,
     STRAP_KEYS,
@@ -150,6 +151,85 @@ pub enum BusEvent {
         reached: bool,
     },
     Reset,
+}
+
+impl BusEvent {
+    /// The bus transaction an op's reply shows, as traces record it: the
+    /// one place a target's vocabulary ([`Op`], [`Reply`]) becomes a
+    /// trace's. A write or read waited (`waited: Some`) when its op asked
+    /// to wait. `None` for an op that touches no register or input (a
+    /// delay, a pin sample, a pulse summary), an await on anything but one
+    /// status flag, or a reply that does not answer the op.
+    pub fn of(op: &Op, reply: &Reply) -> Option<BusEvent> {
+        Some(match (*op, *reply) {
+            (Op::WriteCommand { byte, wait_ibf }, Reply::Written { waited, .. }) => {
+                BusEvent::WriteCommand {
+                    byte,
+                    waited: wait_ibf.map(|_| waited),
+                }
+            }
+            (Op::WriteData { byte, wait_ibf }, Reply::Written { waited, .. }) => {
+                BusEvent::WriteData {
+                    byte,
+                    waited: wait_ibf.map(|_| waited),
+                }
+            }
+            (Op::WriteCommand { byte, .. }, Reply::WriteTimedOut { .. }) => {
+                BusEvent::WriteTimedOut {
+                    command: true,
+                    byte,
+                }
+            }
+            (Op::WriteData { byte, .. }, Reply::WriteTimedOut { .. }) => BusEvent::WriteTimedOut {
+                command: false,
+                byte,
+            },
+            (Op::ReadStatus, Reply::Status { status, .. }) => BusEvent::ReadStatus(status.0),
+            (Op::ReadData { wait_obf }, Reply::Data { byte, waited, .. }) => BusEvent::ReadData {
+                byte,
+                waited: wait_obf.map(|_| waited),
+            },
+            (Op::ReadData { .. }, Reply::ReadTimedOut { .. }) => BusEvent::ReadTimedOut,
+            (Op::AwaitStatus { mask, value, .. }, Reply::Awaited { waited, status, .. }) => {
+                BusEvent::Await {
+                    flag: flag_of(mask)?,
+                    value: value != 0,
+                    waited: Some(waited),
+                    status: status.0,
+                }
+            }
+            (Op::AwaitStatus { mask, value, .. }, Reply::AwaitTimedOut { status, .. }) => {
+                BusEvent::Await {
+                    flag: flag_of(mask)?,
+                    value: value != 0,
+                    waited: None,
+                    status: status.0,
+                }
+            }
+            (Op::SetInput { input, asserted }, Reply::InputSet { .. }) => {
+                BusEvent::SetInput { input, asserted }
+            }
+            (Op::AwaitPulses { count, .. }, Reply::PulsesReached { .. }) => BusEvent::AwaitPulses {
+                count,
+                reached: true,
+            },
+            (Op::AwaitPulses { count, .. }, Reply::PulsesTimedOut { .. }) => {
+                BusEvent::AwaitPulses {
+                    count,
+                    reached: false,
+                }
+            }
+            (Op::Reset, Reply::ResetDone { .. }) => BusEvent::Reset,
+            _ => return None,
+        })
+    }
+}
+
+/// The one status flag `mask` selects ([`Op::await_flag`]).
+fn flag_of(mask: u8) -> Option<Flag> {
+    [Flag::Ibf, Flag::Obf, Flag::Busy, Flag::Err]
+        .into_iter()
+        .find(|f| f.mask() == mask)
 }
 
 /// A trace file that cannot be read.

@@ -324,71 +324,29 @@ impl<'t> Batch<'t> {
         }
     }
 
-    /// Logs a step's reply and judges it. `began` is when the step started
+    /// Logs a step's reply ([`BusEvent::of`]) and judges it. `began` is when the step started
     /// (the end of the step before it).
     fn judge(&mut self, step: Step, reply: Reply, began: Instant) -> Outcome<Done> {
+        if let Some(e) = BusEvent::of(&self.step_op(step), &reply) {
+            self.log_bus(reply.at(), e);
+        }
         match (step, reply) {
-            (
-                Step::Write {
-                    byte,
-                    command,
-                    wait,
-                },
-                Reply::Written { at, waited },
-            ) => {
-                let waited = wait.then_some(waited);
-                let e = if command {
-                    BusEvent::WriteCommand { byte, waited }
-                } else {
-                    BusEvent::WriteData { byte, waited }
-                };
-                self.log_bus(at, e);
-                Ok(Done::At)
-            }
-            (Step::Write { byte, command, .. }, Reply::WriteTimedOut { at, status }) => {
-                self.log_bus(at, BusEvent::WriteTimedOut { command, byte });
-                Err(fail(
-                    format!("IBF = 0 before writing 0x{byte:02X} (flowchart)"),
-                    format!("IBF = 0 within {}", self.limits.ibf_timeout),
-                    format!("status 0x{:02X}", status.0),
-                    at,
-                ))
-            }
-            (Step::Status, Reply::Status { at, status }) => {
-                self.log_bus(at, BusEvent::ReadStatus(status.0));
-                Ok(Done::Status(status))
-            }
-            (Step::ReadData, Reply::Data { at, byte, waited }) => {
-                self.log_bus(
-                    at,
-                    BusEvent::ReadData {
-                        byte,
-                        waited: Some(waited),
-                    },
-                );
-                Ok(Done::Byte(byte))
-            }
-            (Step::ReadData, Reply::ReadTimedOut { at, status }) => {
-                self.log_bus(at, BusEvent::ReadTimedOut);
-                Err(fail(
-                    "OBF = 1 before reading (flowchart)",
-                    format!("OBF = 1 within {}", self.limits.obf_timeout),
-                    format!("status 0x{:02X}", status.0),
-                    at,
-                ))
-            }
-            (Step::Await { flag, value, .. }, Reply::Awaited { at, waited, status }) => {
-                self.log_bus(
-                    at,
-                    BusEvent::Await {
-                        flag,
-                        value,
-                        waited: Some(waited),
-                        status: status.0,
-                    },
-                );
-                Ok(Done::Waited(Some(waited)))
-            }
+            (Step::Write { .. }, Reply::Written { .. }) => Ok(Done::At),
+            (Step::Write { byte, .. }, Reply::WriteTimedOut { at, status }) => Err(fail(
+                format!("IBF = 0 before writing 0x{byte:02X} (flowchart)"),
+                format!("IBF = 0 within {}", self.limits.ibf_timeout),
+                format!("status 0x{:02X}", status.0),
+                at,
+            )),
+            (Step::Status, Reply::Status { status, .. }) => Ok(Done::Status(status)),
+            (Step::ReadData, Reply::Data { byte, .. }) => Ok(Done::Byte(byte)),
+            (Step::ReadData, Reply::ReadTimedOut { at, status }) => Err(fail(
+                "OBF = 1 before reading (flowchart)",
+                format!("OBF = 1 within {}", self.limits.obf_timeout),
+                format!("status 0x{:02X}", status.0),
+                at,
+            )),
+            (Step::Await { .. }, Reply::Awaited { waited, .. }) => Ok(Done::Waited(Some(waited))),
             (
                 Step::Await {
                     flag,
@@ -396,17 +354,8 @@ impl<'t> Batch<'t> {
                     timeout,
                     must,
                 },
-                Reply::AwaitTimedOut { at, status },
+                Reply::AwaitTimedOut { .. },
             ) => {
-                self.log_bus(
-                    at,
-                    BusEvent::Await {
-                        flag,
-                        value,
-                        waited: None,
-                        status: status.0,
-                    },
-                );
                 if must {
                     return Err(fail(
                         format!("{} = {}", flag.name(), u8::from(value)),
@@ -418,45 +367,15 @@ impl<'t> Batch<'t> {
                 Ok(Done::Waited(None))
             }
             (Step::Delay(_), Reply::Delayed { .. }) => Ok(Done::At),
-            (Step::Set { input, on }, Reply::InputSet { at }) => {
-                self.log_bus(
-                    at,
-                    BusEvent::SetInput {
-                        input,
-                        asserted: on,
-                    },
-                );
-                Ok(Done::At)
-            }
-            (Step::AwaitPulses { count, .. }, Reply::PulsesReached { at }) => {
-                self.log_bus(
-                    at,
-                    BusEvent::AwaitPulses {
-                        count,
-                        reached: true,
-                    },
-                );
-                Ok(Done::At)
-            }
-            (Step::AwaitPulses { count: n, .. }, Reply::PulsesTimedOut { at, count }) => {
-                self.log_bus(
-                    at,
-                    BusEvent::AwaitPulses {
-                        count: n,
-                        reached: false,
-                    },
-                );
-                Err(fail(
-                    "pulses output so far",
-                    format!("at least {n}"),
-                    count,
-                    at,
-                ))
-            }
-            (Step::Reset, Reply::ResetDone { at }) => {
-                self.log_bus(at, BusEvent::Reset);
-                Ok(Done::At)
-            }
+            (Step::Set { .. }, Reply::InputSet { .. }) => Ok(Done::At),
+            (Step::AwaitPulses { .. }, Reply::PulsesReached { .. }) => Ok(Done::At),
+            (Step::AwaitPulses { count: n, .. }, Reply::PulsesTimedOut { at, count }) => Err(fail(
+                "pulses output so far",
+                format!("at least {n}"),
+                count,
+                at,
+            )),
+            (Step::Reset, Reply::ResetDone { .. }) => Ok(Done::At),
             (Step::Pins, Reply::Pins { pins, .. }) => Ok(Done::Pins(pins)),
             (step, other) => Err(self.unexpected(&format!("`{}`", self.step_op(step)), &other)),
         }
