@@ -7,8 +7,9 @@
 //! [`backend`] (one bus abstraction, many backends: the emulator, a serial
 //! bridge) and [`bridge::sim`] ← [`scenario`] (the scenario API) ←
 //! [`runner`], [`trace`], [`golden`], [`compare`], [`report`],
-//! [`console`] ← [`fuzzing`], [`fault_matrix`] ← [`cli`] (the command
-//! line). `ARCHITECTURE.md` at the repository root is the map.
+//! [`console`] ← [`fuzzing`] (its oracle in [`invariants`], the second
+//! model of the chip in [`plain_model`]), [`fault_matrix`] ← [`cli`] (the
+//! command line). `ARCHITECTURE.md` at the repository root is the map.
 
 pub mod backend;
 pub mod bridge;
@@ -20,6 +21,8 @@ pub mod fault_matrix;
 pub mod files;
 pub mod fuzzing;
 pub mod golden;
+pub mod invariants;
+pub mod plain_model;
 pub mod report;
 pub mod runner;
 pub mod scenario;

@@ -4,8 +4,8 @@
 //! inputs it reached), so that a user sees what was not exercised.
 
 use super::bus::BusOp;
-use super::oracle::{Checker, Violation};
 use crate::emu::ModelConfig;
+use crate::invariants::oracle::{Checker, Violation};
 use crate::protocol::{Command, ErrorCode, Input, MoveKind, StatusField};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;

@@ -2,8 +2,8 @@
 //! after every op, the invariants of `docs/invariants.md`. Each invariant
 //! has a stable id; a finding is bucketed by it.
 
-use super::bus::BusOp;
 use crate::emu::{Board, ChipError, ModelConfig};
+use crate::fuzzing::bus::{self, BusOp};
 use crate::protocol::capture::{MoveStart, Pin, PulseRun, Record};
 use crate::protocol::{
     ClockSource, Command, FinishStatus, InitData, MoveKind, Register, Status, StatusField, Straps,
@@ -585,7 +585,7 @@ impl Checker {
         // has no side effect (Section 3-1-1): the status after one op is
         // the status before the next.
         let before = self.status.unwrap_or_else(|| chip.read_status());
-        let value = super::bus::apply(chip, op);
+        let value = bus::apply(chip, op);
         // A status read's own value is the status after it.
         let after = match (op, value) {
             (BusOp::ReadStatus, Some(v)) => Status(v),

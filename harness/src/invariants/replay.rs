@@ -4,9 +4,9 @@
 //! needs IBF and OBF as the host saw them: that is how a reproducer runs on
 //! a board, and how a regression scenario made from a finding checks it.
 
-use super::bus::BusOp;
 use super::oracle::{self, Judge, Seen, Violation};
 use crate::backend::{Op, Reply, Target, TargetError};
+use crate::fuzzing::bus::BusOp;
 use crate::protocol::{Record, Straps};
 use crate::scenario::{Driver, Failure, HarnessError, Outcome, Stop};
 use crate::trace::BusEvent;
