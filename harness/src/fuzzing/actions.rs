@@ -15,6 +15,7 @@
 use super::bus;
 use crate::console::Stmt;
 use crate::emu::{ModelConfig, PA_MIN};
+use crate::invariants::judge::Violation;
 use crate::invariants::oracle;
 use crate::protocol::{
     ClockSource, Command, Direction, Excitation, Flag, InitCommand, Input, MotorType, MoveCommand,
@@ -274,7 +275,7 @@ pub fn typed_program(data: &[u8]) -> Vec<Action> {
 /// (the flowchart's waits become the time that passed, to the
 /// microsecond), with the first invariant break. The ops replay as a
 /// `bus_bytes` input, so every finding has one bus-level form.
-pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus::BusOp>, Option<oracle::Violation>) {
+pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus::BusOp>, Option<Violation>) {
     let mut ops = Vec::new();
     let Ok(mut c) = oracle::Checker::new(cfg) else {
         return (ops, None);
@@ -288,7 +289,7 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus::BusOp>, Option<orac
                 ops: &mut Vec<bus::BusOp>,
                 ready: &dyn Fn(Status) -> bool,
                 timeout: Duration|
-     -> Result<(), oracle::Violation> {
+     -> Result<(), Violation> {
         let deadline = c.board().now() + timeout;
         while !ready(c.board().read_status()) && c.board().now() < deadline {
             let now = c.board().now();

@@ -5,7 +5,8 @@
 
 use super::bus::BusOp;
 use crate::emu::ModelConfig;
-use crate::invariants::oracle::{Checker, Violation};
+use crate::invariants::judge::Violation;
+use crate::invariants::oracle::Checker;
 use crate::protocol::{Command, ErrorCode, Input, MoveKind, StatusField};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;

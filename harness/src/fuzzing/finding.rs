@@ -7,7 +7,8 @@
 use super::actions::{lower, typed_program};
 use super::bus::{self, BusOp};
 use crate::emu::ModelConfig;
-use crate::invariants::oracle::{self, Violation};
+use crate::invariants::judge::Violation;
+use crate::invariants::oracle;
 use crate::plain_model::twin::{self, Disagreement};
 use crate::protocol::Straps;
 use crate::time::Duration;

@@ -3,9 +3,16 @@
 //! the emulator; a reproducer or a regression scenario runs them on any
 //! target.
 //!
-//! - [`oracle`]: the judge and the oracle on the emulator.
+//! - [`judge`]: the invariants judged op by op from what the host sees,
+//!   and at the end from the capture; a break is a
+//!   [`Violation`](judge::Violation).
+//! - [`capture`]: the checks that read the capture alone.
+//! - [`oracle`]: the judge on the emulator's chip, the fuzz targets'
+//!   oracle.
 //! - [`replay`]: bus ops replayed on any target and judged by the same
 //!   rules, and the body of a regression scenario.
 
+pub mod capture;
+pub mod judge;
 pub mod oracle;
 pub mod replay;
