@@ -7,6 +7,7 @@
 use super::actions::{lower, typed_program};
 use super::bus::{self, BusOp};
 use crate::emu::ModelConfig;
+use crate::invariants::ids::Invariant;
 use crate::invariants::judge::Violation;
 use crate::invariants::oracle;
 use crate::plain_model::twin::{self, Disagreement};
@@ -50,7 +51,7 @@ pub struct Minimized {
 /// ops), merge neighbouring waits, shorten each wait (binary search) and
 /// zero data bytes, until a whole pass changes nothing. `None` when `ops`
 /// does not break `invariant` to begin with.
-pub fn minimize(ops: &[BusOp], cfg: &ModelConfig, invariant: &str) -> Option<Minimized> {
+pub fn minimize(ops: &[BusOp], cfg: &ModelConfig, invariant: Invariant) -> Option<Minimized> {
     let mut tries = 0;
     let mut breaks = |ops: &[BusOp]| -> Option<Violation> {
         tries += 1;
@@ -230,14 +231,14 @@ pub fn to_bytes(ops: &[BusOp]) -> Vec<u8> {
 }
 
 /// A scenario name for a break of `invariant`: `fuzz_<invariant>_<n>`.
-pub fn scenario_stem(invariant: &str, n: usize) -> String {
-    format!("fuzz_{}_{n}", invariant.replace('-', "_"))
+pub fn scenario_stem(invariant: Invariant, n: usize) -> String {
+    format!("fuzz_{}_{n}", invariant.as_str().replace('-', "_"))
 }
 
 /// A Rust scenario file (for `scenarios/`) that replays `ops` and fails
 /// while `v` still breaks: the body of `ppmc fuzz to-scenario`.
 pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> String {
-    let section = oracle::section(v.invariant);
+    let section = v.invariant.section();
     let source = comment_safe(source);
     let detail = comment_safe(&v.detail);
     let mut s = String::new();
@@ -327,9 +328,9 @@ mod tests {
         let cfg = faults::find("remaining-off-by-one").expect("fault").model();
         let ops = noisy_remaining_finding();
         let v = first_break(&ops, &cfg).expect("the fault breaks it");
-        assert_eq!(v.invariant, "remaining-pulses");
-        let m = minimize(&ops, &cfg, "remaining-pulses").expect("minimized");
-        assert_eq!(m.violation.invariant, "remaining-pulses");
+        assert_eq!(v.invariant, Invariant::RemainingPulses);
+        let m = minimize(&ops, &cfg, Invariant::RemainingPulses).expect("minimized");
+        assert_eq!(m.violation.invariant, Invariant::RemainingPulses);
         assert!(
             m.ops.len() < ops.len() / 2,
             "{} of {}",
@@ -338,7 +339,7 @@ mod tests {
         );
         assert_eq!(
             first_break(&m.ops, &cfg).map(|v| v.invariant),
-            Some("remaining-pulses")
+            Some(Invariant::RemainingPulses)
         );
         // The clean model keeps the invariant on the minimized input.
         assert_eq!(first_break(&m.ops, &ModelConfig::default()), None);
@@ -349,7 +350,7 @@ mod tests {
         );
         // An input that breaks nothing cannot be minimized for it.
         assert_eq!(
-            minimize(&ops, &ModelConfig::default(), "remaining-pulses"),
+            minimize(&ops, &ModelConfig::default(), Invariant::RemainingPulses),
             None
         );
     }
@@ -357,7 +358,7 @@ mod tests {
     #[test]
     fn no_text_from_a_file_name_reaches_the_generated_code_unescaped() {
         let v = Violation {
-            invariant: "remaining-pulses",
+            invariant: Invariant::RemainingPulses,
             op: 0,
             detail: "read 5\nfn evil() {}".into(),
         };
@@ -380,7 +381,7 @@ mod tests {
     #[test]
     fn the_scenario_file_names_the_invariant_and_lists_every_op() {
         let v = Violation {
-            invariant: "remaining-pulses",
+            invariant: Invariant::RemainingPulses,
             op: 1,
             detail: "read 5".into(),
         };
@@ -460,7 +461,7 @@ mod tests {
         };
         let (script, found) = reproducer_with(&data, "x", cfg);
         let v = found.expect("a break");
-        assert_eq!((v.invariant, v.op), ("status-bit3", 4));
+        assert_eq!((v.invariant, v.op), (Invariant::StatusBit3, 4));
         assert!(script.contains("# breaks: invariant status-bit3 after op 4"));
         let marked: Vec<&str> = script.lines().filter(|l| l.contains("# <-")).collect();
         assert_eq!(marked, vec!["rs  # <- the break is seen after this op"]);

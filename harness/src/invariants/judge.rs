@@ -8,6 +8,7 @@
 use super::capture::{
     busy_level, phase_breaks, pulse_outside_busy, record_breaks, shortest_interval_below,
 };
+use super::ids::Invariant;
 use crate::fuzzing::bus::BusOp;
 use crate::protocol::capture::{MoveStart, Pin, Record};
 use crate::protocol::{
@@ -23,8 +24,9 @@ const MAX_PARAMS: u8 = 4;
 /// An invariant break: which invariant, after which op, and what was seen.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Violation {
-    /// The invariant's id in `docs/invariants.md`, e.g. `status-bit3`.
-    pub invariant: &'static str,
+    /// The invariant broken; its id (`Display`) is the one of
+    /// `docs/invariants.md`, e.g. `status-bit3`.
+    pub invariant: Invariant,
     /// Index of the op after which it was seen.
     pub op: usize,
     pub detail: String,
@@ -164,7 +166,7 @@ impl Judge {
                 let line = busy_level(rec, seen.at);
                 if s.busy() != line {
                     return Err(fail(
-                        "busy-status-matches",
+                        Invariant::BusyStatusMatches,
                         format!(
                             "status 0x{:02X} reads BUSY={} at {} while the BUSY line is {}",
                             s.0,
@@ -196,7 +198,7 @@ impl Judge {
         }
         if seen.at < self.last_at {
             return Err(fail(
-                "time-monotonic",
+                Invariant::TimeMonotonic,
                 format!("the clock went from {} back to {}", self.last_at, seen.at),
             ));
         }
@@ -213,19 +215,19 @@ impl Judge {
             detail,
         };
         if let Some(d) = pulse_outside_busy(rec) {
-            return Err(at_end("busy-covers-pulses", d));
+            return Err(at_end(Invariant::BusyCoversPulses, d));
         }
         if let Some(d) = record_breaks(rec) {
-            return Err(at_end("record-ordered", d));
+            return Err(at_end(Invariant::RecordOrdered, d));
         }
         if let Some((invariant, d)) = self.int_breaks(rec) {
             return Err(at_end(invariant, d));
         }
         if let Some(d) = phase_breaks(rec) {
-            return Err(at_end("phase-pattern", d));
+            return Err(at_end(Invariant::PhasePattern, d));
         }
         if let Some(d) = self.interval_breaks(rec) {
-            return Err(at_end("min-interval", d));
+            return Err(at_end(Invariant::MinInterval, d));
         }
         Ok(())
     }
@@ -238,7 +240,7 @@ impl Judge {
     /// come before INT* rises, taken after). One-sided as the finish flag
     /// is: a read command the chip lost cannot release it, so "still
     /// asserted after a read" is not claimed.
-    fn int_breaks(&self, rec: &Record) -> Option<(&'static str, String)> {
+    fn int_breaks(&self, rec: &Record) -> Option<(Invariant, String)> {
         let mut asserted_at = None;
         let mut released_at = Instant::ZERO;
         for p in rec.pins.iter().filter(|p| p.pin == Pin::Int) {
@@ -269,7 +271,7 @@ impl Judge {
                 };
                 if !interrupt {
                     return Some((
-                        "int-mask",
+                        Invariant::IntMask,
                         format!(
                             "INT* asserted at {} at the end of a {} move whose command masks the termination interrupt (bit 4 = 1)",
                             p.at,
@@ -287,7 +289,7 @@ impl Judge {
                     .any(|t| *t >= released_at && *t <= p.at);
                 if !read {
                     return Some((
-                        "int-release",
+                        Invariant::IntRelease,
                         format!(
                             "INT* (asserted at {from}) released at {} without a finish status read written since {}",
                             p.at,
@@ -432,7 +434,7 @@ impl Judge {
     /// pulses (Section 3-4-4) and the finish status polling flag (3-4-1).
     /// The chip takes a read command only when BUSY = 0, so the move the
     /// register tells of has ended by `at`.
-    fn register_breaks(&mut self, rec: &Record, at: Instant) -> Option<(&'static str, String)> {
+    fn register_breaks(&mut self, rec: &Record, at: Instant) -> Option<(Invariant, String)> {
         let Reading {
             command,
             bytes,
@@ -448,7 +450,7 @@ impl Judge {
                 let want = if out >= steps { 0 } else { steps - out - 1 };
                 (u64::from(read) != want).then(|| {
                     (
-                        "remaining-pulses",
+                        Invariant::RemainingPulses,
                         format!(
                             "remaining pulses read {read} after a move of {steps} steps \
                              that output {out} pulses; expected {want}"
@@ -467,7 +469,7 @@ impl Judge {
                 let flag = FinishStatus(bytes[0]).polling();
                 (flag && since == 0).then(|| {
                     (
-                        "finish-flag-once",
+                        Invariant::FinishFlagOnce,
                         format!(
                             "finish status 0x{:02X} has the polling flag set, but no move \
                              ended since the last finish status read",
@@ -483,13 +485,16 @@ impl Judge {
 
 /// Section 3-1-1, Diagram 3-1: bit 3 reads 0; without an error, bits 6-4
 /// count parameter bytes still due, never more than a command takes.
-fn status_breaks(s: Status) -> Option<(&'static str, String)> {
+fn status_breaks(s: Status) -> Option<(Invariant, String)> {
     if s.reserved() {
-        return Some(("status-bit3", format!("status 0x{:02X} has bit 3 set", s.0)));
+        return Some((
+            Invariant::StatusBit3,
+            format!("status 0x{:02X} has bit 3 set", s.0),
+        ));
     }
     match s.field() {
         StatusField::ParamsRemaining(n) if n > MAX_PARAMS => Some((
-            "status-params",
+            Invariant::StatusParams,
             format!(
                 "status 0x{:02X} asks for {n} more parameter bytes; no command takes more than {MAX_PARAMS}",
                 s.0
@@ -516,7 +521,7 @@ mod tests {
         rec.pin(Instant::from_nanos(1_000), Pin::Int, 1);
         rec.pin(Instant::from_nanos(5_000), Pin::Int, 0);
         let v = Judge::default().finish(&rec).expect_err("a break");
-        assert_eq!(v.invariant, "int-release", "{v}");
+        assert_eq!(v.invariant, Invariant::IntRelease, "{v}");
         // Released after a finish status read written since the start
         // (here before INT* rose, taken after): kept.
         let judge = Judge {
@@ -528,7 +533,7 @@ mod tests {
         rec.pin(Instant::from_nanos(7_000), Pin::Int, 1);
         rec.pin(Instant::from_nanos(9_000), Pin::Int, 0);
         let v = judge.finish(&rec).expect_err("a break");
-        assert_eq!(v.invariant, "int-release", "{v}");
+        assert_eq!(v.invariant, Invariant::IntRelease, "{v}");
         assert!(
             v.detail.contains("since the last release at 5.000us"),
             "{v}"
@@ -584,7 +589,7 @@ mod tests {
         };
         assert_eq!(judge.finish(&record(42)), Ok(()));
         let v = judge.finish(&record(40)).expect_err("a break");
-        assert_eq!(v.invariant, "min-interval", "{v}");
+        assert_eq!(v.invariant, Invariant::MinInterval, "{v}");
         assert!(v.detail.contains("every 40.000us"), "{v}");
         // An initialization with RH = 0 is refused (error 5): it does not
         // lower the bound.
@@ -605,7 +610,7 @@ mod tests {
         };
         assert_eq!(
             judge.finish(&record(40)).map_err(|v| v.invariant),
-            Err("min-interval")
+            Err(Invariant::MinInterval)
         );
     }
 }

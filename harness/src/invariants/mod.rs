@@ -3,6 +3,8 @@
 //! the emulator; a reproducer or a regression scenario runs them on any
 //! target.
 //!
+//! - [`ids`]: the invariants by name, [`Invariant`](ids::Invariant), one
+//!   per row of `docs/invariants.md`.
 //! - [`judge`]: the invariants judged op by op from what the host sees,
 //!   and at the end from the capture; a break is a
 //!   [`Violation`](judge::Violation).
@@ -13,6 +15,7 @@
 //!   rules, and the body of a regression scenario.
 
 pub mod capture;
+pub mod ids;
 pub mod judge;
 pub mod oracle;
 pub mod replay;

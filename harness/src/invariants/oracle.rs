@@ -9,30 +9,6 @@ use crate::fuzzing::bus::{self, BusOp};
 use crate::protocol::{Status, Straps};
 use std::cell::Cell;
 
-/// Every invariant id with the datasheet section it comes from.
-pub const INVARIANTS: &[(&str, &str)] = &[
-    ("status-bit3", "3-1-1"),
-    ("status-params", "3-1-1"),
-    ("busy-status-matches", "3-1-1"),
-    ("remaining-pulses", "3-4-4"),
-    ("finish-flag-once", "3-4-1"),
-    ("busy-covers-pulses", "3-1-1"),
-    ("int-mask", "3-3-1"),
-    ("int-release", "3-4-1"),
-    ("phase-pattern", "3-2-1"),
-    ("min-interval", "3-2-2"),
-    ("time-monotonic", "model"),
-    ("record-ordered", "model"),
-];
-
-/// The datasheet section an invariant comes from.
-pub fn section(invariant: &str) -> &'static str {
-    INVARIANTS
-        .iter()
-        .find(|(id, _)| *id == invariant)
-        .map_or("model", |(_, s)| s)
-}
-
 /// Runs `ops` on a fresh chip and returns the first invariant break.
 pub fn check(ops: &[BusOp], cfg: ModelConfig) -> Result<Option<Violation>, ChipError> {
     check_ops(ops.iter().copied(), cfg)
@@ -144,6 +120,7 @@ pub(super) mod tests {
     use super::*;
     use crate::emu::{BoardFaults, Chip};
     use crate::fuzzing::bus::BusOp::*;
+    use crate::invariants::ids::Invariant;
     use crate::time::Duration;
 
     /// Initialization (Section 3-2, the values of `capture_comes_in_chunks`)
@@ -206,7 +183,7 @@ pub(super) mod tests {
         let v = check(&init_and_step(), cfg)
             .expect("chip")
             .expect("a break");
-        assert_eq!((v.invariant, v.op), ("status-bit3", 10));
+        assert_eq!((v.invariant, v.op), (Invariant::StatusBit3, 10));
     }
 
     #[test]
@@ -221,7 +198,7 @@ pub(super) mod tests {
         let v = check(&init_and_step(), cfg)
             .expect("chip")
             .expect("a break");
-        assert_eq!(v.invariant, "status-params");
+        assert_eq!(v.invariant, Invariant::StatusParams);
     }
 
     /// `init_and_step` with the step's termination interrupt masked
@@ -251,7 +228,7 @@ pub(super) mod tests {
         let v = check(&init_and_masked_step(), faulty("int-ignores-mask"))
             .expect("chip")
             .expect("a break");
-        assert_eq!(v.invariant, "int-mask", "{v}");
+        assert_eq!(v.invariant, Invariant::IntMask, "{v}");
         assert!(v.detail.contains("masks the termination interrupt"), "{v}");
         // Unmasked, the same board asserts INT* rightly.
         assert_eq!(
@@ -280,7 +257,7 @@ pub(super) mod tests {
         let v = check(&init_and_two_steps(), faulty("phase-step-skipped"))
             .expect("chip")
             .expect("a break");
-        assert_eq!(v.invariant, "phase-pattern", "{v}");
+        assert_eq!(v.invariant, Invariant::PhasePattern, "{v}");
         assert!(
             v.detail.contains("starts at step 0 of 4ph-12")
                 && v.detail.contains("left the phases at step 7"),
@@ -336,7 +313,10 @@ pub(super) mod tests {
         let v = check(&ops, faulty("remaining-off-by-one"))
             .expect("chip")
             .expect("a break");
-        assert_eq!((v.invariant, v.op), ("remaining-pulses", ops.len() - 1));
+        assert_eq!(
+            (v.invariant, v.op),
+            (Invariant::RemainingPulses, ops.len() - 1)
+        );
         assert!(v.detail.contains("after a move of 101 steps"), "{v}");
     }
 
@@ -352,7 +332,10 @@ pub(super) mod tests {
         let v = check(&ops, faulty("finish-flag-sticky"))
             .expect("chip")
             .expect("a break");
-        assert_eq!((v.invariant, v.op), ("finish-flag-once", ops.len() - 1));
+        assert_eq!(
+            (v.invariant, v.op),
+            (Invariant::FinishFlagOnce, ops.len() - 1)
+        );
     }
 
     /// A read command lost to a later write (IBF = 1) says nothing about

@@ -5,7 +5,6 @@
 //! a board, and how a regression scenario made from a finding checks it.
 
 use super::judge::{Judge, Seen, Violation};
-use super::oracle;
 use crate::backend::{Op, Reply, Target, TargetError};
 use crate::fuzzing::bus::BusOp;
 use crate::protocol::{Record, Straps};
@@ -46,7 +45,7 @@ pub fn regression(d: &mut Driver, ops: &[BusOp]) -> Outcome {
                 expectation: format!(
                     "invariant {} (Section {})",
                     v.invariant,
-                    oracle::section(v.invariant)
+                    v.invariant.section()
                 ),
                 expected: "holds".into(),
                 got: format!("broken after op {}: {}", v.op, v.detail),
