@@ -9,6 +9,10 @@
 //! as energized and as pin levels, DIR, BUSY), every pulse (its time to
 //! the nanosecond and its direction) and every change of a pin outside
 //! pulse stepping, with its time.
+//!
+//! The `model_twin` fuzz target runs [`check`] on every input
+//! ([`crate::fuzzing::targets::model_twin`]); a disagreement is shrunk by
+//! [`crate::fuzzing::finding::minimize_disagreement`] (`ppmc fuzz twin`).
 
 use super::chip::PlainChip;
 use crate::emu::{Board, ModelConfig};
