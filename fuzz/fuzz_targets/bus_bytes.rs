@@ -1,2 +1,2 @@
 #![no_main]
-libfuzzer_sys::fuzz_target!(|data: &[u8]| ppmc::fuzzing::bus_bytes(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| ppmc::fuzzing::targets::bus_bytes(data));

@@ -1,2 +1,2 @@
 #![no_main]
-libfuzzer_sys::fuzz_target!(|data: &[u8]| ppmc::fuzzing::trace_text(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| ppmc::fuzzing::targets::trace_text(data));

@@ -1,2 +1,2 @@
 #![no_main]
-libfuzzer_sys::fuzz_target!(|data: &[u8]| ppmc::fuzzing::typed_actions(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| ppmc::fuzzing::targets::typed_actions(data));

@@ -7,8 +7,9 @@
 use crate::backend::{Target, TargetError};
 use crate::compare::{compare, Tolerances};
 use crate::emu::ModelConfig;
+use crate::fuzzing::actions::lower;
 use crate::fuzzing::differential::{self, DiffSettings};
-use crate::fuzzing::{lower, replay};
+use crate::invariants::replay;
 use crate::runner::run_suite;
 use crate::scenario::{DriverOptions, Scenario, Verdict};
 use std::path::Path;

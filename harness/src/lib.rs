@@ -9,9 +9,10 @@
 //! [`vcd_export`], [`bridge::sim`] ← [`scenario`] (the scenario API) ←
 //! [`runner`] (one target or a [`runner::Farm`] of boards), [`golden`],
 //! [`compare`], [`selftest`], [`console`], [`chaos`] ← [`report`],
-//! [`soak`] ← [`fuzzing`] ← [`fault_matrix`] ← [`cli`] (the command line:
-//! arguments in, results printed, nothing else). `ARCHITECTURE.md` at the
-//! repository root is the map.
+//! [`soak`] ← [`fuzzing`] (its oracle in [`invariants`], the second model
+//! of the chip in [`plain_model`]) ← [`fault_matrix`] ← [`cli`] (the
+//! command line: arguments in, results printed, nothing else).
+//! `ARCHITECTURE.md` at the repository root is the map.
 
 pub mod backend;
 pub mod bridge;
@@ -23,6 +24,8 @@ pub mod fault_matrix;
 pub mod files;
 pub mod fuzzing;
 pub mod golden;
+pub mod invariants;
+pub mod plain_model;
 pub mod report;
 pub mod runner;
 pub mod scenario;

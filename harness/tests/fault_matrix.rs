@@ -6,6 +6,7 @@ use ppmc::backend::EmuTarget;
 use ppmc::emu::ModelConfig;
 use ppmc::fault_matrix::{all_as_expected, check_board, render, FuzzBudget};
 use ppmc::faults::CATALOGUE;
+use ppmc::invariants::ids::Invariant;
 use ppmc::protocol::Straps;
 use std::path::Path;
 
@@ -31,12 +32,12 @@ fn every_fault_is_caught_and_the_clean_board_is_not() {
         row.oracle.as_ref().map(|c| c.first.clone())
     };
     for (fault, invariant) in [
-        ("int-ignores-mask", "int-mask"),
-        ("phase-step-skipped", "phase-pattern"),
-        ("remaining-off-by-one", "remaining-pulses"),
+        ("int-ignores-mask", Invariant::IntMask),
+        ("phase-step-skipped", Invariant::PhasePattern),
+        ("remaining-off-by-one", Invariant::RemainingPulses),
     ] {
         let first = oracle(fault).unwrap_or_else(|| panic!("{fault}: oracle missed it\n{table}"));
-        assert!(first.contains(invariant), "{fault}: {first}");
+        assert!(first.contains(invariant.as_str()), "{fault}: {first}");
     }
     // A Decelerating Stop 1 us late (Table 3-3's 17 us) is caught by the
     // differential fuzz: its programs place a stop 1 us before a pulse, and

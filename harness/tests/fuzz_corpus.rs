@@ -1,5 +1,5 @@
 //! Replays every committed fuzz input (seed corpus and regressions) through
-//! the target bodies in `ppmc::fuzzing`, on stable.
+//! the target bodies in `ppmc::fuzzing::targets`, on stable.
 
 mod common;
 
@@ -22,7 +22,8 @@ fn replay(target: &str, body: fn(&[u8])) -> usize {
 #[test]
 fn a_reset_checker_runs_as_a_fresh_one() {
     use ppmc::emu::{ModelConfig, WiringFaults};
-    use ppmc::fuzzing::{bus, oracle::Checker};
+    use ppmc::fuzzing::bus;
+    use ppmc::invariants::oracle::Checker;
     let inputs = common::fuzz_inputs("bus_bytes");
     assert!(inputs.len() > 50, "the corpus is there");
     for cfg in [
@@ -146,7 +147,7 @@ fn advancing_in_pieces_changes_nothing() {
 
 #[test]
 fn frame_decoder_corpus_replays() {
-    let n = replay("frame_decoder", ppmc::fuzzing::frame_decoder);
+    let n = replay("frame_decoder", ppmc::fuzzing::targets::frame_decoder);
     assert!(n >= 8, "the seed corpus is there ({n} inputs)");
 }
 
@@ -265,7 +266,7 @@ fn write_frame_decoder_seeds() {
 
 #[test]
 fn bus_bytes_corpus_replays() {
-    let n = replay("bus_bytes", ppmc::fuzzing::bus_bytes);
+    let n = replay("bus_bytes", ppmc::fuzzing::targets::bus_bytes);
     assert!(n >= 90, "the seed corpus is there ({n} inputs)");
 }
 
@@ -275,7 +276,8 @@ fn bus_bytes_corpus_replays() {
 #[test]
 fn the_suite_as_fuzz_ops_keeps_every_invariant() {
     use ppmc::emu::ModelConfig;
-    use ppmc::fuzzing::{bus, oracle};
+    use ppmc::fuzzing::bus;
+    use ppmc::invariants::oracle;
     for (name, trace) in suite_traces() {
         let ops = bus::from_trace(&trace);
         assert!(!ops.is_empty(), "{name}");
@@ -311,13 +313,13 @@ fn write_bus_bytes_seeds() {
 
 #[test]
 fn typed_actions_corpus_replays() {
-    let n = replay("typed_actions", ppmc::fuzzing::typed_actions);
+    let n = replay("typed_actions", ppmc::fuzzing::targets::typed_actions);
     assert!(n >= 16, "the seed corpus is there ({n} inputs)");
 }
 
 #[test]
 fn trace_text_corpus_replays() {
-    let n = replay("trace_text", ppmc::fuzzing::trace_text);
+    let n = replay("trace_text", ppmc::fuzzing::targets::trace_text);
     assert!(n >= 14, "the seed corpus is there ({n} inputs)");
 }
 
@@ -334,10 +336,10 @@ fn typed_seeds_move_the_motor() {
         .filter_map(Result::ok)
     {
         let data = fs::read(e.path()).expect("seed");
-        let acts = ppmc::fuzzing::typed_program(&data);
-        let (ops, found) = ppmc::fuzzing::lower(&acts, ModelConfig::default());
+        let acts = ppmc::fuzzing::actions::typed_program(&data);
+        let (ops, found) = ppmc::fuzzing::actions::lower(&acts, ModelConfig::default());
         assert_eq!(found, None, "{}", e.path().display());
-        let mut c = ppmc::fuzzing::oracle::Checker::new(ModelConfig::default()).expect("chip");
+        let mut c = ppmc::invariants::oracle::Checker::new(ModelConfig::default()).expect("chip");
         for op in ops {
             c.apply(op).expect("no break");
         }

@@ -1,4 +1,4 @@
-//! The emulator checked against the plain model (`ppmc::fuzzing::plain`),
+//! The emulator checked against the plain model (`ppmc::plain_model`),
 //! a second model written from the datasheet alone: every conformance
 //! scenario's bus traffic and every committed bus-byte fuzz input, replayed
 //! on both, must give the same reads, pins, pulses and pin changes.
@@ -6,7 +6,8 @@
 mod common;
 
 use ppmc::emu::ModelConfig;
-use ppmc::fuzzing::{bus, twin};
+use ppmc::fuzzing::bus;
+use ppmc::plain_model::twin;
 use ppmc::protocol::Straps;
 use std::fs;
 use std::path::Path;

@@ -7,7 +7,7 @@
 //! (`ppmc record --filter fuzz_remaining_pulses_1`).
 
 use ppmc::fuzzing::bus::BusOp::{self, *};
-use ppmc::fuzzing::replay::regression;
+use ppmc::invariants::replay::regression;
 use ppmc::scenario::prelude::*;
 
 pub fn scenarios() -> Vec<Scenario> {

@@ -14,7 +14,7 @@
 //! the boundary.
 
 use ppmc::fuzzing::bus::BusOp::{self, *};
-use ppmc::fuzzing::replay::regression;
+use ppmc::invariants::replay::regression;
 use ppmc::scenario::prelude::*;
 
 pub fn scenarios() -> Vec<Scenario> {

@@ -7,12 +7,19 @@
 //!
 //! Values are folded into range rather than rejected (rates made valid,
 //! step counts kept short), so that almost every input does something.
+//!
+//! [`lower`] runs actions under the invariant oracle and gives the bus ops
+//! that ran, so that every finding of `typed_actions` has one bus-level
+//! form.
 
+use super::bus;
 use crate::console::Stmt;
-use crate::emu::PA_MIN;
+use crate::emu::{ModelConfig, PA_MIN};
+use crate::invariants::judge::Violation;
+use crate::invariants::oracle;
 use crate::protocol::{
     ClockSource, Command, Direction, Excitation, Flag, InitCommand, Input, MotorType, MoveCommand,
-    MoveKind, OpFlags, OutputLogic, PulseCount, Register,
+    MoveKind, OpFlags, OutputLogic, PulseCount, Register, Status,
 };
 use crate::time::Duration;
 use arbitrary::{Arbitrary, Unstructured};
@@ -73,7 +80,7 @@ pub enum Action {
     /// A stop placed against the pulse train: wait for pulse `1 + pulse %
     /// 1000` of the move, then `micros` us, then Immediate or Decelerating
     /// Stop. Placed so that the stop's latency decides which pulse it
-    /// acts after (Table 3-3's 17 us; see [`crate::fuzzing::differential`]).
+    /// acts after (Table 3-3's 17 us; see [`super::differential`]).
     StopNearPulse { decel: bool, pulse: u16, micros: u8 },
 }
 
@@ -254,6 +261,115 @@ pub fn decode(data: &[u8]) -> Vec<Action> {
         }
     }
     out
+}
+
+/// The actions a `typed_actions` input runs: a valid initialization, then
+/// whatever its bytes decode to.
+pub fn typed_program(data: &[u8]) -> Vec<Action> {
+    let mut acts = vec![Action::default_init()];
+    acts.extend(decode(data));
+    acts
+}
+
+/// Runs typed actions under the oracle and returns the bus ops that ran
+/// (the flowchart's waits become the time that passed, to the
+/// microsecond), with the first invariant break. The ops replay as a
+/// `bus_bytes` input, so every finding has one bus-level form.
+pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus::BusOp>, Option<Violation>) {
+    let mut ops = Vec::new();
+    let Ok(mut c) = oracle::Checker::new(cfg) else {
+        return (ops, None);
+    };
+    let run = |c: &mut oracle::Checker, op: bus::BusOp, ops: &mut Vec<bus::BusOp>| {
+        ops.push(op);
+        c.apply(op)
+    };
+    // Lets time pass until `ready` holds or `timeout` is spent.
+    let wait = |c: &mut oracle::Checker,
+                ops: &mut Vec<bus::BusOp>,
+                ready: &dyn Fn(Status) -> bool,
+                timeout: Duration|
+     -> Result<(), Violation> {
+        let deadline = c.board().now() + timeout;
+        while !ready(c.board().read_status()) && c.board().now() < deadline {
+            let now = c.board().now();
+            let next = c.board().poll_at().unwrap_or(deadline).min(deadline);
+            let us = next.saturating_since(now).as_nanos().div_ceil(1_000).max(1);
+            for op in bus::advances(Duration::from_micros(us)) {
+                ops.push(op);
+                c.apply(op)?;
+            }
+        }
+        Ok(())
+    };
+    let second = Duration::from_secs(1);
+    let result = (|| {
+        for a in acts {
+            for s in a.stmts() {
+                match s {
+                    Stmt::WriteCommand { byte, wait: w } | Stmt::WriteData { byte, wait: w } => {
+                        if w {
+                            wait(&mut c, &mut ops, &|s| !s.ibf(), second)?;
+                        }
+                        let op = if matches!(s, Stmt::WriteCommand { .. }) {
+                            bus::BusOp::Command(byte)
+                        } else {
+                            bus::BusOp::Data(byte)
+                        };
+                        run(&mut c, op, &mut ops)?;
+                    }
+                    Stmt::ReadData { wait: w } => {
+                        if w {
+                            wait(&mut c, &mut ops, &|s| s.obf(), second)?;
+                        }
+                        run(&mut c, bus::BusOp::ReadData, &mut ops)?;
+                    }
+                    Stmt::Await {
+                        flag,
+                        value,
+                        timeout,
+                    } => {
+                        let mask = flag.mask();
+                        let want = if value { mask } else { 0 };
+                        let t = timeout.unwrap_or(second);
+                        wait(&mut c, &mut ops, &|s| s.0 & mask == want, t)?;
+                        run(&mut c, bus::BusOp::ReadStatus, &mut ops)?;
+                    }
+                    Stmt::ReadStatus => run(&mut c, bus::BusOp::ReadStatus, &mut ops)?,
+                    Stmt::Wait(d) => {
+                        for op in bus::advances(d) {
+                            run(&mut c, op, &mut ops)?;
+                        }
+                    }
+                    Stmt::Set { input, asserted } => {
+                        run(&mut c, bus::BusOp::Input { input, asserted }, &mut ops)?
+                    }
+                    Stmt::AwaitPulse { count, timeout } => {
+                        // Time passes to that pulse (to the microsecond
+                        // after it), or not at all if the move will not
+                        // reach it in time.
+                        let deadline = c.board().now() + timeout.unwrap_or(second);
+                        while c.board().move_pulses() < count {
+                            let now = c.board().now();
+                            let Some(at) = c.board().predict_pulse(count) else {
+                                break;
+                            };
+                            if at > deadline {
+                                break;
+                            }
+                            let us = at.saturating_since(now).as_nanos().div_ceil(1_000).max(1);
+                            for op in bus::advances(Duration::from_micros(us)) {
+                                run(&mut c, op, &mut ops)?;
+                            }
+                        }
+                    }
+                    Stmt::Pins | Stmt::Pulses | Stmt::Now => {}
+                }
+            }
+        }
+        c.finish()
+    })();
+    (ops, result.err())
 }
 
 #[cfg(test)]

@@ -4,8 +4,10 @@
 //! inputs it reached), so that a user sees what was not exercised.
 
 use super::bus::BusOp;
-use super::oracle::{Checker, Violation};
 use crate::emu::ModelConfig;
+use crate::invariants::ids::Invariant;
+use crate::invariants::judge::Violation;
+use crate::invariants::oracle::Checker;
 use crate::protocol::{Command, ErrorCode, Input, MoveKind, StatusField};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -13,7 +15,7 @@ use std::fmt::Write as _;
 /// One bucket of findings: every input that broke one invariant.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Bucket {
-    pub invariant: &'static str,
+    pub invariant: Invariant,
     /// Names of the inputs, in the order given.
     pub inputs: Vec<String>,
     /// The input with the fewest ops, and its break: the one to minimize.
@@ -23,6 +25,7 @@ pub struct Bucket {
 /// Buckets `(name, ops)` inputs by the invariant each breaks on `cfg`;
 /// also returns the names of those that break none.
 pub fn triage(inputs: &[(String, Vec<BusOp>)], cfg: &ModelConfig) -> (Vec<Bucket>, Vec<String>) {
+    // Keyed by the id's text: the buckets come in its alphabetical order.
     let mut buckets: BTreeMap<&'static str, Bucket> = BTreeMap::new();
     let mut clean = Vec::new();
     for (name, ops) in inputs {
@@ -30,11 +33,13 @@ pub fn triage(inputs: &[(String, Vec<BusOp>)], cfg: &ModelConfig) -> (Vec<Bucket
             clean.push(name.clone());
             continue;
         };
-        let b = buckets.entry(v.invariant).or_insert_with(|| Bucket {
-            invariant: v.invariant,
-            inputs: Vec::new(),
-            smallest: (name.clone(), ops.len(), v.clone()),
-        });
+        let b = buckets
+            .entry(v.invariant.as_str())
+            .or_insert_with(|| Bucket {
+                invariant: v.invariant,
+                inputs: Vec::new(),
+                smallest: (name.clone(), ops.len(), v.clone()),
+            });
         b.inputs.push(name.clone());
         if ops.len() < b.smallest.1 {
             b.smallest = (name.clone(), ops.len(), v);
@@ -285,7 +290,7 @@ mod tests {
         let (buckets, clean) = triage(&seeds(), &cfg);
         assert_eq!(buckets.len(), 1, "{buckets:?}");
         let b = &buckets[0];
-        assert_eq!(b.invariant, "remaining-pulses");
+        assert_eq!(b.invariant, Invariant::RemainingPulses);
         assert!(b.inputs.len() >= 5, "{}", b.inputs.len());
         assert!(b.inputs.contains(&b.smallest.0));
         assert_eq!(b.inputs.len() + clean.len(), seeds().len());

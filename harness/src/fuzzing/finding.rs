@@ -1,10 +1,17 @@
 //! From a fuzz finding to a regression test: read a crash file of any
 //! target as bus ops, shrink it op-aware while the same invariant still
-//! breaks, and write it as a Rust scenario file.
+//! breaks (or, for a `model_twin` finding, while the two models still
+//! disagree), print it as a console script (the reproducer), and write it
+//! as a Rust scenario file.
 
+use super::actions::{lower, typed_program};
 use super::bus::{self, BusOp};
-use super::oracle::{self, Violation};
 use crate::emu::ModelConfig;
+use crate::invariants::ids::Invariant;
+use crate::invariants::judge::Violation;
+use crate::invariants::oracle;
+use crate::plain_model::twin::{self, Disagreement};
+use crate::protocol::Straps;
 use crate::time::Duration;
 use std::fmt::Write as _;
 
@@ -21,7 +28,7 @@ pub enum InputKind {
 pub fn ops_of(data: &[u8], kind: InputKind, cfg: &ModelConfig) -> Vec<BusOp> {
     match kind {
         InputKind::BusBytes => bus::decode(data),
-        InputKind::TypedActions => super::lower(&super::typed_program(data), cfg.clone()).0,
+        InputKind::TypedActions => lower(&typed_program(data), cfg.clone()).0,
     }
 }
 
@@ -44,7 +51,7 @@ pub struct Minimized {
 /// ops), merge neighbouring waits, shorten each wait (binary search) and
 /// zero data bytes, until a whole pass changes nothing. `None` when `ops`
 /// does not break `invariant` to begin with.
-pub fn minimize(ops: &[BusOp], cfg: &ModelConfig, invariant: &str) -> Option<Minimized> {
+pub fn minimize(ops: &[BusOp], cfg: &ModelConfig, invariant: Invariant) -> Option<Minimized> {
     let mut tries = 0;
     let mut breaks = |ops: &[BusOp]| -> Option<Violation> {
         tries += 1;
@@ -121,15 +128,34 @@ pub fn minimize(ops: &[BusOp], cfg: &ModelConfig, invariant: &str) -> Option<Min
     })
 }
 
+/// Shrinks `ops` while the two models still disagree: drops chunks of
+/// ops, then single ops, halving the chunk each round (ddmin-style). The
+/// disagreement found at the end may differ in detail from the first; it
+/// is returned with the ops.
+pub fn minimize_disagreement(
+    ops: &[BusOp],
+    straps: Straps,
+    cfg: &ModelConfig,
+) -> Option<(Vec<BusOp>, Disagreement)> {
+    let mut best = ops.to_vec();
+    let mut found = twin::check(&best, straps, cfg).err()?;
+    // Nothing after the op where they first differ matters.
+    best.truncate(found.op + 1);
+    drop_chunks(&mut best, |mut trial| {
+        let d = twin::check(&trial, straps, cfg).err()?;
+        trial.truncate(d.op + 1);
+        found = d;
+        Some(trial)
+    });
+    Some((best, found))
+}
+
 /// Drops chunks of `ops`, largest first (half the ops, then halving the
 /// chunk down to single ops): each candidate goes to `keep`, which gives
 /// back what to keep when the candidate still fails (the candidate, or a
 /// cut of it), `None` when it does not. Shared by the oracle's minimizer
-/// and the two-model one ([`super::twin::minimize`]).
-pub(crate) fn drop_chunks(
-    ops: &mut Vec<BusOp>,
-    mut keep: impl FnMut(Vec<BusOp>) -> Option<Vec<BusOp>>,
-) {
+/// and the two-model one ([`minimize_disagreement`]).
+fn drop_chunks(ops: &mut Vec<BusOp>, mut keep: impl FnMut(Vec<BusOp>) -> Option<Vec<BusOp>>) {
     let mut chunk = ops.len().div_ceil(2).max(1);
     loop {
         let mut i = 0;
@@ -160,6 +186,37 @@ fn merge_waits(ops: &[BusOp]) -> Vec<BusOp> {
     out
 }
 
+/// A `bus_bytes` input as a bus script in the console language
+/// (`docs/console.md`): a header naming the invariant it breaks on the
+/// emulator (or saying it breaks none), then one op per line. The script
+/// replays in `ppmc console` on the emulator.
+pub fn reproducer(data: &[u8], source: &str) -> (String, Option<Violation>) {
+    reproducer_with(data, source, ModelConfig::default())
+}
+
+/// [`reproducer`], judged on a model with a configuration.
+pub fn reproducer_with(data: &[u8], source: &str, cfg: ModelConfig) -> (String, Option<Violation>) {
+    let ops = bus::decode(data);
+    let found = oracle::check(&ops, cfg).ok().flatten();
+    let mut out = format!(
+        "# reproducer of {source}: {} bytes, {} ops (fuzz target bus_bytes)\n",
+        data.len(),
+        ops.len()
+    );
+    match &found {
+        Some(v) => out.push_str(&format!("# breaks: invariant {v}\n")),
+        None => out.push_str("# breaks no invariant\n"),
+    }
+    for (i, op) in ops.iter().enumerate() {
+        out.push_str(&format!("{op}"));
+        if found.as_ref().is_some_and(|v| v.op == i) {
+            out.push_str("  # <- the break is seen after this op");
+        }
+        out.push('\n');
+    }
+    (out, found)
+}
+
 /// The ops as a `bus_bytes` input (long waits split so each op holds its
 /// wait exactly).
 pub fn to_bytes(ops: &[BusOp]) -> Vec<u8> {
@@ -174,14 +231,14 @@ pub fn to_bytes(ops: &[BusOp]) -> Vec<u8> {
 }
 
 /// A scenario name for a break of `invariant`: `fuzz_<invariant>_<n>`.
-pub fn scenario_stem(invariant: &str, n: usize) -> String {
-    format!("fuzz_{}_{n}", invariant.replace('-', "_"))
+pub fn scenario_stem(invariant: Invariant, n: usize) -> String {
+    format!("fuzz_{}_{n}", invariant.as_str().replace('-', "_"))
 }
 
 /// A Rust scenario file (for `scenarios/`) that replays `ops` and fails
 /// while `v` still breaks: the body of `ppmc fuzz to-scenario`.
 pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> String {
-    let section = oracle::section(v.invariant);
+    let section = v.invariant.section();
     let source = comment_safe(source);
     let detail = comment_safe(&v.detail);
     let mut s = String::new();
@@ -195,7 +252,7 @@ pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> 
         v.invariant, v.op, detail,
     );
     s.push_str("use ppmc::fuzzing::bus::BusOp::{self, *};\n");
-    s.push_str("use ppmc::fuzzing::replay::regression;\n");
+    s.push_str("use ppmc::invariants::replay::regression;\n");
     s.push_str("use ppmc::scenario::prelude::*;\n\n");
     let _ = writeln!(
         s,
@@ -250,6 +307,9 @@ fn comment_safe(text: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::backend::EmuTarget;
+    use crate::console;
+    use crate::emu::WiringFaults;
     use crate::faults;
 
     fn noisy_remaining_finding() -> Vec<BusOp> {
@@ -268,9 +328,9 @@ mod tests {
         let cfg = faults::find("remaining-off-by-one").expect("fault").model();
         let ops = noisy_remaining_finding();
         let v = first_break(&ops, &cfg).expect("the fault breaks it");
-        assert_eq!(v.invariant, "remaining-pulses");
-        let m = minimize(&ops, &cfg, "remaining-pulses").expect("minimized");
-        assert_eq!(m.violation.invariant, "remaining-pulses");
+        assert_eq!(v.invariant, Invariant::RemainingPulses);
+        let m = minimize(&ops, &cfg, Invariant::RemainingPulses).expect("minimized");
+        assert_eq!(m.violation.invariant, Invariant::RemainingPulses);
         assert!(
             m.ops.len() < ops.len() / 2,
             "{} of {}",
@@ -279,7 +339,7 @@ mod tests {
         );
         assert_eq!(
             first_break(&m.ops, &cfg).map(|v| v.invariant),
-            Some("remaining-pulses")
+            Some(Invariant::RemainingPulses)
         );
         // The clean model keeps the invariant on the minimized input.
         assert_eq!(first_break(&m.ops, &ModelConfig::default()), None);
@@ -290,7 +350,7 @@ mod tests {
         );
         // An input that breaks nothing cannot be minimized for it.
         assert_eq!(
-            minimize(&ops, &ModelConfig::default(), "remaining-pulses"),
+            minimize(&ops, &ModelConfig::default(), Invariant::RemainingPulses),
             None
         );
     }
@@ -298,7 +358,7 @@ mod tests {
     #[test]
     fn no_text_from_a_file_name_reaches_the_generated_code_unescaped() {
         let v = Violation {
-            invariant: "remaining-pulses",
+            invariant: Invariant::RemainingPulses,
             op: 0,
             detail: "read 5\nfn evil() {}".into(),
         };
@@ -321,7 +381,7 @@ mod tests {
     #[test]
     fn the_scenario_file_names_the_invariant_and_lists_every_op() {
         let v = Violation {
-            invariant: "remaining-pulses",
+            invariant: Invariant::RemainingPulses,
             op: 1,
             detail: "read 5".into(),
         };
@@ -344,5 +404,69 @@ mod tests {
         ));
         assert!(text.contains("regression(d, OPS)"));
         assert!(text.contains("fn fuzz_remaining_pulses_2(d: &mut Driver)"));
+    }
+
+    fn sample() -> Vec<BusOp> {
+        use BusOp::*;
+        vec![
+            Command(0x06),
+            Advance(Duration::from_micros(40)),
+            Data(100),
+            Advance(Duration::from_millis(3)),
+            ReadStatus,
+            Input {
+                input: crate::protocol::Input::L1,
+                asserted: true,
+            },
+            ReadData,
+            Advance(Duration::from_secs(2)),
+            ReadStatus,
+        ]
+    }
+
+    /// The printed script parses as console input, op for op, and its
+    /// status reads on the emulator give the same bytes as the oracle's
+    /// chip saw (the console runs the same model through the target).
+    #[test]
+    fn a_reproducer_replays_in_the_console() {
+        let data = bus::encode(&sample());
+        let (script, found) = reproducer(&data, "crash-1");
+        assert_eq!(found, None);
+        assert!(script.starts_with("# reproducer of crash-1"));
+        let lines = console::parse_script(&script).expect("the script parses");
+        assert_eq!(lines.len(), sample().len());
+        let mut t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+        let mut out = Vec::new();
+        console::run(
+            &mut t,
+            &lines,
+            &console::ConsoleOptions::default(),
+            &mut out,
+        )
+        .expect("the script runs");
+        let printed = String::from_utf8(out).expect("utf-8");
+        let statuses: Vec<&str> = printed.lines().filter(|l| l.starts_with("rs ")).collect();
+        assert_eq!(statuses.len(), 2, "{printed}");
+    }
+
+    #[test]
+    fn a_reproducer_names_the_break_and_marks_its_op() {
+        let data = bus::encode(&sample());
+        let cfg = ModelConfig {
+            board: WiringFaults {
+                status_stuck_high: 0x08,
+                ..WiringFaults::default()
+            },
+            ..ModelConfig::default()
+        };
+        let (script, found) = reproducer_with(&data, "x", cfg);
+        let v = found.expect("a break");
+        assert_eq!((v.invariant, v.op), (Invariant::StatusBit3, 4));
+        assert!(script.contains("# breaks: invariant status-bit3 after op 4"));
+        let marked: Vec<&str> = script.lines().filter(|l| l.contains("# <-")).collect();
+        assert_eq!(marked, vec!["rs  # <- the break is seen after this op"]);
+        // On the clean emulator the same input breaks nothing, and says so.
+        let (script, _) = reproducer(&data, "x");
+        assert!(script.contains("breaks no invariant"));
     }
 }

@@ -29,7 +29,7 @@ pub fn run(input: &InputArgs, output: Option<PathBuf>) -> Result<(), CliError> {
             m.violation.invariant,
             out.display()
         );
-    let (script, _) = crate::fuzzing::reproducer_with(&bytes, &out.display().to_string(), cfg);
+    let (script, _) = finding::reproducer_with(&bytes, &out.display().to_string(), cfg);
     outln!("{}", script.trim_end_matches('\n'));
     Ok(())
 }

@@ -6,7 +6,7 @@ pub fn run(input: &InputArgs) -> Result<(), CliError> {
     let (cfg, ops) = input.load()?;
     let data = finding::to_bytes(&ops);
     let source = input.file.display().to_string();
-    let (script, found) = crate::fuzzing::reproducer_with(&data, &source, cfg);
+    let (script, found) = finding::reproducer_with(&data, &source, cfg);
     outln!("{}", script.trim_end_matches('\n'));
     if found.is_some() {
         Err(CliError::Verdict)

@@ -4,7 +4,8 @@
 //! show one.
 
 use super::*;
-use crate::fuzzing::{bus, twin};
+use crate::fuzzing::bus;
+use crate::plain_model::twin;
 use crate::protocol::Straps;
 
 pub fn run(file: &Path, output: Option<PathBuf>) -> Result<(), CliError> {
@@ -31,7 +32,7 @@ pub fn run(file: &Path, output: Option<PathBuf>) -> Result<(), CliError> {
         Err(d) => d,
     };
     outln!("{}: the models disagree {d}", file.display());
-    let Some((small, found)) = twin::minimize(&ops, straps, &cfg) else {
+    let Some((small, found)) = finding::minimize_disagreement(&ops, straps, &cfg) else {
         return Err(CliError::Verdict);
     };
     let out = output.unwrap_or_else(|| super::with_suffix(file, "min"));

@@ -1,4 +1,4 @@
-//! The emulator against the plain model ([`super::plain`]): the same bus
+//! The emulator against the plain model ([`super::chip`]): the same bus
 //! ops on both, and everything a host or a logic analyser could see
 //! compared after every op. The first difference is a [`Disagreement`];
 //! which model is right is then a question for the datasheet
@@ -9,10 +9,14 @@
 //! as energized and as pin levels, DIR, BUSY), every pulse (its time to
 //! the nanosecond and its direction) and every change of a pin outside
 //! pulse stepping, with its time.
+//!
+//! The `model_twin` fuzz target runs [`check`] on every input
+//! ([`crate::fuzzing::targets::model_twin`]); a disagreement is shrunk by
+//! [`crate::fuzzing::finding::minimize_disagreement`] (`ppmc fuzz twin`).
 
-use super::bus::{self, BusOp};
-use super::plain::PlainChip;
+use super::chip::PlainChip;
 use crate::emu::{Board, ModelConfig};
+use crate::fuzzing::bus::{self, BusOp};
 use crate::protocol::{Direction, Pin, PinEvent, PulseRun, Straps};
 use crate::time::Instant;
 use std::fmt;
@@ -238,40 +242,4 @@ impl Changes {
         }
         self.read = events.len();
     }
-}
-
-/// Checks one fuzz input (bus-byte format, [`bus::decode`]) at the
-/// default straps and model: the body of the `model_twin` fuzz target.
-/// Inputs are cut at [`MAX_OPS`] ops, so that each runs in bounded time.
-pub fn fuzz(data: &[u8]) {
-    let ops = bus::decode(data);
-    let ops = &ops[..ops.len().min(MAX_OPS)];
-    if let Err(d) = check(ops, Straps::default(), &ModelConfig::default()) {
-        panic!("model-twin: {d}");
-    }
-}
-
-/// Ops of one input the `model_twin` target compares.
-pub const MAX_OPS: usize = 64;
-
-/// Shrinks `ops` while the two models still disagree: drops chunks of
-/// ops, then single ops, halving the chunk each round (ddmin-style). The
-/// disagreement found at the end may differ in detail from the first; it
-/// is returned with the ops.
-pub fn minimize(
-    ops: &[BusOp],
-    straps: Straps,
-    cfg: &ModelConfig,
-) -> Option<(Vec<BusOp>, Disagreement)> {
-    let mut best = ops.to_vec();
-    let mut found = check(&best, straps, cfg).err()?;
-    // Nothing after the op where they first differ matters.
-    best.truncate(found.op + 1);
-    super::finding::drop_chunks(&mut best, |mut trial| {
-        let d = check(&trial, straps, cfg).err()?;
-        trial.truncate(d.op + 1);
-        found = d;
-        Some(trial)
-    });
-    Some((best, found))
 }

@@ -1,12 +1,12 @@
 //! Bus ops replayed on any target, judged by the same invariants as on the
-//! emulator ([`super::oracle::Judge`]). Around every op the status register
+//! emulator ([`super::judge::Judge`]). Around every op the status register
 //! is read (a read with no side effect, Section 3-1-1), because the judge
 //! needs IBF and OBF as the host saw them: that is how a reproducer runs on
 //! a board, and how a regression scenario made from a finding checks it.
 
-use super::bus::BusOp;
-use super::oracle::{self, Judge, Seen, Violation};
+use super::judge::{Judge, Seen, Violation};
 use crate::backend::{Op, Reply, Target, TargetError};
+use crate::fuzzing::bus::BusOp;
 use crate::protocol::{Record, Straps};
 use crate::scenario::{Driver, Failure, HarnessError, Outcome, Stop};
 use crate::trace::BusEvent;
@@ -45,7 +45,7 @@ pub fn regression(d: &mut Driver, ops: &[BusOp]) -> Outcome {
                 expectation: format!(
                     "invariant {} (Section {})",
                     v.invariant,
-                    oracle::section(v.invariant)
+                    v.invariant.section()
                 ),
                 expected: "holds".into(),
                 got: format!("broken after op {}: {}", v.op, v.detail),
