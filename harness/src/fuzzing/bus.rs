@@ -7,6 +7,7 @@
 //! delimited rather than fixed-width, a mutation inside one op, even one
 //! that inserts or deletes bytes, leaves the ops after it intact.
 
+use crate::backend::Op;
 use crate::protocol::Input;
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, EventKind, Trace};
@@ -36,6 +37,25 @@ pub enum BusOp {
 }
 
 impl BusOp {
+    /// The target op it runs as: a raw write or read (no flowchart wait),
+    /// an input driven, time let pass.
+    pub fn op(self) -> Op {
+        match self {
+            BusOp::Command(byte) => Op::WriteCommand {
+                byte,
+                wait_ibf: None,
+            },
+            BusOp::Data(byte) => Op::WriteData {
+                byte,
+                wait_ibf: None,
+            },
+            BusOp::ReadStatus => Op::ReadStatus,
+            BusOp::ReadData => Op::ReadData { wait_obf: None },
+            BusOp::Input { input, asserted } => Op::SetInput { input, asserted },
+            BusOp::Advance(d) => Op::Delay(d),
+        }
+    }
+
     /// Decodes one op from its bytes (without separator); `None` for an
     /// empty op.
     pub fn decode(bytes: &[u8]) -> Option<BusOp> {

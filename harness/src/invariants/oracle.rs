@@ -118,7 +118,7 @@ impl Checker {
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::emu::{WiringFaults, Chip};
+    use crate::emu::{Chip, WiringFaults};
     use crate::fuzzing::bus::BusOp::*;
     use crate::invariants::ids::Invariant;
     use crate::time::Duration;

@@ -18,21 +18,10 @@ use crate::trace::BusEvent;
 pub fn regression(d: &mut Driver, ops: &[BusOp]) -> Outcome {
     let replies = d.exec(&probed_ops(ops))?;
     for (op, r) in ops.iter().zip(replies.chunks(OPS_PER_BUS_OP)) {
-        let e = match (*op, r.get(1)) {
-            (BusOp::Command(byte), _) => BusEvent::WriteCommand { byte, waited: None },
-            (BusOp::Data(byte), _) => BusEvent::WriteData { byte, waited: None },
-            (BusOp::ReadStatus, Some(Reply::Status { status, .. })) => {
-                BusEvent::ReadStatus(status.0)
-            }
-            (BusOp::ReadData, Some(Reply::Data { byte, .. })) => BusEvent::ReadData {
-                byte: *byte,
-                waited: None,
-            },
-            (BusOp::Input { input, asserted }, _) => BusEvent::SetInput { input, asserted },
-            _ => continue,
-        };
         if let Some(r) = r.get(1) {
-            d.log_bus(r.at(), e);
+            if let Some(e) = BusEvent::of(&op.op(), r) {
+                d.log_bus(r.at(), e);
+            }
         }
     }
     let capture = d.capture()?.clone();
@@ -62,21 +51,7 @@ pub const OPS_PER_BUS_OP: usize = 3;
 pub fn probed_ops(ops: &[BusOp]) -> Vec<Op> {
     let mut out = Vec::with_capacity(ops.len() * OPS_PER_BUS_OP);
     for op in ops {
-        let main = match *op {
-            BusOp::Command(byte) => Op::WriteCommand {
-                byte,
-                wait_ibf: None,
-            },
-            BusOp::Data(byte) => Op::WriteData {
-                byte,
-                wait_ibf: None,
-            },
-            BusOp::ReadStatus => Op::ReadStatus,
-            BusOp::ReadData => Op::ReadData { wait_obf: None },
-            BusOp::Input { input, asserted } => Op::SetInput { input, asserted },
-            BusOp::Advance(d) => Op::Delay(d),
-        };
-        out.extend([Op::ReadStatus, main, Op::ReadStatus]);
+        out.extend([Op::ReadStatus, op.op(), Op::ReadStatus]);
     }
     out
 }
