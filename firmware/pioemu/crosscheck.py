@@ -3,7 +3,7 @@
 
 Reads the JSON that `firmware/bridge/examples/pio_trace.rs` writes (each
 program as the firmware assembles and configures it, run on our PIO model
-in `firmware/bridge/src/twin/pio.rs` over a fixed stimulus), runs the same
+in `firmware/bridge/src/twin/pio/` over a fixed stimulus), runs the same
 instruction words in pioemu (PyPI `rp2040-pio-emulator`, an independent
 emulator written from the RP2040 datasheet) with the same configuration,
 inputs and TX FIFO writes, and compares them cycle for cycle: PC, X, pin
@@ -349,7 +349,7 @@ def main():
     with open(args.trace) as f:
         doc = json.load(f)
     assert doc.get("format") == 1, "trace format 1"
-    print(f"pioemu {pioemu.__version__} against our PIO model (firmware/bridge/src/twin/pio.rs)")
+    print(f"pioemu {pioemu.__version__} against our PIO model (firmware/bridge/src/twin/pio/)")
     if args.perturb:
         missed = []
         for t in doc["traces"]:

@@ -6,6 +6,7 @@
 //! Needs qemu-system-arm and Debian's Rust for the Cortex-M target
 //! (firmware/README.md). Without them the tests say so and pass, except in
 //! CI (`CI` set), where `.ci/run` installs them and their absence fails.
+//! The test of `run-qemu --help` needs neither.
 
 mod common;
 
@@ -40,6 +41,51 @@ fn available() -> bool {
         eprintln!("qemu-system-arm or Debian's Rust is missing: the firmware is not run");
     }
     qemu && rust
+}
+
+/// `run-qemu --help` prints the comment at the script's top and nothing
+/// else: every line it prints is a line of that comment, less its `# `
+/// (no line of the script's code, as `set -euo pipefail` once was). Needs
+/// neither QEMU nor the image: the options are read first.
+#[test]
+fn run_qemu_help_prints_its_header_comment_and_no_line_of_code() {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/run-qemu");
+    let source = std::fs::read_to_string(&script).expect("firmware/run-qemu");
+    let header: Vec<&str> = source
+        .lines()
+        .skip(1)
+        .take_while(|l| l.starts_with('#'))
+        .collect();
+    let out = Command::new(&script)
+        .arg("--help")
+        .output()
+        .expect("run firmware/run-qemu --help");
+    assert!(out.status.success(), "{out:?}");
+    let help = String::from_utf8(out.stdout).expect("utf-8 help");
+    let lines: Vec<&str> = help.lines().collect();
+    assert_eq!(lines.len(), header.len(), "{help}");
+    for (printed, comment) in lines.iter().zip(&header) {
+        let bare = comment.strip_prefix("# ").or(comment.strip_prefix('#'));
+        assert_eq!(
+            Some(*printed),
+            bare,
+            "a line of --help that is not the header's:\n{help}"
+        );
+    }
+    assert!(
+        help.starts_with("Runs the bridge firmware on a virtual board"),
+        "{help}"
+    );
+    for option in [
+        "--clock-mhz",
+        "--csel",
+        "--vsel",
+        "--ext-clock-khz",
+        "--chip-fault",
+        "--link",
+    ] {
+        assert!(help.contains(option), "--help names {option}:\n{help}");
+    }
 }
 
 #[test]

@@ -67,7 +67,7 @@ pub const MOVE_BYTES: usize = 32;
 ///
 /// A chip that pulses at random intervals would make a run of every pulse,
 /// without end within one op: the board code stops recording at
-/// [`CAPTURE_RECORDS`] + `OP_RECORDS` (`board.rs`), and the engine answers
+/// [`CAPTURE_RECORDS`] + `OP_RECORDS` (`board/capture.rs`), and the engine answers
 /// CAPTURE_OVERRUN.
 pub const OP_RECORDS: usize = 2 * 254 + 2 + 1 + 16;
 

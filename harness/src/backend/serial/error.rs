@@ -63,7 +63,7 @@ pub enum SerialError {
         old: u32,
         new: u32,
         /// What the bridge says restarted it, from its new HELLO (the RP2350
-        /// image's panic record: `a panic at board.rs:123`).
+        /// image's panic record: `a panic at cycles.rs:123`).
         why: Option<String>,
     },
     /// After a reconnect the bridge no longer held this host's cached

@@ -1,0 +1,146 @@
+//! The capture: the edge counters' words drained from their FIFOs and
+//! placed in time, the pin changes of every source kept in time order
+//! until no source can precede them, then moved into the record; the
+//! record's room, and a stalled counter reported as a lost capture.
+
+use super::{record_time, Board};
+use crate::hal::{Counter, Hal};
+use crate::{limits, pins, timebase};
+use ppmc_core::protocol::{Direction, Pin, PinEvent};
+use ppmc_core::time::Instant;
+
+/// An edge counter has pushed its word within this many ticks of the edge
+/// (16 system clock cycles: the 2-cycle input synchroniser, a pass of the
+/// counter's loop, the push), so a drain that starts after a tick has
+/// every edge from before it, less this.
+pub(super) const SETTLE_TICKS: u64 = 8;
+
+/// The most records the board code keeps between chip resets: the
+/// capture's capacity and what one op may add beyond it
+/// ([`limits::OP_RECORDS`]). Past it, edges and pin changes are dropped,
+/// and the engine answers CAPTURE_OVERRUN (the record holds more than the
+/// capacity): a chip that pulses without end cannot exhaust the heap.
+const MOST_RECORDS: usize = limits::CAPTURE_RECORDS as usize + limits::OP_RECORDS;
+
+impl<H: Hal> Board<H> {
+    /// Takes what the capture holds: the outputs the CPU samples, then the
+    /// edge words from the PIO counters (an edge from before the sample is
+    /// in its FIFO by then), and moves into the record the pin changes no
+    /// source can precede any more. Called between ops, in every wait, and
+    /// while the bridge waits for the host.
+    pub fn poll(&mut self) {
+        // Called between requests, when the core may have slept.
+        self.hal.resync();
+        self.refresh();
+    }
+
+    /// [`Board::poll`] within an op.
+    pub(super) fn refresh(&mut self) {
+        self.hal.keepalive();
+        let started = self.now_ticks();
+        self.poll_inner();
+        self.poll_ticks = self.now_ticks() - started;
+    }
+
+    fn poll_inner(&mut self) {
+        let word = self.hal.read_high_pins() & pins::SAMPLED_HIGH;
+        let sampled = self.now_ticks();
+        let before = core::mem::replace(&mut self.last_sample, sampled);
+        // A change happened after the outputs were last seen unchanged and
+        // by now: stamped halfway (within half a pass of the loop that
+        // watched them).
+        let since = core::mem::replace(&mut self.unchanged, sampled);
+        let changed = self.at(since + sampled.saturating_sub(since) / 2);
+        self.last_word = word;
+        self.drain();
+        // A change of S1..S5 is a step when a POUT edge came since the
+        // last sample (or just before it, its word then still on its way).
+        let stepped = self.last_pulse + SETTLE_TICKS >= before;
+        self.sample(word, changed, sampled, stepped);
+        let horizon = self.at(sampled.saturating_sub(SETTLE_TICKS));
+        let n = self.pending.partition_point(|p| p.at <= horizon);
+        self.record.pins.extend(self.pending.drain(..n));
+    }
+
+    /// The edge counters' words, each placed in time by the clock read
+    /// after it was taken from its FIFO (so at or after its edge).
+    fn drain(&mut self) {
+        let (timer, epoch) = (self.timer, self.epoch);
+        let ticks = |hal: &H, started: u64, w: u32| {
+            let e = timebase::place(w, (hal.cycles() - started) / 2);
+            (e.bit, started / 2 + e.at)
+        };
+        while let Some(w) = self.hal.capture_pull(Counter::Pout) {
+            if !self.room() {
+                continue;
+            }
+            let (bit, t) = ticks(&self.hal, self.started, w);
+            self.last_pulse = self.last_pulse.max(t);
+            let new_move = self
+                .record
+                .moves
+                .last()
+                .is_some_and(|m| m.first_run == self.record.runs.len());
+            let at = record_time(timer, epoch, t);
+            self.edges
+                .push(&mut self.record, at, Direction::from_bit(bit), new_move);
+        }
+        for (c, pin) in [
+            (Counter::Int, Pin::Int),
+            (Counter::Hold, Pin::Hold),
+            (Counter::Aux, Pin::Aux),
+        ] {
+            while let Some(w) = self.hal.capture_pull(c) {
+                let (high, t) = ticks(&self.hal, self.started, w);
+                // HOLD's level as it is, INT*'s and AUX*'s (active low)
+                // asserted when low.
+                let value = match pin {
+                    Pin::Hold => high,
+                    _ => !high,
+                };
+                self.pin(record_time(timer, epoch, t), pin, u8::from(value));
+            }
+        }
+        if self.hal.capture_stalled() {
+            // A counter stopped counting while its FIFO was full: this
+            // capture has a hole, and every later count would be late by
+            // the stall. The capture is lost until the next chip reset;
+            // the counters start again now, on a fresh timebase.
+            self.lost = true;
+            self.overruns += 1;
+            self.started = self.hal.start_counters();
+        }
+    }
+
+    /// A pin change, kept in time order until [`Board::poll`] moves it to
+    /// the record.
+    pub(super) fn pin(&mut self, at: Instant, pin: Pin, value: u8) {
+        if !self.room() {
+            return;
+        }
+        let i = self.pending.partition_point(|p| p.at <= at);
+        self.pending.insert(i, PinEvent { at, pin, value });
+    }
+
+    /// Whether the record (and the changes on their way to it) has room
+    /// for another record ([`MOST_RECORDS`]).
+    fn room(&self) -> bool {
+        let r = &self.record;
+        r.runs.len() + r.pins.len() + r.moves.len() + self.pending.len() < MOST_RECORDS
+    }
+
+    /// Drains the capture until tick `t`.
+    pub(super) fn drain_until(&mut self, t: u64) {
+        while self.now_ticks() < t {
+            self.refresh();
+            self.idle(t);
+        }
+    }
+
+    /// Lets the hardware idle until tick `until` or a change of the
+    /// outputs it watches.
+    pub(super) fn idle(&mut self, until: u64) {
+        let seen = self.hal.idle(until * 2) / 2;
+        self.unchanged = self.unchanged.max(seen);
+    }
+}

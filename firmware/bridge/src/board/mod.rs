@@ -1,0 +1,213 @@
+//! The chip on the bridge's pins, as the bridge engine's [`Bus`]: bus
+//! cycles through the PIO step player, inputs on GPIO outputs, outputs
+//! captured by the PIO edge counters and by sampling, the capture kept as
+//! the protocol's record (pulse runs through `EdgeRuns`, move records
+//! through `MoveTracker`). The pin map is [`crate::pins`].
+//!
+//! This is the RP2350 image's board code, over a thin hardware layer
+//! ([`Hal`]): the image runs it on the RP2350, the board twin on the PIO
+//! model ([`crate::twin`]), so that what the twin proves is this code.
+//!
+//! Every wait has a deadline: a state machine that never finishes a bus
+//! cycle makes the bridge report a hardware fault (protocol error
+//! `HARDWARE`), not hang.
+//!
+//! This file holds the board's state ([`Board`]), its start and its
+//! clock; the rest is by concern:
+//!
+//! - `ops.rs`: the engine's ops ([`Bus`] for [`Board`]), delays that aim
+//!   the next op's moment, the chip's reset;
+//! - `cycles.rs`: bus cycles through the PIO step player, status and data
+//!   reads, writes, waits on a status flag;
+//! - `capture.rs`: the edge counters' words drained into the record, the
+//!   pin changes kept in time order until no source can precede them;
+//! - `outputs.rs`: the outputs the CPU samples, as pin changes and as the
+//!   pins a read reports;
+//! - `selftest.rs`: the self-test, the generator's bursts into the capture.
+//!
+//! [`Bus`]: ppmc_core::bus::Bus
+
+mod capture;
+mod cycles;
+mod ops;
+mod outputs;
+mod selftest;
+
+use crate::bus::BusTiming;
+use crate::hal::Hal;
+use crate::pins;
+use crate::timebase;
+use alloc::string::String;
+use alloc::vec::Vec;
+use ppmc_core::bridge::move_tracker::MoveTracker;
+use ppmc_core::bridge::wire::Timer;
+use ppmc_core::bus::Op;
+use ppmc_core::protocol::{EdgeRuns, PinEvent, Record, Straps};
+use ppmc_core::time::{Duration, Instant};
+
+pub struct Board<H: Hal> {
+    hal: H,
+    sysclk_hz: u32,
+    timer: Timer,
+    timing: BusTiming,
+    straps: Straps,
+    /// The cycle the edge counters started on.
+    started: u64,
+    /// Bridge ticks at the last chip reset: time zero of the record.
+    epoch: u64,
+    record: Record,
+    /// Pin changes not yet in the record, in time order: the record keeps
+    /// them in time order, and they come from several sources (the edge
+    /// counters, the sampled outputs, BUSY in status reads) at different
+    /// delays. Each poll moves those no source can precede any more.
+    pending: Vec<PinEvent>,
+    /// Ticks of the last sample of the outputs the CPU reads, and of the
+    /// last POUT edge taken.
+    last_sample: u64,
+    last_pulse: u64,
+    /// The cycle the bus player will be back at its `pull` with every step
+    /// written so far played, as the board code predicts from the steps'
+    /// lengths: when the next cycle's steps start, unless they come later.
+    player_free: u64,
+    /// The moment of the last op (ticks): a write's WR* rise, a read's RD*
+    /// fall, an input's change, the pulse an `AwaitPulses` waited for, a
+    /// delay's end. A delay counts from it.
+    moment: u64,
+    /// The op after the one running, in its batch ([`Bus::next_op`]).
+    next: Option<Op>,
+    /// Where a delay that ended early aims the next op's moment (ticks).
+    aim: Option<u64>,
+    /// The last batch has ended (the core may sleep before the next: the
+    /// clock is set right first). The op running ends its batch when
+    /// `next` is `None`.
+    batch_done: bool,
+    /// Pin samples taken without a poll around them.
+    samples: u32,
+    /// How long the last poll took (ticks).
+    poll_ticks: u64,
+    /// RD*'s fall at the last status read (ticks).
+    last_status: u64,
+    /// The sampled outputs (masked) as last seen, and the last tick they
+    /// were seen so.
+    last_word: u16,
+    unchanged: u64,
+    edges: EdgeRuns,
+    tracker: MoveTracker,
+    /// Last sampled S1..S5 levels, AUXO levels and DIR, for changes.
+    last_s: u8,
+    last_auxo: u8,
+    last_dir: bool,
+    busy: bool,
+    lost: bool,
+    /// Stop switching seen: the phases chopping on and off while stopped.
+    switching: bool,
+    /// When S1..S5 last went all off or came back from it (ticks).
+    last_toggle: u64,
+    /// The bridge's own hardware failed: what.
+    fault: Option<String>,
+    /// Capture overruns since boot (each restarted the counters).
+    pub overruns: u32,
+}
+
+impl<H: Hal> core::fmt::Debug for Board<H> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Board")
+            .field("timer", &self.timer)
+            .field("straps", &self.straps)
+            .field("started", &self.started)
+            .field("epoch", &self.epoch)
+            .field("busy", &self.busy)
+            .field("lost", &self.lost)
+            .field("fault", &self.fault)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<H: Hal> Board<H> {
+    /// The board code over `hal`: starts the edge counters and samples the
+    /// outputs.
+    pub fn new(mut hal: H, timing: BusTiming, straps: Straps) -> Board<H> {
+        let sysclk_hz = hal.sysclk_hz();
+        let timer = Timer {
+            hz: timebase::timer_hz(sysclk_hz),
+        };
+        let started = hal.start_counters();
+        let epoch = hal.cycles() / 2;
+        let mut bus = Board {
+            hal,
+            sysclk_hz,
+            timer,
+            timing,
+            straps,
+            started,
+            epoch,
+            record: Record::default(),
+            pending: Vec::new(),
+            last_sample: 0,
+            last_pulse: 0,
+            player_free: 0,
+            moment: epoch,
+            next: None,
+            aim: None,
+            poll_ticks: 0,
+            samples: 0,
+            batch_done: true,
+            last_status: epoch,
+            last_word: 0,
+            unchanged: epoch,
+            edges: EdgeRuns::new(timer.edge_tolerance()),
+            tracker: MoveTracker::new(),
+            last_s: 0,
+            last_auxo: 0,
+            last_dir: false,
+            busy: false,
+            lost: false,
+            switching: false,
+            last_toggle: 0,
+            fault: None,
+            overruns: 0,
+        };
+        let word = bus.hal.read_high_pins() & pins::SAMPLED_HIGH;
+        let now = bus.now_ticks();
+        bus.sample(word, bus.at(now), now, false);
+        bus.last_word = word;
+        bus
+    }
+
+    /// The timer HELLO_REPLY announces.
+    pub fn timer(&self) -> Timer {
+        self.timer
+    }
+
+    /// The hardware layer (the twin's tests look through it).
+    pub fn hal(&self) -> &H {
+        &self.hal
+    }
+
+    pub fn hal_mut(&mut self) -> &mut H {
+        &mut self.hal
+    }
+
+    /// The record's time of system clock cycle `cycle`.
+    pub fn time_of_cycle(&self, cycle: u64) -> Instant {
+        self.at(cycle / 2)
+    }
+
+    /// Ticks to the record's time.
+    fn at(&self, ticks: u64) -> Instant {
+        record_time(self.timer, self.epoch, ticks)
+    }
+
+    fn now_ticks(&self) -> u64 {
+        self.hal.cycles() / 2
+    }
+
+    fn deadline(&self, d: Duration) -> u64 {
+        self.now_ticks() + self.timer.to_ticks(d.as_nanos())
+    }
+}
+
+/// Bridge ticks as the record's time: since `epoch`, the last chip reset.
+fn record_time(timer: Timer, epoch: u64, ticks: u64) -> Instant {
+    Instant::from_nanos(timer.to_nanos(ticks.saturating_sub(epoch)))
+}

@@ -1,0 +1,376 @@
+//! The engine's ops on the board ([`Bus`] for [`Board`]): each op run
+//! with the capture drained around it, delays that end early to aim the
+//! next op's moment, pin reads on a delay's grid, waits for pulses, and
+//! the chip's reset.
+
+use super::cycles::ANCHOR;
+use super::Board;
+use crate::bus::{self, Cycle};
+use crate::hal::Hal;
+use crate::pins;
+use alloc::string::String;
+use ppmc_core::bus::{Bus, Op, Reply, SelfTestPlan, SelfTestReply};
+use ppmc_core::protocol::{Input as ChipInput, Record, Status, Straps};
+use ppmc_core::time::{Duration, Instant};
+
+/// What the code between a delay's end and the next op's moment may take,
+/// beyond the op's bus cycles, so that the op can aim its moment at the
+/// delay's end ([`Board::lead`]).
+const CPU_LEAD_US: u64 = 2;
+
+/// Time enough for a look at the capture FIFOs' levels (ticks: 32 cycles).
+const LOOK_TICKS: u64 = 16;
+
+/// The kinds of op a delay ends early for ([`Bus::next_op`]), to aim
+/// their moment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Lag {
+    /// A write that waits for IBF = 0 (a status read first).
+    WriteAfterIbf,
+    Write,
+    /// A read that waits for OBF = 1.
+    ReadAfterObf,
+    Read,
+    Input,
+    /// A pin sample.
+    Pins,
+}
+
+impl Lag {
+    fn of(op: Op) -> Option<Lag> {
+        Some(match op {
+            Op::WriteCommand { wait_ibf, .. } | Op::WriteData { wait_ibf, .. } => {
+                if wait_ibf.is_some() {
+                    Lag::WriteAfterIbf
+                } else {
+                    Lag::Write
+                }
+            }
+            Op::ReadData { wait_obf: Some(_) } => Lag::ReadAfterObf,
+            Op::ReadData { wait_obf: None } | Op::ReadStatus => Lag::Read,
+            Op::SetInput { .. } => Lag::Input,
+            Op::ReadPins => Lag::Pins,
+            _ => return None,
+        })
+    }
+}
+
+fn level(asserted: bool) -> bool {
+    // The chip's inputs are active low: asserted is low.
+    !asserted
+}
+
+impl<H: Hal> Board<H> {
+    /// How long before its moment an op of kind `k` must start (ticks):
+    /// its bus cycles before the moment (a status read first, for one that
+    /// waits on a flag), and [`CPU_LEAD_US`] for the code between.
+    fn lead(&self, k: Lag) -> u64 {
+        let cycles = |c: Cycle, to_moment: bool| -> u64 {
+            let Ok(steps) = self.timing.steps(c, self.sysclk_hz) else {
+                return 0;
+            };
+            let words = steps.words();
+            let n = if to_moment {
+                c.moment_step()
+            } else {
+                words.len()
+            };
+            let sum: u64 = words[..n]
+                .iter()
+                .map(|w| u64::from(bus::step_cycles(*w)))
+                .sum();
+            sum + if to_moment {
+                u64::from(bus::PINS_AT)
+            } else {
+                0
+            }
+        };
+        let read = Cycle::Read { a0: true };
+        let write = Cycle::Write { a0: true, byte: 0 };
+        let anchor = u64::from(bus::step_cycles(ANCHOR));
+        let c = match k {
+            Lag::WriteAfterIbf => cycles(read, false) + anchor + cycles(write, true),
+            Lag::Write => anchor + cycles(write, true),
+            Lag::ReadAfterObf => cycles(read, false) + anchor + cycles(read, true),
+            Lag::Read => anchor + cycles(read, true),
+            Lag::Input | Lag::Pins => 0,
+        };
+        c / 2 + self.timer.to_ticks(CPU_LEAD_US * 1_000)
+    }
+
+    /// `Op::Delay`: until `d` after the last op's moment. When the next op
+    /// is one with a moment ([`Bus::next_op`]), the delay ends early by
+    /// that op's [`Board::lead`], and the op aims its moment at the delay's
+    /// end: a bus cycle through a wait step in the player, to the cycle; an
+    /// input or a pin sample by spinning on the clock.
+    fn delay(&mut self, d: Duration) -> Reply {
+        let target = self.moment + self.timer.to_ticks(d.as_nanos());
+        let kind = self.next.and_then(Lag::of);
+        let until = target.saturating_sub(kind.map_or(0, |k| self.lead(k)));
+        loop {
+            let now = self.now_ticks();
+            if now >= until {
+                break;
+            }
+            // No poll that would end past `until`: the capture waits in
+            // its FIFOs until the next op's poll.
+            if now + self.poll_ticks < until {
+                self.refresh();
+            }
+            self.idle(until);
+        }
+        let end = self.now_ticks();
+        // Late (the CPU took longer than `d`): the next op acts now.
+        self.aim = kind.map(|_| target.max(end));
+        self.moment = target.max(end);
+        Reply::Delayed {
+            at: self.at(self.moment),
+        }
+    }
+
+    /// Spins on the clock until tick `t`.
+    fn spin_until(&mut self, t: u64) {
+        while self.now_ticks() < t {}
+    }
+
+    /// The time of pulse `n` (from 1) of the last move, if it came.
+    fn pulse_time(&self, n: u64) -> Option<Instant> {
+        let first = self.record.moves.last()?.first_run;
+        let mut left = n.checked_sub(1)?;
+        for r in &self.record.runs[first..] {
+            let c = u64::from(r.count);
+            if left < c {
+                return Some(r.at(left as u32));
+            }
+            left -= c;
+        }
+        None
+    }
+
+    pub(super) fn reset_chip(&mut self) -> Reply {
+        self.hal.set_reset(false);
+        // The inputs start over too (`Op::Reset`): all released.
+        for i in 0..pins::INPUTS.len() {
+            self.hal.set_input(i, level(false));
+        }
+        // RESET held low for 100 us, well beyond any chip's minimum.
+        let until = self.deadline(Duration::from_micros(100));
+        while self.now_ticks() < until {
+            self.idle(until);
+        }
+        self.hal.set_reset(true);
+        self.refresh();
+        // A fresh timebase for the new record: whatever a stall did to the
+        // last one is gone.
+        self.started = self.hal.start_counters();
+        self.epoch = self.now_ticks();
+        self.moment = self.epoch;
+        self.record = Record::default();
+        self.pending.clear();
+        self.last_pulse = 0;
+        self.edges.reset();
+        self.tracker.reset();
+        self.lost = false;
+        self.busy = false;
+        self.switching = false;
+        Reply::ResetDone {
+            at: self.at(self.epoch),
+        }
+    }
+}
+
+impl<H: Hal> Bus for Board<H> {
+    fn run(&mut self, op: Op) -> Reply {
+        if self.fault.is_some() {
+            // The engine answers HARDWARE for the whole batch.
+            return Reply::InputSet {
+                at: self.at(self.now_ticks()),
+            };
+        }
+        // The core may have slept since the batch before (between
+        // requests, in the executor's `wfe`), never within one.
+        if self.batch_done {
+            self.hal.resync();
+            self.batch_done = false;
+        }
+        // The capture is drained between ops, but for those aimed at a
+        // moment: an op right after a delay that ended early for it, and a
+        // delay that will end early for the next (its loop drains the
+        // capture while there is time). A tight run of pin samples so
+        // drains nothing; a FIFO that fills meanwhile stalls its counter,
+        // and the next drain reports the capture lost (CAPTURE_OVERRUN).
+        let aimed = self.aim.is_some();
+        let aiming = matches!(op, Op::Delay(_)) && self.next.and_then(Lag::of).is_some();
+        if !aimed && !aiming {
+            self.refresh();
+        }
+        let reply = match op {
+            Op::WriteCommand { byte, wait_ibf } => self.write(true, byte, wait_ibf),
+            Op::WriteData { byte, wait_ibf } => self.write(false, byte, wait_ibf),
+            Op::ReadStatus => {
+                let (t, status) = self.read_status(self.aim);
+                Reply::Status {
+                    at: self.at(t),
+                    status,
+                }
+            }
+            Op::ReadData { wait_obf } => {
+                let mut waited = Duration::ZERO;
+                if let Some(d) = wait_obf {
+                    let deadline = self.deadline(d);
+                    match self.wait_status(Status::OBF, Status::OBF, deadline) {
+                        Ok((w, _)) => waited = Duration::from_nanos(self.timer.to_nanos(w)),
+                        Err((t, status)) => {
+                            return Reply::ReadTimedOut {
+                                at: self.at(t),
+                                status,
+                            }
+                        }
+                    }
+                }
+                let aim = self.aim;
+                let (t, b) = self.cycle(Cycle::Read { a0: false }, aim);
+                Reply::Data {
+                    at: self.at(t),
+                    byte: b.unwrap_or(0),
+                    waited,
+                }
+            }
+            Op::Delay(d) => self.delay(d),
+            Op::AwaitStatus {
+                mask,
+                value,
+                timeout,
+            } => {
+                let start = self.now_ticks();
+                let deadline = self.deadline(timeout);
+                match self.wait_status(mask, value & mask, deadline) {
+                    Ok((w, status)) => Reply::Awaited {
+                        at: self.at(start + w),
+                        waited: Duration::from_nanos(self.timer.to_nanos(w)),
+                        status,
+                    },
+                    Err((t, status)) => Reply::AwaitTimedOut {
+                        at: self.at(t),
+                        status,
+                    },
+                }
+            }
+            Op::SetInput { input, asserted } => {
+                let i = ChipInput::ALL.iter().position(|x| *x == input).unwrap_or(0);
+                if let Some(t) = self.aim {
+                    self.spin_until(t);
+                }
+                self.hal.set_input(i, level(asserted));
+                self.moment = self.now_ticks();
+                Reply::InputSet {
+                    at: self.at(self.moment),
+                }
+            }
+            Op::ReadPins => match self.aim {
+                Some(t) => {
+                    // Read where the delay before it aimed, the cycles of a
+                    // GPIO read after the clock said so: stamped there, so
+                    // that regular samples stay on their grid (one SAMPLES
+                    // entry on the wire, as on the model). No poll: the
+                    // capture waits in its FIFOs (a tight sampling loop).
+                    // Every 8th sample, a look at the capture's FIFOs, when
+                    // there is time before the sample; every 64th, in any
+                    // case. Drained when a quarter full, at the cost of
+                    // that sample's place on the grid.
+                    self.samples += 1;
+                    let look = self.samples.is_multiple_of(8)
+                        && (self.now_ticks() + LOOK_TICKS < t || self.samples.is_multiple_of(64));
+                    let mut late = false;
+                    if look {
+                        if self.hal.capture_level() >= 2 {
+                            self.refresh();
+                        }
+                        // Past the sample's time: stamped when read.
+                        late = self.now_ticks() > t;
+                    }
+                    self.spin_until(t);
+                    let word = self.hal.read_high_pins();
+                    self.moment = if late { self.now_ticks() } else { t };
+                    Reply::Pins {
+                        at: self.at(self.moment),
+                        pins: self.pins_from(word),
+                    }
+                }
+                None => {
+                    let pins = self.pins();
+                    self.moment = self.last_sample;
+                    Reply::Pins {
+                        at: self.at(self.moment),
+                        pins,
+                    }
+                }
+            },
+            Op::ReadPulses => Reply::Pulses {
+                at: self.at(self.now_ticks()),
+                summary: self.record.last_move_pulses(),
+            },
+            Op::AwaitPulses { count, timeout } => {
+                let deadline = self.deadline(timeout);
+                loop {
+                    self.refresh();
+                    let n = self.record.last_move_pulses().count;
+                    let t = self.now_ticks();
+                    if n >= count {
+                        // The moment is the pulse's own, not when the
+                        // capture brought it: a delay counts from it.
+                        let at = self.pulse_time(count).unwrap_or(self.at(t));
+                        self.moment = self.epoch + self.timer.to_ticks(at.as_nanos());
+                        break Reply::PulsesReached { at };
+                    }
+                    if t >= deadline {
+                        break Reply::PulsesTimedOut {
+                            at: self.at(t),
+                            count: n,
+                        };
+                    }
+                    self.idle(deadline);
+                }
+            }
+            Op::Reset => self.reset_chip(),
+        };
+        if matches!(op, Op::Delay(_)) && self.aim.is_some() {
+            return reply;
+        }
+        let ends_batch = self.next.is_none();
+        if !(aimed && op == Op::ReadPins) || ends_batch {
+            self.refresh();
+        }
+        self.batch_done |= ends_batch;
+        self.aim = None;
+        reply
+    }
+
+    fn next_op(&mut self, next: Option<Op>) {
+        self.next = next;
+    }
+
+    fn record(&self) -> &Record {
+        &self.record
+    }
+
+    fn straps(&self) -> Straps {
+        self.straps
+    }
+
+    fn now(&self) -> Instant {
+        self.at(self.now_ticks())
+    }
+
+    fn capture_lost(&self) -> bool {
+        self.lost
+    }
+
+    fn fault(&self) -> Option<&str> {
+        self.fault.as_deref()
+    }
+
+    fn self_test(&mut self, plan: &SelfTestPlan) -> Result<SelfTestReply, String> {
+        self.run_self_test(plan)
+    }
+}
