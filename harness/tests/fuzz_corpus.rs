@@ -22,7 +22,7 @@ fn replay(target: &str, body: fn(&[u8])) -> usize {
 #[test]
 fn a_reset_checker_runs_as_a_fresh_one() {
     use ppmc::emu::{ModelConfig, WiringFaults};
-    use ppmc::fuzzing::bus;
+    use ppmc::fuzzing::bus_bytes;
     use ppmc::invariants::oracle::Checker;
     let inputs = common::fuzz_inputs("bus_bytes");
     assert!(inputs.len() > 50, "the corpus is there");
@@ -38,7 +38,7 @@ fn a_reset_checker_runs_as_a_fresh_one() {
     ] {
         let mut reused = Checker::new(cfg.clone()).expect("a valid configuration");
         for (f, data) in &inputs {
-            let ops = bus::decode(data);
+            let ops = bus_bytes::decode(data);
             let run = |c: &mut Checker| (c.run(ops.iter().copied()), format!("{c:?}"));
             let mut fresh = Checker::new(cfg.clone()).expect("a valid configuration");
             reused.reset();
@@ -57,7 +57,7 @@ fn a_reset_checker_runs_as_a_fresh_one() {
 #[test]
 fn advancing_in_pieces_changes_nothing() {
     use ppmc::emu::{Board, ModelConfig};
-    use ppmc::fuzzing::bus::{self, BusOp};
+    use ppmc::fuzzing::bus_bytes::{self, BusOp};
     use ppmc::protocol::capture::{MoveStart, PulseRun, Record};
     use ppmc::protocol::Straps;
     use ppmc::time::Duration;
@@ -93,7 +93,10 @@ fn advancing_in_pieces_changes_nothing() {
     };
     let run = |ops: &[BusOp]| {
         let mut board = Board::new(Straps::default(), ModelConfig::default()).expect("board");
-        let reads: Vec<Option<u8>> = ops.iter().map(|op| bus::apply(&mut board, *op)).collect();
+        let reads: Vec<Option<u8>> = ops
+            .iter()
+            .map(|op| bus_bytes::apply(&mut board, *op))
+            .collect();
         (
             reads,
             canonical(board.record()),
@@ -105,7 +108,7 @@ fn advancing_in_pieces_changes_nothing() {
     assert!(inputs.len() > 50, "the corpus is there");
     let mut cut = 0;
     for (f, data) in &inputs {
-        let ops = bus::decode(data);
+        let ops = bus_bytes::decode(data);
         // Each advance in up to 13 pieces of growing length, the piece ends
         // falling anywhere relative to the pulses; a read between the
         // pieces stands for the op's read.
@@ -276,10 +279,10 @@ fn bus_bytes_corpus_replays() {
 #[test]
 fn the_suite_as_fuzz_ops_keeps_every_invariant() {
     use ppmc::emu::ModelConfig;
-    use ppmc::fuzzing::bus;
+    use ppmc::fuzzing::bus_bytes;
     use ppmc::invariants::oracle;
     for (name, trace) in suite_traces() {
-        let ops = bus::from_trace(&trace);
+        let ops = bus_bytes::from_trace(&trace);
         assert!(!ops.is_empty(), "{name}");
         let v = oracle::check(&ops, ModelConfig::default()).expect("chip");
         assert_eq!(v, None, "{name}");
@@ -302,10 +305,10 @@ fn write_bus_bytes_seeds() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/bus_bytes");
     fs::create_dir_all(&dir).expect("corpus dir");
     for (name, trace) in suite_traces() {
-        let ops = ppmc::fuzzing::bus::from_trace(&trace);
+        let ops = ppmc::fuzzing::bus_bytes::from_trace(&trace);
         fs::write(
             dir.join(format!("{name}.bin")),
-            ppmc::fuzzing::bus::encode(&ops),
+            ppmc::fuzzing::bus_bytes::encode(&ops),
         )
         .expect("seed written");
     }
@@ -374,10 +377,10 @@ fn write_typed_and_trace_seeds() {
         fs::write(traces.join(format!("{name}.trace")), trace.render()).expect("seed written");
     }
     for (name, trace) in suite_traces().into_iter().skip(5).step_by(16) {
-        let ops = ppmc::fuzzing::bus::from_trace(&trace);
+        let ops = ppmc::fuzzing::bus_bytes::from_trace(&trace);
         fs::write(
             traces.join(format!("ops-{name}.bin")),
-            ppmc::fuzzing::bus::encode(&ops),
+            ppmc::fuzzing::bus_bytes::encode(&ops),
         )
         .expect("seed written");
     }

@@ -24,7 +24,7 @@
 //!   FIFO never fills); `pulled`: `[k, word]`, words a `pull` took.
 
 use pio::{Instruction, InstructionOperands};
-use ppmc_bridge_fw::bus::{self, BusTiming, Cycle};
+use ppmc_bridge_fw::bus_cycle::{self, BusTiming, Cycle};
 use ppmc_bridge_fw::pioregs::{self, block, SmRegs};
 use ppmc_bridge_fw::programs::{self, Loaded};
 use ppmc_bridge_fw::twin::pio::{Inputs, World};
@@ -194,14 +194,14 @@ fn main() {
     // batch. The outside drives D0-D7 with a value that changes every
     // third cycle, so a sample one cycle early or late reads another byte.
     let player = programs::bus_player();
-    let idle = bus::IDLE;
+    let idle = bus_cycle::IDLE;
     let mut tx: Vec<(usize, u32)> = [
-        bus::step(0xFF, idle | 0xA5, false, 3),
-        bus::step(0x00, idle & !(1 << bus::pin::RD), true, 0),
-        bus::step(0x00, idle, true, 5),
-        bus::step(0xFF, 0x3C | 1 << bus::pin::A0, true, 2),
-        bus::step(0x0F, idle | 0x81, false, 0),
-        bus::step(0xFF, idle, false, 9),
+        bus_cycle::step(0xFF, idle | 0xA5, false, 3),
+        bus_cycle::step(0x00, idle & !(1 << bus_cycle::pin::RD), true, 0),
+        bus_cycle::step(0x00, idle, true, 5),
+        bus_cycle::step(0xFF, 0x3C | 1 << bus_cycle::pin::A0, true, 2),
+        bus_cycle::step(0x0F, idle | 0x81, false, 0),
+        bus_cycle::step(0xFF, idle, false, 9),
     ]
     .into_iter()
     .map(|w| (0, w))
@@ -223,7 +223,7 @@ fn main() {
         tx.extend(steps.words().iter().map(|w| (150, *w)));
     }
     let bus_outside = |k: usize| (((k / 3) * 37 + 11) as u32 & 0xFF, 0xFF);
-    let all = (1u32 << bus::pin::COUNT) - 1;
+    let all = (1u32 << bus_cycle::pin::COUNT) - 1;
     let bus_run = Run {
         name: "bus_player",
         block: block::BUS,

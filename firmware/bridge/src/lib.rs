@@ -34,7 +34,7 @@ extern crate alloc;
 extern crate std;
 
 pub mod board;
-pub mod bus;
+pub mod bus_cycle;
 pub mod clock;
 pub mod hal;
 pub mod limits;

@@ -58,11 +58,11 @@ impl Loaded {
 
 /// The bus cycle player (PIO0, SM0).
 ///
-/// Each word from the TX FIFO is one *step* ([`crate::bus::Step`]): the
+/// Each word from the TX FIFO is one *step* ([`crate::bus_cycle::Step`]): the
 /// directions of D0-D7, then the levels of D0-D7, A0, CS*, DIR (of the
 /// level shifter), RD* and WR* (the 13 OUT pins, GPIO 0-12), then whether
 /// to sample D0-D7 at the end of the step, then how long the step lasts:
-/// `x + 7` cycles, `x + 9` with a sample ([`crate::bus::STEP_CYCLES`]).
+/// `x + 7` cycles, `x + 9` with a sample ([`crate::bus_cycle::STEP_CYCLES`]).
 /// A sampled byte goes to the RX FIFO. Between cycles the machine waits at
 /// `pull` with the pins as the last step left them.
 ///
@@ -293,7 +293,7 @@ pub fn relocate(p: Loaded, origin: u8) -> Loaded {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bus::{BusTiming, Cycle, IDLE};
+    use crate::bus_cycle::{BusTiming, Cycle, IDLE};
     use crate::pioregs;
     use crate::twin::pio::{Inputs, World};
     use std::vec::Vec;

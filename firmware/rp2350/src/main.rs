@@ -5,7 +5,7 @@
 //!   from `ppmc-core`, the same code `ppmc bridge-sim` and the QEMU board
 //!   run.
 //! - Bus cycles played by a PIO state machine from timed steps
-//!   (`ppmc_bridge_fw::bus`), inputs to the chip on GPIO outputs.
+//!   (`ppmc_bridge_fw::bus_cycle`), inputs to the chip on GPIO outputs.
 //! - POUT (with DIR) stamped by a PIO edge counter on PIO1, INT*, HOLD and
 //!   AUX* by three on PIO2, all four started on one cycle, to two system
 //!   clock cycles (13.3 ns at 150 MHz: `timer_hz` 75 MHz); S1..S5,
@@ -54,7 +54,7 @@ use embassy_time::{with_timeout, Duration};
 use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
 use embedded_alloc::LlffHeap as Heap;
 use ppmc_bridge_fw::board::Board;
-use ppmc_bridge_fw::bus::BusTiming;
+use ppmc_bridge_fw::bus_cycle::BusTiming;
 use ppmc_bridge_fw::{limits, pins, pioregs, programs, usb};
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::protocol::Straps;
@@ -232,7 +232,7 @@ async fn main(_spawner: Spawner) {
     ];
     // Idle levels (CS*, DIR towards the chip, RD*, WR* high), then
     // directions, then the player's configuration, then enable.
-    hw::bus_pins(ppmc_bridge_fw::bus::IDLE, 0x1FFF, 0x1FFF);
+    hw::bus_pins(ppmc_bridge_fw::bus_cycle::IDLE, 0x1FFF, 0x1FFF);
     hw::configure(0, 0, &pioregs::bus_player(&player));
     embassy_rp::pac::PIO0
         .ctrl()

@@ -12,7 +12,7 @@
 //! that ran, so that every finding of `typed_actions` has one bus-level
 //! form.
 
-use super::bus;
+use super::bus_bytes;
 use crate::console::Stmt;
 use crate::emu::{ModelConfig, PA_MIN};
 use crate::invariants::judge::Violation;
@@ -275,18 +275,18 @@ pub fn typed_program(data: &[u8]) -> Vec<Action> {
 /// (the flowchart's waits become the time that passed, to the
 /// microsecond), with the first invariant break. The ops replay as a
 /// `bus_bytes` input, so every finding has one bus-level form.
-pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus::BusOp>, Option<Violation>) {
+pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus_bytes::BusOp>, Option<Violation>) {
     let mut ops = Vec::new();
     let Ok(mut c) = oracle::Checker::new(cfg) else {
         return (ops, None);
     };
-    let run = |c: &mut oracle::Checker, op: bus::BusOp, ops: &mut Vec<bus::BusOp>| {
+    let run = |c: &mut oracle::Checker, op: bus_bytes::BusOp, ops: &mut Vec<bus_bytes::BusOp>| {
         ops.push(op);
         c.apply(op)
     };
     // Lets time pass until `ready` holds or `timeout` is spent.
     let wait = |c: &mut oracle::Checker,
-                ops: &mut Vec<bus::BusOp>,
+                ops: &mut Vec<bus_bytes::BusOp>,
                 ready: &dyn Fn(Status) -> bool,
                 timeout: Duration|
      -> Result<(), Violation> {
@@ -295,7 +295,7 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus::BusOp>, Option<Viol
             let now = c.board().now();
             let next = c.board().poll_at().unwrap_or(deadline).min(deadline);
             let us = next.saturating_since(now).as_nanos().div_ceil(1_000).max(1);
-            for op in bus::advances(Duration::from_micros(us)) {
+            for op in bus_bytes::advances(Duration::from_micros(us)) {
                 ops.push(op);
                 c.apply(op)?;
             }
@@ -312,9 +312,9 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus::BusOp>, Option<Viol
                             wait(&mut c, &mut ops, &|s| !s.ibf(), second)?;
                         }
                         let op = if matches!(s, Stmt::WriteCommand { .. }) {
-                            bus::BusOp::Command(byte)
+                            bus_bytes::BusOp::Command(byte)
                         } else {
-                            bus::BusOp::Data(byte)
+                            bus_bytes::BusOp::Data(byte)
                         };
                         run(&mut c, op, &mut ops)?;
                     }
@@ -322,7 +322,7 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus::BusOp>, Option<Viol
                         if w {
                             wait(&mut c, &mut ops, &|s| s.obf(), second)?;
                         }
-                        run(&mut c, bus::BusOp::ReadData, &mut ops)?;
+                        run(&mut c, bus_bytes::BusOp::ReadData, &mut ops)?;
                     }
                     Stmt::Await {
                         flag,
@@ -333,17 +333,19 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus::BusOp>, Option<Viol
                         let want = if value { mask } else { 0 };
                         let t = timeout.unwrap_or(second);
                         wait(&mut c, &mut ops, &|s| s.0 & mask == want, t)?;
-                        run(&mut c, bus::BusOp::ReadStatus, &mut ops)?;
+                        run(&mut c, bus_bytes::BusOp::ReadStatus, &mut ops)?;
                     }
-                    Stmt::ReadStatus => run(&mut c, bus::BusOp::ReadStatus, &mut ops)?,
+                    Stmt::ReadStatus => run(&mut c, bus_bytes::BusOp::ReadStatus, &mut ops)?,
                     Stmt::Wait(d) => {
-                        for op in bus::advances(d) {
+                        for op in bus_bytes::advances(d) {
                             run(&mut c, op, &mut ops)?;
                         }
                     }
-                    Stmt::Set { input, asserted } => {
-                        run(&mut c, bus::BusOp::Input { input, asserted }, &mut ops)?
-                    }
+                    Stmt::Set { input, asserted } => run(
+                        &mut c,
+                        bus_bytes::BusOp::Input { input, asserted },
+                        &mut ops,
+                    )?,
                     Stmt::AwaitPulse { count, timeout } => {
                         // Time passes to that pulse (to the microsecond
                         // after it), or not at all if the move will not
@@ -358,7 +360,7 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus::BusOp>, Option<Viol
                                 break;
                             }
                             let us = at.saturating_since(now).as_nanos().div_ceil(1_000).max(1);
-                            for op in bus::advances(Duration::from_micros(us)) {
+                            for op in bus_bytes::advances(Duration::from_micros(us)) {
                                 run(&mut c, op, &mut ops)?;
                             }
                         }

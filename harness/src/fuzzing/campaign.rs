@@ -3,7 +3,7 @@
 //! commands in which chip state, which error codes, finish causes and
 //! inputs it reached), so that a user sees what was not exercised.
 
-use super::bus::BusOp;
+use super::bus_bytes::BusOp;
 use crate::emu::ModelConfig;
 use crate::invariants::ids::Invariant;
 use crate::invariants::judge::Violation;
@@ -266,7 +266,7 @@ fn list(v: &[String]) -> String {
 mod tests {
     use super::*;
     use crate::faults;
-    use crate::fuzzing::bus;
+    use crate::fuzzing::bus_bytes;
 
     fn seeds() -> Vec<(String, Vec<BusOp>)> {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/bus_bytes");
@@ -275,7 +275,10 @@ mod tests {
             .filter_map(Result::ok)
             .map(|e| {
                 let name = e.file_name().to_string_lossy().into_owned();
-                (name, bus::decode(&std::fs::read(e.path()).expect("seed")))
+                (
+                    name,
+                    bus_bytes::decode(&std::fs::read(e.path()).expect("seed")),
+                )
             })
             .collect();
         v.sort_by(|a, b| a.0.cmp(&b.0));

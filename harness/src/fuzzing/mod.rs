@@ -16,7 +16,7 @@
 //!   reference emulator (`ppmc fuzz run`).
 
 pub mod actions;
-pub mod bus;
+pub mod bus_bytes;
 pub mod campaign;
 pub mod differential;
 pub mod finding;

@@ -6,7 +6,7 @@
 //! (`harness/tests/fuzz_corpus.rs`, `harness/tests/model_twin.rs`).
 
 use super::actions::{lower, typed_program};
-use super::bus;
+use super::bus_bytes;
 use crate::bridge::frame::{self, FrameDecoder};
 use crate::bridge::wire::{Request, Response, Timer};
 use crate::emu::ModelConfig;
@@ -62,7 +62,7 @@ pub fn bus_bytes(data: &[u8]) {
 
 /// [`bus_bytes`] on a model with a configuration (e.g. an injected fault).
 pub fn bus_bytes_with(data: &[u8], cfg: ModelConfig) {
-    match oracle::check_ops(bus::ops(data), cfg) {
+    match oracle::check_ops(bus_bytes::ops(data), cfg) {
         Ok(None) => {}
         Ok(Some(v)) => panic!("invariant {v}"),
         Err(e) => panic!("the model refused its configuration: {e}"),
@@ -109,8 +109,8 @@ pub fn trace_text(data: &[u8]) {
     let Ok(mut chip) = crate::emu::Board::new(Straps::default(), ModelConfig::default()) else {
         return;
     };
-    for op in bus::decode(data) {
-        bus::apply(&mut chip, op);
+    for op in bus_bytes::decode(data) {
+        bus_bytes::apply(&mut chip, op);
     }
     let t = Trace::new("fuzz", "-", "emu", Straps::default(), Vec::new()).assemble(
         Vec::new(),
@@ -121,11 +121,11 @@ pub fn trace_text(data: &[u8]) {
 }
 
 /// The emulator against the plain model ([`twin::check`]) on one input
-/// in the bus-byte format ([`bus::decode`]), at the default straps and
+/// in the bus-byte format ([`bus_bytes::decode`]), at the default straps and
 /// model. Inputs are cut at [`MODEL_TWIN_MAX_OPS`] ops, so that each runs
 /// in bounded time.
 pub fn model_twin(data: &[u8]) {
-    let ops = bus::decode(data);
+    let ops = bus_bytes::decode(data);
     let ops = &ops[..ops.len().min(MODEL_TWIN_MAX_OPS)];
     if let Err(d) = twin::check(ops, Straps::default(), &ModelConfig::default()) {
         panic!("model-twin: {d}");

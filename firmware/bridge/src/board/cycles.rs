@@ -4,7 +4,7 @@
 //! and data reads, writes, and waits on a status flag.
 
 use super::Board;
-use crate::bus::{self, Cycle};
+use crate::bus_cycle::{self, Cycle};
 use crate::hal::Hal;
 use alloc::format;
 use alloc::string::String;
@@ -18,7 +18,7 @@ const CYCLE_DEADLINE_US: u64 = 1_000;
 
 /// The step an aimed cycle starts with: the bus left idle for 47 cycles,
 /// time enough for the CPU to write the wait step after it.
-pub(super) const ANCHOR: u32 = bus::step(0xFF, bus::IDLE, false, 40);
+pub(super) const ANCHOR: u32 = bus_cycle::step(0xFF, bus_cycle::IDLE, false, 40);
 
 impl<H: Hal> Board<H> {
     /// The bridge's own hardware failed: later ops do nothing, and the
@@ -58,20 +58,24 @@ impl<H: Hal> Board<H> {
             let goal = t * 2;
             let before: u64 = steps.words()[..c.moment_step()]
                 .iter()
-                .map(|w| u64::from(bus::step_cycles(*w)))
+                .map(|w| u64::from(bus_cycle::step_cycles(*w)))
                 .sum::<u64>()
-                + u64::from(bus::PINS_AT);
-            let anchor = u64::from(bus::step_cycles(ANCHOR));
-            let fits = anchor + u64::from(bus::MAX_COUNT + bus::STEP_CYCLES) + before;
+                + u64::from(bus_cycle::PINS_AT);
+            let anchor = u64::from(bus_cycle::step_cycles(ANCHOR));
+            let fits = anchor + u64::from(bus_cycle::MAX_COUNT + bus_cycle::STEP_CYCLES) + before;
             while self.hal.cycles() + fits < goal {}
             let Some(pull) = self.push_step(ANCHOR, deadline, c) else {
                 return (self.now_ticks(), None);
             };
-            let waited = pull + anchor + u64::from(bus::STEP_CYCLES) + before;
+            let waited = pull + anchor + u64::from(bus_cycle::STEP_CYCLES) + before;
             if goal >= waited {
-                let count = (goal - waited).min(u64::from(bus::MAX_COUNT)) as u32;
+                let count = (goal - waited).min(u64::from(bus_cycle::MAX_COUNT)) as u32;
                 if self
-                    .push_step(bus::step(0xFF, bus::IDLE, false, count), deadline, c)
+                    .push_step(
+                        bus_cycle::step(0xFF, bus_cycle::IDLE, false, count),
+                        deadline,
+                        c,
+                    )
                     .is_none()
                 {
                     return (self.now_ticks(), None);
@@ -83,7 +87,7 @@ impl<H: Hal> Board<H> {
                 return (self.now_ticks(), None);
             };
             if i == c.moment_step() {
-                moment = pull + u64::from(bus::PINS_AT);
+                moment = pull + u64::from(bus_cycle::PINS_AT);
             }
         }
         self.moment = moment / 2;
@@ -128,7 +132,7 @@ impl<H: Hal> Board<H> {
         }
         let pushed = self.hal.bus_push(w);
         let pull = self.player_free.max(pushed + 1);
-        self.player_free = pull + u64::from(bus::step_cycles(w));
+        self.player_free = pull + u64::from(bus_cycle::step_cycles(w));
         Some(pull)
     }
 

@@ -33,7 +33,7 @@ mod ops;
 mod outputs;
 mod selftest;
 
-use crate::bus::BusTiming;
+use crate::bus_cycle::BusTiming;
 use crate::hal::Hal;
 use crate::pins;
 use crate::timebase;

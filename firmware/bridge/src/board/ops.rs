@@ -5,7 +5,7 @@
 
 use super::cycles::ANCHOR;
 use super::Board;
-use crate::bus::{self, Cycle};
+use crate::bus_cycle::{self, Cycle};
 use crate::hal::Hal;
 use crate::pins;
 use alloc::string::String;
@@ -77,17 +77,17 @@ impl<H: Hal> Board<H> {
             };
             let sum: u64 = words[..n]
                 .iter()
-                .map(|w| u64::from(bus::step_cycles(*w)))
+                .map(|w| u64::from(bus_cycle::step_cycles(*w)))
                 .sum();
             sum + if to_moment {
-                u64::from(bus::PINS_AT)
+                u64::from(bus_cycle::PINS_AT)
             } else {
                 0
             }
         };
         let read = Cycle::Read { a0: true };
         let write = Cycle::Write { a0: true, byte: 0 };
-        let anchor = u64::from(bus::step_cycles(ANCHOR));
+        let anchor = u64::from(bus_cycle::step_cycles(ANCHOR));
         let c = match k {
             Lag::WriteAfterIbf => cycles(read, false) + anchor + cycles(write, true),
             Lag::Write => anchor + cycles(write, true),

@@ -15,7 +15,7 @@ pub mod pio;
 #[cfg(test)]
 mod tests;
 
-use crate::bus::BusTiming;
+use crate::bus_cycle::BusTiming;
 use crate::hal::{Counter, Hal};
 use crate::pins;
 use crate::pioregs::{self, block, fdebug, START_COUNTERS, STOP_COUNTERS};
@@ -172,7 +172,7 @@ impl Twin {
             .configure(0, &player)
             .map_err(|e| std::boxed::Box::new(e) as _)?;
         let bus_mask: u64 = (1 << pins::BUS_COUNT) - 1;
-        let idle = u64::from(crate::bus::IDLE >> 8) << pins::A0;
+        let idle = u64::from(crate::bus_cycle::IDLE >> 8) << pins::A0;
         w.blocks[0].force_pins(bus_mask, idle, 0);
         w.blocks[0].force_pins(bus_mask, idle, bus_mask);
         for g in 0..pins::BUS_COUNT {

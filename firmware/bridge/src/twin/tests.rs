@@ -382,8 +382,8 @@ fn defect_4_writing_a_cycle_without_looking_loses_steps() {
     let t = BusTiming::DEFAULT;
     let mut outside = Inputs(|_, _, _| (0, 0));
     for c in [
-        crate::bus::Cycle::Write { a0: true, byte: 1 },
-        crate::bus::Cycle::Read { a0: true },
+        crate::bus_cycle::Cycle::Write { a0: true, byte: 1 },
+        crate::bus_cycle::Cycle::Read { a0: true },
     ] {
         for s in t.steps(c, SYSCLK_HZ).expect("fits").words() {
             w.blocks[0].txf_write(0, *s);

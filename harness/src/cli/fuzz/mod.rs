@@ -130,7 +130,7 @@ pub(super) fn load_inputs(
     paths: &[PathBuf],
     kind: InputKind,
     cfg: &ModelConfig,
-) -> Result<Vec<(String, Vec<crate::fuzzing::bus::BusOp>)>, CliError> {
+) -> Result<Vec<(String, Vec<crate::fuzzing::bus_bytes::BusOp>)>, CliError> {
     let mut files = Vec::new();
     for p in paths {
         if p.is_dir() {
@@ -166,7 +166,9 @@ pub(super) struct InputArgs {
 
 impl InputArgs {
     /// The model, the input's bytes and its bus ops.
-    pub(super) fn load(&self) -> Result<(ModelConfig, Vec<crate::fuzzing::bus::BusOp>), CliError> {
+    pub(super) fn load(
+        &self,
+    ) -> Result<(ModelConfig, Vec<crate::fuzzing::bus_bytes::BusOp>), CliError> {
         let cfg = self.model.model()?;
         let data = crate::files::read(&self.file, crate::files::MAX_INPUT_BYTES)?;
         let ops = finding::ops_of(&data, self.model.kind, &cfg);

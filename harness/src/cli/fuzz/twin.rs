@@ -4,13 +4,13 @@
 //! show one.
 
 use super::*;
-use crate::fuzzing::bus;
+use crate::fuzzing::bus_bytes;
 use crate::plain_model::twin;
 use crate::protocol::Straps;
 
 pub fn run(file: &Path, output: Option<PathBuf>) -> Result<(), CliError> {
     let data = crate::files::read(file, crate::files::MAX_INPUT_BYTES)?;
-    let ops = bus::decode(&data);
+    let ops = bus_bytes::decode(&data);
     let cfg = ModelConfig::default();
     let straps = Straps::default();
     let d = match twin::check(&ops, straps, &cfg) {
@@ -36,7 +36,7 @@ pub fn run(file: &Path, output: Option<PathBuf>) -> Result<(), CliError> {
         return Err(CliError::Verdict);
     };
     let out = output.unwrap_or_else(|| super::with_suffix(file, "min"));
-    crate::files::write(&out, &bus::encode(&small))?;
+    crate::files::write(&out, &bus_bytes::encode(&small))?;
     errln!(
         "ppmc fuzz twin: {} ops -> {} ops; wrote {}",
         ops.len(),
