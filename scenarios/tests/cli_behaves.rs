@@ -177,3 +177,57 @@ fn bridge_sim_takes_the_chips_options_and_no_clients() {
         "an unknown option is a usage error"
     );
 }
+
+/// Issue 29: a script's `--help` printed lines of its code
+/// (`scripts/network-figures`), or was not read at all and started the
+/// work (`scripts/fuzz-figures` began building every fuzz target). Each
+/// prints its header comment, and only that, and ends at once.
+#[test]
+fn each_scripts_help_is_its_header_comment_and_starts_nothing() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    for script in ["scripts/network-figures", "scripts/fuzz-figures"] {
+        let path = root.join(script);
+        let source = std::fs::read_to_string(&path).expect("the script");
+        let header: Vec<String> = source
+            .lines()
+            .skip(1)
+            .take_while(|l| l.starts_with('#'))
+            .map(|l| {
+                l.trim_start_matches('#')
+                    .strip_prefix(' ')
+                    .unwrap_or(l.trim_start_matches('#'))
+                    .to_string()
+            })
+            .collect();
+        let mut child = Command::new(&path)
+            .arg("--help")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the script runs");
+        let status = wait_bounded(&mut child, Duration::from_secs(20));
+        let mut out = String::new();
+        let mut err = String::new();
+        child
+            .stdout
+            .take()
+            .expect("piped")
+            .read_to_string(&mut out)
+            .expect("stdout");
+        child
+            .stderr
+            .take()
+            .expect("piped")
+            .read_to_string(&mut err)
+            .expect("stderr");
+        assert!(status.success(), "{script} --help: {status:?}\n{err}");
+        assert!(err.is_empty(), "{script} --help started something:\n{err}");
+        let printed: Vec<&str> = out.lines().collect();
+        assert_eq!(printed, header, "{script} --help");
+        let bad = Command::new(&path)
+            .arg("--no-such-option")
+            .output()
+            .expect("runs");
+        assert_eq!(bad.status.code(), Some(2), "{script}: an unknown option");
+    }
+}
