@@ -19,21 +19,36 @@ pub struct LogicInfo {
     /// `D[7:0]` is eight channels, `D[0]` to `D[7]`.
     pub channels: Vec<String>,
     /// The capture's resolution in picoseconds: the sample period of a
-    /// sampled capture (sigrok, Saleae), the timescale of a VCD. No edge
-    /// is known closer than this.
+    /// sampled capture (sigrok, Saleae; rounded, at least 1), the
+    /// timescale of a VCD. No edge is known closer than this.
     pub resolution_ps: u64,
+    /// The sample rate of a sampled capture, exactly as the file gives it
+    /// (24 MHz is no whole number of picoseconds); `None` for a VCD. A
+    /// change of a sampled capture is at sample `n`, `time_ps` being
+    /// `n * 10^12 / rate` rounded to the nearest picosecond.
+    pub sample_rate_hz: Option<u64>,
     /// What the file is, in words, for reports: `sigrok session (.sr,
     /// version 2)`, `VCD (sigrok-cli)`, `Saleae Logic 2 binary (version 1)`.
     pub format: String,
 }
 
 impl LogicInfo {
-    /// The sample rate this resolution stands for, in hertz (rounded).
-    pub fn sample_rate_hz(&self) -> u64 {
-        if self.resolution_ps == 0 {
-            return 0;
+    /// The sample rate, in hertz: the file's, or the one the resolution
+    /// stands for (rounded).
+    pub fn rate_hz(&self) -> u64 {
+        match self.sample_rate_hz {
+            Some(r) => r,
+            None if self.resolution_ps == 0 => 0,
+            None => (1_000_000_000_000 + self.resolution_ps / 2) / self.resolution_ps,
         }
-        (1_000_000_000_000 + self.resolution_ps / 2) / self.resolution_ps
+    }
+
+    /// The time of sample `n` of a capture at `rate` Hz, in picoseconds,
+    /// rounded (saturating).
+    pub fn sample_time_ps(n: u64, rate: u64) -> u64 {
+        let t =
+            (u128::from(n) * 1_000_000_000_000 + u128::from(rate / 2)) / u128::from(rate.max(1));
+        u64::try_from(t).unwrap_or(u64::MAX)
     }
 
     /// The index of the channel named `name`, if the capture has one.
@@ -127,9 +142,17 @@ mod tests {
         let info = LogicInfo {
             channels: vec!["CS".into(), "RD".into()],
             resolution_ps: 41_667,
+            sample_rate_hz: Some(24_000_000),
             format: "test".into(),
         };
-        assert_eq!(info.sample_rate_hz(), 24_000_000);
+        assert_eq!(info.rate_hz(), 24_000_000);
+        assert_eq!(LogicInfo::sample_time_ps(3, 24_000_000), 125_000);
+        let vcd = LogicInfo {
+            sample_rate_hz: None,
+            resolution_ps: 1_000,
+            ..info.clone()
+        };
+        assert_eq!(vcd.rate_hz(), 1_000_000_000);
         assert_eq!(info.channel("RD"), Some(1));
         let e = LogicError::new(Path::new("a.sr"), "byte 7 of logic-1-1", "truncated");
         assert_eq!(e.to_string(), "a.sr: byte 7 of logic-1-1: truncated");
