@@ -3,4 +3,6 @@
 //! level changes of [`source`]. Nothing here knows the chip: mapping
 //! channels to its signals, decoding its bus and judging it come on top.
 
+pub mod decode;
+pub mod map;
 pub mod source;
