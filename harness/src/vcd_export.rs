@@ -16,10 +16,16 @@
 //! that samples coarser than the width drawn loses pulses. The file is
 //! written as a stream, so a 16-million-pulse trace costs time but not
 //! memory.
+//!
+//! With the bus ([`Export::bus`], `ppmc export --bus`), the host's side is
+//! drawn too: `cs`, `rd`, `wr` (active low, 1 = high), `a0` and `d0`..`d7`,
+//! one bus cycle per register access of the trace, at [`BUS_TIMING_NOTE`]'s
+//! timing: what a logic analyzer on the chip's bus would record, for
+//! `ppmc decode` and `ppmc judge` to read back (`docs/captures.md`).
 
 use crate::protocol::{Direction, Pin, Winding};
 use crate::time::{Duration, Instant};
-use crate::trace::{EventKind, Trace};
+use crate::trace::{BusEvent, EventKind, Trace};
 use std::io::{self, Write};
 use vcd::{IdCode, TimescaleUnit, Value};
 
@@ -42,6 +48,38 @@ pub const SIGNALS: [&str; 16] = [
     "auxo2",
     "auxo3",
 ];
+
+/// The bus's wires, after [`SIGNALS`], when the export draws the bus.
+pub const BUS_SIGNALS: [&str; 12] = [
+    "cs", "rd", "wr", "a0", "d0", "d1", "d2", "d3", "d4", "d5", "d6", "d7",
+];
+
+const WIRES: usize = SIGNALS.len() + BUS_SIGNALS.len();
+const CS: usize = SIGNALS.len();
+const RD: usize = CS + 1;
+const WR: usize = CS + 2;
+const A0: usize = CS + 3;
+const D0: usize = CS + 4;
+
+/// A bus cycle of the export, in ns: CS* falls `BUS_SETUP` before the
+/// strobe, the strobe (RD* or WR*) lasts `BUS_STROBE` and rises at the
+/// access's time in the trace, CS* rises `BUS_HOLD` after it; cycles that
+/// share a time in the trace are laid out `BUS_CYCLE` apart, ending at it.
+/// The whole file is then late by the whole microseconds the first cycles
+/// need before the trace's time 0 ([`bus_lead`]).
+pub const BUS_SETUP: u64 = 50;
+pub const BUS_STROBE: u64 = 100;
+pub const BUS_HOLD: u64 = 20;
+pub const BUS_CYCLE: u64 = 200;
+
+/// The most accesses at one time laid out before it; more end together.
+const MAX_LAID_OUT: u64 = 8;
+
+/// How far before an event a bus cycle may begin, in ns.
+const LOOK_BACK: u64 = MAX_LAID_OUT * BUS_CYCLE + BUS_SETUP + BUS_STROBE;
+
+/// The header's word on the bus's timing.
+pub const BUS_TIMING_NOTE: &str = "bus: one cycle per register access: CS* low 50 ns before the strobe, RD* or WR* low for 100 ns rising at the access's time in the trace (the data held from the strobe's fall to CS* rising 20 ns after it), A0 high for the command and status registers; accesses at one time in the trace are laid out 200 ns apart, the last ending at that time. A status wait (await) is drawn as the one status read that ended it. Every time in this file is the trace's plus the lead in the comment below, which makes room for the cycles at the trace's start.";
 
 const POUT: usize = 0;
 const DIR: usize = 1;
@@ -66,6 +104,20 @@ pub fn export(trace: &Trace, out: impl Write) -> io::Result<()> {
     export_window(trace, None, out)
 }
 
+/// What an export draws.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Export {
+    /// Only the trace from `.0` to `.1` ([`export_window`]).
+    pub window: Option<(Instant, Instant)>,
+    /// The host's bus too: CS*, RD*, WR*, A0, D0-D7.
+    pub bus: bool,
+}
+
+/// Writes `trace` as VCD to `out`, as `what` says.
+pub fn export_with(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
+    write(trace, what, out)
+}
+
 /// Writes the part of `trace` from `window.0` to `window.1` as VCD to
 /// `out` (the whole trace with `None`): the signals' values at the
 /// window's start come first, at its start time, and only what changes
@@ -77,6 +129,11 @@ pub fn export_window(
     window: Option<(Instant, Instant)>,
     out: impl Write,
 ) -> io::Result<()> {
+    write(trace, Export { window, bus: false }, out)
+}
+
+fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
+    let window = what.window;
     let mut w = vcd::Writer::new(io::BufWriter::new(out));
     w.comment(&format!(
         "ppmc trace of {} (section {})",
@@ -86,10 +143,16 @@ pub fn export_window(
         w.comment(&format!("the trace from {from} to {to} only"))?;
     }
     w.comment(POUT_WIDTH_NOTE)?;
+    let lead = if what.bus { bus_lead(trace) } else { 0 };
+    if what.bus {
+        w.comment(BUS_TIMING_NOTE)?;
+        w.comment(&format!("lead: {lead} ns (the trace's time 0 is #{lead})"))?;
+    }
     w.timescale(1, TimescaleUnit::NS)?;
     w.add_module("ppmc")?;
-    let mut ids = Vec::with_capacity(SIGNALS.len());
-    for name in SIGNALS {
+    let mut ids = Vec::with_capacity(WIRES);
+    let bus_names = if what.bus { &BUS_SIGNALS[..] } else { &[] };
+    for name in SIGNALS.iter().chain(bus_names) {
         ids.push(w.add_wire(1, name)?);
     }
     w.upscope()?;
@@ -98,12 +161,19 @@ pub fn export_window(
     let mut state = Emitter {
         w,
         ids,
-        values: [false; SIGNALS.len()],
+        values: [false; WIRES],
         last_time: 0,
+        lead,
+        reorder: what.bus.then(std::collections::BTreeMap::new),
+        seq: 0,
         from: from.as_nanos(),
         to: to.as_nanos(),
         started: false,
     };
+    // An idle bus: CS*, RD* and WR* high.
+    for i in [CS, RD, WR] {
+        state.values[i] = true;
+    }
     if from == Instant::ZERO {
         state.start()?;
     }
@@ -111,7 +181,8 @@ pub fn export_window(
     let mut phase: u32 = 0;
     // Falling edge of the last POUT, not yet written.
     let mut pending_fall: Option<Instant> = None;
-    for e in &trace.events {
+    for (k, e) in trace.events.iter().enumerate() {
+        state.drain_before((e.at.as_nanos() + state.lead).saturating_sub(LOOK_BACK))?;
         match &e.kind {
             EventKind::Move {
                 dir,
@@ -145,6 +216,7 @@ pub fn export_window(
                 }
                 for i in first_in..past.max(first_in) {
                     let t = run.at(i);
+                    state.drain_before((t.as_nanos() + state.lead).saturating_sub(LOOK_BACK))?;
                     state.flush_before(&mut pending_fall, t)?;
                     state.set(t, POUT, true)?;
                     if let Some(wd) = winding {
@@ -178,12 +250,37 @@ pub fn export_window(
                     }
                 }
             }
-            EventKind::Bus(_) | EventKind::Measure { .. } => {}
+            EventKind::Bus(b) => {
+                let Some((read, a0, byte)) = bus_cycle(b) else {
+                    continue;
+                };
+                // Accesses after this one at the same time come first.
+                let later = trace.events[k + 1..]
+                    .iter()
+                    .take_while(|n| n.at == e.at)
+                    .filter(|n| matches!(&n.kind, EventKind::Bus(nb) if bus_cycle(nb).is_some()))
+                    .count() as u64;
+                let end = (e.at.as_nanos() + state.lead)
+                    .saturating_sub(later.min(MAX_LAID_OUT) * BUS_CYCLE);
+                let strobe = if read { RD } else { WR };
+                let setup = end.saturating_sub(BUS_SETUP + BUS_STROBE);
+                let fall = end.saturating_sub(BUS_STROBE);
+                state.set_file(setup, CS, false)?;
+                state.set_file(setup, A0, a0)?;
+                state.set_file(fall, strobe, false)?;
+                for i in 0..8 {
+                    state.set_file(fall, D0 + i, byte >> i & 1 == 1)?;
+                }
+                state.set_file(end, strobe, true)?;
+                state.set_file(end + BUS_HOLD, CS, true)?;
+            }
+            EventKind::Measure { .. } => {}
         }
     }
     if let Some(f) = pending_fall.take() {
         state.set(f, POUT, false)?;
     }
+    state.drain_before(u64::MAX)?;
     // The trace's end (or the window's), where nothing changes.
     let end = trace
         .events
@@ -195,10 +292,48 @@ pub fn export_window(
     if !state.started {
         state.start()?;
     }
+    let end = end + state.lead;
     if end > state.last_time {
         state.w.timestamp(end)?;
     }
     state.w.flush()
+}
+
+/// How late the bus export writes every time, in ns: the whole
+/// microseconds that the cycles laid out before the earliest accesses
+/// need (three accesses at the trace's time 0 need 600 ns, and CS*
+/// falls 150 ns before the first strobe ends: 1 us).
+pub fn bus_lead(trace: &Trace) -> u64 {
+    let mut need = 0u64;
+    let mut group: Option<(Instant, u64)> = None;
+    for e in &trace.events {
+        let EventKind::Bus(b) = &e.kind else { continue };
+        if bus_cycle(b).is_none() {
+            continue;
+        }
+        let n = match group {
+            Some((t, n)) if t == e.at => n + 1,
+            _ => 1,
+        };
+        group = Some((e.at, n));
+        let before = (n - 1).min(MAX_LAID_OUT) * BUS_CYCLE + BUS_SETUP + BUS_STROBE;
+        need = need.max(before.saturating_sub(e.at.as_nanos()));
+    }
+    need.div_ceil(1000) * 1000
+}
+
+/// The bus cycle a bus event is drawn as: a read or not, A0, the byte on
+/// D0-D7. `None` for what puts no cycle on the bus (a write or read that
+/// timed out, an input driven, a reset).
+fn bus_cycle(b: &BusEvent) -> Option<(bool, bool, u8)> {
+    Some(match *b {
+        BusEvent::WriteCommand { byte, .. } => (false, true, byte),
+        BusEvent::WriteData { byte, .. } => (false, false, byte),
+        BusEvent::ReadStatus(s) => (true, true, s),
+        BusEvent::ReadData { byte, .. } => (true, false, byte),
+        BusEvent::Await { status, .. } => (true, true, status),
+        _ => return None,
+    })
 }
 
 /// The first pulse of `run` (of `count`) at or after `t`: `count` if none.
@@ -222,10 +357,17 @@ struct Emitter<W: Write> {
     w: vcd::Writer<W>,
     ids: Vec<IdCode>,
     /// Every wire's value as last written.
-    values: [bool; SIGNALS.len()],
+    values: [bool; WIRES],
     /// The last timestamp written (the window's start is the `$dumpvars`
     /// block's).
     last_time: u64,
+    /// What every time of the trace is written late by, in ns.
+    lead: u64,
+    /// With the bus, changes wait here in time order (file time, order of
+    /// arrival) until nothing earlier can come: a bus cycle is laid out
+    /// before the access it ends at.
+    reorder: Option<std::collections::BTreeMap<(u64, u64), (usize, bool)>>,
+    seq: u64,
     /// The window, in ns: changes before `from` only set the values the
     /// `$dumpvars` block starts with; changes after `to` are not written.
     from: u64,
@@ -258,17 +400,54 @@ impl<W: Write> Emitter<W> {
         self.w.end()
     }
 
-    /// Sets wire `i` at `at`: writes nothing unless its value changes.
+    /// Sets wire `i` at `at` (the trace's time).
     fn set(&mut self, at: Instant, i: usize, v: bool) -> io::Result<()> {
-        if self.values[i] == v {
+        self.set_file(at.as_nanos() + self.lead, i, v)
+    }
+
+    /// Sets wire `i` at `t`, the file's time: at once, or through the
+    /// reorder buffer when there is one.
+    fn set_file(&mut self, t: u64, i: usize, v: bool) -> io::Result<()> {
+        if let Some(q) = &mut self.reorder {
+            self.seq += 1;
+            q.insert((t, self.seq), (i, v));
             return Ok(());
         }
-        let t = at.as_nanos();
-        if t < self.from {
+        self.write(t, i, v)
+    }
+
+    /// Writes the buffered changes before `t` (the file's time).
+    fn drain_before(&mut self, t: u64) -> io::Result<()> {
+        let Some(mut q) = self.reorder.take() else {
+            return Ok(());
+        };
+        let mut result = Ok(());
+        while let Some(entry) = q.first_entry() {
+            if entry.key().0 >= t {
+                break;
+            }
+            let ((at, _), (i, v)) = entry.remove_entry();
+            result = self.write(at, i, v);
+            if result.is_err() {
+                break;
+            }
+        }
+        self.reorder = Some(q);
+        result
+    }
+
+    /// Writes wire `i`'s value at `t`, the file's time: nothing unless it
+    /// changes.
+    fn write(&mut self, t: u64, i: usize, v: bool) -> io::Result<()> {
+        if i >= self.ids.len() || self.values[i] == v {
+            return Ok(());
+        }
+        let trace_t = t.saturating_sub(self.lead);
+        if trace_t < self.from {
             self.values[i] = v;
             return Ok(());
         }
-        if t > self.to {
+        if trace_t > self.to {
             return Ok(());
         }
         if !self.started {
@@ -488,5 +667,116 @@ end
         assert!(dir_high, "DIR shows CCW");
         // 0b0101: AUXO0 and AUXO2.
         assert_eq!(auxo_seen, [true, false, true, false]);
+    }
+
+    /// The bus as a logic analyzer would record it: decoded back (Table
+    /// 3-1) it gives every access of the trace, its byte and its time (the
+    /// last of those at one time ending at it, all late by the lead).
+    #[test]
+    fn the_bus_export_decodes_to_the_traces_accesses() {
+        use crate::logic::decode::{Access, BusDecoder};
+        use crate::logic::map::BusChannels;
+        use crate::logic::source::{Change, LogicInfo};
+        let text = "ppmc-trace 1
+scenario bus
+section 3-1
+target emu
+detail sysclk_hz 16000000
+detail csel high
+detail vsel high
+detail ext_clock_hz none
+events
+0.000us reset
+0.000us await busy=0 after 0.000us status=0x00
+0.000us await ibf=0 after 0.000us status=0x00
+0.000us wc 0x02 waited=0.000us
+6.000us wd 0x64 waited=6.000us
+68.000us pin s 0b11000
+90.000us pin hold 1
+90.000us rs 0x80
+95.000us rd 0x5a waited=1.000us
+end
+";
+        let trace = Trace::parse(text).expect("trace");
+        let mut buf = Vec::new();
+        export_with(
+            &trace,
+            Export {
+                window: None,
+                bus: true,
+            },
+            &mut buf,
+        )
+        .expect("export");
+        let lead = bus_lead(&trace);
+        assert_eq!(lead, 1000);
+        let mut parser = Parser::new(&buf[..]);
+        let header = parser.parse_header().expect("header");
+        let code = |n: &str| header.find_var(&["ppmc", n]).expect("declared").code;
+        let wires: Vec<IdCode> = BUS_SIGNALS.iter().map(|n| code(n)).collect();
+        let info = LogicInfo {
+            channels: BUS_SIGNALS.iter().map(|n| n.to_string()).collect(),
+            resolution_ps: 1000,
+            sample_rate_hz: None,
+            format: "test".into(),
+        };
+        let bus = BusChannels {
+            cs: 0,
+            rd: 1,
+            wr: 2,
+            a0: 3,
+            d: [4, 5, 6, 7, 8, 9, 10, 11],
+        };
+        let mut dec = BusDecoder::new(bus, &info, 20_000);
+        let (mut now, mut levels, mut got) = (0u64, 0u64, Vec::new());
+        let mut pending = false;
+        for cmd in parser {
+            match cmd.expect("body") {
+                Command::Timestamp(t) => {
+                    if pending {
+                        got.extend(dec.push(Change {
+                            time_ps: now * 1000,
+                            levels,
+                            unknown: 0,
+                        }));
+                        pending = false;
+                    }
+                    now = t;
+                }
+                Command::ChangeScalar(id, v) => {
+                    if let Some(k) = wires.iter().position(|w| *w == id) {
+                        levels = (levels & !(1 << k)) | (u64::from(v == Value::V1) << k);
+                        pending = true;
+                    }
+                }
+                _ => {}
+            }
+        }
+        if pending {
+            got.extend(dec.push(Change {
+                time_ps: now * 1000,
+                levels,
+                unknown: 0,
+            }));
+        }
+        let want: Vec<(Access, u8, u64)> = vec![
+            (Access::ReadStatus, 0x00, 600),
+            (Access::ReadStatus, 0x00, 800),
+            (Access::WriteCommand, 0x02, 1000),
+            (Access::WriteData, 0x64, 7000),
+            (Access::ReadStatus, 0x80, 91_000),
+            (Access::ReadData, 0x5A, 96_000),
+        ];
+        let got: Vec<(Access, u8, u64)> = got
+            .iter()
+            .map(|t| (t.access, t.byte, t.end_ps / 1000))
+            .collect();
+        assert_eq!(got, want);
+        assert_eq!(dec.summary().one_sample, 0);
+        // Without the bus, the bus wires are not there.
+        let mut plain = Vec::new();
+        export(&trace, &mut plain).expect("export");
+        let plain = String::from_utf8(plain).expect("text");
+        assert!(!plain.contains(" cs $end"), "{plain}");
     }
 }

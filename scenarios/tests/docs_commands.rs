@@ -21,8 +21,9 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 /// The files whose commands run.
-const FILES: [&str; 12] = [
+const FILES: [&str; 13] = [
     "README.md",
+    "docs/captures.md",
     "docs/board-farm.md",
     "firmware/README.md",
     "docs/bridge-hardware.md",

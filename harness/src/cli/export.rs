@@ -6,7 +6,7 @@ use crate::trace::Trace;
 use clap::Args;
 use std::path::PathBuf;
 
-/// Which scenarios to take.
+/// What to export, and where.
 #[derive(Debug, Args)]
 pub struct ExportArgs {
     /// A trace or golden file.
@@ -15,6 +15,12 @@ pub struct ExportArgs {
     /// standard output).
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Draw the host's bus too: CS*, RD*, WR*, A0 and D0-D7, one cycle per
+    /// register access of the trace (its timing is in the file's header
+    /// and docs/captures.md), as a logic analyzer on the chip's bus would
+    /// record it.
+    #[arg(long)]
+    bus: bool,
 }
 
 pub fn run(args: ExportArgs) -> Result<(), CliError> {
@@ -34,10 +40,14 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
         Some(o) => o.clone(),
         None => args.trace.with_extension("vcd"),
     };
+    let what = crate::vcd_export::Export {
+        window: None,
+        bus: args.bus,
+    };
     // Streamed: a 16-million-pulse trace costs time, not memory.
     if out.as_os_str() == "-" {
         let stdout = std::io::stdout().lock();
-        return match crate::vcd_export::export(&trace, stdout) {
+        return match crate::vcd_export::export_with(&trace, what, stdout) {
             // A reader that stops early (`| head`) is not an error.
             Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
                 Err(CliError::Failed(format!("standard output: {e}")))
@@ -56,7 +66,7 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
         )));
     }
     files::check_writable(&out)?;
-    files::write_with(&out, |w| crate::vcd_export::export(&trace, w))?;
+    files::write_with(&out, |w| crate::vcd_export::export_with(&trace, what, w))?;
     outln!("wrote {}", out.display());
     Ok(())
 }
