@@ -330,6 +330,9 @@ pub struct EmuBus {
     /// pass the board's bus faults.
     board: Board,
     cfg: ModelConfig,
+    /// How long a register access takes on the bus; zero (the default):
+    /// an access takes no time, as the golden traces are recorded.
+    bus_cycle: Duration,
 }
 
 impl EmuBus {
@@ -337,7 +340,25 @@ impl EmuBus {
         Ok(EmuBus {
             board: Board::new(straps, cfg.clone())?,
             cfg,
+            bus_cycle: Duration::ZERO,
         })
+    }
+
+    /// Makes every register access take `cycle` of the chip's time, the
+    /// access happening at its end (a write latched as WR* rises, a read
+    /// sampled as RD* rises), and a status wait end with the poll that saw
+    /// it: a host on a real bus, whose accesses never share an instant.
+    /// What `ppmc export --scenario` records its captures with.
+    pub fn set_bus_cycle(&mut self, cycle: Duration) {
+        self.bus_cycle = cycle;
+    }
+
+    /// One bus cycle passes.
+    fn cycle(&mut self) {
+        if self.bus_cycle > Duration::ZERO {
+            let to = self.board.now() + self.bus_cycle;
+            self.board.advance_to(to);
+        }
     }
 
     /// The model itself (its own status, without the board).
@@ -440,6 +461,7 @@ impl EmuBus {
                         }
                     }
                 }
+                self.cycle();
                 if matches!(op, Op::WriteCommand { .. }) {
                     self.board.write_command(byte);
                 } else {
@@ -451,6 +473,7 @@ impl EmuBus {
                 }
             }
             Op::ReadStatus => {
+                self.cycle();
                 let (at, status) = self.status_at();
                 Reply::Status { at, status }
             }
@@ -465,6 +488,7 @@ impl EmuBus {
                         }
                     }
                 }
+                self.cycle();
                 let byte = self.board.read_data();
                 Reply::Data {
                     at: self.board.now(),
@@ -481,16 +505,16 @@ impl EmuBus {
                 mask,
                 value,
                 timeout,
-            } => match self.wait_for(mask, value & mask, timeout) {
-                Ok(waited) => {
-                    let (at, status) = self.status_at();
-                    Reply::Awaited { at, waited, status }
+            } => {
+                let result = self.wait_for(mask, value & mask, timeout);
+                // The poll that saw it (or the last one) ends a cycle on.
+                self.cycle();
+                let (at, status) = self.status_at();
+                match result {
+                    Ok(waited) => Reply::Awaited { at, waited, status },
+                    Err(()) => Reply::AwaitTimedOut { at, status },
                 }
-                Err(()) => {
-                    let (at, status) = self.status_at();
-                    Reply::AwaitTimedOut { at, status }
-                }
-            },
+            }
             Op::SetInput { input, asserted } => {
                 self.board.set_input(input, asserted);
                 Reply::InputSet {

@@ -25,6 +25,7 @@ pub mod files;
 pub mod fuzzing;
 pub mod golden;
 pub mod invariants;
+pub mod judge;
 pub mod logic;
 pub mod plain_model;
 pub mod report;

@@ -20,6 +20,13 @@ impl EmuTarget {
         })
     }
 
+    /// Every register access takes `cycle` of the chip's time
+    /// ([`EmuBus::set_bus_cycle`]): a host on a real bus.
+    pub fn with_bus_cycle(mut self, cycle: crate::time::Duration) -> Self {
+        self.bus.set_bus_cycle(cycle);
+        self
+    }
+
     pub fn chip(&self) -> &Chip {
         self.bus.chip()
     }

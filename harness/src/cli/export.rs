@@ -1,7 +1,11 @@
-//! `ppmc export`: a trace as a VCD waveform.
+//! `ppmc export`: a trace as a VCD waveform, or a scenario run on the
+//! emulator (clean or with a board fault) as a logic analyzer would record
+//! it.
 
+use crate::backend::EmuTarget;
 use crate::cli::{usage, CliError};
 use crate::files;
+use crate::scenario::{run_scenario, DriverOptions, Scenario};
 use crate::trace::Trace;
 use clap::Args;
 use std::path::PathBuf;
@@ -10,7 +14,19 @@ use std::path::PathBuf;
 #[derive(Debug, Args)]
 pub struct ExportArgs {
     /// A trace or golden file.
-    trace: PathBuf,
+    #[arg(required_unless_present = "scenario", conflicts_with = "scenario")]
+    trace: Option<PathBuf>,
+    /// Instead of a trace: run this scenario on the emulator, every
+    /// register access taking a bus cycle as on a real bus (the golden
+    /// traces' accesses take no time), and export what a logic analyzer on
+    /// the board would record (with --bus, the bus too). Needs -o.
+    #[arg(long, value_name = "NAME", requires = "output")]
+    scenario: Option<String>,
+    /// With --scenario: run the chip with this fault of the catalogue
+    /// (`ppmc fault-matrix --list`), swap-error-A-B or status-stuck-0xNN;
+    /// repeat to combine.
+    #[arg(long = "chip-fault", value_name = "FAULT", requires = "scenario")]
+    chip_faults: Vec<String>,
     /// The VCD file to write (default: the trace's name with .vcd; `-` for
     /// standard output).
     #[arg(short, long)]
@@ -23,22 +39,51 @@ pub struct ExportArgs {
     bus: bool,
 }
 
-pub fn run(args: ExportArgs) -> Result<(), CliError> {
-    let text = files::read_text(&args.trace, files::MAX_TRACE_BYTES)?;
-    let trace = match Trace::parse(&text) {
-        Ok(t) => t,
-        Err(e) => {
-            return Err(usage(format!(
-                "{}:{}: {}",
-                args.trace.display(),
-                e.line,
-                e.message
-            )))
-        }
+/// The trace of `name` run on the emulator with `faults`, every register
+/// access taking a bus cycle.
+fn scenario_trace(name: &str, faults: &[String], suite: &[Scenario]) -> Result<Trace, CliError> {
+    let Some(s) = suite.iter().find(|s| s.name == name) else {
+        return Err(usage(format!("no scenario `{name}` (see `ppmc list`)")));
     };
-    let out = match &args.output {
-        Some(o) => o.clone(),
-        None => args.trace.with_extension("vcd"),
+    let mut model = crate::emu::ModelConfig::default();
+    crate::faults::apply_all(faults, &mut model)
+        .map_err(|e| usage(format!("--chip-fault: {e}")))?;
+    let target = EmuTarget::new(crate::protocol::Straps::default(), model)
+        .map_err(|e| usage(e.to_string()))?;
+    let cycle = crate::time::Duration::from_nanos(crate::vcd_export::BUS_CYCLE);
+    let mut target = target.with_bus_cycle(cycle);
+    let r = run_scenario(&mut target, s, DriverOptions::default());
+    r.trace.ok_or_else(|| {
+        CliError::Failed(format!(
+            "{name}: the scenario left no trace ({})",
+            r.verdict.detail().unwrap_or_default()
+        ))
+    })
+}
+
+pub fn run(args: ExportArgs, suite: &[Scenario]) -> Result<(), CliError> {
+    let (trace, input) = match (&args.trace, &args.scenario) {
+        (_, Some(name)) => (scenario_trace(name, &args.chip_faults, suite)?, None),
+        (Some(path), None) => {
+            let text = files::read_text(path, files::MAX_TRACE_BYTES)?;
+            match Trace::parse(&text) {
+                Ok(t) => (t, Some(path.clone())),
+                Err(e) => {
+                    return Err(usage(format!(
+                        "{}:{}: {}",
+                        path.display(),
+                        e.line,
+                        e.message
+                    )))
+                }
+            }
+        }
+        (None, None) => return Err(usage("give a trace file or --scenario NAME")),
+    };
+    let out = match (&args.output, &input) {
+        (Some(o), _) => o.clone(),
+        (None, Some(i)) => i.with_extension("vcd"),
+        (None, None) => return Err(usage("--scenario needs -o FILE (or - for standard output)")),
     };
     let what = crate::vcd_export::Export {
         window: None,
@@ -55,7 +100,7 @@ pub fn run(args: ExportArgs) -> Result<(), CliError> {
             _ => Ok(()),
         };
     }
-    if files::same_file(&out, &args.trace) {
+    if input.as_ref().is_some_and(|i| files::same_file(&out, i)) {
         let how = match args.output {
             Some(_) => "-o names the input trace",
             None => "the default output (the trace's name with .vcd) is the input trace itself",

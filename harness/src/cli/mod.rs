@@ -114,7 +114,7 @@ pub fn main(suite: Vec<Scenario>) -> ExitCode {
         Command::List(args) => list::run(args, suite),
         Command::Record(args) => record::run(args, suite),
         Command::Compare(args) => compare::run(args, suite),
-        Command::Export(args) => export::run(args),
+        Command::Export(args) => export::run(args, suite),
         Command::Console(args) => console::run(args),
         Command::Bench(args) => bench::run(args, suite),
         Command::BridgeSim(args) => bridge_sim::run(args),

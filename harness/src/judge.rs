@@ -1,0 +1,436 @@
+//! A board judged from a capture of its bus and pins (issue 30,
+//! `docs/captures.md`): the host's writes, decoded from the capture, go
+//! into the reference model at their captured times; what the chip
+//! answered (status and data reads) and put out (POUT's pulses) is
+//! compared with what the model does, within the capture's resolution and
+//! the usual tolerances. The verdict keeps the parties apart:
+//!
+//! - a **board** divergence: the chip answered or pulsed otherwise than
+//!   the model would, given the same writes at the same times;
+//! - **host** findings: the firmware driving the chip used it against
+//!   chapter 3 (a byte written while IBF is 1, which replaces the waiting
+//!   one; a data read before OBF), not failures of the board;
+//! - a **capture** problem: a signal missing, a sample rate too low for
+//!   the strobes, a file that does not read.
+//!
+//! The model starts at the capture's start, or where the `reset` channel
+//! falls when the capture has one (the chip's RESET released).
+
+use crate::compare::Tolerances;
+use crate::emu::{Board, ModelConfig};
+use crate::logic::decode::{Access, BusDecoder, Transaction, GLITCH_PS};
+use crate::logic::map::{ChannelMap, Signal};
+use crate::logic::source::{Change, LogicError, LogicSource};
+use crate::protocol::Straps;
+use crate::time::{Duration, Instant};
+use std::fmt;
+
+/// How to judge.
+#[derive(Debug, Clone)]
+pub struct JudgeOptions {
+    pub straps: Straps,
+    pub model: ModelConfig,
+    pub tolerances: Tolerances,
+    /// Strobes shorter than this are glitches, in picoseconds.
+    pub glitch_ps: u64,
+}
+
+impl Default for JudgeOptions {
+    fn default() -> Self {
+        JudgeOptions {
+            straps: Straps::default(),
+            model: ModelConfig::default(),
+            tolerances: Tolerances::default(),
+            glitch_ps: GLITCH_PS,
+        }
+    }
+}
+
+/// Where the board first did otherwise than the model.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Divergence {
+    /// When, in picoseconds of the capture.
+    pub at_ps: u64,
+    /// What differs, in words: `POUT pulse 12`, `status read`.
+    pub what: String,
+    pub board: String,
+    pub model: String,
+    /// The last register access before it, as the console writes it.
+    pub after: Option<String>,
+}
+
+/// The host firmware using the chip against chapter 3.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct HostFinding {
+    pub at_ps: u64,
+    /// The datasheet section it breaks.
+    pub section: &'static str,
+    pub what: String,
+}
+
+/// The verdict on a capture.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Verdict {
+    /// The board did what the model does, as far as the capture shows.
+    Passed,
+    /// The board diverged from the model: the board's fault.
+    Failed(Divergence),
+    /// The capture cannot be judged (or only in part): its fault, not the
+    /// board's.
+    Capture(String),
+}
+
+/// What judging a capture found.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Judgement {
+    pub verdict: Verdict,
+    pub host: Vec<HostFinding>,
+    /// The register accesses decoded and the POUT pulses compared.
+    pub accesses: u64,
+    pub pulses: u64,
+    /// What could not be judged, and why (a signal with no channel).
+    pub not_judged: Vec<String>,
+}
+
+impl fmt::Display for Divergence {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} at {}: board {}, model {}",
+            self.what,
+            Instant::from_nanos(self.at_ps / 1000),
+            self.board,
+            self.model
+        )?;
+        if let Some(a) = &self.after {
+            write!(f, " (after `{a}`)")?;
+        }
+        Ok(())
+    }
+}
+
+/// The model beside the capture, and what has been compared.
+struct Bench {
+    board: Board,
+    /// The capture's time of the model's time zero, in picoseconds.
+    zero_ps: u64,
+    tol: Tolerances,
+    resolution_ps: u64,
+    /// Captured POUT rising edges not yet compared, in capture time.
+    edges: std::collections::VecDeque<u64>,
+    /// The next model pulse to compare: its run and index.
+    run: usize,
+    pulse: u32,
+    /// The last model pulse compared, for the interval tolerance.
+    last_model: Option<Instant>,
+    compared: u64,
+    last_access: Option<Transaction>,
+}
+
+impl Bench {
+    /// The model's time for capture time `ps` (never before its zero).
+    fn model_time(&self, ps: u64) -> Instant {
+        Instant::from_nanos(ps.saturating_sub(self.zero_ps) / 1000)
+    }
+
+    fn capture_ps(&self, t: Instant) -> u64 {
+        t.as_nanos() * 1000 + self.zero_ps
+    }
+
+    /// How far a pulse may be from the model's, in picoseconds: the
+    /// floor, two samples, and the interval tolerance of the time since
+    /// the model's last pulse.
+    fn allowed_ps(&self, model: Instant) -> u64 {
+        let since = self
+            .last_model
+            .map_or(0, |l| model.as_nanos().saturating_sub(l.as_nanos()));
+        let rel = since.saturating_mul(self.tol.interval_bp) / 10_000;
+        (self.tol.floor.as_nanos() + rel) * 1000 + 2 * self.resolution_ps
+    }
+
+    /// The model's next pulse, if it has put it out by now.
+    fn next_model_pulse(&self) -> Option<Instant> {
+        let runs = &self.board.record().runs;
+        let mut run = self.run;
+        let mut pulse = self.pulse;
+        while let Some(r) = runs.get(run) {
+            if pulse < r.count {
+                return Some(r.at(pulse));
+            }
+            run += 1;
+            pulse = 0;
+        }
+        None
+    }
+
+    fn take_model_pulse(&mut self) {
+        let runs = &self.board.record().runs;
+        while let Some(r) = runs.get(self.run) {
+            if self.pulse < r.count {
+                self.pulse += 1;
+                return;
+            }
+            self.run += 1;
+            self.pulse = 0;
+        }
+    }
+
+    /// Compares the pulses, the board's and the model's, that lie before
+    /// `horizon_ps` by more than their tolerance: the model has been run
+    /// up to `horizon_ps`, so nothing earlier can still change.
+    fn compare_pulses(&mut self, horizon_ps: u64) -> Result<(), Divergence> {
+        loop {
+            let model = self.next_model_pulse();
+            let board = self.edges.front().copied();
+            let diverge =
+                |what: String, board: String, model: String, at_ps: u64, s: &Bench| Divergence {
+                    at_ps,
+                    what,
+                    board,
+                    model,
+                    after: s.last_access.map(|t| t.to_string()),
+                };
+            match (board, model) {
+                (None, None) => return Ok(()),
+                (Some(b), None) => {
+                    let allowed = self.allowed_ps(self.model_time(b));
+                    if b + allowed >= horizon_ps {
+                        return Ok(());
+                    }
+                    return Err(diverge(
+                        format!("POUT pulse {}", self.compared + 1),
+                        format!("a pulse at {}", Instant::from_nanos(b / 1000)),
+                        "no pulse".into(),
+                        b,
+                        self,
+                    ));
+                }
+                (b, Some(m)) => {
+                    let m_ps = self.capture_ps(m);
+                    let allowed = self.allowed_ps(m);
+                    match b {
+                        Some(b) if b.abs_diff(m_ps) <= allowed => {
+                            self.edges.pop_front();
+                            self.take_model_pulse();
+                            self.last_model = Some(m);
+                            self.compared += 1;
+                        }
+                        Some(b) if b.min(m_ps) + allowed < horizon_ps => {
+                            return Err(diverge(
+                                format!("POUT pulse {}", self.compared + 1),
+                                format!("at {}", Instant::from_nanos(b / 1000)),
+                                format!(
+                                    "at {} (allowed {})",
+                                    m,
+                                    Duration::from_nanos(allowed / 1000)
+                                ),
+                                b.min(m_ps),
+                                self,
+                            ));
+                        }
+                        None if m_ps + allowed < horizon_ps => {
+                            return Err(diverge(
+                                format!("POUT pulse {}", self.compared + 1),
+                                "no pulse".into(),
+                                format!("a pulse at {m}"),
+                                m_ps,
+                                self,
+                            ));
+                        }
+                        _ => return Ok(()),
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Why a capture could not be judged at all.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum JudgeError {
+    /// The capture does not read.
+    #[error("{0}")]
+    Capture(#[from] LogicError),
+    /// The model cannot take the options (straps out of range).
+    #[error("the reference model: {0}")]
+    Model(String),
+}
+
+/// Judges the capture `source` of a board whose signals are on `map`'s
+/// channels.
+pub fn judge(
+    source: &mut dyn LogicSource,
+    map: &ChannelMap,
+    opts: &JudgeOptions,
+) -> Result<Judgement, JudgeError> {
+    let info = source.info().clone();
+    let mut not_judged = Vec::new();
+    let Some(bus) = map.bus() else {
+        let missing: Vec<String> = map
+            .missing()
+            .into_iter()
+            .filter(|s| {
+                matches!(
+                    s,
+                    Signal::Cs | Signal::Rd | Signal::Wr | Signal::A0 | Signal::D(_)
+                )
+            })
+            .map(|s| s.name())
+            .collect();
+        return Ok(Judgement {
+            verdict: Verdict::Capture(format!(
+                "the bus cannot be decoded: no channel for {} (give --map SIGNAL=CHANNEL)",
+                missing.join(", ")
+            )),
+            host: Vec::new(),
+            accesses: 0,
+            pulses: 0,
+            not_judged,
+        });
+    };
+    let pout = map.get(Signal::Pout);
+    if pout.is_none() {
+        not_judged.push("POUT's pulses: no channel for POUT".to_string());
+    }
+    let reset = info.channel("reset");
+    let board = Board::new(opts.straps, opts.model.clone())
+        .map_err(|e| JudgeError::Model(e.to_string()))?;
+    let mut bench = Bench {
+        board,
+        zero_ps: 0,
+        tol: opts.tolerances,
+        resolution_ps: info.resolution_ps,
+        edges: Default::default(),
+        run: 0,
+        pulse: 0,
+        last_model: None,
+        compared: 0,
+        last_access: None,
+    };
+    let mut decoder = BusDecoder::new(bus, &info, opts.glitch_ps);
+    let mut host = Vec::new();
+    let mut prev: Option<Change> = None;
+    let mut started = reset.is_none();
+    let mut failed = None;
+    while let Some(c) = source.next_change()? {
+        if !started {
+            // The model starts where RESET is released.
+            if let Some(r) = reset {
+                if c.high(r) {
+                    prev = Some(c);
+                    continue;
+                }
+                started = true;
+                bench.zero_ps = c.time_ps;
+            }
+        }
+        // The model up to now: every access before this change is in it.
+        let now = bench.model_time(c.time_ps);
+        if now > bench.board.now() {
+            bench.board.advance_to(now);
+        }
+        if failed.is_none() {
+            if let Err(d) = bench.compare_pulses(c.time_ps) {
+                failed = Some(d);
+            }
+        }
+        if let Some(ch) = pout {
+            if c.high(ch) && prev.is_some_and(|q| !q.high(ch)) {
+                bench.edges.push_back(c.time_ps);
+            }
+        }
+        if let Some(t) = decoder.push(c) {
+            // The status as the strobe began (it may change during it).
+            let began = bench.model_time(t.start_ps);
+            if began > bench.board.now() {
+                bench.board.advance_to(began);
+            }
+            let status_then = bench.board.read_status();
+            let at = bench.model_time(t.end_ps);
+            if at > bench.board.now() {
+                bench.board.advance_to(at);
+            }
+            let status = bench.board.read_status();
+            match t.access {
+                Access::WriteCommand | Access::WriteData => {
+                    if status.ibf() {
+                        host.push(HostFinding {
+                            at_ps: t.end_ps,
+                            section: "3-1-1",
+                            what: format!(
+                                "`{t}` written while IBF was 1: the chip had not taken the byte before, and this one replaces it"
+                            ),
+                        });
+                    }
+                    if t.access == Access::WriteCommand {
+                        bench.board.write_command(t.byte);
+                    } else {
+                        bench.board.write_data(t.byte);
+                    }
+                }
+                Access::ReadStatus => {
+                    // The status may change during the strobe: the model's
+                    // at its start or its end will do.
+                    let mask = !t.unknown;
+                    let differs = |s: u8| (t.byte & mask) != (s & mask);
+                    if failed.is_none() && differs(status.0) && differs(status_then.0) {
+                        failed = Some(Divergence {
+                            at_ps: t.end_ps,
+                            what: "status read".into(),
+                            board: format!("0x{:02X}", t.byte),
+                            model: format!("0x{:02X}", status.0),
+                            after: bench.last_access.map(|a| a.to_string()),
+                        });
+                    }
+                }
+                Access::ReadData => {
+                    if !status.obf() {
+                        host.push(HostFinding {
+                            at_ps: t.end_ps,
+                            section: "3-1-1",
+                            what: "a data read before OBF was 1: no byte was waiting".into(),
+                        });
+                    }
+                    let byte = bench.board.read_data();
+                    let mask = !t.unknown;
+                    if failed.is_none() && status.obf() && (t.byte & mask) != (byte & mask) {
+                        failed = Some(Divergence {
+                            at_ps: t.end_ps,
+                            what: "data read".into(),
+                            board: format!("0x{:02X}", t.byte),
+                            model: format!("0x{byte:02X}"),
+                            after: bench.last_access.map(|a| a.to_string()),
+                        });
+                    }
+                }
+            }
+            bench.last_access = Some(t);
+        }
+        prev = Some(c);
+    }
+    let end = source.end_ps();
+    let until = bench.model_time(end);
+    if until > bench.board.now() {
+        bench.board.advance_to(until);
+    }
+    if failed.is_none() {
+        // Past the capture's end nothing more can be seen: what the model
+        // put out before it, the board must have too.
+        if let Err(d) = bench.compare_pulses(end) {
+            failed = Some(d);
+        }
+    }
+    let summary = decoder.summary();
+    let verdict = match (failed, summary.rate_problem(&info)) {
+        (_, Some(why)) => Verdict::Capture(why),
+        (Some(d), None) => Verdict::Failed(d),
+        (None, None) => Verdict::Passed,
+    };
+    Ok(Judgement {
+        verdict,
+        host,
+        accesses: summary.transactions,
+        pulses: bench.compared,
+        not_judged,
+    })
+}
