@@ -39,7 +39,11 @@ const FILES: [&str; 13] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 27] = [
+const ELSEWHERE: [(&str, &str); 28] = [
+    (
+        "SIGROKDECODE_DIR=contrib/sigrok sigrok-cli",
+        "in scenarios/tests/vcd_sigrok.rs (the PulseView decoder on a capture of a scenario)",
+    ),
     (
         "timeout -s INT 5 ppmc run",
         "in scenarios/tests/cli_signals.rs (timeout -s INT during the long move on a real-time bridge, ten times)",

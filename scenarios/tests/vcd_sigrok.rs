@@ -120,3 +120,85 @@ fn sigrok_counts_every_pulse_of_an_exported_trace() {
         .sum();
     assert!(high > 0, "no AUXO edge reached sigrok");
 }
+
+/// Issue 30, item 7: the PulseView decoder in `contrib/sigrok/ppmc104`,
+/// run by sigrok-cli itself on a capture `ppmc export --scenario --bus`
+/// wrote, names every register access of the scenario (Table 3-1), in
+/// order and with its byte, as the scenario's trace records them.
+#[test]
+fn the_pulseview_decoder_names_every_register_access() {
+    use ppmc::backend::EmuTarget;
+    use ppmc::scenario::{run_scenario, DriverOptions};
+    use ppmc::trace::{BusEvent, EventKind};
+    if !sigrok() {
+        return;
+    }
+    // A move, its finish status read (data reads), INT* released.
+    let name = "s3_4_1_finish_read_releases_int";
+    let dir = scratch("pulseview-decoder");
+    let vcd = dir.path().join("capture.vcd");
+    let out = ppmc(&[
+        "export",
+        "--scenario",
+        name,
+        "--bus",
+        "-o",
+        vcd.to_str().expect("utf-8 path"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // What the trace says the host did, with the same bus cycles.
+    let suite = ppmc_scenarios::all();
+    let s = suite.iter().find(|s| s.name == name).expect("scenario");
+    let mut t = EmuTarget::new(ppmc::protocol::Straps::default(), Default::default())
+        .expect("emulator")
+        .with_bus_cycle(ppmc::time::Duration::from_nanos(
+            ppmc::vcd_export::BUS_CYCLE,
+        ));
+    let trace = run_scenario(&mut t, s, DriverOptions::default())
+        .trace
+        .expect("trace");
+    let want: Vec<String> = trace
+        .events
+        .iter()
+        .filter_map(|e| match &e.kind {
+            EventKind::Bus(BusEvent::WriteCommand { byte, .. }) => {
+                Some(format!("Write command 0x{byte:02X}"))
+            }
+            EventKind::Bus(BusEvent::WriteData { byte, .. }) => {
+                Some(format!("Write data 0x{byte:02X}"))
+            }
+            EventKind::Bus(BusEvent::ReadStatus(s)) => Some(format!("Read status 0x{s:02X}")),
+            EventKind::Bus(BusEvent::Await { status, .. }) => {
+                Some(format!("Read status 0x{status:02X}"))
+            }
+            EventKind::Bus(BusEvent::ReadData { byte, .. }) => {
+                Some(format!("Read data 0x{byte:02X}"))
+            }
+            _ => None,
+        })
+        .collect();
+    assert!(want.len() > 10, "{want:?}");
+    let channels: Vec<String> = ["cs", "rd", "wr", "a0"]
+        .into_iter()
+        .map(String::from)
+        .chain((0..8).map(|i| format!("d{i}")))
+        .map(|c| format!("{c}={c}"))
+        .collect();
+    let decoders = Path::new(env!("CARGO_MANIFEST_DIR")).join("../contrib/sigrok");
+    let out = Command::new("sigrok-cli")
+        .env("SIGROKDECODE_DIR", &decoders)
+        // 1 ns timescale; 10 ns samples: each 100 ns strobe is ten.
+        .args(["-I", "vcd:downsample=10", "-i"])
+        .arg(&vcd)
+        .args(["-P", &format!("ppmc104:{}", channels.join(":"))])
+        .args(["-A", "ppmc104=accesses"])
+        .output()
+        .expect("sigrok-cli runs");
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let got: Vec<String> = text(&out.stdout)
+        .lines()
+        .filter_map(|l| l.strip_prefix("ppmc104-1: "))
+        .map(str::to_string)
+        .collect();
+    assert_eq!(got, want, "sigrok-cli with contrib/sigrok/ppmc104");
+}
