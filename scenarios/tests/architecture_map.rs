@@ -8,7 +8,8 @@
 use std::path::{Path, PathBuf};
 
 /// The repository's top-level folders a rooted path starts with.
-const ROOTS: [&str; 10] = [
+const ROOTS: [&str; 11] = [
+    "contrib/",
     "core/",
     "harness/",
     "scenarios/",
