@@ -4,3 +4,5 @@
 //! channels to its signals, decoding its bus and judging it come on top.
 
 pub mod source;
+pub mod vcd;
+mod vcd_header;
