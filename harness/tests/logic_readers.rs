@@ -9,6 +9,8 @@
 //! Without sigrok-cli the tests that need it say so and pass, except in CI
 //! (`CI` set), where its absence fails.
 
+use ppmc::logic::saleae::SaleaeBinary;
+use ppmc::logic::saleae_csv::SaleaeCsv;
 use ppmc::logic::source::{Change, LogicInfo, LogicSource};
 use ppmc::logic::vcd::VcdReader;
 use std::collections::BTreeMap;
@@ -347,4 +349,218 @@ fn a_vcd_sigrok_cli_wrote_agrees_with_its_csv_sample_by_sample() {
         assert_eq!(got, want, "{rate}: sample numbers and levels");
         assert_eq!(sample(end), 20_000, "{rate}: the end is the sample count");
     }
+}
+
+/// A channel of a made-up capture: its level from each time on (`None`:
+/// no data), in nanoseconds.
+type Events = Vec<(i64, Option<bool>)>;
+
+/// The changes a capture of these channels must read as, from `start`.
+fn merged(channels: &[Events], start: i64) -> Vec<Change> {
+    let mut times: Vec<i64> = channels.iter().flatten().map(|e| e.0).collect();
+    times.sort();
+    times.dedup();
+    let (mut levels, mut unknown) = (0u64, (1u64 << channels.len()) - 1);
+    let mut out: Vec<Change> = Vec::new();
+    for t in times {
+        for (i, ch) in channels.iter().enumerate() {
+            for e in ch.iter().filter(|e| e.0 == t) {
+                let bit = 1u64 << i;
+                (levels, unknown) = match e.1 {
+                    Some(true) => (levels | bit, unknown & !bit),
+                    Some(false) => (levels & !bit, unknown & !bit),
+                    None => (levels & !bit, unknown | bit),
+                };
+            }
+        }
+        if out
+            .last()
+            .is_none_or(|c| (c.levels, c.unknown) != (levels, unknown))
+        {
+            let time_ps = u64::try_from(t - start).expect("after the start") * 1000;
+            out.push(Change {
+                time_ps,
+                levels,
+                unknown,
+            });
+        }
+    }
+    out
+}
+
+/// Toggle times from `begin`, 20 ns to 2 us apart, up to `end`.
+fn toggles(seed: u64, begin: i64, end: i64) -> Vec<i64> {
+    let mut x = seed;
+    let mut t = begin;
+    let mut out = Vec::new();
+    loop {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        t += 20 + (x >> 33) as i64 % 1980;
+        if t >= end {
+            return out;
+        }
+        out.push(t);
+    }
+}
+
+/// A time in nanoseconds as Saleae's files give it: f64 seconds.
+fn secs(ns: i64) -> f64 {
+    ns as f64 / 1e9
+}
+
+/// Saleae's header: `byte[8] identifier` (`<SALEAE>`), `int32 version`,
+/// `int32 type` (0, digital), little-endian.
+fn saleae_header(version: i32) -> Vec<u8> {
+    let mut b = b"<SALEAE>".to_vec();
+    b.extend_from_slice(&version.to_le_bytes());
+    b.extend_from_slice(&0i32.to_le_bytes());
+    b
+}
+
+/// Version 0: `uint32 initial_state; double begin_time; double end_time;
+/// uint64 num_transitions;` then `double transition_time` each.
+fn saleae_v0(initial: bool, begin: i64, end: i64, times: &[i64]) -> Vec<u8> {
+    let mut b = saleae_header(0);
+    b.extend_from_slice(&u32::from(initial).to_le_bytes());
+    b.extend_from_slice(&secs(begin).to_le_bytes());
+    b.extend_from_slice(&secs(end).to_le_bytes());
+    b.extend_from_slice(&(times.len() as u64).to_le_bytes());
+    for &t in times {
+        b.extend_from_slice(&secs(t).to_le_bytes());
+    }
+    b
+}
+
+/// Version 1: `uint64 chunk_count;` then per chunk `uint32 initial_state;
+/// double sample_rate; double begin_time; double end_time; uint64
+/// num_transitions;` and its `double transition_time`s.
+fn saleae_v1(rate: f64, chunks: &[(bool, i64, i64, Vec<i64>)]) -> Vec<u8> {
+    let mut b = saleae_header(1);
+    b.extend_from_slice(&(chunks.len() as u64).to_le_bytes());
+    for (initial, begin, end, times) in chunks {
+        b.extend_from_slice(&u32::from(*initial).to_le_bytes());
+        b.extend_from_slice(&rate.to_le_bytes());
+        b.extend_from_slice(&secs(*begin).to_le_bytes());
+        b.extend_from_slice(&secs(*end).to_le_bytes());
+        b.extend_from_slice(&(times.len() as u64).to_le_bytes());
+        for &t in times {
+            b.extend_from_slice(&secs(t).to_le_bytes());
+        }
+    }
+    b
+}
+
+/// A chunk's events: its initial state at its begin, then each toggle.
+fn chunk_events(initial: bool, begin: i64, times: &[i64]) -> Events {
+    let mut level = initial;
+    let mut out = vec![(begin, Some(level))];
+    for &t in times {
+        level = !level;
+        out.push((t, Some(level)));
+    }
+    out
+}
+
+fn read_source(src: &mut dyn LogicSource) -> (LogicInfo, Vec<Change>, u64) {
+    let info = src.info().clone();
+    let (changes, end) = read_all(src);
+    (info, changes, end)
+}
+
+/// Saleae Logic 2 exports written here from Saleae's published layout
+/// (not with the reader's code): four channels over 3 ms from a trigger
+/// 0.5 ms in (negative times before it), a few thousand edges, as version
+/// 0 files, as version 1 files with a gap in one channel, and as the CSV
+/// of the version 1 capture. Each reads as the changes the test works out
+/// from its own model.
+#[test]
+fn saleae_exports_written_from_the_published_format_read_back() {
+    let (begin, end) = (-500_000i64, 2_500_000i64);
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let v0_dir = dir.path().join("v0");
+    let v1_dir = dir.path().join("v1");
+    std::fs::create_dir_all(&v0_dir).expect("a folder");
+    std::fs::create_dir_all(&v1_dir).expect("a folder");
+    let (mut v0_model, mut v1_model) = (Vec::new(), Vec::new());
+    for ch in 0..4u64 {
+        let initial = ch % 2 == 1;
+        let times = toggles(ch + 7, begin, end);
+        let v0 = saleae_v0(initial, begin, end, &times);
+        std::fs::write(v0_dir.join(format!("digital_{ch}.bin")), v0).expect("written");
+        v0_model.push(chunk_events(initial, begin, &times));
+        // Channel 2 of version 1 has no data from 1 ms to 1.2 ms: two
+        // chunks, the second starting high.
+        let chunks = match ch {
+            2 => {
+                let (a, b) = (1_000_000, 1_200_000);
+                let first: Vec<i64> = times.iter().copied().filter(|&t| t < a).collect();
+                let second: Vec<i64> = times.iter().copied().filter(|&t| t > b).collect();
+                vec![(initial, begin, a, first), (true, b, end, second)]
+            }
+            _ => vec![(initial, begin, end, times)],
+        };
+        let mut events = Events::new();
+        for (k, (initial, b, e, times)) in chunks.iter().enumerate() {
+            events.extend(chunk_events(*initial, *b, times));
+            if k + 1 < chunks.len() {
+                events.push((*e, None));
+            }
+        }
+        v1_model.push(events);
+        let v1 = saleae_v1(500e6, &chunks);
+        std::fs::write(v1_dir.join(format!("digital_{ch}.bin")), v1).expect("written");
+    }
+    let names = ["Channel 0", "Channel 1", "Channel 2", "Channel 3"];
+
+    let (info, changes, got_end) =
+        read_source(&mut SaleaeBinary::open(&v0_dir).expect("the version 0 export opens"));
+    assert_eq!(info.channels, names);
+    assert_eq!(info.sample_rate_hz, None);
+    let want = merged(&v0_model, begin);
+    assert!(want.len() > 4000, "{} changes", want.len());
+    assert_eq!(changes, want, "version 0");
+    assert_eq!(got_end, 3_000_000_000);
+
+    let (info, changes, got_end) =
+        read_source(&mut SaleaeBinary::open(&v1_dir).expect("the version 1 export opens"));
+    assert_eq!(info.channels, names);
+    assert_eq!(
+        (info.sample_rate_hz, info.resolution_ps),
+        (Some(500_000_000), 2000)
+    );
+    let want = merged(&v1_model, begin);
+    assert!(want.iter().any(|c| c.unknown == 0b100), "the gap is there");
+    assert_eq!(changes, want, "version 1");
+    assert_eq!(got_end, 3_000_000_000);
+
+    // The CSV: `Time [s],Channel 0,...`, a row per time some channel
+    // changes, `X` for no data.
+    let mut csv = String::from("Time [s],Channel 0,Channel 1,Channel 2,Channel 3\n");
+    for c in &want {
+        let ns = begin + (c.time_ps / 1000) as i64;
+        let sign = if ns < 0 { "-" } else { "" };
+        csv.push_str(&format!(
+            "{sign}{}.{:09}",
+            ns.abs() / 1_000_000_000,
+            ns.abs() % 1_000_000_000
+        ));
+        for i in 0..4 {
+            let v = match (c.unknown >> i & 1, c.levels >> i & 1) {
+                (1, _) => "X",
+                (_, 1) => "1",
+                _ => "0",
+            };
+            csv.push(',');
+            csv.push_str(v);
+        }
+        csv.push('\n');
+    }
+    let path = dir.path().join("digital.csv");
+    std::fs::write(&path, csv).expect("written");
+    let (info, changes, got_end) = read_source(&mut SaleaeCsv::open(&path).expect("the CSV opens"));
+    assert_eq!(info.channels, names);
+    assert_eq!(changes, want, "CSV");
+    assert_eq!(got_end, want.last().expect("changes").time_ps);
 }

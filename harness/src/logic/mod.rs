@@ -3,6 +3,8 @@
 //! level changes of [`source`]. Nothing here knows the chip: mapping
 //! channels to its signals, decoding its bus and judging it come on top.
 
+pub mod saleae;
+pub mod saleae_csv;
 pub mod source;
 pub mod vcd;
 mod vcd_header;
