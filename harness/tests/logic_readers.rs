@@ -564,3 +564,94 @@ fn saleae_exports_written_from_the_published_format_read_back() {
     assert_eq!(changes, want, "CSV");
     assert_eq!(got_end, want.last().expect("changes").time_ps);
 }
+
+/// How fast the readers go: a VCD of about 100 MB (sixteen 1-bit signals
+/// and an 8-bit bus, sigrok-cli's layout) and a Saleae version 1 export of
+/// 16 channels and 16 million transitions, written to a temporary folder
+/// and read through; the `vcd` crate's parser on the same VCD for
+/// comparison. Run in release:
+/// `cargo test --release -p ppmc --test logic_readers -- --ignored --nocapture`.
+#[test]
+#[ignore = "a measurement: ~230 MB of temporary files"]
+fn throughput() {
+    use std::io::Write;
+    use std::time::Instant;
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let vcd = dir.path().join("big.vcd");
+    {
+        let f = std::fs::File::create(&vcd).expect("a temporary file");
+        let mut w = std::io::BufWriter::new(f);
+        write!(w, "$timescale 1 ns $end\n$scope module libsigrok $end\n").expect("written");
+        for i in 0..16u8 {
+            writeln!(w, "$var wire 1 {} D{i} $end", (b'!' + i) as char).expect("written");
+        }
+        writeln!(
+            w,
+            "$var wire 8 {{ bus [7:0] $end\n$upscope $end\n$enddefinitions $end"
+        )
+        .expect("written");
+        let (mut x, mut t, mut written) = (1u64, 0u64, 0usize);
+        while written < 100 << 20 {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            t += 1 + (x >> 40) % 1000;
+            let id = |k: u64| (b'!' + (x >> k) as u8 % 16) as char;
+            let mut line = format!("#{t} {}{} {}{}", x >> 28 & 1, id(20), x >> 29 & 1, id(24));
+            if x >> 30 & 3 == 0 {
+                line.push_str(&format!(" b{:b} {{", x >> 32 & 0xff));
+            }
+            line.push('\n');
+            w.write_all(line.as_bytes()).expect("written");
+            written += line.len();
+        }
+        w.flush().expect("written");
+    }
+    let mb = std::fs::metadata(&vcd).expect("the VCD").len() as f64 / 1e6;
+    let started = Instant::now();
+    let mut r = VcdReader::open(&vcd).expect("opens");
+    let mut n = 0u64;
+    while r.next_change().expect("reads").is_some() {
+        n += 1;
+    }
+    let s = started.elapsed().as_secs_f64();
+    eprintln!(
+        "VcdReader: {mb:.0} MB, {n} changes in {s:.2} s: {:.0} MB/s",
+        mb / s
+    );
+    let started = Instant::now();
+    let f = std::fs::File::open(&vcd).expect("opens");
+    let mut p = vcd::Parser::new(std::io::BufReader::with_capacity(1 << 16, f));
+    p.parse_header().expect("a header");
+    let mut commands = 0u64;
+    for c in p {
+        c.expect("parses");
+        commands += 1;
+    }
+    let s = started.elapsed().as_secs_f64();
+    eprintln!(
+        "vcd crate's Parser: {commands} commands in {s:.2} s: {:.0} MB/s (no state kept)",
+        mb / s
+    );
+
+    let bins = dir.path().join("saleae");
+    std::fs::create_dir_all(&bins).expect("a folder");
+    for ch in 0..16u64 {
+        let times: Vec<i64> = toggles(ch + 1, 0, 2_000_000_000);
+        let times = &times[..times.len().min(1_000_000)];
+        let end = times.last().copied().unwrap_or(0) + 1;
+        let b = saleae_v1(500e6, &[(false, 0, end, times.to_vec())]);
+        std::fs::write(bins.join(format!("digital_{ch}.bin")), b).expect("written");
+    }
+    let started = Instant::now();
+    let mut r = SaleaeBinary::open(&bins).expect("opens");
+    let mut n = 0u64;
+    while r.next_change().expect("reads").is_some() {
+        n += 1;
+    }
+    let s = started.elapsed().as_secs_f64();
+    eprintln!(
+        "SaleaeBinary: 16 files, 128 MB, {n} changes in {s:.2} s: {:.0} MB/s",
+        128.0 / s
+    );
+}

@@ -490,6 +490,7 @@ impl LogicSource for SaleaeBinary {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
 
     fn header(version: i32) -> Vec<u8> {
         let mut b = MAGIC.to_vec();
@@ -696,5 +697,30 @@ mod tests {
             e.to_string().starts_with("/nonexistent/digital_0.bin: "),
             "{e}"
         );
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// A good file with bytes changed or cut: changes or an error,
+        /// never a panic.
+        #[test]
+        fn damaged_files_never_panic(
+            edits in proptest::collection::vec((any::<usize>(), any::<u8>()), 0..4),
+            cut in any::<usize>(),
+            version in 0..2u8,
+        ) {
+            let mut b = match version {
+                0 => v0(1, 0.0, 1e-3, &[1e-4, 2e-4, 3e-4]),
+                _ => v1(&[(1, 1e6, 0.0, 1e-4, &[5e-5]), (0, 1e6, 2e-4, 1e-3, &[3e-4, 4e-4])]),
+            };
+            for (at, v) in edits {
+                let n = b.len();
+                b[at % n] = v;
+            }
+            let n = b.len();
+            b.truncate(n - cut % 9);
+            let _ = read(&[b]);
+        }
     }
 }

@@ -294,6 +294,7 @@ pub fn seconds_to_ps(s: &str) -> Option<i128> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
 
     fn read(text: &str) -> Result<(LogicInfo, Vec<Change>, u64), LogicError> {
         let mut r = SaleaeCsv::new(
@@ -408,6 +409,26 @@ mod tests {
             match read(text) {
                 Ok(r) => panic!("{want}: read {r:?}"),
                 Err(e) => assert!(e.to_string().contains(want), "{want}: {e}"),
+            }
+        }
+    }
+
+    proptest! {
+        /// Random bytes after a good header: rows or an error, never a
+        /// panic, the changes in time order.
+        #[test]
+        fn random_rows_never_panic(bytes in proptest::collection::vec(
+            prop_oneof![Just(b','), Just(b'\n'), Just(b'0'), Just(b'1'), Just(b'X'), Just(b'.'), Just(b'-'), Just(b'e'), any::<u8>()],
+            0..300,
+        )) {
+            let mut text = b"Time [s],a,b\n".to_vec();
+            text.extend(bytes);
+            let r = SaleaeCsv::new(&text[..], Path::new("t.csv"));
+            let mut r = r.expect("the header is good");
+            let mut last = None;
+            while let Ok(Some(c)) = r.next_change() {
+                prop_assert!(last.is_none_or(|t| t < c.time_ps));
+                last = Some(c.time_ps);
             }
         }
     }

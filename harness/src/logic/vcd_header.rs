@@ -128,7 +128,7 @@ impl Decl {
         let (msb, lsb) = self.range.unwrap_or((i64::from(self.width) - 1, 0));
         let step = if msb >= lsb { 1 } else { -1 };
         (0..i64::from(self.width))
-            .map(|p| format!("{base}[{}]", lsb + step * p))
+            .map(|p| format!("{base}[{}]", lsb.saturating_add(step * p)))
             .collect()
     }
 }
