@@ -208,6 +208,23 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String, FileError> {
     })
 }
 
+/// Opens a regular file for reading as a stream, for a file too large to
+/// hold (a logic-analyzer capture): no size limit, but never a FIFO or a
+/// device (symlinks to a regular file are followed).
+pub fn open_stream(path: &Path) -> Result<File, FileError> {
+    let file = open_for_reading(path).map_err(FileError::io(path, Action::Reading))?;
+    let meta = file
+        .metadata()
+        .map_err(FileError::io(path, Action::Reading))?;
+    match kind_of(meta.file_type()) {
+        Some(kind) => Err(FileError::NotRegularSource {
+            path: path.to_path_buf(),
+            kind,
+        }),
+        None => Ok(file),
+    }
+}
+
 /// Whether a look-up failed because nothing is at the path: not there, or
 /// a folder on the way is not a folder (which [`check_writable`] then names).
 fn gone(e: &io::Error) -> bool {
