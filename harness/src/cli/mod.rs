@@ -14,6 +14,7 @@ mod console;
 mod export;
 mod fault_matrix;
 mod fuzz;
+mod judge;
 mod list;
 mod progress;
 mod record;
@@ -54,8 +55,18 @@ enum Command {
     /// and its first divergence.
     Compare(compare::CompareArgs),
     /// Write a trace as a VCD waveform (POUT, DIR, S1..S5, INT, HOLD, AUX,
-    /// BUSY) for GTKWave or PulseView.
+    /// BUSY; with --bus the host's bus too) for GTKWave or PulseView, or a
+    /// scenario run on the emulator as a logic analyzer would record it.
     Export(export::ExportArgs),
+    /// Print the register accesses of a logic-analyzer capture of the
+    /// chip's bus, in the bus console's language (docs/captures.md).
+    Decode(judge::DecodeArgs),
+    /// Judge a board from a logic-analyzer capture of its bus and pins:
+    /// the captured writes replayed into the reference model, the chip's
+    /// answers and pulses compared (docs/captures.md). Exit status: 0
+    /// passed; 1 the board diverged; 3 the board passed but the host
+    /// firmware broke a rule of chapter 3; 4 the capture cannot be judged.
+    Judge(judge::JudgeArgs),
     /// Run a bus script against a target and print one line per result.
     ///
     /// Reads the script from FILE, from -e, or from standard input. On a
@@ -115,6 +126,8 @@ pub fn main(suite: Vec<Scenario>) -> ExitCode {
         Command::Record(args) => record::run(args, suite),
         Command::Compare(args) => compare::run(args, suite),
         Command::Export(args) => export::run(args, suite),
+        Command::Decode(args) => judge::decode(args),
+        Command::Judge(args) => judge::run(args),
         Command::Console(args) => console::run(args),
         Command::Bench(args) => bench::run(args, suite),
         Command::BridgeSim(args) => bridge_sim::run(args),
@@ -155,6 +168,9 @@ pub(crate) enum CliError {
     /// input breaks an invariant, a fault went undetected); it has said
     /// why (exit 1).
     Verdict,
+    /// The command ran and its verdict's kind is this exit status (`ppmc
+    /// judge`: 3 the host firmware, 4 the capture); it has said why.
+    Code(u8),
 }
 
 impl CliError {
@@ -192,6 +208,7 @@ impl CliError {
                 ExitCode::from(if users { 2 } else { 1 })
             }
             CliError::Verdict => ExitCode::from(1),
+            CliError::Code(c) => ExitCode::from(c),
             CliError::Interrupted => ExitCode::from(130),
         }
     }

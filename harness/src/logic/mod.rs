@@ -8,6 +8,7 @@
 
 pub mod decode;
 pub mod map;
+pub mod open;
 pub mod saleae;
 pub mod saleae_csv;
 pub mod source;

@@ -1,0 +1,159 @@
+//! `ppmc decode` and `ppmc judge` on captures (issue 30,
+//! `docs/captures.md`): a scenario's capture from `ppmc export --scenario
+//! --bus`, judged on the clean model (passes) and with a board fault
+//! (fails, the board's); a hand-written capture whose host writes while
+//! IBF is 1 (the host firmware's finding, exit 3); one without a bus
+//! channel (the capture's, exit 4). The decoded accesses replay with
+//! `ppmc console`.
+
+mod common;
+use common::{ppmc, scratch, text};
+use std::path::Path;
+
+fn export(dir: &Path, name: &str, scenario: &str, faults: &[&str]) -> String {
+    let path = dir.join(name).to_str().expect("utf-8").to_string();
+    let mut args = vec!["export", "--scenario", scenario, "--bus", "-o", &path];
+    for f in faults {
+        args.extend(["--chip-fault", f]);
+    }
+    let out = ppmc(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    path
+}
+
+/// Sections 3-3 and 3-4: a clean board's capture passes, every pulse
+/// compared; one that loses the last pulse of a move fails, blamed on the
+/// board, with the pulse and the access before it.
+#[test]
+fn a_clean_capture_passes_and_a_faulty_boards_fails() {
+    let dir = scratch("judge");
+    let clean = export(
+        dir.path(),
+        "clean.vcd",
+        "s3_3_5_constant_speed_100_steps",
+        &[],
+    );
+    let out = ppmc(&["judge", &clean]);
+    let said = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{said}{}", text(&out.stderr));
+    assert!(said.contains("100 POUT pulses compared"), "{said}");
+    assert!(said.contains("PASS the board"), "{said}");
+    let bad = export(
+        dir.path(),
+        "bad.vcd",
+        "s3_3_5_constant_speed_100_steps",
+        &["drop-last-pulse"],
+    );
+    let out = ppmc(&["judge", &bad]);
+    let said = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{said}");
+    assert!(said.contains("FAIL the board: POUT pulse 100"), "{said}");
+}
+
+/// `ppmc decode` prints the accesses in the console's language, and
+/// `ppmc console` replays them (3-1: the same registers, the same bytes).
+#[test]
+fn decoded_accesses_replay_in_the_console() {
+    let dir = scratch("decode");
+    let cap = export(
+        dir.path(),
+        "cap.vcd",
+        "s3_4_1_finish_read_releases_int",
+        &[],
+    );
+    let out = ppmc(&["decode", &cap]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let script = text(&out.stdout);
+    assert!(script.contains("wc! 0x02"), "{script}");
+    let file = dir.path().join("session.ppmc");
+    std::fs::write(&file, &script).expect("script");
+    let out = ppmc(&["console", file.to_str().expect("utf-8")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // Every status the capture read, the replay reads too.
+    let captured: Vec<&str> = script
+        .lines()
+        .filter_map(|l| l.strip_prefix("rs  # "))
+        .map(|l| &l[..4])
+        .collect();
+    let replayed: Vec<String> = text(&out.stdout)
+        .lines()
+        .filter_map(|l| l.strip_prefix("rs "))
+        .map(str::to_string)
+        .collect();
+    assert_eq!(captured, replayed, "{script}");
+}
+
+/// A VCD of the bus by hand: `cycles` are (ns, write, a0, byte), each a
+/// 100 ns strobe ending at its time; `wires` the bus wires it declares.
+fn hand_vcd(cycles: &[(u64, bool, bool, u8)], wires: &[&str]) -> String {
+    let mut v = String::from("$timescale 1 ns $end\n$scope module bus $end\n");
+    let code = |i: usize| char::from(b'!' + i as u8);
+    for (i, w) in wires.iter().enumerate() {
+        v.push_str(&format!("$var wire 1 {} {w} $end\n", code(i)));
+    }
+    v.push_str("$upscope $end\n$enddefinitions $end\n#0\n$dumpvars\n");
+    let idle = |w: &str| matches!(w, "cs" | "rd" | "wr");
+    for (i, w) in wires.iter().enumerate() {
+        v.push_str(&format!("{}{}\n", u8::from(idle(w)), code(i)));
+    }
+    v.push_str("$end\n");
+    let set = |v: &mut String, t: u64, w: &str, level: bool| {
+        if let Some(i) = wires.iter().position(|x| *x == w) {
+            v.push_str(&format!("#{t}\n{}{}\n", u8::from(level), code(i)));
+        }
+    };
+    for &(t, write, a0, byte) in cycles {
+        let strobe = if write { "wr" } else { "rd" };
+        set(&mut v, t - 150, "cs", false);
+        set(&mut v, t - 150, "a0", a0);
+        set(&mut v, t - 100, strobe, false);
+        for b in 0..8 {
+            set(&mut v, t - 100, &format!("d{b}"), byte >> b & 1 == 1);
+        }
+        set(&mut v, t, strobe, true);
+        set(&mut v, t + 20, "cs", true);
+    }
+    v.push_str(&format!("#{}\n", cycles.last().map_or(0, |c| c.0) + 1000));
+    v
+}
+
+const BUS: [&str; 12] = [
+    "cs", "rd", "wr", "a0", "d0", "d1", "d2", "d3", "d4", "d5", "d6", "d7",
+];
+
+/// Section 3-1-1: a host that writes the data byte 300 ns after the
+/// command, while IBF is still 1, is the host firmware's fault (exit 3),
+/// not the board's; a capture without WR* cannot be judged (exit 4).
+#[test]
+fn host_findings_and_capture_problems_are_their_own_kinds() {
+    let dir = scratch("judge-kinds");
+    let hasty = dir.path().join("hasty.vcd");
+    std::fs::write(
+        &hasty,
+        hand_vcd(&[(1000, true, true, 0x02), (1300, true, false, 0x64)], &BUS),
+    )
+    .expect("vcd");
+    let out = ppmc(&["judge", hasty.to_str().expect("utf-8")]);
+    let said = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(3), "{said}{}", text(&out.stderr));
+    assert!(said.contains("host firmware (section 3-1-1)"), "{said}");
+    assert!(said.contains("written while IBF was 1"), "{said}");
+    assert!(said.contains("PASS the board"), "{said}");
+    let no_wr: Vec<&str> = BUS.iter().copied().filter(|w| *w != "wr").collect();
+    let partial = dir.path().join("no-wr.vcd");
+    std::fs::write(&partial, hand_vcd(&[(1000, false, true, 0x00)], &no_wr)).expect("vcd");
+    let out = ppmc(&["judge", partial.to_str().expect("utf-8")]);
+    let said = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(4), "{said}");
+    assert!(said.contains("no channel for WR"), "{said}");
+    // A file that is no capture is the user's input (exit 2), named.
+    let junk = dir.path().join("junk.txt");
+    std::fs::write(&junk, "hello").expect("junk");
+    let out = ppmc(&["judge", junk.to_str().expect("utf-8")]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("junk.txt"),
+        "{}",
+        text(&out.stderr)
+    );
+}
