@@ -21,7 +21,7 @@ use crate::emu::{Board, ModelConfig};
 use crate::logic::decode::{Access, BusDecoder, Transaction, GLITCH_PS};
 use crate::logic::map::{ChannelMap, Signal};
 use crate::logic::source::{Change, LogicError, LogicSource};
-use crate::protocol::Straps;
+use crate::protocol::{Direction, Straps};
 use crate::time::{Duration, Instant};
 use std::fmt;
 
@@ -116,8 +116,9 @@ struct Bench {
     zero_ps: u64,
     tol: Tolerances,
     resolution_ps: u64,
-    /// Captured POUT rising edges not yet compared, in capture time.
-    edges: std::collections::VecDeque<u64>,
+    /// Captured POUT rising edges not yet compared, in capture time, each
+    /// with DIR's level then (high: CCW) where the capture has DIR.
+    edges: std::collections::VecDeque<(u64, Option<bool>)>,
     /// The next model pulse to compare: its run and index.
     run: usize,
     pulse: u32,
@@ -149,13 +150,13 @@ impl Bench {
     }
 
     /// The model's next pulse, if it has put it out by now.
-    fn next_model_pulse(&self) -> Option<Instant> {
+    fn next_model_pulse(&self) -> Option<(Instant, Direction)> {
         let runs = &self.board.record().runs;
         let mut run = self.run;
         let mut pulse = self.pulse;
         while let Some(r) = runs.get(run) {
             if pulse < r.count {
-                return Some(r.at(pulse));
+                return Some((r.at(pulse), r.dir));
             }
             run += 1;
             pulse = 0;
@@ -181,7 +182,8 @@ impl Bench {
     fn compare_pulses(&mut self, horizon_ps: u64) -> Result<(), Divergence> {
         loop {
             let model = self.next_model_pulse();
-            let board = self.edges.front().copied();
+            let board_dir = self.edges.front().and_then(|e| e.1);
+            let board = self.edges.front().map(|e| e.0);
             let diverge =
                 |what: String, board: String, model: String, at_ps: u64, s: &Bench| Divergence {
                     at_ps,
@@ -205,11 +207,28 @@ impl Bench {
                         self,
                     ));
                 }
-                (b, Some(m)) => {
+                (b, Some((m, dir))) => {
                     let m_ps = self.capture_ps(m);
                     let allowed = self.allowed_ps(m);
                     match b {
                         Some(b) if b.abs_diff(m_ps) <= allowed => {
+                            let ccw = dir == Direction::Ccw;
+                            if board_dir.is_some_and(|high| high != ccw) {
+                                let word = |ccw: bool| {
+                                    if ccw {
+                                        "CCW (DIR high)"
+                                    } else {
+                                        "CW (DIR low)"
+                                    }
+                                };
+                                return Err(diverge(
+                                    format!("DIR at POUT pulse {}", self.compared + 1),
+                                    word(!ccw).to_string(),
+                                    word(ccw).to_string(),
+                                    b,
+                                    self,
+                                ));
+                            }
                             self.edges.pop_front();
                             self.take_model_pulse();
                             self.last_model = Some(m);
@@ -291,6 +310,16 @@ pub fn judge(
     let pout = map.get(Signal::Pout);
     if pout.is_none() {
         not_judged.push("POUT's pulses: no channel for POUT".to_string());
+    } else if map.get(Signal::Dir).is_none() {
+        not_judged.push("the direction of each pulse: no channel for DIR".to_string());
+    }
+    for (signal, why) in [
+        (Signal::Int, "INT*: not compared yet"),
+        (Signal::Busy, "BUSY: not compared yet"),
+    ] {
+        if map.get(signal).is_some() {
+            not_judged.push(why.to_string());
+        }
     }
     let reset = info.channel("reset");
     let board = Board::new(opts.straps, opts.model.clone())
@@ -336,7 +365,8 @@ pub fn judge(
         }
         if let Some(ch) = pout {
             if c.high(ch) && prev.is_some_and(|q| !q.high(ch)) {
-                bench.edges.push_back(c.time_ps);
+                let dir = map.get(Signal::Dir).map(|d| c.high(d));
+                bench.edges.push_back((c.time_ps, dir));
             }
         }
         if let Some(t) = decoder.push(c) {

@@ -147,8 +147,9 @@ fn a_clean_boards_captures_pass() {
     }
 }
 
-/// A board that loses the last pulse of a move (3-3), or whose status
-/// reads a stuck bit (3-1-1), fails, blamed on the board.
+/// A board that loses the last pulse of a move (3-3), whose status reads
+/// a stuck bit (3-1-1), or whose DIR line is inverted (3-3), fails, blamed
+/// on the board.
 #[test]
 fn a_faulty_boards_capture_fails_at_its_first_divergence() {
     for (fault, scenario, what) in [
