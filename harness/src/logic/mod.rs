@@ -3,4 +3,5 @@
 //! level changes of [`source`]. Nothing here knows the chip: mapping
 //! channels to its signals, decoding its bus and judging it come on top.
 
+pub mod sigrok;
 pub mod source;
