@@ -13,6 +13,7 @@ use ppmc::logic::sigrok::SigrokReader;
 use ppmc::logic::source::{LogicInfo, LogicSource};
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::time::Instant;
 
 fn sigrok() -> bool {
     let found = Command::new("sigrok-cli")
@@ -328,5 +329,38 @@ fn exported_traces_converted_at_several_rates_read_as_sigrok_cli_prints_them() {
                 + u64::from(got[0].1 >> pout & 1 == 1);
             assert_eq!(rising, pulses, "{name} at /{downsample}: POUT rising edges");
         }
+    }
+}
+
+/// How fast the reader goes, on the `.sr` files `PPMC_SR_SPEED` names
+/// (a path list): MB of samples a second, best of three. A measurement,
+/// not a check: `PPMC_SR_SPEED=big.sr cargo test --release -p ppmc --test
+/// logic_sigrok -- --ignored --nocapture`.
+#[test]
+#[ignore = "a measurement: run in release with PPMC_SR_SPEED naming .sr files"]
+fn read_speed() {
+    let Some(files) = std::env::var_os("PPMC_SR_SPEED") else {
+        eprintln!("PPMC_SR_SPEED names no .sr files: nothing measured");
+        return;
+    };
+    for path in std::env::split_paths(&files) {
+        let mut best = f64::INFINITY;
+        let (mut bytes, mut changes) = (0, 0u64);
+        for _ in 0..3 {
+            let start = Instant::now();
+            let mut r = SigrokReader::open(&path).unwrap_or_else(|e| panic!("{e}"));
+            changes = 0;
+            while r.next_change().unwrap_or_else(|e| panic!("{e}")).is_some() {
+                changes += 1;
+            }
+            best = best.min(start.elapsed().as_secs_f64());
+            bytes = r.samples() * r.unitsize() as u64;
+        }
+        println!(
+            "{}: {:.0} MB of samples, {changes} changes, {best:.3} s: {:.0} MB/s",
+            path.display(),
+            bytes as f64 / 1e6,
+            bytes as f64 / 1e6 / best
+        );
     }
 }

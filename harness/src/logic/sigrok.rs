@@ -1,39 +1,35 @@
 //! sigrok session files (`.sr`, version 2), as sigrok-cli and PulseView
-//! write them (libsigrok's `srzip` output), read as one stream of level
+//! save them (libsigrok's `srzip` output), read as one stream of level
 //! changes: [`SigrokReader`], a [`LogicSource`].
 //!
 //! The file is a ZIP archive of `version` (the text `2`; version 1, from
 //! libsigrok before 0.3, is refused by name), `metadata` and the samples.
-//! `metadata` is a GLib key file; its `[device 1]` gives `capturefile`
-//! (the samples' base name, `logic-1`; absent from an analog-only capture,
-//! refused), `total probes` (the logic channels, enabled or not),
-//! `samplerate` (`24 MHz`, `1.5 kHz`, `200Hz`: as libsigrok's
-//! `sr_parse_sizestring` reads it), `unitsize` (bytes per sample, enough
-//! for the probes) and `probeK=NAME` for each enabled channel K (1-based;
-//! a channel without its line was disabled). `analogK` keys and
-//! `analog-1-K-M` entries (analog channels) are ignored. The samples are
-//! `logic-1-1`, `logic-1-2`, ... (or one `logic-1`) end to end, `unitsize`
-//! bytes each, little endian, bit K-1 for probe K; the chunks must run
-//! from 1 with no gap, each of whole samples (libsigrok only warns).
+//! `metadata` is a GLib key file whose `[device 1]` gives `capturefile`
+//! (the samples' base name, `logic-1`; an analog-only capture has none),
+//! `total probes` (logic channels, enabled or not), `samplerate` (`24 MHz`,
+//! `1.5 kHz`, `200Hz`: [`parse_rate`]), `unitsize` (bytes per sample) and
+//! `probeK=NAME` for each enabled channel K (1-based; a channel without
+//! its line was disabled); analog channels (`analogK`, `analog-1-K-M`)
+//! are ignored. The samples are `logic-1-1`, `logic-1-2`, ... (or one
+//! `logic-1`) end to end, `unitsize` bytes each, little endian, bit K-1
+//! for probe K; the chunks must run from 1 with no gap, each of whole
+//! samples (libsigrok only warns). [`LogicInfo::channels`] are the enabled
+//! channels in probe order; the bits of disabled ones are ignored.
 //!
-//! [`LogicInfo::channels`] are the enabled channels, in probe order; the
-//! bits of disabled ones (whatever the device left there) are ignored.
-//! A change at sample `n` is at [`LogicInfo::sample_time_ps`]`(n, rate)`.
-//!
-//! Memory stays bounded whatever the capture's length: chunk after chunk
-//! is decompressed in blocks of [`BLOCK_BYTES`], and only the previous
-//! sample is kept. The scan compares 8 bytes at a time with the previous
-//! sample repeated (unit sizes 1, 2, 4, 8), so a run of equal samples
-//! costs one compare per 8 bytes; other unit sizes go sample by sample.
+//! Memory stays bounded whatever the capture's length: the chunks are
+//! decompressed in turn, in blocks of [`BLOCK_BYTES`], and only the
+//! previous sample is kept. The scan compares 8 bytes at a time with the
+//! previous sample repeated (unit sizes 1, 2, 4, 8); others go sample by
+//! sample.
 //!
 //! The ZIP crate is `zip` (zip-rs/zip2), the maintained pure-Rust one,
 //! with its deflate codec only (zlib-rs; libzip writes deflated or stored
 //! entries): it checks each entry's CRC-32 and lends an entry as a `Read`
 //! that decompresses as it is read (`ZipArchive::by_name`). That entry
-//! borrows the archive, so no one value can keep both from one call of
-//! [`LogicSource::next_change`] to the next: a thread owns the archive and
-//! hands blocks over a channel of [`BLOCKS_IN_FLIGHT`], inflating on one
-//! core while the scan runs on another; it ends when the reader is dropped.
+//! borrows the archive, so no one value can keep both between two calls
+//! of [`LogicSource::next_change`]: a thread owns the archive and hands
+//! blocks over a channel of [`BLOCKS_IN_FLIGHT`] (inflating on one core
+//! while the scan runs on another) until the reader is dropped.
 //!
 //! Errors name the file and where (`line 5 of metadata`, `byte 4096 of
 //! logic-1-3`); nothing panics.
@@ -67,37 +63,38 @@ struct Metadata {
     probes: Vec<(u32, String)>,
 }
 
+/// A decompressed block: `len` bytes of chunk `chunk` from its byte
+/// `offset` on, in `buf`. A chunk's last block is shorter than the
+/// others (maybe empty); the others hold whole samples.
+#[derive(Debug, Default)]
+struct Block {
+    chunk: usize,
+    offset: u64,
+    buf: Vec<u8>,
+    len: usize,
+}
+
 /// One message of the decompressing thread.
 #[derive(Debug)]
 enum Piece {
-    /// `len` bytes of chunk `chunk` in `buf`, after the ones before; a
-    /// chunk's last block is shorter than the others (maybe empty).
-    Data {
-        chunk: usize,
-        buf: Vec<u8>,
-        len: usize,
-    },
+    Data(Block),
     Failed(LogicError),
-    /// Every chunk was read.
     Finished,
 }
 
-/// Where the scan is.
+/// Where the scan is: `block.buf[pos..block.len]` is still to scan.
 #[derive(Debug, Default)]
 struct Scan {
-    /// The block being scanned: `block[pos..len]` is still to scan.
-    block: Vec<u8>,
+    block: Block,
     pos: usize,
-    len: usize,
-    /// Which chunk the block is of, and the chunk's bytes before it.
-    chunk: usize,
-    chunk_offset: u64,
-    /// The sample number of `block[0]`; the samples taken so far.
+    /// The sample number of the block's first; the samples taken so far.
     first_sample: u64,
     samples: u64,
     /// The previous sample's enabled bits, once there is one.
     prev: Option<u64>,
+    /// Every chunk was read; or an error, which every later call repeats.
     finished: bool,
+    failed: Option<LogicError>,
 }
 
 /// A sigrok session file read as it goes. See the module documentation.
@@ -106,15 +103,18 @@ pub struct SigrokReader {
     path: PathBuf,
     info: LogicInfo,
     chunks: Vec<String>,
-    unitsize: usize,
-    /// The enabled channels' bits in a raw sample; whether they are the
-    /// low ones (no gathering needed).
-    mask: u64,
-    dense: bool,
+    unit: Unit,
     rx: Receiver<Piece>,
     recycle: Sender<Vec<u8>>,
     scan: Scan,
-    failed: Option<LogicError>,
+}
+
+/// Picoseconds in a second.
+const PS_PER_S: u64 = 1_000_000_000_000;
+
+/// Eight bytes, little endian (0 if `bytes` is not eight long).
+fn le64(bytes: &[u8]) -> u64 {
+    <[u8; 8]>::try_from(bytes).map_or(0, u64::from_le_bytes)
 }
 
 /// An error of `path` at `at`.
@@ -131,8 +131,8 @@ impl SigrokReader {
             let what = format!("not a ZIP archive, which a sigrok session file is: {e}");
             LogicError::new(path, "", what)
         })?;
-        check_version(path, &read_entry(&mut archive, path, "version", 64)?)?;
-        let text = read_entry(&mut archive, path, "metadata", MAX_METADATA_BYTES)?;
+        check_version(path, &read_entry(&mut archive, path, "version")?)?;
+        let text = read_entry(&mut archive, path, "metadata")?;
         let meta = parse_metadata(path, &text)?;
         let chunks = chunk_names(path, archive.file_names(), &meta.capturefile)?;
         let (tx, rx) = mpsc::sync_channel(BLOCKS_IN_FLIGHT);
@@ -149,20 +149,17 @@ impl SigrokReader {
             sample_rate_hz: Some(meta.rate),
             format: "sigrok session (.sr, version 2)".into(),
         };
-        let (path, unitsize) = (path.to_path_buf(), meta.unitsize);
-        let dense = mask & mask.wrapping_add(1) == 0;
-        let (scan, failed) = (Scan::default(), None);
+        let unit = Unit::new(meta.unitsize, mask, meta.rate);
+        let path = path.to_path_buf();
+        let scan = Scan::default();
         Ok(SigrokReader {
             path,
             info,
             chunks,
-            unitsize,
-            mask,
-            dense,
+            unit,
             rx,
             recycle,
             scan,
-            failed,
         })
     }
 
@@ -171,11 +168,156 @@ impl SigrokReader {
         self.scan.samples
     }
 
-    /// The enabled channels' levels of a raw sample, bit `i` for
+    /// The bytes of one sample in the file (`unitsize`).
+    pub fn unitsize(&self) -> usize {
+        self.unit.bytes
+    }
+
+    /// The next change in the block being scanned, if any.
+    fn change_in_block(&mut self) -> Option<Change> {
+        let (unit, s) = (&self.unit, &mut self.scan);
+        let block = &s.block.buf[..s.block.len];
+        let at = match s.prev {
+            None if s.pos + unit.bytes <= block.len() => s.pos,
+            None => return None,
+            Some(prev) => unit.find_change(block, s.pos, prev)?,
+        };
+        let raw = unit.sample_at(block, at);
+        (s.prev, s.pos) = (Some(raw), at + unit.bytes);
+        let time_ps = unit.time_ps(s.first_sample + unit.sample_number(at));
+        let levels = unit.levels(raw);
+        Some(Change {
+            time_ps,
+            levels,
+            unknown: 0,
+        })
+    }
+
+    /// Takes the thread's next block, or its end.
+    fn next_block(&mut self) -> Result<(), LogicError> {
+        let block = match self.rx.recv() {
+            Ok(Piece::Data(block)) => block,
+            Ok(Piece::Failed(e)) => return Err(e),
+            Ok(Piece::Finished) if self.scan.samples == 0 => {
+                return fail(&self.path, "", "no samples: every chunk is empty")
+            }
+            Ok(Piece::Finished) => {
+                self.scan.finished = true;
+                return Ok(());
+            }
+            Err(_) => return fail(&self.path, "", "the decompressing thread stopped early"),
+        };
+        let (u, s) = (self.unit.bytes, &mut self.scan);
+        let old = std::mem::replace(&mut s.block, block);
+        // Back to the thread for the next block; if it has gone, dropped.
+        let _ = self.recycle.send(old.buf);
+        let (chunk, offset, len) = (s.block.chunk, s.block.offset, s.block.len);
+        if len % u != 0 {
+            let name = self.chunks.get(chunk).map_or("?", String::as_str);
+            let at = format!("byte {} of {name}", offset + (len - len % u) as u64);
+            let what = format!(
+                "the chunk ends {} byte(s) into a sample of {u} bytes (unitsize {u}): \
+                 a chunk holds whole samples",
+                len % u
+            );
+            return fail(&self.path, at, what);
+        }
+        (s.first_sample, s.pos) = (s.samples, 0);
+        s.samples += (len / u) as u64;
+        Ok(())
+    }
+}
+
+impl LogicSource for SigrokReader {
+    fn info(&self) -> &LogicInfo {
+        &self.info
+    }
+
+    fn next_change(&mut self) -> Result<Option<Change>, LogicError> {
+        while self.scan.failed.is_none() {
+            if let Some(change) = self.change_in_block() {
+                return Ok(Some(change));
+            }
+            if self.scan.finished {
+                return Ok(None);
+            }
+            if let Err(e) = self.next_block() {
+                self.scan.failed = Some(e);
+            }
+        }
+        self.scan.failed.clone().map_or(Ok(None), Err)
+    }
+
+    fn end_ps(&self) -> u64 {
+        match self.scan.samples {
+            0 => 0,
+            n => self.unit.time_ps(n - 1),
+        }
+    }
+}
+
+/// A sample's layout and time: its bytes, the enabled channels' bits,
+/// the sample rate, and what makes the scan fast.
+#[derive(Debug, Clone, Copy)]
+struct Unit {
+    bytes: usize,
+    mask: u64,
+    rate: u64,
+    /// The sample period if it is a whole number of picoseconds (a time is
+    /// then one multiplication).
+    period_ps: Option<u64>,
+    /// `bytes` is `2^shift * (bytes >> shift)`: a byte offset becomes a
+    /// sample number without a division for the usual 1, 2, 4 and 8.
+    shift: u32,
+    /// When `bytes` divides 8, a word of 1 in each sample's place:
+    /// 0x0101..01 for 1 byte, 0x0001..0001 for 2, ...
+    ones: Option<u64>,
+}
+
+impl Unit {
+    fn new(bytes: usize, mask: u64, rate: u64) -> Unit {
+        let (shift, low) = (bytes.trailing_zeros(), u64::MAX >> (64 - 8 * bytes));
+        let ones = (8 % bytes == 0).then_some(u64::MAX / low);
+        let period_ps = (PS_PER_S % rate == 0).then_some(PS_PER_S / rate);
+        Unit {
+            rate,
+            period_ps,
+            bytes,
+            mask,
+            shift,
+            ones,
+        }
+    }
+
+    /// The enabled bits of the sample at byte `at` of `block`.
+    fn sample_at(&self, block: &[u8], at: usize) -> u64 {
+        if let Some(eight) = block.get(at..at + 8) {
+            return le64(eight) & self.mask;
+        }
+        let bytes = block.get(at..at + self.bytes).unwrap_or_default();
+        bytes.iter().rev().fold(0, |v, &b| v << 8 | u64::from(b)) & self.mask
+    }
+
+    /// The time of sample `n`: [`LogicInfo::sample_time_ps`], faster.
+    fn time_ps(&self, n: u64) -> u64 {
+        match self.period_ps.and_then(|p| n.checked_mul(p)) {
+            Some(t) => t,
+            _ => LogicInfo::sample_time_ps(n, self.rate),
+        }
+    }
+
+    /// The number of the sample at byte `at` of a block (`at` being a
+    /// sample boundary).
+    fn sample_number(&self, at: usize) -> u64 {
+        let (k, odd) = (at >> self.shift, self.bytes >> self.shift);
+        (if odd == 1 { k } else { k / odd }) as u64
+    }
+
+    /// The channels' levels of enabled bits, bit `i` for
     /// [`LogicInfo::channels`]`[i]`.
     fn levels(&self, raw: u64) -> u64 {
-        if self.dense {
-            return raw;
+        if self.mask & self.mask.wrapping_add(1) == 0 {
+            return raw; // the enabled bits are the low ones
         }
         let (mut out, mut rest, mut i) = (0u64, self.mask, 0);
         while rest != 0 {
@@ -186,148 +328,38 @@ impl SigrokReader {
         out
     }
 
-    /// The next change in the block being scanned, if any.
-    fn change_in_block(&mut self) -> Option<Change> {
-        let (u, s) = (self.unitsize, &mut self.scan);
-        let at = match s.prev {
-            None if s.pos + u <= s.len => s.pos,
-            None => return None,
-            Some(prev) => find_change(&s.block[..s.len], s.pos, u, prev, self.mask)?,
-        };
-        let raw = sample_at(&s.block, at, u) & self.mask;
-        (s.prev, s.pos) = (Some(raw), at + u);
-        let n = s.first_sample + (at / u) as u64;
-        let time_ps = LogicInfo::sample_time_ps(n, self.info.rate_hz());
-        Some(Change {
-            time_ps,
-            levels: self.levels(raw),
-            unknown: 0,
-        })
-    }
-
-    /// Takes the thread's next block; `Ok(false)` at the end.
-    fn next_block(&mut self) -> Result<bool, LogicError> {
-        let (chunk, buf, len) = match self.rx.recv() {
-            Ok(Piece::Data { chunk, buf, len }) => (chunk, buf, len),
-            Ok(Piece::Failed(e)) => return Err(e),
-            Ok(Piece::Finished) if self.scan.samples == 0 => {
-                return fail(&self.path, "", "no samples: every chunk is empty")
+    /// The byte offset of the first sample at or after `pos` (a sample
+    /// boundary) whose enabled bits differ from `prev`.
+    fn find_change(&self, block: &[u8], pos: usize, prev: u64) -> Option<usize> {
+        let (u, mut i) = (self.bytes, pos);
+        if let Some(ones) = self.ones {
+            // Whole words of samples against `prev` repeated: four at a
+            // time while the block lasts, then one.
+            let (rep, mask) = (prev.wrapping_mul(ones), self.mask.wrapping_mul(ones));
+            let word = |at: usize| (le64(&block[at..at + 8]) ^ rep) & mask;
+            while i + 32 <= block.len() && word(i) | word(i + 8) | word(i + 16) | word(i + 24) == 0
+            {
+                i += 32;
             }
-            Ok(Piece::Finished) => {
-                self.scan.finished = true;
-                return Ok(false);
-            }
-            Err(_) => return fail(&self.path, "", "the decompressing thread stopped early"),
-        };
-        let (u, s) = (self.unitsize, &mut self.scan);
-        s.chunk_offset = if chunk == s.chunk {
-            s.chunk_offset + s.len as u64
-        } else {
-            0
-        };
-        s.chunk = chunk;
-        let old = std::mem::replace(&mut s.block, buf);
-        // Back to the thread for the next block; if it has gone, dropped.
-        let _ = self.recycle.send(old);
-        if len % u != 0 {
-            let name = self.chunks.get(chunk).map_or("?", String::as_str);
-            let at = format!("byte {} of {name}", s.chunk_offset + (len - len % u) as u64);
-            let what = format!(
-                "the chunk ends {} byte(s) into a sample of {u} bytes (unitsize {u}): \
-                 a chunk holds whole samples",
-                len % u
-            );
-            return fail(&self.path, at, what);
-        }
-        (s.first_sample, s.pos, s.len) = (s.samples, 0, len);
-        s.samples += (len / u) as u64;
-        Ok(true)
-    }
-}
-
-impl LogicSource for SigrokReader {
-    fn info(&self) -> &LogicInfo {
-        &self.info
-    }
-
-    fn next_change(&mut self) -> Result<Option<Change>, LogicError> {
-        if let Some(e) = &self.failed {
-            return Err(e.clone());
-        }
-        loop {
-            if let Some(change) = self.change_in_block() {
-                return Ok(Some(change));
-            }
-            match self.scan.finished {
-                true => return Ok(None),
-                false => {
-                    if let Err(e) = self.next_block() {
-                        self.failed = Some(e.clone());
-                        return Err(e);
-                    }
+            while i + 8 <= block.len() {
+                let diff = word(i);
+                if diff != 0 {
+                    // The sample of the first byte that differs (`u` is a
+                    // power of two here).
+                    let byte = (diff.trailing_zeros() / 8) as usize;
+                    return Some(i + (byte & !(u - 1)));
                 }
+                i += 8;
             }
         }
-    }
-
-    fn end_ps(&self) -> u64 {
-        match self.scan.samples {
-            0 => 0,
-            n => LogicInfo::sample_time_ps(n - 1, self.info.rate_hz()),
-        }
-    }
-}
-
-/// Sample `at` (a byte offset) of `block`: `u` bytes, little endian.
-fn sample_at(block: &[u8], at: usize, u: usize) -> u64 {
-    let mut bytes = [0u8; 8];
-    if let Some(src) = block.get(at..at + u) {
-        bytes[..u].copy_from_slice(src);
-    }
-    u64::from_le_bytes(bytes)
-}
-
-/// `value`'s low `u` bytes repeated over a `u64` (`u` dividing 8).
-fn repeat(value: u64, u: usize) -> u64 {
-    let bits = 8 * u as u32;
-    let one = value & u64::MAX.checked_shr(64 - bits).unwrap_or(0);
-    (0..8 / u as u32).fold(0, |acc, k| acc | one.checked_shl(k * bits).unwrap_or(0))
-}
-
-/// The byte offset of the first whole sample at or after `pos` (a sample
-/// boundary) whose `mask`ed bits differ from `prev`.
-fn find_change(block: &[u8], pos: usize, u: usize, prev: u64, mask: u64) -> Option<usize> {
-    let mut i = pos;
-    if 8 % u == 0 {
-        let (rep, mrep) = (repeat(prev, u), repeat(mask, u));
-        let word = |at: usize| {
-            let mut b = [0u8; 8];
-            b.copy_from_slice(&block[at..at + 8]);
-            (u64::from_le_bytes(b) ^ rep) & mrep
-        };
-        // Four words at a time while the block lasts, then one.
-        while i + 32 <= block.len() {
-            if word(i) | word(i + 8) | word(i + 16) | word(i + 24) != 0 {
-                break;
+        while i + u <= block.len() {
+            if self.sample_at(block, i) != prev {
+                return Some(i);
             }
-            i += 32;
+            i += u;
         }
-        while i + 8 <= block.len() {
-            let diff = word(i);
-            if diff != 0 {
-                let byte = (diff.trailing_zeros() / 8) as usize;
-                return Some(i + byte / u * u);
-            }
-            i += 8;
-        }
+        None
     }
-    while i + u <= block.len() {
-        if sample_at(block, i, u) & mask != prev {
-            return Some(i);
-        }
-        i += u;
-    }
-    None
 }
 
 /// The thread's body: each chunk in turn, decompressed into blocks of
@@ -365,8 +397,14 @@ fn inflate(
                     }
                 }
             }
+            let piece = Piece::Data(Block {
+                chunk,
+                offset,
+                buf,
+                len,
+            });
             offset += len as u64;
-            if tx.send(Piece::Data { chunk, buf, len }).is_err() {
+            if tx.send(piece).is_err() {
                 return; // the reader was dropped
             }
             if len < fill {
@@ -391,13 +429,8 @@ fn open_regular(path: &Path) -> Result<File, LogicError> {
     }
 }
 
-/// The whole of a small entry, at most `limit` bytes.
-fn read_entry(
-    zip: &mut ZipArchive<File>,
-    path: &Path,
-    name: &str,
-    limit: u64,
-) -> Result<Vec<u8>, LogicError> {
+/// The whole of a small entry, at most [`MAX_METADATA_BYTES`].
+fn read_entry(zip: &mut ZipArchive<File>, path: &Path, name: &str) -> Result<Vec<u8>, LogicError> {
     let entry = match zip.by_name(name) {
         Ok(e) => e,
         Err(ZipError::FileNotFound) => {
@@ -406,11 +439,15 @@ fn read_entry(
         Err(e) => return fail(path, name, format!("cannot open: {e}")),
     };
     let mut bytes = Vec::new();
-    if let Err(e) = entry.take(limit + 1).read_to_end(&mut bytes) {
+    if let Err(e) = entry.take(MAX_METADATA_BYTES + 1).read_to_end(&mut bytes) {
         return fail(path, name, format!("cannot decompress: {e}"));
     }
-    match bytes.len() as u64 > limit {
-        true => fail(path, name, format!("larger than {limit} bytes")),
+    match bytes.len() as u64 > MAX_METADATA_BYTES {
+        true => fail(
+            path,
+            name,
+            format!("larger than {MAX_METADATA_BYTES} bytes"),
+        ),
         false => Ok(bytes),
     }
 }
@@ -461,19 +498,16 @@ fn chunk_names<'a>(
 
 /// A GLib key file value's escapes (`\s`, `\n`, `\t`, `\r`, `\\`) undone.
 fn unescape(value: &str) -> String {
-    let mut out = String::with_capacity(value.len());
     let mut chars = value.chars();
+    let mut out = String::with_capacity(value.len());
     while let Some(c) = chars.next() {
-        out.push(match (c, c == '\\') {
-            (_, true) => match chars.next() {
-                Some('s') => ' ',
-                Some('n') => '\n',
-                Some('t') => '\t',
-                Some('r') => '\r',
-                Some(other) => other,
-                None => '\\',
-            },
-            (c, false) => c,
+        out.push(match (c, if c == '\\' { chars.next() } else { None }) {
+            (_, Some('s')) => ' ',
+            (_, Some('n')) => '\n',
+            (_, Some('t')) => '\t',
+            (_, Some('r')) => '\r',
+            (_, Some(escaped)) => escaped,
+            (c, None) => c,
         });
     }
     out
@@ -484,27 +518,17 @@ type LineError = (usize, String);
 
 /// Reads `metadata`: its `[device 1]` section.
 fn parse_metadata(path: &Path, bytes: &[u8]) -> Result<Metadata, LogicError> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        (
-            1 + bytes[..e.valid_up_to()]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count(),
-            "not UTF-8 text".to_string(),
-        )
-    });
-    match text
-        .and_then(device_section)
-        .and_then(|(keys, line)| device_metadata(&keys, line))
-    {
-        Ok(meta) => Ok(meta),
-        Err((0, what)) => Err(LogicError::new(path, "metadata", what)),
-        Err((line, what)) => Err(LogicError::new(
-            path,
-            format!("line {line} of metadata"),
-            what,
-        )),
-    }
+    let parsed = match std::str::from_utf8(bytes) {
+        Ok(text) => device_section(text).and_then(|(keys, line)| device_metadata(&keys, line)),
+        Err(e) => {
+            let line = bytes[..e.valid_up_to()].split(|&b| b == b'\n').count();
+            Err((line, "not UTF-8 text".into()))
+        }
+    };
+    parsed.map_err(|(line, what)| match line {
+        0 => LogicError::new(path, "metadata", what),
+        n => LogicError::new(path, format!("line {n} of metadata"), what),
+    })
 }
 
 /// The keys of `[device 1]`, each with its line's number, and the
@@ -593,19 +617,14 @@ fn device_metadata(keys: &Keys, section: usize) -> Result<Metadata, LineError> {
         let Some(number) = key.strip_prefix("probe") else {
             continue;
         };
-        match number.parse::<u32>() {
-            Ok(k) if (1..=total as u32).contains(&k) && !name.is_empty() => {
-                probes.push((k - 1, name.clone()))
-            }
-            Ok(k) if (1..=total as u32).contains(&k) => {
-                return Err((*line, format!("`{key}` has no name")))
-            }
-            _ => {
-                return Err((
-                    *line,
-                    format!("`{key}` is no probe of 1 to total probes={total}"),
-                ))
-            }
+        match number
+            .parse::<u32>()
+            .ok()
+            .filter(|k| (1..=total as u32).contains(k))
+        {
+            Some(_) if name.is_empty() => return Err((*line, format!("`{key}` has no name"))),
+            Some(k) => probes.push((k - 1, name.clone())),
+            None => return Err((*line, format!("`{key}` is no probe of 1 to {total}"))),
         }
     }
     if probes.is_empty() {
@@ -657,11 +676,8 @@ pub fn parse_rate(text: &str) -> Option<u64> {
     if frac_hz % scale != 0 {
         return None;
     }
-    let hz = int
-        .parse::<u128>()
-        .ok()?
-        .checked_mul(mult)?
-        .checked_add(frac_hz / scale)?;
+    let int = int.parse::<u128>().ok()?;
+    let hz = int.checked_mul(mult)?.checked_add(frac_hz / scale)?;
     u64::try_from(hz).ok().filter(|&r| r > 0)
 }
 
@@ -1032,7 +1048,7 @@ mod tests {
             (
                 good.replace("probe1=CS", "probe9=CS"),
                 "line 9 of metadata",
-                "`probe9` is no probe",
+                "`probe9` is no probe of 1 to 8",
             ),
             (
                 good.replace("probe1=CS", "probe1="),
@@ -1216,8 +1232,14 @@ mod tests {
             let block = &block[..len];
             let mask = if u == 8 { mask } else { mask & ((1u64 << (8 * u)) - 1) };
             let prev = prev & mask;
-            let slow = (0..len / u).map(|i| i * u).find(|&i| sample_at(block, i, u) & mask != prev);
-            prop_assert_eq!(find_change(block, 0, u, prev, mask), slow);
+            let sample = |i: usize| block[i..i + u].iter().rev().fold(0u64, |a, &b| a << 8 | u64::from(b));
+            let slow = (0..len / u).map(|i| i * u).find(|&i| sample(i) & mask != prev);
+            let unit = Unit::new(u, mask, 1);
+            prop_assert_eq!(unit.find_change(block, 0, prev), slow);
+            for i in (0..len).step_by(u) {
+                prop_assert_eq!(unit.sample_at(block, i), sample(i) & mask);
+                prop_assert_eq!(unit.sample_number(i), (i / u) as u64);
+            }
         }
 
         #[test]
