@@ -157,3 +157,52 @@ fn host_findings_and_capture_problems_are_their_own_kinds() {
         text(&out.stderr)
     );
 }
+
+/// Issue 30, item 6: a scenario's capture converted by sigrok-cli itself
+/// into sigrok sessions (`.sr`) at 100 MHz and 24 MHz is judged as
+/// passing, every pulse compared; at 4 MHz the 100 ns strobes last a
+/// single sample, and the capture (exit 4), not the board, is blamed.
+#[test]
+fn sigrok_sessions_at_three_sample_rates_are_judged() {
+    let found = std::process::Command::new("sigrok-cli")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !found {
+        assert!(std::env::var_os("CI").is_none(), "CI must have sigrok-cli");
+        eprintln!("sigrok-cli is not installed: .sr captures are not judged");
+        return;
+    }
+    let dir = scratch("judge-sr");
+    let vcd = export(
+        dir.path(),
+        "cap.vcd",
+        "s3_3_5_constant_speed_100_steps",
+        &[],
+    );
+    // The VCD's 1 ns timescale divided: 100 MHz, 23.8 MHz, 4 MHz.
+    for (downsample, code, says) in [
+        (10, 0, "100 POUT pulses compared"),
+        (42, 0, "100 POUT pulses compared"),
+        (250, 4, "needs at least 8 MHz"),
+    ] {
+        let sr = dir.path().join(format!("cap-{downsample}.sr"));
+        let out = std::process::Command::new("sigrok-cli")
+            .args([
+                "-I",
+                &format!("vcd:downsample={downsample}"),
+                "-i",
+                &vcd,
+                "-o",
+            ])
+            .arg(&sr)
+            .output()
+            .expect("sigrok-cli runs");
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let out = ppmc(&["judge", sr.to_str().expect("utf-8")]);
+        let said = text(&out.stdout);
+        assert_eq!(out.status.code(), Some(code), "{downsample}: {said}");
+        assert!(said.contains(says), "{downsample}: {said}");
+        assert!(said.contains("sigrok session"), "{said}");
+    }
+}

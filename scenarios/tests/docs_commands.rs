@@ -39,7 +39,11 @@ const FILES: [&str; 13] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 28] = [
+const ELSEWHERE: [(&str, &str); 29] = [
+    (
+        "sigrok-cli -I vcd:downsample=42",
+        "in scenarios/tests/cli_capture.rs (the same conversion at three rates, each capture judged)",
+    ),
     (
         "SIGROKDECODE_DIR=contrib/sigrok sigrok-cli",
         "in scenarios/tests/vcd_sigrok.rs (the PulseView decoder on a capture of a scenario)",
@@ -140,7 +144,11 @@ const ELSEWHERE: [(&str, &str); 28] = [
 /// local stand-in: `(text in the command, where)`. Those "in
 /// scenarios/tests/labgrid/place.sh" must appear in that script as written
 /// (with `"$ppmc"` for `ppmc`).
-const PPMC_ELSEWHERE: [(&str, &str); 4] = [
+const PPMC_ELSEWHERE: [(&str, &str); 5] = [
+    (
+        "judge out/capture.sr",
+        "in scenarios/tests/cli_capture.rs (sigrok-cli converts a capture to .sr at 100, 24 and 4 MHz, each judged)",
+    ),
     (
         "selftest --target serial:",
         "in scenarios/tests/cli_selftest.rs (against the board twin: a bridge-sim has no generator)",

@@ -13,6 +13,7 @@
 
 use super::map::BusChannels;
 use super::source::{Change, LogicInfo};
+use crate::time::Duration;
 use std::fmt;
 
 /// Which register a bus access reached (Table 3-1).
@@ -82,10 +83,11 @@ impl Summary {
         let rate = info.rate_hz();
         let needs = rate.saturating_mul(2);
         Some(format!(
-            "{} bus strobes lasted a single sample at {}: the capture samples too slowly for this bus and may have lost strobes; it needs at least {} (two samples a strobe)",
+            "{} bus strobes lasted a single sample at {}: the capture samples too slowly for this bus and may have lost strobes; it needs at least {} (two samples a strobe), more if the strobes are shorter than {}",
             self.one_sample,
             hz(rate),
-            hz(needs)
+            hz(needs),
+            Duration::from_nanos(info.resolution_ps / 1000)
         ))
     }
 }

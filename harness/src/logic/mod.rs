@@ -11,6 +11,7 @@ pub mod map;
 pub mod open;
 pub mod saleae;
 pub mod saleae_csv;
+pub mod sigrok;
 pub mod source;
 pub mod vcd;
 mod vcd_header;

@@ -7,6 +7,7 @@
 
 use super::saleae::SaleaeBinary;
 use super::saleae_csv::SaleaeCsv;
+use super::sigrok::SigrokReader;
 use super::source::{LogicError, LogicSource};
 use super::vcd::VcdReader;
 use std::io::Read;
@@ -22,6 +23,7 @@ pub fn open(path: &Path) -> Result<Box<dyn LogicSource>, LogicError> {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
+        Some("sr") => return Ok(Box::new(SigrokReader::open(path)?)),
         Some("vcd") => return Ok(Box::new(VcdReader::open(path)?)),
         Some("csv") => return Ok(Box::new(SaleaeCsv::open(path)?)),
         Some("bin") => return Ok(Box::new(SaleaeBinary::open(path)?)),
@@ -32,7 +34,9 @@ pub fn open(path: &Path) -> Result<Box<dyn LogicSource>, LogicError> {
         .and_then(|mut f| f.read(&mut head))
         .map_err(|e| LogicError::new(path, "", format!("cannot read: {e}")))?;
     let head = &head[..n];
-    if head.starts_with(b"<SALEAE>") {
+    if head.starts_with(b"PK\x03\x04") {
+        Ok(Box::new(SigrokReader::open(path)?))
+    } else if head.starts_with(b"<SALEAE>") {
         Ok(Box::new(SaleaeBinary::open(path)?))
     } else if head.trim_ascii_start().starts_with(b"$") {
         Ok(Box::new(VcdReader::open(path)?))
