@@ -134,6 +134,14 @@ impl Bench {
         Instant::from_nanos(ps.saturating_sub(self.zero_ps) / 1000)
     }
 
+    /// Runs the model up to capture time `ps` (never back).
+    fn run_to(&mut self, ps: u64) {
+        let t = self.model_time(ps);
+        if t > self.board.now() {
+            self.board.advance_to(t);
+        }
+    }
+
     fn capture_ps(&self, t: Instant) -> u64 {
         t.as_nanos() * 1000 + self.zero_ps
     }
@@ -284,28 +292,17 @@ pub fn judge(
 ) -> Result<Judgement, JudgeError> {
     let info = source.info().clone();
     let mut not_judged = Vec::new();
-    let Some(bus) = map.bus() else {
-        let missing: Vec<String> = map
-            .missing()
-            .into_iter()
-            .filter(|s| {
-                matches!(
-                    s,
-                    Signal::Cs | Signal::Rd | Signal::Wr | Signal::A0 | Signal::D(_)
-                )
+    let bus = match map.require_bus() {
+        Ok(bus) => bus,
+        Err(why) => {
+            return Ok(Judgement {
+                verdict: Verdict::Capture(why),
+                host: Vec::new(),
+                accesses: 0,
+                pulses: 0,
+                not_judged,
             })
-            .map(|s| s.name())
-            .collect();
-        return Ok(Judgement {
-            verdict: Verdict::Capture(format!(
-                "the bus cannot be decoded: no channel for {} (give --map SIGNAL=CHANNEL)",
-                missing.join(", ")
-            )),
-            host: Vec::new(),
-            accesses: 0,
-            pulses: 0,
-            not_judged,
-        });
+        }
     };
     let pout = map.get(Signal::Pout);
     if pout.is_none() {
@@ -354,10 +351,7 @@ pub fn judge(
             }
         }
         // The model up to now: every access before this change is in it.
-        let now = bench.model_time(c.time_ps);
-        if now > bench.board.now() {
-            bench.board.advance_to(now);
-        }
+        bench.run_to(c.time_ps);
         if failed.is_none() {
             if let Err(d) = bench.compare_pulses(c.time_ps) {
                 failed = Some(d);
@@ -371,15 +365,9 @@ pub fn judge(
         }
         if let Some(t) = decoder.push(c) {
             // The status as the strobe began (it may change during it).
-            let began = bench.model_time(t.start_ps);
-            if began > bench.board.now() {
-                bench.board.advance_to(began);
-            }
+            bench.run_to(t.start_ps);
             let status_then = bench.board.read_status();
-            let at = bench.model_time(t.end_ps);
-            if at > bench.board.now() {
-                bench.board.advance_to(at);
-            }
+            bench.run_to(t.end_ps);
             let status = bench.board.read_status();
             match t.access {
                 Access::WriteCommand | Access::WriteData => {
@@ -439,10 +427,7 @@ pub fn judge(
         prev = Some(c);
     }
     let end = source.end_ps();
-    let until = bench.model_time(end);
-    if until > bench.board.now() {
-        bench.board.advance_to(until);
-    }
+    bench.run_to(end);
     if failed.is_none() {
         // Past the capture's end nothing more can be seen: what the model
         // put out before it, the board must have too.

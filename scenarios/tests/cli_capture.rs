@@ -164,13 +164,7 @@ fn host_findings_and_capture_problems_are_their_own_kinds() {
 /// single sample, and the capture (exit 4), not the board, is blamed.
 #[test]
 fn sigrok_sessions_at_three_sample_rates_are_judged() {
-    let found = std::process::Command::new("sigrok-cli")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !found {
-        assert!(std::env::var_os("CI").is_none(), "CI must have sigrok-cli");
-        eprintln!("sigrok-cli is not installed: .sr captures are not judged");
+    if !common::sigrok_cli("judging .sr captures") {
         return;
     }
     let dir = scratch("judge-sr");

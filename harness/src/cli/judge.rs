@@ -72,24 +72,9 @@ pub struct DecodeArgs {
 pub fn decode(args: DecodeArgs) -> Result<(), CliError> {
     let (mut source, map) = args.capture.open()?;
     let info = source.info().clone();
-    let Some(bus) = map.bus() else {
-        return Err(usage(format!(
-            "{}: the bus cannot be decoded: no channel for {} (give --map SIGNAL=CHANNEL)",
-            args.capture.capture.display(),
-            map.missing()
-                .iter()
-                .filter(|s| !matches!(
-                    s,
-                    crate::logic::map::Signal::Pout
-                        | crate::logic::map::Signal::Dir
-                        | crate::logic::map::Signal::Int
-                        | crate::logic::map::Signal::Busy
-                ))
-                .map(|s| s.name())
-                .collect::<Vec<_>>()
-                .join(", ")
-        )));
-    };
+    let bus = map
+        .require_bus()
+        .map_err(|why| usage(format!("{}: {why}", args.capture.capture.display())))?;
     let mut d = BusDecoder::new(bus, &info, args.capture.glitch.as_nanos() * 1000);
     outln!(
         "# {} ({}), decoded by ppmc: replay with `ppmc console`",

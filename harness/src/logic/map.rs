@@ -158,6 +158,28 @@ impl ChannelMap {
         })
     }
 
+    /// The bus's channels, or why the bus cannot be decoded: the bus
+    /// signals no channel carries, named.
+    pub fn require_bus(&self) -> Result<BusChannels, String> {
+        self.bus().ok_or_else(|| {
+            let missing: Vec<String> = self
+                .missing()
+                .into_iter()
+                .filter(|s| {
+                    matches!(
+                        s,
+                        Signal::Cs | Signal::Rd | Signal::Wr | Signal::A0 | Signal::D(_)
+                    )
+                })
+                .map(Signal::name)
+                .collect();
+            format!(
+                "the bus cannot be decoded: no channel for {} (give --map SIGNAL=CHANNEL)",
+                missing.join(", ")
+            )
+        })
+    }
+
     /// The signals no channel carries.
     pub fn missing(&self) -> Vec<Signal> {
         Signal::ALL
