@@ -21,7 +21,7 @@
 //! drawn too: `cs`, `rd`, `wr` (active low, 1 = high), `a0` and `d0`..`d7`,
 //! one bus cycle per register access of the trace, at [`BUS_TIMING_NOTE`]'s
 //! timing: what a logic analyzer on the chip's bus would record, for
-//! `ppmc decode` and `ppmc judge` to read back (`docs/captures.md`).
+//! `ppmc decode` and `ppmc judge` to read back (`docs/capture.md`).
 
 use crate::protocol::{Direction, Pin, Winding};
 use crate::time::{Duration, Instant};

@@ -1,5 +1,5 @@
 //! `ppmc decode` and `ppmc judge` on captures (issue 30,
-//! `docs/captures.md`): a scenario's capture from `ppmc export --scenario
+//! `docs/capture.md`): a scenario's capture from `ppmc export --scenario
 //! --bus`, judged on the clean model (passes) and with a board fault
 //! (fails, the board's); a hand-written capture whose host writes while
 //! IBF is 1 (the host firmware's finding, exit 3); one without a bus

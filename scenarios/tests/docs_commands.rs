@@ -23,7 +23,7 @@ use std::time::Duration;
 /// The files whose commands run.
 const FILES: [&str; 13] = [
     "README.md",
-    "docs/captures.md",
+    "docs/capture.md",
     "docs/board-farm.md",
     "firmware/README.md",
     "docs/bridge-hardware.md",

@@ -33,7 +33,7 @@ pub struct ExportArgs {
     output: Option<PathBuf>,
     /// Draw the host's bus too: CS*, RD*, WR*, A0 and D0-D7, one cycle per
     /// register access of the trace (its timing is in the file's header
-    /// and docs/captures.md), as a logic analyzer on the chip's bus would
+    /// and docs/capture.md), as a logic analyzer on the chip's bus would
     /// record it.
     #[arg(long)]
     bus: bool,

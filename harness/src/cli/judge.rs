@@ -1,6 +1,6 @@
 //! `ppmc decode` and `ppmc judge`: a logic-analyzer capture of the chip's
 //! bus and pins, decoded into register accesses, or judged against the
-//! reference model (`docs/captures.md`).
+//! reference model (`docs/capture.md`).
 
 use super::args::{parse_duration, ChipArgs, ToleranceArgs};
 use crate::cli::{usage, CliError};
@@ -117,7 +117,7 @@ pub fn decode(args: DecodeArgs) -> Result<(), CliError> {
 
 /// Judge a board from a capture of its bus and pins: the captured writes
 /// replayed into the reference model, the chip's answers and pulses
-/// compared (docs/captures.md). Exit status: 0 passed; 1 the board
+/// compared (docs/capture.md). Exit status: 0 passed; 1 the board
 /// diverged; 3 the board passed but the host firmware broke a rule of
 /// chapter 3; 4 the capture cannot be judged (a channel missing, a sample
 /// rate too low for the bus).

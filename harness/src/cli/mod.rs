@@ -59,11 +59,11 @@ enum Command {
     /// scenario run on the emulator as a logic analyzer would record it.
     Export(export::ExportArgs),
     /// Print the register accesses of a logic-analyzer capture of the
-    /// chip's bus, in the bus console's language (docs/captures.md).
+    /// chip's bus, in the bus console's language (docs/capture.md).
     Decode(judge::DecodeArgs),
     /// Judge a board from a logic-analyzer capture of its bus and pins:
     /// the captured writes replayed into the reference model, the chip's
-    /// answers and pulses compared (docs/captures.md). Exit status: 0
+    /// answers and pulses compared (docs/capture.md). Exit status: 0
     /// passed; 1 the board diverged; 3 the board passed but the host
     /// firmware broke a rule of chapter 3; 4 the capture cannot be judged.
     Judge(judge::JudgeArgs),

@@ -1,5 +1,5 @@
 //! A board judged from a capture of its bus and pins (issue 30,
-//! `docs/captures.md`): the host's writes, decoded from the capture, go
+//! `docs/capture.md`): the host's writes, decoded from the capture, go
 //! into the reference model at their captured times; what the chip
 //! answered (status and data reads) and put out (POUT's pulses) is
 //! compared with what the model does, within the capture's resolution and
@@ -24,6 +24,10 @@ use crate::logic::source::{Change, LogicError, LogicSource};
 use crate::protocol::{Direction, Straps};
 use crate::time::{Duration, Instant};
 use std::fmt;
+
+mod host;
+pub use host::HostFinding;
+use host::HostRules;
 
 /// How to judge.
 #[derive(Debug, Clone)]
@@ -57,15 +61,6 @@ pub struct Divergence {
     pub model: String,
     /// The last register access before it, as the console writes it.
     pub after: Option<String>,
-}
-
-/// The host firmware using the chip against chapter 3.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct HostFinding {
-    pub at_ps: u64,
-    /// The datasheet section it breaks.
-    pub section: &'static str,
-    pub what: String,
 }
 
 /// The verdict on a capture.
@@ -335,6 +330,7 @@ pub fn judge(
     };
     let mut decoder = BusDecoder::new(bus, &info, opts.glitch_ps);
     let mut host = Vec::new();
+    let mut rules = HostRules::default();
     let mut prev: Option<Change> = None;
     let mut started = reset.is_none();
     let mut failed = None;
@@ -369,17 +365,9 @@ pub fn judge(
             let status_then = bench.board.read_status();
             bench.run_to(t.end_ps);
             let status = bench.board.read_status();
+            rules.before(&t, &bench.board, &mut host);
             match t.access {
                 Access::WriteCommand | Access::WriteData => {
-                    if status.ibf() {
-                        host.push(HostFinding {
-                            at_ps: t.end_ps,
-                            section: "3-1-1",
-                            what: format!(
-                                "`{t}` written while IBF was 1: the chip had not taken the byte before, and this one replaces it"
-                            ),
-                        });
-                    }
                     if t.access == Access::WriteCommand {
                         bench.board.write_command(t.byte);
                     } else {
@@ -402,13 +390,6 @@ pub fn judge(
                     }
                 }
                 Access::ReadData => {
-                    if !status.obf() {
-                        host.push(HostFinding {
-                            at_ps: t.end_ps,
-                            section: "3-1-1",
-                            what: "a data read before OBF was 1: no byte was waiting".into(),
-                        });
-                    }
                     let byte = bench.board.read_data();
                     let mask = !t.unknown;
                     if failed.is_none() && status.obf() && (t.byte & mask) != (byte & mask) {
@@ -422,12 +403,14 @@ pub fn judge(
                     }
                 }
             }
+            rules.after(&t, &bench.board, &mut host);
             bench.last_access = Some(t);
         }
         prev = Some(c);
     }
     let end = source.end_ps();
     bench.run_to(end);
+    rules.finish(end, &bench.board, &mut host);
     if failed.is_none() {
         // Past the capture's end nothing more can be seen: what the model
         // put out before it, the board must have too.
