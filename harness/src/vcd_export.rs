@@ -54,12 +54,20 @@ pub const BUS_SIGNALS: [&str; 12] = [
     "cs", "rd", "wr", "a0", "d0", "d1", "d2", "d3", "d4", "d5", "d6", "d7",
 ];
 
-const WIRES: usize = SIGNALS.len() + BUS_SIGNALS.len();
+/// The inputs the board drives into the chip, after the bus's wires, when
+/// the export draws the bus: each at its electrical level, low while
+/// asserted (the pins are active low, Section 3-3).
+pub const INPUT_SIGNALS: [&str; 10] = [
+    "l1", "l2", "l3", "l4", "alm", "cnp", "auxi0", "auxi1", "auxi2", "auxi3",
+];
+
+const WIRES: usize = SIGNALS.len() + BUS_SIGNALS.len() + INPUT_SIGNALS.len();
 const CS: usize = SIGNALS.len();
 const RD: usize = CS + 1;
 const WR: usize = CS + 2;
 const A0: usize = CS + 3;
 const D0: usize = CS + 4;
+const L1: usize = D0 + 8;
 
 /// A bus cycle of the export, in ns: CS* falls `BUS_SETUP` before the
 /// strobe, the strobe (RD* or WR*) lasts `BUS_STROBE` and rises at the
@@ -79,7 +87,7 @@ const MAX_LAID_OUT: u64 = 8;
 const LOOK_BACK: u64 = MAX_LAID_OUT * BUS_CYCLE + BUS_SETUP + BUS_STROBE;
 
 /// The header's word on the bus's timing.
-pub const BUS_TIMING_NOTE: &str = "bus: one cycle per register access: CS* low 50 ns before the strobe, RD* or WR* low for 100 ns rising at the access's time in the trace (the data held from the strobe's fall to CS* rising 20 ns after it), A0 high for the command and status registers; accesses at one time in the trace are laid out 200 ns apart, the last ending at that time. A status wait (await) is drawn as the one status read that ended it. Every time in this file is the trace's plus the lead in the comment below, which makes room for the cycles at the trace's start.";
+pub const BUS_TIMING_NOTE: &str = "bus: one cycle per register access: CS* low 50 ns before the strobe, RD* or WR* low for 100 ns rising at the access's time in the trace (the data held from the strobe's fall to CS* rising 20 ns after it), A0 high for the command and status registers; accesses at one time in the trace are laid out 200 ns apart, the last ending at that time. A status wait (await) is drawn as the one status read that ended it. The inputs the board drives (l1..l4, alm, cnp, auxi0..auxi3) are drawn at their level, low while asserted. Every time in this file is the trace's plus the lead in the comment below, which makes room for the cycles at the trace's start.";
 
 const POUT: usize = 0;
 const DIR: usize = 1;
@@ -151,8 +159,12 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
     w.timescale(1, TimescaleUnit::NS)?;
     w.add_module("ppmc")?;
     let mut ids = Vec::with_capacity(WIRES);
-    let bus_names = if what.bus { &BUS_SIGNALS[..] } else { &[] };
-    for name in SIGNALS.iter().chain(bus_names) {
+    let (bus_names, input_names) = if what.bus {
+        (&BUS_SIGNALS[..], &INPUT_SIGNALS[..])
+    } else {
+        (&[][..], &[][..])
+    };
+    for name in SIGNALS.iter().chain(bus_names).chain(input_names) {
         ids.push(w.add_wire(1, name)?);
     }
     w.upscope()?;
@@ -170,18 +182,18 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
         to: to.as_nanos(),
         started: false,
     };
-    // An idle bus: CS*, RD* and WR* high.
-    for i in [CS, RD, WR] {
+    // An idle bus (CS*, RD* and WR* high), no input asserted.
+    for i in [CS, RD, WR].into_iter().chain(L1..L1 + INPUT_SIGNALS.len()) {
         state.values[i] = true;
     }
     if from == Instant::ZERO {
         state.start()?;
     }
-    let mut winding: Option<Winding> = None;
-    let mut phase: u32 = 0;
-    // Falling edge of the last POUT, not yet written.
-    let mut pending_fall: Option<Instant> = None;
+    let mut pulses = Pulses::default();
     for (k, e) in trace.events.iter().enumerate() {
+        // A run's pulses come in time order with the events logged after
+        // it (a stop written while it runs).
+        pulses.draw_until(&mut state, e.at)?;
         state.drain_before((e.at.as_nanos() + state.lead).saturating_sub(LOOK_BACK))?;
         match &e.kind {
             EventKind::Move {
@@ -190,13 +202,16 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
                 phase: p,
                 ..
             } => {
-                state.flush_before(&mut pending_fall, e.at)?;
-                winding = *wd;
-                phase = *p;
+                pulses.draw_until(&mut state, Instant::from_nanos(u64::MAX))?;
+                state.flush_before(&mut pulses.pending_fall, e.at)?;
+                pulses.winding = *wd;
+                pulses.phase = *p;
                 state.set(e.at, DIR, *dir == Direction::Ccw)?;
             }
             EventKind::Pulses { dir, count, .. } => {
                 let Some(run) = e.pulse_run() else { continue };
+                // A run still being drawn ends before this one starts.
+                pulses.draw_until(&mut state, Instant::from_nanos(u64::MAX))?;
                 let width = if *count > 1 {
                     Duration::from_micros(1)
                         .min(Duration::from_nanos(run.interval().as_nanos() / 2))
@@ -208,31 +223,22 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
                 let early = Instant::from_nanos(from.as_nanos().saturating_sub(width.as_nanos()));
                 let first_in = first_at_or_after(&run, *count, early);
                 let late = Instant::from_nanos(to.as_nanos().saturating_add(1));
-                let past = first_at_or_after(&run, *count, late);
+                let past = first_at_or_after(&run, *count, late).max(first_in);
                 if first_in > 0 {
-                    if let Some(wd) = winding {
-                        phase = wd.advance(phase, *dir, u64::from(first_in));
+                    if let Some(wd) = pulses.winding {
+                        pulses.phase = wd.advance(pulses.phase, *dir, u64::from(first_in));
                     }
                 }
-                for i in first_in..past.max(first_in) {
-                    let t = run.at(i);
-                    state.drain_before((t.as_nanos() + state.lead).saturating_sub(LOOK_BACK))?;
-                    state.flush_before(&mut pending_fall, t)?;
-                    state.set(t, POUT, true)?;
-                    if let Some(wd) = winding {
-                        phase = wd.advance(phase, *dir, 1);
-                        state.set_bits(t, S1, 5, wd.pattern(phase))?;
-                    }
-                    pending_fall = Some(t + width.max(Duration::from_nanos(1)));
-                }
-                if past < *count {
-                    if let Some(wd) = winding {
-                        phase = wd.advance(phase, *dir, u64::from(*count - past.max(first_in)));
-                    }
-                }
+                pulses.run = Some(RunDrawing {
+                    run,
+                    dir: *dir,
+                    next: first_in,
+                    past,
+                    width,
+                });
             }
             EventKind::Pin { pin, value } => {
-                state.flush_before(&mut pending_fall, e.at)?;
+                state.flush_before(&mut pulses.pending_fall, e.at)?;
                 let v = *value != 0;
                 match pin {
                     Pin::Busy => state.set(e.at, BUSY, v)?,
@@ -248,6 +254,11 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
                             state.set(e.at, AUXO0 + k, value & (1 << k) != 0)?;
                         }
                     }
+                }
+            }
+            EventKind::Bus(BusEvent::SetInput { input, asserted }) => {
+                if what.bus {
+                    state.set(e.at, L1 + usize::from(input.index()), !asserted)?;
                 }
             }
             EventKind::Bus(b) => {
@@ -277,7 +288,8 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
             EventKind::Measure { .. } => {}
         }
     }
-    if let Some(f) = pending_fall.take() {
+    pulses.draw_until(&mut state, Instant::from_nanos(u64::MAX))?;
+    if let Some(f) = pulses.pending_fall.take() {
         state.set(f, POUT, false)?;
     }
     state.drain_before(u64::MAX)?;
@@ -334,6 +346,57 @@ fn bus_cycle(b: &BusEvent) -> Option<(bool, bool, u8)> {
         BusEvent::Await { status, .. } => (true, true, status),
         _ => return None,
     })
+}
+
+/// The run of pulses being drawn, and the phase outputs it steps.
+#[derive(Default)]
+struct Pulses {
+    run: Option<RunDrawing>,
+    winding: Option<Winding>,
+    phase: u32,
+    /// The falling edge of the last pulse drawn, not yet written.
+    pending_fall: Option<Instant>,
+}
+
+struct RunDrawing {
+    run: crate::protocol::PulseRun,
+    dir: Direction,
+    /// The next pulse to draw, and the first past the window.
+    next: u32,
+    past: u32,
+    width: Duration,
+}
+
+impl Pulses {
+    /// Draws the run's pulses before `until` (all of them, and the phase
+    /// steps of those past the window, once it is done).
+    fn draw_until<W: Write>(&mut self, state: &mut Emitter<W>, until: Instant) -> io::Result<()> {
+        let Some(r) = &mut self.run else {
+            return Ok(());
+        };
+        while r.next < r.past {
+            let t = r.run.at(r.next);
+            if t >= until {
+                return Ok(());
+            }
+            state.drain_before((t.as_nanos() + state.lead).saturating_sub(LOOK_BACK))?;
+            state.flush_before(&mut self.pending_fall, t)?;
+            state.set(t, POUT, true)?;
+            if let Some(wd) = self.winding {
+                self.phase = wd.advance(self.phase, r.dir, 1);
+                state.set_bits(t, S1, 5, wd.pattern(self.phase))?;
+            }
+            self.pending_fall = Some(t + r.width.max(Duration::from_nanos(1)));
+            r.next += 1;
+        }
+        if r.past < r.run.count {
+            if let Some(wd) = self.winding {
+                self.phase = wd.advance(self.phase, r.dir, u64::from(r.run.count - r.past));
+            }
+        }
+        self.run = None;
+        Ok(())
+    }
 }
 
 /// The first pulse of `run` (of `count`) at or after `t`: `count` if none.

@@ -23,7 +23,8 @@ pub struct CaptureArgs {
     /// channel by its name in the capture or its number from 0, e.g.
     /// `CS=0,RD=1,WR=2,A0=3,D0-7=4-11,POUT=12`; `@FILE` reads them from a
     /// file, one or more a line, `#` for comments. Signals: CS, RD, WR,
-    /// A0, D0..D7, POUT, DIR, INT, BUSY. Default: the capture's channel
+    /// A0, D0..D7, POUT, DIR, INT, BUSY, and the inputs the board drives
+    /// (L1..L4, ALM, CNP, AUXI0..AUXI3), which the model is given. Default: the capture's channel
     /// names, where they are the chip's (`CS*`, `nRD`, `D3`, `POUT`).
     #[arg(long, value_name = "PAIRS|@FILE")]
     map: Option<String>,

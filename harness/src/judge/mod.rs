@@ -21,7 +21,7 @@ use crate::emu::{Board, ModelConfig};
 use crate::logic::decode::{Access, BusDecoder, Transaction, GLITCH_PS};
 use crate::logic::map::{ChannelMap, Signal};
 use crate::logic::source::{Change, LogicError, LogicSource};
-use crate::protocol::{Direction, Straps};
+use crate::protocol::{Direction, Input, Straps};
 use crate::time::{Duration, Instant};
 use std::fmt;
 
@@ -313,6 +313,21 @@ pub fn judge(
             not_judged.push(why.to_string());
         }
     }
+    let inputs: Vec<(Input, usize)> = Input::ALL
+        .into_iter()
+        .filter_map(|i| map.get(Signal::Input(i)).map(|c| (i, c)))
+        .collect();
+    if inputs.len() < Input::ALL.len() {
+        let missing: Vec<String> = Input::ALL
+            .into_iter()
+            .filter(|i| !inputs.iter().any(|(j, _)| j == i))
+            .map(|i| Signal::Input(i).name())
+            .collect();
+        not_judged.push(format!(
+            "inputs {}: no channel, taken as never asserted",
+            missing.join(", ")
+        ));
+    }
     let reset = info.channel("reset");
     let board = Board::new(opts.straps, opts.model.clone())
         .map_err(|e| JudgeError::Model(e.to_string()))?;
@@ -348,6 +363,13 @@ pub fn judge(
         }
         // The model up to now: every access before this change is in it.
         bench.run_to(c.time_ps);
+        // The inputs as the board drove them (active low).
+        for &(input, ch) in &inputs {
+            let was_high = prev.map_or(true, |q| q.high(ch));
+            if c.high(ch) != was_high {
+                bench.board.set_input(input, !c.high(ch));
+            }
+        }
         if failed.is_none() {
             if let Err(d) = bench.compare_pulses(c.time_ps) {
                 failed = Some(d);

@@ -6,6 +6,7 @@
 //! [`ChannelMap::bus`] whether the bus can be decoded at all.
 
 use super::source::LogicInfo;
+use crate::protocol::Input;
 use std::fmt;
 
 /// A signal of the chip a capture may carry.
@@ -27,11 +28,15 @@ pub enum Signal {
     Int,
     /// BUSY, where the board brings it out.
     Busy,
+    /// An input the board drives into the chip: the limits L1*..L4*, ALM*,
+    /// CNP* and AUXI0..3, all active low (the pin pulled low asserts it).
+    /// The judge gives the model what the capture shows on them.
+    Input(Input),
 }
 
 impl Signal {
     /// Every signal, bus first.
-    pub const ALL: [Signal; 16] = [
+    pub const ALL: [Signal; 26] = [
         Signal::Cs,
         Signal::Rd,
         Signal::Wr,
@@ -48,6 +53,16 @@ impl Signal {
         Signal::Dir,
         Signal::Int,
         Signal::Busy,
+        Signal::Input(Input::L1),
+        Signal::Input(Input::L2),
+        Signal::Input(Input::L3),
+        Signal::Input(Input::L4),
+        Signal::Input(Input::Alm),
+        Signal::Input(Input::Cnp),
+        Signal::Input(Input::Auxi0),
+        Signal::Input(Input::Auxi1),
+        Signal::Input(Input::Auxi2),
+        Signal::Input(Input::Auxi3),
     ];
 
     /// Its name in a map and in reports: `CS`, `D3`, `POUT`.
@@ -62,6 +77,7 @@ impl Signal {
             Signal::Dir => "DIR".into(),
             Signal::Int => "INT".into(),
             Signal::Busy => "BUSY".into(),
+            Signal::Input(i) => i.name().to_ascii_uppercase(),
         }
     }
 
@@ -92,6 +108,12 @@ impl Signal {
         }
         if low("INT") {
             return Some(Signal::Int);
+        }
+        if let Some(i) = Input::ALL
+            .into_iter()
+            .find(|i| low(&i.name().to_ascii_uppercase()))
+        {
+            return Some(Signal::Input(i));
         }
         match n.as_str() {
             "A0" | "A" => return Some(Signal::A0),
@@ -238,7 +260,7 @@ impl ChannelMap {
                 }
                 let s = Signal::parse(sig).ok_or_else(|| {
                     at(format!(
-                        "no signal `{sig}`: use CS, RD, WR, A0, D0..D7, POUT, DIR, INT or BUSY"
+                        "no signal `{sig}`: use CS, RD, WR, A0, D0..D7, POUT, DIR, INT, BUSY, L1..L4, ALM, CNP or AUXI0..AUXI3"
                     ))
                 })?;
                 map.replace(s, channel(chan, info).map_err(&at)?);
@@ -306,6 +328,9 @@ mod tests {
             ("wr_n", Signal::Wr),
             ("A0", Signal::A0),
             ("D[7]", Signal::D(7)),
+            ("L3*", Signal::Input(Input::L3)),
+            ("nALM", Signal::Input(Input::Alm)),
+            ("auxi2", Signal::Input(Input::Auxi2)),
             ("DB3", Signal::D(3)),
             ("pout", Signal::Pout),
             ("INT*", Signal::Int),
