@@ -122,13 +122,15 @@ fn judged(trace: &Trace) -> ppmc::judge::Judgement {
 }
 
 /// Sections 3-3 (moves), 3-4 (register reads), 3-2 (initialization): a
-/// clean board's captures pass, every pulse compared.
+/// clean board's captures pass, every pulse compared. The host of
+/// `e4_accel_pulses_11221` misuses the chip on purpose: its findings are
+/// the host firmware's (3-2-2, then 3-2), not the board's.
 #[test]
 fn a_clean_boards_captures_pass() {
-    for name in [
-        "s3_3_5_constant_speed_100_steps",
-        "s3_3_1_immediate_stop_of_accel_move",
-        "e4_accel_pulses_11221",
+    for (name, host) in [
+        ("s3_3_5_constant_speed_100_steps", &[][..]),
+        ("s3_3_1_immediate_stop_of_accel_move", &[]),
+        ("e4_accel_pulses_11221", &["3-2-2", "3-2"]),
     ] {
         let trace = trace_of(name, ModelConfig::default());
         let pulses: u64 = trace
@@ -143,7 +145,8 @@ fn a_clean_boards_captures_pass() {
         assert_eq!(j.verdict, Verdict::Passed, "{name}: {j:?}");
         assert!(j.accesses > 5, "{name}: {j:?}");
         assert_eq!(j.pulses, pulses, "{name}");
-        assert!(j.host.is_empty(), "{name}: {:?}", j.host);
+        let sections: Vec<&str> = j.host.iter().map(|h| h.section).collect();
+        assert_eq!(sections, host, "{name}: {:?}", j.host);
     }
 }
 

@@ -1,10 +1,10 @@
 //! `ppmc decode` and `ppmc judge` on captures (issue 30,
 //! `docs/capture.md`): a scenario's capture from `ppmc export --scenario
 //! --bus`, judged on the clean model (passes) and with a board fault
-//! (fails, the board's); a hand-written capture whose host writes while
-//! IBF is 1 (the host firmware's finding, exit 3); one without a bus
-//! channel (the capture's, exit 4). The decoded accesses replay with
-//! `ppmc console`.
+//! (fails, the board's); hand-written captures whose host writes while
+//! IBF is 1, or moves before initializing (the host firmware's findings,
+//! exit 3); one without a bus channel (the capture's, exit 4). The
+//! decoded accesses replay with `ppmc console`.
 
 mod common;
 use common::{ppmc, scratch, text};
@@ -138,6 +138,23 @@ fn host_findings_and_capture_problems_are_their_own_kinds() {
     assert_eq!(out.status.code(), Some(3), "{said}{}", text(&out.stderr));
     assert!(said.contains("host firmware (section 3-1-1)"), "{said}");
     assert!(said.contains("written while IBF was 1"), "{said}");
+    assert!(said.contains("PASS the board"), "{said}");
+    // Section 3-2: a single step before any initialization, which the
+    // chip answers with error 2 (status 0xA0), is the host's too (exit 3).
+    let uninit = dir.path().join("uninit.vcd");
+    std::fs::write(
+        &uninit,
+        hand_vcd(
+            &[(1000, true, true, 0x42), (21_000, false, true, 0xA0)],
+            &BUS,
+        ),
+    )
+    .expect("vcd");
+    let out = ppmc(&["judge", uninit.to_str().expect("utf-8")]);
+    let said = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(3), "{said}{}", text(&out.stderr));
+    assert!(said.contains("host firmware (section 3-2)"), "{said}");
+    assert!(said.contains("before the initialization command"), "{said}");
     assert!(said.contains("PASS the board"), "{said}");
     let no_wr: Vec<&str> = BUS.iter().copied().filter(|w| *w != "wr").collect();
     let partial = dir.path().join("no-wr.vcd");

@@ -9,7 +9,8 @@
 //!   the model would, given the same writes at the same times;
 //! - **host** findings: the firmware driving the chip used it against
 //!   chapter 3 (a byte written while IBF is 1, which replaces the waiting
-//!   one; a data read before OBF), not failures of the board;
+//!   one; a data read before OBF; a byte the chip answered with an error
+//!   of Table 3-2; the rules are in `host.rs`), not failures of the board;
 //! - a **capture** problem: a signal missing, a sample rate too low for
 //!   the strobes, a file that does not read.
 //!
