@@ -153,6 +153,35 @@ impl Bench {
         (self.tol.floor.as_nanos() + rel) * 1000 + 2 * self.resolution_ps
     }
 
+    /// The inputs changed at capture time `ps`: given to the model. The
+    /// change happened up to a sample before `ps`, and the model's own
+    /// pulses run up to a sample late (the writes that timed them were
+    /// seen late too), so where the model has a pulse within a sample of
+    /// the change, the capture cannot say which came first: the board's
+    /// own pulses there say (`board_pulsed`), and the model takes the
+    /// change a sample after `ps` if the board pulsed, a sample before if
+    /// not (notes N53).
+    fn give_inputs(&mut self, ps: u64, changes: &[(Input, bool)], board_pulsed: bool) {
+        let r = self.resolution_ps;
+        self.run_to(ps.saturating_sub(r));
+        let pulses =
+            |b: &Board| -> u64 { b.record().runs.iter().map(|r| u64::from(r.count)).sum() };
+        let mut probe = self.board.clone();
+        let late = self.model_time(ps + r);
+        if late > probe.now() {
+            probe.advance_to(late);
+        }
+        let model_pulsed = pulses(&probe) > pulses(&self.board);
+        if !model_pulsed {
+            self.run_to(ps);
+        } else if board_pulsed {
+            self.run_to(ps + r);
+        }
+        for &(input, asserted) in changes {
+            self.board.set_input(input, asserted);
+        }
+    }
+
     /// The model's next pulse, if it has put it out by now.
     fn next_model_pulse(&self) -> Option<(Instant, Direction)> {
         let runs = &self.board.record().runs;
@@ -268,6 +297,55 @@ impl Bench {
     }
 }
 
+/// A capture read with a little look-ahead: the board's pulses just
+/// after an input's change say on which side of it they came.
+struct Lookahead<'a> {
+    src: &'a mut dyn LogicSource,
+    ahead: std::collections::VecDeque<Change>,
+    /// The source is done, or failed (the error given in its turn).
+    done: bool,
+    failed: Option<LogicError>,
+}
+
+impl<'a> Lookahead<'a> {
+    fn new(src: &'a mut dyn LogicSource) -> Self {
+        Lookahead {
+            src,
+            ahead: Default::default(),
+            done: false,
+            failed: None,
+        }
+    }
+
+    fn next(&mut self) -> Result<Option<Change>, LogicError> {
+        if let Some(c) = self.ahead.pop_front() {
+            return Ok(Some(c));
+        }
+        if let Some(e) = self.failed.take() {
+            return Err(e);
+        }
+        if self.done {
+            return Ok(None);
+        }
+        self.src.next_change()
+    }
+
+    /// The changes to come up to `ps`, read ahead.
+    fn peek_until(&mut self, ps: u64) -> impl Iterator<Item = &Change> {
+        while !self.done
+            && self.failed.is_none()
+            && self.ahead.back().is_none_or(|b| b.time_ps <= ps)
+        {
+            match self.src.next_change() {
+                Ok(Some(c)) => self.ahead.push_back(c),
+                Ok(None) => self.done = true,
+                Err(e) => self.failed = Some(e),
+            }
+        }
+        self.ahead.iter().take_while(move |c| c.time_ps <= ps)
+    }
+}
+
 /// Why a capture could not be judged at all.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum JudgeError {
@@ -350,7 +428,8 @@ pub fn judge(
     let mut prev: Option<Change> = None;
     let mut started = reset.is_none();
     let mut failed = None;
-    while let Some(c) = source.next_change()? {
+    let mut source = Lookahead::new(source);
+    while let Some(c) = source.next()? {
         if !started {
             // The model starts where RESET is released.
             if let Some(r) = reset {
@@ -362,15 +441,29 @@ pub fn judge(
                 bench.zero_ps = c.time_ps;
             }
         }
+        // The inputs as the board drove them (active low).
+        let changed: Vec<(Input, bool)> = inputs
+            .iter()
+            .filter(|&&(_, ch)| c.high(ch) != prev.is_none_or(|q| q.high(ch)))
+            .map(|&(input, ch)| (input, !c.high(ch)))
+            .collect();
+        if !changed.is_empty() {
+            let pulse_near = |t: u64| t.abs_diff(c.time_ps) <= 2 * bench.resolution_ps;
+            let board_pulsed = bench.edges.iter().any(|e| pulse_near(e.0))
+                || pout.is_some_and(|ch| {
+                    let mut level = prev.is_some_and(|q| q.high(ch));
+                    let this = std::iter::once(&c);
+                    this.chain(source.peek_until(c.time_ps + 2 * bench.resolution_ps))
+                        .any(|n| {
+                            let rose = n.high(ch) && !level;
+                            level = n.high(ch);
+                            rose
+                        })
+                });
+            bench.give_inputs(c.time_ps, &changed, board_pulsed);
+        }
         // The model up to now: every access before this change is in it.
         bench.run_to(c.time_ps);
-        // The inputs as the board drove them (active low).
-        for &(input, ch) in &inputs {
-            let was_high = prev.map_or(true, |q| q.high(ch));
-            if c.high(ch) != was_high {
-                bench.board.set_input(input, !c.high(ch));
-            }
-        }
         if failed.is_none() {
             if let Err(d) = bench.compare_pulses(c.time_ps) {
                 failed = Some(d);
@@ -388,7 +481,12 @@ pub fn judge(
             let status_then = bench.board.read_status();
             bench.run_to(t.end_ps);
             let status = bench.board.read_status();
-            rules.before(&t, &bench.board, &mut host);
+            // Past the board's first divergence the model no longer
+            // stands for the chip: its word on the host would be noise.
+            let judging_host = failed.is_none();
+            if judging_host {
+                rules.before(&t, &bench.board, &mut host);
+            }
             match t.access {
                 Access::WriteCommand | Access::WriteData => {
                     if t.access == Access::WriteCommand {
@@ -426,14 +524,18 @@ pub fn judge(
                     }
                 }
             }
-            rules.after(&t, &bench.board, &mut host);
+            if judging_host {
+                rules.after(&t, &bench.board, &mut host);
+            }
             bench.last_access = Some(t);
         }
         prev = Some(c);
     }
-    let end = source.end_ps();
+    let end = source.src.end_ps();
     bench.run_to(end);
-    rules.finish(end, &bench.board, &mut host);
+    if failed.is_none() {
+        rules.finish(end, &bench.board, &mut host);
+    }
     if failed.is_none() {
         // Past the capture's end nothing more can be seen: what the model
         // put out before it, the board must have too.
