@@ -185,7 +185,11 @@ fn bridge_sim_takes_the_chips_options_and_no_clients() {
 #[test]
 fn each_scripts_help_is_its_header_comment_and_starts_nothing() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    for script in ["scripts/network-figures", "scripts/fuzz-figures"] {
+    for script in [
+        "scripts/network-figures",
+        "scripts/fuzz-figures",
+        "scripts/judge-figures",
+    ] {
         let path = root.join(script);
         let source = std::fs::read_to_string(&path).expect("the script");
         let header: Vec<String> = source

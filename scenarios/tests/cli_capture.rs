@@ -217,3 +217,37 @@ fn sigrok_sessions_at_three_sample_rates_are_judged() {
         assert!(said.contains("sigrok session"), "{said}");
     }
 }
+
+/// `scripts/judge-figures`, which makes the figures of
+/// `docs/performance.md` ("Judging a capture"), on a 10 MB capture (the
+/// debug build): sigrok-cli converts a scenario's capture cut to 0.01 GB
+/// and to a tenth of it, and each row is judged, passes and has its
+/// figures.
+#[test]
+fn the_judge_figures_script_measures_both_lengths() {
+    if !common::sigrok_cli("the judge's figures") {
+        return;
+    }
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/judge-figures");
+    let out = std::process::Command::new(script)
+        .args(["--gigabytes", "0.01", "--runs", "1"])
+        .args(["--ppmc", env!("CARGO_BIN_EXE_ppmc")])
+        .output()
+        .expect("the script runs");
+    let said = text(&out.stdout);
+    assert!(out.status.success(), "{said}{}", text(&out.stderr));
+    assert!(
+        said.starts_with("| samples (100 MHz, 4 bytes each) |"),
+        "{said}"
+    );
+    for row in ["| 250000 | 0.001 GB |", "| 2500000 | 0.010 GB |"] {
+        let line = said
+            .lines()
+            .find(|l| l.starts_with(row))
+            .unwrap_or_else(|| panic!("no row `{row}`:\n{said}"));
+        assert!(
+            line.ends_with(" MiB |") && line.contains(" M/s |"),
+            "{line}"
+        );
+    }
+}

@@ -39,7 +39,7 @@ const FILES: [&str; 13] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 29] = [
+const ELSEWHERE: [(&str, &str); 30] = [
     (
         "sigrok-cli -I vcd:downsample=42",
         "in scenarios/tests/cli_capture.rs (the same conversion at three rates, each capture judged)",
@@ -59,6 +59,10 @@ const ELSEWHERE: [(&str, &str); 29] = [
     (
         "scripts/network-figures",
         "in scenarios/tests/cli_network.rs (every row once, the debug build)",
+    ),
+    (
+        "scripts/judge-figures",
+        "in scenarios/tests/cli_capture.rs (a 0.01 GB capture and a tenth of it, the debug build)",
     ),
     (
         "labgrid-client",
