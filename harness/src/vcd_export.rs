@@ -87,7 +87,7 @@ const MAX_LAID_OUT: u64 = 8;
 const LOOK_BACK: u64 = MAX_LAID_OUT * BUS_CYCLE + BUS_SETUP + BUS_STROBE;
 
 /// The header's word on the bus's timing.
-pub const BUS_TIMING_NOTE: &str = "bus: one cycle per register access: CS* low 50 ns before the strobe, RD* or WR* low for 100 ns rising at the access's time in the trace (the data held from the strobe's fall to CS* rising 20 ns after it), A0 high for the command and status registers; accesses at one time in the trace are laid out 200 ns apart, the last ending at that time. A status wait (await) is drawn as the one status read that ended it. The inputs the board drives (l1..l4, alm, cnp, auxi0..auxi3) are drawn at their level, low while asserted. Every time in this file is the trace's plus the lead in the comment below, which makes room for the cycles at the trace's start.";
+pub const BUS_TIMING_NOTE: &str = "bus: one cycle per register access: CS* low 50 ns before the strobe, RD* or WR* low for 100 ns rising at the access's time in the trace (the data held from the strobe's fall to CS* rising 20 ns after it), A0 high for the command and status registers; accesses at one time in the trace are laid out 200 ns apart, the last ending at that time. A status wait (await) is drawn as the one status read that ended it. Every pin is drawn at its level, as a logic analyzer sees it: the active-low outputs (int, aux, auxo0..auxo3) and the inputs the board drives (l1..l4, alm, cnp, auxi0..auxi3) low while asserted. Every time in this file is the trace's plus the lead in the comment below, which makes room for the cycles at the trace's start.";
 
 const POUT: usize = 0;
 const DIR: usize = 1;
@@ -182,9 +182,16 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
         to: to.as_nanos(),
         started: false,
     };
-    // An idle bus (CS*, RD* and WR* high), no input asserted.
+    // An idle bus (CS*, RD* and WR* high), no input asserted; drawn as a
+    // logic analyzer sees them, the active-low outputs high while not
+    // asserted.
     for i in [CS, RD, WR].into_iter().chain(L1..L1 + INPUT_SIGNALS.len()) {
         state.values[i] = true;
+    }
+    if what.bus {
+        for i in [INT, AUX].into_iter().chain(AUXO0..AUXO0 + 4) {
+            state.values[i] = true;
+        }
     }
     if from == Instant::ZERO {
         state.start()?;
@@ -242,16 +249,18 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
                 let v = *value != 0;
                 match pin {
                     Pin::Busy => state.set(e.at, BUSY, v)?,
-                    Pin::Int => state.set(e.at, INT, v)?,
+                    // As a logic analyzer sees them, the active-low
+                    // outputs are low while asserted.
+                    Pin::Int => state.set(e.at, INT, v != what.bus)?,
                     Pin::Hold => state.set(e.at, HOLD, v)?,
-                    Pin::Aux => state.set(e.at, AUX, v)?,
+                    Pin::Aux => state.set(e.at, AUX, v != what.bus)?,
                     Pin::Switching => state.set(e.at, SWITCHING, v)?,
                     Pin::Dir => state.set(e.at, DIR, v)?,
                     Pin::Phases => state.set_bits(e.at, S1, 5, *value)?,
                     // auxo0 is bit 0.
                     Pin::Auxo => {
                         for k in 0..4 {
-                            state.set(e.at, AUXO0 + k, value & (1 << k) != 0)?;
+                            state.set(e.at, AUXO0 + k, (value & (1 << k) != 0) != what.bus)?;
                         }
                     }
                 }

@@ -148,9 +148,10 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         outln!("not judged: {n}");
     }
     outln!(
-        "{} register accesses, {} POUT pulses compared",
+        "{} register accesses, {} POUT pulses compared, {} changes of the other outputs compared",
         j.accesses,
-        j.pulses
+        j.pulses,
+        j.changes
     );
     for h in &j.host {
         outln!(

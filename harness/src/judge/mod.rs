@@ -27,6 +27,7 @@ use crate::time::{Duration, Instant};
 use std::fmt;
 
 mod host;
+mod outputs;
 pub use host::HostFinding;
 use host::HostRules;
 
@@ -84,6 +85,9 @@ pub struct Judgement {
     /// The register accesses decoded and the POUT pulses compared.
     pub accesses: u64,
     pub pulses: u64,
+    /// The changes of the other outputs compared (INT*, BUSY, HOLD, AUX*,
+    /// AUXO0..3).
+    pub changes: u64,
     /// What could not be judged, and why (a signal with no channel).
     pub not_judged: Vec<String>,
 }
@@ -374,6 +378,7 @@ pub fn judge(
                 host: Vec::new(),
                 accesses: 0,
                 pulses: 0,
+                changes: 0,
                 not_judged,
             })
         }
@@ -383,14 +388,6 @@ pub fn judge(
         not_judged.push("POUT's pulses: no channel for POUT".to_string());
     } else if map.get(Signal::Dir).is_none() {
         not_judged.push("the direction of each pulse: no channel for DIR".to_string());
-    }
-    for (signal, why) in [
-        (Signal::Int, "INT*: not compared yet"),
-        (Signal::Busy, "BUSY: not compared yet"),
-    ] {
-        if map.get(signal).is_some() {
-            not_judged.push(why.to_string());
-        }
     }
     let inputs: Vec<(Input, usize)> = Input::ALL
         .into_iter()
@@ -422,6 +419,19 @@ pub fn judge(
         compared: 0,
         last_access: None,
     };
+    let mut outputs = outputs::Outputs::new(map, &bench.board);
+    let unwatched: Vec<String> = [Signal::Int, Signal::Busy, Signal::Hold, Signal::Aux]
+        .into_iter()
+        .chain((0..4).map(Signal::Auxo))
+        .filter(|s| !outputs.signals().any(|w| w == *s))
+        .map(Signal::name)
+        .collect();
+    if !unwatched.is_empty() {
+        not_judged.push(format!("outputs {}: no channel", unwatched.join(", ")));
+    }
+    if (1..=5).any(|k| info.channel(&format!("s{k}")).is_some()) {
+        not_judged.push("the phase outputs S1..S5: not compared yet".into());
+    }
     let mut decoder = BusDecoder::new(bus, &info, opts.glitch_ps);
     let mut host = Vec::new();
     let mut rules = HostRules::default();
@@ -466,6 +476,20 @@ pub fn judge(
         bench.run_to(c.time_ps);
         if failed.is_none() {
             if let Err(d) = bench.compare_pulses(c.time_ps) {
+                failed = Some(d);
+            }
+        }
+        outputs.observe(&c);
+        if failed.is_none() {
+            let after = bench.last_access.map(|a| a.to_string());
+            if let Err(d) = outputs.compare(
+                &bench.board,
+                bench.zero_ps,
+                c.time_ps,
+                &bench.tol,
+                bench.resolution_ps,
+                after,
+            ) {
                 failed = Some(d);
             }
         }
@@ -527,6 +551,7 @@ pub fn judge(
             if judging_host {
                 rules.after(&t, &bench.board, &mut host);
             }
+            outputs.access(t.end_ps);
             bench.last_access = Some(t);
         }
         prev = Some(c);
@@ -543,6 +568,19 @@ pub fn judge(
             failed = Some(d);
         }
     }
+    if failed.is_none() {
+        let after = bench.last_access.map(|a| a.to_string());
+        if let Err(d) = outputs.compare(
+            &bench.board,
+            bench.zero_ps,
+            end,
+            &bench.tol,
+            bench.resolution_ps,
+            after,
+        ) {
+            failed = Some(d);
+        }
+    }
     let summary = decoder.summary();
     let verdict = match (failed, summary.rate_problem(&info)) {
         (_, Some(why)) => Verdict::Capture(why),
@@ -554,6 +592,7 @@ pub fn judge(
         host,
         accesses: summary.transactions,
         pulses: bench.compared,
+        changes: outputs.compared(),
         not_judged,
     })
 }

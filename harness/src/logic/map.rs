@@ -28,6 +28,12 @@ pub enum Signal {
     Int,
     /// BUSY, where the board brings it out.
     Busy,
+    /// HOLD, high while on.
+    Hold,
+    /// AUX*, active low.
+    Aux,
+    /// AUXO0..AUXO3, active low.
+    Auxo(u8),
     /// An input the board drives into the chip: the limits L1*..L4*, ALM*,
     /// CNP* and AUXI0..3, all active low (the pin pulled low asserts it).
     /// The judge gives the model what the capture shows on them.
@@ -36,7 +42,7 @@ pub enum Signal {
 
 impl Signal {
     /// Every signal, bus first.
-    pub const ALL: [Signal; 26] = [
+    pub const ALL: [Signal; 32] = [
         Signal::Cs,
         Signal::Rd,
         Signal::Wr,
@@ -53,6 +59,12 @@ impl Signal {
         Signal::Dir,
         Signal::Int,
         Signal::Busy,
+        Signal::Hold,
+        Signal::Aux,
+        Signal::Auxo(0),
+        Signal::Auxo(1),
+        Signal::Auxo(2),
+        Signal::Auxo(3),
         Signal::Input(Input::L1),
         Signal::Input(Input::L2),
         Signal::Input(Input::L3),
@@ -77,6 +89,9 @@ impl Signal {
             Signal::Dir => "DIR".into(),
             Signal::Int => "INT".into(),
             Signal::Busy => "BUSY".into(),
+            Signal::Hold => "HOLD".into(),
+            Signal::Aux => "AUX".into(),
+            Signal::Auxo(i) => format!("AUXO{i}"),
             Signal::Input(i) => i.name().to_ascii_uppercase(),
         }
     }
@@ -109,6 +124,14 @@ impl Signal {
         if low("INT") {
             return Some(Signal::Int);
         }
+        if low("AUX") {
+            return Some(Signal::Aux);
+        }
+        for i in 0..4 {
+            if low(&format!("AUXO{i}")) {
+                return Some(Signal::Auxo(i));
+            }
+        }
         if let Some(i) = Input::ALL
             .into_iter()
             .find(|i| low(&i.name().to_ascii_uppercase()))
@@ -120,6 +143,7 @@ impl Signal {
             "POUT" => return Some(Signal::Pout),
             "DIR" => return Some(Signal::Dir),
             "BUSY" => return Some(Signal::Busy),
+            "HOLD" => return Some(Signal::Hold),
             _ => {}
         }
         let digits = n
@@ -260,7 +284,7 @@ impl ChannelMap {
                 }
                 let s = Signal::parse(sig).ok_or_else(|| {
                     at(format!(
-                        "no signal `{sig}`: use CS, RD, WR, A0, D0..D7, POUT, DIR, INT, BUSY, L1..L4, ALM, CNP or AUXI0..AUXI3"
+                        "no signal `{sig}`: use CS, RD, WR, A0, D0..D7, POUT, DIR, INT, BUSY, HOLD, AUX, AUXO0..AUXO3, L1..L4, ALM, CNP or AUXI0..AUXI3"
                     ))
                 })?;
                 map.replace(s, channel(chan, info).map_err(&at)?);
@@ -329,6 +353,9 @@ mod tests {
             ("A0", Signal::A0),
             ("D[7]", Signal::D(7)),
             ("L3*", Signal::Input(Input::L3)),
+            ("AUX*", Signal::Aux),
+            ("auxo3_n", Signal::Auxo(3)),
+            ("HOLD", Signal::Hold),
             ("nALM", Signal::Input(Input::Alm)),
             ("auxi2", Signal::Input(Input::Auxi2)),
             ("DB3", Signal::D(3)),
@@ -350,10 +377,7 @@ mod tests {
         let m = ChannelMap::from_names(&i).expect("names");
         let bus = m.bus().expect("the whole bus");
         assert_eq!((bus.cs, bus.rd, bus.d[7]), (0, 1, 11));
-        assert_eq!(
-            m.missing(),
-            [Signal::Pout, Signal::Dir, Signal::Int, Signal::Busy]
-        );
+        assert_eq!(m.missing(), Signal::ALL[12..]);
         let m = ChannelMap::parse("POUT=x, CS=3 # swapped\nA0=0", &i).expect("map");
         assert_eq!(
             (m.get(Signal::Pout), m.get(Signal::Cs), m.get(Signal::A0)),

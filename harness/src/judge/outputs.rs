@@ -1,0 +1,245 @@
+//! The chip's outputs besides POUT and DIR, compared change by change:
+//! INT*, BUSY, HOLD, AUX* and AUXO0..AUXO3 as the capture shows them,
+//! against the model's record of its pins, each change within the
+//! capture's resolution and the latency tolerance of the time since what
+//! caused it (the last register access or the last pulse before it:
+//! Table 3-3 times INT*, BUSY and HOLD from them).
+
+use super::Divergence;
+use crate::compare::Tolerances;
+use crate::emu::Board;
+use crate::logic::map::{ChannelMap, Signal};
+use crate::logic::source::Change;
+use crate::protocol::{Pin, PulseRun};
+use crate::time::{Duration, Instant};
+use std::collections::VecDeque;
+
+/// The outputs compared, as a judge holds them.
+pub(super) struct Outputs {
+    watches: Vec<Watch>,
+    /// Recent register accesses, in capture time (the newest last).
+    accesses: VecDeque<u64>,
+    compared: u64,
+}
+
+/// One output pin and its two sides.
+struct Watch {
+    signal: Signal,
+    channel: usize,
+    pin: Pin,
+    /// Low while asserted (INT*, AUX*, AUXO).
+    active_low: bool,
+    /// Which bit of the model's value (AUXO's four pins share one event).
+    bit: u8,
+    /// The board's changes not compared yet: capture time, asserted.
+    board: VecDeque<(u64, bool)>,
+    /// The board's level as last seen (asserted), once seen.
+    seen: Option<bool>,
+    /// The model's level as far as compared, and where its record of pin
+    /// changes has been read to.
+    model: bool,
+    next_event: usize,
+}
+
+impl Watch {
+    fn model_level(&self, value: u8) -> bool {
+        value >> self.bit & 1 == 1
+    }
+
+    fn word(&self, asserted: bool) -> &'static str {
+        match (self.active_low, asserted) {
+            (true, true) => "asserted (low)",
+            (true, false) => "released (high)",
+            (false, true) => "high",
+            (false, false) => "low",
+        }
+    }
+}
+
+/// The last pulse of `runs` at or before `t`.
+fn last_pulse_by(runs: &[PulseRun], t: Instant) -> Option<Instant> {
+    let run = runs.iter().rev().find(|r| r.count > 0 && r.start <= t)?;
+    let (mut lo, mut hi) = (0u32, run.count - 1);
+    while lo < hi {
+        let mid = lo + (hi - lo).div_ceil(2);
+        if run.at(mid) <= t {
+            lo = mid;
+        } else {
+            hi = mid - 1;
+        }
+    }
+    Some(run.at(lo))
+}
+
+impl Outputs {
+    /// The outputs `map` has channels for, their model side as `board`
+    /// stands now (the capture's start).
+    pub(super) fn new(map: &ChannelMap, board: &Board) -> Outputs {
+        let pins = board.pins();
+        let mut watches = Vec::new();
+        let mut watch = |signal: Signal, pin: Pin, active_low: bool, bit: u8, now: bool| {
+            if let Some(channel) = map.get(signal) {
+                watches.push(Watch {
+                    signal,
+                    channel,
+                    pin,
+                    active_low,
+                    bit,
+                    board: VecDeque::new(),
+                    seen: None,
+                    model: now,
+                    next_event: board.record().pins.len(),
+                });
+            }
+        };
+        watch(Signal::Int, Pin::Int, true, 0, pins.int);
+        watch(Signal::Busy, Pin::Busy, false, 0, pins.busy);
+        watch(Signal::Hold, Pin::Hold, false, 0, pins.hold);
+        watch(Signal::Aux, Pin::Aux, true, 0, pins.aux);
+        for k in 0..4 {
+            let now = pins.auxo >> k & 1 == 1;
+            watch(Signal::Auxo(k), Pin::Auxo, true, k, now);
+        }
+        Outputs {
+            watches,
+            accesses: VecDeque::new(),
+            compared: 0,
+        }
+    }
+
+    /// The signals compared.
+    pub(super) fn signals(&self) -> impl Iterator<Item = Signal> + '_ {
+        self.watches.iter().map(|w| w.signal)
+    }
+
+    /// Changes compared so far.
+    pub(super) fn compared(&self) -> u64 {
+        self.compared
+    }
+
+    /// A register access ended at `ps`: what the changes after it are
+    /// timed from.
+    pub(super) fn access(&mut self, ps: u64) {
+        if self.accesses.len() == 64 {
+            self.accesses.pop_front();
+        }
+        self.accesses.push_back(ps);
+    }
+
+    /// The capture's change `c`: the board's side of every output. Its
+    /// first level counts as a change when the model's differs.
+    pub(super) fn observe(&mut self, c: &Change) {
+        for w in &mut self.watches {
+            let asserted = c.high(w.channel) != w.active_low;
+            match w.seen {
+                Some(level) if level == asserted => {}
+                None if asserted == w.model => {}
+                _ => w.board.push_back((c.time_ps, asserted)),
+            }
+            w.seen = Some(asserted);
+        }
+    }
+
+    /// Compares the changes, the board's and the model's, that lie before
+    /// `horizon_ps` by more than their tolerance (the model has run up to
+    /// `horizon_ps`). `zero_ps` is the capture's time of the model's zero.
+    pub(super) fn compare(
+        &mut self,
+        board: &Board,
+        zero_ps: u64,
+        horizon_ps: u64,
+        tol: &Tolerances,
+        resolution_ps: u64,
+        after: Option<String>,
+    ) -> Result<(), Divergence> {
+        let record = board.record();
+        let to_ps = |t: Instant| t.as_nanos() * 1000 + zero_ps;
+        for w in &mut self.watches {
+            loop {
+                // The model's next change of this pin.
+                let mut model = None;
+                while let Some(e) = record.pins.get(w.next_event) {
+                    if e.pin == w.pin && w.model_level(e.value) != w.model {
+                        model = Some((e.at, w.model_level(e.value)));
+                        break;
+                    }
+                    w.next_event += 1;
+                }
+                // How far the change may be from the model's: the floor,
+                // two samples, and the latency tolerance of the time since
+                // its cause.
+                let allowed = |m_ps: u64, accesses: &VecDeque<u64>| {
+                    let m = Instant::from_nanos(m_ps.saturating_sub(zero_ps) / 1000);
+                    let pulse = last_pulse_by(&record.runs, m).map(to_ps);
+                    let access = accesses.iter().rev().find(|&&a| a <= m_ps).copied();
+                    let cause = pulse.max(access).unwrap_or(zero_ps);
+                    let since = m_ps.saturating_sub(cause);
+                    tol.floor.as_nanos() * 1000
+                        + since.saturating_mul(tol.latency_bp) / 10_000
+                        + 2 * resolution_ps
+                };
+                let diverge =
+                    |w: &Watch, at_ps: u64, board: String, model: String, level: bool| Divergence {
+                        at_ps,
+                        what: format!("{} {}", w.signal.name(), w.word(level)),
+                        board,
+                        model,
+                        after: after.clone(),
+                    };
+                let at = |ps: u64| Instant::from_nanos(ps / 1000);
+                match (w.board.front().copied(), model) {
+                    (None, None) => break,
+                    (Some((b, level)), None) => {
+                        if b + allowed(b, &self.accesses) >= horizon_ps {
+                            break;
+                        }
+                        return Err(diverge(
+                            w,
+                            b,
+                            format!("at {}", at(b)),
+                            "no change".into(),
+                            level,
+                        ));
+                    }
+                    (b, Some((m, level))) => {
+                        let m_ps = to_ps(m);
+                        let allowed = allowed(m_ps, &self.accesses);
+                        match b {
+                            Some((b, bl)) if bl == level && b.abs_diff(m_ps) <= allowed => {
+                                w.board.pop_front();
+                                w.model = level;
+                                w.next_event += 1;
+                                self.compared += 1;
+                            }
+                            Some((b, bl)) if b.min(m_ps) + allowed < horizon_ps => {
+                                let (at_ps, shown) = if b < m_ps { (b, bl) } else { (m_ps, level) };
+                                return Err(diverge(
+                                    w,
+                                    at_ps,
+                                    format!("{} at {}", w.word(bl), at(b)),
+                                    format!(
+                                        "{} at {m} (allowed {})",
+                                        w.word(level),
+                                        Duration::from_nanos(allowed / 1000)
+                                    ),
+                                    shown,
+                                ));
+                            }
+                            None if m_ps + allowed < horizon_ps => {
+                                return Err(diverge(
+                                    w,
+                                    m_ps,
+                                    "no change".into(),
+                                    format!("at {m}"),
+                                    level,
+                                ));
+                            }
+                            _ => break,
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
