@@ -1,0 +1,159 @@
+//! Issue 30's proof that the judge and the model agree on every scenario
+//! of the suite, as a lab would record it: each scenario run on the clean
+//! emulator and exported as a full-pin capture (`ppmc export --scenario
+//! NAME --bus`: the bus, POUT, DIR, the phases, INT*, BUSY, HOLD, AUX*,
+//! AUXO, and the inputs the board drives), converted by sigrok-cli itself
+//! into sigrok sessions at 100, 50 and 23.8 MHz (the last not a divisor of
+//! the export's microsecond grid, so every edge is seen late by a
+//! different part of a sample), and each judged: the board passes. The
+//! scenarios that break chapter 3's host rules on purpose (the error
+//! scenarios: a command while BUSY, data no command asked for) pass the
+//! board with host findings (exit 3).
+//!
+//! `cargo test` judges a sample of the suite, one scenario of each kind;
+//! CI sets `PPMC_SUITE_CAPTURES=all` and judges every scenario (`.ci/run`).
+
+mod common;
+use common::{ppmc, scratch, text};
+use std::path::Path;
+use std::sync::Mutex;
+
+/// One scenario of each kind: inputs that stop a move, a Decelerating
+/// Stop written while the pulses run, the error and host-rule scenarios,
+/// the auxiliary outputs, register reads, and the speed limit.
+const SAMPLE: [&str; 9] = [
+    "s3_3_6_continuous_until_l1",
+    "s3_3_8_origin_search_stops_at_cnp",
+    "s3_6_decel_stop_17us_not_before",
+    "s3_3_7_high_speed_until_l3",
+    "e1_operation_command_while_busy",
+    "s3_5_3_aux_output_drives_auxo",
+    "s3_4_2_input_status_alm_cnp",
+    "s3_2_2_over_speed_locks_out_the_host",
+    "s3_5_4_software_reset_while_busy_is_aux_on",
+];
+
+/// The VCD's 1 ns timescale divided: 100, 50 and 23.8 MHz.
+const DOWNSAMPLE: [u32; 3] = [10, 20, 42];
+
+/// Captures larger than this are judged from the VCD alone: a sigrok
+/// session of the 16,777,216-step move (706 s) would hold 17 G samples at
+/// 24 MHz, more than a lab would record.
+const SR_LIMIT_BYTES: u64 = 50 << 20;
+
+/// Judges `capture` and says what went wrong, if anything: the board must
+/// pass, exit 0, or 3 with host findings.
+fn judge(capture: &Path) -> Result<bool, String> {
+    let out = ppmc(&["judge", capture.to_str().expect("utf-8")]);
+    let said = text(&out.stdout);
+    let code = out.status.code();
+    if !said.contains("PASS the board") || !matches!(code, Some(0 | 3)) {
+        return Err(format!(
+            "{}: exit {code:?}\n{said}{}",
+            capture.display(),
+            text(&out.stderr)
+        ));
+    }
+    Ok(code == Some(3))
+}
+
+/// Exports, converts and judges `name`; whether the host broke chapter
+/// 3's rules in it.
+fn check(dir: &Path, name: &str) -> Result<bool, String> {
+    let vcd = dir.join(format!("{name}.vcd"));
+    let out = ppmc(&[
+        "export",
+        "--scenario",
+        name,
+        "--bus",
+        "-o",
+        vcd.to_str().expect("utf-8"),
+    ]);
+    if !out.status.success() {
+        return Err(format!("{name}: export: {}", text(&out.stderr)));
+    }
+    let host = judge(&vcd)?;
+    let size = std::fs::metadata(&vcd).map_err(|e| e.to_string())?.len();
+    if size <= SR_LIMIT_BYTES {
+        for ds in DOWNSAMPLE {
+            let sr = dir.join(format!("{name}-{ds}.sr"));
+            let out = std::process::Command::new("sigrok-cli")
+                .args(["-I", &format!("vcd:downsample={ds}"), "-i"])
+                .arg(&vcd)
+                .arg("-o")
+                .arg(&sr)
+                .output()
+                .map_err(|e| format!("sigrok-cli: {e}"))?;
+            if !out.status.success() {
+                return Err(format!("{name}: sigrok-cli: {}", text(&out.stderr)));
+            }
+            if judge(&sr)? != host {
+                return Err(format!(
+                    "{name}: host findings at 1/{ds} ns and not in the VCD, or the other way"
+                ));
+            }
+            let _ = std::fs::remove_file(&sr);
+        }
+    }
+    let _ = std::fs::remove_file(&vcd);
+    Ok(host)
+}
+
+#[test]
+fn every_scenarios_capture_passes_at_three_sample_rates() {
+    if !common::sigrok_cli("converting captures to sigrok sessions") {
+        return;
+    }
+    let all = std::env::var("PPMC_SUITE_CAPTURES").is_ok_and(|v| v == "all");
+    let names: Vec<String> = if all {
+        ppmc_scenarios::all()
+            .iter()
+            .map(|s| s.name.to_string())
+            .collect()
+    } else {
+        SAMPLE.iter().map(|s| s.to_string()).collect()
+    };
+    let dir = scratch("suite-captures");
+    let queue = Mutex::new(names.clone());
+    let results = Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| loop {
+                let Some(name) = queue.lock().expect("queue").pop() else {
+                    return;
+                };
+                let r = check(dir.path(), &name);
+                results.lock().expect("results").push((name, r));
+            });
+        }
+    });
+    let results = results.into_inner().expect("results");
+    assert_eq!(results.len(), names.len());
+    let failed: Vec<&str> = results
+        .iter()
+        .filter_map(|(_, r)| r.as_ref().err().map(String::as_str))
+        .collect();
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+    let mut host: Vec<&str> = results
+        .iter()
+        .filter(|(_, r)| r == &Ok(true))
+        .map(|(n, _)| n.as_str())
+        .collect();
+    host.sort();
+    // Only scenarios that misuse the chip on purpose give host findings.
+    let on_purpose = |n: &str| {
+        n.starts_with('e')
+            || n.contains("error")
+            || n.contains("while_busy")
+            || n.contains("while_ibf")
+            || n.starts_with("s3_5_4_software_reset")
+    };
+    assert!(host.iter().all(|n| on_purpose(n)), "{host:?}");
+    assert!(host.contains(&"e1_operation_command_while_busy"), "{host:?}");
+    eprintln!(
+        "{} scenarios judged at {} sample rates; host findings in {}",
+        results.len(),
+        DOWNSAMPLE.len() + 1,
+        host.len()
+    );
+}
