@@ -741,6 +741,77 @@ end
         assert_eq!(auxo_seen, [true, false, true, false]);
     }
 
+    /// What the trace logs after a run of pulses began, while it runs (a
+    /// Decelerating Stop written, 3-3-2; a limit asserted, 3-3-6), is
+    /// drawn at its own time, among the run's pulses; the inputs and the
+    /// active-low outputs at their level, low while asserted.
+    #[test]
+    fn what_happens_during_a_run_is_drawn_at_its_time() {
+        let text = "ppmc-trace 1
+scenario during
+section 3-3-2
+target emu
+detail sysclk_hz 16000000
+detail csel high
+detail vsel high
+detail ext_clock_hz none
+events
+0.000us reset
+100.000us move constant cw steps=100 pout=0 winding=4ph-2 phase=0
+300.000us pulses cw n=100 dt=50.000us
+2000.000us wc 0x41 waited=0.000us
+3000.000us set l1 on
+5300.000us pin int 1
+end
+";
+        let trace = Trace::parse(text).expect("trace");
+        let mut buf = Vec::new();
+        let what = Export {
+            window: None,
+            bus: true,
+        };
+        export_with(&trace, what, &mut buf).expect("export");
+        let lead = bus_lead(&trace);
+        let mut parser = Parser::new(&buf[..]);
+        let header = parser.parse_header().expect("header");
+        let code = |n: &str| header.find_var(&["ppmc", n]).expect("declared").code;
+        let (wr, l1, int, pout) = (code("wr"), code("l1"), code("int"), code("pout"));
+        let (mut now, mut last) = (0u64, 0u64);
+        let mut seen = Vec::new();
+        let mut rises_before_wr = 0;
+        let at = |us: u64| us * 1000 + lead;
+        for cmd in parser {
+            match cmd.expect("body") {
+                Command::Timestamp(t) => {
+                    assert!(t >= last, "time goes back: {t} after {last}");
+                    (now, last) = (t, t);
+                }
+                Command::ChangeScalar(id, v) if id == wr || id == l1 || id == int => {
+                    seen.push((now, id, v));
+                }
+                Command::ChangeScalar(id, Value::V1) if id == pout && now < at(2000) => {
+                    rises_before_wr += 1;
+                }
+                _ => {}
+            }
+        }
+        // Idle: WR*, L1* and INT* high.
+        let start: Vec<_> = seen.iter().filter(|s| s.0 == 0).map(|s| s.2).collect();
+        assert_eq!(start, [Value::V1; 3]);
+        let changes: Vec<_> = seen.into_iter().filter(|s| s.0 > 0).collect();
+        assert_eq!(
+            changes,
+            [
+                (at(2000) - BUS_STROBE, wr, Value::V0),
+                (at(2000), wr, Value::V1),
+                (at(3000), l1, Value::V0),
+                (at(5300), int, Value::V0),
+            ]
+        );
+        // The pulses from 300 us, 50 us apart, before the write at 2000 us.
+        assert_eq!(rises_before_wr, 34);
+    }
+
     /// The bus as a logic analyzer would record it: decoded back (Table
     /// 3-1) it gives every access of the trace, its byte and its time (the
     /// last of those at one time ending at it, all late by the lead).

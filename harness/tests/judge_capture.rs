@@ -8,84 +8,13 @@ use ppmc::backend::EmuTarget;
 use ppmc::emu::ModelConfig;
 use ppmc::judge::{judge, JudgeOptions, Verdict};
 use ppmc::logic::map::ChannelMap;
-use ppmc::logic::source::{Change, LogicError, LogicInfo, LogicSource};
+use ppmc::logic::source::LogicSource;
+use ppmc::logic::vcd::VcdReader;
 use ppmc::protocol::Straps;
 use ppmc::scenario::{run_scenario, DriverOptions};
 use ppmc::trace::Trace;
 use ppmc::vcd_export::{export_with, Export};
-use vcd::{Command, IdCode, Parser, Value};
-
-/// A VCD of our own export as a change stream (1 ns timescale).
-struct VcdChanges {
-    info: LogicInfo,
-    changes: std::vec::IntoIter<Change>,
-    end_ps: u64,
-}
-
-impl VcdChanges {
-    fn new(buf: &[u8]) -> VcdChanges {
-        let mut parser = Parser::new(buf);
-        let header = parser.parse_header().expect("header");
-        let vars: Vec<(IdCode, String)> = header
-            .items
-            .iter()
-            .flat_map(|i| match i {
-                vcd::ScopeItem::Scope(s) => s.items.clone(),
-                other => vec![other.clone()],
-            })
-            .filter_map(|i| match i {
-                vcd::ScopeItem::Var(v) => Some((v.code, v.reference.clone())),
-                _ => None,
-            })
-            .collect();
-        let (mut now, mut levels, mut out) = (0u64, 0u64, Vec::<Change>::new());
-        let flush = |now: u64, levels: u64, out: &mut Vec<Change>| {
-            if out.last().is_none_or(|l| l.levels != levels) {
-                out.push(Change {
-                    time_ps: now * 1000,
-                    levels,
-                    unknown: 0,
-                });
-            }
-        };
-        for cmd in parser {
-            match cmd.expect("body") {
-                Command::Timestamp(t) => {
-                    flush(now, levels, &mut out);
-                    now = t;
-                }
-                Command::ChangeScalar(id, v) => {
-                    let k = vars.iter().position(|(c, _)| *c == id).expect("declared");
-                    levels = (levels & !(1 << k)) | (u64::from(v == Value::V1) << k);
-                }
-                _ => {}
-            }
-        }
-        flush(now, levels, &mut out);
-        VcdChanges {
-            info: LogicInfo {
-                channels: vars.into_iter().map(|(_, n)| n).collect(),
-                resolution_ps: 1000,
-                sample_rate_hz: None,
-                format: "VCD (ppmc export --bus)".into(),
-            },
-            changes: out.into_iter(),
-            end_ps: now * 1000,
-        }
-    }
-}
-
-impl LogicSource for VcdChanges {
-    fn info(&self) -> &LogicInfo {
-        &self.info
-    }
-    fn next_change(&mut self) -> Result<Option<Change>, LogicError> {
-        Ok(self.changes.next())
-    }
-    fn end_ps(&self) -> u64 {
-        self.end_ps
-    }
-}
+use std::path::Path;
 
 /// The trace of `name` on a model with `cfg`.
 fn trace_of(name: &str, cfg: ModelConfig) -> Trace {
@@ -101,7 +30,9 @@ fn trace_of(name: &str, cfg: ModelConfig) -> Trace {
     r.trace.expect("a trace")
 }
 
-fn capture_of(trace: &Trace) -> VcdChanges {
+/// The capture of `trace` as a logic analyzer would record it, read by
+/// the project's VCD reader.
+fn capture_of(trace: &Trace) -> VcdReader<std::io::Cursor<Vec<u8>>> {
     let mut buf = Vec::new();
     export_with(
         trace,
@@ -112,7 +43,7 @@ fn capture_of(trace: &Trace) -> VcdChanges {
         &mut buf,
     )
     .expect("export");
-    VcdChanges::new(&buf)
+    VcdReader::new(std::io::Cursor::new(buf), Path::new("capture.vcd")).expect("reads")
 }
 
 fn judged(trace: &Trace) -> ppmc::judge::Judgement {
@@ -151,8 +82,9 @@ fn a_clean_boards_captures_pass() {
 }
 
 /// A board that loses the last pulse of a move (3-3), whose status reads
-/// a stuck bit (3-1-1), or whose DIR line is inverted (3-3), fails, blamed
-/// on the board.
+/// a stuck bit (3-1-1), whose INT* comes late or whose BUSY rises early
+/// (Table 3-3), whose HOLD never turns on (3-2-1) or whose AUXO pins are
+/// reversed (3-5-3) fails, blamed on the board, at its first divergence.
 #[test]
 fn a_faulty_boards_capture_fails_at_its_first_divergence() {
     for (fault, scenario, what) in [
@@ -163,6 +95,26 @@ fn a_faulty_boards_capture_fails_at_its_first_divergence() {
         ),
         (
             "status-stuck-0x04",
+            "s3_3_5_constant_speed_100_steps",
+            "status read",
+        ),
+        // Table 3-3: INT* 8% late after the final POUT.
+        (
+            "int-late",
+            "s3_3_5_constant_speed_100_steps",
+            "INT asserted",
+        ),
+        // 3-2-1: HOLD never turns on.
+        (
+            "hold-stuck-off",
+            "s3_3_5_constant_speed_100_steps",
+            "HOLD high",
+        ),
+        // 3-5-3: AUXO0..3 in reverse order.
+        ("auxo-reversed", "s3_5_3_aux_output_drives_auxo", "AUXO"),
+        // Table 3-3: BUSY rises early, which the host's status poll sees.
+        (
+            "busy-rise-early",
             "s3_3_5_constant_speed_100_steps",
             "status read",
         ),
