@@ -251,3 +251,72 @@ fn the_judge_figures_script_measures_both_lengths() {
         );
     }
 }
+
+/// Issue 30, item 8: a FIFO where a capture should be, and a 10 GB sparse
+/// file (all zeros) under each format's name, are each refused at once
+/// with the file named (exit 2), in bounded time and memory: nothing
+/// blocks on the FIFO, nothing reads the 10 GB.
+#[test]
+fn fifos_and_huge_empty_files_are_refused_by_name() {
+    let dir = scratch("bad-captures");
+    let fifo = |name: &str| {
+        let p = dir.path().join(name);
+        let made = std::process::Command::new("mkfifo")
+            .arg(&p)
+            .status()
+            .expect("mkfifo runs");
+        assert!(made.success());
+        p
+    };
+    let sparse = |name: &str| {
+        let p = dir.path().join(name);
+        let f = std::fs::File::create(&p).expect("create");
+        f.set_len(10 << 30).expect("a sparse 10 GB file");
+        p
+    };
+    let saleae = dir.path().join("saleae");
+    std::fs::create_dir(&saleae).expect("folder");
+    let cases = [
+        (fifo("fifo.sr"), "not a regular file"),
+        (fifo("fifo.vcd"), "is a FIFO"),
+        (fifo("fifo.csv"), "is a FIFO"),
+        (sparse("big.sr"), ""),
+        (sparse("big.vcd"), "where a command ($...) should be"),
+        (sparse("big.csv"), "a line longer than"),
+        (sparse("digital_0.bin"), "not a Saleae binary export"),
+        (
+            {
+                let p = saleae.join("digital_0.bin");
+                let made = std::process::Command::new("mkfifo")
+                    .arg(&p)
+                    .status()
+                    .expect("mkfifo runs");
+                assert!(made.success());
+                saleae.clone()
+            },
+            "is a FIFO",
+        ),
+    ];
+    for (path, says) in cases {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_ppmc"))
+            .arg("judge")
+            .arg(&path)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("ppmc runs");
+        let status = common::wait_bounded(&mut child, std::time::Duration::from_secs(30));
+        let mut err = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().expect("stderr"), &mut err)
+            .expect("stderr reads");
+        let name = path
+            .file_name()
+            .expect("name")
+            .to_string_lossy()
+            .into_owned();
+        assert_eq!(status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(&name), "{name}: {err}");
+        assert!(err.contains(says), "{name}: {err}");
+        assert!(!err.contains("panicked"), "{name}: {err}");
+    }
+}

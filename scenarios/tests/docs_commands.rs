@@ -39,7 +39,7 @@ const FILES: [&str; 13] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 30] = [
+const ELSEWHERE: [(&str, &str); 31] = [
     (
         "sigrok-cli -I vcd:downsample=42",
         "in scenarios/tests/cli_capture.rs (the same conversion at three rates, each capture judged)",
@@ -133,6 +133,10 @@ const ELSEWHERE: [(&str, &str); 30] = [
     (
         "cp fuzz/artifacts",
         "a template: there is no finding to copy on a clean checkout",
+    ),
+    (
+        "sigrok-cli -d fx2lafw",
+        "needs a logic analyzer on a board; scenarios/tests/suite_captures.rs judges sigrok-cli's sessions of every scenario",
     ),
     (
         "sigrok-cli",
@@ -232,7 +236,8 @@ fn commands(file: &'static str) -> Vec<Doc> {
     let mut out = Vec::new();
     let mut block: Option<&str> = None;
     for (i, line) in body.lines().enumerate() {
-        if let Some(lang) = line.strip_prefix("```") {
+        // Fences indented in a list item count too.
+        if let Some(lang) = line.trim_start().strip_prefix("```") {
             block = match block {
                 Some(_) => None,
                 None => Some(lang.trim()),
@@ -401,6 +406,12 @@ fn run(doc: &Doc, args: &str, dir: &Path, boards: &mut [Option<Bridge>; 2]) -> R
         args = args.replace(from, to);
     }
     let (mut argv, stdin) = words(&args);
+    // `> file`: standard output into a file of the scratch directory.
+    let into = argv.iter().position(|w| w == ">").map(|i| {
+        let file = argv.get(i + 1).cloned().unwrap_or_default();
+        argv.truncate(i);
+        file
+    });
     if argv.first().map(String::as_str) == Some("bridge-sim") {
         // Started, must say where it serves, stopped.
         Bridge::start(dir, "doc-bridge", &argv[1..])?;
@@ -456,6 +467,9 @@ fn run(doc: &Doc, args: &str, dir: &Path, boards: &mut [Option<Bridge>; 2]) -> R
     });
     let status = wait_bounded(&mut child, Duration::from_secs(240));
     let stdout = text(&out_t.join().unwrap_or_default());
+    if let Some(file) = &into {
+        std::fs::write(dir.join(file), &stdout).map_err(|e| format!("> {file}: {e}"))?;
+    }
     let stderr = text(&err_t.join().unwrap_or_default());
     if let Some(want) = &doc.output {
         if stdout != *want {
@@ -476,7 +490,10 @@ fn run(doc: &Doc, args: &str, dir: &Path, boards: &mut [Option<Bridge>; 2]) -> R
 }
 
 /// Commands whose documented purpose ends in a verdict (exit status 1).
-const EXIT_1: [&str; 1] = ["fuzz triage fuzz/artifacts/bus_bytes/"];
+const EXIT_1: [&str; 2] = [
+    "fuzz triage fuzz/artifacts/bus_bytes/",
+    "judge out/faulty.vcd",
+];
 
 fn tail(s: &str) -> String {
     let lines: Vec<&str> = s.lines().collect();

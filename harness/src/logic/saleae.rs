@@ -130,7 +130,7 @@ impl Channel {
 
     /// Opens a channel's file and reads its header and first chunk's.
     fn open(file: &Path) -> Result<(Channel, u32, Option<Chunk>), LogicError> {
-        let f = files::open_stream(file).map_err(|e| LogicError::new(file, "", e.to_string()))?;
+        let f = files::open_stream(file).map_err(|e| LogicError::opening(file, e))?;
         let len = f.metadata().map(|m| m.len()).unwrap_or(u64::MAX);
         let mut c = Channel {
             file: file.to_path_buf(),

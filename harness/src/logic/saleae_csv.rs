@@ -47,7 +47,7 @@ impl<R> fmt::Debug for SaleaeCsv<R> {
 impl SaleaeCsv<BufReader<File>> {
     /// Opens a CSV export and reads its header.
     pub fn open(path: &Path) -> Result<Self, LogicError> {
-        let f = files::open_stream(path).map_err(|e| LogicError::new(path, "", e.to_string()))?;
+        let f = files::open_stream(path).map_err(|e| LogicError::opening(path, e))?;
         SaleaeCsv::new(BufReader::with_capacity(1 << 16, f), path)
     }
 }

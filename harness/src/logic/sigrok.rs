@@ -127,7 +127,9 @@ impl SigrokReader {
     /// now (their errors returned now), the samples as
     /// [`LogicSource::next_change`] asks.
     pub fn open(path: &Path) -> Result<SigrokReader, LogicError> {
-        let mut archive = ZipArchive::new(open_regular(path)?).map_err(|e| {
+        let mut file = open_regular(path)?;
+        check_zip_ends(path, &mut file)?;
+        let mut archive = ZipArchive::new(file).map_err(|e| {
             let what = format!("not a ZIP archive, which a sigrok session file is: {e}");
             LogicError::new(path, "", what)
         })?;
@@ -413,6 +415,40 @@ fn inflate(
         }
     }
     let _ = tx.send(Piece::Finished);
+}
+
+/// Whether `file` starts as a ZIP archive does and has the end of its
+/// central directory where one must be, within the last 64 KiB (a
+/// comment's length) of its end: checked before the `zip` crate, which
+/// searches a file with none, 10 GB of zeros say, to its start.
+fn check_zip_ends(path: &Path, file: &mut File) -> Result<(), LogicError> {
+    use std::io::{Read, Seek, SeekFrom};
+    const EOCD: &[u8] = b"PK\x05\x06";
+    let not_zip = |why: &str| {
+        fail::<()>(
+            path,
+            "",
+            format!("not a ZIP archive, which a sigrok session file is: {why}"),
+        )
+    };
+    let cannot = |e: std::io::Error| LogicError::new(path, "", format!("cannot read: {e}"));
+    let len = file.metadata().map_err(cannot)?.len();
+    let mut head = [0u8; 4];
+    if len < 22 || file.read_exact(&mut head).is_err() {
+        return not_zip("too short");
+    }
+    if &head != b"PK\x03\x04" && &head != EOCD {
+        return not_zip("it does not start with a ZIP entry");
+    }
+    let tail_len = len.min(22 + 0xFFFF);
+    file.seek(SeekFrom::Start(len - tail_len)).map_err(cannot)?;
+    let mut tail = vec![0u8; tail_len as usize];
+    file.read_exact(&mut tail).map_err(cannot)?;
+    file.seek(SeekFrom::Start(0)).map_err(cannot)?;
+    if !tail.windows(4).any(|w| w == EOCD) {
+        return not_zip("no end of central directory (a truncated file?)");
+    }
+    Ok(())
 }
 
 /// Opens a regular file for reading, never blocking on a FIFO.

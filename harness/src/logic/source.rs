@@ -111,6 +111,15 @@ impl LogicError {
             what: what.into(),
         }
     }
+
+    /// A file that would not open (`crate::files::open_stream`'s error,
+    /// which names the file itself: named once).
+    pub fn opening(file: &Path, e: impl fmt::Display) -> LogicError {
+        let text = e.to_string();
+        let prefix = format!("{}: ", file.display());
+        let what = text.strip_prefix(&prefix).unwrap_or(&text);
+        LogicError::new(file, "", what)
+    }
 }
 
 impl fmt::Display for LogicError {

@@ -88,8 +88,7 @@ impl VcdReader<BufReader<File>> {
     /// Opens a VCD file (a regular file: never blocks on a FIFO) and reads
     /// its header.
     pub fn open(path: &Path) -> Result<Self, LogicError> {
-        let file =
-            files::open_stream(path).map_err(|e| LogicError::new(path, "", e.to_string()))?;
+        let file = files::open_stream(path).map_err(|e| LogicError::opening(path, e))?;
         VcdReader::new(BufReader::with_capacity(1 << 16, file), path)
     }
 }

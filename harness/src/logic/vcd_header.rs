@@ -65,7 +65,9 @@ impl<R: BufRead> Tokens<R> {
             let take = (i - start).min(MAX_TOKEN.saturating_sub(self.tok.len()));
             self.tok.extend_from_slice(&buf[start..start + take]);
             self.long |= take < i - start;
-            let ended = i < buf.len();
+            // A token too long ends here: the caller says so, without
+            // reading the rest of it (a 10 GB file of one token).
+            let ended = i < buf.len() || self.long;
             self.r.consume(i);
             if ended {
                 return Ok(true);
