@@ -1,6 +1,7 @@
 //! `ppmc fault-matrix`: every catalogued board fault against the suite,
 //! the golden traces, a bounded differential fuzz and the fuzz oracle,
-//! over the pty.
+//! over the pty, and judged from logic-analyzer captures of the suite
+//! (made in process: a capture is the analyzer's, not the link's).
 
 use crate::backend::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
 use crate::bridge::sim::{LinkFaults, PtyBridge};
@@ -92,9 +93,13 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
         rows.push(row);
     }
     let table = fault_matrix::render(&rows);
+    let notes = fault_matrix::capture::notes(&rows);
     outln!("{}", table.trim_end_matches('\n'));
+    outln!("\n{}", notes.trim_end_matches('\n'));
     if let Some(path) = &args.output {
         let mut text = table.clone();
+        text.push('\n');
+        text.push_str(&notes);
         text.push_str("\nWhat each check saw first:\n\n");
         for r in &rows {
             for (check, c) in [
@@ -102,6 +107,7 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 ("golden", &r.golden),
                 ("fuzz", &r.fuzz),
                 ("oracle", &r.oracle),
+                ("capture", &r.capture),
             ] {
                 if let Some(c) = c {
                     text.push_str(&format!(
@@ -131,10 +137,10 @@ fn board_row(
     golden: &std::path::Path,
     budget: FuzzBudget,
 ) -> Result<Row, String> {
-    let emu = EmuTarget::new(Straps::default(), model).map_err(|e| e.to_string())?;
+    let emu = EmuTarget::new(Straps::default(), model.clone()).map_err(|e| e.to_string())?;
     if in_process {
         let mut t = emu;
-        return fault_matrix::check_board(name, &mut t, suite, golden, budget)
+        return fault_matrix::check_board(name, &mut t, &model, suite, golden, budget)
             .map_err(|e| e.to_string());
     }
     let sim = PtyBridge::start(emu, LinkFaults::default()).map_err(|e| e.to_string())?;
@@ -144,21 +150,28 @@ fn board_row(
         Ok(t) => Box::new(t),
         // The run's health check (hello, chip reset, status 0x00) refuses
         // the board before any scenario: `ppmc run` stops right there.
+        // The captures are judged all the same: a logic analyzer on the
+        // board needs no link.
         Err(e) if e.to_string().contains("health check") => {
+            let refused = t0.elapsed();
+            let captures = fault_matrix::capture::judge_captures(&model, suite)
+                .map_err(|e| format!("harness error in the capture column: {e}"))?;
             return Ok(Row {
                 board: name.to_string(),
                 suite: Some(fault_matrix::Catch {
                     first: format!("refused by the health check: {e}"),
-                    after: t0.elapsed(),
+                    after: refused,
                 }),
                 golden: None,
                 fuzz: None,
                 oracle: None,
-            })
+                capture: captures.catch,
+                capture_skipped: captures.skipped,
+            });
         }
         Err(e) => return Err(e.to_string()),
     };
-    let row = fault_matrix::check_board(name, t.as_mut(), suite, golden, budget)
+    let row = fault_matrix::check_board(name, t.as_mut(), &model, suite, golden, budget)
         .map_err(|e| e.to_string());
     drop(t);
     sim.stop();

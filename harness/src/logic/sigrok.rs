@@ -437,7 +437,7 @@ fn check_zip_ends(path: &Path, file: &mut File) -> Result<(), LogicError> {
     if len < 22 || file.read_exact(&mut head).is_err() {
         return not_zip("too short");
     }
-    if &head != b"PK\x03\x04" && &head != EOCD {
+    if &head != b"PK\x03\x04" && head != EOCD {
         return not_zip("it does not start with a ZIP entry");
     }
     let tail_len = len.min(22 + 0xFFFF);

@@ -1,8 +1,10 @@
 //! The fault matrix: each board fault of the catalogue (and the clean
-//! board) against the four checks a user has: the conformance suite, the
+//! board) against the five checks a user has: the conformance suite, the
 //! golden trace comparison, a bounded differential fuzz against the
-//! emulator, and the fuzz oracle's invariants judged on the board's own
-//! replies. Which caught it, with what, after how much wall time.
+//! emulator, the fuzz oracle's invariants judged on the board's own
+//! replies, and the board judged from logic-analyzer captures of the suite
+//! ([`capture`], `ppmc judge`). Which caught it, with what, after how much
+//! wall time.
 
 use crate::backend::{Target, TargetError};
 use crate::compare::{compare, Tolerances};
@@ -14,6 +16,10 @@ use crate::runner::run_suite;
 use crate::scenario::{DriverOptions, Scenario, Verdict};
 use std::path::Path;
 use std::time::{Duration as WallDuration, Instant as WallClock};
+
+pub mod capture;
+
+use capture::{CaptureError, Skipped};
 
 /// A check that caught a fault: what it saw first, and the wall time from
 /// the start of that check to the moment it was seen.
@@ -32,6 +38,10 @@ pub struct Row {
     pub golden: Option<Catch>,
     pub fuzz: Option<Catch>,
     pub oracle: Option<Catch>,
+    /// The first scenario whose capture the judge failed the board on.
+    pub capture: Option<Catch>,
+    /// The scenarios whose capture was not judged, as too long for one.
+    pub capture_skipped: Vec<Skipped>,
 }
 
 impl Row {
@@ -40,7 +50,19 @@ impl Row {
             || self.golden.is_some()
             || self.fuzz.is_some()
             || self.oracle.is_some()
+            || self.capture.is_some()
     }
+}
+
+/// Why a row could not be made: never a verdict on the board.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckError {
+    /// The target failed (the link).
+    #[error(transparent)]
+    Target(#[from] TargetError),
+    /// The harness failed to make or judge one of its own captures.
+    #[error("harness error in the capture column: {0}")]
+    Capture(#[from] CaptureError),
 }
 
 /// How much fuzzing a row gets: the differential fuzz runs `seeds`
@@ -64,15 +86,19 @@ impl Default for FuzzBudget {
     }
 }
 
-/// Runs the four checks on `target`. A target failure (the link) is an
+/// Runs the five checks on `target`, a board with `model`: the capture
+/// column runs the suite on its own emulator with that model, as a logic
+/// analyzer on the board would record it ([`capture::judge_captures`]).
+/// A target failure (the link) or a capture the harness cannot make is an
 /// error, not a catch.
 pub fn check_board(
     board: &str,
     target: &mut dyn Target,
+    model: &ModelConfig,
     suite: &[Scenario],
     golden_dir: &Path,
     budget: FuzzBudget,
-) -> Result<Row, TargetError> {
+) -> Result<Row, CheckError> {
     let t0 = WallClock::now();
     let mut first_fail: Option<Catch> = None;
     let mut first_divergence: Option<Catch> = None;
@@ -113,10 +139,7 @@ pub fn check_board(
         }
     });
     if let Some(message) = link_error {
-        return Err(TargetError::new(
-            crate::backend::TargetErrorKind::Link,
-            message,
-        ));
+        return Err(TargetError::new(crate::backend::TargetErrorKind::Link, message).into());
     }
     let t1 = WallClock::now();
     let settings = DiffSettings::default();
@@ -151,12 +174,15 @@ pub fn check_board(
             break;
         }
     }
+    let captures = capture::judge_captures(model, suite)?;
     Ok(Row {
         board: board.to_string(),
         suite: first_fail,
         golden: first_divergence,
         fuzz,
         oracle,
+        capture: captures.catch,
+        capture_skipped: captures.skipped,
     })
 }
 
@@ -167,7 +193,7 @@ pub fn render(rows: &[Row]) -> String {
         None => "-".into(),
     };
     let mut s = String::from(
-        "| board | conformance suite | golden traces | differential fuzz | fuzz oracle | verdict |\n|---|---:|---:|---:|---:|---|\n",
+        "| board | conformance suite | golden traces | differential fuzz | fuzz oracle | judged from captures | verdict |\n|---|---:|---:|---:|---:|---:|---|\n",
     );
     for r in rows {
         let verdict = match (r.board == "clean", r.caught()) {
@@ -177,19 +203,21 @@ pub fn render(rows: &[Row]) -> String {
             (false, false) => "MISSED",
         };
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {verdict} |\n",
+            "| {} | {} | {} | {} | {} | {} | {verdict} |\n",
             r.board,
             cell(&r.suite),
             cell(&r.golden),
             cell(&r.fuzz),
-            cell(&r.oracle)
+            cell(&r.oracle),
+            cell(&r.capture)
         ));
     }
     s
 }
 
 /// Whether the matrix is as it must be: every fault caught, the clean
-/// board by nothing.
+/// board by nothing (its captures included). A fault the capture column
+/// misses is no failure of the matrix: [`capture::why_missed`] says why.
 pub fn all_as_expected(rows: &[Row]) -> bool {
     rows.iter().all(|r| r.caught() != (r.board == "clean"))
 }

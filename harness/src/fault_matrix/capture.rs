@@ -1,0 +1,338 @@
+//! The fault matrix's capture column (issue 30, `docs/capture.md`): a
+//! board judged from logic-analyzer captures, as `ppmc judge` judges one.
+//! Each scenario of the suite runs on the emulator with the board's model
+//! and a 200 ns bus cycle (a host on a real bus), is exported with the bus
+//! and every pin drawn (`ppmc export --bus`), read back by the project's
+//! own VCD reader and judged against the clean reference model. The first
+//! scenario judged `Failed` (a board divergence) is the catch; host
+//! findings are the firmware's, not the board's, and are no catch.
+//!
+//! A capture is what a logic analyzer records, so a scenario that lasts
+//! longer than [`LONGEST`] of chip time is not judged: nobody records the
+//! 16,777,216-step move's 706 s (665 MB of VCD). The skipped ones are
+//! named in the column's notes.
+//!
+//! For each fault the column misses, [`why_missed`] says why, and says
+//! only what is true: an effect on a pin the capture has but the judge
+//! does not compare yet is [`Unseen::NotCompared`], not something a
+//! capture cannot show.
+
+use super::Catch;
+use crate::backend::{EmuTarget, Op, Reply, Target, TargetError, TargetInfo};
+use crate::emu::ModelConfig;
+use crate::judge::{judge, JudgeOptions, Verdict};
+use crate::logic::map::ChannelMap;
+use crate::logic::source::LogicSource;
+use crate::logic::vcd::VcdReader;
+use crate::protocol::{Record, Straps};
+use crate::scenario::{run_scenario, DriverOptions, Scenario};
+use crate::time::Duration;
+use crate::trace::{BusEvent, Event, EventKind, Trace};
+use crate::vcd_export::{export_with, Export, BUS_CYCLE};
+use std::path::Path;
+use std::time::Instant as WallClock;
+
+/// The longest scenario judged from its capture, in chip time: a logic
+/// analyzer's recording, not a 706 s one.
+pub const LONGEST: Duration = Duration::from_secs(10);
+
+/// A scenario whose capture was not judged: it lasts longer than
+/// [`LONGEST`] on this board.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Skipped {
+    pub scenario: &'static str,
+    /// The scenario's chip time on this board.
+    pub lasts: Duration,
+}
+
+impl std::fmt::Display for Skipped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} (lasts {:.0} s of chip time: a logic analyzer capture of that length is not made)",
+            self.scenario,
+            self.lasts.as_secs_f64()
+        )
+    }
+}
+
+/// What the capture column made of a board.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct CaptureColumn {
+    /// The first scenario judged `Failed`: `<scenario>: <divergence>`.
+    pub catch: Option<Catch>,
+    /// Scenarios judged (up to and including the catch).
+    pub judged: usize,
+    /// Scenarios not judged, as too long for a capture.
+    pub skipped: Vec<Skipped>,
+}
+
+/// The harness failed to make or read one of its own captures: an error
+/// of ours, never a verdict on the board.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("the capture of {scenario}: {why}")]
+pub struct CaptureError {
+    pub scenario: String,
+    pub why: String,
+}
+
+/// Judges `suite`'s captures of a board with `model` (the clean model, or
+/// a fault's), stopping at the first scenario judged `Failed`.
+pub fn judge_captures(
+    model: &ModelConfig,
+    suite: &[Scenario],
+) -> Result<CaptureColumn, CaptureError> {
+    let t0 = WallClock::now();
+    let err = |scenario: &str, why: String| CaptureError {
+        scenario: scenario.to_string(),
+        why,
+    };
+    let emu = EmuTarget::new(Straps::default(), model.clone())
+        .map_err(|e| err("(the emulator)", e.to_string()))?
+        .with_bus_cycle(Duration::from_nanos(BUS_CYCLE));
+    let mut target = Analyzer {
+        emu,
+        bus: Vec::new(),
+    };
+    let opts = JudgeOptions::default();
+    let mut column = CaptureColumn::default();
+    for s in suite {
+        let r = run_scenario(&mut target, s, DriverOptions::default());
+        if r.elapsed > LONGEST {
+            column.skipped.push(Skipped {
+                scenario: s.name,
+                lasts: r.elapsed,
+            });
+            continue;
+        }
+        let trace = target
+            .trace(s)
+            .map_err(|e| err(s.name, format!("the emulator's capture: {e}")))?;
+        let mut vcd = Vec::new();
+        export_with(
+            &trace,
+            Export {
+                window: None,
+                bus: true,
+            },
+            &mut vcd,
+        )
+        .map_err(|e| err(s.name, format!("export: {e}")))?;
+        let mut source = VcdReader::new(&vcd[..], Path::new(s.name))
+            .map_err(|e| err(s.name, format!("read back: {e}")))?;
+        let map = ChannelMap::from_names(source.info())
+            .map_err(|e| err(s.name, format!("channel map: {e}")))?;
+        let j = judge(&mut source, &map, &opts).map_err(|e| err(s.name, e.to_string()))?;
+        column.judged += 1;
+        match j.verdict {
+            Verdict::Passed => {}
+            Verdict::Failed(d) => {
+                column.catch = Some(Catch {
+                    first: format!("{}: {d}", s.name),
+                    after: t0.elapsed(),
+                });
+                return Ok(column);
+            }
+            // Our own export, blamed as a capture: the harness's fault.
+            Verdict::Capture(why) => {
+                return Err(err(s.name, format!("judged as a bad capture: {why}")))
+            }
+        }
+    }
+    Ok(column)
+}
+
+/// The emulator with every register access it served logged, as a logic
+/// analyzer on the bus records them. The scenario's own trace will not
+/// do: it logs the bus only up to a scenario's first failing step, though
+/// the steps queued after it ran on the chip too (`Batch::flush`), so the
+/// capture of a failed scenario would show pins going on beside a bus
+/// gone quiet, and the judge would blame the board for the writes missing.
+struct Analyzer {
+    emu: EmuTarget,
+    /// The accesses since the last reset, at their replies' times.
+    bus: Vec<Event>,
+}
+
+impl Analyzer {
+    /// The scenario just run, as a logic analyzer saw it: every access
+    /// since the reset and everything the chip put out.
+    fn trace(&mut self, s: &Scenario) -> Result<Trace, TargetError> {
+        let info = self.emu.info();
+        let record = self.emu.capture()?;
+        Ok(
+            Trace::new(s.name, s.section, &info.name, info.straps, info.extra).assemble(
+                std::mem::take(&mut self.bus),
+                &record,
+                Vec::new(),
+            ),
+        )
+    }
+}
+
+impl Target for Analyzer {
+    fn info(&self) -> TargetInfo {
+        self.emu.info()
+    }
+
+    fn capture(&mut self) -> Result<Record, TargetError> {
+        self.emu.capture()
+    }
+
+    fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
+        let replies = self.emu.execute(ops)?;
+        for (op, reply) in ops.iter().zip(&replies) {
+            // The capture, and the chip's time, start again at a reset.
+            if matches!(op, Op::Reset) {
+                self.bus.clear();
+            }
+            if let Some(e) = BusEvent::of(op, reply) {
+                self.bus.push(Event {
+                    at: reply.at(),
+                    kind: EventKind::Bus(e),
+                });
+            }
+        }
+        Ok(replies)
+    }
+}
+
+/// Why the capture column misses a fault.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unseen {
+    /// The effect is on pins the capture has, which the judge does not
+    /// compare yet (it compares status and data reads, POUT's pulses and
+    /// DIR at each pulse).
+    NotCompared(&'static str),
+    /// No capture of the chip's bus and pins shows it.
+    CannotShow(&'static str),
+}
+
+impl std::fmt::Display for Unseen {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Unseen::NotCompared(why) => write!(f, "not compared by the judge yet: {why}"),
+            Unseen::CannotShow(why) => write!(f, "a capture cannot show it: {why}"),
+        }
+    }
+}
+
+/// Why the capture column misses `fault`, for the faults it misses now;
+/// `None` for the faults it catches (and names it does not know). As the
+/// judge compares more pins, entries leave this table.
+pub fn why_missed(fault: &str) -> Option<Unseen> {
+    MISSED
+        .iter()
+        .find(|(name, _)| *name == fault)
+        .map(|&(_, why)| why)
+}
+
+/// The faults the column misses, and why. Every one of the catalogue's
+/// 27 shows on a pin or the bus that the capture has: none is missed
+/// because a capture cannot show it. What the judge compares now is the
+/// status and data reads, POUT's pulses and DIR at each pulse; the pins
+/// below are in every capture the column judges, and an entry leaves this
+/// table when the judge compares its pin (the harness test's list of the
+/// faults caught grows by it).
+const MISSED: &[(&str, Unseen)] = &[
+    (
+        "hold-on-early",
+        Unseen::NotCompared(
+            "HOLD turns on 6% early after the final POUT (Table 3-3); it shows only on the \
+             HOLD pin, in the capture",
+        ),
+    ),
+    (
+        "excitation-off-slow",
+        Unseen::NotCompared(
+            "software reset de-energizes the phases 6% late (Table 3-3); it shows only on \
+             S1..S5, in the capture",
+        ),
+    ),
+    (
+        "single-step-slow",
+        Unseen::NotCompared(
+            "a single step ends 5% late (Table 3-3): BUSY falls, and INT* asserts where \
+             unmasked, 5.6 us late, on pins the capture has; a status poll in those \
+             microseconds would show it as a status read too, but the suite waits for \
+             BUSY = 0 with a status wait, which the export draws as the one read that \
+             ended it",
+        ),
+    ),
+    (
+        "int-ignores-mask",
+        Unseen::NotCompared(
+            "INT* asserts at the end of a move whose command masks it (3-3-1); it shows only \
+             on the INT* pin, in the capture",
+        ),
+    ),
+    (
+        "reset-quirk-missing",
+        Unseen::NotCompared(
+            "a software reset during BUSY does not turn AUX on (3-5-4): the move goes on \
+             either way, so it shows only on the AUX pin, in the capture",
+        ),
+    ),
+    (
+        "hold-stuck-off",
+        Unseen::NotCompared(
+            "the HOLD output never turns on (3-2-1); it shows only on the HOLD pin, in the \
+             capture (the chip's output status register reads what the chip drives)",
+        ),
+    ),
+    (
+        "auxo-reversed",
+        Unseen::NotCompared(
+            "AUXO0..3 come out in reverse bit order (3-5-5); it shows only on the AUXO0..3 \
+             pins, in the capture (the chip's registers read what the chip drives)",
+        ),
+    ),
+];
+
+/// The capture column's notes under the matrix: the scenarios not judged
+/// and why, and why each fault it misses is missed.
+pub fn notes(rows: &[super::Row]) -> String {
+    let mut s = format!(
+        "Captures: each scenario run on the emulator with the board's model and a {BUS_CYCLE} ns \
+         bus cycle, exported with the bus and every pin (`ppmc export --bus`) and judged as \
+         `ppmc judge` does, against the clean model; the cell is the time to the first \
+         scenario judged FAIL.\n"
+    );
+    let mut skipped: Vec<(&str, Duration, Vec<&str>)> = Vec::new();
+    for r in rows {
+        for k in &r.capture_skipped {
+            match skipped.iter_mut().find(|(n, _, _)| *n == k.scenario) {
+                Some((_, lasts, boards)) => {
+                    *lasts = (*lasts).max(k.lasts);
+                    boards.push(&r.board);
+                }
+                None => skipped.push((k.scenario, k.lasts, vec![&r.board])),
+            }
+        }
+    }
+    for (scenario, lasts, boards) in skipped {
+        let on = if boards.len() == rows.len() {
+            "every board".to_string()
+        } else {
+            boards.join(", ")
+        };
+        s.push_str(&format!(
+            "- not judged: `{scenario}` lasts up to {:.0} s of chip time (on {on}): a logic \
+             analyzer capture of {:.0} s is not made (longest judged: {} s)\n",
+            lasts.as_secs_f64(),
+            lasts.as_secs_f64(),
+            LONGEST.as_secs_f64()
+        ));
+    }
+    for r in rows
+        .iter()
+        .filter(|r| r.board != "clean" && r.capture.is_none())
+    {
+        let why = why_missed(&r.board).map_or_else(
+            || "MISSED, with no reason on file (`fault_matrix::capture::MISSED`)".to_string(),
+            |u| u.to_string(),
+        );
+        s.push_str(&format!("- `{}` missed: {why}\n", r.board));
+    }
+    s
+}
