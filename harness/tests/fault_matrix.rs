@@ -70,6 +70,9 @@ const CAUGHT_BY_CAPTURES: &[&str] = &[
     "init-slow",
     "int-late",
     "decel-stop-slow",
+    "hold-on-early",
+    "excitation-off-slow",
+    "single-step-slow",
     "drop-last-pulse",
     "remaining-off-by-one",
     "swap-error-2-3",
@@ -81,7 +84,11 @@ const CAUGHT_BY_CAPTURES: &[&str] = &[
     "phase-step-skipped",
     "obf-never-cleared",
     "finish-flag-sticky",
+    "int-ignores-mask",
     "dir-inverted",
+    "reset-quirk-missing",
+    "hold-stuck-off",
+    "auxo-reversed",
     "decel-stop-immediate",
     "params-not-counted",
 ];
@@ -119,7 +126,12 @@ fn the_capture_column_is_as_it_stands(rows: &[ppmc::fault_matrix::Row], table: &
                         "status read",
                         "data read",
                         "POUT pulse",
-                        "DIR at POUT pulse"
+                        "DIR at POUT pulse",
+                        "INT ",
+                        "BUSY ",
+                        "HOLD ",
+                        "AUX ",
+                        "AUXO",
                     ]
                     .iter()
                     .any(|w| divergence.starts_with(w)),

@@ -234,60 +234,7 @@ pub fn why_missed(fault: &str) -> Option<Unseen> {
 /// below are in every capture the column judges, and an entry leaves this
 /// table when the judge compares its pin (the harness test's list of the
 /// faults caught grows by it).
-const MISSED: &[(&str, Unseen)] = &[
-    (
-        "hold-on-early",
-        Unseen::NotCompared(
-            "HOLD turns on 6% early after the final POUT (Table 3-3); it shows only on the \
-             HOLD pin, in the capture",
-        ),
-    ),
-    (
-        "excitation-off-slow",
-        Unseen::NotCompared(
-            "software reset de-energizes the phases 6% late (Table 3-3); it shows only on \
-             S1..S5, in the capture",
-        ),
-    ),
-    (
-        "single-step-slow",
-        Unseen::NotCompared(
-            "a single step ends 5% late (Table 3-3): BUSY falls, and INT* asserts where \
-             unmasked, 5.6 us late, on pins the capture has; a status poll in those \
-             microseconds would show it as a status read too, but the suite waits for \
-             BUSY = 0 with a status wait, which the export draws as the one read that \
-             ended it",
-        ),
-    ),
-    (
-        "int-ignores-mask",
-        Unseen::NotCompared(
-            "INT* asserts at the end of a move whose command masks it (3-3-1); it shows only \
-             on the INT* pin, in the capture",
-        ),
-    ),
-    (
-        "reset-quirk-missing",
-        Unseen::NotCompared(
-            "a software reset during BUSY does not turn AUX on (3-5-4): the move goes on \
-             either way, so it shows only on the AUX pin, in the capture",
-        ),
-    ),
-    (
-        "hold-stuck-off",
-        Unseen::NotCompared(
-            "the HOLD output never turns on (3-2-1); it shows only on the HOLD pin, in the \
-             capture (the chip's output status register reads what the chip drives)",
-        ),
-    ),
-    (
-        "auxo-reversed",
-        Unseen::NotCompared(
-            "AUXO0..3 come out in reverse bit order (3-5-5); it shows only on the AUXO0..3 \
-             pins, in the capture (the chip's registers read what the chip drives)",
-        ),
-    ),
-];
+const MISSED: &[(&str, Unseen)] = &[];
 
 /// The capture column's notes under the matrix: the scenarios not judged
 /// and why, and why each fault it misses is missed.

@@ -190,14 +190,15 @@ impl Outputs {
                 match (w.board.front().copied(), model) {
                     (None, None) => break,
                     (Some((b, level)), None) => {
-                        if b + allowed(b, &self.accesses) >= horizon_ps {
+                        let allowed = allowed(b, &self.accesses);
+                        if b + allowed >= horizon_ps {
                             break;
                         }
                         return Err(diverge(
                             w,
                             b,
                             format!("at {}", at(b)),
-                            "no change".into(),
+                            format!("no change within {}", Duration::from_nanos(allowed / 1000)),
                             level,
                         ));
                     }
