@@ -48,8 +48,8 @@ const ON_PURPOSE: [&str; 6] = [
 const DOWNSAMPLE: [u32; 3] = [10, 20, 42];
 
 /// Captures larger than this are judged from the VCD alone: a sigrok
-/// session of the 16,777,216-step move (706 s) would hold 17 G samples at
-/// 24 MHz, more than a lab would record.
+/// session of the 16,777,216-step move (over 600 s of chip time) would
+/// hold some 15 G samples at 24 MHz, more than a lab would record.
 const SR_LIMIT_BYTES: u64 = 50 << 20;
 
 /// Judges `capture` and says what went wrong, if anything: the board must

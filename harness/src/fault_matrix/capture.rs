@@ -227,13 +227,11 @@ pub fn why_missed(fault: &str) -> Option<Unseen> {
         .map(|&(_, why)| why)
 }
 
-/// The faults the column misses, and why. Every one of the catalogue's
-/// 27 shows on a pin or the bus that the capture has: none is missed
-/// because a capture cannot show it. What the judge compares now is the
-/// status and data reads, POUT's pulses and DIR at each pulse; the pins
-/// below are in every capture the column judges, and an entry leaves this
-/// table when the judge compares its pin (the harness test's list of the
-/// faults caught grows by it).
+/// The faults the column misses, and why: none today. Every one of the
+/// catalogue's 27 shows on the bus or a pin the judge compares (the status
+/// and data reads, POUT's pulses, DIR at each, INT*, BUSY, HOLD, AUX* and
+/// AUXO). A fault added to the catalogue that only the phases S1..S5 show
+/// (not compared yet) would be entered here, with why.
 const MISSED: &[(&str, Unseen)] = &[];
 
 /// The capture column's notes under the matrix: the scenarios not judged
