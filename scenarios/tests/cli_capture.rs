@@ -237,10 +237,10 @@ fn the_judge_figures_script_measures_both_lengths() {
     let said = text(&out.stdout);
     assert!(out.status.success(), "{said}{}", text(&out.stderr));
     assert!(
-        said.starts_with("| samples (100 MHz, 4 bytes each) |"),
+        said.starts_with("| samples (100 MHz, 5 bytes each) |"),
         "{said}"
     );
-    for row in ["| 250000 | 0.001 GB |", "| 2500000 | 0.010 GB |"] {
+    for row in ["| 200000 | 0.001 GB |", "| 2000000 | 0.010 GB |"] {
         let line = said
             .lines()
             .find(|l| l.starts_with(row))
@@ -248,6 +248,11 @@ fn the_judge_figures_script_measures_both_lengths() {
         assert!(
             line.ends_with(" MiB |") && line.contains(" M/s |"),
             "{line}"
+        );
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        assert!(
+            cells.get(4).is_some_and(|c| c.parse::<u64>().is_ok()),
+            "no count of pulses compared: {line}"
         );
     }
 }
