@@ -149,7 +149,10 @@ fn every_scenarios_capture_passes_at_three_sample_rates() {
             || n.starts_with("s3_5_4_software_reset")
     };
     assert!(host.iter().all(|n| on_purpose(n)), "{host:?}");
-    assert!(host.contains(&"e1_operation_command_while_busy"), "{host:?}");
+    assert!(
+        host.contains(&"e1_operation_command_while_busy"),
+        "{host:?}"
+    );
     eprintln!(
         "{} scenarios judged at {} sample rates; host findings in {}",
         results.len(),
