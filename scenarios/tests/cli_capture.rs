@@ -4,10 +4,13 @@
 //! (fails, the board's); hand-written captures whose host writes while
 //! IBF is 1, or moves before initializing (the host firmware's findings,
 //! exit 3); one without a bus channel (the capture's, exit 4). The
-//! decoded accesses replay with `ppmc console`.
+//! decoded accesses replay with `ppmc console`. The same verdicts in the
+//! JUnit report and the JSON run record (`--junit`, `--json`), each its
+//! own kind.
 
 mod common;
-use common::{ppmc, scratch, text};
+use common::{check_record, ppmc, run_record_schema, scratch, text};
+use serde_json::Value;
 use std::path::Path;
 
 fn export(dir: &Path, name: &str, scenario: &str, faults: &[&str]) -> String {
@@ -324,4 +327,224 @@ fn fifos_and_huge_empty_files_are_refused_by_name() {
         assert!(err.contains(says), "{name}: {err}");
         assert!(!err.contains("panicked"), "{name}: {err}");
     }
+}
+
+/// `ppmc judge CAPTURE --junit J --json R`: the JUnit report and the JSON
+/// run record (checked against `docs/run-record.schema.json`), and the
+/// judgement's exit status.
+fn judged(dir: &Path, capture: &str) -> (Option<i32>, quick_junit::Report, String, Value) {
+    let junit = dir.join("judge.xml");
+    let json = dir.join("judge.json");
+    let _ = std::fs::remove_file(&junit);
+    let _ = std::fs::remove_file(&json);
+    let out = ppmc(&[
+        "judge",
+        capture,
+        "--junit",
+        junit.to_str().expect("utf-8"),
+        "--json",
+        json.to_str().expect("utf-8"),
+    ]);
+    let xml = std::fs::read_to_string(&junit).expect("the JUnit report is written");
+    let report = quick_junit::Report::deserialize_from_str(&xml).expect("the JUnit report parses");
+    let record: Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("written"))
+        .expect("the record is JSON");
+    check_record(&run_record_schema(), &record);
+    assert_eq!(record["run"]["source"]["kind"], "capture", "{record:#}");
+    assert_eq!(record["run"]["source"]["path"], capture);
+    // What CI asserts of a run's reports holds of a judge's too: the
+    // summary counts one verdict per test case.
+    let cases: usize = report.test_suites.iter().map(|s| s.test_cases.len()).sum();
+    let s = &record["summary"];
+    let counted: u64 = ["passed", "marginal", "failed", "error", "not_run"]
+        .iter()
+        .map(|k| s[k].as_u64().expect("a count"))
+        .sum();
+    assert_eq!(counted as usize, cases, "{record:#}");
+    (out.status.code(), report, xml, record)
+}
+
+/// A test case's failure or error: its element, type, message and text;
+/// `None` when it passed.
+fn outcome(c: &quick_junit::TestCase) -> Option<(&'static str, String, String, String)> {
+    match &c.status {
+        quick_junit::TestCaseStatus::Success { .. } => None,
+        quick_junit::TestCaseStatus::NonSuccess {
+            kind,
+            message,
+            ty,
+            description,
+            ..
+        } => Some((
+            match kind {
+                quick_junit::NonSuccessKind::Failure => "failure",
+                quick_junit::NonSuccessKind::Error => "error",
+            },
+            ty.as_ref().map(|t| t.to_string()).unwrap_or_default(),
+            message.as_ref().map(|t| t.to_string()).unwrap_or_default(),
+            description
+                .as_ref()
+                .map(|t| t.to_string())
+                .unwrap_or_default(),
+        )),
+        quick_junit::TestCaseStatus::Skipped { .. } => {
+            Some(("skipped", "".into(), "".into(), "".into()))
+        }
+    }
+}
+
+/// Sections 3-3 and 3-4, in the reports (issue 30): a clean board's
+/// capture is two passing test cases, the board and the host firmware,
+/// blamed on no one; the capture is the record's source. A board that
+/// loses the last pulse of a move is a failure of type `device`, its
+/// message the divergence, its text what was not judged and what was
+/// compared, the record blaming the board; the host firmware still passes.
+#[test]
+fn judge_reports_blame_the_board_for_its_divergence() {
+    let dir = scratch("judge-reports");
+    let clean = export(
+        dir.path(),
+        "clean.vcd",
+        "s3_3_5_constant_speed_100_steps",
+        &[],
+    );
+    let (code, report, xml, record) = judged(dir.path(), &clean);
+    assert_eq!(code, Some(0), "{xml}");
+    let suite = &report.test_suites[0];
+    let names: Vec<&str> = suite.test_cases.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["judge.clean.vcd", "judge.clean.vcd.host-firmware"],
+        "{xml}"
+    );
+    assert!(
+        suite.test_cases.iter().all(|c| outcome(c).is_none()),
+        "{xml}"
+    );
+    assert_eq!(record["summary"]["passed"], 2);
+    assert_eq!(record["scenarios"][0]["blame"], Value::Null);
+    assert_eq!(
+        record["scenarios"][1]["host_findings"],
+        serde_json::json!([])
+    );
+    assert_eq!(record["run"]["source"]["pulses"], 100);
+    assert_eq!(record["run"]["source"]["format"], "VCD (ppmc)");
+
+    let bad = export(
+        dir.path(),
+        "bad.vcd",
+        "s3_3_5_constant_speed_100_steps",
+        &["drop-last-pulse"],
+    );
+    let (code, report, xml, record) = judged(dir.path(), &bad);
+    assert_eq!(code, Some(1), "{xml}");
+    let cases = &report.test_suites[0].test_cases;
+    let (tag, ty, message, text) = outcome(&cases[0]).expect("the board fails");
+    assert_eq!((tag, ty.as_str()), ("failure", "device"), "{xml}");
+    assert!(message.starts_with("POUT pulse 100 at "), "{message}");
+    assert!(text.contains("not judged: "), "{text}");
+    assert!(text.contains("99 POUT pulses compared"), "{text}");
+    assert_eq!(outcome(&cases[1]), None, "the host is not blamed: {xml}");
+    assert_eq!(report.failures, 1);
+    assert_eq!(report.errors, 0);
+    let board = &record["scenarios"][0];
+    assert_eq!(board["verdict"], "failed");
+    assert_eq!(board["blame"], "board");
+    assert_eq!(board["failure"]["expectation"], "POUT pulse 100");
+    assert_eq!(record["scenarios"][1]["verdict"], "passed");
+    assert_eq!(record["scenarios"][1]["blame"], Value::Null);
+}
+
+/// Section 3-1-1, in the reports: a host that writes the data byte while
+/// IBF is still 1 is a failure of type `host` on the host firmware's
+/// test case, each finding with its section, while the board's passes;
+/// the record blames the host and lists its findings.
+#[test]
+fn judge_reports_blame_the_host_firmware_for_its_findings() {
+    let dir = scratch("judge-reports-host");
+    let hasty = dir.path().join("hasty.vcd");
+    std::fs::write(
+        &hasty,
+        hand_vcd(&[(1000, true, true, 0x02), (1300, true, false, 0x64)], &BUS),
+    )
+    .expect("vcd");
+    let (code, report, xml, record) = judged(dir.path(), hasty.to_str().expect("utf-8"));
+    assert_eq!(code, Some(3), "{xml}");
+    let cases = &report.test_suites[0].test_cases;
+    assert_eq!(cases[0].name.as_str(), "judge.hasty.vcd");
+    assert_eq!(outcome(&cases[0]), None, "the board passes: {xml}");
+    assert_eq!(cases[1].name.as_str(), "judge.hasty.vcd.host-firmware");
+    let (tag, ty, message, text) = outcome(&cases[1]).expect("the host fails");
+    assert_eq!((tag, ty.as_str()), ("failure", "host"), "{xml}");
+    assert!(
+        message.contains("broke chapter 3's rules 1 times"),
+        "{message}"
+    );
+    assert!(text.contains("host firmware (section 3-1-1)"), "{text}");
+    assert!(text.contains("written while IBF was 1"), "{text}");
+    assert_eq!(cases[1].classname.as_deref(), Some("section 3-1-1"));
+    assert_eq!(record["scenarios"][0]["verdict"], "passed");
+    let host = &record["scenarios"][1];
+    assert_eq!(host["verdict"], "failed");
+    assert_eq!(host["blame"], "host");
+    assert_eq!(host["host_findings"][0]["section"], "3-1-1");
+    assert_eq!(host["host_findings"][0]["at_ns"], 1300);
+}
+
+/// A capture without WR* (no bus to decode: Table 3-1's strobes) is an
+/// error of type `capture`, neither the board's nor the host's: one test
+/// case, no failure; the record's error kind and blame are the capture.
+#[test]
+fn judge_reports_blame_the_capture_for_a_missing_channel() {
+    let dir = scratch("judge-reports-capture");
+    let no_wr: Vec<&str> = BUS.iter().copied().filter(|w| *w != "wr").collect();
+    let partial = dir.path().join("no-wr.vcd");
+    std::fs::write(&partial, hand_vcd(&[(1000, false, true, 0x00)], &no_wr)).expect("vcd");
+    let (code, report, xml, record) = judged(dir.path(), partial.to_str().expect("utf-8"));
+    assert_eq!(code, Some(4), "{xml}");
+    assert_eq!((report.failures, report.errors), (0, 1), "{xml}");
+    let cases = &report.test_suites[0].test_cases;
+    assert_eq!(cases.len(), 1, "nothing else was judged: {xml}");
+    let (tag, ty, message, _) = outcome(&cases[0]).expect("an error");
+    assert_eq!((tag, ty.as_str()), ("error", "capture"), "{xml}");
+    assert!(message.contains("no channel for WR"), "{message}");
+    let s = &record["scenarios"][0];
+    assert_eq!(s["verdict"], "error");
+    assert_eq!(s["blame"], "capture");
+    assert_eq!(s["error"]["kind"], "capture");
+    assert_eq!(record["summary"]["error"], 1);
+}
+
+/// The reports keep `ppmc run`'s write rules: the two reports in one file
+/// is bad usage (exit 2) and nothing is judged; `--json -` puts the record
+/// on standard output and the verdict lines on standard error.
+#[test]
+fn judge_reports_keep_the_write_rules() {
+    let dir = scratch("judge-reports-rules");
+    let cap = export(
+        dir.path(),
+        "cap.vcd",
+        "s3_4_1_finish_read_releases_int",
+        &[],
+    );
+    let same = dir.path().join("r.out");
+    let s = same.to_str().expect("utf-8");
+    let out = ppmc(&["judge", &cap, "--junit", s, "--json", s]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("are the same file"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(text(&out.stdout).is_empty(), "{}", text(&out.stdout));
+    assert!(!same.exists());
+    let out = ppmc(&["judge", &cap, "--json", "-"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let record: Value = serde_json::from_slice(&out.stdout).expect("the record alone");
+    check_record(&run_record_schema(), &record);
+    assert!(
+        text(&out.stderr).contains("PASS the board"),
+        "{}",
+        text(&out.stderr)
+    );
 }

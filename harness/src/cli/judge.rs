@@ -3,11 +3,14 @@
 //! reference model (`docs/capture.md`).
 
 use super::args::{parse_duration, ChipArgs, ToleranceArgs};
+use crate::backend::TargetInfo;
 use crate::cli::{usage, CliError};
-use crate::judge::{judge, JudgeOptions, Verdict};
+use crate::judge::{judge, HostFinding, JudgeOptions, Judgement, Verdict};
 use crate::logic::decode::BusDecoder;
 use crate::logic::map::ChannelMap;
 use crate::logic::source::{LogicInfo, LogicSource};
+use crate::report::{self, Blame, BoardInfo, CaptureSource, Judged, Listing, RunInfo};
+use crate::scenario::{Failure, HarnessError, ScenarioResult, Verdict as ScenarioVerdict};
 use crate::time::{Duration, Instant};
 use clap::Args;
 use std::path::PathBuf;
@@ -130,36 +133,215 @@ pub struct JudgeArgs {
     chip: ChipArgs,
     #[command(flatten)]
     tolerance: ToleranceArgs,
+    /// Write a JUnit XML report (a test case for the board, a divergence a
+    /// failure of type device; one for the host firmware, its findings a
+    /// failure of type host; a capture that cannot be judged an error of
+    /// type capture); `-` for standard output (the verdict lines then go
+    /// to standard error).
+    #[arg(long, value_name = "FILE")]
+    junit: Option<PathBuf>,
+    /// Write a JSON run record (docs/run-record.schema.json, as `ppmc run`
+    /// writes it; the capture stands as the board, `run.source` says what
+    /// it is, each result names whom it blames); `-` for standard output.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
 }
 
 pub fn run(args: JudgeArgs) -> Result<(), CliError> {
+    let started = std::time::Instant::now();
     let (mut source, map) = args.capture.open()?;
     let info = source.info().clone();
-    describe(&info, &args.capture.capture);
     let opts = JudgeOptions {
         straps: args.chip.straps().map_err(usage)?,
         model: args.chip.model(),
         tolerances: args.tolerance.tolerances().map_err(usage)?,
         glitch_ps: args.capture.glitch.as_nanos() * 1000,
     };
+    super::run::prepare_reports(args.junit.as_deref(), args.json.as_deref())?;
+    describe(&info, &args.capture.capture);
     let j = judge(source.as_mut(), &map, &opts)
         .map_err(|e| CliError::BadInput(format!("ppmc: {e}")))?;
+    let mut problems = Vec::new();
+    if args.junit.is_some() || args.json.is_some() {
+        let wall = started.elapsed();
+        let (run, results, judged) = records(&args.capture.capture, &info, &opts, &j, wall);
+        let on = vec![Some(0); results.len()];
+        let listing = Listing::all(&results, &[], &on).judged(&judged);
+        if let Some(p) = &args.junit {
+            if let Err(e) = super::run::write_report(p, report::junit_listing(&run, &listing)) {
+                problems.push(e);
+            }
+        }
+        if let Some(p) = &args.json {
+            if let Err(e) = super::run::write_report(p, report::json_listing(&run, &listing)) {
+                problems.push(e);
+            }
+        }
+    }
+    let verdict = say(&j);
+    match problems.into_iter().next() {
+        Some(p) => Err(CliError::Failed(p)),
+        None => verdict,
+    }
+}
+
+/// The judgement as the reports list it (issue 30): the capture stands as
+/// the board; a result for the board (`judge.<file>`), failed when it
+/// diverged, an error when the capture cannot be judged; and one for the
+/// host firmware (`judge.<file>.host-firmware`), failed when it broke a
+/// rule of chapter 3, there whenever the capture was judged or a finding
+/// made. Each result says whom its verdict blames.
+fn records(
+    path: &std::path::Path,
+    info: &LogicInfo,
+    opts: &JudgeOptions,
+    j: &Judgement,
+    wall: std::time::Duration,
+) -> (RunInfo, Vec<ScenarioResult>, Vec<Judged>) {
+    let shown = path.display().to_string();
+    let file = path
+        .file_name()
+        .map_or_else(|| shown.clone(), |f| f.to_string_lossy().into_owned());
+    let target = TargetInfo {
+        name: format!("capture:{shown}"),
+        straps: opts.straps,
+        extra: Vec::new(),
+    };
+    let mut run = RunInfo::new(vec![BoardInfo::new(shown.clone(), &target, None)], "one");
+    let tol = &opts.tolerances;
+    run.options = report::RunOptions {
+        repeat: 1,
+        latency_tol_pct: tol.latency_bp as f64 / 100.0,
+        interval_tol_pct: tol.interval_bp as f64 / 100.0,
+        time_floor_ns: tol.floor.as_nanos(),
+        ..Default::default()
+    };
+    run.wall_s = wall.as_secs_f64();
+    run.source = Some(CaptureSource {
+        kind: "capture",
+        path: shown,
+        format: info.format.clone(),
+        channels: info.channels.clone(),
+        sample_rate_hz: info.sample_rate_hz,
+        resolution_ps: info.resolution_ps,
+        accesses: j.accesses,
+        pulses: j.pulses,
+        changes: j.changes,
+        not_judged: j.not_judged.clone(),
+    });
+    // A result's name and section outlive it in the reports; this process
+    // judges one capture, so the two names are kept for its life.
+    let keep = |s: String| -> &'static str { Box::leak(s.into_boxed_str()) };
+    let result = |name, section, verdict, wall| ScenarioResult {
+        name,
+        section,
+        tags: &["capture"],
+        verdict,
+        measurements: Vec::new(),
+        trace: None,
+        elapsed: Duration::ZERO,
+        wall,
+    };
+    let mut notes: Vec<String> = j
+        .not_judged
+        .iter()
+        .map(|n| format!("not judged: {n}"))
+        .collect();
+    notes.push(counts(j));
+    let (verdict, blame, message) = match &j.verdict {
+        Verdict::Passed => (ScenarioVerdict::Passed, None, None),
+        Verdict::Failed(d) => (
+            ScenarioVerdict::Failed(Failure {
+                expectation: d.what.clone(),
+                expected: d.model.clone(),
+                got: d.board.clone(),
+                at: Instant::from_nanos(d.at_ps / 1000),
+            }),
+            Some(Blame::Board),
+            Some(d.to_string()),
+        ),
+        Verdict::Capture(why) => (
+            ScenarioVerdict::Error(HarnessError::Capture(why.clone())),
+            Some(Blame::Capture),
+            Some(why.clone()),
+        ),
+    };
+    let mut results = vec![result(keep(format!("judge.{file}")), "3", verdict, wall)];
+    let mut judged = vec![Judged {
+        blame,
+        message,
+        host: None,
+        notes,
+    }];
+    let captured = !matches!(j.verdict, Verdict::Capture(_));
+    if captured || !j.host.is_empty() {
+        let mut sections: Vec<&str> = j.host.iter().map(|h| h.section).collect();
+        sections.sort_unstable();
+        sections.dedup();
+        let section = match sections.is_empty() {
+            true => "3",
+            false => keep(sections.join(", ")),
+        };
+        let name = keep(format!("judge.{file}.host-firmware"));
+        let host = j.host.clone();
+        let (verdict, blame, message) = match host.first() {
+            None => (ScenarioVerdict::Passed, None, None),
+            Some(first) => (
+                ScenarioVerdict::Failed(Failure {
+                    expectation: "the host firmware keeps the rules of chapter 3".into(),
+                    expected: "no access against them".into(),
+                    got: format!(
+                        "{} findings, the first (section {}): {}",
+                        host.len(),
+                        first.section,
+                        first.what
+                    ),
+                    at: Instant::from_nanos(first.at_ps / 1000),
+                }),
+                Some(Blame::Host),
+                Some(format!(
+                    "the host firmware broke chapter 3's rules {} times",
+                    host.len()
+                )),
+            ),
+        };
+        results.push(result(name, section, verdict, std::time::Duration::ZERO));
+        judged.push(Judged {
+            blame,
+            message,
+            notes: host.iter().map(finding).collect(),
+            host: Some(host),
+        });
+    }
+    (run, results, judged)
+}
+
+/// What was compared, in one line.
+fn counts(j: &Judgement) -> String {
+    format!(
+        "{} register accesses, {} POUT pulses compared, {} changes of the other outputs compared",
+        j.accesses, j.pulses, j.changes
+    )
+}
+
+/// A host finding, in one line.
+fn finding(h: &HostFinding) -> String {
+    format!(
+        "host firmware (section {}): at {}: {}",
+        h.section,
+        Instant::from_nanos(h.at_ps / 1000),
+        h.what
+    )
+}
+
+/// Says the judgement; its kind is the exit status.
+fn say(j: &Judgement) -> Result<(), CliError> {
     for n in &j.not_judged {
         outln!("not judged: {n}");
     }
-    outln!(
-        "{} register accesses, {} POUT pulses compared, {} changes of the other outputs compared",
-        j.accesses,
-        j.pulses,
-        j.changes
-    );
+    outln!("{}", counts(j));
     for h in &j.host {
-        outln!(
-            "host firmware (section {}): at {}: {}",
-            h.section,
-            Instant::from_nanos(h.at_ps / 1000),
-            h.what
-        );
+        outln!("{}", finding(h));
     }
     let word = |w: &str| super::out::verdict_word(w, 0);
     match &j.verdict {

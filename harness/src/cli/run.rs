@@ -186,6 +186,37 @@ pub(super) fn write_report(
     files::write_report(path, text.as_bytes()).map_err(|e| e.to_string())
 }
 
+/// Tries the `--junit` and `--json` outputs before the work, rather than
+/// finding them unusable after it: each writable, not the same file, at
+/// most one on standard output (the verdict lines then go to standard
+/// error).
+pub(super) fn prepare_reports(junit: Option<&Path>, json: Option<&Path>) -> Result<(), CliError> {
+    let reports: Vec<&Path> = [junit, json].into_iter().flatten().collect();
+    for report in &reports {
+        files::check_writable(report)?;
+    }
+    if let (Some(junit), Some(json)) = (junit, json) {
+        if files::same_file(junit, json) {
+            return Err(usage(format!(
+                "--junit {} and --json {} are the same file: give each report its own",
+                junit.display(),
+                json.display()
+            )));
+        }
+    }
+    match reports.iter().filter(|p| p.as_os_str() == "-").count() {
+        0 => Ok(()),
+        // Standard output carries the report: the verdicts go to stderr.
+        1 => {
+            super::out::people_to_stderr();
+            Ok(())
+        }
+        _ => Err(usage(
+            "--junit - and --json - cannot both take standard output",
+        )),
+    }
+}
+
 fn summary_lines(t: &Tally, results: usize) {
     outln!(
         "{results} scenarios: {} passed, {} marginal, {} failed, {} errors, {} not run",
@@ -245,29 +276,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     if let Some(dir) = &args.artifacts {
         files::prepare_folder(dir)?;
     }
-    let reports: Vec<&PathBuf> = [&args.junit, &args.json].into_iter().flatten().collect();
-    for report in &reports {
-        files::check_writable(report)?;
-    }
-    if let (Some(junit), Some(json)) = (&args.junit, &args.json) {
-        if files::same_file(junit, json) {
-            return Err(usage(format!(
-                "--junit {} and --json {} are the same file: give each report its own",
-                junit.display(),
-                json.display()
-            )));
-        }
-    }
-    match reports.iter().filter(|p| p.as_os_str() == "-").count() {
-        0 => {}
-        // Standard output carries the report: the verdicts go to stderr.
-        1 => super::out::people_to_stderr(),
-        _ => {
-            return Err(usage(
-                "--junit - and --json - cannot both take standard output",
-            ))
-        }
-    }
+    prepare_reports(args.junit.as_deref(), args.json.as_deref())?;
     if let Some(dir) = &args.golden {
         if !dir.is_dir() {
             return Err(usage(format!(
@@ -419,6 +428,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         passes: &passes,
         repeated: &repeated,
         tally,
+        judged: &[],
     };
     if let Some(p) = &args.junit {
         if let Err(e) = write_report(p, report::junit_listing(&info, &listing)) {

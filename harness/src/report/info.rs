@@ -95,6 +95,35 @@ pub struct RunInfo {
     /// The machine the harness ran on.
     pub host: String,
     pub options: RunOptions,
+    /// What the results were judged from when it is no run of boards: a
+    /// logic-analyzer capture (`ppmc judge`). Absent from a run's record.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub source: Option<CaptureSource>,
+}
+
+/// A logic-analyzer capture a board was judged from (`ppmc judge`), and
+/// what of it was judged.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CaptureSource {
+    /// Always `capture`.
+    pub kind: &'static str,
+    pub path: String,
+    /// What the file is, in words: `VCD (ppmc)`, `sigrok session (.sr,
+    /// version 2)`.
+    pub format: String,
+    /// The channels' names, as the capture gives them.
+    pub channels: Vec<String>,
+    /// The sample rate of a sampled capture; `None` for a VCD.
+    pub sample_rate_hz: Option<u64>,
+    /// No edge is known closer than this.
+    pub resolution_ps: u64,
+    /// The register accesses decoded, the POUT pulses and the changes of
+    /// the other outputs compared.
+    pub accesses: u64,
+    pub pulses: u64,
+    pub changes: u64,
+    /// What could not be judged, and why (a signal with no channel).
+    pub not_judged: Vec<String>,
 }
 
 impl RunInfo {
@@ -108,6 +137,7 @@ impl RunInfo {
             wall_s: 0.0,
             host: hostname(),
             options: RunOptions::default(),
+            source: None,
         }
     }
 

@@ -2,7 +2,7 @@
 //! `docs/run-record.schema.json`).
 
 use super::info::RunInfo;
-use super::listing::{error_kind, Listing, ReportError};
+use super::listing::{error_kind, Blame, Listing, ReportError};
 use super::tally::Tally;
 use crate::scenario::{NotRun, ScenarioResult, Verdict};
 use serde::Serialize;
@@ -28,11 +28,19 @@ struct JsonFailure<'a> {
     at_ns: u64,
 }
 
+/// The host firmware using the chip against chapter 3, found in a capture.
+#[derive(Serialize)]
+struct JsonFinding<'a> {
+    at_ns: u64,
+    section: &'a str,
+    what: &'a str,
+}
+
 /// Why the harness could not judge, as fields.
 #[derive(Serialize)]
 struct JsonError {
-    /// `harness`, `infrastructure` (target unreachable or lost) or
-    /// `interrupted`.
+    /// `harness`, `infrastructure` (target unreachable or lost),
+    /// `interrupted`, or `capture` (a capture that cannot be judged).
     kind: &'static str,
     message: String,
 }
@@ -56,6 +64,13 @@ struct JsonScenario<'a> {
     elapsed_ns: u64,
     wall_s: f64,
     measurements: Vec<JsonMeasurement<'a>>,
+    /// Judged from a capture (absent otherwise): whom the verdict blames,
+    /// `board`, `host` or `capture`; null when it passed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    blame: Option<Option<&'static str>>,
+    /// On the result that judges the host firmware: its findings.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    host_findings: Option<Vec<JsonFinding<'a>>>,
 }
 
 /// The verdict's one spelling in the JSON record.
@@ -180,7 +195,10 @@ pub fn json_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> 
                 section: r.section,
                 tags: r.tags,
                 verdict: json_verdict(&r.verdict),
-                detail: r.verdict.detail(),
+                detail: l
+                    .judged_of(i)
+                    .and_then(|j| j.message.clone())
+                    .or_else(|| r.verdict.detail()),
                 failure: match &r.verdict {
                     Verdict::Failed(f) => Some(JsonFailure {
                         expectation: &f.expectation,
@@ -192,7 +210,10 @@ pub fn json_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> 
                 },
                 error: match &r.verdict {
                     Verdict::Error(e) => Some(JsonError {
-                        kind: error_kind(e),
+                        kind: match l.judged_of(i).and_then(|j| j.blame) {
+                            Some(Blame::Capture) => "capture",
+                            _ => error_kind(e),
+                        },
                         message: e.to_string(),
                     }),
                     Verdict::NotRun(NotRun::Interrupted) => Some(JsonError {
@@ -221,6 +242,16 @@ pub fn json_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> 
                         at_ns: m.at.as_nanos(),
                     })
                     .collect(),
+                blame: l.judged_of(i).map(|j| j.blame.map(Blame::name)),
+                host_findings: l.judged_of(i).and_then(|j| j.host.as_ref()).map(|h| {
+                    h.iter()
+                        .map(|f| JsonFinding {
+                            at_ns: f.at_ps / 1000,
+                            section: f.section,
+                            what: &f.what,
+                        })
+                        .collect()
+                }),
             })
             .collect(),
     };

@@ -1,7 +1,7 @@
 //! JUnit XML for CI systems (see [`junit`]).
 
 use super::info::{BoardInfo, RunInfo};
-use super::listing::{error_kind, Listing, ReportError};
+use super::listing::{error_kind, Blame, Judged, Listing, ReportError};
 use crate::scenario::{Grade, NotRun, ScenarioResult, Verdict};
 use crate::soak::Repeated;
 use std::collections::BTreeMap;
@@ -41,8 +41,27 @@ enum Case<'a> {
 }
 
 /// The child element a test case's verdict gives it, if any: failure,
-/// error or skipped, with its type and message.
-fn verdict_element(v: &Verdict) -> Option<(&'static str, &'static str, String)> {
+/// error or skipped, with its type and message. A result judged from a
+/// capture is typed by whom it blames: `device` (the board), `host` (the
+/// host firmware) or `capture`, with the judge's line as its message.
+fn verdict_element(
+    v: &Verdict,
+    judged: Option<&Judged>,
+) -> Option<(&'static str, &'static str, String)> {
+    let (tag, kind, message) = own_element(v)?;
+    let Some(j) = judged else {
+        return Some((tag, kind, message));
+    };
+    let kind = match j.blame {
+        Some(Blame::Board) => "device",
+        Some(Blame::Host) => "host",
+        Some(Blame::Capture) => "capture",
+        None => kind,
+    };
+    Some((tag, kind, j.message.clone().unwrap_or(message)))
+}
+
+fn own_element(v: &Verdict) -> Option<(&'static str, &'static str, String)> {
     match v {
         Verdict::Passed | Verdict::Marginal => None,
         Verdict::Failed(f) => Some(("failure", "device", f.to_string())),
@@ -120,7 +139,7 @@ pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError>
         vec![(board, cases)]
     };
     let element = |c: &Case| match c {
-        Case::One(i) => verdict_element(&results[*i].verdict),
+        Case::One(i) => verdict_element(&results[*i].verdict, l.judged_of(*i)),
         Case::Many(r) => repeated_element(r),
     };
     let kind_count = |cases: &[Case], tag: &str| {
@@ -177,7 +196,11 @@ pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError>
                 Case::Many(r) => r.wall.as_secs_f64(),
             })
             .sum();
-        let mut suite_name = "ppmc-conformance".to_string();
+        let mut suite_name = match info.source {
+            Some(_) => "ppmc-judge",
+            None => "ppmc-conformance",
+        }
+        .to_string();
         if let Some(shard) = &info.options.shard {
             suite_name.push_str(&format!(" shard {shard}"));
         }
@@ -216,6 +239,18 @@ pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError>
                 }));
             }
         }
+        if let Some(c) = &info.source {
+            props.extend([
+                ("capture.path".into(), c.path.clone()),
+                ("capture.format".into(), c.format.clone()),
+                ("capture.channels".into(), c.channels.join(",")),
+                (
+                    "capture.sample_rate_hz".into(),
+                    c.sample_rate_hz.map(|r| r.to_string()).unwrap_or_default(),
+                ),
+                ("capture.resolution_ps".into(), c.resolution_ps.to_string()),
+            ]);
+        }
         props.extend(cases.iter().zip(&names).map(|(c, n)| {
             let elapsed = match c {
                 Case::One(i) => results[*i].elapsed,
@@ -239,7 +274,13 @@ pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError>
             match c {
                 Case::One(i) => {
                     let shared = board.is_none().then(|| info.board_name(l.board_of(*i)));
-                    testcase(&mut x, &results[*i], name, l.attachments.get(*i), shared);
+                    let r = &results[*i];
+                    let extra = Extra {
+                        attachments: l.attachments.get(*i),
+                        board: shared,
+                        judged: l.judged_of(*i),
+                    };
+                    testcase(&mut x, r, name, &extra);
                 }
                 Case::Many(r) => {
                     let shared = board.is_none().then(|| info.board_name(r.board));
@@ -330,14 +371,20 @@ fn board_props(prefix: &str, b: &BoardInfo) -> Vec<(String, String)> {
     props
 }
 
-/// One `<testcase>`; `board` names the board when the suite is shared.
-fn testcase(
-    x: &mut String,
-    r: &ScenarioResult,
-    name: &str,
-    attachments: Option<&Vec<String>>,
-    board: Option<&str>,
-) {
+/// What a `<testcase>` says besides its result: the files saved for it,
+/// its board when the suite is shared, what the judge of a capture adds.
+struct Extra<'a> {
+    attachments: Option<&'a Vec<String>>,
+    board: Option<&'a str>,
+    judged: Option<&'a Judged>,
+}
+
+/// One `<testcase>`. A result judged from a capture has the judge's notes
+/// (what was not judged, what was compared, each finding) after its
+/// failure's or error's message, or in `system-out` when it passed.
+fn testcase(x: &mut String, r: &ScenarioResult, name: &str, extra: &Extra) {
+    let (attachments, board) = (extra.attachments, extra.board);
+    let notes = extra.judged.map_or(&[][..], |j| &j.notes[..]);
     let _ = write!(
         x,
         "    <testcase name=\"{}\" classname=\"section {}\" time=\"{:.6}\"",
@@ -346,15 +393,23 @@ fn testcase(
         r.wall.as_secs_f64()
     );
     let mut body = String::new();
-    if let Some((tag, kind, message)) = verdict_element(&r.verdict) {
+    let element = verdict_element(&r.verdict, extra.judged);
+    if let Some((tag, kind, message)) = &element {
+        let text = std::iter::once(message.as_str())
+            .chain(notes.iter().map(String::as_str))
+            .collect::<Vec<_>>()
+            .join("\n");
         let _ = writeln!(
             body,
             "      <{tag} type=\"{kind}\" message=\"{}\">{}</{tag}>",
-            esc(&message),
-            esc_text(&message)
+            esc(message),
+            esc_text(&text)
         );
     }
     let mut out: Vec<String> = Vec::new();
+    if element.is_none() {
+        out.extend(notes.iter().cloned());
+    }
     if let Some(b) = board {
         out.push(format!("board: {b}"));
     }

@@ -29,6 +29,44 @@ pub struct Listing<'a> {
     pub repeated: &'a [Repeated],
     /// Every verdict of the run, listed or not.
     pub tally: Tally,
+    /// What the results judged from a capture add (`ppmc judge`), in the
+    /// results' order; empty for a run of boards.
+    pub judged: &'a [Judged],
+}
+
+/// The party a result judged from a capture blames (issue 30): the board,
+/// the host firmware driving it, or the capture itself.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Blame {
+    Board,
+    Host,
+    Capture,
+}
+
+impl Blame {
+    /// Its one spelling in the JSON record.
+    pub fn name(self) -> &'static str {
+        match self {
+            Blame::Board => "board",
+            Blame::Host => "host",
+            Blame::Capture => "capture",
+        }
+    }
+}
+
+/// What a result judged from a capture adds to its verdict.
+#[derive(Debug, Clone, Default)]
+pub struct Judged {
+    /// Whom the verdict blames; `None` when it passed.
+    pub blame: Option<Blame>,
+    /// The verdict's line as the judge prints it, in place of the
+    /// verdict's own words.
+    pub message: Option<String>,
+    /// The host firmware's findings, on the result that judges the host.
+    pub host: Option<Vec<crate::judge::HostFinding>>,
+    /// What the verdict's text says after its message: what was not
+    /// judged, what was compared, each finding.
+    pub notes: Vec<String>,
 }
 
 impl<'a> Listing<'a> {
@@ -45,7 +83,18 @@ impl<'a> Listing<'a> {
             passes: &[],
             repeated: &[],
             tally: Tally::of(results),
+            judged: &[],
         }
+    }
+
+    /// The results, judged from a capture: `judged` in their order.
+    pub fn judged(mut self, judged: &'a [Judged]) -> Listing<'a> {
+        self.judged = judged;
+        self
+    }
+
+    pub(super) fn judged_of(&self, i: usize) -> Option<&'a Judged> {
+        self.judged.get(i)
     }
 
     pub(super) fn board_of(&self, i: usize) -> Option<usize> {

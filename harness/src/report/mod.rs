@@ -11,8 +11,8 @@ mod junit;
 mod listing;
 pub(crate) mod tally;
 
-pub use info::{rfc3339, BoardInfo, RunInfo, RunOptions};
+pub use info::{rfc3339, BoardInfo, CaptureSource, RunInfo, RunOptions};
 pub use json::{json, json_listing};
 pub use junit::{junit, junit_listing};
-pub use listing::{Listing, ReportError};
+pub use listing::{Blame, Judged, Listing, ReportError};
 pub use tally::Tally;
