@@ -130,7 +130,55 @@ struct Streams {
     anchor: Instant,
 }
 
-fn streams(t: &Trace, anchor: Instant) -> Streams {
+/// What of the traces a compare looks at: all of them, or, when one of
+/// them is a logic-analyzer capture's (`ppmc judge --trace`, its
+/// `capture_pins` detail), what a capture can say of the chip: the
+/// register writes and data reads (not the host's status polling, which
+/// is the host's and which a capture draws otherwise), the moves, the
+/// pulses, and the pins the capture holds; not the driver's measurements.
+#[derive(Debug, Clone, Default)]
+struct View {
+    /// The pins the capture holds, when one side is a capture's.
+    capture: Option<Vec<Pin>>,
+}
+
+impl View {
+    fn of(golden: &Trace, got: &Trace) -> View {
+        let pins = [got, golden].into_iter().find_map(|t| {
+            t.details
+                .iter()
+                .find(|(k, _)| k == crate::trace::CAPTURE_PINS)
+                .map(|(_, v)| {
+                    Pin::ALL
+                        .into_iter()
+                        .filter(|p| v.split(',').any(|n| n == p.name()))
+                        .collect()
+                })
+        });
+        View { capture: pins }
+    }
+
+    /// The bus event as this view compares it, if it does.
+    fn bus(&self, b: BusEvent) -> Option<BusEvent> {
+        if self.capture.is_none() {
+            return Some(b);
+        }
+        match b {
+            BusEvent::WriteCommand { byte, .. } => {
+                Some(BusEvent::WriteCommand { byte, waited: None })
+            }
+            BusEvent::WriteData { byte, .. } => Some(BusEvent::WriteData { byte, waited: None }),
+            BusEvent::ReadData { byte, .. } => Some(BusEvent::ReadData { byte, waited: None }),
+            _ => None,
+        }
+    }
+
+    fn pin(&self, pin: Pin) -> bool {
+        self.capture.as_ref().is_none_or(|pins| pins.contains(&pin))
+    }
+}
+
+fn streams(t: &Trace, anchor: Instant, view: &View) -> Streams {
     let mut s = Streams::default();
     let mut anchor = anchor;
     let mut pending_first = false;
@@ -140,7 +188,9 @@ fn streams(t: &Trace, anchor: Instant) -> Streams {
                 if *b == BusEvent::Reset {
                     anchor = e.at;
                 }
-                s.bus.push((e.at, *b));
+                if let Some(b) = view.bus(*b) {
+                    s.bus.push((e.at, b));
+                }
             }
             k @ EventKind::Move { .. } => {
                 anchor = e.at;
@@ -157,9 +207,11 @@ fn streams(t: &Trace, anchor: Instant) -> Streams {
                 }
                 pending_first = false;
             }
-            EventKind::Pin { pin, value } => {
+            EventKind::Pin { pin, value } if view.pin(*pin) => {
                 s.pins.entry(*pin).or_default().push((e.at, *value, anchor));
             }
+            EventKind::Pin { .. } => {}
+            EventKind::Measure { .. } if view.capture.is_some() => {}
             EventKind::Measure { name, value } => {
                 s.measures
                     .entry(name.clone())
@@ -248,8 +300,9 @@ pub fn compare_from(
     tol: &Tolerances,
     from: &Resume,
 ) -> Result<Resume, Divergence> {
-    let g = streams(golden, from.anchors.0);
-    let o = streams(got, from.anchors.1);
+    let view = View::of(golden, got);
+    let g = streams(golden, from.anchors.0, &view);
+    let o = streams(got, from.anchors.1, &view);
     let mut first = First::default();
     compare_bus(&g, &o, tol, from.bus, &mut first);
     compare_moves(&g, &o, from.moves, &mut first);

@@ -36,6 +36,12 @@ use std::fmt::{self, Write as _};
 /// The format version written in the first line.
 pub const TRACE_VERSION: u32 = 1;
 
+/// The detail a trace made from a logic-analyzer capture carries
+/// (`ppmc judge --trace`): the pins it holds, by their names, `,` between.
+/// A compare with such a trace looks at what a capture can say of the
+/// chip ([`crate::compare`]).
+pub const CAPTURE_PINS: &str = "capture_pins";
+
 /// A complete trace of one scenario run.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Trace {

@@ -548,3 +548,48 @@ fn judge_reports_keep_the_write_rules() {
         text(&out.stderr)
     );
 }
+
+/// Issue 30, item 5: `ppmc judge --trace` writes a capture as a trace, and
+/// `ppmc compare` judges it against the golden trace as it judges a board
+/// behind the bridge: a clean board's capture compares equal (3-3-4's
+/// moves, pulses and outputs; the writes and data reads), a board that
+/// loses a move's last pulse (3-3-1) diverges at the number of pulses. A
+/// trace already there is never replaced.
+#[test]
+fn a_captures_trace_compares_with_the_golden_trace() {
+    let dir = scratch("judge-trace");
+    let scenario = "s3_3_4_accel_1000_steps_cw";
+    let golden = concat!(env!("CARGO_MANIFEST_DIR"), "/../golden");
+    for (faults, folder, verdict) in [
+        (&[][..], "clean", "PASS"),
+        (&["drop-last-pulse"][..], "faulty", "FAIL"),
+    ] {
+        let cap = export(dir.path(), &format!("{folder}.vcd"), scenario, faults);
+        let traces = dir.path().join(folder);
+        let traces = traces.to_str().expect("utf-8");
+        let out = ppmc(&["judge", &cap, "--trace", traces, "--scenario", scenario]);
+        let said = text(&out.stdout);
+        assert!(
+            said.contains(&format!("trace: {traces}/{scenario}.snap")),
+            "{said}"
+        );
+        let out = ppmc(&["compare", golden, "--traces", traces, "--filter", scenario]);
+        let said = text(&out.stdout);
+        assert!(said.starts_with(&format!("{verdict} ")), "{said}");
+        if verdict == "FAIL" {
+            assert!(said.contains("number of pulses: expected 1000"), "{said}");
+            // The clean capture's trace is not put over the faulty one.
+            let clean = dir.path().join("clean.vcd");
+            let out = ppmc(&[
+                "judge",
+                clean.to_str().expect("utf-8"),
+                "--trace",
+                traces,
+                "--scenario",
+                scenario,
+            ]);
+            assert_ne!(out.status.code(), Some(0));
+            assert!(text(&out.stderr).contains("exists, with another trace"));
+        }
+    }
+}

@@ -5,7 +5,7 @@
 use super::args::{parse_duration, ChipArgs, ToleranceArgs};
 use crate::backend::TargetInfo;
 use crate::cli::{usage, CliError};
-use crate::judge::{judge, HostFinding, JudgeOptions, Judgement, Verdict};
+use crate::judge::{judge_traced, HostFinding, JudgeOptions, Judgement, Verdict};
 use crate::logic::decode::BusDecoder;
 use crate::logic::map::ChannelMap;
 use crate::logic::source::{LogicInfo, LogicSource};
@@ -145,6 +145,16 @@ pub struct JudgeArgs {
     /// it is, each result names whom it blames); `-` for standard output.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    /// Also write the capture as a trace in our format, `DIR/<scenario>.snap`
+    /// (never replacing a file there), for `ppmc compare GOLDEN --traces
+    /// DIR`: the writes and data reads, the moves they started, the pulses
+    /// and the outputs the capture has (docs/capture.md).
+    #[arg(long, value_name = "DIR")]
+    trace: Option<PathBuf>,
+    /// The scenario the capture records: the trace's name (default: the
+    /// capture file's name without its extension).
+    #[arg(long, value_name = "NAME", requires = "trace")]
+    scenario: Option<String>,
 }
 
 pub fn run(args: JudgeArgs) -> Result<(), CliError> {
@@ -158,10 +168,34 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         glitch_ps: args.capture.glitch.as_nanos() * 1000,
     };
     super::run::prepare_reports(args.junit.as_deref(), args.json.as_deref())?;
+    let name = match (&args.trace, &args.scenario) {
+        (None, _) => None,
+        (Some(_), Some(n)) => Some(n.clone()),
+        (Some(_), None) => Some(
+            args.capture
+                .capture
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "capture".into()),
+        ),
+    };
+    if let Some(dir) = &args.trace {
+        crate::files::prepare_folder(dir)?;
+    }
     describe(&info, &args.capture.capture);
-    let j = judge(source.as_mut(), &map, &opts)
+    let (j, trace) = judge_traced(source.as_mut(), &map, &opts, name.as_deref())
         .map_err(|e| CliError::BadInput(format!("ppmc: {e}")))?;
     let mut problems = Vec::new();
+    if let (Some(dir), Some(t)) = (&args.trace, &trace) {
+        match crate::golden::write(dir, t, false) {
+            Ok(_) => outln!("trace: {}", crate::golden::path_for(dir, &t.scenario).display()),
+            Err(crate::golden::GoldenError::Exists { path }) => problems.push(format!(
+                "--trace: {}: exists, with another trace: remove it, or give another folder or --scenario",
+                path.display()
+            )),
+            Err(e) => problems.push(format!("--trace: {e}")),
+        }
+    }
     if args.junit.is_some() || args.json.is_some() {
         let wall = started.elapsed();
         let (run, results, judged) = records(&args.capture.capture, &info, &opts, &j, wall);

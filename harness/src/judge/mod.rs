@@ -28,6 +28,7 @@ use std::fmt;
 
 mod host;
 mod outputs;
+pub mod trace;
 pub use host::HostFinding;
 use host::HostRules;
 
@@ -368,19 +369,34 @@ pub fn judge(
     map: &ChannelMap,
     opts: &JudgeOptions,
 ) -> Result<Judgement, JudgeError> {
+    judge_traced(source, map, opts, None).map(|(j, _)| j)
+}
+
+/// [`judge`], and with `scenario` the capture as a trace of that name
+/// (`ppmc judge --trace`, [`trace`]): `None` where the bus cannot be
+/// decoded.
+pub fn judge_traced(
+    source: &mut dyn LogicSource,
+    map: &ChannelMap,
+    opts: &JudgeOptions,
+    scenario: Option<&str>,
+) -> Result<(Judgement, Option<crate::trace::Trace>), JudgeError> {
     let info = source.info().clone();
     let mut not_judged = Vec::new();
     let bus = match map.require_bus() {
         Ok(bus) => bus,
         Err(why) => {
-            return Ok(Judgement {
-                verdict: Verdict::Capture(why),
-                host: Vec::new(),
-                accesses: 0,
-                pulses: 0,
-                changes: 0,
-                not_judged,
-            })
+            return Ok((
+                Judgement {
+                    verdict: Verdict::Capture(why),
+                    host: Vec::new(),
+                    accesses: 0,
+                    pulses: 0,
+                    changes: 0,
+                    not_judged,
+                },
+                None,
+            ))
         }
     };
     let pout = map.get(Signal::Pout);
@@ -439,6 +455,7 @@ pub fn judge(
     let mut started = reset.is_none();
     let mut failed = None;
     let mut source = Lookahead::new(source);
+    let mut tracer = scenario.map(|_| trace::CaptureTrace::new(map, &info));
     while let Some(c) = source.next()? {
         if !started {
             // The model starts where RESET is released.
@@ -492,6 +509,9 @@ pub fn judge(
             ) {
                 failed = Some(d);
             }
+        }
+        if let Some(tr) = &mut tracer {
+            tr.change(&c, prev.as_ref(), bench.model_time(c.time_ps), &bench.board);
         }
         if let Some(ch) = pout {
             if c.high(ch) && prev.is_some_and(|q| !q.high(ch)) {
@@ -552,6 +572,9 @@ pub fn judge(
                 rules.after(&t, &bench.board, &mut host);
             }
             outputs.access(t.end_ps);
+            if let Some(tr) = &mut tracer {
+                tr.access(&t, bench.model_time(t.end_ps));
+            }
             bench.last_access = Some(t);
         }
         prev = Some(c);
@@ -587,12 +610,18 @@ pub fn judge(
         (Some(d), None) => Verdict::Failed(d),
         (None, None) => Verdict::Passed,
     };
-    Ok(Judgement {
-        verdict,
-        host,
-        accesses: summary.transactions,
-        pulses: bench.compared,
-        changes: outputs.compared(),
-        not_judged,
-    })
+    let trace = tracer
+        .zip(scenario)
+        .map(|(tr, name)| tr.finish(name, &info, &bench.board, opts.straps));
+    Ok((
+        Judgement {
+            verdict,
+            host,
+            accesses: summary.transactions,
+            pulses: bench.compared,
+            changes: outputs.compared(),
+            not_judged,
+        },
+        trace,
+    ))
 }
