@@ -25,11 +25,18 @@
 //! The ZIP crate is `zip` (zip-rs/zip2), the maintained pure-Rust one,
 //! with its deflate codec only (zlib-rs; libzip writes deflated or stored
 //! entries): it checks each entry's CRC-32 and lends an entry as a `Read`
-//! that decompresses as it is read (`ZipArchive::by_name`). That entry
-//! borrows the archive, so no one value can keep both between two calls
-//! of [`LogicSource::next_change`]: a thread owns the archive and hands
-//! blocks over a channel of [`BLOCKS_IN_FLIGHT`] (inflating on one core
-//! while the scan runs on another) until the reader is dropped.
+//! that decompresses as it is read. The entries are read from their local
+//! headers in the file's order (`read_zipfile_from_stream`), once to find
+//! them (the samples skipped, not decompressed) and once for the samples,
+//! never through `ZipArchive`, which holds the whole central directory,
+//! some 0.5 KB an entry: that would grow with the capture. libsigrok
+//! writes the chunks in order, with their sizes in their local headers;
+//! a file whose chunks are out of order, or which leaves the sizes to
+//! data descriptors, is refused by name. An entry borrows the reader, so
+//! no one value can keep both between two calls of
+//! [`LogicSource::next_change`]: a thread owns the file and hands blocks
+//! over a channel of [`BLOCKS_IN_FLIGHT`] (inflating on one core while
+//! the scan runs on another) until the reader is dropped.
 //!
 //! Errors name the file and where (`line 5 of metadata`, `byte 4096 of
 //! logic-1-3`); nothing panics.
@@ -41,7 +48,6 @@ use std::io::{ErrorKind, Read};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver, Sender, SyncSender};
 use zip::result::ZipError;
-use zip::ZipArchive;
 
 /// The bytes of one decompressed block (cut to whole samples).
 pub const BLOCK_BYTES: usize = 256 << 10;
@@ -129,20 +135,26 @@ impl SigrokReader {
     pub fn open(path: &Path) -> Result<SigrokReader, LogicError> {
         let mut file = open_regular(path)?;
         check_zip_ends(path, &mut file)?;
-        let mut archive = ZipArchive::new(file).map_err(|e| {
-            let what = format!("not a ZIP archive, which a sigrok session file is: {e}");
-            LogicError::new(path, "", what)
-        })?;
-        check_version(path, &read_entry(&mut archive, path, "version")?)?;
-        let text = read_entry(&mut archive, path, "metadata")?;
+        let entries = Entries::read(path, &mut file)?;
+        let version = entries
+            .version
+            .ok_or_else(|| LogicError::new(path, "", "no `version`: not a sigrok session file"))?;
+        check_version(path, &version)?;
+        let text = entries
+            .metadata
+            .ok_or_else(|| LogicError::new(path, "", "no `metadata`: not a sigrok session file"))?;
         let meta = parse_metadata(path, &text)?;
-        let chunks = chunk_names(path, archive.file_names(), &meta.capturefile)?;
+        let chunks = chunk_names(
+            path,
+            entries.names.iter().map(String::as_str),
+            &meta.capturefile,
+        )?;
         let (tx, rx) = mpsc::sync_channel(BLOCKS_IN_FLIGHT);
         let (recycle, recycled) = mpsc::channel();
         let (names, who, unit) = (chunks.clone(), path.to_path_buf(), meta.unitsize);
         std::thread::Builder::new()
             .name("sigrok-inflate".into())
-            .spawn(move || inflate(archive, &who, &names, unit, &tx, &recycled))
+            .spawn(move || inflate(file, &who, &names, unit, &tx, &recycled))
             .map_err(|e| LogicError::new(path, "", format!("cannot start a thread: {e}")))?;
         let mask = meta.probes.iter().fold(0u64, |m, (bit, _)| m | 1u64 << bit);
         let info = LogicInfo {
@@ -364,10 +376,54 @@ impl Unit {
     }
 }
 
+/// What the ZIP's entries are, read from their local headers in turn
+/// (`zip::read::read_zipfile_from_stream`), not from the archive's central
+/// directory: `ZipArchive` holds that whole, some 0.5 KB an entry, which
+/// would grow with the capture. The samples are skipped here, not
+/// decompressed.
+#[derive(Debug, Default)]
+struct Entries {
+    version: Option<Vec<u8>>,
+    metadata: Option<Vec<u8>>,
+    /// The other entries' names, in the file's order.
+    names: Vec<String>,
+}
+
+impl Entries {
+    fn read(path: &Path, file: &mut File) -> Result<Entries, LogicError> {
+        use std::io::{BufReader, Seek, SeekFrom};
+        let not_zip = |e: ZipError| {
+            let what = format!("not a ZIP archive as libsigrok writes a session: {e}");
+            LogicError::new(path, "", what)
+        };
+        let mut entries = Entries::default();
+        let mut r = BufReader::with_capacity(1 << 16, &mut *file);
+        while let Some(entry) = zip::read::read_zipfile_from_stream(&mut r).map_err(not_zip)? {
+            let name = entry.name().to_string();
+            match name.as_str() {
+                "version" | "metadata" => {
+                    let bytes = read_small(entry, path, &name)?;
+                    match name.as_str() {
+                        "version" => entries.version = Some(bytes),
+                        _ => entries.metadata = Some(bytes),
+                    }
+                }
+                _ => entries.names.push(name),
+            }
+        }
+        drop(r);
+        file.seek(SeekFrom::Start(0))
+            .map_err(|e| LogicError::new(path, "", format!("cannot read: {e}")))?;
+        Ok(entries)
+    }
+}
+
 /// The thread's body: each chunk in turn, decompressed into blocks of
 /// whole samples (but a chunk's last), sent to the scan until it is gone.
+/// The entries are read in the file's order, as libsigrok writes them: a
+/// chunk met before the one due is an error (`chunks` are in order).
 fn inflate(
-    mut archive: ZipArchive<File>,
+    file: File,
     path: &Path,
     chunks: &[String],
     unitsize: usize,
@@ -378,10 +434,21 @@ fn inflate(
     let failed = |at: String, what: String| {
         let _ = tx.send(Piece::Failed(LogicError::new(path, at, what)));
     };
+    let mut r = std::io::BufReader::with_capacity(1 << 16, file);
     for (chunk, name) in chunks.iter().enumerate() {
-        let mut entry = match archive.by_name(name) {
-            Ok(e) => e,
-            Err(e) => return failed(name.clone(), format!("cannot open this chunk: {e}")),
+        let mut entry = loop {
+            match zip::read::read_zipfile_from_stream(&mut r) {
+                Ok(Some(e)) if e.name() == name => break e,
+                Ok(Some(e)) if chunks.iter().any(|c| c == e.name()) => {
+                    return failed(
+                        e.name().to_string(),
+                        format!("comes before `{name}` in the file: the chunks are not in order"),
+                    )
+                }
+                Ok(Some(_)) => {} // version, metadata, analog: skipped
+                Ok(None) => return failed(name.clone(), "not found in the file".into()),
+                Err(e) => return failed(name.clone(), format!("cannot open this chunk: {e}")),
+            }
         };
         let mut offset = 0u64;
         loop {
@@ -466,14 +533,7 @@ fn open_regular(path: &Path) -> Result<File, LogicError> {
 }
 
 /// The whole of a small entry, at most [`MAX_METADATA_BYTES`].
-fn read_entry(zip: &mut ZipArchive<File>, path: &Path, name: &str) -> Result<Vec<u8>, LogicError> {
-    let entry = match zip.by_name(name) {
-        Ok(e) => e,
-        Err(ZipError::FileNotFound) => {
-            return fail(path, "", format!("no `{name}`: not a sigrok session file"))
-        }
-        Err(e) => return fail(path, name, format!("cannot open: {e}")),
-    };
+fn read_small(entry: impl Read, path: &Path, name: &str) -> Result<Vec<u8>, LogicError> {
     let mut bytes = Vec::new();
     if let Err(e) = entry.take(MAX_METADATA_BYTES + 1).read_to_end(&mut bytes) {
         return fail(path, name, format!("cannot decompress: {e}"));
@@ -1135,6 +1195,27 @@ mod tests {
             &error(&s.file("utf8.sr", &zip)),
             "line 11 of metadata",
             "not UTF-8",
+        );
+    }
+
+    #[test]
+    fn chunks_out_of_order_in_the_file_are_refused_by_name() {
+        let s = Scratch::new();
+        let meta = metadata(8, "1 MHz", 1, &[(1, "A")]);
+        let zip = zip_bytes(
+            &[
+                ("version", b"2"),
+                ("metadata", meta.as_bytes()),
+                ("logic-1-2", &[1, 1]),
+                ("logic-1-1", &[0, 0]),
+            ],
+            CompressionMethod::Deflated,
+        );
+        let e = error(&s.file("order.sr", &zip));
+        says(
+            &e,
+            "logic-1-2",
+            "comes before `logic-1-1` in the file: the chunks are not in order",
         );
     }
 
