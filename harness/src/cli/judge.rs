@@ -180,6 +180,12 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         ),
     };
     if let Some(dir) = &args.trace {
+        use crate::logic::map::Signal;
+        if map.get(Signal::Pout).is_none() || map.get(Signal::Dir).is_none() {
+            return Err(usage(
+                "--trace needs channels for POUT and DIR: a trace without them cannot compare its pulses (give --map POUT=...,DIR=...)",
+            ));
+        }
         crate::files::prepare_folder(dir)?;
     }
     describe(&info, &args.capture.capture);

@@ -22,7 +22,7 @@ use crate::emu::{Board, ModelConfig};
 use crate::logic::decode::{Access, BusDecoder, Transaction, GLITCH_PS};
 use crate::logic::map::{ChannelMap, Signal};
 use crate::logic::source::{Change, LogicError, LogicSource};
-use crate::protocol::{Direction, Input, Straps};
+use crate::protocol::{Direction, Input, Status, Straps};
 use crate::time::{Duration, Instant};
 use std::fmt;
 
@@ -125,6 +125,15 @@ struct Bench {
     pulse: u32,
     /// The last model pulse compared, for the interval tolerance.
     last_model: Option<Instant>,
+    /// The last pair of pulses matched in the move in progress (board,
+    /// model, capture time): the next pulse of the move is expected where
+    /// the board's last one was plus the model's interval, so that a board
+    /// whose clock runs a few ppm off the model's is judged interval by
+    /// interval, not drifting out of its tolerance as a move goes on.
+    chain: Option<(u64, u64)>,
+    /// How far the board's last matched pulse was from the model's: the
+    /// outputs timed from it (INT*, BUSY, HOLD) may be as far off.
+    pulse_offset_ps: u64,
     compared: u64,
     last_access: Option<Transaction>,
 }
@@ -144,7 +153,21 @@ impl Bench {
     }
 
     fn capture_ps(&self, t: Instant) -> u64 {
-        t.as_nanos() * 1000 + self.zero_ps
+        t.as_nanos()
+            .saturating_mul(1000)
+            .saturating_add(self.zero_ps)
+    }
+
+    /// Where the board's pulse matching the model's at `m_ps` is
+    /// expected, in capture time: chained from the last matched pair
+    /// within a move, at the model's own time for a move's first pulse.
+    fn expected_ps(&self, m_ps: u64, first_of_move: bool) -> u64 {
+        match self.chain {
+            Some((b, last_m)) if !first_of_move && last_m <= m_ps => {
+                b.saturating_add(m_ps - last_m)
+            }
+            _ => m_ps,
+        }
     }
 
     /// How far a pulse may be from the model's, in picoseconds: the
@@ -155,24 +178,41 @@ impl Bench {
             .last_model
             .map_or(0, |l| model.as_nanos().saturating_sub(l.as_nanos()));
         let rel = since.saturating_mul(self.tol.interval_bp) / 10_000;
-        (self.tol.floor.as_nanos() + rel) * 1000 + 2 * self.resolution_ps
+        (self.tol.floor.as_nanos().saturating_add(rel))
+            .saturating_mul(1000)
+            .saturating_add(2 * self.resolution_ps)
     }
 
-    /// The inputs changed at capture time `ps`: given to the model. The
-    /// change happened up to a sample before `ps`, and the model's own
-    /// pulses run up to a sample late (the writes that timed them were
-    /// seen late too), so where the model has a pulse within a sample of
-    /// the change, the capture cannot say which came first: the board's
-    /// own pulses there say (`board_pulsed`), and the model takes the
-    /// change a sample after `ps` if the board pulsed, a sample before if
-    /// not (notes N53).
-    fn give_inputs(&mut self, ps: u64, changes: &[(Input, bool)], board_pulsed: bool) {
-        let r = self.resolution_ps;
-        self.run_to(ps.saturating_sub(r));
+    /// The model as the outputs are compared with it.
+    fn frame(&self) -> outputs::Frame<'_> {
+        outputs::Frame {
+            board: &self.board,
+            zero_ps: self.zero_ps,
+            tol: &self.tol,
+            resolution_ps: self.resolution_ps,
+            slack_ps: self.pulse_offset_ps,
+        }
+    }
+
+    /// How close to an input's change at `ps` a pulse may stand on
+    /// either side of it, as far as the capture can tell: the pulses' own
+    /// tolerance there, and at least a sample.
+    fn pulse_window(&self, ps: u64) -> u64 {
+        self.allowed_ps(self.model_time(ps)).max(self.resolution_ps)
+    }
+
+    /// The inputs changed at capture time `ps`: given to the model. Where
+    /// the model has a pulse within `w` of the change (the pulses'
+    /// tolerance, [`Bench::pulse_window`]), the capture cannot say on
+    /// which side of the change the chip's came: the board's own pulses
+    /// there say (`board_pulsed`). The model takes the change after its
+    /// pulse if the board pulsed, before it if not (notes N53).
+    fn give_inputs(&mut self, ps: u64, changes: &[(Input, bool)], board_pulsed: bool, w: u64) {
+        self.run_to(ps.saturating_sub(w));
         let pulses =
             |b: &Board| -> u64 { b.record().runs.iter().map(|r| u64::from(r.count)).sum() };
         let mut probe = self.board.clone();
-        let late = self.model_time(ps + r);
+        let late = self.model_time(ps.saturating_add(w));
         if late > probe.now() {
             probe.advance_to(late);
         }
@@ -180,21 +220,27 @@ impl Bench {
         if !model_pulsed {
             self.run_to(ps);
         } else if board_pulsed {
-            self.run_to(ps + r);
+            // Just past the model's pulse (or the change, if later).
+            if let Some(last) = probe.record().runs.last().map(|r| r.last()) {
+                let after = self.capture_ps(last).saturating_add(1000);
+                self.run_to(after.max(ps));
+            }
         }
         for &(input, asserted) in changes {
             self.board.set_input(input, asserted);
         }
     }
 
-    /// The model's next pulse, if it has put it out by now.
-    fn next_model_pulse(&self) -> Option<(Instant, Direction)> {
-        let runs = &self.board.record().runs;
+    /// The model's next pulse, if it has put it out by now, and whether
+    /// it is the first of its move.
+    fn next_model_pulse(&self) -> Option<(Instant, Direction, bool)> {
+        let record = self.board.record();
         let mut run = self.run;
         let mut pulse = self.pulse;
-        while let Some(r) = runs.get(run) {
+        while let Some(r) = record.runs.get(run) {
             if pulse < r.count {
-                return Some((r.at(pulse), r.dir));
+                let first = pulse == 0 && record.moves.iter().any(|m| m.first_run == run);
+                return Some((r.at(pulse), r.dir, first));
             }
             run += 1;
             pulse = 0;
@@ -234,7 +280,7 @@ impl Bench {
                 (None, None) => return Ok(()),
                 (Some(b), None) => {
                     let allowed = self.allowed_ps(self.model_time(b));
-                    if b + allowed >= horizon_ps {
+                    if b.saturating_add(allowed) >= horizon_ps {
                         return Ok(());
                     }
                     return Err(diverge(
@@ -245,8 +291,9 @@ impl Bench {
                         self,
                     ));
                 }
-                (b, Some((m, dir))) => {
-                    let m_ps = self.capture_ps(m);
+                (b, Some((m, dir, first))) => {
+                    let model_ps = self.capture_ps(m);
+                    let m_ps = self.expected_ps(model_ps, first);
                     let allowed = self.allowed_ps(m);
                     match b {
                         Some(b) if b.abs_diff(m_ps) <= allowed => {
@@ -270,26 +317,28 @@ impl Bench {
                             self.edges.pop_front();
                             self.take_model_pulse();
                             self.last_model = Some(m);
+                            self.chain = Some((b, model_ps));
+                            self.pulse_offset_ps = b.abs_diff(model_ps);
                             self.compared += 1;
                         }
-                        Some(b) if b.min(m_ps) + allowed < horizon_ps => {
+                        Some(b) if b.min(m_ps).saturating_add(allowed) < horizon_ps => {
                             return Err(diverge(
                                 format!("POUT pulse {}", self.compared + 1),
                                 format!("at {}", Instant::from_nanos(b / 1000)),
                                 format!(
                                     "at {} (allowed {})",
-                                    m,
+                                    Instant::from_nanos(m_ps / 1000),
                                     Duration::from_nanos(allowed / 1000)
                                 ),
                                 b.min(m_ps),
                                 self,
                             ));
                         }
-                        None if m_ps + allowed < horizon_ps => {
+                        None if m_ps.saturating_add(allowed) < horizon_ps => {
                             return Err(diverge(
                                 format!("POUT pulse {}", self.compared + 1),
                                 "no pulse".into(),
-                                format!("a pulse at {m}"),
+                                format!("a pulse at {}", Instant::from_nanos(m_ps / 1000)),
                                 m_ps,
                                 self,
                             ));
@@ -299,6 +348,25 @@ impl Bench {
                 }
             }
         }
+    }
+}
+
+/// The model's status at the capture's recent changes, for a status read
+/// that may have seen it as its strobe began.
+#[derive(Default)]
+struct StatusLog(std::collections::VecDeque<(u64, u8)>);
+
+impl StatusLog {
+    fn push(&mut self, ps: u64, status: u8) {
+        if self.0.len() == 64 {
+            self.0.pop_front();
+        }
+        self.0.push_back((ps, status));
+    }
+
+    /// The status at the last change at or before `ps`.
+    fn at(&self, ps: u64) -> Option<u8> {
+        self.0.iter().rev().find(|(t, _)| *t <= ps).map(|&(_, s)| s)
     }
 }
 
@@ -432,6 +500,8 @@ pub fn judge_traced(
         run: 0,
         pulse: 0,
         last_model: None,
+        chain: None,
+        pulse_offset_ps: 0,
         compared: 0,
         last_access: None,
     };
@@ -455,8 +525,12 @@ pub fn judge_traced(
     let mut started = reset.is_none();
     let mut failed = None;
     let mut source = Lookahead::new(source);
+    let mut status_log = StatusLog::default();
     let mut tracer = scenario.map(|_| trace::CaptureTrace::new(map, &info));
     while let Some(c) = source.next()? {
+        // The inputs' levels before this change: none at the model's start
+        // (an input held asserted through reset is asserted from it).
+        let mut inputs_before = prev;
         if !started {
             // The model starts where RESET is released.
             if let Some(r) = reset {
@@ -466,31 +540,35 @@ pub fn judge_traced(
                 }
                 started = true;
                 bench.zero_ps = c.time_ps;
+                inputs_before = None;
             }
         }
         // The inputs as the board drove them (active low).
         let changed: Vec<(Input, bool)> = inputs
             .iter()
-            .filter(|&&(_, ch)| c.high(ch) != prev.is_none_or(|q| q.high(ch)))
+            .filter(|&&(_, ch)| c.high(ch) != inputs_before.is_none_or(|q| q.high(ch)))
             .map(|&(input, ch)| (input, !c.high(ch)))
             .collect();
         if !changed.is_empty() {
-            let pulse_near = |t: u64| t.abs_diff(c.time_ps) <= 2 * bench.resolution_ps;
-            let board_pulsed = bench.edges.iter().any(|e| pulse_near(e.0))
+            // A pulse this close to the change may stand on either side of
+            // it: the pulses' own tolerance, at least a sample.
+            let w = bench.pulse_window(c.time_ps);
+            let board_pulsed = bench.edges.iter().any(|e| e.0.abs_diff(c.time_ps) <= w)
                 || pout.is_some_and(|ch| {
                     let mut level = prev.is_some_and(|q| q.high(ch));
                     let this = std::iter::once(&c);
-                    this.chain(source.peek_until(c.time_ps + 2 * bench.resolution_ps))
+                    this.chain(source.peek_until(c.time_ps.saturating_add(w)))
                         .any(|n| {
                             let rose = n.high(ch) && !level;
                             level = n.high(ch);
                             rose
                         })
                 });
-            bench.give_inputs(c.time_ps, &changed, board_pulsed);
+            bench.give_inputs(c.time_ps, &changed, board_pulsed, w);
         }
         // The model up to now: every access before this change is in it.
         bench.run_to(c.time_ps);
+        status_log.push(c.time_ps, bench.board.read_status().0);
         if failed.is_none() {
             if let Err(d) = bench.compare_pulses(c.time_ps) {
                 failed = Some(d);
@@ -499,14 +577,7 @@ pub fn judge_traced(
         outputs.observe(&c);
         if failed.is_none() {
             let after = bench.last_access.map(|a| a.to_string());
-            if let Err(d) = outputs.compare(
-                &bench.board,
-                bench.zero_ps,
-                c.time_ps,
-                &bench.tol,
-                bench.resolution_ps,
-                after,
-            ) {
+            if let Err(d) = outputs.compare(&bench.frame(), c.time_ps, after) {
                 failed = Some(d);
             }
         }
@@ -520,11 +591,11 @@ pub fn judge_traced(
             }
         }
         if let Some(t) = decoder.push(c) {
-            // The status as the strobe began (it may change during it).
-            bench.run_to(t.start_ps);
-            let status_then = bench.board.read_status();
+            // The status as the strobe began (it may change during it),
+            // as the model stood at that change of the capture.
             bench.run_to(t.end_ps);
             let status = bench.board.read_status();
+            let status_then = Status(status_log.at(t.start_ps).unwrap_or(status.0));
             // Past the board's first divergence the model no longer
             // stands for the chip: its word on the host would be noise.
             let judging_host = failed.is_none();
@@ -571,7 +642,11 @@ pub fn judge_traced(
             if judging_host {
                 rules.after(&t, &bench.board, &mut host);
             }
-            outputs.access(t.end_ps);
+            // What times an output: a write, or the data read that
+            // releases INT* (3-4-1); never the host's status polling.
+            if t.access != Access::ReadStatus {
+                outputs.access(t.end_ps);
+            }
             if let Some(tr) = &mut tracer {
                 tr.access(&t, bench.model_time(t.end_ps));
             }
@@ -593,19 +668,16 @@ pub fn judge_traced(
     }
     if failed.is_none() {
         let after = bench.last_access.map(|a| a.to_string());
-        if let Err(d) = outputs.compare(
-            &bench.board,
-            bench.zero_ps,
-            end,
-            &bench.tol,
-            bench.resolution_ps,
-            after,
-        ) {
+        if let Err(d) = outputs.compare(&bench.frame(), end, after) {
             failed = Some(d);
         }
     }
     let summary = decoder.summary();
-    let verdict = match (failed, summary.rate_problem(&info)) {
+    let held = (!started).then(|| {
+        "the `reset` channel never falls: the chip is held in reset for the whole capture"
+            .to_string()
+    });
+    let verdict = match (failed, summary.rate_problem(&info).or(held)) {
         (_, Some(why)) => Verdict::Capture(why),
         (Some(d), None) => Verdict::Failed(d),
         (None, None) => Verdict::Passed,

@@ -14,6 +14,19 @@ use crate::protocol::{Pin, PulseRun};
 use crate::time::{Duration, Instant};
 use std::collections::VecDeque;
 
+/// The model beside the capture, as the outputs are compared with it.
+#[derive(Clone, Copy)]
+pub(super) struct Frame<'a> {
+    pub(super) board: &'a Board,
+    /// The capture's time of the model's zero.
+    pub(super) zero_ps: u64,
+    pub(super) tol: &'a Tolerances,
+    pub(super) resolution_ps: u64,
+    /// How far the board's last pulse was from the model's: an output
+    /// timed from it may be as far off.
+    pub(super) slack_ps: u64,
+}
+
 /// The outputs compared, as a judge holds them.
 pub(super) struct Outputs {
     watches: Vec<Watch>,
@@ -142,18 +155,24 @@ impl Outputs {
 
     /// Compares the changes, the board's and the model's, that lie before
     /// `horizon_ps` by more than their tolerance (the model has run up to
-    /// `horizon_ps`). `zero_ps` is the capture's time of the model's zero.
+    /// `horizon_ps`). `zero_ps` is the capture's time of the model's zero;
+    /// `slack_ps` how far the board's last pulse was from the model's (an
+    /// output timed from it may be as far off).
     pub(super) fn compare(
         &mut self,
-        board: &Board,
-        zero_ps: u64,
+        f: &Frame<'_>,
         horizon_ps: u64,
-        tol: &Tolerances,
-        resolution_ps: u64,
         after: Option<String>,
     ) -> Result<(), Divergence> {
+        let Frame {
+            board,
+            zero_ps,
+            tol,
+            resolution_ps,
+            slack_ps,
+        } = *f;
         let record = board.record();
-        let to_ps = |t: Instant| t.as_nanos() * 1000 + zero_ps;
+        let to_ps = |t: Instant| t.as_nanos().saturating_mul(1000).saturating_add(zero_ps);
         for w in &mut self.watches {
             loop {
                 // The model's next change of this pin.
@@ -174,9 +193,10 @@ impl Outputs {
                     let access = accesses.iter().rev().find(|&&a| a <= m_ps).copied();
                     let cause = pulse.max(access).unwrap_or(zero_ps);
                     let since = m_ps.saturating_sub(cause);
-                    tol.floor.as_nanos() * 1000
-                        + since.saturating_mul(tol.latency_bp) / 10_000
-                        + 2 * resolution_ps
+                    (tol.floor.as_nanos().saturating_mul(1000))
+                        .saturating_add(since.saturating_mul(tol.latency_bp) / 10_000)
+                        .saturating_add(2 * resolution_ps)
+                        .saturating_add(slack_ps)
                 };
                 let diverge =
                     |w: &Watch, at_ps: u64, board: String, model: String, level: bool| Divergence {
@@ -191,7 +211,7 @@ impl Outputs {
                     (None, None) => break,
                     (Some((b, level)), None) => {
                         let allowed = allowed(b, &self.accesses);
-                        if b + allowed >= horizon_ps {
+                        if b.saturating_add(allowed) >= horizon_ps {
                             break;
                         }
                         return Err(diverge(
@@ -212,7 +232,7 @@ impl Outputs {
                                 w.next_event += 1;
                                 self.compared += 1;
                             }
-                            Some((b, bl)) if b.min(m_ps) + allowed < horizon_ps => {
+                            Some((b, bl)) if b.min(m_ps).saturating_add(allowed) < horizon_ps => {
                                 let (at_ps, shown) = if b < m_ps { (b, bl) } else { (m_ps, level) };
                                 return Err(diverge(
                                     w,
@@ -226,7 +246,7 @@ impl Outputs {
                                     shown,
                                 ));
                             }
-                            None if m_ps + allowed < horizon_ps => {
+                            None if m_ps.saturating_add(allowed) < horizon_ps => {
                                 return Err(diverge(
                                     w,
                                     m_ps,

@@ -103,6 +103,7 @@ impl<R: BufRead> VcdReader<R> {
             tok: Vec::new(),
             tok_line: 1,
             long: false,
+            skipped: 0,
         };
         let map = read_header(&mut tokens)?;
         Ok(VcdReader {

@@ -10,6 +10,10 @@ use std::collections::HashMap;
 use std::io::{self, BufRead};
 use std::path::PathBuf;
 
+/// The most bytes of a token read past [`MAX_TOKEN`] before the file is
+/// refused.
+const MAX_SKIPPED: u64 = 1 << 20;
+
 /// The longest token kept: a longer one is cut there (and refused where it
 /// matters: a name, a value, a time).
 pub const MAX_TOKEN: usize = 4096;
@@ -30,6 +34,8 @@ pub(super) struct Tokens<R> {
     pub(super) tok_line: u64,
     /// `tok` was cut at [`MAX_TOKEN`] bytes.
     pub(super) long: bool,
+    /// The bytes of `tok` read past [`MAX_TOKEN`] and dropped.
+    pub(super) skipped: u64,
 }
 
 impl<R: BufRead> Tokens<R> {
@@ -37,6 +43,7 @@ impl<R: BufRead> Tokens<R> {
     pub(super) fn next(&mut self) -> io::Result<bool> {
         self.tok.clear();
         self.long = false;
+        self.skipped = 0;
         loop {
             let buf = match self.r.fill_buf() {
                 Ok(b) => b,
@@ -65,12 +72,19 @@ impl<R: BufRead> Tokens<R> {
             let take = (i - start).min(MAX_TOKEN.saturating_sub(self.tok.len()));
             self.tok.extend_from_slice(&buf[start..start + take]);
             self.long |= take < i - start;
-            // A token too long ends here: the caller says so, without
-            // reading the rest of it (a 10 GB file of one token).
-            let ended = i < buf.len() || self.long;
+            self.skipped += (i - start - take) as u64;
+            let ended = i < buf.len();
             self.r.consume(i);
             if ended {
                 return Ok(true);
+            }
+            // A token past its limit is read on, not kept, but never for
+            // long: a file of one 10 GB token is no VCD.
+            if self.skipped > MAX_SKIPPED {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidData,
+                    format!("a token longer than {MAX_SKIPPED} bytes: not a VCD"),
+                ));
             }
         }
     }
