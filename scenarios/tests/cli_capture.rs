@@ -593,3 +593,17 @@ fn a_captures_trace_compares_with_the_golden_trace() {
         }
     }
 }
+
+/// Issue 30, item 8: a capture with nothing on the bus (the probes off
+/// it, or the recording started after the host's accesses) is the
+/// capture's problem (exit 4), never a pass.
+#[test]
+fn a_capture_with_nothing_on_the_bus_is_the_captures_problem() {
+    let dir = scratch("quiet-bus");
+    let quiet = dir.path().join("quiet.vcd");
+    std::fs::write(&quiet, hand_vcd(&[], &BUS)).expect("vcd");
+    let out = ppmc(&["judge", quiet.to_str().expect("utf-8")]);
+    let said = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(4), "{said}{}", text(&out.stderr));
+    assert!(said.contains("no register access on the bus"), "{said}");
+}

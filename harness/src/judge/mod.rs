@@ -677,7 +677,12 @@ pub fn judge_traced(
         "the `reset` channel never falls: the chip is held in reset for the whole capture"
             .to_string()
     });
-    let verdict = match (failed, summary.rate_problem(&info).or(held)) {
+    let quiet = (summary.transactions == 0).then(|| {
+        "no register access on the bus: nothing to judge (are the probes on CS*, RD*, WR*? did the recording start after the host's accesses?)"
+            .to_string()
+    });
+    let problem = summary.rate_problem(&info).or(held).or(quiet);
+    let verdict = match (failed, problem) {
         (_, Some(why)) => Verdict::Capture(why),
         (Some(d), None) => Verdict::Failed(d),
         (None, None) => Verdict::Passed,
