@@ -574,7 +574,11 @@ pub fn judge_traced(
                 failed = Some(d);
             }
         }
-        outputs.observe(&c);
+        // Past the first divergence nothing more is compared: nothing
+        // more is kept for it either.
+        if failed.is_none() {
+            outputs.observe(&c);
+        }
         if failed.is_none() {
             let after = bench.last_access.map(|a| a.to_string());
             if let Err(d) = outputs.compare(&bench.frame(), c.time_ps, after) {
@@ -584,7 +588,7 @@ pub fn judge_traced(
         if let Some(tr) = &mut tracer {
             tr.change(&c, prev.as_ref(), bench.model_time(c.time_ps), &bench.board);
         }
-        if let Some(ch) = pout {
+        if let Some(ch) = pout.filter(|_| failed.is_none()) {
             if c.high(ch) && prev.is_some_and(|q| !q.high(ch)) {
                 let dir = map.get(Signal::Dir).map(|d| c.high(d));
                 bench.edges.push_back((c.time_ps, dir));
