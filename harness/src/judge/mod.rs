@@ -134,6 +134,9 @@ struct Bench {
     /// How far the board's last matched pulse was from the model's: the
     /// outputs timed from it (INT*, BUSY, HOLD) may be as far off.
     pulse_offset_ps: u64,
+    /// The last write, data read or matched pulse, in capture time: what
+    /// a flag's change is timed from.
+    last_cause_ps: u64,
     compared: u64,
     last_access: Option<Transaction>,
 }
@@ -181,6 +184,29 @@ impl Bench {
         (self.tol.floor.as_nanos().saturating_add(rel))
             .saturating_mul(1000)
             .saturating_add(2 * self.resolution_ps)
+    }
+
+    /// How far a flag the board changes may stand from the model's, for
+    /// a status read at `ps`: the floor, two samples, the latency
+    /// tolerance of the time since its cause (the last write, data read
+    /// or pulse), and the last pulse's offset.
+    fn latency_window(&self, ps: u64) -> u64 {
+        let since = ps.saturating_sub(self.last_cause_ps);
+        (self.tol.floor.as_nanos().saturating_mul(1000))
+            .saturating_add(since.saturating_mul(self.tol.latency_bp) / 10_000)
+            .saturating_add(2 * self.resolution_ps)
+            .saturating_add(self.pulse_offset_ps)
+    }
+
+    /// The model's status at capture time `ps`, ahead of the model (a
+    /// copy run there; the model itself stays).
+    fn status_after(&self, ps: u64) -> u8 {
+        let mut probe = self.board.clone();
+        let t = self.model_time(ps);
+        if t > probe.now() {
+            probe.advance_to(t);
+        }
+        probe.read_status().0
     }
 
     /// The model as the outputs are compared with it.
@@ -319,6 +345,7 @@ impl Bench {
                             self.last_model = Some(m);
                             self.chain = Some((b, model_ps));
                             self.pulse_offset_ps = b.abs_diff(model_ps);
+                            self.last_cause_ps = self.last_cause_ps.max(b);
                             self.compared += 1;
                         }
                         Some(b) if b.min(m_ps).saturating_add(allowed) < horizon_ps => {
@@ -367,6 +394,13 @@ impl StatusLog {
     /// The status at the last change at or before `ps`.
     fn at(&self, ps: u64) -> Option<u8> {
         self.0.iter().rev().find(|(t, _)| *t <= ps).map(|&(_, s)| s)
+    }
+
+    /// The statuses in force from `ps` on: the one at `ps`, and those of
+    /// the changes after it.
+    fn since(&self, ps: u64) -> impl Iterator<Item = u8> + '_ {
+        let first = self.0.iter().rposition(|(t, _)| *t <= ps).unwrap_or(0);
+        self.0.iter().skip(first).map(|&(_, s)| s)
     }
 }
 
@@ -502,6 +536,7 @@ pub fn judge_traced(
         last_model: None,
         chain: None,
         pulse_offset_ps: 0,
+        last_cause_ps: 0,
         compared: 0,
         last_access: None,
     };
@@ -616,10 +651,19 @@ pub fn judge_traced(
                 }
                 Access::ReadStatus => {
                     // The status may change during the strobe: the model's
-                    // at its start or its end will do.
+                    // at its start or its end will do; and a flag the
+                    // board changes a little before or after the model
+                    // (within the latency tolerance of the time since
+                    // what caused it) too.
                     let mask = !t.unknown;
-                    let differs = |s: u8| (t.byte & mask) != (s & mask);
-                    if failed.is_none() && differs(status.0) && differs(status_then.0) {
+                    let matches = |s: u8| (t.byte & mask) == (s & mask);
+                    let w = bench.latency_window(t.start_ps);
+                    let near = || {
+                        status_log.since(t.start_ps.saturating_sub(w)).any(matches)
+                            || matches(bench.status_after(t.end_ps.saturating_add(w)))
+                    };
+                    if failed.is_none() && !matches(status.0) && !matches(status_then.0) && !near()
+                    {
                         failed = Some(Divergence {
                             at_ps: t.end_ps,
                             what: "status read".into(),
@@ -650,6 +694,7 @@ pub fn judge_traced(
             // releases INT* (3-4-1); never the host's status polling.
             if t.access != Access::ReadStatus {
                 outputs.access(t.end_ps);
+                bench.last_cause_ps = bench.last_cause_ps.max(t.end_ps);
             }
             if let Some(tr) = &mut tracer {
                 tr.access(&t, bench.model_time(t.end_ps));
