@@ -26,8 +26,10 @@ pub struct CaptureArgs {
     /// channel by its name in the capture or its number from 0, e.g.
     /// `CS=0,RD=1,WR=2,A0=3,D0-7=4-11,POUT=12`; `@FILE` reads them from a
     /// file, one or more a line, `#` for comments. Signals: CS, RD, WR,
-    /// A0, D0..D7, POUT, DIR, INT, BUSY, and the inputs the board drives
-    /// (L1..L4, ALM, CNP, AUXI0..AUXI3), which the model is given. Default: the capture's channel
+    /// A0, D0..D7, POUT, DIR, INT, BUSY, HOLD, AUX, AUXO0..AUXO3, and the
+    /// inputs the board drives (L1..L4, ALM, CNP, AUXI0..AUXI3), which
+    /// the model is given; a channel named `reset` starts the model where
+    /// it falls. Default: the capture's channel
     /// names, where they are the chip's (`CS*`, `nRD`, `D3`, `POUT`).
     #[arg(long, value_name = "PAIRS|@FILE")]
     map: Option<String>,
@@ -120,11 +122,12 @@ pub fn decode(args: DecodeArgs) -> Result<(), CliError> {
 }
 
 /// Judge a board from a capture of its bus and pins: the captured writes
-/// replayed into the reference model, the chip's answers and pulses
-/// compared (docs/capture.md). Exit status: 0 passed; 1 the board
+/// replayed into the reference model, the chip's answers, pulses and
+/// outputs compared (docs/capture.md). Exit status: 0 passed; 1 the board
 /// diverged; 3 the board passed but the host firmware broke a rule of
 /// chapter 3; 4 the capture cannot be judged (a channel missing, a sample
-/// rate too low for the bus).
+/// rate too low for the bus, nothing on the bus); 2 a file that does not
+/// read, or bad usage.
 #[derive(Debug, Args)]
 pub struct JudgeArgs {
     #[command(flatten)]

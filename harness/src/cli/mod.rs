@@ -63,9 +63,10 @@ enum Command {
     Decode(judge::DecodeArgs),
     /// Judge a board from a logic-analyzer capture of its bus and pins:
     /// the captured writes replayed into the reference model, the chip's
-    /// answers and pulses compared (docs/capture.md). Exit status: 0
-    /// passed; 1 the board diverged; 3 the board passed but the host
-    /// firmware broke a rule of chapter 3; 4 the capture cannot be judged.
+    /// answers, pulses and outputs compared (docs/capture.md). Exit
+    /// status: 0 passed; 1 the board diverged; 3 the board passed but the
+    /// host firmware broke a rule of chapter 3; 4 the capture cannot be
+    /// judged; 2 a file that does not read, or bad usage.
     Judge(judge::JudgeArgs),
     /// Run a bus script against a target and print one line per result.
     ///
