@@ -9,6 +9,8 @@
 //! Without sigrok-cli the tests that need it say so and pass, except in CI
 //! (`CI` set), where its absence fails.
 
+mod common;
+
 use ppmc::logic::saleae::SaleaeBinary;
 use ppmc::logic::saleae_csv::SaleaeCsv;
 use ppmc::logic::source::{Change, LogicInfo, LogicSource};
@@ -153,21 +155,6 @@ fn a_femtosecond_vcd_with_dumpoff() {
     assert_eq!(end, 200_000);
 }
 
-fn sigrok() -> bool {
-    let found = Command::new("sigrok-cli")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !found {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI must check the VCD reader against sigrok-cli (apt install sigrok-cli)"
-        );
-        eprintln!("sigrok-cli is not installed: the VCD reader is not checked against it");
-    }
-    found
-}
-
 fn run_sigrok(args: &[&str]) {
     let out = Command::new("sigrok-cli")
         .args(args)
@@ -217,7 +204,7 @@ fn edges(path: &Path) -> (LogicInfo, BTreeMap<String, Edges>, u64) {
 /// at the very end, which sigrok drops, left out).
 #[test]
 fn vcds_sigrok_cli_rewrote_have_the_same_edges() {
-    if !sigrok() {
+    if !common::sigrok_cli("the VCD reader") {
         return;
     }
     let dir = tempfile::tempdir().expect("a temporary folder");
@@ -287,7 +274,7 @@ fn vcds_sigrok_cli_rewrote_have_the_same_edges() {
 /// VCD rounds to the nanosecond; at 250 kHz, a whole number of them).
 #[test]
 fn a_vcd_sigrok_cli_wrote_agrees_with_its_csv_sample_by_sample() {
-    if !sigrok() {
+    if !common::sigrok_cli("the VCD reader") {
         return;
     }
     let dir = tempfile::tempdir().expect("a temporary folder");

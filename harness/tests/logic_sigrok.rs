@@ -9,26 +9,13 @@
 //! Without sigrok-cli the tests say so and pass, except in CI (`CI` set),
 //! where `.ci/run` installs it and its absence fails.
 
+mod common;
+
 use ppmc::logic::sigrok::SigrokReader;
 use ppmc::logic::source::{LogicInfo, LogicSource};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
-
-fn sigrok() -> bool {
-    let found = Command::new("sigrok-cli")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !found {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI must check the sigrok reader with sigrok-cli (apt install sigrok-cli)"
-        );
-        eprintln!("sigrok-cli is not installed: the .sr reader is not checked against it");
-    }
-    found
-}
 
 /// Runs sigrok-cli; its standard output.
 fn sigrok_cli(args: &[&str]) -> String {
@@ -166,7 +153,7 @@ fn scratch() -> tempfile::TempDir {
 
 #[test]
 fn demo_device_captures_read_as_sigrok_cli_prints_them() {
-    if !sigrok() {
+    if !common::sigrok_cli("the sigrok reader") {
         return;
     }
     let dir = scratch();
@@ -243,7 +230,7 @@ fn demo_device_captures_read_as_sigrok_cli_prints_them() {
 
 #[test]
 fn analog_channels_beside_are_left_out() {
-    if !sigrok() {
+    if !common::sigrok_cli("the sigrok reader") {
         return;
     }
     let dir = scratch();
@@ -291,7 +278,7 @@ fn vcd_of(dir: &Path, name: &str) -> (PathBuf, u64) {
 
 #[test]
 fn exported_traces_converted_at_several_rates_read_as_sigrok_cli_prints_them() {
-    if !sigrok() {
+    if !common::sigrok_cli("the sigrok reader") {
         return;
     }
     let dir = scratch();
