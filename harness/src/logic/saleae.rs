@@ -489,6 +489,7 @@ impl LogicSource for SaleaeBinary {
 
 #[cfg(test)]
 mod tests {
+    use super::super::source::testing::{ch, drain, Read};
     use super::*;
     use proptest::prelude::*;
 
@@ -538,23 +539,9 @@ mod tests {
         (dir, paths)
     }
 
-    fn read(files: &[Vec<u8>]) -> Result<(LogicInfo, Vec<Change>, u64), LogicError> {
+    fn read(files: &[Vec<u8>]) -> Result<Read, LogicError> {
         let (_dir, paths) = write(files);
-        let mut r = SaleaeBinary::open_files(&paths)?;
-        let mut out = Vec::new();
-        while let Some(c) = r.next_change()? {
-            out.push(c);
-        }
-        assert_eq!(r.next_change(), Ok(None));
-        Ok((r.info().clone(), out, r.end_ps()))
-    }
-
-    fn ch(time_ps: u64, levels: u64, unknown: u64) -> Change {
-        Change {
-            time_ps,
-            levels,
-            unknown,
-        }
+        drain(&mut SaleaeBinary::open_files(&paths)?)
     }
 
     #[test]

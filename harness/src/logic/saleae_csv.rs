@@ -293,28 +293,15 @@ pub fn seconds_to_ps(s: &str) -> Option<i128> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::source::testing::{ch, drain, Read};
     use super::*;
     use proptest::prelude::*;
 
-    fn read(text: &str) -> Result<(LogicInfo, Vec<Change>, u64), LogicError> {
-        let mut r = SaleaeCsv::new(
+    fn read(text: &str) -> Result<Read, LogicError> {
+        drain(&mut SaleaeCsv::new(
             BufReader::with_capacity(5, text.as_bytes()),
             Path::new("t.csv"),
-        )?;
-        let mut out = Vec::new();
-        while let Some(c) = r.next_change()? {
-            out.push(c);
-        }
-        assert_eq!(r.next_change(), Ok(None));
-        Ok((r.info().clone(), out, r.end_ps()))
-    }
-
-    fn ch(time_ps: u64, levels: u64, unknown: u64) -> Change {
-        Change {
-            time_ps,
-            levels,
-            unknown,
-        }
+        )?)
     }
 
     #[test]

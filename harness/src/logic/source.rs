@@ -133,6 +133,33 @@ impl fmt::Display for LogicError {
 
 impl std::error::Error for LogicError {}
 
+/// What the readers' tests share.
+#[cfg(test)]
+pub(super) mod testing {
+    use super::*;
+
+    /// What a source reads as: its info, every change, its end.
+    pub(crate) type Read = (LogicInfo, Vec<Change>, u64);
+
+    /// Every change of `r`, or its first error; once done, it stays done.
+    pub(crate) fn drain(r: &mut dyn LogicSource) -> Result<Read, LogicError> {
+        let mut out = Vec::new();
+        while let Some(c) = r.next_change()? {
+            out.push(c);
+        }
+        assert_eq!(r.next_change(), Ok(None), "the end stays the end");
+        Ok((r.info().clone(), out, r.end_ps()))
+    }
+
+    pub(crate) fn ch(time_ps: u64, levels: u64, unknown: u64) -> Change {
+        Change {
+            time_ps,
+            levels,
+            unknown,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

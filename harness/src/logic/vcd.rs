@@ -363,20 +363,13 @@ fn value(digits: &[u8], width: u32) -> Option<(u64, u64)> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::source::testing::{ch, drain, Read};
     use super::*;
     use proptest::prelude::*;
 
-    type Read = (LogicInfo, Vec<Change>, u64);
-
     fn read_with(text: &[u8], capacity: usize) -> Result<Read, LogicError> {
         let r = BufReader::with_capacity(capacity, text);
-        let mut v = VcdReader::new(r, Path::new("t.vcd"))?;
-        let mut out = Vec::new();
-        while let Some(c) = v.next_change()? {
-            out.push(c);
-        }
-        assert_eq!(v.next_change(), Ok(None), "the end stays the end");
-        Ok((v.info().clone(), out, v.end_ps()))
+        drain(&mut VcdReader::new(r, Path::new("t.vcd"))?)
     }
 
     fn read(text: &str) -> Read {
@@ -391,14 +384,6 @@ mod tests {
         match read_with(text.as_bytes(), 1 << 16) {
             Ok(r) => panic!("read: {r:?}"),
             Err(e) => e.to_string(),
-        }
-    }
-
-    fn ch(time_ps: u64, levels: u64, unknown: u64) -> Change {
-        Change {
-            time_ps,
-            levels,
-            unknown,
         }
     }
 
