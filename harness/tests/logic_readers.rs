@@ -17,7 +17,6 @@ use ppmc::logic::source::{Change, LogicInfo, LogicSource};
 use ppmc::logic::vcd::VcdReader;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -155,18 +154,6 @@ fn a_femtosecond_vcd_with_dumpoff() {
     assert_eq!(end, 200_000);
 }
 
-fn run_sigrok(args: &[&str]) {
-    let out = Command::new("sigrok-cli")
-        .args(args)
-        .output()
-        .expect("sigrok-cli runs");
-    assert!(
-        out.status.success(),
-        "sigrok-cli {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
 fn path_str(p: &Path) -> &str {
     p.to_str().expect("a UTF-8 temporary path")
 }
@@ -222,7 +209,7 @@ fn vcds_sigrok_cli_rewrote_have_the_same_edges() {
         let file = std::fs::File::create(&ours).expect("a temporary file");
         ppmc::vcd_export::export(&trace, std::io::BufWriter::new(file)).expect("exported");
         let theirs = dir.path().join(format!("{name}.{downsample}.vcd"));
-        run_sigrok(&[
+        common::run_sigrok_cli(&[
             "-I",
             &format!("vcd:downsample={downsample}"),
             "-i",
@@ -282,7 +269,7 @@ fn a_vcd_sigrok_cli_wrote_agrees_with_its_csv_sample_by_sample() {
         let sr = dir.path().join(format!("demo-{rate}.sr"));
         let vcd = dir.path().join(format!("demo-{rate}.vcd"));
         let csv = dir.path().join(format!("demo-{rate}.csv"));
-        run_sigrok(&[
+        common::run_sigrok_cli(&[
             "-d",
             "demo",
             "--samples",
@@ -294,8 +281,8 @@ fn a_vcd_sigrok_cli_wrote_agrees_with_its_csv_sample_by_sample() {
             "-o",
             path_str(&sr),
         ]);
-        run_sigrok(&["-i", path_str(&sr), "-O", "vcd", "-o", path_str(&vcd)]);
-        run_sigrok(&["-i", path_str(&sr), "-O", "csv", "-o", path_str(&csv)]);
+        common::run_sigrok_cli(&["-i", path_str(&sr), "-O", "vcd", "-o", path_str(&vcd)]);
+        common::run_sigrok_cli(&["-i", path_str(&sr), "-O", "csv", "-o", path_str(&csv)]);
         // The CSV: `;` comments, a header, then one row per sample.
         let text = std::fs::read_to_string(&csv).expect("sigrok's CSV");
         let rows: Vec<u64> = text

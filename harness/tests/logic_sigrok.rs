@@ -14,23 +14,7 @@ mod common;
 use ppmc::logic::sigrok::SigrokReader;
 use ppmc::logic::source::{LogicInfo, LogicSource};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
-
-/// Runs sigrok-cli; its standard output.
-fn sigrok_cli(args: &[&str]) -> String {
-    let out = Command::new("sigrok-cli")
-        .args(args)
-        .output()
-        .expect("sigrok-cli runs");
-    assert!(
-        out.status.success(),
-        "sigrok-cli {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).expect("sigrok-cli prints text")
-}
 
 fn arg(p: &Path) -> &str {
     p.to_str().expect("a UTF-8 path")
@@ -39,7 +23,7 @@ fn arg(p: &Path) -> &str {
 /// What sigrok-cli prints of a session file: the channel names and every
 /// sample (bit `i` = column `i`), from `-O csv`.
 fn csv(sr: &Path) -> (Vec<String>, Vec<u64>) {
-    let text = sigrok_cli(&["-i", arg(sr), "-O", "csv:label=channel:header=false"]);
+    let text = common::run_sigrok_cli(&["-i", arg(sr), "-O", "csv:label=channel:header=false"]);
     let mut lines = text.lines();
     let names = lines
         .next()
@@ -63,7 +47,7 @@ fn csv(sr: &Path) -> (Vec<String>, Vec<u64>) {
 /// channels, logic sample count. A disabled channel is listed too, named
 /// by libsigrok for its index (`4`); it is left out here.
 fn show(sr: &Path) -> (u64, Vec<String>, u64) {
-    let text = sigrok_cli(&["-i", arg(sr), "--show"]);
+    let text = common::run_sigrok_cli(&["-i", arg(sr), "--show"]);
     let field = |key: &str| {
         text.lines()
             .find_map(|l| l.strip_prefix(key))
@@ -217,7 +201,7 @@ fn demo_device_captures_read_as_sigrok_cli_prints_them() {
         let sr = dir.path().join(format!("{name}.sr"));
         let mut all = args.to_vec();
         all.extend(["-o", arg(&sr)]);
-        sigrok_cli(&all);
+        common::run_sigrok_cli(&all);
         assert!(chunks(&sr) > 1, "{name}: one chunk only");
         let got = agree(&sr);
         let info = read(&sr).0;
@@ -238,8 +222,8 @@ fn analog_channels_beside_are_left_out() {
     let logic = dir.path().join("logic.sr");
     // The demo's 8 logic and 5 analog channels, then its logic alone: the
     // demo's patterns start alike, so the logic samples are the same.
-    sigrok_cli(&["-d", "demo", "--samples", "20000", "-o", arg(&both)]);
-    sigrok_cli(&[
+    common::run_sigrok_cli(&["-d", "demo", "--samples", "20000", "-o", arg(&both)]);
+    common::run_sigrok_cli(&[
         "-d",
         "demo:analog_channels=0",
         "--samples",
@@ -293,7 +277,7 @@ fn exported_traces_converted_at_several_rates_read_as_sigrok_cli_prints_them() {
         let (vcd, pulses) = vcd_of(dir.path(), name);
         let sr = dir.path().join(format!("{name}-{downsample}.sr"));
         let input = format!("vcd:downsample={downsample}");
-        sigrok_cli(&["-I", &input, "-i", arg(&vcd), "-o", arg(&sr)]);
+        common::run_sigrok_cli(&["-I", &input, "-i", arg(&vcd), "-o", arg(&sr)]);
         let got = agree(&sr);
         let info = read(&sr).0;
         assert_eq!(

@@ -400,3 +400,18 @@ pub fn sigrok_cli(what: &str) -> bool {
     }
     found
 }
+
+/// Runs sigrok-cli with `args`, which must succeed; its standard output.
+pub fn run_sigrok_cli(args: &[&str]) -> String {
+    let out = std::process::Command::new("sigrok-cli")
+        .args(args)
+        .output()
+        .expect("sigrok-cli runs");
+    assert!(
+        out.status.success(),
+        "sigrok-cli {}: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("sigrok-cli prints text")
+}
