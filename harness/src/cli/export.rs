@@ -2,10 +2,9 @@
 //! emulator (clean or with a board fault) as a logic analyzer would record
 //! it.
 
-use crate::backend::EmuTarget;
 use crate::cli::{usage, CliError};
 use crate::files;
-use crate::scenario::{run_scenario, DriverOptions, Scenario};
+use crate::scenario::Scenario;
 use crate::trace::Trace;
 use clap::Args;
 use std::path::PathBuf;
@@ -40,7 +39,8 @@ pub struct ExportArgs {
 }
 
 /// The trace of `name` run on the emulator with `faults`, every register
-/// access taking a bus cycle.
+/// access taking a bus cycle, as a logic analyzer records it (every
+/// access the chip served, though the scenario fail).
 fn scenario_trace(name: &str, faults: &[String], suite: &[Scenario]) -> Result<Trace, CliError> {
     let Some(s) = suite.iter().find(|s| s.name == name) else {
         return Err(usage(format!("no scenario `{name}` (see `ppmc list`)")));
@@ -48,17 +48,9 @@ fn scenario_trace(name: &str, faults: &[String], suite: &[Scenario]) -> Result<T
     let mut model = crate::emu::ModelConfig::default();
     crate::faults::apply_all(faults, &mut model)
         .map_err(|e| usage(format!("--chip-fault: {e}")))?;
-    let target = EmuTarget::new(crate::protocol::Straps::default(), model)
-        .map_err(|e| usage(e.to_string()))?;
-    let cycle = crate::time::Duration::from_nanos(crate::vcd_export::BUS_CYCLE);
-    let mut target = target.with_bus_cycle(cycle);
-    let r = run_scenario(&mut target, s, DriverOptions::default());
-    r.trace.ok_or_else(|| {
-        CliError::Failed(format!(
-            "{name}: the scenario left no trace ({})",
-            r.verdict.detail().unwrap_or_default()
-        ))
-    })
+    crate::fault_matrix::capture::analyzer_trace(&model, s)
+        .map(|(trace, _)| trace)
+        .map_err(|e| CliError::Failed(format!("{name}: {e}")))
 }
 
 pub fn run(args: ExportArgs, suite: &[Scenario]) -> Result<(), CliError> {

@@ -87,27 +87,17 @@ pub fn judge_captures(
         scenario: scenario.to_string(),
         why,
     };
-    let emu = EmuTarget::new(Straps::default(), model.clone())
-        .map_err(|e| err("(the emulator)", e.to_string()))?
-        .with_bus_cycle(Duration::from_nanos(BUS_CYCLE));
-    let mut target = Analyzer {
-        emu,
-        bus: Vec::new(),
-    };
     let opts = JudgeOptions::default();
     let mut column = CaptureColumn::default();
     for s in suite {
-        let r = run_scenario(&mut target, s, DriverOptions::default());
-        if r.elapsed > LONGEST {
+        let (trace, lasts) = analyzer_trace(model, s).map_err(|e| err(s.name, e))?;
+        if lasts > LONGEST {
             column.skipped.push(Skipped {
                 scenario: s.name,
-                lasts: r.elapsed,
+                lasts,
             });
             continue;
         }
-        let trace = target
-            .trace(s)
-            .map_err(|e| err(s.name, format!("the emulator's capture: {e}")))?;
         let mut vcd = Vec::new();
         export_with(
             &trace,
@@ -140,6 +130,26 @@ pub fn judge_captures(
         }
     }
     Ok(column)
+}
+
+/// Scenario `s` run on the emulator with `model` as a host on a real bus
+/// runs it, every register access taking a bus cycle, and recorded as a
+/// logic analyzer on the bus and pins records it ([`Analyzer`]): every
+/// access the chip served and everything it put out. With how long it
+/// ran. What `ppmc export --scenario` writes, and what this column judges.
+pub fn analyzer_trace(model: &ModelConfig, s: &Scenario) -> Result<(Trace, Duration), String> {
+    let emu = EmuTarget::new(Straps::default(), model.clone())
+        .map_err(|e| format!("the emulator: {e}"))?
+        .with_bus_cycle(Duration::from_nanos(BUS_CYCLE));
+    let mut target = Analyzer {
+        emu,
+        bus: Vec::new(),
+    };
+    let r = run_scenario(&mut target, s, DriverOptions::default());
+    let trace = target
+        .trace(s)
+        .map_err(|e| format!("the emulator's capture: {e}"))?;
+    Ok((trace, r.elapsed))
 }
 
 /// The emulator with every register access it served logged, as a logic
@@ -201,8 +211,7 @@ impl Target for Analyzer {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Unseen {
     /// The effect is on pins the capture has, which the judge does not
-    /// compare yet (it compares status and data reads, POUT's pulses and
-    /// DIR at each pulse).
+    /// compare yet (the phases S1..S5).
     NotCompared(&'static str),
     /// No capture of the chip's bus and pins shows it.
     CannotShow(&'static str),
