@@ -4,14 +4,12 @@
 //! against the reference model. A clean board passes; a faulty one
 //! (`ppmc::faults`) fails, blamed on the board, at its first divergence.
 
-use ppmc::backend::EmuTarget;
 use ppmc::emu::ModelConfig;
+use ppmc::fault_matrix::capture::analyzer_trace;
 use ppmc::judge::{judge, JudgeOptions, Verdict};
 use ppmc::logic::map::ChannelMap;
 use ppmc::logic::source::LogicSource;
 use ppmc::logic::vcd::VcdReader;
-use ppmc::protocol::Straps;
-use ppmc::scenario::{run_scenario, DriverOptions};
 use ppmc::trace::Trace;
 use ppmc::vcd_export::{export_with, Export};
 use std::path::Path;
@@ -21,13 +19,7 @@ fn trace_of(name: &str, cfg: ModelConfig) -> Trace {
     let suite = ppmc_scenarios::all();
     let s = suite.iter().find(|s| s.name == name).expect("scenario");
     // A host on a real bus: every access takes a bus cycle.
-    let mut t = EmuTarget::new(Straps::default(), cfg)
-        .expect("emulator")
-        .with_bus_cycle(ppmc::time::Duration::from_nanos(
-            ppmc::vcd_export::BUS_CYCLE,
-        ));
-    let r = run_scenario(&mut t, s, DriverOptions::default());
-    r.trace.expect("a trace")
+    analyzer_trace(&cfg, s).expect("a capture").0
 }
 
 /// The capture of `trace` as a logic analyzer would record it, read by

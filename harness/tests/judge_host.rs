@@ -5,14 +5,12 @@
 //! section, while the board itself passes; a correct host's capture gives
 //! none.
 
-use ppmc::backend::EmuTarget;
 use ppmc::emu::{Board, ModelConfig};
 use ppmc::judge::{judge, JudgeOptions, Judgement, Verdict};
 use ppmc::logic::map::ChannelMap;
 use ppmc::logic::source::LogicSource;
 use ppmc::logic::vcd::VcdReader;
 use ppmc::protocol::Straps;
-use ppmc::scenario::{run_scenario, DriverOptions};
 use ppmc::time::Instant;
 use ppmc::vcd_export::{export_with, Export};
 use std::path::Path;
@@ -124,13 +122,8 @@ fn judged_hand(cycles: &[(u64, Bus)], end_us: u64) -> Judgement {
 fn judged_scenario(name: &str) -> Judgement {
     let suite = ppmc_scenarios::all();
     let s = suite.iter().find(|s| s.name == name).expect("scenario");
-    let mut t = EmuTarget::new(Straps::default(), ModelConfig::default())
-        .expect("emulator")
-        .with_bus_cycle(ppmc::time::Duration::from_nanos(
-            ppmc::vcd_export::BUS_CYCLE,
-        ));
-    let r = run_scenario(&mut t, s, DriverOptions::default());
-    let trace = r.trace.expect("a trace");
+    let (trace, _) =
+        ppmc::fault_matrix::capture::analyzer_trace(&ModelConfig::default(), s).expect("a capture");
     let mut buf = Vec::new();
     let export = Export {
         window: None,

@@ -5,15 +5,14 @@
 //! its channels' edges and put together again with the board's
 //! difference.
 
-use ppmc::backend::EmuTarget;
 use ppmc::emu::ModelConfig;
+use ppmc::fault_matrix::capture::analyzer_trace;
 use ppmc::judge::{judge, JudgeOptions, Verdict};
 use ppmc::logic::map::ChannelMap;
 use ppmc::logic::source::{Change, LogicError, LogicInfo, LogicSource};
 use ppmc::logic::vcd::VcdReader;
 use ppmc::protocol::Straps;
-use ppmc::scenario::{run_scenario, DriverOptions};
-use ppmc::vcd_export::{export_with, Export, BUS_CYCLE};
+use ppmc::vcd_export::{export_with, Export};
 use std::path::Path;
 
 /// A capture as a list of changes.
@@ -48,12 +47,7 @@ impl Edges {
     fn of(scenario: &str) -> Edges {
         let suite = ppmc_scenarios::all();
         let s = suite.iter().find(|s| s.name == scenario).expect("scenario");
-        let mut t = EmuTarget::new(Straps::default(), ModelConfig::default())
-            .expect("emulator")
-            .with_bus_cycle(ppmc::time::Duration::from_nanos(BUS_CYCLE));
-        let trace = run_scenario(&mut t, s, DriverOptions::default())
-            .trace
-            .expect("a trace");
+        let (trace, _) = analyzer_trace(&ModelConfig::default(), s).expect("a capture");
         let mut buf = Vec::new();
         let what = Export {
             window: None,

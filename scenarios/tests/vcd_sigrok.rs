@@ -116,8 +116,6 @@ fn sigrok_counts_every_pulse_of_an_exported_trace() {
 /// order and with its byte, as the scenario's trace records them.
 #[test]
 fn the_pulseview_decoder_names_every_register_access() {
-    use ppmc::backend::EmuTarget;
-    use ppmc::scenario::{run_scenario, DriverOptions};
     use ppmc::trace::{BusEvent, EventKind};
     if !sigrok() {
         return;
@@ -138,14 +136,8 @@ fn the_pulseview_decoder_names_every_register_access() {
     // What the trace says the host did, with the same bus cycles.
     let suite = ppmc_scenarios::all();
     let s = suite.iter().find(|s| s.name == name).expect("scenario");
-    let mut t = EmuTarget::new(ppmc::protocol::Straps::default(), Default::default())
-        .expect("emulator")
-        .with_bus_cycle(ppmc::time::Duration::from_nanos(
-            ppmc::vcd_export::BUS_CYCLE,
-        ));
-    let trace = run_scenario(&mut t, s, DriverOptions::default())
-        .trace
-        .expect("trace");
+    let (trace, _) =
+        ppmc::fault_matrix::capture::analyzer_trace(&Default::default(), s).expect("a capture");
     let want: Vec<String> = trace
         .events
         .iter()
