@@ -34,6 +34,7 @@ pub mod scenario;
 pub mod selftest;
 pub mod soak;
 pub mod stop;
+pub mod store;
 pub mod trace;
 pub mod vcd_export;
 

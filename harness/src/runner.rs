@@ -4,7 +4,9 @@
 //! [`Farm`], which keeps the boards it could not reach out of the verdict.
 
 use crate::backend::{self, Op, OpenError, OpenOptions, Target, TargetInfo, TargetSpec};
-use crate::scenario::{run_scenario, DriverOptions, NotRun, Scenario, ScenarioResult, Verdict};
+use crate::scenario::{
+    run_scenario, Attempt, DriverOptions, NotRun, Scenario, ScenarioResult, Verdict,
+};
 use crate::stop::Stop;
 use crate::time::Duration;
 
@@ -154,14 +156,27 @@ fn run_checked(
     s: &Scenario,
     opts: DriverOptions,
 ) -> (ScenarioResult, Option<String>) {
-    let r = run_scenario(target, s, opts);
-    let mut lost = None;
-    if matches!(r.verdict, Verdict::Error(_)) {
-        if let Err(e) = target.execute(&[Op::Reset]) {
-            lost = Some(e.to_string());
+    let mut earlier = Vec::new();
+    loop {
+        let mut r = run_scenario(target, s, opts);
+        let mut lost = None;
+        if matches!(r.verdict, Verdict::Error(_)) {
+            if let Err(e) = target.execute(&[Op::Reset]) {
+                lost = Some(e.to_string());
+            }
         }
+        // Again on the same board, while it is there and the policy takes
+        // this end; every attempt stays on record.
+        let again = lost.is_none()
+            && earlier.len() < opts.retry.times as usize
+            && opts.retry.takes(&r.verdict);
+        if again {
+            earlier.push(Attempt::of(&r));
+            continue;
+        }
+        r.attempts = earlier;
+        return (r, lost);
     }
-    (r, lost)
 }
 
 /// The result of a scenario that did not run, and why.
@@ -175,6 +190,7 @@ pub fn not_run(s: &Scenario, why: NotRun) -> ScenarioResult {
         trace: None,
         elapsed: Duration::ZERO,
         wall: std::time::Duration::ZERO,
+        attempts: Vec::new(),
     }
 }
 
@@ -434,6 +450,13 @@ impl Farm {
     /// The specs, in the order given: board `b` of the results is `specs()[b]`.
     pub fn specs(&self) -> &[TargetSpec] {
         &self.specs
+    }
+
+    /// What board `b`'s link has cost so far ([`Target::link_stats`]);
+    /// `None` for the emulator or a board not reached.
+    pub fn link_stats(&self, b: usize) -> Option<Vec<(&'static str, u64)>> {
+        let t = self.reached.iter().position(|r| *r == b)?;
+        self.targets[t].link_stats()
     }
 
     /// Board `b`: what its target says of itself, or why it was not reached.

@@ -9,6 +9,7 @@
 //! What is held grows with the suite and the cap, never with the passes.
 
 use crate::report::tally::Tally;
+use crate::report::Figures;
 use crate::runner::BoardResult;
 use crate::scenario::{Grade, NotRun, ScenarioResult, Verdict};
 use crate::time::Duration;
@@ -30,6 +31,17 @@ pub struct Listed {
     pub result: ScenarioResult,
     /// The files saved for it (`--artifacts`).
     pub attachments: Vec<String>,
+    /// What the HTML report draws of it.
+    pub figures: Option<Figures>,
+}
+
+/// What a run keeps of a result beside it, for the reports: listed with
+/// the result, dropped with it when the soak only counts it.
+#[derive(Debug, Default)]
+pub struct Kept {
+    /// The files saved for it (`--artifacts`).
+    pub attachments: Vec<String>,
+    pub figures: Option<Figures>,
 }
 
 /// One measurement of a scenario over many runs.
@@ -87,14 +99,13 @@ pub struct Repeated {
 impl Repeated {
     /// How many runs these are.
     pub fn runs(&self) -> usize {
-        let t = &self.tally;
-        t.passed + t.marginal + t.failed + t.errors + t.not_run
+        self.tally.runs()
     }
 
     fn add(&mut self, pass: usize, r: &ScenarioResult) {
         self.first_pass = self.first_pass.min(pass);
         self.last_pass = self.last_pass.max(pass);
-        count(&mut self.tally, &r.verdict);
+        self.tally.count(r);
         if r.verdict == Verdict::NotRun(NotRun::Interrupted) {
             self.interrupted += 1;
         }
@@ -122,16 +133,6 @@ impl Repeated {
                 }),
             }
         }
-    }
-}
-
-fn count(t: &mut Tally, v: &Verdict) {
-    match v {
-        Verdict::Passed => t.passed += 1,
-        Verdict::Marginal => t.marginal += 1,
-        Verdict::Failed(_) => t.failed += 1,
-        Verdict::Error(_) => t.errors += 1,
-        Verdict::NotRun(_) => t.not_run += 1,
     }
 }
 
@@ -172,13 +173,14 @@ impl Soak {
     }
 
     /// Takes one result: `board` is its board as the reports name it (an
-    /// index into the run's boards), `attachments` the files saved for it.
-    pub fn add(&mut self, r: BoardResult, board: Option<usize>, attachments: Vec<String>) {
+    /// index into the run's boards), `kept` what the run keeps beside it.
+    pub fn add(&mut self, r: BoardResult, board: Option<usize>, kept: Kept) {
         let pass = self.pass_of(r.slot);
-        count(&mut self.tally, &r.result.verdict);
-        count(self.boards.entry(board).or_default(), &r.result.verdict);
+        self.tally.count(&r.result);
+        self.boards.entry(board).or_default().count(&r.result);
         let listed = pass == 1 || {
-            let more = !r.result.verdict.ok() && self.listed_later < MAX_LISTED;
+            let more =
+                (!r.result.verdict.ok() || r.result.flaky()) && self.listed_later < MAX_LISTED;
             self.listed_later += usize::from(more);
             more
         };
@@ -188,7 +190,8 @@ impl Soak {
                 pass,
                 board,
                 result: r.result,
-                attachments,
+                attachments: kept.attachments,
+                figures: kept.figures,
             });
             return;
         }
@@ -283,7 +286,7 @@ mod tests {
             || false,
             |_, _, _| {},
             |r| {
-                soak.add(r, Some(0), Vec::new());
+                soak.add(r, Some(0), Kept::default());
                 most = most.max(soak.listed_len());
             },
         );
@@ -343,7 +346,7 @@ mod tests {
                 slot,
                 result,
             };
-            soak.add(r, Some(0), Vec::new());
+            soak.add(r, Some(0), Kept::default());
         }
         let (listed, repeated) = soak.finish();
         assert_eq!(listed.len(), 1);

@@ -1,7 +1,7 @@
 //! The emulator as a target: the reference model's [`EmuBus`] behind the
 //! [`Target`] trait.
 
-use super::target::{Op, Reply, Target, TargetError, TargetInfo};
+use super::target::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
 use crate::emu::{Chip, ChipError, ModelConfig};
 use crate::protocol::{Record, RecordMark, Straps};
 use ppmc_core::bus::{Bus, EmuBus};
@@ -11,13 +11,38 @@ use ppmc_core::bus::{Bus, EmuBus};
 #[derive(Debug, Clone)]
 pub struct EmuTarget {
     bus: EmuBus,
+    /// The catalogue's board faults the model was given, for the reports.
+    chip_faults: String,
+    /// Batches run so far, and the one that fails as a lost link would
+    /// (`emu,drop-batch=N`), once.
+    batches: u64,
+    drop_batch: Option<u64>,
 }
 
 impl EmuTarget {
     pub fn new(straps: Straps, cfg: ModelConfig) -> Result<Self, ChipError> {
         Ok(EmuTarget {
             bus: EmuBus::new(straps, cfg)?,
+            chip_faults: String::new(),
+            batches: 0,
+            drop_batch: None,
         })
+    }
+
+    /// Makes batch `n` (from 1) fail as a lost link would, once, without
+    /// running it (`emu,drop-batch=N`): to try `--retries` and the reports
+    /// of a flaky board without one.
+    pub fn with_dropped_batch(mut self, n: Option<u64>) -> Self {
+        self.drop_batch = n;
+        self
+    }
+
+    /// Names the board faults its model was made with (`chip-fault=`), so
+    /// that the reports say which board this was.
+    pub fn with_chip_faults<S: AsRef<str>>(mut self, names: &[S]) -> Self {
+        let names: Vec<&str> = names.iter().map(AsRef::as_ref).collect();
+        self.chip_faults = names.join("+");
+        self
     }
 
     /// Every register access takes `cycle` of the chip's time
@@ -58,7 +83,10 @@ impl Target for EmuTarget {
         TargetInfo {
             name: "emu".to_string(),
             straps: self.bus.straps(),
-            extra: Vec::new(),
+            extra: match self.chip_faults.is_empty() {
+                true => Vec::new(),
+                false => vec![("chip_faults".to_string(), self.chip_faults.clone())],
+            },
         }
     }
 
@@ -71,6 +99,16 @@ impl Target for EmuTarget {
     }
 
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
+        self.batches += 1;
+        if self.drop_batch == Some(self.batches) {
+            return Err(TargetError::new(
+                TargetErrorKind::Link,
+                format!(
+                    "batch {} dropped on purpose (emu,drop-batch={}): no reply",
+                    self.batches, self.batches
+                ),
+            ));
+        }
         Ok(ops.iter().map(|op| self.bus.run(*op)).collect())
     }
 

@@ -113,8 +113,13 @@ pub fn open(spec: &TargetSpec, opts: &OpenOptions) -> Result<Box<dyn Target>, Op
     match address {
         Address::Emu => {
             let straps = opts.straps_of(spec)?;
-            let t = EmuTarget::new(straps, opts.model.clone())
+            let mut model = opts.model.clone();
+            crate::faults::apply_all(&spec.chip_faults, &mut model)
                 .map_err(|e| OpenError::Invalid(e.to_string()))?;
+            let t = EmuTarget::new(straps, model)
+                .map_err(|e| OpenError::Invalid(e.to_string()))?
+                .with_chip_faults(&spec.chip_faults)
+                .with_dropped_batch(spec.drop_batch);
             Ok(Box::new(t))
         }
         Address::Serial { path, baud } => {

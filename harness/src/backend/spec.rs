@@ -256,12 +256,20 @@ pub struct TargetSpec {
     pub name: Option<String>,
     /// The board revision label (`rev=`).
     pub rev: Option<String>,
+    /// The board's serial number (`board-serial=`).
+    pub serial: Option<String>,
     /// Reply padding to ask the bridge for (`pad=`); default: the link
     /// kind's ([`LinkKind::default_pad`]).
     pub pad: Option<u16>,
     /// The board's own strap options (`clock-mhz=`, `csel=`, ...), over
     /// those given for every board.
     pub straps: StrapOptions,
+    /// Board faults of the catalogue the emulator models (`chip-fault=`,
+    /// once per fault; `emu` only): a faulty board without a board.
+    pub chip_faults: Vec<String>,
+    /// The emulator's batch that fails as a lost link would, once
+    /// (`drop-batch=`; `emu` only).
+    pub drop_batch: Option<u64>,
 }
 
 impl FromStr for TargetSpec {
@@ -284,8 +292,11 @@ impl TargetSpec {
             address: String::new(),
             name: None,
             rev: None,
+            serial: None,
             pad: None,
             straps: StrapOptions::default(),
+            chip_faults: Vec::new(),
+            drop_batch: None,
         };
         let bad = |what: &str| SpecError(format!("--target `{spec}`: {what}"));
         let number = |k: &str, v: &str| {
@@ -311,6 +322,7 @@ impl TargetSpec {
             match k {
                 "name" => t.name = Some(text(k, v)?),
                 "rev" => t.rev = Some(text(k, v)?),
+                "board-serial" => t.serial = Some(text(k, v)?),
                 "pad" => {
                     t.pad = Some(
                         v.parse::<u16>()
@@ -318,6 +330,21 @@ impl TargetSpec {
                             .filter(|p| *p <= ppmc_core::bridge::wire::MAX_PAD)
                             .ok_or_else(|| bad(&format!("pad={v}: give 0 to 512 bytes")))?,
                     )
+                }
+                "chip-fault" => {
+                    let name = text(k, v)?;
+                    if ppmc_core::emu::faults::find(&name).is_none() {
+                        return Err(bad(&format!(
+                            "chip-fault={name}: not in the board-fault catalogue (ppmc fault-matrix --list)"
+                        )));
+                    }
+                    t.chip_faults.push(name);
+                }
+                "drop-batch" => {
+                    t.drop_batch =
+                        Some(v.parse::<u64>().ok().filter(|n| *n >= 1).ok_or_else(|| {
+                            bad(&format!("drop-batch={v}: give the batch's number, from 1"))
+                        })?)
                 }
                 "clock-mhz" => t.straps.clock_mhz = Some(number(k, v)?),
                 "ext-clock-khz" => t.straps.ext_clock_khz = Some(number(k, v)?),
@@ -370,6 +397,16 @@ impl TargetSpec {
         let a = self.address.as_str();
         if a == "emu" {
             return Ok(Address::Emu);
+        }
+        if self.drop_batch.is_some() {
+            return Err(SpecError(format!(
+                "--target `{a}`: drop-batch= fails a batch of the emulator; a real link brings its own faults (to make them: ppmc chaos-proxy, ppmc bridge-sim --drop-rate)"
+            )));
+        }
+        if !self.chip_faults.is_empty() {
+            return Err(SpecError(format!(
+                "--target `{a}`: chip-fault= makes the emulator a faulty board; a real board brings its own faults (for a faulty board behind a bridge: ppmc bridge-sim --chip-fault)"
+            )));
         }
         let Some(kind) = LinkKind::ALL
             .into_iter()

@@ -156,6 +156,13 @@ pub trait Target: Send {
         ))
     }
 
+    /// What the link to the target has cost so far, by name (round trips,
+    /// retransmissions, corrupt frames, reopens); `None` for a target with
+    /// no link (the emulator).
+    fn link_stats(&self) -> Option<Vec<(&'static str, u64)>> {
+        None
+    }
+
     /// Runs one op.
     fn execute_one(&mut self, op: Op) -> Result<Reply, TargetError> {
         let mut replies = self.execute(std::slice::from_ref(&op))?;

@@ -23,9 +23,13 @@ pub struct TargetArgs {
     /// as ser2net's telnet(rfc2217) mode and labgrid's exporter serve it) or
     /// `labgrid:<place>` (the serial port of a labgrid place you have
     /// acquired). Any of them may end in options of that board alone:
-    /// `,name=LABEL`, `,rev=LABEL`, `,pad=BYTES` (reply padding, default 64
+    /// `,name=LABEL`, `,rev=LABEL`, `,board-serial=SERIAL`, `,pad=BYTES` (reply padding, default 64
     /// on a network target, 0 on a serial port) and the straps `,clock-mhz=`, `,csel=`,
     /// `,vsel=`, `,ext-clock-khz=` (they override the flags below).
+    /// `emu,chip-fault=NAME` (once per fault) makes the emulator a board
+    /// with that fault of the catalogue (`ppmc fault-matrix --list`), and
+    /// `emu,drop-batch=N` fails its Nth batch once, as a lost link would
+    /// (to try `--retries`).
     /// `ppmc run` takes several, one per board, and spreads the suite over
     /// them.
     #[arg(long = "target", value_name = "TARGET", default_value = "emu")]
@@ -42,6 +46,14 @@ pub struct TargetArgs {
     /// a noisy line is alive).
     #[arg(long, value_name = "N", default_value_t = 10)]
     link_retries: u32,
+    /// The board's serial number, for the reports and the results store
+    /// (a target's own `,board-serial=` overrides it).
+    #[arg(long, value_name = "SERIAL")]
+    pub(super) board_serial: Option<String>,
+    /// The board's revision label, for the reports and the results store
+    /// (a target's own `,rev=` overrides it).
+    #[arg(long, value_name = "REV")]
+    pub(super) board_rev: Option<String>,
     /// Asked for (a signal), opening a target and every wait on its link
     /// end early.
     #[arg(skip)]

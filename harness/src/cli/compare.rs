@@ -32,6 +32,11 @@ pub struct CompareArgs {
     /// writes it; the compared trace set stands as the board).
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    /// Write the HTML report (docs/reports.md): each move's speed profile
+    /// over the golden one with its tolerance band, the first divergence
+    /// marked, the pins around it.
+    #[arg(long, value_name = "FILE")]
+    html: Option<PathBuf>,
 }
 
 pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
@@ -58,11 +63,15 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             tolerance: args.tolerance,
             junit: args.junit,
             json: args.json,
+            html: args.html,
+            store: None,
             artifacts: None,
             artifacts_window: super::run::Window::All,
-            board_rev: None,
             each: false,
             repeat: 1,
+            retries: 0,
+            retry_failures: false,
+            flaky_is_failure: false,
             marginal: 0.25,
         };
         return super::run::run(run_args, suite);
@@ -73,6 +82,11 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             dir.display()
         )));
     }
+    super::run::prepare_reports(
+        args.junit.as_deref(),
+        args.json.as_deref(),
+        args.html.as_deref(),
+    )?;
     // A trace that diverges fails, as in `ppmc run --golden`; a file that
     // cannot be used (missing, unreadable, corrupt, at other straps) is an
     // error of its own: the file is at fault, not the board.
@@ -83,7 +97,10 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             target: format!("traces:{}", dir.display()),
             target_details: Default::default(),
             board_rev: None,
+            board_serial: None,
             bridge_firmware: None,
+            bridge_serial: None,
+            link: None,
             error: None,
         }],
         "one",
@@ -99,6 +116,7 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
     };
     args.select.describe(&mut info.options);
     let mut results = Vec::with_capacity(scenarios.len());
+    let mut figures = Vec::with_capacity(scenarios.len());
     for s in &scenarios {
         let mut r = ScenarioResult {
             name: s.name,
@@ -109,12 +127,14 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             trace: None,
             elapsed: Duration::ZERO,
             wall: std::time::Duration::ZERO,
+            attempts: Vec::new(),
         };
         match golden::load(dir, s.name) {
             Ok(t) => {
                 r.elapsed = Duration::from_nanos(t.events.last().map_or(0, |e| e.at.as_nanos()));
                 r.trace = Some(t);
-                super::run::check_golden(&mut r, &args.golden, &tol);
+                let golden = super::run::check_golden(&mut r, &args.golden, &tol);
+                figures.push(super::run::figures_of(&r, golden.as_ref()));
                 r.trace = None;
             }
             Err(GoldenError::Missing { path }) => {
@@ -122,6 +142,7 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             }
             Err(e) => r.verdict = Verdict::Error(HarnessError::Golden(e.to_string())),
         }
+        figures.resize(results.len() + 1, None);
         outln!("{}", super::run::verdict_line(&r, None));
         results.push(r);
     }
@@ -133,8 +154,14 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             problems.push(e);
         }
     }
+    let listing = report::Listing::all(&results, &[], &on).with_figures(&figures);
     if let Some(p) = &args.json {
-        if let Err(e) = super::run::write_report(p, report::json(&info, &results, &on)) {
+        if let Err(e) = super::run::write_report(p, report::json_listing(&info, &listing)) {
+            problems.push(e);
+        }
+    }
+    if let Some(p) = &args.html {
+        if let Err(e) = super::run::write_html(p, report::json_listing(&info, &listing)) {
             problems.push(e);
         }
     }

@@ -170,7 +170,7 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         tolerances: args.tolerance.tolerances().map_err(usage)?,
         glitch_ps: args.capture.glitch.as_nanos() * 1000,
     };
-    super::run::prepare_reports(args.junit.as_deref(), args.json.as_deref())?;
+    super::run::prepare_reports(args.junit.as_deref(), args.json.as_deref(), None)?;
     let name = match (&args.trace, &args.scenario) {
         (None, _) => None,
         (Some(_), Some(n)) => Some(n.clone()),
@@ -284,6 +284,7 @@ fn records(
         trace: None,
         elapsed: Duration::ZERO,
         wall,
+        attempts: Vec::new(),
     };
     let mut notes: Vec<String> = j
         .not_judged

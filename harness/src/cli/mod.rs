@@ -14,10 +14,12 @@ mod console;
 mod export;
 mod fault_matrix;
 mod fuzz;
+mod history;
 mod judge;
 mod list;
 mod progress;
 mod record;
+mod report;
 mod run;
 mod selftest;
 mod signals;
@@ -104,6 +106,15 @@ enum Command {
     /// that fails never turns into a verdict on the board. Prints where it
     /// listens; runs until SIGINT.
     ChaosProxy(chaos_proxy::ChaosProxyArgs),
+    /// Draw run records as one offline HTML page: every verdict, each
+    /// measurement against its Table 3-3 band, each move's speed profile
+    /// over the golden one with the first divergence marked, the pins
+    /// around each failure (docs/reports.md).
+    Report(report::ReportArgs),
+    /// What a results store (`ppmc run --store FILE`) says across runs:
+    /// yield per revision, the scenarios with the lowest pass rate, each
+    /// measurement's spread and Cpk per revision (docs/results-store.md).
+    History(history::HistoryArgs),
 }
 
 /// The whole `ppmc` command line over `suite`: parses the process's
@@ -136,6 +147,8 @@ pub fn main(suite: Vec<Scenario>) -> ExitCode {
         Command::FaultMatrix(args) => fault_matrix::run(args, suite),
         Command::ChaosProxy(args) => chaos_proxy::run(args),
         Command::Selftest(args) => selftest::run(args),
+        Command::Report(args) => report::run(args),
+        Command::History(args) => history::run(args),
     };
     match done {
         Ok(()) => ExitCode::SUCCESS,

@@ -165,6 +165,7 @@ mod tests {
             trace: trace.then(|| Trace::parse(text).expect("valid trace")),
             elapsed: Duration::ZERO,
             wall: std::time::Duration::ZERO,
+            attempts: Vec::new(),
         }
     }
 

@@ -6,12 +6,14 @@ use crate::cli::{usage, CliError};
 use crate::compare::{compare, Tolerances};
 use crate::files;
 use crate::golden::{self};
-use crate::report::{self, BoardInfo, Listing, RunInfo, RunOptions, Tally};
+use crate::report::{self, BoardInfo, Figures, Listing, Record, RunInfo, RunOptions, Tally};
 use crate::runner::{Farm, Spread};
 use crate::scenario::{
-    DriverOptions, Failure, Grading, HarnessError, NotRun, Scenario, ScenarioResult, Verdict,
+    DriverOptions, Failure, Grading, HarnessError, NotRun, Retry, Scenario, ScenarioResult, Verdict,
 };
-use crate::soak::Soak;
+use crate::soak::{Kept, Soak};
+use crate::store::Store;
+use crate::trace::Trace;
 use clap::Args;
 use std::cell::RefCell;
 use std::collections::BTreeMap;
@@ -38,6 +40,17 @@ pub struct RunArgs {
     /// standard output.
     #[arg(long, value_name = "FILE")]
     pub(super) json: Option<PathBuf>,
+    /// Write the HTML report: one file, offline (docs/reports.md): every
+    /// verdict, each measurement against its Table 3-3 band, each move's
+    /// speed profile over the golden one (with --golden) and the first
+    /// divergence marked, the pins around each failure.
+    #[arg(long, value_name = "FILE")]
+    pub(super) html: Option<PathBuf>,
+    /// Keep the run record in a results store (SQLite; made when not
+    /// there), for `ppmc history` and `ppmc report --store`
+    /// (docs/results-store.md).
+    #[arg(long, value_name = "FILE")]
+    pub(super) store: Option<PathBuf>,
     /// Keep the trace and VCD of every scenario that did not pass here.
     /// The VCD shows `--artifacts-window` either side of the failure.
     #[arg(long, value_name = "DIR")]
@@ -49,10 +62,6 @@ pub struct RunArgs {
     /// time: its VCD is whole.
     #[arg(long, value_name = "DURATION|all", default_value = "10ms", value_parser = parse_window)]
     pub(super) artifacts_window: Window,
-    /// Board revision label for the reports (a target's own `,rev=`
-    /// overrides it).
-    #[arg(long)]
-    pub(super) board_rev: Option<String>,
     /// With several `--target`s: run the whole selection on every board
     /// (to compare boards), instead of spreading it over them.
     #[arg(long)]
@@ -65,6 +74,19 @@ pub struct RunArgs {
     /// still writes the reports.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     pub(super) repeat: u32,
+    /// Try a scenario that ended in a link or bridge error again, up to N
+    /// times, on the same board. Every attempt stays on record (JUnit in
+    /// Maven Surefire's dialect, the JSON record, the HTML report); one
+    /// that passed only on a retry is FLAKY, never plainly passed.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub(super) retries: u32,
+    /// With --retries: try a device failure again too (a board that fails
+    /// and then passes is flaky hardware, and says so).
+    #[arg(long, requires = "retries")]
+    pub(super) retry_failures: bool,
+    /// A scenario that passed only on a retry fails the run (exit 1).
+    #[arg(long)]
+    pub(super) flaky_is_failure: bool,
     /// Width of the MARGINAL zone inside each Table 3-3 limit, in percent of
     /// the limit.
     #[arg(long, default_value_t = 0.25)]
@@ -73,6 +95,7 @@ pub struct RunArgs {
 
 pub(super) fn verdict_line(r: &ScenarioResult, board: Option<&str>) -> String {
     let tag = match r.verdict {
+        _ if r.flaky() => "FLAKY",
         Verdict::Passed => "PASS",
         Verdict::Marginal => "MARGINAL",
         Verdict::Failed(_) => "FAIL",
@@ -93,20 +116,27 @@ pub(super) fn verdict_line(r: &ScenarioResult, board: Option<&str>) -> String {
         s.push_str("\n         ");
         s.push_str(&d);
     }
+    for (n, a) in r.attempts.iter().enumerate() {
+        s.push_str(&format!("\n         attempt {}: ", n + 1));
+        s.push_str(&a.verdict.detail().unwrap_or_else(|| "passed".into()));
+    }
     s
 }
 
 /// Applies the golden comparison to a result: a divergence or an unusable
-/// golden file fails the scenario (never the process).
-pub(super) fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) {
+/// golden file fails the scenario (never the process). Returns the golden
+/// trace compared with, for the report to draw.
+pub(super) fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) -> Option<Trace> {
     if !r.verdict.ok() {
-        return;
+        // Not compared, but drawn beside the board's all the same.
+        let straps = &r.trace.as_ref()?.straps;
+        return golden::load_for(dir, r.name, straps).ok();
     }
     let Some(trace) = &r.trace else {
         r.verdict = Verdict::Error(HarnessError::Golden(
             "no capture to compare with the golden trace".into(),
         ));
-        return;
+        return None;
     };
     let fail = |expectation: String, expected: String, got: String, at| {
         Verdict::Failed(Failure {
@@ -126,11 +156,25 @@ pub(super) fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances)
                     d.at,
                 );
             }
+            Some(g)
         }
         // A missing, corrupt or mismatched golden file is the harness's
         // input at fault, never the device.
-        Err(e) => r.verdict = Verdict::Error(HarnessError::Golden(e.to_string())),
+        Err(e) => {
+            r.verdict = Verdict::Error(HarnessError::Golden(e.to_string()));
+            None
+        }
     }
+}
+
+/// What the HTML report draws of a result: its moves over the golden
+/// trace's, and the pins around its failure.
+pub(super) fn figures_of(r: &ScenarioResult, golden: Option<&Trace>) -> Option<Figures> {
+    let failed_at = match &r.verdict {
+        Verdict::Failed(f) => Some(f.at),
+        _ => None,
+    };
+    r.trace.as_ref().map(|t| Figures::of(t, golden, failed_at))
 }
 
 /// How much of a failed scenario's waveform to keep.
@@ -190,36 +234,90 @@ pub(super) fn write_report(
 /// finding them unusable after it: each writable, not the same file, at
 /// most one on standard output (the verdict lines then go to standard
 /// error).
-pub(super) fn prepare_reports(junit: Option<&Path>, json: Option<&Path>) -> Result<(), CliError> {
-    let reports: Vec<&Path> = [junit, json].into_iter().flatten().collect();
-    for report in &reports {
+pub(super) fn prepare_reports(
+    junit: Option<&Path>,
+    json: Option<&Path>,
+    html: Option<&Path>,
+) -> Result<(), CliError> {
+    let named = [("--junit", junit), ("--json", json), ("--html", html)];
+    let reports: Vec<(&str, &Path)> = named
+        .into_iter()
+        .filter_map(|(flag, p)| p.map(|p| (flag, p)))
+        .collect();
+    for (_, report) in &reports {
         files::check_writable(report)?;
     }
-    if let (Some(junit), Some(json)) = (junit, json) {
-        if files::same_file(junit, json) {
-            return Err(usage(format!(
-                "--junit {} and --json {} are the same file: give each report its own",
-                junit.display(),
-                json.display()
-            )));
+    for (i, (a, pa)) in reports.iter().enumerate() {
+        for (b, pb) in &reports[i + 1..] {
+            if files::same_file(pa, pb) {
+                return Err(usage(format!(
+                    "{a} {} and {b} {} are the same file: give each report its own",
+                    pa.display(),
+                    pb.display()
+                )));
+            }
         }
     }
-    match reports.iter().filter(|p| p.as_os_str() == "-").count() {
+    let on_stdout: Vec<&str> = reports
+        .iter()
+        .filter(|(_, p)| p.as_os_str() == "-")
+        .map(|(flag, _)| *flag)
+        .collect();
+    match on_stdout.len() {
         0 => Ok(()),
         // Standard output carries the report: the verdicts go to stderr.
         1 => {
             super::out::people_to_stderr();
             Ok(())
         }
-        _ => Err(usage(
-            "--junit - and --json - cannot both take standard output",
-        )),
+        _ => Err(usage(format!(
+            "{} - cannot both take standard output",
+            on_stdout.join(" - and ")
+        ))),
     }
 }
 
+/// Opens the results store a run will keep its record in, before the run:
+/// a store that cannot be used is found before the boards' time is spent.
+pub(super) fn open_store(path: Option<&Path>) -> Result<Option<Store>, CliError> {
+    path.map(|p| Store::open(p).map_err(|e| CliError::BadInput(format!("ppmc: --store {e}"))))
+        .transpose()
+}
+
+/// Keeps a run record in the store.
+pub(super) fn keep(
+    store: &mut Store,
+    record: Result<String, report::ReportError>,
+) -> Result<(), String> {
+    let text = record.map_err(|e| format!("--store {}: {e}", store.path().display()))?;
+    let parsed = Record::parse(&text, "the run record").map_err(|e| e.to_string())?;
+    store
+        .add(&parsed, &text)
+        .map(|_| ())
+        .map_err(|e| format!("--store {e}"))
+}
+
+/// The HTML report of a run record, drawn from the record as `ppmc report`
+/// draws it (one path from a run to its page, whichever command makes it).
+pub(super) fn write_html(
+    path: &Path,
+    record: Result<String, report::ReportError>,
+) -> Result<(), String> {
+    let text = record.map_err(|e| format!("{}: {e}", path.display()))?;
+    let record = Record::parse(&text, "the run record").map_err(|e| e.to_string())?;
+    let page = report::html(std::slice::from_ref(&record), "ppmc run report");
+    files::write_report(path, page.as_bytes()).map_err(|e| e.to_string())
+}
+
 fn summary_lines(t: &Tally, results: usize) {
+    // Flaky only when there are any: a clean run's lines stay as CI log
+    // readers know them.
+    let flaky = match t.flaky {
+        0 => String::new(),
+        n => format!(" {n} flaky (passed only on a retry),"),
+    };
     outln!(
-        "{results} scenarios: {} passed, {} marginal, {} failed, {} errors, {} not run",
+        "{results} scenarios: {} passed,{flaky} {} marginal, {} failed, {} errors, {} not run",
         t.passed,
         t.marginal,
         t.failed,
@@ -227,8 +325,12 @@ fn summary_lines(t: &Tally, results: usize) {
         t.not_run
     );
     // The closing line CI log readers look for; the same counts.
+    let flaky = match t.flaky {
+        0 => String::new(),
+        n => format!(" {n} flaky,"),
+    };
     outln!(
-        "suite: {} passed, {} failed, {} errors, {} not run",
+        "suite: {} passed,{flaky} {} failed, {} errors, {} not run",
         t.passed + t.marginal,
         t.failed,
         t.errors,
@@ -246,6 +348,9 @@ impl RunArgs {
             latency_tol_pct: tol.latency_bp as f64 / 100.0,
             interval_tol_pct: tol.interval_bp as f64 / 100.0,
             time_floor_ns: tol.floor.as_nanos(),
+            retries: self.retries,
+            retry_failures: self.retry_failures,
+            flaky_is_failure: self.flaky_is_failure,
             ..RunOptions::default()
         };
         self.select.describe(&mut o);
@@ -276,7 +381,12 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     if let Some(dir) = &args.artifacts {
         files::prepare_folder(dir)?;
     }
-    prepare_reports(args.junit.as_deref(), args.json.as_deref())?;
+    prepare_reports(
+        args.junit.as_deref(),
+        args.json.as_deref(),
+        args.html.as_deref(),
+    )?;
+    let mut store = open_store(args.store.as_deref())?;
     if let Some(dir) = &args.golden {
         if !dir.is_dir() {
             return Err(usage(format!(
@@ -297,11 +407,19 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         .iter()
         .enumerate()
         .map(|(b, spec)| {
-            let rev = spec.rev.clone().or_else(|| args.board_rev.clone());
+            let rev = spec.rev.clone().or_else(|| args.target.board_rev.clone());
+            let serial = spec
+                .serial
+                .clone()
+                .or_else(|| args.target.board_serial.clone());
             let name = spec.label().to_string();
-            match farm.board(b) {
+            let board = match farm.board(b) {
                 Ok(t) => BoardInfo::new(name, &t, rev),
                 Err(e) => BoardInfo::unreached(name, spec.address.clone(), rev, e.to_string()),
+            };
+            BoardInfo {
+                board_serial: serial,
+                ..board
             }
         })
         .collect();
@@ -333,6 +451,15 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             .json
             .as_ref()
             .map(|p| write_report(p, report::json(&info, &results, &on)));
+        let _ = args
+            .html
+            .as_ref()
+            .map(|p| write_html(p, report::json(&info, &results, &on)));
+        if let Some(store) = &mut store {
+            if let Err(e) = keep(store, report::json(&info, &results, &on)) {
+                errln!("ppmc: {e}");
+            }
+        }
         summary_lines(&Tally::of(&results), results.len());
         if stop.requested() {
             return Err(CliError::Interrupted);
@@ -354,6 +481,10 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         grading: Grading {
             marginal_bp: (args.marginal * 100.0).round() as u64,
         },
+        retry: Retry {
+            times: args.retries,
+            failures: args.retry_failures,
+        },
         ..DriverOptions::default()
     };
     let repeat = args.repeat as usize;
@@ -365,6 +496,9 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let mut problems = Vec::new();
     // The files saved for each result, by its slot, until the soak takes it.
     let saved: RefCell<BTreeMap<usize, Vec<String>>> = RefCell::new(BTreeMap::new());
+    // What the reports draw of each result, by its slot, likewise.
+    let drawn: RefCell<BTreeMap<usize, Figures>> = RefCell::new(BTreeMap::new());
+    let draw = args.json.is_some() || args.html.is_some();
     // What the reports keep of the results as they come (`--repeat`: the
     // first pass and what did not pass, in full; the rest counted).
     let mut soak = Soak::new(scenarios.len(), repeat);
@@ -378,8 +512,14 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         spread,
         stopped,
         |slot, b, r| {
-            if let Some(dir) = &args.golden {
-                check_golden(r, dir, &tol);
+            let golden = args
+                .golden
+                .as_ref()
+                .and_then(|dir| check_golden(r, dir, &tol));
+            if draw {
+                if let Some(f) = figures_of(r, golden.as_ref()) {
+                    drawn.borrow_mut().insert(slot, f);
+                }
             }
             progress.step(r.name);
             let name = board_name(b);
@@ -402,11 +542,24 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         },
         |r| {
             let board = r.board;
-            let files = saved.borrow_mut().remove(&r.slot).unwrap_or_default();
-            soak.add(r, board, files);
+            let attachments = saved.borrow_mut().remove(&r.slot).unwrap_or_default();
+            let figures = drawn.borrow_mut().remove(&r.slot);
+            soak.add(
+                r,
+                board,
+                Kept {
+                    attachments,
+                    figures,
+                },
+            );
         },
     );
     progress.finish();
+    for (b, board) in info.boards.iter_mut().enumerate() {
+        board.link = farm
+            .link_stats(b)
+            .map(|stats| stats.into_iter().map(|(k, v)| (k.to_string(), v)).collect());
+    }
     let interrupted = stopped();
     info.wall_s = started.elapsed().as_secs_f64();
     let tally = soak.tally();
@@ -417,9 +570,13 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let (listed, repeated) = soak.finish();
     let on: Vec<Option<usize>> = listed.iter().map(|l| l.board).collect();
     let passes: Vec<usize> = listed.iter().map(|l| l.pass).collect();
+    let mut figures = Vec::with_capacity(listed.len());
     let (results, attachments): (Vec<ScenarioResult>, Vec<Vec<String>>) = listed
         .into_iter()
-        .map(|l| (l.result, l.attachments))
+        .map(|l| {
+            figures.push(l.figures);
+            (l.result, l.attachments)
+        })
         .unzip();
     let listing = Listing {
         results: &results,
@@ -429,6 +586,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         repeated: &repeated,
         tally,
         judged: &[],
+        figures: &figures,
     };
     if let Some(p) = &args.junit {
         if let Err(e) = write_report(p, report::junit_listing(&info, &listing)) {
@@ -437,6 +595,16 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     }
     if let Some(p) = &args.json {
         if let Err(e) = write_report(p, report::json_listing(&info, &listing)) {
+            problems.push(e);
+        }
+    }
+    if let Some(p) = &args.html {
+        if let Err(e) = write_html(p, report::json_listing(&info, &listing)) {
+            problems.push(e);
+        }
+    }
+    if let Some(store) = &mut store {
+        if let Err(e) = keep(store, report::json_listing(&info, &listing)) {
             problems.push(e);
         }
     }
@@ -474,6 +642,12 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 .collect::<Vec<_>>()
                 .join(", ")
         )))
+    } else if args.flaky_is_failure && tally.flaky > 0 {
+        errln!(
+            "ppmc: {} scenarios passed only on a retry, and --flaky-is-failure is given",
+            tally.flaky
+        );
+        Err(CliError::Verdict)
     } else if tally.ok() && problems.is_empty() {
         Ok(())
     } else {
@@ -495,7 +669,7 @@ fn file_name(label: &str) -> String {
 
 /// How many runs a tally counts.
 fn runs_of(t: &Tally) -> usize {
-    t.passed + t.marginal + t.failed + t.errors + t.not_run
+    t.runs()
 }
 
 /// One line per board: how many scenarios it ran and how they went

@@ -23,6 +23,10 @@ pub struct RunOptions {
     pub latency_tol_pct: f64,
     pub interval_tol_pct: f64,
     pub time_floor_ns: u64,
+    /// `--retries`, `--retry-failures`, `--flaky-is-failure`.
+    pub retries: u32,
+    pub retry_failures: bool,
+    pub flaky_is_failure: bool,
 }
 
 /// A board of a run: what the reports call it and what is known of it.
@@ -36,25 +40,38 @@ pub struct BoardInfo {
     pub target_details: BTreeMap<String, String>,
     /// The board revision label (`rev=` or `--board-rev`).
     pub board_rev: Option<String>,
+    /// The board's serial number (`board-serial=` or `--board-serial`).
+    pub board_serial: Option<String>,
     /// The bus bridge's firmware version, when the target is a board.
     pub bridge_firmware: Option<String>,
+    /// The bus bridge's serial number, where it is known: its USB serial
+    /// number, as the operating system read it from the device.
+    pub bridge_serial: Option<String>,
+    /// What the link to the bridge cost over the run (round trips,
+    /// retransmissions, corrupt frames, reopens); none for the emulator.
+    pub link: Option<BTreeMap<String, u64>>,
     /// Why the board took no part in the run, or left it early.
     pub error: Option<String>,
 }
 
 impl BoardInfo {
     pub fn new(name: String, target: &TargetInfo, board_rev: Option<String>) -> BoardInfo {
-        let bridge_firmware = target
-            .extra
-            .iter()
-            .find(|(k, _)| k == "bridge_firmware")
-            .map(|(_, v)| v.clone());
+        let extra = |key: &str| {
+            target
+                .extra
+                .iter()
+                .find(|(k, _)| k == key)
+                .map(|(_, v)| v.clone())
+        };
         BoardInfo {
             name,
             target: target.name.clone(),
             target_details: target.details().into_iter().collect(),
             board_rev,
-            bridge_firmware,
+            board_serial: None,
+            bridge_firmware: extra("bridge_firmware"),
+            bridge_serial: extra("bridge_serial"),
+            link: None,
             error: None,
         }
     }
@@ -72,7 +89,10 @@ impl BoardInfo {
             name,
             target_details: BTreeMap::new(),
             board_rev,
+            board_serial: None,
             bridge_firmware: None,
+            bridge_serial: None,
+            link: None,
             error: Some(why),
         }
     }

@@ -1,6 +1,7 @@
 //! The JSON run record (see [`json`]; its schema is
 //! `docs/run-record.schema.json`).
 
+use super::figures::Figures;
 use super::info::RunInfo;
 use super::listing::{error_kind, Blame, Listing, ReportError};
 use super::tally::Tally;
@@ -71,6 +72,41 @@ struct JsonScenario<'a> {
     /// On the result that judges the host firmware: its findings.
     #[serde(skip_serializing_if = "Option::is_none")]
     host_findings: Option<Vec<JsonFinding<'a>>>,
+    /// The attempts before the last, when the scenario was tried again.
+    attempts: Vec<JsonAttempt>,
+    /// What the HTML report draws: each move's pulse runs (the board's and
+    /// the golden's), the pins around the failure.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    figures: Option<&'a Figures>,
+}
+
+/// An attempt before a scenario's last.
+#[derive(Serialize)]
+struct JsonAttempt {
+    verdict: &'static str,
+    detail: Option<String>,
+    error: Option<JsonError>,
+    elapsed_ns: u64,
+    wall_s: f64,
+}
+
+/// The error fields of a verdict that is an error or "not run".
+fn json_error(v: &Verdict) -> Option<JsonError> {
+    match v {
+        Verdict::Error(e) => Some(JsonError {
+            kind: error_kind(e),
+            message: e.to_string(),
+        }),
+        Verdict::NotRun(NotRun::Interrupted) => Some(JsonError {
+            kind: "interrupted",
+            message: NotRun::Interrupted.to_string(),
+        }),
+        Verdict::NotRun(why) => Some(JsonError {
+            kind: "infrastructure",
+            message: why.to_string(),
+        }),
+        _ => None,
+    }
 }
 
 /// The verdict's one spelling in the JSON record.
@@ -147,7 +183,7 @@ pub fn json_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> 
     let repeats = info.options.repeat > 1 && !l.passes.is_empty();
     let board_name = |b: Option<usize>| b.and_then(|b| info.boards.get(b)).map(|b| b.name.as_str());
     let run = JsonRun {
-        format: "ppmc-run-record/3",
+        format: "ppmc-run-record/4",
         run: info,
         summary: l.tally,
         repeated: repeats.then(|| {
@@ -194,7 +230,21 @@ pub fn json_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> 
                     .map(|b| b.name.as_str()),
                 section: r.section,
                 tags: r.tags,
-                verdict: json_verdict(&r.verdict),
+                verdict: match r.flaky() {
+                    true => "flaky",
+                    false => json_verdict(&r.verdict),
+                },
+                attempts: r
+                    .attempts
+                    .iter()
+                    .map(|a| JsonAttempt {
+                        verdict: json_verdict(&a.verdict),
+                        detail: a.verdict.detail(),
+                        error: json_error(&a.verdict),
+                        elapsed_ns: a.elapsed.as_nanos(),
+                        wall_s: a.wall.as_secs_f64(),
+                    })
+                    .collect(),
                 detail: l
                     .judged_of(i)
                     .and_then(|j| j.message.clone())
@@ -208,24 +258,13 @@ pub fn json_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> 
                     }),
                     _ => None,
                 },
-                error: match &r.verdict {
-                    Verdict::Error(e) => Some(JsonError {
-                        kind: match l.judged_of(i).and_then(|j| j.blame) {
-                            Some(Blame::Capture) => "capture",
-                            _ => error_kind(e),
-                        },
-                        message: e.to_string(),
-                    }),
-                    Verdict::NotRun(NotRun::Interrupted) => Some(JsonError {
-                        kind: "interrupted",
-                        message: NotRun::Interrupted.to_string(),
-                    }),
-                    Verdict::NotRun(why) => Some(JsonError {
-                        kind: "infrastructure",
-                        message: why.to_string(),
-                    }),
-                    _ => None,
-                },
+                error: json_error(&r.verdict).map(|e| match l.judged_of(i).and_then(|j| j.blame) {
+                    Some(Blame::Capture) if matches!(r.verdict, Verdict::Error(_)) => JsonError {
+                        kind: "capture",
+                        ..e
+                    },
+                    _ => e,
+                }),
                 elapsed_ns: r.elapsed.as_nanos(),
                 wall_s: r.wall.as_secs_f64(),
                 measurements: r
@@ -252,6 +291,7 @@ pub fn json_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> 
                         })
                         .collect()
                 }),
+                figures: l.figures_of(i),
             })
             .collect(),
     };

@@ -360,6 +360,14 @@ fn board_props(prefix: &str, b: &BoardInfo) -> Vec<(String, String)> {
             b.bridge_firmware.clone().unwrap_or_default(),
         ),
     ];
+    for (key, value) in [
+        ("board_serial", &b.board_serial),
+        ("bridge_serial", &b.bridge_serial),
+    ] {
+        if let Some(v) = value {
+            props.push((format!("{prefix}{key}"), v.clone()));
+        }
+    }
     if let Some(e) = &b.error {
         props.push((format!("{prefix}error"), e.clone()));
     }
@@ -369,6 +377,38 @@ fn board_props(prefix: &str, b: &BoardInfo) -> Vec<(String, String)> {
             .map(|(k, v)| (format!("{prefix}target.{k}"), v.clone())),
     );
     props
+}
+
+/// The attempts before a scenario's last, in Maven Surefire's dialect
+/// (as nextest and Jenkins read it): in a test that passed in the end,
+/// each is a `flakyFailure` (the device) or `flakyError` (the link, the
+/// harness); in one that never passed, a `rerunFailure` or `rerunError`
+/// beside the last attempt's `failure` or `error`. Each carries its type
+/// (which `junit-10.xsd` requires), its message, and its text in
+/// `stackTrace`.
+fn attempts(body: &mut String, r: &ScenarioResult) {
+    let prefix = if r.verdict.ok() { "flaky" } else { "rerun" };
+    for (n, a) in r.attempts.iter().enumerate() {
+        let Some((tag, kind, message)) = own_element(&a.verdict) else {
+            continue;
+        };
+        let tag = match tag {
+            "failure" => "Failure",
+            _ => "Error",
+        };
+        let _ = writeln!(
+            body,
+            "      <{prefix}{tag} type=\"{kind}\" message=\"{}\"><stackTrace>{}</stackTrace><system-out>{}</system-out></{prefix}{tag}>",
+            esc(&message),
+            esc_text(&message),
+            esc_text(&format!(
+                "attempt {} of {}, {:.6} s",
+                n + 1,
+                r.attempts.len() + 1,
+                a.wall.as_secs_f64()
+            ))
+        );
+    }
 }
 
 /// What a `<testcase>` says besides its result: the files saved for it,
@@ -406,6 +446,7 @@ fn testcase(x: &mut String, r: &ScenarioResult, name: &str, extra: &Extra) {
             esc_text(&text)
         );
     }
+    attempts(&mut body, r);
     let mut out: Vec<String> = Vec::new();
     if element.is_none() {
         out.extend(notes.iter().cloned());

@@ -2,6 +2,7 @@
 //! how they type a scenario's error, and the error of a report that could
 //! not be rendered ([`ReportError`]).
 
+use super::figures::Figures;
 use super::tally::Tally;
 use crate::backend::TargetErrorKind;
 use crate::scenario::{HarnessError, ScenarioResult};
@@ -32,6 +33,9 @@ pub struct Listing<'a> {
     /// What the results judged from a capture add (`ppmc judge`), in the
     /// results' order; empty for a run of boards.
     pub judged: &'a [Judged],
+    /// What the HTML report draws of each result, in the results' order;
+    /// missing entries mean none.
+    pub figures: &'a [Option<Figures>],
 }
 
 /// The party a result judged from a capture blames (issue 30): the board,
@@ -84,7 +88,18 @@ impl<'a> Listing<'a> {
             repeated: &[],
             tally: Tally::of(results),
             judged: &[],
+            figures: &[],
         }
+    }
+
+    /// The results, with what the HTML report draws of each.
+    pub fn with_figures(mut self, figures: &'a [Option<Figures>]) -> Listing<'a> {
+        self.figures = figures;
+        self
+    }
+
+    pub(super) fn figures_of(&self, i: usize) -> Option<&'a Figures> {
+        self.figures.get(i).and_then(Option::as_ref)
     }
 
     /// The results, judged from a capture: `judged` in their order.
@@ -150,6 +165,7 @@ mod tests {
             trace: None,
             elapsed: crate::time::Duration::ZERO,
             wall: std::time::Duration::ZERO,
+            attempts: Vec::new(),
         };
         let results = [
             result(

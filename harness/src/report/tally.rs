@@ -9,6 +9,9 @@ use serde::Serialize;
 pub struct Tally {
     pub passed: usize,
     pub marginal: usize,
+    /// Passed (or marginal) only on a retry: counted here, not in
+    /// `passed` or `marginal`.
+    pub flaky: usize,
     pub failed: usize,
     /// Spelled as the verdict is in the JSON record.
     #[serde(rename = "error")]
@@ -25,19 +28,36 @@ impl Tally {
     pub fn of_refs(results: &[&ScenarioResult]) -> Tally {
         let mut t = Tally::default();
         for r in results {
-            match r.verdict {
-                Verdict::Passed => t.passed += 1,
-                Verdict::Marginal => t.marginal += 1,
-                Verdict::Failed(_) => t.failed += 1,
-                Verdict::Error(_) => t.errors += 1,
-                Verdict::NotRun(_) => t.not_run += 1,
-            }
+            t.count(r);
         }
         t
     }
 
-    /// Whether the run passes: nothing failed, errored or was left out.
+    /// Counts one result: a pass on a retry as flaky.
+    pub fn count(&mut self, r: &ScenarioResult) {
+        match r.verdict {
+            _ if r.flaky() => self.flaky += 1,
+            Verdict::Passed => self.passed += 1,
+            Verdict::Marginal => self.marginal += 1,
+            Verdict::Failed(_) => self.failed += 1,
+            Verdict::Error(_) => self.errors += 1,
+            Verdict::NotRun(_) => self.not_run += 1,
+        }
+    }
+
+    /// How many results it counts.
+    pub fn runs(&self) -> usize {
+        self.passed + self.marginal + self.flaky + self.failed + self.errors + self.not_run
+    }
+
+    /// Whether the run passes: nothing failed, errored or was left out (a
+    /// flaky pass passes, unless `--flaky-is-failure`: [`Tally::ok_strict`]).
     pub fn ok(&self) -> bool {
         self.failed == 0 && self.errors == 0 && self.not_run == 0
+    }
+
+    /// [`Tally::ok`], and nothing passed only on a retry.
+    pub fn ok_strict(&self) -> bool {
+        self.ok() && self.flaky == 0
     }
 }

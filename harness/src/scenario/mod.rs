@@ -26,7 +26,7 @@ pub use outcome::{Failure, HarnessError, Outcome, Stop};
 /// Declares a scenario where it is written; see the `ppmc-macros` crate.
 pub use ppmc_macros::scenario;
 pub use run::{run_scenario, Scenario};
-pub use verdict::{NotRun, ScenarioResult, Verdict};
+pub use verdict::{Attempt, NotRun, Retry, ScenarioResult, Verdict};
 
 /// What scenario files import.
 pub mod prelude {

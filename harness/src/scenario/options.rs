@@ -22,6 +22,9 @@ pub struct DriverOptions {
     /// Virtual time one scenario may use before it is stopped as an error.
     pub budget: Duration,
     pub grading: Grading,
+    /// When the runner tries a scenario again (the driver itself never
+    /// does).
+    pub retry: super::verdict::Retry,
 }
 
 impl Default for DriverOptions {
@@ -33,6 +36,7 @@ impl Default for DriverOptions {
             idle_timeout: Duration::from_secs(60),
             budget: Duration::from_secs(120),
             grading: Grading::default(),
+            retry: super::verdict::Retry::default(),
         }
     }
 }

@@ -149,5 +149,6 @@ pub fn run_scenario(
         trace,
         elapsed,
         wall: started.elapsed(),
+        attempts: Vec::new(),
     }
 }

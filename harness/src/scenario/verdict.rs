@@ -79,4 +79,60 @@ pub struct ScenarioResult {
     pub elapsed: Duration,
     /// Wall-clock time the harness spent on it.
     pub wall: std::time::Duration,
+    /// The attempts before this one, oldest first, when the runner tried
+    /// the scenario again ([`Retry`]); empty when it ran once.
+    pub attempts: Vec<Attempt>,
+}
+
+impl ScenarioResult {
+    /// Passed, but only on a retry: an attempt before it did not.
+    pub fn flaky(&self) -> bool {
+        self.verdict.ok() && !self.attempts.is_empty()
+    }
+}
+
+/// An attempt at a scenario that was tried again: how it ended.
+#[derive(Debug, Clone)]
+pub struct Attempt {
+    pub verdict: Verdict,
+    pub elapsed: Duration,
+    pub wall: std::time::Duration,
+}
+
+impl Attempt {
+    /// The attempt `r` was.
+    pub fn of(r: &ScenarioResult) -> Attempt {
+        Attempt {
+            verdict: r.verdict.clone(),
+            elapsed: r.elapsed,
+            wall: r.wall,
+        }
+    }
+}
+
+/// When the runner tries a scenario again, on the same board (`--retries`,
+/// `--retry-failures`): every attempt stays on record, and a scenario
+/// that passed only on a retry is flaky, never plainly passed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Retry {
+    /// Attempts after the first, at most.
+    pub times: u32,
+    /// Retry a device failure too, not only a link or bridge error.
+    pub failures: bool,
+}
+
+impl Retry {
+    /// Whether a scenario that ended in `v` is tried again: a link error
+    /// (the link, a garbled reply, a capture that did not come back), and
+    /// with `failures` a device failure. Never the scenario's own bug, a
+    /// budget, a golden file, or a stop.
+    pub fn takes(&self, v: &Verdict) -> bool {
+        use crate::backend::TargetErrorKind;
+        match v {
+            Verdict::Error(HarnessError::Target { kind, .. }) => *kind == TargetErrorKind::Link,
+            Verdict::Error(HarnessError::Reply(_) | HarnessError::Capture(_)) => true,
+            Verdict::Failed(_) => self.failures,
+            _ => false,
+        }
+    }
 }

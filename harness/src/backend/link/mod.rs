@@ -23,6 +23,12 @@ pub trait Link: Send + fmt::Debug {
     fn reopen(&mut self) -> io::Result<()>;
     /// What to call the link in messages: `serial:/dev/ttyACM0`.
     fn name(&self) -> String;
+    /// The serial number of the device at the link's far end, where the
+    /// operating system knows it (a USB serial port's iSerial); `None`
+    /// across a network.
+    fn device_serial(&self) -> Option<String> {
+        None
+    }
 }
 
 /// A read that ended because its timeout passed (or, on a nonblocking

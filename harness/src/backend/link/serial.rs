@@ -34,6 +34,18 @@ impl SerialLink {
         Ok(link)
     }
 
+    /// The USB serial number of the device behind `path`, as Linux's sysfs
+    /// gives it (`/sys/class/tty/<tty>/device/../serial`); `None` for a port
+    /// that is not USB, or elsewhere.
+    pub fn usb_serial(path: &str) -> Option<String> {
+        let dev = std::fs::canonicalize(path).ok()?;
+        let tty = dev.file_name()?.to_str()?;
+        let iface = std::fs::canonicalize(format!("/sys/class/tty/{tty}/device")).ok()?;
+        let serial = std::fs::read_to_string(iface.parent()?.join("serial")).ok()?;
+        let serial = serial.trim();
+        (!serial.is_empty() && serial.len() <= 128).then(|| serial.to_string())
+    }
+
     fn port(&mut self) -> io::Result<&mut Box<dyn serialport::SerialPort>> {
         self.port
             .as_mut()
@@ -99,6 +111,10 @@ impl Link for SerialLink {
 
     fn name(&self) -> String {
         format!("serial:{}", self.path)
+    }
+
+    fn device_serial(&self) -> Option<String> {
+        SerialLink::usb_serial(&self.path)
     }
 }
 

@@ -277,14 +277,28 @@ impl<L: Link> SerialTarget<L> {
 }
 
 impl<L: Link> Target for SerialTarget<L> {
+    fn link_stats(&self) -> Option<Vec<(&'static str, u64)>> {
+        let s = self.stats;
+        Some(vec![
+            ("round_trips", s.round_trips),
+            ("retransmissions", s.retransmissions),
+            ("corrupt_frames", s.corrupt_frames),
+            ("reopens", s.reopens),
+        ])
+    }
+
     fn info(&self) -> TargetInfo {
+        let mut extra = vec![
+            ("bridge_firmware".into(), self.hello.firmware.clone()),
+            ("bridge_protocol".into(), self.hello.version.to_string()),
+        ];
+        if let Some(serial) = self.link.device_serial() {
+            extra.push(("bridge_serial".into(), serial));
+        }
         TargetInfo {
             name: self.link.name(),
             straps: self.hello.straps,
-            extra: vec![
-                ("bridge_firmware".into(), self.hello.firmware.clone()),
-                ("bridge_protocol".into(), self.hello.version.to_string()),
-            ],
+            extra,
         }
     }
 

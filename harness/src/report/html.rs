@@ -1,0 +1,296 @@
+//! The HTML report (see [`html`]): one file, offline, from run records.
+
+use super::plots;
+use super::record::{Record, ScenarioRecord};
+use super::svg::esc;
+use std::fmt::Write as _;
+
+/// The page's style: inline, like everything else in it.
+pub(super) const STYLE: &str = include_str!("report.css");
+
+/// One self-contained HTML page of `records`: the runs' facts and boards,
+/// every scenario with its verdict, each measurement against its band,
+/// each move's speed profile over the golden one with the first
+/// divergence marked, the pins around each failure, and the link's health.
+/// Nothing in it reaches the network (its Content-Security-Policy forbids
+/// it too): no script, no font, no style from elsewhere; it opens from
+/// `file://` and as a CI artifact, as it is, years later.
+pub fn html(records: &[Record], title: &str) -> String {
+    let mut s = String::with_capacity(64 << 10);
+    let _ = write!(
+        s,
+        r#"<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8">
+<meta http-equiv="Content-Security-Policy" content="default-src 'none'; style-src 'unsafe-inline'; img-src data:">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{}</title><style>{STYLE}</style></head><body>
+<h1>{}</h1>
+"#,
+        esc(title),
+        esc(title)
+    );
+    if records.len() > 1 {
+        s.push_str(r#"<section class="runs"><h2>Runs</h2><table><tr><th>run</th><th>board</th><th>revision</th><th>started</th><th>verdicts</th></tr>"#);
+        for (i, r) in records.iter().enumerate() {
+            let board = r.run.boards.first();
+            let _ = write!(
+                s,
+                r##"<tr><td><a href="#run-{i}">run {}</a></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>"##,
+                i + 1,
+                esc(board.map_or("", |b| b.name.as_str())),
+                esc(board.and_then(|b| b.board_rev.as_deref()).unwrap_or("")),
+                esc(&r.run.started),
+                summary_chips(r)
+            );
+        }
+        s.push_str("</table></section>\n");
+    }
+    for (i, r) in records.iter().enumerate() {
+        run_section(&mut s, r, i);
+    }
+    let _ = write!(
+        s,
+        r#"<footer>Made by ppmc {} from {} run record{}. Long speed profiles are reduced for drawing to the least and greatest interval in each pixel column; such plots say so.</footer>
+</body></html>
+"#,
+        esc(crate::VERSION),
+        records.len(),
+        if records.len() == 1 { "" } else { "s" }
+    );
+    s
+}
+
+/// The verdict counts as coloured chips.
+fn summary_chips(r: &Record) -> String {
+    let t = &r.summary;
+    let mut s = String::new();
+    for (class, n, word) in [
+        ("passed", t.passed, "passed"),
+        ("marginal", t.marginal, "marginal"),
+        ("flaky", t.flaky, "flaky"),
+        ("failed", t.failed, "failed"),
+        ("error", t.error, "errors"),
+        ("not_run", t.not_run, "not run"),
+    ] {
+        if n > 0 || class == "passed" || class == "failed" {
+            let _ = write!(s, r#"<span class="chip {class}">{n} {word}</span> "#);
+        }
+    }
+    s
+}
+
+/// Whether a scenario is one to look at first: it did not pass cleanly.
+fn noteworthy(sc: &ScenarioRecord) -> bool {
+    !matches!(sc.verdict.as_str(), "passed" | "marginal")
+}
+
+fn run_section(s: &mut String, r: &Record, i: usize) {
+    let _ = write!(
+        s,
+        r#"<section class="run" id="run-{i}"><h2>Run {} <span class="summary">{}</span></h2>"#,
+        i + 1,
+        summary_chips(r)
+    );
+    let golden = r.run.options.golden.as_deref().unwrap_or("none");
+    let _ = write!(
+        s,
+        r#"<table class="facts"><tr><th>ppmc</th><td>{}</td><th>commit</th><td>{}</td></tr><tr><th>started</th><td>{}</td><th>wall time</th><td>{:.1} s</td></tr><tr><th>host</th><td>{}</td><th>golden traces</th><td>{}</td></tr><tr><th>tolerances</th><td>intervals {}%, floor {} ns</td><th>marginal zone</th><td>{}% of each limit</td></tr></table>"#,
+        esc(&r.run.harness_version),
+        esc(&r.run.git_revision),
+        esc(&r.run.started),
+        r.run.wall_s,
+        esc(&r.run.host),
+        esc(golden),
+        r.run.options.interval_tol_pct,
+        r.run.options.time_floor_ns,
+        r.run.options.marginal_pct,
+    );
+    boards(s, r);
+    // The scenarios: a table of all, then each in full, those that did not
+    // pass first and open.
+    s.push_str(r#"<h3>Scenarios</h3><table class="scenarios"><tr><th>scenario</th><th>section</th><th>board</th><th>verdict</th><th>attempts</th><th>device time</th></tr>"#);
+    for (k, sc) in r.scenarios.iter().enumerate() {
+        let _ = write!(
+            s,
+            r##"<tr class="{}"><td><a href="#r{i}-s{k}">{}</a></td><td>{}</td><td>{}</td><td><span class="chip {}">{}</span></td><td>{}</td><td>{}</td></tr>"##,
+            esc(&sc.verdict),
+            esc(&display_name(sc)),
+            esc(&sc.section),
+            esc(sc.board.as_deref().unwrap_or("")),
+            esc(&sc.verdict),
+            esc(&sc.verdict.replace('_', " ")),
+            sc.attempts.len().max(1),
+            esc(&plots::human(sc.elapsed_ns)),
+        );
+    }
+    s.push_str("</table>");
+    let tol = (r.run.options.interval_tol_pct, r.run.options.time_floor_ns);
+    let order = r
+        .scenarios
+        .iter()
+        .enumerate()
+        .filter(|(_, sc)| noteworthy(sc))
+        .chain(
+            r.scenarios
+                .iter()
+                .enumerate()
+                .filter(|(_, sc)| !noteworthy(sc)),
+        );
+    for (k, sc) in order {
+        scenario(s, sc, &format!("r{i}-s{k}"), tol);
+    }
+    s.push_str("</section>\n");
+}
+
+fn display_name(sc: &ScenarioRecord) -> String {
+    match sc.pass {
+        Some(p) => format!("{} [pass {p}]", sc.name),
+        None => sc.name.clone(),
+    }
+}
+
+/// The boards: identity, straps and, through a bridge, the link's health.
+fn boards(s: &mut String, r: &Record) {
+    s.push_str(r#"<h3>Boards</h3><table class="boards"><tr><th>board</th><th>target</th><th>revision</th><th>serial</th><th>bridge firmware</th><th>bridge serial</th><th>details</th><th>link</th></tr>"#);
+    for b in &r.run.boards {
+        let details: Vec<String> = b
+            .target_details
+            .iter()
+            .map(|(k, v)| format!("{k} {v}"))
+            .collect();
+        let link = b.link.as_ref().map_or("(no bridge)".to_string(), |l| {
+            l.iter()
+                .map(|(k, v)| format!("{} {v}", k.replace('_', " ")))
+                .collect::<Vec<_>>()
+                .join(", ")
+        });
+        let _ = write!(
+            s,
+            r#"<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class="small">{}</td><td class="link">{}</td></tr>"#,
+            esc(&b.name),
+            esc(&b.target),
+            esc(b.board_rev.as_deref().unwrap_or("")),
+            esc(b.board_serial.as_deref().unwrap_or("")),
+            esc(b.bridge_firmware.as_deref().unwrap_or("")),
+            esc(b.bridge_serial.as_deref().unwrap_or("")),
+            esc(&details.join(", ")),
+            esc(&link),
+        );
+        if let Some(e) = &b.error {
+            let _ = write!(
+                s,
+                r#"<tr><td colspan="8" class="error">not reached: {}</td></tr>"#,
+                esc(e)
+            );
+        }
+    }
+    s.push_str("</table>");
+}
+
+fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64)) {
+    let _ = write!(
+        s,
+        r#"<details class="scenario {}" id="{id}" data-scenario="{}"{}><summary><span class="chip {}">{}</span> {} <span class="section">section {}</span></summary>"#,
+        esc(&sc.verdict),
+        esc(&sc.name),
+        if noteworthy(sc) {
+            " open data-open"
+        } else {
+            ""
+        },
+        esc(&sc.verdict),
+        esc(&sc.verdict.replace('_', " ")),
+        esc(&display_name(sc)),
+        esc(&sc.section),
+    );
+    if let Some(f) = &sc.failure {
+        let _ = write!(
+            s,
+            r#"<p class="failure"><b>{}</b> at {}: expected {}, got {}</p>"#,
+            esc(&f.expectation),
+            esc(&plots::us(f.at_ns)),
+            esc(&f.expected),
+            esc(&f.got)
+        );
+    } else if let Some(e) = &sc.error {
+        let _ = write!(
+            s,
+            r#"<p class="error">{} error: {}</p>"#,
+            esc(&e.kind),
+            esc(&e.message)
+        );
+    } else if let Some(d) = &sc.detail {
+        let _ = write!(s, r#"<p class="detail">{}</p>"#, esc(d));
+    }
+    if !sc.attempts.is_empty() {
+        s.push_str(r#"<table class="attempts"><tr><th>attempt</th><th>verdict</th><th>what happened</th></tr>"#);
+        for (n, a) in sc.attempts.iter().enumerate() {
+            let _ = write!(
+                s,
+                r#"<tr><td>{}</td><td><span class="chip {}">{}</span></td><td>{}</td></tr>"#,
+                n + 1,
+                esc(&a.verdict),
+                esc(&a.verdict.replace('_', " ")),
+                esc(a.detail.as_deref().unwrap_or(""))
+            );
+        }
+        s.push_str("</table>");
+    }
+    if !sc.measurements.is_empty() {
+        s.push_str(r#"<table class="measurements"><tr><th>measurement</th><th>value</th><th>grade</th><th>against its band</th></tr>"#);
+        for m in &sc.measurements {
+            let _ = write!(
+                s,
+                r#"<tr><td>{}</td><td>{}</td><td><span class="chip {}">{}</span></td><td>{}</td></tr>"#,
+                esc(&m.name),
+                esc(&plots::us(m.value_ns)),
+                esc(&m.grade),
+                esc(&m.grade),
+                plots::measurement(m)
+            );
+        }
+        s.push_str("</table>");
+    }
+    if let Some(fig) = &sc.figures {
+        let label = match &sc.failure {
+            Some(f) if f.expectation.starts_with("golden trace") => "first divergence",
+            _ => "failed here",
+        };
+        let mark = sc.failure.as_ref().map(|f| f.at_ns);
+        // The move the failure is in: the last that started before it.
+        let marked = mark.and_then(|at| fig.moves.iter().rposition(|m| m.at_ns <= at));
+        for (n, m) in fig.moves.iter().enumerate() {
+            let _ = write!(
+                s,
+                r#"<div class="move" data-move="{}" data-pulses="{}"><h4>move {}: {} {}, {} steps, {} pulses{}</h4>"#,
+                n + 1,
+                m.pulses(),
+                n + 1,
+                esc(&m.kind),
+                esc(&m.dir),
+                m.steps,
+                m.pulses(),
+                if m.golden.is_some() {
+                    " (grey: the golden trace, with its tolerance band)"
+                } else {
+                    ""
+                }
+            );
+            if m.pulses() > 1 || m.golden.is_some() {
+                let mark = mark.filter(|_| marked == Some(n)).map(|at| (at, label));
+                s.push_str(&plots::profiles(m, mark, tol));
+            }
+            s.push_str("</div>");
+        }
+        if let Some(w) = &fig.waveform {
+            let _ = write!(
+                s,
+                r#"<h4>the pins around the failure ({} to {})</h4>{}"#,
+                esc(&plots::us(w.from_ns)),
+                esc(&plots::us(w.to_ns)),
+                plots::waveform(w)
+            );
+        }
+    }
+    s.push_str("</details>\n");
+}

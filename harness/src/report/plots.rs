@@ -1,0 +1,353 @@
+//! The report's plots, each one SVG: a measurement against its Table 3-3
+//! band, a move's speed profile over the golden one, and the pins around
+//! a failure.
+
+use super::figures::{MoveFigure, Waveform};
+use super::record::MeasurementRecord;
+use super::svg::{esc, reduce, Plot, Segment};
+use std::fmt::Write as _;
+
+/// The profiles' pixel size.
+const PROFILE: (f64, f64) = (470.0, 210.0);
+
+/// A measurement's band as a strip: red outside the limits, amber in the
+/// marginal zones, green between, the value a dark tick; `data-*` give
+/// the numbers.
+pub fn measurement(m: &MeasurementRecord) -> String {
+    let (w, h) = (380.0, 34.0);
+    let (l, r) = (8.0, 8.0);
+    let hi = m.hi_ns.unwrap_or(u64::MAX);
+    let finite_top = m.hi_ns.unwrap_or(m.lo_ns.max(m.marginal_lo_ns));
+    let top = (finite_top.max(m.value_ns) as f64 * 1.25).max(1.0);
+    let x = |ns: u64| l + (ns as f64).min(top) / top * (w - l - r);
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        r#"<svg class="measure" width="{w}" height="{h}" viewBox="0 0 {w} {h}" role="img" data-value-ns="{}" data-lo-ns="{}" data-hi-ns="{}" data-grade="{}">"#,
+        m.value_ns,
+        m.lo_ns,
+        m.hi_ns.map_or("inf".to_string(), |v| v.to_string()),
+        esc(&m.grade)
+    );
+    let mhi = m.marginal_hi_ns.unwrap_or(u64::MAX);
+    let zones = [
+        ("out", 0, m.lo_ns),
+        ("marginal", m.lo_ns, m.marginal_lo_ns),
+        ("in", m.marginal_lo_ns, mhi),
+        ("marginal", mhi, hi),
+        ("out", hi, u64::MAX),
+    ];
+    for (class, a, b) in zones {
+        let (xa, xb) = (x(a), x(b));
+        if xb > xa {
+            let _ = write!(
+                s,
+                r#"<rect class="zone {class}" x="{xa:.1}" y="6" width="{:.1}" height="12"/>"#,
+                xb - xa
+            );
+        }
+    }
+    let xv = x(m.value_ns);
+    let _ = write!(
+        s,
+        r#"<line class="value" x1="{xv:.1}" y1="2" x2="{xv:.1}" y2="22"/><text class="tick" x="{:.1}" y="31" text-anchor="start">{}</text><text class="tick" x="{:.1}" y="31" text-anchor="end">{}</text></svg>"#,
+        x(m.lo_ns),
+        esc(&us(m.lo_ns)),
+        x(finite_top),
+        esc(&m.hi_ns.map_or("no upper limit".to_string(), us)),
+    );
+    s
+}
+
+/// Nanoseconds as microseconds, for labels.
+pub fn us(ns: u64) -> String {
+    format!("{:.3} us", ns as f64 / 1000.0)
+}
+
+/// A duration in the unit that reads best: `850 ns`, `17.000 us`,
+/// `164.452 ms`, `637.551 s`.
+pub fn human(ns: u64) -> String {
+    match ns {
+        0..=999 => format!("{ns} ns"),
+        1_000..=999_999 => format!("{:.3} us", ns as f64 / 1e3),
+        1_000_000..=999_999_999 => format!("{:.3} ms", ns as f64 / 1e6),
+        _ => format!("{:.3} s", ns as f64 / 1e9),
+    }
+}
+
+/// A move's pulse intervals as segments: against the pulse number (from
+/// 2: the first pulse has no interval) or against the time from the move.
+fn segments(runs: &[[u64; 3]], by_time: bool, band: impl Fn(f64) -> f64) -> Vec<Segment> {
+    let mut out = Vec::new();
+    let mut pulse = 0u64;
+    let mut last: Option<u64> = None;
+    for &[from, count, span] in runs.iter().filter(|r| r[1] > 0) {
+        let x = |p: u64, t: u64| if by_time { t as f64 / 1e6 } else { p as f64 };
+        if let Some(prev) = last {
+            let gap = from.saturating_sub(prev) as f64 / 1000.0;
+            out.push(Segment {
+                x0: x(pulse + 1, from),
+                x1: x(pulse + 1, from),
+                n: 1,
+                y: band(gap),
+            });
+        }
+        if count > 1 {
+            let dt = span as f64 / (count - 1) as f64 / 1000.0;
+            out.push(Segment {
+                x0: x(pulse + 2, from + (span / (count - 1))),
+                x1: x(pulse + count, from + span),
+                n: count - 1,
+                y: band(dt),
+            });
+        }
+        pulse += count;
+        last = Some(from + span);
+    }
+    out
+}
+
+/// Where the scenario failed in this move: the pulse at or after the
+/// failure, its number and its time from the move.
+pub fn mark_in(m: &MoveFigure, at_ns: u64) -> Option<(u64, u64)> {
+    let t = at_ns.checked_sub(m.at_ns)?;
+    let mut pulse = 0u64;
+    let mut best = None;
+    for &[from, count, span] in &m.runs {
+        if count == 0 {
+            continue;
+        }
+        if t <= from + span {
+            let k = match count {
+                1 => 0,
+                _ if t <= from => 0,
+                n => ((t - from) as u128 * u128::from(n - 1)).div_ceil(u128::from(span.max(1)))
+                    as u64,
+            };
+            let when = from + if count > 1 { k * span / (count - 1) } else { 0 };
+            return Some((pulse + k + 1, when));
+        }
+        pulse += count;
+        best = Some((pulse, from + span));
+    }
+    best
+}
+
+/// The two speed profiles of a move (interval against pulse number, and
+/// against time), the golden one beneath with its tolerance band, and the
+/// failure marked. `tol` is the interval tolerance, percent, and floor, ns.
+pub fn profiles(m: &MoveFigure, mark: Option<(u64, &str)>, tol: (f64, u64)) -> String {
+    let mut out = String::new();
+    for by_time in [false, true] {
+        out.push_str(&profile(m, mark, tol, by_time));
+    }
+    out
+}
+
+fn profile(m: &MoveFigure, mark: Option<(u64, &str)>, tol: (f64, u64), by_time: bool) -> String {
+    let (pct, floor) = (tol.0 / 100.0, tol.1 as f64 / 1000.0);
+    let board = segments(&m.runs, by_time, |y| y);
+    let golden = m.golden.as_deref().map(|g| {
+        (
+            segments(g, by_time, |y| y),
+            segments(g, by_time, |y| (y - y * pct - floor).max(0.0)),
+            segments(g, by_time, |y| y + y * pct + floor),
+        )
+    });
+    let all = board.iter().chain(golden.iter().flat_map(|g| g.2.iter()));
+    let (mut x_lo, mut x_hi, mut y_hi) = (f64::INFINITY, f64::NEG_INFINITY, 0f64);
+    for s in all {
+        x_lo = x_lo.min(s.x0);
+        x_hi = x_hi.max(s.x1);
+        y_hi = y_hi.max(s.y);
+    }
+    if x_lo > x_hi {
+        (x_lo, x_hi) = (0.0, 1.0);
+    }
+    let class = if by_time {
+        "profile by-time"
+    } else {
+        "profile by-pulse"
+    };
+    let mut p = Plot::new(PROFILE.0, PROFILE.1, (x_lo, x_hi), (0.0, y_hi * 1.1), class);
+    p.axes(
+        if by_time {
+            "time from the move (ms)"
+        } else {
+            "pulse number"
+        },
+        "interval (us)",
+    );
+    let cols = p.columns();
+    let mut decimated = false;
+    if let Some((line, lo, hi)) = &golden {
+        let (lo, hi) = (reduce(lo, x_lo, x_hi, cols), reduce(hi, x_lo, x_hi, cols));
+        p.band("band", &lo.points, &hi.points);
+        let g = reduce(line, x_lo, x_hi, cols);
+        decimated |= g.decimated;
+        p.line("golden", &g.points);
+    }
+    let b = reduce(&board, x_lo, x_hi, cols);
+    decimated |= b.decimated;
+    p.line("board", &b.points);
+    if let Some((at, label)) = mark {
+        if let Some((pulse, t)) = mark_in(m, at) {
+            let x = if by_time {
+                t as f64 / 1e6
+            } else {
+                pulse as f64
+            };
+            p.mark("divergence", x, &format!("{label}: pulse {pulse}"));
+        }
+    }
+    if decimated {
+        p.note("reduced: least and greatest per pixel column");
+    }
+    p.finish()
+}
+
+/// The pins around a failure: POUT's pulses (and the golden's), each pin,
+/// the bus accesses, the failure marked.
+pub fn waveform(w: &Waveform) -> String {
+    let row = 24.0;
+    let rows = 1 + usize::from(w.golden_pout.is_some()) + w.pins.len() + 1;
+    let (width, label_w) = (940.0, 90.0);
+    let height = rows as f64 * row + 30.0;
+    let span = (w.to_ns.saturating_sub(w.from_ns)).max(1) as f64;
+    let x =
+        |t: u64| label_w + (t.saturating_sub(w.from_ns)) as f64 / span * (width - label_w - 10.0);
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        r#"<svg class="waveform" width="{width}" height="{height}" viewBox="0 0 {width} {height}" role="img" data-pulses="{}">"#,
+        w.pout.len()
+    );
+    let mut y = 4.0;
+    let name = |s: &mut String, y: f64, label: &str| {
+        let _ = write!(
+            s,
+            r#"<text class="pin" x="4" y="{:.1}">{}</text>"#,
+            y + 14.0,
+            esc(label)
+        );
+    };
+    let ticks = |s: &mut String, y: f64, pulses: &[u64], class: &str| {
+        let _ = write!(s, r#"<path class="{class}" d=""#);
+        for &t in pulses {
+            let _ = write!(s, "M{:.1} {:.1}V{:.1}", x(t), y + 18.0, y + 3.0);
+        }
+        s.push_str(r#""/>"#);
+    };
+    name(&mut s, y, "POUT");
+    ticks(&mut s, y, &w.pout, "pout");
+    y += row;
+    if let Some(g) = &w.golden_pout {
+        name(&mut s, y, "POUT golden");
+        ticks(&mut s, y, g, "pout golden");
+        y += row;
+    }
+    for pin in &w.pins {
+        name(&mut s, y, &pin.name);
+        let (lo, hi) = (y + 18.0, y + 4.0);
+        let mut v = u64::from(pin.initial);
+        let mut t0 = w.from_ns;
+        let mut pieces = Vec::new();
+        for &[t, nv] in pin
+            .changes
+            .iter()
+            .chain(std::iter::once(&[w.to_ns, u64::MAX]))
+        {
+            pieces.push((t0, t.max(t0), v));
+            (t0, v) = (t, nv);
+        }
+        for (a, b, v) in pieces {
+            if pin.bits == 1 {
+                let yy = if v != 0 { hi } else { lo };
+                let _ = write!(
+                    s,
+                    r#"<line class="level" x1="{:.1}" y1="{yy:.1}" x2="{:.1}" y2="{yy:.1}"/>"#,
+                    x(a),
+                    x(b),
+                );
+                // An edge where the level changed, not at the window's edge.
+                if a > w.from_ns {
+                    let _ = write!(
+                        s,
+                        r#"<line class="level" x1="{0:.1}" y1="{lo:.1}" x2="{0:.1}" y2="{hi:.1}"/>"#,
+                        x(a)
+                    );
+                }
+            } else {
+                let _ = write!(
+                    s,
+                    r#"<rect class="bus" x="{:.1}" y="{hi:.1}" width="{:.1}" height="14"/><text class="val" x="{:.1}" y="{:.1}">{v:0width$b}</text>"#,
+                    x(a),
+                    (x(b) - x(a)).max(0.5),
+                    x(a) + 2.0,
+                    hi + 11.0,
+                    width = usize::from(pin.bits)
+                );
+            }
+        }
+        y += row;
+    }
+    name(&mut s, y, "bus");
+    for (t, what) in &w.bus {
+        let _ = write!(
+            s,
+            r#"<g class="access"><line x1="{0:.1}" y1="{1:.1}" x2="{0:.1}" y2="{2:.1}"/><text x="{3:.1}" y="{2:.1}">{4}</text></g>"#,
+            x(*t),
+            y + 3.0,
+            y + 18.0,
+            x(*t) + 2.0,
+            esc(what)
+        );
+    }
+    y += row;
+    let xm = x(w.mark_ns);
+    let _ = write!(
+        s,
+        r#"<line class="mark" x1="{xm:.1}" y1="0" x2="{xm:.1}" y2="{y:.1}"/><text class="tick" x="{label_w}" y="{:.1}">{}</text><text class="tick" x="{:.1}" y="{:.1}" text-anchor="end">{}</text></svg>"#,
+        y + 14.0,
+        esc(&us(w.from_ns)),
+        width - 10.0,
+        y + 14.0,
+        esc(&us(w.to_ns)),
+    );
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mv(runs: Vec<[u64; 3]>) -> MoveFigure {
+        MoveFigure {
+            at_ns: 1_000,
+            runs,
+            ..MoveFigure::default()
+        }
+    }
+
+    #[test]
+    fn intervals_come_from_the_runs_and_the_gaps_between() {
+        // Pulses at 100, 300, 500 (run 1), then 650, 750 (run 2).
+        let s = segments(&[[100, 3, 400], [650, 2, 100]], false, |y| y);
+        let points: Vec<_> = s.iter().map(|s| (s.x0, s.x1, s.n, s.y)).collect();
+        assert_eq!(
+            points,
+            vec![(2.0, 3.0, 2, 0.2), (4.0, 4.0, 1, 0.15), (5.0, 5.0, 1, 0.1)]
+        );
+    }
+
+    #[test]
+    fn a_failure_marks_the_pulse_at_or_after_it() {
+        let m = mv(vec![[100, 3, 400], [650, 2, 100]]);
+        assert_eq!(mark_in(&m, 1_000 + 300), Some((2, 300)));
+        assert_eq!(mark_in(&m, 1_000 + 301), Some((3, 500)));
+        assert_eq!(mark_in(&m, 1_000 + 600), Some((4, 650)));
+        // After the last pulse: the last pulse.
+        assert_eq!(mark_in(&m, 1_000 + 9_000), Some((5, 750)));
+        assert_eq!(mark_in(&m, 10), None);
+    }
+}

@@ -1,0 +1,414 @@
+//! The results store: every run record kept in one SQLite file
+//! (`--store results.db`), keyed by board serial, revision, bridge, ppmc
+//! version, commit and time, for `ppmc history` and `ppmc report --store`
+//! (`docs/results-store.md`).
+//!
+//! `mod.rs` opens a store (made new, or an older one brought up to this
+//! schema) and adds run records to it; `stats.rs` asks it what a lab
+//! wants to know: yield per revision, each scenario's pass rate, each
+//! measurement's spread and Cpk, revision against revision, the trend.
+//!
+//! The schema is versioned by SQLite's `user_version`: [`SCHEMA`] is this
+//! ppmc's; an older store is migrated in place, in one transaction, by
+//! [`MIGRATIONS`]; a newer one is refused, never written.
+
+mod stats;
+
+pub use stats::{mean_sd, Distribution, History, RevisionYield, ScenarioRate, TrendPoint};
+
+use crate::report::Record;
+use rusqlite::{params, Connection, OpenFlags, Transaction};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// This ppmc's store schema.
+pub const SCHEMA: u32 = 1;
+
+/// Each schema from the first, as the statements that make it from the one
+/// before (`MIGRATIONS[0]` makes schema 1 from an empty file). A store at
+/// schema N runs `MIGRATIONS[N..]`. Never edit one that has shipped: add
+/// the next.
+pub const MIGRATIONS: [&str; 1] = [r#"
+CREATE TABLE runs (
+    id              INTEGER PRIMARY KEY,
+    started         TEXT    NOT NULL,  -- RFC 3339, UTC
+    harness_version TEXT    NOT NULL,
+    git_revision    TEXT    NOT NULL,
+    host            TEXT    NOT NULL,
+    source          TEXT    NOT NULL,  -- 'boards' or 'capture'
+    wall_s          REAL    NOT NULL,
+    passed          INTEGER NOT NULL,
+    marginal        INTEGER NOT NULL,
+    flaky           INTEGER NOT NULL,
+    failed          INTEGER NOT NULL,
+    errors          INTEGER NOT NULL,
+    not_run         INTEGER NOT NULL,
+    record          TEXT    NOT NULL   -- the JSON run record, without its figures
+);
+CREATE TABLE boards (
+    id              INTEGER PRIMARY KEY,
+    run_id          INTEGER NOT NULL REFERENCES runs(id),
+    name            TEXT    NOT NULL,
+    target          TEXT    NOT NULL,
+    board_serial    TEXT,
+    board_rev       TEXT,
+    bridge_firmware TEXT,
+    bridge_serial   TEXT,
+    reached         INTEGER NOT NULL   -- 0: the board took no part
+);
+CREATE TABLE results (
+    id         INTEGER PRIMARY KEY,
+    run_id     INTEGER NOT NULL REFERENCES runs(id),
+    board_id   INTEGER REFERENCES boards(id),
+    scenario   TEXT    NOT NULL,
+    section    TEXT    NOT NULL,
+    pass       INTEGER,
+    verdict    TEXT    NOT NULL,  -- passed, marginal, flaky, failed, error, not_run
+    attempts   INTEGER NOT NULL,
+    elapsed_ns INTEGER NOT NULL,
+    detail     TEXT
+);
+CREATE TABLE measurements (
+    result_id      INTEGER NOT NULL REFERENCES results(id),
+    name           TEXT    NOT NULL,
+    value_ns       INTEGER NOT NULL,
+    lo_ns          INTEGER NOT NULL,
+    hi_ns          INTEGER,          -- NULL: no upper limit
+    marginal_lo_ns INTEGER NOT NULL,
+    marginal_hi_ns INTEGER,
+    grade          TEXT    NOT NULL
+);
+CREATE INDEX boards_run ON boards(run_id);
+CREATE INDEX boards_rev ON boards(board_rev, board_serial);
+CREATE INDEX results_run ON results(run_id);
+CREATE INDEX results_board ON results(board_id);
+CREATE INDEX results_scenario ON results(scenario);
+CREATE INDEX measurements_result ON measurements(result_id);
+CREATE INDEX measurements_name ON measurements(name);
+"#];
+
+/// A store that could not be opened, read or written: the file, and why.
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: {why}")]
+pub struct StoreError {
+    pub path: PathBuf,
+    pub why: String,
+}
+
+/// An open results store.
+#[derive(Debug)]
+pub struct Store {
+    conn: Connection,
+    path: PathBuf,
+    /// The migrated copy an older store is read through, removed on drop.
+    _copy: Option<tempfile::NamedTempFile>,
+}
+
+impl Store {
+    /// Opens the store at `path`, made new when nothing is there, an older
+    /// one migrated to [`SCHEMA`]. A symlink, a folder, a file that is not
+    /// SQLite, or a store of a newer ppmc is refused by name.
+    pub fn open(path: &Path) -> Result<Store, StoreError> {
+        Store::open_with(path, true)
+    }
+
+    /// Opens an existing store to read it, changing nothing in it: a store
+    /// of an older schema is migrated in a temporary copy, so that an
+    /// archived store, read-only or shared, reads as it is.
+    pub fn open_existing(path: &Path) -> Result<Store, StoreError> {
+        let err = |why: String| StoreError {
+            path: path.to_path_buf(),
+            why,
+        };
+        if !path.exists() {
+            return Err(err(
+                "no results store here (ppmc run --store FILE makes one)".into(),
+            ));
+        }
+        crate::files::check_replaceable(path).map_err(|e| err(e.to_string()))?;
+        let flags = OpenFlags::SQLITE_OPEN_READ_ONLY
+            | OpenFlags::SQLITE_OPEN_NOFOLLOW
+            | OpenFlags::SQLITE_OPEN_NO_MUTEX;
+        let conn = Connection::open_with_flags(path, flags).map_err(|e| err(e.to_string()))?;
+        conn.busy_timeout(Duration::from_secs(30))
+            .map_err(|e| err(e.to_string()))?;
+        let store = Store {
+            conn,
+            path: path.to_path_buf(),
+            _copy: None,
+        };
+        let at = store.schema()?;
+        if at == SCHEMA {
+            return Ok(store);
+        }
+        if at == 0 {
+            return Err(err(
+                "not a ppmc results store: it has no schema version (an empty file, or another program's SQLite file)".into(),
+            ));
+        }
+        if at > SCHEMA {
+            return Err(err(format!(
+                "a results store of schema {at}, made by a newer ppmc; this one reads schemas up to {SCHEMA}: update ppmc"
+            )));
+        }
+        let copy = tempfile::Builder::new()
+            .prefix("ppmc-store-")
+            .suffix(".db")
+            .tempfile()
+            .map_err(|e| {
+                err(format!(
+                    "copying the store to read it at schema {SCHEMA}: {e}"
+                ))
+            })?;
+        // SQLite's own copy: consistent even while another ppmc writes.
+        store
+            .conn
+            .execute("VACUUM INTO ?1", [copy.path().to_string_lossy()])
+            .map_err(|e| {
+                err(format!(
+                    "copying the store to read it at schema {SCHEMA}: {e}"
+                ))
+            })?;
+        let flags = OpenFlags::SQLITE_OPEN_READ_WRITE | OpenFlags::SQLITE_OPEN_NO_MUTEX;
+        let conn =
+            Connection::open_with_flags(copy.path(), flags).map_err(|e| err(e.to_string()))?;
+        let mut s = Store {
+            conn,
+            path: path.to_path_buf(),
+            _copy: Some(copy),
+        };
+        s.migrate()?;
+        Ok(s)
+    }
+
+    fn open_with(path: &Path, create: bool) -> Result<Store, StoreError> {
+        let err = |why: String| StoreError {
+            path: path.to_path_buf(),
+            why,
+        };
+        crate::files::check_replaceable(path).map_err(|e| err(e.to_string()))?;
+        let mut flags = OpenFlags::SQLITE_OPEN_READ_WRITE
+            | OpenFlags::SQLITE_OPEN_NOFOLLOW
+            | OpenFlags::SQLITE_OPEN_NO_MUTEX;
+        if create {
+            flags |= OpenFlags::SQLITE_OPEN_CREATE;
+        }
+        let conn = Connection::open_with_flags(path, flags).map_err(|e| err(e.to_string()))?;
+        // Two CI jobs writing one store wait for each other, briefly.
+        conn.busy_timeout(Duration::from_secs(30))
+            .map_err(|e| err(e.to_string()))?;
+        let mut store = Store {
+            conn,
+            path: path.to_path_buf(),
+            _copy: None,
+        };
+        store.migrate()?;
+        Ok(store)
+    }
+
+    fn fail(&self, e: impl std::fmt::Display) -> StoreError {
+        StoreError {
+            path: self.path.clone(),
+            why: e.to_string(),
+        }
+    }
+
+    /// The store's schema version.
+    pub fn schema(&self) -> Result<u32, StoreError> {
+        self.conn
+            .query_row("PRAGMA user_version", [], |r| r.get(0))
+            .map_err(|e| self.fail(not_a_store(e)))
+    }
+
+    /// Brings the store to [`SCHEMA`], in one transaction.
+    fn migrate(&mut self) -> Result<(), StoreError> {
+        let at = self.schema()?;
+        if at > SCHEMA {
+            return Err(self.fail(format!(
+                "a results store of schema {at}, made by a newer ppmc; this one reads schemas up to {SCHEMA}: update ppmc"
+            )));
+        }
+        if at == SCHEMA {
+            return Ok(());
+        }
+        if at == 0 {
+            // Version 0 is a new, empty file, or some other SQLite file.
+            let tables: i64 = self
+                .conn
+                .query_row("SELECT count(*) FROM sqlite_master", [], |r| r.get(0))
+                .map_err(|e| self.fail(not_a_store(e)))?;
+            if tables > 0 {
+                return Err(self.fail(
+                    "an SQLite file that is not a ppmc results store (it has tables, and no schema version)",
+                ));
+            }
+        }
+        let path = self.path.clone();
+        let tx = self.conn.transaction().map_err(|e| fail_at(&path, e))?;
+        for (n, step) in MIGRATIONS.iter().enumerate().skip(at as usize) {
+            tx.execute_batch(step)
+                .map_err(|e| fail_at(&path, format!("migrating to schema {}: {e}", n + 1)))?;
+        }
+        tx.pragma_update(None, "user_version", SCHEMA)
+            .map_err(|e| fail_at(&path, e))?;
+        tx.commit().map_err(|e| fail_at(&path, e))
+    }
+
+    /// Adds a run record, in one transaction: the run, its boards, every
+    /// result and measurement. Returns the run's id in the store.
+    pub fn add(&mut self, record: &Record, text: &str) -> Result<i64, StoreError> {
+        let path = self.path.clone();
+        let tx = self.conn.transaction().map_err(|e| fail_at(&path, e))?;
+        let id = insert(&tx, record, text).map_err(|e| fail_at(&path, e))?;
+        tx.commit().map_err(|e| fail_at(&path, e))?;
+        Ok(id)
+    }
+
+    /// How many runs the store holds.
+    pub fn runs(&self) -> Result<u64, StoreError> {
+        self.conn
+            .query_row("SELECT count(*) FROM runs", [], |r| r.get(0))
+            .map_err(|e| self.fail(e))
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    pub(crate) fn conn(&self) -> &Connection {
+        &self.conn
+    }
+}
+
+fn fail_at(path: &Path, e: impl std::fmt::Display) -> StoreError {
+    StoreError {
+        path: path.to_path_buf(),
+        why: e.to_string(),
+    }
+}
+
+/// SQLite's word for a file that is not a database, in ours.
+fn not_a_store(e: rusqlite::Error) -> String {
+    match e.sqlite_error_code() {
+        Some(rusqlite::ErrorCode::NotADatabase) => {
+            "not a results store (not an SQLite file)".to_string()
+        }
+        _ => e.to_string(),
+    }
+}
+
+/// The record as the store keeps it: without its figures, which only the
+/// run's own report draws, and which would make a lab's store grow by
+/// the pulse runs of every move.
+pub fn stored_text(text: &str) -> String {
+    match serde_json::from_str::<serde_json::Value>(text) {
+        Ok(mut v) => {
+            if let Some(list) = v.get_mut("scenarios").and_then(|s| s.as_array_mut()) {
+                for s in list {
+                    if let Some(o) = s.as_object_mut() {
+                        o.remove("figures");
+                    }
+                }
+            }
+            v.to_string()
+        }
+        Err(_) => text.to_string(),
+    }
+}
+
+fn insert(tx: &Transaction, r: &Record, text: &str) -> rusqlite::Result<i64> {
+    let s = &r.summary;
+    let source = if r.run.source.is_some() {
+        "capture"
+    } else {
+        "boards"
+    };
+    tx.execute(
+        "INSERT INTO runs (started, harness_version, git_revision, host, source, wall_s,
+             passed, marginal, flaky, failed, errors, not_run, record)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)",
+        params![
+            r.run.started,
+            r.run.harness_version,
+            r.run.git_revision,
+            r.run.host,
+            source,
+            r.run.wall_s,
+            s.passed,
+            s.marginal,
+            s.flaky,
+            s.failed,
+            s.error,
+            s.not_run,
+            stored_text(text),
+        ],
+    )?;
+    let run = tx.last_insert_rowid();
+    let mut board_ids = Vec::with_capacity(r.run.boards.len());
+    for b in &r.run.boards {
+        tx.execute(
+            "INSERT INTO boards (run_id, name, target, board_serial, board_rev,
+                 bridge_firmware, bridge_serial, reached)
+             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
+            params![
+                run,
+                b.name,
+                b.target,
+                b.board_serial,
+                b.board_rev,
+                b.bridge_firmware,
+                b.bridge_serial,
+                b.error.is_none(),
+            ],
+        )?;
+        board_ids.push((b.name.as_str(), tx.last_insert_rowid()));
+    }
+    let mut result = tx.prepare(
+        "INSERT INTO results (run_id, board_id, scenario, section, pass, verdict, attempts,
+             elapsed_ns, detail)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
+    )?;
+    let mut measure = tx.prepare(
+        "INSERT INTO measurements (result_id, name, value_ns, lo_ns, hi_ns, marginal_lo_ns,
+             marginal_hi_ns, grade)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
+    )?;
+    for sc in &r.scenarios {
+        let board = sc
+            .board
+            .as_deref()
+            .and_then(|n| board_ids.iter().find(|(name, _)| *name == n))
+            .map(|(_, id)| *id);
+        let detail = sc
+            .failure
+            .as_ref()
+            .map(|f| format!("{}: expected {}, got {}", f.expectation, f.expected, f.got))
+            .or_else(|| sc.error.as_ref().map(|e| e.message.clone()))
+            .or_else(|| sc.detail.clone());
+        result.execute(params![
+            run,
+            board,
+            sc.name,
+            sc.section,
+            sc.pass,
+            sc.verdict,
+            sc.attempts.len().max(1) as i64,
+            sc.elapsed_ns as i64,
+            detail,
+        ])?;
+        let rid = tx.last_insert_rowid();
+        for m in &sc.measurements {
+            measure.execute(params![
+                rid,
+                m.name,
+                m.value_ns as i64,
+                m.lo_ns as i64,
+                m.hi_ns.map(|v| v as i64),
+                m.marginal_lo_ns as i64,
+                m.marginal_hi_ns.map(|v| v as i64),
+                m.grade,
+            ])?;
+        }
+    }
+    Ok(run)
+}

@@ -1,0 +1,100 @@
+//! A results store filled by runs of two board revisions, the second with
+//! a board fault of the catalogue (the first POUT of an accel/decel move
+//! 5 % late, Table 3-3): `ppmc history` and `ppmc report --store` show the
+//! faulty revision's yield and its measurement's distribution apart from
+//! the good one's (issue 31, docs/results-store.md).
+
+mod common;
+
+use common::{ppmc, scratch, text};
+
+#[test]
+fn the_store_sets_a_faulty_revision_apart_from_a_good_one() {
+    let dir = scratch("store");
+    let db = dir.path().join("results.db");
+    let db_s = db.to_str().expect("utf-8");
+    for (board, code) in [
+        ("emu,rev=A,board-serial=A-1", 0),
+        ("emu,rev=A,board-serial=A-2,clock-mhz=15.9", 0),
+        (
+            "emu,rev=B,board-serial=B-1,chip-fault=accel-first-pout-slow",
+            1,
+        ),
+        (
+            "emu,rev=B,board-serial=B-2,clock-mhz=15.9,chip-fault=accel-first-pout-slow",
+            1,
+        ),
+    ] {
+        let out = ppmc(&[
+            "run",
+            "--filter",
+            "s3_3_4_longest_triangle_first_pout",
+            "--target",
+            board,
+            "--store",
+            db_s,
+        ]);
+        assert_eq!(
+            out.status.code(),
+            Some(code),
+            "{board}: {}",
+            text(&out.stdout)
+        );
+    }
+    let out = ppmc(&["history", "--store", db_s]);
+    let said = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{said}");
+    assert!(said.contains("4 runs, 4 boards"), "{said}");
+    assert!(
+        said.contains("  A             100.0%  2 of 2 board tests passed, 2 boards"),
+        "{said}"
+    );
+    assert!(
+        said.contains("  B               0.0%  0 of 2 board tests passed, 2 boards"),
+        "{said}"
+    );
+
+    let page = dir.path().join("history.html");
+    let out = ppmc(&[
+        "report",
+        "--store",
+        db_s,
+        "-o",
+        page.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let html = std::fs::read_to_string(&page).expect("written");
+    for banned in ["<script", "http://", "https://", "src="] {
+        assert!(!html.contains(banned), "{banned} in the page");
+    }
+    // The measurement of the faulty revision outside its band comes first,
+    // both revisions on one scale, B's mean 5 % above A's.
+    let group = html
+        .split("<div class=\"measure-group\"")
+        .nth(1)
+        .expect("a measurement group");
+    assert!(
+        group.contains("data-measure=\"accel_first_pout\""),
+        "{group}"
+    );
+    let mean = |rev: &str| -> f64 {
+        let at = group
+            .find(&format!(
+                "<g class=\"rev\" data-rev=\"{rev}\" data-mean-ns=\""
+            ))
+            .unwrap_or_else(|| panic!("{rev} in {group}"));
+        let v = &group[at..];
+        let v = &v[v.find("data-mean-ns=\"").expect("mean") + 14..];
+        v[..v.find('"').expect("q")].parse().expect("a number")
+    };
+    let (a, b) = (mean("A"), mean("B"));
+    assert!((b / a - 1.05).abs() < 0.01, "A {a} ns, B {b} ns");
+    assert!(html.contains("data-rev=\"B\" data-yield=\"0.0000\""));
+    assert!(html.contains("data-rev=\"A\" data-yield=\"1.0000\""));
+
+    // Nothing is written over: not the store, not a report asked onto it.
+    let out = ppmc(&["report", "--store", db_s, "-o", db_s]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = ppmc(&["history", "--store", db_s]);
+    assert_eq!(out.status.code(), Some(0));
+}
