@@ -9,7 +9,7 @@
 //! [`vcd_export`], [`bridge::sim`] ← [`scenario`] (the scenario API) ←
 //! [`runner`] (one target or a [`runner::Farm`] of boards), [`golden`],
 //! [`compare`], [`selftest`], [`console`], [`chaos`] ← [`report`],
-//! [`soak`] ← [`fuzzing`] (its oracle in [`invariants`], the second model
+//! [`soak`], [`store`] ← [`fuzzing`] (its oracle in [`invariants`], the second model
 //! of the chip in [`plain_model`]) ← [`fault_matrix`] ← [`cli`] (the
 //! command line: arguments in, results printed, nothing else).
 //! `ARCHITECTURE.md` at the repository root is the map.

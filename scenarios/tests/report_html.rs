@@ -103,10 +103,15 @@ fn a_faulty_board_has_its_failure_marked_on_the_speed_profile() {
     // time, at the pulse the failure's time falls on.
     let failed = "s3_6_decel_stop_17us_not_after";
     let s = section(&html, failed);
-    let at = html.find(&format!("data-scenario=\"{failed}\"")).expect("there");
+    let at = html
+        .find(&format!("data-scenario=\"{failed}\""))
+        .expect("there");
     let tag = &html[html[..at].rfind("<details").expect("its element")..];
     let tag = &tag[..tag.find('>').expect("closed")];
-    assert!(tag.contains("class=\"scenario failed\"") && tag.contains(" open"), "{tag}");
+    assert!(
+        tag.contains("class=\"scenario failed\"") && tag.contains(" open"),
+        "{tag}"
+    );
     assert_eq!(s.matches("<g class=\"divergence\"").count(), 2, "{s}");
     let sc = record["scenarios"]
         .as_array()

@@ -92,9 +92,44 @@ fn the_store_sets_a_faulty_revision_apart_from_a_good_one() {
     assert!(html.contains("data-rev=\"B\" data-yield=\"0.0000\""));
     assert!(html.contains("data-rev=\"A\" data-yield=\"1.0000\""));
 
-    // Nothing is written over: not the store, not a report asked onto it.
+    // Nothing is written over: not the store, not a report asked onto it,
+    // and a soak, whose record counts its passes, is not stored.
     let out = ppmc(&["report", "--store", db_s, "-o", db_s]);
     assert_eq!(out.status.code(), Some(2));
+    let refused = |more: &[&str], says: &str| {
+        let mut args = vec!["run", "--filter", "e0_undefined", "--store", db_s];
+        args.extend_from_slice(more);
+        let out = ppmc(&args);
+        assert_eq!(out.status.code(), Some(2), "{more:?}");
+        let err = text(&out.stderr);
+        assert!(err.contains(says), "{more:?}: {err}");
+    };
+    for flag in ["--json", "--html", "--junit"] {
+        refused(&[flag, db_s], "are the same file");
+    }
+    refused(&["--repeat", "2"], "--store with --repeat");
     let out = ppmc(&["history", "--store", db_s]);
     assert_eq!(out.status.code(), Some(0));
+}
+
+/// `scripts/store-figures`, as docs/performance.md runs it, on a store of
+/// three runs: its table has the row it promises, every run's results.
+#[test]
+fn the_store_figures_script_fills_a_store_and_times_its_report() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let out = std::process::Command::new(format!("{root}/scripts/store-figures"))
+        .args([
+            "--runs",
+            "3",
+            "--draws",
+            "1",
+            "--ppmc",
+            env!("CARGO_BIN_EXE_ppmc"),
+        ])
+        .output()
+        .expect("the script runs");
+    let said = text(&out.stdout);
+    assert!(out.status.success(), "{said}{}", text(&out.stderr));
+    let row = said.lines().last().expect("a row");
+    assert!(row.starts_with("| 3 | 288 | "), "{said}");
 }

@@ -37,6 +37,9 @@ pub struct CompareArgs {
     /// marked, the pins around it.
     #[arg(long, value_name = "FILE")]
     html: Option<PathBuf>,
+    /// Keep the run record in a results store (docs/results-store.md).
+    #[arg(long, value_name = "FILE")]
+    store: Option<PathBuf>,
 }
 
 pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
@@ -64,7 +67,7 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             junit: args.junit,
             json: args.json,
             html: args.html,
-            store: None,
+            store: args.store,
             artifacts: None,
             artifacts_window: super::run::Window::All,
             each: false,
@@ -86,7 +89,9 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
         args.junit.as_deref(),
         args.json.as_deref(),
         args.html.as_deref(),
+        args.store.as_deref(),
     )?;
+    let mut store = super::run::open_store(args.store.as_deref())?;
     // A trace that diverges fails, as in `ppmc run --golden`; a file that
     // cannot be used (missing, unreadable, corrupt, at other straps) is an
     // error of its own: the file is at fault, not the board.
@@ -162,6 +167,11 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
     }
     if let Some(p) = &args.html {
         if let Err(e) = super::run::write_html(p, report::json_listing(&info, &listing)) {
+            problems.push(e);
+        }
+    }
+    if let Some(store) = &mut store {
+        if let Err(e) = super::run::keep(store, report::json_listing(&info, &listing)) {
             problems.push(e);
         }
     }

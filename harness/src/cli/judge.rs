@@ -148,6 +148,17 @@ pub struct JudgeArgs {
     /// it is, each result names whom it blames); `-` for standard output.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    /// Keep the run record in a results store (SQLite; made when not
+    /// there), beside the runs of boards behind a bridge
+    /// (docs/results-store.md).
+    #[arg(long, value_name = "FILE")]
+    store: Option<PathBuf>,
+    /// The board's serial number, for the reports and the store.
+    #[arg(long, value_name = "SERIAL")]
+    board_serial: Option<String>,
+    /// The board's revision label, for the reports and the store.
+    #[arg(long, value_name = "REV")]
+    board_rev: Option<String>,
     /// Also write the capture as a trace in our format, `DIR/<scenario>.snap`
     /// (never replacing a file there), for `ppmc compare GOLDEN --traces
     /// DIR`: the writes and data reads, the moves they started, the pulses
@@ -170,7 +181,12 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         tolerances: args.tolerance.tolerances().map_err(usage)?,
         glitch_ps: args.capture.glitch.as_nanos() * 1000,
     };
-    super::run::prepare_reports(args.junit.as_deref(), args.json.as_deref(), None)?;
+    super::run::prepare_reports(
+        args.junit.as_deref(),
+        args.json.as_deref(),
+        None,
+        args.store.as_deref(),
+    )?;
     let name = match (&args.trace, &args.scenario) {
         (None, _) => None,
         (Some(_), Some(n)) => Some(n.clone()),
@@ -191,6 +207,7 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         }
         crate::files::prepare_folder(dir)?;
     }
+    let mut store = super::run::open_store(args.store.as_deref())?;
     describe(&info, &args.capture.capture);
     let (j, trace) = judge_traced(source.as_mut(), &map, &opts, name.as_deref())
         .map_err(|e| CliError::BadInput(format!("ppmc: {e}")))?;
@@ -205,9 +222,11 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
             Err(e) => problems.push(format!("--trace: {e}")),
         }
     }
-    if args.junit.is_some() || args.json.is_some() {
+    if args.junit.is_some() || args.json.is_some() || store.is_some() {
         let wall = started.elapsed();
-        let (run, results, judged) = records(&args.capture.capture, &info, &opts, &j, wall);
+        let (mut run, results, judged) = records(&args.capture.capture, &info, &opts, &j, wall);
+        run.boards[0].board_rev = args.board_rev.clone();
+        run.boards[0].board_serial = args.board_serial.clone();
         let on = vec![Some(0); results.len()];
         let listing = Listing::all(&results, &[], &on).judged(&judged);
         if let Some(p) = &args.junit {
@@ -217,6 +236,11 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         }
         if let Some(p) = &args.json {
             if let Err(e) = super::run::write_report(p, report::json_listing(&run, &listing)) {
+                problems.push(e);
+            }
+        }
+        if let Some(store) = &mut store {
+            if let Err(e) = super::run::keep(store, report::json_listing(&run, &listing)) {
                 problems.push(e);
             }
         }

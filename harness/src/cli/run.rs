@@ -238,8 +238,21 @@ pub(super) fn prepare_reports(
     junit: Option<&Path>,
     json: Option<&Path>,
     html: Option<&Path>,
+    store: Option<&Path>,
 ) -> Result<(), CliError> {
-    let named = [("--junit", junit), ("--json", json), ("--html", html)];
+    if store.is_some_and(|s| s.as_os_str() == "-") {
+        return Err(usage(
+            "--store -: a results store is a file, not standard output",
+        ));
+    }
+    // The store is told apart from the reports too: a report written over
+    // it would replace a lab's history.
+    let named = [
+        ("--junit", junit),
+        ("--json", json),
+        ("--html", html),
+        ("--store", store),
+    ];
     let reports: Vec<(&str, &Path)> = named
         .into_iter()
         .filter_map(|(flag, p)| p.map(|p| (flag, p)))
@@ -385,7 +398,13 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         args.junit.as_deref(),
         args.json.as_deref(),
         args.html.as_deref(),
+        args.store.as_deref(),
     )?;
+    if args.store.is_some() && args.repeat > 1 {
+        return Err(usage(
+            "--store with --repeat: a soak's record lists its first pass and what did not pass, and counts the rest, so the store would see its failures and not its passes; store single runs",
+        ));
+    }
     let mut store = open_store(args.store.as_deref())?;
     if let Some(dir) = &args.golden {
         if !dir.is_dir() {
@@ -680,8 +699,12 @@ fn board_lines(info: &RunInfo, tallies: &[Tally]) {
             Some(_) => " (not reached)",
             None => "",
         };
+        let flaky = match t.flaky {
+            0 => String::new(),
+            n => format!(" {n} flaky,"),
+        };
         outln!(
-            "board {}{state}: {} scenarios, {} passed, {} failed, {} errors, {} not run",
+            "board {}{state}: {} scenarios, {} passed,{flaky} {} failed, {} errors, {} not run",
             board.name,
             runs_of(t),
             t.passed + t.marginal,

@@ -47,7 +47,7 @@ pub struct MoveFigure {
 impl MoveFigure {
     /// The pulses of the board's runs.
     pub fn pulses(&self) -> u64 {
-        self.runs.iter().map(|r| r[1]).sum()
+        self.runs.iter().fold(0u64, |n, r| n.saturating_add(r[1]))
     }
 }
 
@@ -139,9 +139,9 @@ fn pulse_at(base: u64, run: &[u64; 3], k: u64) -> u64 {
     let [from, count, span] = *run;
     let step = match count {
         0 | 1 => 0,
-        n => k.saturating_mul(span) / (n - 1),
+        n => (u128::from(k) * u128::from(span) / u128::from(n - 1)) as u64,
     };
-    base + from + step
+    base.saturating_add(from).saturating_add(step)
 }
 
 /// The pulses of `runs` (placed at `base`) within `from..=to`, at most
@@ -150,7 +150,8 @@ fn pulses_within(base: u64, runs: &[[u64; 3]], from: u64, to: u64, cap: usize) -
     let mut out = Vec::new();
     for run in runs {
         let [start, count, span] = *run;
-        let (first, last) = (base + start, base + start + span);
+        let first = base.saturating_add(start);
+        let last = first.saturating_add(span);
         if count == 0 || last < from || first > to {
             continue;
         }
@@ -214,7 +215,7 @@ fn waveform(trace: &Trace, moves: &[MoveFigure], mark: u64) -> Waveform {
             if count == 0 {
                 continue;
             }
-            let at = m.at_ns + from;
+            let at = m.at_ns.saturating_add(from);
             let k = match (count, mark > at) {
                 (1, _) | (_, false) => 0,
                 (n, true) => ((mark - at) as u128 * u128::from(n - 1) / u128::from(span.max(1)))

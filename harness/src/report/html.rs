@@ -119,7 +119,7 @@ fn run_section(s: &mut String, r: &Record, i: usize) {
             esc(sc.board.as_deref().unwrap_or("")),
             esc(&sc.verdict),
             esc(&sc.verdict.replace('_', " ")),
-            sc.attempts.len().max(1),
+            sc.attempts.len() + 1,
             esc(&plots::human(sc.elapsed_ns)),
         );
     }
@@ -224,14 +224,25 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64)) {
     }
     if !sc.attempts.is_empty() {
         s.push_str(r#"<table class="attempts"><tr><th>attempt</th><th>verdict</th><th>what happened</th></tr>"#);
-        for (n, a) in sc.attempts.iter().enumerate() {
+        // The earlier attempts, then the last, which the scenario's own
+        // fields are.
+        let last = match sc.verdict.as_str() {
+            "flaky" => "passed",
+            v => v,
+        };
+        let rows = sc
+            .attempts
+            .iter()
+            .map(|a| (a.verdict.as_str(), a.detail.as_deref()))
+            .chain(std::iter::once((last, sc.detail.as_deref())));
+        for (n, (verdict, detail)) in rows.enumerate() {
             let _ = write!(
                 s,
                 r#"<tr><td>{}</td><td><span class="chip {}">{}</span></td><td>{}</td></tr>"#,
                 n + 1,
-                esc(&a.verdict),
-                esc(&a.verdict.replace('_', " ")),
-                esc(a.detail.as_deref().unwrap_or(""))
+                esc(verdict),
+                esc(&verdict.replace('_', " ")),
+                esc(detail.unwrap_or(""))
             );
         }
         s.push_str("</table>");

@@ -302,12 +302,13 @@ fn repeated_case(x: &mut String, r: &Repeated, name: &str, board: Option<&str>) 
         out.push(format!("board: {b}"));
     }
     out.push(format!(
-        "repeated: {} runs of passes {}-{} not listed one by one: {} passed, {} marginal, {} failed, {} errors, {} not run ({} interrupted)",
+        "repeated: {} runs of passes {}-{} not listed one by one: {} passed, {} marginal, {} flaky, {} failed, {} errors, {} not run ({} interrupted)",
         r.runs(),
         r.first_pass,
         r.last_pass,
         t.passed,
         t.marginal,
+        t.flaky,
         t.failed,
         t.errors,
         t.not_run,
@@ -388,14 +389,23 @@ fn board_props(prefix: &str, b: &BoardInfo) -> Vec<(String, String)> {
 /// `stackTrace`.
 fn attempts(body: &mut String, r: &ScenarioResult) {
     let prefix = if r.verdict.ok() { "flaky" } else { "rerun" };
-    for (n, a) in r.attempts.iter().enumerate() {
-        let Some((tag, kind, message)) = own_element(&a.verdict) else {
-            continue;
-        };
-        let tag = match tag {
-            "failure" => "Failure",
-            _ => "Error",
-        };
+    // Surefire's own schema takes the failures before the errors.
+    let mut earlier: Vec<(usize, &str, &str, String)> = r
+        .attempts
+        .iter()
+        .enumerate()
+        .filter_map(|(n, a)| {
+            let (tag, kind, message) = own_element(&a.verdict)?;
+            let tag = match tag {
+                "failure" => "Failure",
+                _ => "Error",
+            };
+            Some((n, tag, kind, message))
+        })
+        .collect();
+    earlier.sort_by_key(|(n, tag, ..)| (*tag != "Failure", *n));
+    for (n, tag, kind, message) in earlier {
+        let a = &r.attempts[n];
         let _ = writeln!(
             body,
             "      <{prefix}{tag} type=\"{kind}\" message=\"{}\"><stackTrace>{}</stackTrace><system-out>{}</system-out></{prefix}{tag}>",

@@ -85,9 +85,10 @@ fn segments(runs: &[[u64; 3]], by_time: bool, band: impl Fn(f64) -> f64) -> Vec<
         let x = |p: u64, t: u64| if by_time { t as f64 / 1e6 } else { p as f64 };
         if let Some(prev) = last {
             let gap = from.saturating_sub(prev) as f64 / 1000.0;
+            let p = pulse.saturating_add(1);
             out.push(Segment {
-                x0: x(pulse + 1, from),
-                x1: x(pulse + 1, from),
+                x0: x(p, from),
+                x1: x(p, from),
                 n: 1,
                 y: band(gap),
             });
@@ -95,14 +96,17 @@ fn segments(runs: &[[u64; 3]], by_time: bool, band: impl Fn(f64) -> f64) -> Vec<
         if count > 1 {
             let dt = span as f64 / (count - 1) as f64 / 1000.0;
             out.push(Segment {
-                x0: x(pulse + 2, from + (span / (count - 1))),
-                x1: x(pulse + count, from + span),
+                x0: x(
+                    pulse.saturating_add(2),
+                    from.saturating_add(span / (count - 1)),
+                ),
+                x1: x(pulse.saturating_add(count), from.saturating_add(span)),
                 n: count - 1,
                 y: band(dt),
             });
         }
-        pulse += count;
-        last = Some(from + span);
+        pulse = pulse.saturating_add(count);
+        last = Some(from.saturating_add(span));
     }
     out
 }
@@ -117,18 +121,22 @@ pub fn mark_in(m: &MoveFigure, at_ns: u64) -> Option<(u64, u64)> {
         if count == 0 {
             continue;
         }
-        if t <= from + span {
+        if t <= from.saturating_add(span) {
             let k = match count {
                 1 => 0,
                 _ if t <= from => 0,
                 n => ((t - from) as u128 * u128::from(n - 1)).div_ceil(u128::from(span.max(1)))
                     as u64,
             };
-            let when = from + if count > 1 { k * span / (count - 1) } else { 0 };
-            return Some((pulse + k + 1, when));
+            let when = match count {
+                1 => from,
+                n => from
+                    .saturating_add((u128::from(k) * u128::from(span) / u128::from(n - 1)) as u64),
+            };
+            return Some((pulse.saturating_add(k + 1), when));
         }
-        pulse += count;
-        best = Some((pulse, from + span));
+        pulse = pulse.saturating_add(count);
+        best = Some((pulse, from.saturating_add(span)));
     }
     best
 }
@@ -263,11 +271,22 @@ pub fn waveform(w: &Waveform) -> String {
         for (a, b, v) in pieces {
             if pin.bits == 1 {
                 let yy = if v != 0 { hi } else { lo };
+                // High is shaded down to low, so a level reads at a glance.
+                if v != 0 {
+                    let _ = write!(
+                        s,
+                        r#"<rect class="high" x="{:.1}" y="{hi:.1}" width="{:.1}" height="{:.1}"/>"#,
+                        x(a),
+                        (x(b) - x(a)).max(0.5),
+                        lo - hi
+                    );
+                }
                 let _ = write!(
                     s,
-                    r#"<line class="level" x1="{:.1}" y1="{yy:.1}" x2="{:.1}" y2="{yy:.1}"/>"#,
+                    r#"<line class="level" x1="{:.1}" y1="{yy:.1}" x2="{:.1}" y2="{yy:.1}" data-level="{}"/>"#,
                     x(a),
                     x(b),
+                    u8::from(v != 0)
                 );
                 // An edge where the level changed, not at the window's edge.
                 if a > w.from_ns {

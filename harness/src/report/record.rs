@@ -160,10 +160,14 @@ impl Record {
         match f.format.as_deref() {
             Some(v) if FORMATS.contains(&v) => {}
             Some(v) if v.starts_with("ppmc-run-record/") => {
+                let n = v["ppmc-run-record/".len()..]
+                    .parse::<u32>()
+                    .unwrap_or(u32::MAX);
+                let when = if n < 3 { "older" } else { "newer" };
                 return Err(err(format!(
-                    "run record format {v} is newer than this ppmc reads ({}): update ppmc",
+                    "run record format {v} is {when} than this ppmc reads ({})",
                     FORMATS.join(", ")
-                )))
+                )));
             }
             _ => {
                 return Err(err(

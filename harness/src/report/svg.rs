@@ -32,7 +32,7 @@ pub struct Reduced {
 /// `x_lo..=x_hi`: every point when they are no more than the columns,
 /// otherwise each column's least and greatest value, in column order.
 pub fn reduce(segments: &[Segment], x_lo: f64, x_hi: f64, columns: usize) -> Reduced {
-    let total: u64 = segments.iter().map(|s| s.n).sum();
+    let total = segments.iter().fold(0u64, |n, s| n.saturating_add(s.n));
     if total <= columns as u64 {
         let mut points = Vec::with_capacity(total as usize);
         for s in segments {

@@ -17,7 +17,7 @@ mod stats;
 pub use stats::{mean_sd, Distribution, History, RevisionYield, ScenarioRate, TrendPoint};
 
 use crate::report::Record;
-use rusqlite::{params, Connection, OpenFlags, Transaction};
+use rusqlite::{params, Connection, OpenFlags, Transaction, TransactionBehavior};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -64,7 +64,8 @@ CREATE TABLE results (
     section    TEXT    NOT NULL,
     pass       INTEGER,
     verdict    TEXT    NOT NULL,  -- passed, marginal, flaky, failed, error, not_run
-    attempts   INTEGER NOT NULL,
+    blame      TEXT,              -- judged from a capture: board, host or capture
+    attempts   INTEGER NOT NULL,  -- how many times it ran
     elapsed_ns INTEGER NOT NULL,
     detail     TEXT
 );
@@ -116,11 +117,18 @@ impl Store {
     /// of an older schema is migrated in a temporary copy, so that an
     /// archived store, read-only or shared, reads as it is.
     pub fn open_existing(path: &Path) -> Result<Store, StoreError> {
+        Store::open_existing_with(path, &MIGRATIONS)
+    }
+
+    /// [`Store::open_existing`] with `migrations` as this ppmc's (its
+    /// schema their count): a test brings a store to a schema to come.
+    fn open_existing_with(path: &Path, migrations: &[&str]) -> Result<Store, StoreError> {
         let err = |why: String| StoreError {
             path: path.to_path_buf(),
             why,
         };
-        if !path.exists() {
+        // Not there at all; a dangling link is named as a link below.
+        if std::fs::symlink_metadata(path).is_err() {
             return Err(err(
                 "no results store here (ppmc run --store FILE makes one)".into(),
             ));
@@ -137,8 +145,8 @@ impl Store {
             path: path.to_path_buf(),
             _copy: None,
         };
-        let at = store.schema()?;
-        if at == SCHEMA {
+        let (at, schema) = (store.schema()?, migrations.len() as u32);
+        if at == schema {
             return Ok(store);
         }
         if at == 0 {
@@ -146,38 +154,35 @@ impl Store {
                 "not a ppmc results store: it has no schema version (an empty file, or another program's SQLite file)".into(),
             ));
         }
-        if at > SCHEMA {
-            return Err(err(format!(
-                "a results store of schema {at}, made by a newer ppmc; this one reads schemas up to {SCHEMA}: update ppmc"
-            )));
+        if at > schema {
+            return Err(err(newer(at, schema)));
         }
+        let copying = |e: &dyn std::fmt::Display| {
+            err(format!(
+                "copying the store to read it at schema {schema}: {e}"
+            ))
+        };
         let copy = tempfile::Builder::new()
             .prefix("ppmc-store-")
             .suffix(".db")
             .tempfile()
-            .map_err(|e| {
-                err(format!(
-                    "copying the store to read it at schema {SCHEMA}: {e}"
-                ))
-            })?;
-        // SQLite's own copy: consistent even while another ppmc writes.
+            .map_err(|e| copying(&e))?;
+        // SQLite's own copy, consistent even while another ppmc writes; it
+        // must make the file itself.
+        let target = copy.path().to_path_buf();
+        std::fs::remove_file(&target).map_err(|e| copying(&e))?;
         store
             .conn
-            .execute("VACUUM INTO ?1", [copy.path().to_string_lossy()])
-            .map_err(|e| {
-                err(format!(
-                    "copying the store to read it at schema {SCHEMA}: {e}"
-                ))
-            })?;
+            .execute("VACUUM INTO ?1", [target.to_string_lossy()])
+            .map_err(|e| copying(&e))?;
         let flags = OpenFlags::SQLITE_OPEN_READ_WRITE | OpenFlags::SQLITE_OPEN_NO_MUTEX;
-        let conn =
-            Connection::open_with_flags(copy.path(), flags).map_err(|e| err(e.to_string()))?;
+        let conn = Connection::open_with_flags(&target, flags).map_err(|e| err(e.to_string()))?;
         let mut s = Store {
             conn,
             path: path.to_path_buf(),
             _copy: Some(copy),
         };
-        s.migrate()?;
+        s.migrate_with(migrations)?;
         Ok(s)
     }
 
@@ -187,6 +192,12 @@ impl Store {
             why,
         };
         crate::files::check_replaceable(path).map_err(|e| err(e.to_string()))?;
+        // A store in a folder not there yet: the folder is made, as a
+        // report's would be.
+        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(parent)
+                .map_err(|e| err(format!("making its folder {}: {e}", parent.display())))?;
+        }
         let mut flags = OpenFlags::SQLITE_OPEN_READ_WRITE
             | OpenFlags::SQLITE_OPEN_NOFOLLOW
             | OpenFlags::SQLITE_OPEN_NO_MUTEX;
@@ -222,34 +233,48 @@ impl Store {
 
     /// Brings the store to [`SCHEMA`], in one transaction.
     fn migrate(&mut self) -> Result<(), StoreError> {
-        let at = self.schema()?;
-        if at > SCHEMA {
-            return Err(self.fail(format!(
-                "a results store of schema {at}, made by a newer ppmc; this one reads schemas up to {SCHEMA}: update ppmc"
-            )));
+        self.migrate_with(&MIGRATIONS)
+    }
+
+    /// Brings the store to the schema of `migrations`, in one transaction
+    /// that holds the write lock from its start: of two ppmc making one
+    /// new store at once, the second finds it made.
+    fn migrate_with(&mut self, migrations: &[&str]) -> Result<(), StoreError> {
+        let schema = migrations.len() as u32;
+        if self.schema()? == schema {
+            return Ok(());
         }
-        if at == SCHEMA {
+        let path = self.path.clone();
+        let tx = self
+            .conn
+            .transaction_with_behavior(TransactionBehavior::Immediate)
+            .map_err(|e| fail_at(&path, not_a_store(e)))?;
+        let at: u32 = tx
+            .query_row("PRAGMA user_version", [], |r| r.get(0))
+            .map_err(|e| fail_at(&path, not_a_store(e)))?;
+        if at > schema {
+            return Err(fail_at(&path, newer(at, schema)));
+        }
+        if at == schema {
             return Ok(());
         }
         if at == 0 {
             // Version 0 is a new, empty file, or some other SQLite file.
-            let tables: i64 = self
-                .conn
+            let tables: i64 = tx
                 .query_row("SELECT count(*) FROM sqlite_master", [], |r| r.get(0))
-                .map_err(|e| self.fail(not_a_store(e)))?;
+                .map_err(|e| fail_at(&path, not_a_store(e)))?;
             if tables > 0 {
-                return Err(self.fail(
+                return Err(fail_at(
+                    &path,
                     "an SQLite file that is not a ppmc results store (it has tables, and no schema version)",
                 ));
             }
         }
-        let path = self.path.clone();
-        let tx = self.conn.transaction().map_err(|e| fail_at(&path, e))?;
-        for (n, step) in MIGRATIONS.iter().enumerate().skip(at as usize) {
+        for (n, step) in migrations.iter().enumerate().skip(at as usize) {
             tx.execute_batch(step)
                 .map_err(|e| fail_at(&path, format!("migrating to schema {}: {e}", n + 1)))?;
         }
-        tx.pragma_update(None, "user_version", SCHEMA)
+        tx.pragma_update(None, "user_version", schema)
             .map_err(|e| fail_at(&path, e))?;
         tx.commit().map_err(|e| fail_at(&path, e))
     }
@@ -278,6 +303,13 @@ impl Store {
     pub(crate) fn conn(&self) -> &Connection {
         &self.conn
     }
+}
+
+/// The refusal of a store a newer ppmc made.
+fn newer(at: u32, schema: u32) -> String {
+    format!(
+        "a results store of schema {at}, made by a newer ppmc; this one reads schemas up to {schema}: update ppmc"
+    )
 }
 
 fn fail_at(path: &Path, e: impl std::fmt::Display) -> StoreError {
@@ -364,9 +396,9 @@ fn insert(tx: &Transaction, r: &Record, text: &str) -> rusqlite::Result<i64> {
         board_ids.push((b.name.as_str(), tx.last_insert_rowid()));
     }
     let mut result = tx.prepare(
-        "INSERT INTO results (run_id, board_id, scenario, section, pass, verdict, attempts,
-             elapsed_ns, detail)
-         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
+        "INSERT INTO results (run_id, board_id, scenario, section, pass, verdict, blame,
+             attempts, elapsed_ns, detail)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)",
     )?;
     let mut measure = tx.prepare(
         "INSERT INTO measurements (result_id, name, value_ns, lo_ns, hi_ns, marginal_lo_ns,
@@ -392,7 +424,8 @@ fn insert(tx: &Transaction, r: &Record, text: &str) -> rusqlite::Result<i64> {
             sc.section,
             sc.pass,
             sc.verdict,
-            sc.attempts.len().max(1) as i64,
+            sc.blame,
+            sc.attempts.len() as i64 + 1,
             sc.elapsed_ns as i64,
             detail,
         ])?;
@@ -411,4 +444,40 @@ fn insert(tx: &Transaction, r: &Record, text: &str) -> rusqlite::Result<i64> {
         }
     }
     Ok(run)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An older store is read through a migrated copy: the copy is at the
+    /// newer schema (a column a later ppmc added is there), the file
+    /// itself is not touched. Schema 2 here is a stand-in for the next.
+    #[test]
+    fn an_older_store_is_read_through_a_migrated_copy() {
+        let dir = tempfile::tempdir().expect("scratch");
+        let path = dir.path().join("old.db");
+        drop(Store::open(&path).expect("made at schema 1"));
+        let before = std::fs::read(&path).expect("read");
+        let next = [MIGRATIONS[0], "ALTER TABLE runs ADD COLUMN note TEXT;"];
+        let s = Store::open_existing_with(&path, &next).expect("read at schema 2");
+        assert_eq!(s.schema().expect("schema"), 2);
+        let n: i64 = s
+            .conn()
+            .query_row("SELECT count(note) FROM runs", [], |r| r.get(0))
+            .expect("the new column");
+        assert_eq!(n, 0);
+        drop(s);
+        assert_eq!(std::fs::read(&path).expect("read"), before, "untouched");
+        // The other way round, a store of schema 2 is refused by schema 1.
+        let newer_path = dir.path().join("new.db");
+        let mut s = Store::open(&newer_path).expect("made");
+        s.migrate_with(&next).expect("to 2");
+        drop(s);
+        let e = Store::open_existing(&newer_path).expect_err("refused");
+        assert!(
+            e.to_string().contains("schema 2, made by a newer ppmc"),
+            "{e}"
+        );
+    }
 }

@@ -6,7 +6,8 @@
 //! A board is known by its serial where it gave one (`--board-serial`),
 //! else by its name in the run; a board test is one board in one run, and
 //! it passed when none of its results failed, erred or was not run (a
-//! flaky result passed, and is counted as flaky too).
+//! flaky result passed, and is counted as flaky too; so did a result
+//! judged from a capture that blames the host firmware, not the board).
 
 use super::{Store, StoreError};
 use std::collections::BTreeMap;
@@ -46,10 +47,14 @@ pub struct ScenarioRate {
 }
 
 impl ScenarioRate {
-    /// Passed (a flaky pass included) of those that ran to a verdict on
-    /// the board.
+    /// Passed (a flaky pass included) of those that ran (a scenario not
+    /// run, on a board not reached or a run stopped, is no verdict on a
+    /// board).
     pub fn rate(&self) -> f64 {
-        ratio(self.passed + self.flaky, self.results)
+        ratio(
+            self.passed + self.flaky,
+            self.results.saturating_sub(self.not_run),
+        )
     }
 }
 
@@ -187,7 +192,8 @@ impl Store {
             "SELECT b.id AS id, b.run_id AS run_id, {REV} AS rev, {BOARD} AS board,
                 (SELECT count(*) FROM results r WHERE r.board_id = b.id) AS results,
                 (SELECT count(*) FROM results r WHERE r.board_id = b.id
-                     AND r.verdict IN ('passed', 'marginal', 'flaky')) AS passed,
+                     AND (r.verdict IN ('passed', 'marginal', 'flaky')
+                          OR r.blame = 'host')) AS passed,
                 (SELECT count(*) FROM results r WHERE r.board_id = b.id
                      AND r.verdict = 'flaky') AS flaky
              FROM boards b WHERE b.reached"
@@ -238,7 +244,8 @@ impl Store {
                 "SELECT r.scenario, min(r.section), count(*),
                      sum(r.verdict IN ('passed', 'marginal')), sum(r.verdict = 'flaky'),
                      sum(r.verdict = 'failed'), sum(r.verdict = 'error'),
-                     sum(r.verdict = 'not_run'), count(DISTINCT {BOARD})
+                     sum(r.verdict = 'not_run'),
+                     count(DISTINCT CASE WHEN b.reached THEN {BOARD} END)
                  FROM results r LEFT JOIN boards b ON b.id = r.board_id
                  GROUP BY r.scenario"
             ))

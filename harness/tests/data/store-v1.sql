@@ -36,7 +36,8 @@ CREATE TABLE results (
     section    TEXT    NOT NULL,
     pass       INTEGER,
     verdict    TEXT    NOT NULL,  -- passed, marginal, flaky, failed, error, not_run
-    attempts   INTEGER NOT NULL,
+    blame      TEXT,              -- judged from a capture: board, host or capture
+    attempts   INTEGER NOT NULL,  -- how many times it ran
     elapsed_ns INTEGER NOT NULL,
     detail     TEXT
 );
@@ -64,11 +65,11 @@ INSERT INTO runs VALUES (2, '2026-11-21T10:00:00Z', '0.1.0', 'd3de167d47ac', 'la
     1, 0, 0, 1, 0, 0, '{"format":"ppmc-run-record/4"}');
 INSERT INTO boards VALUES (1, 1, 'emu', 'emu', 'A-0001', 'A', NULL, NULL, 1);
 INSERT INTO boards VALUES (2, 2, 'bench-2', 'serial:/dev/ttyACM0', 'B-0001', 'B', 'ppmc-bridge-rp2350 0.1.0', 'E6614C311B4E5A2F', 1);
-INSERT INTO results VALUES (1, 1, 1, 's3_3_4_accel_trapezoid_200_steps', '3-3-4', NULL, 'passed', 1, 181402000, NULL);
-INSERT INTO results VALUES (2, 1, 1, 's3_3_5_constant_speed_100_steps', '3-3-5', NULL, 'passed', 1, 174978000, NULL);
-INSERT INTO results VALUES (3, 2, 2, 's3_3_4_accel_trapezoid_200_steps', '3-3-4', NULL, 'failed', 1, 181412000,
+INSERT INTO results VALUES (1, 1, 1, 's3_3_4_accel_trapezoid_200_steps', '3-3-4', NULL, 'passed', NULL, 1, 181402000, NULL);
+INSERT INTO results VALUES (2, 1, 1, 's3_3_5_constant_speed_100_steps', '3-3-5', NULL, 'passed', NULL, 1, 174978000, NULL);
+INSERT INTO results VALUES (3, 2, 2, 's3_3_4_accel_trapezoid_200_steps', '3-3-4', NULL, 'failed', NULL, 1, 181412000,
     'accel_first_pout (Table 3-3): expected 198.000us..=1111.000us, got 1200.000us');
-INSERT INTO results VALUES (4, 2, 2, 's3_3_5_constant_speed_100_steps', '3-3-5', NULL, 'passed', 2, 174978000, NULL);
+INSERT INTO results VALUES (4, 2, 2, 's3_3_5_constant_speed_100_steps', '3-3-5', NULL, 'flaky', NULL, 2, 174978000, NULL);
 INSERT INTO measurements VALUES (1, 'accel_first_pout', 200000, 198000, 1111000, 200282, 1108222, 'PASS');
 INSERT INTO measurements VALUES (3, 'accel_first_pout', 1200000, 198000, 1111000, 200282, 1108222, 'FAIL');
 PRAGMA user_version = 1;
