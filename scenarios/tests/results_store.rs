@@ -133,3 +133,54 @@ fn the_store_figures_script_fills_a_store_and_times_its_report() {
     let row = said.lines().last().expect("a row");
     assert!(row.starts_with("| 3 | 288 | "), "{said}");
 }
+
+/// `ppmc judge --store`: a board judged from a capture is kept beside the
+/// boards run through a bridge. A board that diverges fails its board
+/// test; one whose host firmware broke a rule of chapter 3 (exit 3) does
+/// not, its finding blamed on the host firmware.
+#[test]
+fn boards_judged_from_captures_are_kept_with_whom_they_blame() {
+    let dir = scratch("store");
+    let db = dir.path().join("results.db");
+    let db_s = db.to_str().expect("utf-8");
+    let capture = |name: &str, scenario: &str, fault: Option<&str>| {
+        let path = dir.path().join(name);
+        let mut args = vec!["export", "--scenario", scenario, "--bus", "-o"];
+        args.push(path.to_str().expect("utf-8"));
+        if let Some(f) = fault {
+            args.extend(["--chip-fault", f]);
+        }
+        let out = ppmc(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        path
+    };
+    let faulty = capture(
+        "faulty.vcd",
+        "s3_3_5_constant_speed_100_steps",
+        Some("drop-last-pulse"),
+    );
+    let misused = capture("misused.vcd", "e0_undefined_command_code", None);
+    for (file, rev, code) in [(&faulty, "C", 1), (&misused, "D", 3)] {
+        let out = ppmc(&[
+            "judge",
+            file.to_str().expect("utf-8"),
+            "--store",
+            db_s,
+            "--board-rev",
+            rev,
+            "--board-serial",
+            &format!("{rev}-1"),
+        ]);
+        assert_eq!(out.status.code(), Some(code), "{}", text(&out.stdout));
+    }
+    let out = ppmc(&["history", "--store", db_s]);
+    let said = text(&out.stdout);
+    assert!(
+        said.contains("  C               0.0%  0 of 1 board tests passed, 1 boards"),
+        "{said}"
+    );
+    assert!(
+        said.contains("  D             100.0%  1 of 1 board tests passed, 1 boards"),
+        "{said}"
+    );
+}

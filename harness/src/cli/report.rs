@@ -23,13 +23,9 @@ pub struct ReportArgs {
     /// boards, the trend over time.
     #[arg(long, value_name = "FILE")]
     store: Option<PathBuf>,
-    /// Where to write the page; `-` for standard output.
-    #[arg(
-        short = 'o',
-        long = "output",
-        value_name = "FILE",
-        default_value = "report.html"
-    )]
+    /// Where to write the page (replaced if it is there); `-` for
+    /// standard output.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: PathBuf,
     /// The page's title.
     #[arg(long, default_value = "ppmc report")]
