@@ -459,6 +459,12 @@ impl Farm {
         self.targets[t].link_stats()
     }
 
+    /// Board `b`'s bridge's serial number ([`Target::bridge_serial`]).
+    pub fn bridge_serial(&self, b: usize) -> Option<String> {
+        let t = self.reached.iter().position(|r| *r == b)?;
+        self.targets[t].bridge_serial()
+    }
+
     /// Board `b`: what its target says of itself, or why it was not reached.
     pub fn board(&self, b: usize) -> Result<TargetInfo, &OpenError> {
         match self.reached.iter().position(|r| *r == b) {

@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{check_record, ppmc, run_record_schema, scratch, text};
+use common::{check_record, ppmc, run_record_schema, scratch, text, BridgeSim};
 use std::path::Path;
 
 fn read(p: &Path) -> String {
@@ -386,4 +386,50 @@ fn a_flaky_board_is_on_record_with_every_attempt() {
             .len(),
         2
     );
+}
+
+/// Through a bridge (`ppmc bridge-sim`, protocol version 8): the bridge's
+/// serial number from its HELLO, its firmware, and the link's cost, in
+/// the record, the store and the page.
+#[test]
+fn a_board_behind_a_bridge_is_named_by_the_bridge_and_its_link_shown() {
+    let sim = BridgeSim::start(&["--serial", "E6614C311B4E5A2F"]);
+    let dir = scratch("report");
+    let (rec, page, db) = (
+        dir.path().join("r.json"),
+        dir.path().join("r.html"),
+        dir.path().join("r.db"),
+    );
+    let target = format!("{},rev=B,board-serial=B-0007", sim.target());
+    let out = ppmc(&[
+        "run",
+        "--filter",
+        "s3_3_5_constant_speed_100",
+        "--target",
+        &target,
+        "--json",
+        rec.to_str().expect("utf-8"),
+        "--html",
+        page.to_str().expect("utf-8"),
+        "--store",
+        db.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    let record = json(&rec);
+    check_record(&run_record_schema(), &record);
+    let board = &record["run"]["boards"][0];
+    assert_eq!(board["bridge_serial"], "E6614C311B4E5A2F");
+    assert_eq!(board["board_serial"], "B-0007");
+    assert!(board["bridge_firmware"]
+        .as_str()
+        .expect("firmware")
+        .starts_with("ppmc-bridge-sim"));
+    assert!(
+        board["link"]["round_trips"].as_u64().expect("counted") > 0,
+        "{board}"
+    );
+    let html = read(&page);
+    assert!(html.contains("<td>E6614C311B4E5A2F</td>") && html.contains("round trips"));
+    let c = ppmc(&["history", "--store", db.to_str().expect("utf-8")]);
+    assert!(text(&c.stdout).contains("  B             100.0%  1 of 1 board tests passed, 1 boards"));
 }

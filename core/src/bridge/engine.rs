@@ -55,6 +55,8 @@ pub struct BridgeEngine<B> {
     bus: B,
     /// What HELLO_REPLY says the bridge runs.
     firmware: String,
+    /// The bridge's serial number, for HELLO_REPLY (empty: none).
+    serial: String,
     decoder: FrameDecoder,
     session: u32,
     timer: Timer,
@@ -88,6 +90,7 @@ impl<B: Bus> BridgeEngine<B> {
         BridgeEngine {
             bus,
             firmware: firmware.into(),
+            serial: String::new(),
             decoder: FrameDecoder::new(),
             session,
             timer: Timer::NANOS,
@@ -100,6 +103,17 @@ impl<B: Bus> BridgeEngine<B> {
             pad: 0,
             frames: 0,
         }
+    }
+
+    /// Gives the bridge a serial number, which HELLO_REPLY carries (an
+    /// RP2350's chip ID): at most 255 bytes of it are sent.
+    pub fn with_serial(mut self, serial: &str) -> Self {
+        let mut end = serial.len().min(255);
+        while !serial.is_char_boundary(end) {
+            end -= 1;
+        }
+        self.serial = serial[..end].into();
+        self
     }
 
     /// A bridge whose capture buffer holds `records` records (pulse runs,
@@ -320,6 +334,7 @@ impl<B: Bus> BridgeEngine<B> {
             },
             Request::Hello { host, .. } => Response::Hello(Hello {
                 resumed: self.greet(host),
+                serial: self.serial.clone(),
                 version: PROTOCOL_VERSION,
                 session: self.session,
                 timer_hz: self.timer.hz,

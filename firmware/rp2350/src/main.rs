@@ -300,6 +300,10 @@ async fn main(_spawner: Spawner) {
     let mut watchdog = Watchdog::new(p.WATCHDOG);
     watchdog.start(Duration::from_millis(hw::WATCHDOG_MS));
     let session = embassy_rp::clocks::RoscRng.next_u32();
+    // The chip's ID: the USB serial number, and HELLO_REPLY's, so that two
+    // bridges are told apart on a host (/dev/serial/by-id) and across a
+    // network alike.
+    let chip_serial = hex16(embassy_rp::otp::get_chipid().unwrap_or(0));
     spawn_core1(p.CORE1, CORE1_STACK.init(Stack::new()), move || {
         // SAFETY: core 1's own DCB and DWT, set up once here.
         let mut core1 = unsafe { cortex_m::Peripherals::steal() };
@@ -309,6 +313,7 @@ async fn main(_spawner: Spawner) {
         let board = Board::new(hal, timing, straps);
         let timer = board.timer();
         let mut engine = BridgeEngine::new(board, session, false, firmware)
+            .with_serial(core::str::from_utf8(&chip_serial).unwrap_or(""))
             .with_timer(timer)
             .with_capture_capacity(limits::CAPTURE_RECORDS);
         let mut buf = [0u8; 64];
@@ -351,10 +356,9 @@ async fn main(_spawner: Spawner) {
     let mut config = embassy_usb::Config::new(0x1209, 0x0001);
     config.manufacturer = Some("ppmc");
     config.product = Some("PPMC-104BFP bus bridge");
-    // The chip's ID: two bridges on one host are told apart
-    // (/dev/serial/by-id).
+    // The chip's ID, as HELLO_REPLY gives it.
     static SERIAL: StaticCell<[u8; 16]> = StaticCell::new();
-    let serial = SERIAL.init(hex16(embassy_rp::otp::get_chipid().unwrap_or(0)));
+    let serial = SERIAL.init(chip_serial);
     config.serial_number = core::str::from_utf8(serial).ok();
     config.max_power = 100;
     config.max_packet_size_0 = 64;

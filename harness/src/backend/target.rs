@@ -156,6 +156,13 @@ pub trait Target: Send {
         ))
     }
 
+    /// The bus bridge's serial number, where it gives one (its HELLO) or
+    /// the operating system knows it (a USB serial port's); `None` for the
+    /// emulator.
+    fn bridge_serial(&self) -> Option<String> {
+        None
+    }
+
     /// What the link to the target has cost so far, by name (round trips,
     /// retransmissions, corrupt frames, reopens); `None` for a target with
     /// no link (the emulator).

@@ -37,6 +37,11 @@ pub struct BridgeSimArgs {
     /// 500000000. Default: a nanosecond timer in step with the chip.
     #[arg(long, value_name = "HZ")]
     timer_hz: Option<u64>,
+    /// The serial number the bridge gives in its HELLO, as an RP2350
+    /// bridge gives its chip ID (the reports name the bridge by it).
+    /// Default: none.
+    #[arg(long, value_name = "TEXT")]
+    serial: Option<String>,
     /// Probability of losing each byte on the link, e.g. 0.01.
     #[arg(long, default_value_t = 0.0)]
     drop_rate: f64,
@@ -129,7 +134,9 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
         Some(hz) => timed_engine(emu, session, !args.realtime, hz),
         None => engine(emu, session, !args.realtime),
     };
-    let mut server = server.with_capture_capacity(args.capture_capacity);
+    let mut server = server
+        .with_capture_capacity(args.capture_capacity)
+        .with_serial(args.serial.as_deref().unwrap_or(""));
     // Nobody may be reading stdout (a closed pipe): never let that stop
     // the bridge.
     let mut out = io::stdout();

@@ -438,6 +438,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             };
             BoardInfo {
                 board_serial: serial,
+                bridge_serial: farm.bridge_serial(b),
                 ..board
             }
         })

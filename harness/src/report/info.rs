@@ -44,8 +44,9 @@ pub struct BoardInfo {
     pub board_serial: Option<String>,
     /// The bus bridge's firmware version, when the target is a board.
     pub bridge_firmware: Option<String>,
-    /// The bus bridge's serial number, where it is known: its USB serial
-    /// number, as the operating system read it from the device.
+    /// The bus bridge's serial number, where it is known: what its HELLO
+    /// gives (an RP2350's chip ID), else the USB serial number the
+    /// operating system read from the device.
     pub bridge_serial: Option<String>,
     /// What the link to the bridge cost over the run (round trips,
     /// retransmissions, corrupt frames, reopens); none for the emulator.
@@ -70,7 +71,7 @@ impl BoardInfo {
             board_rev,
             board_serial: None,
             bridge_firmware: extra("bridge_firmware"),
-            bridge_serial: extra("bridge_serial"),
+            bridge_serial: None,
             link: None,
             error: None,
         }

@@ -231,6 +231,7 @@ impl Response {
                 w.str(&h.firmware);
                 put_straps(&mut w, &h.straps);
                 w.u8(u8::from(h.resumed));
+                w.str(&h.serial);
             }
             Response::Batch(replies) => {
                 w.u8(kind::BATCH_REPLY);
@@ -294,6 +295,7 @@ impl Response {
                 firmware: r.str()?,
                 straps: get_straps(&mut r)?,
                 resumed: r.bool("resumed flag")?,
+                serial: r.str()?,
             }),
             kind::BATCH_REPLY => Response::Batch(get_replies(&mut r)?),
             kind::CAPTURE_REPLY => Response::Capture(get_capture(&mut r)?),

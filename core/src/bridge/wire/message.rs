@@ -9,7 +9,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 /// The protocol version this build speaks.
-pub const PROTOCOL_VERSION: u16 = 7;
+pub const PROTOCOL_VERSION: u16 = 8;
 
 /// Message kinds (the second payload byte).
 pub mod kind {
@@ -125,6 +125,10 @@ pub struct Hello {
     /// used the bridge since, so a request the host sends again is answered
     /// from the cache, not run twice (`docs/bridge-protocol.md` section 3).
     pub resumed: bool,
+    /// The bridge's serial number (an RP2350's chip ID, which its USB
+    /// descriptor gives too), so that the reports name the bridge across
+    /// a network as well; empty when it has none.
+    pub serial: String,
 }
 
 /// A host request.

@@ -158,11 +158,11 @@ fn a_hello_of_another_version_is_read_for_its_version() {
     );
     // A later version's, with fields this one does not know.
     assert_eq!(
-        Request::decode(&[3, kind::HELLO, 8, 0, 1, 2, 3, 4, 5, 6, 7], T),
+        Request::decode(&[3, kind::HELLO, 9, 0, 1, 2, 3, 4, 5, 6, 7], T),
         Ok((
             3,
             Request::Hello {
-                version: 8,
+                version: 9,
                 host: 0
             }
         ))
@@ -302,6 +302,7 @@ fn hello_capture_and_error_round_trip() {
             ext_clock_hz: Some(500_000),
         },
         resumed: true,
+        serial: "E6614C311B4E5A2F".into(),
     });
     assert_eq!(Response::decode(&hello.encode(1, T), T), Ok((1, hello)));
     let cap = Response::Capture(CaptureChunk {

@@ -115,6 +115,7 @@ impl<L: Link> SerialTarget<L> {
                 firmware: String::new(),
                 straps: Straps::default(),
                 resumed: false,
+                serial: String::new(),
             },
             timer: Timer::NANOS,
             opts,
@@ -277,6 +278,14 @@ impl<L: Link> SerialTarget<L> {
 }
 
 impl<L: Link> Target for SerialTarget<L> {
+    /// The serial number the bridge gives in its HELLO, else the USB
+    /// serial number the operating system read from the device.
+    fn bridge_serial(&self) -> Option<String> {
+        Some(self.hello.serial.clone())
+            .filter(|s| !s.is_empty())
+            .or_else(|| self.link.device_serial())
+    }
+
     fn link_stats(&self) -> Option<Vec<(&'static str, u64)>> {
         let s = self.stats;
         Some(vec![
@@ -288,17 +297,13 @@ impl<L: Link> Target for SerialTarget<L> {
     }
 
     fn info(&self) -> TargetInfo {
-        let mut extra = vec![
-            ("bridge_firmware".into(), self.hello.firmware.clone()),
-            ("bridge_protocol".into(), self.hello.version.to_string()),
-        ];
-        if let Some(serial) = self.link.device_serial() {
-            extra.push(("bridge_serial".into(), serial));
-        }
         TargetInfo {
             name: self.link.name(),
             straps: self.hello.straps,
-            extra,
+            extra: vec![
+                ("bridge_firmware".into(), self.hello.firmware.clone()),
+                ("bridge_protocol".into(), self.hello.version.to_string()),
+            ],
         }
     }
 

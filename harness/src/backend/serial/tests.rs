@@ -539,6 +539,7 @@ fn a_bridge_of_another_protocol_version_is_refused() {
                     firmware: "future".into(),
                     straps: Straps::default(),
                     resumed: false,
+                    serial: String::new(),
                 });
                 self.0
                     .extend(frame::encode(&hello.encode(seq, Timer::NANOS)));
