@@ -1,6 +1,7 @@
 //! `ppmc history`: what a results store says across runs, as text.
 
 use crate::cli::CliError;
+use crate::report::printable as p;
 use crate::store::Store;
 use clap::Args;
 use std::path::PathBuf;
@@ -21,6 +22,8 @@ pub fn run(args: HistoryArgs) -> Result<(), CliError> {
     let h = store
         .history()
         .map_err(|e| CliError::Failed(e.to_string()))?;
+    // Every text of the store printed through `p`: a label a lab script
+    // planted may hold a terminal's escape sequences.
     outln!(
         "{}: {} runs, {} boards{}",
         args.store.display(),
@@ -28,13 +31,13 @@ pub fn run(args: HistoryArgs) -> Result<(), CliError> {
         h.boards,
         h.span
             .as_ref()
-            .map_or(String::new(), |(a, b)| format!(", {a} to {b}"))
+            .map_or(String::new(), |(a, b)| format!(", {} to {}", p(a), p(b)))
     );
     outln!("yield per revision (a board test passes when none of its scenarios failed, erred or was not run):");
     for r in &h.revisions {
         outln!(
             "  {:<12} {:>6.1}%  {} of {} board tests passed, {} boards{}",
-            r.rev,
+            p(&r.rev),
             r.rate() * 100.0,
             r.passed,
             r.tests,
@@ -58,8 +61,8 @@ pub fn run(args: HistoryArgs) -> Result<(), CliError> {
         outln!(
             "  {:>6.1}%  {} (section {}): {} results, {} failed, {} errors, {} flaky, {} not run, {} boards",
             s.rate() * 100.0,
-            s.scenario,
-            s.section,
+            p(&s.scenario),
+            p(&s.section),
             s.results,
             s.failed,
             s.errors,
@@ -72,9 +75,9 @@ pub fn run(args: HistoryArgs) -> Result<(), CliError> {
     for d in &h.measurements {
         outln!(
             "  {} in {} on {}: n={} mean={:.3}us sd={:.1}ns min={:.3}us max={:.3}us Cpk={}",
-            d.name,
-            d.scenario,
-            d.rev,
+            p(&d.name),
+            p(&d.scenario),
+            p(&d.rev),
             d.values.len(),
             d.mean_ns / 1e3,
             d.sd_ns(),

@@ -304,10 +304,11 @@ pub(super) fn keep(
 ) -> Result<(), String> {
     let text = record.map_err(|e| format!("--store {}: {e}", store.path().display()))?;
     let parsed = Record::parse(&text, "the run record").map_err(|e| e.to_string())?;
-    store
-        .add(&parsed, &text)
-        .map(|_| ())
-        .map_err(|e| format!("--store {e}"))
+    store.add(&parsed, &text).map(|_| ()).map_err(|e| {
+        format!(
+            "--store {e}: the run's record was not kept in the store (the reports were written)"
+        )
+    })
 }
 
 /// The HTML report of a run record, drawn from the record as `ppmc report`

@@ -136,8 +136,9 @@ fn run_section(s: &mut String, r: &Record, i: usize) {
                 .enumerate()
                 .filter(|(_, sc)| !noteworthy(sc)),
         );
+    let mut budget = MAX_PAGE_MOVES;
     for (k, sc) in order {
-        scenario(s, sc, &format!("r{i}-s{k}"), tol);
+        scenario(s, sc, &format!("r{i}-s{k}"), tol, &mut budget);
     }
     s.push_str("</section>\n");
 }
@@ -187,7 +188,13 @@ fn boards(s: &mut String, r: &Record) {
     s.push_str("</table>");
 }
 
-fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64)) {
+/// Moves drawn at most for a scenario, and on a page: a record is read
+/// from a file, and the page stays a page whatever it holds (the suite's
+/// scenarios have a few moves each, 122 in all).
+const MAX_MOVES: usize = 64;
+const MAX_PAGE_MOVES: usize = 2_000;
+
+fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64), budget: &mut usize) {
     let _ = write!(
         s,
         r#"<details class="scenario {}" id="{id}" data-scenario="{}"{}><summary><span class="chip {}">{}</span> {} <span class="section">section {}</span></summary>"#,
@@ -270,7 +277,12 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64)) {
         let mark = sc.failure.as_ref().map(|f| f.at_ns);
         // The move the failure is in: the last that started before it.
         let marked = mark.and_then(|at| fig.moves.iter().rposition(|m| m.at_ns <= at));
-        for (n, m) in fig.moves.iter().enumerate() {
+        let shown = fig.moves.len().min(MAX_MOVES).min(*budget);
+        *budget -= shown;
+        // The marked move is drawn whatever the cap.
+        let drawn = |n: usize| n < shown || Some(n) == marked;
+        let left_out = (0..fig.moves.len()).filter(|n| !drawn(*n)).count();
+        for (n, m) in fig.moves.iter().enumerate().filter(|(n, _)| drawn(*n)) {
             let _ = write!(
                 s,
                 r#"<div class="move" data-move="{}" data-pulses="{}"><h4>move {}: {} {}, {} steps, {} pulses{}</h4>"#,
@@ -293,6 +305,12 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64)) {
             }
             s.push_str("</div>");
         }
+        if left_out > 0 {
+            let _ = write!(
+                s,
+                r#"<p class="detail">{left_out} more moves, not drawn (the run record holds them; a page draws at most {MAX_MOVES} a scenario and {MAX_PAGE_MOVES} in all)</p>"#
+            );
+        }
         if let Some(w) = &fig.waveform {
             let _ = write!(
                 s,
@@ -304,4 +322,51 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64)) {
         }
     }
     s.push_str("</details>\n");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A record as a file gives it: one scenario with `moves` moves, a
+    /// failure, and a waveform whose window is `window`.
+    fn record(moves: usize, window: (u64, u64)) -> Record {
+        let m = r#"{"at_ns":1000,"kind":"constant","dir":"cw","steps":3,"runs":[[10,3,200]]}"#;
+        let text = format!(
+            r#"{{"format":"ppmc-run-record/4","run":{{"harness_version":"0","git_revision":"x",
+            "boards":[{{"name":"b\u0000<i>","target":"emu","board_rev":null,"bridge_firmware":null,"error":null}}],
+            "started":"s","wall_s":0,"host":"h","options":{{"golden":null,"marginal_pct":0.25,
+            "interval_tol_pct":1,"time_floor_ns":100}}}},"summary":{{"passed":0,"marginal":0,
+            "failed":1,"error":0,"not_run":0}},"scenarios":[{{"name":"s","board":"b","section":"3-1",
+            "verdict":"failed","detail":null,"failure":{{"expectation":"e","expected":"x","got":"y",
+            "at_ns":1100}},"error":null,"elapsed_ns":5,"measurements":[],"figures":{{"moves":[{}],
+            "waveform":{{"from_ns":{},"to_ns":{},"mark_ns":1100,"pout":[1010],"pins":[{{"name":"busy",
+            "bits":255,"initial":1,"changes":[[1200,0]]}}],"bus":[]}}}}}}]}}"#,
+            vec![m; moves].join(","),
+            window.0,
+            window.1
+        );
+        Record::parse(&text, "t").expect("a record")
+    }
+
+    #[test]
+    fn a_record_with_too_much_to_draw_is_drawn_within_bounds() {
+        let page = html(&[record(100, (900, 1300))], "t");
+        // The cap's moves, and the one the failure is in (the last).
+        assert_eq!(page.matches("<div class=\"move\"").count(), MAX_MOVES + 1);
+        assert!(page.contains("data-move=\"100\""));
+        assert!(page.contains("35 more moves, not drawn"), "{page}");
+        assert!(page.contains("<svg class=\"waveform\""));
+        // Text is escaped, and a control character is no HTML text.
+        assert!(page.contains("b\u{FFFD}&lt;i&gt;") && !page.contains('\0'));
+    }
+
+    #[test]
+    fn a_waveform_with_an_empty_window_is_said_not_drawn() {
+        for window in [(1300, 900), (1000, 1000)] {
+            let page = html(&[record(1, window)], "t");
+            assert!(!page.contains("<svg class=\"waveform\""));
+            assert!(page.contains("empty window: not drawn"));
+        }
+    }
 }

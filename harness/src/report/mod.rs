@@ -29,6 +29,6 @@ pub use info::{rfc3339, BoardInfo, CaptureSource, RunInfo, RunOptions};
 pub use json::{json, json_listing};
 pub use junit::{junit, junit_listing};
 pub use listing::{Blame, Judged, Listing, ReportError};
-pub use record::{Record, RecordError, FORMATS as RECORD_FORMATS};
+pub use record::{printable, Record, RecordError, FORMATS as RECORD_FORMATS};
 pub use svg::{reduce, Reduced, Segment};
 pub use tally::Tally;

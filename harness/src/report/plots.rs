@@ -2,7 +2,11 @@
 //! band, a move's speed profile over the golden one, and the pins around
 //! a failure.
 
-use super::figures::{MoveFigure, Waveform};
+use super::figures::{MoveFigure, PinWave, Waveform, MAX_WAVE_PULSES};
+
+/// Pins, and changes of each, a waveform draws at most.
+const MAX_WAVE_PINS: usize = 16;
+const MAX_WAVE_CHANGES: usize = 2_000;
 use super::record::MeasurementRecord;
 use super::svg::{esc, reduce, Plot, Segment};
 use std::fmt::Write as _;
@@ -217,13 +221,38 @@ fn profile(m: &MoveFigure, mark: Option<(u64, &str)>, tol: (f64, u64), by_time: 
 /// The pins around a failure: POUT's pulses (and the golden's), each pin,
 /// the bus accesses, the failure marked.
 pub fn waveform(w: &Waveform) -> String {
+    // A record is read from a file: what it holds is drawn within bounds,
+    // however much of it there is.
+    if w.to_ns <= w.from_ns {
+        return r#"<p class="detail">(the record's waveform has an empty window: not drawn)</p>"#
+            .into();
+    }
+    let cap = |v: &[u64]| v[..v.len().min(MAX_WAVE_PULSES)].to_vec();
+    let pins = &w.pins[..w.pins.len().min(MAX_WAVE_PINS)];
+    let w = Waveform {
+        pout: cap(&w.pout),
+        golden_pout: w.golden_pout.as_deref().map(cap),
+        bus: w.bus[..w.bus.len().min(MAX_WAVE_PULSES)].to_vec(),
+        pins: pins
+            .iter()
+            .map(|p| PinWave {
+                bits: p.bits.clamp(1, 8),
+                changes: p.changes[..p.changes.len().min(MAX_WAVE_CHANGES)].to_vec(),
+                ..p.clone()
+            })
+            .collect(),
+        ..w.clone()
+    };
+    let w = &w;
     let row = 24.0;
     let rows = 1 + usize::from(w.golden_pout.is_some()) + w.pins.len() + 1;
     let (width, label_w) = (940.0, 90.0);
     let height = rows as f64 * row + 30.0;
-    let span = (w.to_ns.saturating_sub(w.from_ns)).max(1) as f64;
-    let x =
-        |t: u64| label_w + (t.saturating_sub(w.from_ns)) as f64 / span * (width - label_w - 10.0);
+    let span = (w.to_ns - w.from_ns) as f64;
+    let x = |t: u64| {
+        let at = label_w + t.saturating_sub(w.from_ns) as f64 / span * (width - label_w - 10.0);
+        at.min(width - 10.0)
+    };
     let mut s = String::new();
     let _ = write!(
         s,

@@ -135,16 +135,41 @@ pub struct ScenarioRecord {
 }
 
 /// A run record that could not be read: the file, and why.
-#[derive(Debug, thiserror::Error)]
-#[error("{path}: {why}")]
+#[derive(Debug)]
 pub struct RecordError {
+    /// Empty when `why` names the file itself.
     pub path: String,
     pub why: String,
+}
+
+impl std::fmt::Display for RecordError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.path.is_empty() {
+            true => f.write_str(&self.why),
+            false => write!(f, "{}: {}", self.path, self.why),
+        }
+    }
+}
+
+impl std::error::Error for RecordError {}
+
+/// `text` safe to print on a terminal: control characters (an escape
+/// sequence a hostile file plants) shown as escapes, not sent.
+pub fn printable(text: &str) -> String {
+    text.chars()
+        .flat_map(|c| match c.is_control() {
+            true => c.escape_default().collect::<Vec<_>>(),
+            false => vec![c],
+        })
+        .collect()
 }
 
 impl Record {
     /// The run record in `text`; `path` names it in an error.
     pub fn parse(text: &str, path: &str) -> Result<Record, RecordError> {
+        // A byte-order mark, as some editors write one: not JSON, but no
+        // reason to refuse the record.
+        let text = text.strip_prefix('\u{FEFF}').unwrap_or(text);
         let err = |why: String| RecordError {
             path: path.to_string(),
             why,
@@ -160,12 +185,14 @@ impl Record {
         match f.format.as_deref() {
             Some(v) if FORMATS.contains(&v) => {}
             Some(v) if v.starts_with("ppmc-run-record/") => {
-                let n = v["ppmc-run-record/".len()..]
-                    .parse::<u32>()
-                    .unwrap_or(u32::MAX);
-                let when = if n < 3 { "older" } else { "newer" };
+                let why = match v["ppmc-run-record/".len()..].parse::<u32>() {
+                    Ok(n) if n < 3 => "older than this ppmc reads",
+                    Ok(_) => "newer than this ppmc reads: update ppmc",
+                    Err(_) => "not a format of ppmc's",
+                };
                 return Err(err(format!(
-                    "run record format {v} is {when} than this ppmc reads ({})",
+                    "run record format {} is {why} (it reads {})",
+                    printable(v),
                     FORMATS.join(", ")
                 )));
             }
@@ -181,10 +208,42 @@ impl Record {
     /// The run record in the file at `path`.
     pub fn read(path: &Path) -> Result<Record, RecordError> {
         let name = path.display().to_string();
+        // The file error names the path itself.
         let text = crate::files::read_text(path, MAX_RECORD_BYTES).map_err(|e| RecordError {
-            path: name.clone(),
+            path: String::new(),
             why: e.to_string(),
         })?;
         Record::parse(&text, &name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn terminal_escapes_are_shown_not_sent() {
+        assert_eq!(printable("A\u{1b}]0;x\u{7}\r"), "A\\u{1b}]0;x\\u{7}\\r");
+        assert_eq!(printable("rev B"), "rev B");
+    }
+
+    #[test]
+    fn formats_are_told_apart() {
+        let says = |f: &str| {
+            Record::parse(&format!(r#"{{"format":"{f}"}}"#), "r")
+                .expect_err("refused")
+                .to_string()
+        };
+        assert!(says("ppmc-run-record/2").contains("older than this ppmc reads"));
+        assert!(says("ppmc-run-record/99").contains("newer than this ppmc reads"));
+        assert!(says("ppmc-run-record/x").contains("not a format of ppmc's"));
+        assert!(says("something").contains("not a ppmc run record"));
+        // A byte-order mark is no reason to refuse a record.
+        assert!(
+            Record::parse("\u{FEFF}{\"format\":\"ppmc-run-record/99\"}", "r")
+                .expect_err("refused")
+                .to_string()
+                .contains("newer")
+        );
     }
 }

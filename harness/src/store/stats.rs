@@ -220,7 +220,7 @@ impl Store {
             .map_err(q)?;
         let mut st = c
             .prepare(&format!(
-                "SELECT run_id, (SELECT started FROM runs WHERE id = run_id), rev, board,
+                "SELECT run_id, coalesce((SELECT started FROM runs WHERE id = run_id), ''), rev, board,
                      results, passed
                  FROM ({tests}) ORDER BY 2, run_id, id"
             ))
