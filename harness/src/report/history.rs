@@ -16,18 +16,10 @@ const BINS: usize = 40;
 /// of every board test over time.
 pub fn history_html(h: &History, title: &str, store: &str) -> String {
     let mut s = String::with_capacity(256 << 10);
-    let _ = write!(
+    super::html::head(&mut s, title);
+    let _ = writeln!(
         s,
-        r#"<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8">
-<meta http-equiv="Content-Security-Policy" content="default-src 'none'; style-src 'unsafe-inline'; img-src data:">
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<title>{0}</title><style>{1}</style></head><body>
-<h1>{0}</h1>
-<p class="detail">{2}: {3} runs, {4} boards{5}.</p>
-"#,
-        esc(title),
-        super::html::STYLE,
+        r#"<p class="detail">{}: {} runs, {} boards{}.</p>"#,
         esc(store),
         h.runs,
         h.boards,

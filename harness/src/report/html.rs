@@ -6,7 +6,7 @@ use super::svg::esc;
 use std::fmt::Write as _;
 
 /// The page's style: inline, like everything else in it.
-pub(super) const STYLE: &str = include_str!("report.css");
+const STYLE: &str = include_str!("report.css");
 
 /// One self-contained HTML page of `records`: the runs' facts and boards,
 /// every scenario with its verdict, each measurement against its band,
@@ -17,18 +17,7 @@ pub(super) const STYLE: &str = include_str!("report.css");
 /// `file://` and as a CI artifact, as it is, years later.
 pub fn html(records: &[Record], title: &str) -> String {
     let mut s = String::with_capacity(64 << 10);
-    let _ = write!(
-        s,
-        r#"<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8">
-<meta http-equiv="Content-Security-Policy" content="default-src 'none'; style-src 'unsafe-inline'; img-src data:">
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<title>{}</title><style>{STYLE}</style></head><body>
-<h1>{}</h1>
-"#,
-        esc(title),
-        esc(title)
-    );
+    head(&mut s, title);
     if records.len() > 1 {
         s.push_str(r#"<section class="runs"><h2>Runs</h2><table><tr><th>run</th><th>board</th><th>revision</th><th>started</th><th>verdicts</th></tr>"#);
         for (i, r) in records.iter().enumerate() {
@@ -58,6 +47,22 @@ pub fn html(records: &[Record], title: &str) -> String {
         if records.len() == 1 { "" } else { "s" }
     );
     s
+}
+
+/// A page's head and title, as every page of ppmc's has it: the style
+/// inline, and a Content-Security-Policy that lets nothing load.
+pub(super) fn head(s: &mut String, title: &str) {
+    let _ = write!(
+        s,
+        r#"<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8">
+<meta http-equiv="Content-Security-Policy" content="default-src 'none'; style-src 'unsafe-inline'; img-src data:">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{0}</title><style>{STYLE}</style></head><body>
+<h1>{0}</h1>
+"#,
+        esc(title)
+    );
 }
 
 /// The verdict counts as coloured chips.
