@@ -333,6 +333,25 @@ pub struct EmuBus {
     /// How long a register access takes on the bus; zero (the default):
     /// an access takes no time, as the golden traces are recorded.
     bus_cycle: Duration,
+    /// How the host times an access it waits for ([`HostTiming`]).
+    host: HostTiming,
+}
+
+/// How a host on a real bus times an access that waits for the chip (a
+/// write for IBF = 0, a read for OBF = 1, a status wait), with
+/// [`EmuBus::set_bus_cycle`]'s cycle per access.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum HostTiming {
+    /// It polls the status, and its access ends a bus cycle after the
+    /// poll that saw the chip ready (the chapter's flowcharts).
+    #[default]
+    Polling,
+    /// It waits Table 3-3's times instead of polling, and its access ends
+    /// the instant the chip is ready (or a bus cycle after its last
+    /// access, if later): the edge case of a host that writes each byte
+    /// exactly when the chip allows it. A logic analyzer's sampling then
+    /// cannot say on which side of the flag's change the access fell.
+    Exact,
 }
 
 impl EmuBus {
@@ -341,6 +360,7 @@ impl EmuBus {
             board: Board::new(straps, cfg.clone())?,
             cfg,
             bus_cycle: Duration::ZERO,
+            host: HostTiming::Polling,
         })
     }
 
@@ -351,6 +371,25 @@ impl EmuBus {
     /// What `ppmc export --scenario` records its captures with.
     pub fn set_bus_cycle(&mut self, cycle: Duration) {
         self.bus_cycle = cycle;
+    }
+
+    /// How the host times an access it waits for ([`HostTiming`]).
+    pub fn set_host_timing(&mut self, host: HostTiming) {
+        self.host = host;
+    }
+
+    /// An access that waited since `start` ends now: a bus cycle on
+    /// (polling), or now if a cycle since `start` has passed (exact).
+    fn cycle_after_wait(&mut self, start: Instant) {
+        match self.host {
+            HostTiming::Polling => self.cycle(),
+            HostTiming::Exact => {
+                let to = start + self.bus_cycle;
+                if to > self.board.now() {
+                    self.board.advance_to(to);
+                }
+            }
+        }
     }
 
     /// One bus cycle passes.
@@ -452,6 +491,7 @@ impl EmuBus {
         match op {
             Op::WriteCommand { byte, wait_ibf } | Op::WriteData { byte, wait_ibf } => {
                 let mut waited = Duration::ZERO;
+                let start = self.board.now();
                 if let Some(timeout) = wait_ibf {
                     match self.wait_for(Status::IBF, 0, timeout) {
                         Ok(w) => waited = w,
@@ -461,7 +501,7 @@ impl EmuBus {
                         }
                     }
                 }
-                self.cycle();
+                self.cycle_after_wait(start);
                 if matches!(op, Op::WriteCommand { .. }) {
                     self.board.write_command(byte);
                 } else {
@@ -479,6 +519,7 @@ impl EmuBus {
             }
             Op::ReadData { wait_obf } => {
                 let mut waited = Duration::ZERO;
+                let start = self.board.now();
                 if let Some(timeout) = wait_obf {
                     match self.wait_for(Status::OBF, Status::OBF, timeout) {
                         Ok(w) => waited = w,
@@ -488,7 +529,7 @@ impl EmuBus {
                         }
                     }
                 }
-                self.cycle();
+                self.cycle_after_wait(start);
                 let byte = self.board.read_data();
                 Reply::Data {
                     at: self.board.now(),
@@ -506,9 +547,11 @@ impl EmuBus {
                 value,
                 timeout,
             } => {
+                let start = self.board.now();
                 let result = self.wait_for(mask, value & mask, timeout);
-                // The poll that saw it (or the last one) ends a cycle on.
-                self.cycle();
+                // The poll that saw it (or the last one) ends a cycle on;
+                // an exact host's read ends as the status changes.
+                self.cycle_after_wait(start);
                 let (at, status) = self.status_at();
                 match result {
                     Ok(waited) => Reply::Awaited { at, waited, status },

@@ -9,8 +9,10 @@
 //! as zero samples, without a word), and a value is written only when it
 //! changes, with a timestamp only where something changes. Timescale 1 ns,
 //! the trace's own resolution. The initial values are at `#0`, and a last,
-//! empty timestamp marks the trace's end (its last event: a bus access, a
-//! measurement), so that a viewer shows the whole trace. POUT is drawn as a
+//! empty timestamp [`TAIL`] after the trace's end (its last event: a bus
+//! access, a measurement) closes the file, so that a viewer shows the
+//! whole trace and a converter that samples it (sigrok-cli, which drops
+//! the changes at a file's last timestamp) keeps the last access. POUT is drawn as a
 //! pulse of 1 us, or half the period when pulses come faster: the trace
 //! records rising edges only, and the file's header says so, since a viewer
 //! that samples coarser than the width drawn loses pulses. The file is
@@ -313,12 +315,14 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
     if !state.started {
         state.start()?;
     }
-    let end = end + state.lead;
-    if end > state.last_time {
-        state.w.timestamp(end)?;
-    }
+    let end = end.max(state.last_time.saturating_sub(state.lead)) + state.lead + TAIL;
+    state.w.timestamp(end)?;
     state.w.flush()
 }
+
+/// How long the file goes on after the trace's last event (and its last
+/// change), in ns: a sampling converter keeps every change before it.
+pub const TAIL: u64 = 1_000;
 
 /// How late the bus export writes every time, in ns: the whole
 /// microseconds that the cycles laid out before the earliest accesses

@@ -607,3 +607,175 @@ fn a_capture_with_nothing_on_the_bus_is_the_captures_problem() {
     assert_eq!(out.status.code(), Some(4), "{said}{}", text(&out.stderr));
     assert!(said.contains("no register access on the bus"), "{said}");
 }
+
+/// `ppmc judge` on `capture` with `args`: its exit status and everything
+/// it said.
+fn judge_with(capture: &str, args: &[&str]) -> (Option<i32>, String) {
+    let mut all = vec!["judge", capture];
+    all.extend_from_slice(args);
+    let out = ppmc(&all);
+    (
+        out.status.code(),
+        format!("{}{}", text(&out.stdout), text(&out.stderr)),
+    )
+}
+
+/// The VCD `src` with each line passed through `f` (`None` drops it).
+fn rewrite(src: &str, dst: &Path, f: impl Fn(&str) -> Option<String>) -> String {
+    let text = std::fs::read_to_string(src).expect("our VCD");
+    let out: Vec<String> = text.lines().filter_map(f).collect();
+    std::fs::write(dst, out.join("\n") + "\n").expect("write");
+    dst.to_str().expect("utf-8").to_string()
+}
+
+/// Issue 40: a capture that stops early (in the middle of a line, of a
+/// move: 3-3-4's 1,000 pulses cut after some 500) is the capture's
+/// problem, exit 4, never a pass; with --partial, a pass that says what
+/// was not judged.
+#[test]
+fn a_capture_cut_short_is_the_captures_problem() {
+    let dir = scratch("judge-cut");
+    let whole = export(dir.path(), "whole.vcd", "s3_3_4_accel_1000_steps_cw", &[]);
+    let text = std::fs::read_to_string(&whole).expect("VCD");
+    let half = dir.path().join("half.vcd");
+    // Half the file, cut three bytes into a line.
+    let cut = text.len() / 2;
+    let cut = text[..cut].rfind('\n').expect("lines") + 4;
+    std::fs::write(&half, &text[..cut]).expect("write");
+    let half = half.to_str().expect("utf-8");
+    let (code, said) = judge_with(half, &[]);
+    assert_eq!(code, Some(4), "{said}");
+    assert!(said.contains("ERROR the capture"), "{said}");
+    assert!(
+        said.contains("the file ends in the middle of line"),
+        "{said}"
+    );
+    assert!(
+        said.contains("the recording ends during move 1, the board still moving"),
+        "{said}"
+    );
+    assert!(said.contains("pulses unjudged"), "{said}");
+    let (code, said) = judge_with(half, &["--partial"]);
+    assert_eq!(code, Some(0), "{said}");
+    assert!(
+        said.contains("not judged: the recording ends during move 1"),
+        "{said}"
+    );
+    assert!(said.contains("PASS the board"), "{said}");
+    // Cut at a line's end, mid-move: the move alone says it.
+    let at_line = &text[..text[..text.len() / 2].rfind('\n').expect("lines") + 1];
+    let line_cut = dir.path().join("line.vcd");
+    std::fs::write(&line_cut, at_line).expect("write");
+    let (code, said) = judge_with(line_cut.to_str().expect("utf-8"), &[]);
+    assert_eq!(code, Some(4), "{said}");
+    assert!(!said.contains("middle of line"), "{said}");
+    assert!(said.contains("the board still moving"), "{said}");
+}
+
+/// A map names each signal once and each channel once: bad usage (exit
+/// 2), naming both pairs. A VCD of a million nested scopes is refused at
+/// the nesting limit, in bounded memory (exit 2, the file's line named).
+#[test]
+fn a_doubled_map_and_a_million_scopes_are_refused() {
+    let dir = scratch("judge-refused");
+    let vcd = export(dir.path(), "c.vcd", "s3_3_5_constant_speed_100_steps", &[]);
+    for (map, says) in [
+        ("CS=cs,CS=rd", "CS is given twice (`CS=cs` before)"),
+        ("CS=cs,RD=cs", "channel `cs` is given for CS already"),
+    ] {
+        let (code, said) = judge_with(&vcd, &["--map", map]);
+        assert_eq!(code, Some(2), "{map}: {said}");
+        assert!(said.contains(says), "{map}: {said}");
+    }
+    let deep = dir.path().join("deep.vcd");
+    let mut f = std::io::BufWriter::new(std::fs::File::create(&deep).expect("create"));
+    use std::io::Write;
+    writeln!(f, "$timescale 1 ns $end").expect("write");
+    for _ in 0..1_000_000 {
+        writeln!(f, "$scope module m $end").expect("write");
+    }
+    writeln!(f, "$var wire 1 ! cs $end\n$enddefinitions $end\n#0 1!").expect("write");
+    drop(f);
+    let (code, said) = judge_with(deep.to_str().expect("utf-8"), &[]);
+    assert_eq!(code, Some(2), "{said}");
+    assert!(
+        said.contains("line 258: $scope nested deeper than 256 levels"),
+        "{said}"
+    );
+}
+
+/// A wrong map is the capture's problem, naming the signal, never the
+/// board's: POUT with no channel while the chip pulses; D0 and D1
+/// exchanged; CS and RD exchanged; channels named as sigrok names them
+/// (`D0`..`D37`), never taken for the data lines.
+#[test]
+fn a_wrong_map_is_the_captures_problem_naming_the_signal() {
+    let dir = scratch("judge-wrong-map");
+    let vcd = export(dir.path(), "a.vcd", "s3_3_4_accel_1000_steps_cw", &[]);
+    let no_pout = rewrite(&vcd, &dir.path().join("nopout.vcd"), |l| {
+        Some(l.replace(" pout $end", " probe7 $end"))
+    });
+    let (code, said) = judge_with(&no_pout, &[]);
+    assert_eq!(code, Some(4), "{said}");
+    assert!(said.contains("no channel for POUT"), "{said}");
+    assert!(!said.contains("FAIL the board"), "{said}");
+    let (code, said) = judge_with(&vcd, &["--map", "D0=d1,D1=d0"]);
+    assert_eq!(code, Some(4), "{said}");
+    assert!(said.contains("but D0 and D1 look exchanged"), "{said}");
+    let (code, said) = judge_with(&vcd, &["--map", "CS=rd,RD=cs"]);
+    assert_eq!(code, Some(4), "{said}");
+    assert!(said.contains("but CS and RD look exchanged"), "{said}");
+    let n = std::cell::Cell::new(0);
+    let default_names = rewrite(&vcd, &dir.path().join("names.vcd"), |l| {
+        let w: Vec<&str> = l.split(' ').collect();
+        if w.len() == 6 && w[0] == "$var" {
+            let k = n.get();
+            n.set(k + 1);
+            return Some(format!("{} {} {} {} D{k} {}", w[0], w[1], w[2], w[3], w[5]));
+        }
+        Some(l.to_string())
+    });
+    let (code, said) = judge_with(&default_names, &[]);
+    assert_eq!(code, Some(4), "{said}");
+    assert!(
+        said.contains("named as the analyzer names them (D0..D37)"),
+        "{said}"
+    );
+}
+
+/// POUT and DIR inverted by the board's output stage: `~` in the map
+/// judges them (3-3-4's pulses and direction); without it, the board's
+/// divergence comes with a hint naming the map that passes.
+#[test]
+fn inverted_pout_and_dir_are_judged_with_a_tilde_and_hinted_without() {
+    let dir = scratch("judge-inverted");
+    let vcd = export(dir.path(), "a.vcd", "s3_3_4_accel_1000_steps_cw", &[]);
+    let text = std::fs::read_to_string(&vcd).expect("VCD");
+    let code_of = |name: &str| {
+        text.lines()
+            .find(|l| l.ends_with(&format!(" {name} $end")) && l.starts_with("$var"))
+            .and_then(|l| l.split(' ').nth(3))
+            .expect("declared")
+            .to_string()
+    };
+    let (pout, dirc) = (code_of("pout"), code_of("dir"));
+    let inverted = rewrite(&vcd, &dir.path().join("inv.vcd"), |l| {
+        for c in [&pout, &dirc] {
+            match l.strip_suffix(c.as_str()) {
+                Some("0") => return Some(format!("1{c}")),
+                Some("1") => return Some(format!("0{c}")),
+                _ => {}
+            }
+        }
+        Some(l.to_string())
+    });
+    let (code, said) = judge_with(&inverted, &["--map", "POUT=~pout,DIR=~dir"]);
+    assert_eq!(code, Some(0), "{said}");
+    assert!(said.contains("1000 POUT pulses compared"), "{said}");
+    let (code, said) = judge_with(&inverted, &[]);
+    assert_eq!(code, Some(1), "{said}");
+    assert!(
+        said.contains("hint: POUT looks inverted and DIR looks inverted: judged with `--map POUT=~pout,DIR=~dir` the board passes"),
+        "{said}"
+    );
+}

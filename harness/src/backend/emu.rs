@@ -52,6 +52,13 @@ impl EmuTarget {
         self
     }
 
+    /// How the host times the accesses it waits for
+    /// ([`EmuBus::set_host_timing`]).
+    pub fn with_host_timing(mut self, host: ppmc_core::bus::HostTiming) -> Self {
+        self.bus.set_host_timing(host);
+        self
+    }
+
     pub fn chip(&self) -> &Chip {
         self.bus.chip()
     }

@@ -7,6 +7,7 @@ use crate::files;
 use crate::scenario::Scenario;
 use crate::trace::Trace;
 use clap::Args;
+use ppmc_core::bus::HostTiming;
 use std::path::PathBuf;
 
 /// What to export, and where.
@@ -36,26 +37,45 @@ pub struct ExportArgs {
     /// record it.
     #[arg(long)]
     bus: bool,
+    /// With --scenario: how the host times an access it waits for.
+    /// `polling` (default): it polls the status and accesses a bus cycle
+    /// after the poll that saw the chip ready. `exact`: it waits Table
+    /// 3-3's times instead, and each access ends the instant the chip is
+    /// ready (IBF falls, OBF rises), the edge case for a logic analyzer's
+    /// sampling (docs/capture.md).
+    #[arg(long, value_name = "HOW", default_value = "polling", value_parser = ["polling", "exact"], requires = "scenario")]
+    host: String,
 }
 
 /// The trace of `name` run on the emulator with `faults`, every register
 /// access taking a bus cycle, as a logic analyzer records it (every
 /// access the chip served, though the scenario fail).
-fn scenario_trace(name: &str, faults: &[String], suite: &[Scenario]) -> Result<Trace, CliError> {
+fn scenario_trace(
+    name: &str,
+    faults: &[String],
+    host: HostTiming,
+    suite: &[Scenario],
+) -> Result<Trace, CliError> {
     let Some(s) = suite.iter().find(|s| s.name == name) else {
         return Err(usage(format!("no scenario `{name}` (see `ppmc list`)")));
     };
     let mut model = crate::emu::ModelConfig::default();
     crate::faults::apply_all(faults, &mut model)
         .map_err(|e| usage(format!("--chip-fault: {e}")))?;
-    crate::fault_matrix::capture::analyzer_trace(&model, s)
+    crate::fault_matrix::capture::analyzer_trace_with(&model, s, host)
         .map(|(trace, _)| trace)
         .map_err(|e| CliError::Failed(format!("{name}: {e}")))
 }
 
 pub fn run(args: ExportArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let (trace, input) = match (&args.trace, &args.scenario) {
-        (_, Some(name)) => (scenario_trace(name, &args.chip_faults, suite)?, None),
+        (_, Some(name)) => {
+            let host = match args.host.as_str() {
+                "exact" => HostTiming::Exact,
+                _ => HostTiming::Polling,
+            };
+            (scenario_trace(name, &args.chip_faults, host, suite)?, None)
+        }
         (Some(path), None) => {
             let text = files::read_text(path, files::MAX_TRACE_BYTES)?;
             match Trace::parse(&text) {

@@ -5,7 +5,7 @@
 use super::args::{parse_duration, ChipArgs, ToleranceArgs};
 use crate::backend::TargetInfo;
 use crate::cli::{usage, CliError};
-use crate::judge::{judge_traced, HostFinding, JudgeOptions, Judgement, Verdict};
+use crate::judge::{judge_reopening, HostFinding, JudgeOptions, Judgement, Verdict};
 use crate::logic::decode::BusDecoder;
 use crate::logic::map::ChannelMap;
 use crate::logic::source::{LogicInfo, LogicSource};
@@ -29,8 +29,11 @@ pub struct CaptureArgs {
     /// A0, D0..D7, POUT, DIR, INT, BUSY, HOLD, AUX, AUXO0..AUXO3, and the
     /// inputs the board drives (L1..L4, ALM, CNP, AUXI0..AUXI3), which
     /// the model is given; a channel named `reset` starts the model where
-    /// it falls. Default: the capture's channel
-    /// names, where they are the chip's (`CS*`, `nRD`, `D3`, `POUT`).
+    /// it falls. `~` before a channel reads it inverted (`POUT=~12`,
+    /// `DIR=~dir`: an output stage that inverts). Each signal once, each
+    /// channel once. Default: the capture's channel names, where they are
+    /// the chip's (`CS*`, `nRD`, `D3`, `POUT`); an analyzer's own names
+    /// (sigrok's `D0`..`D15`) are never taken for the data lines.
     #[arg(long, value_name = "PAIRS|@FILE")]
     map: Option<String>,
     /// Bus strobes shorter than this are glitches, dropped.
@@ -48,7 +51,7 @@ impl CaptureArgs {
             Some(text) => {
                 let text = match text.strip_prefix('@') {
                     Some(file) => crate::files::read_text(std::path::Path::new(file), 1 << 20)?,
-                    None => text.replace(',', "\n"),
+                    None => text.clone(),
                 };
                 ChannelMap::parse(&text, source.info())
             }
@@ -79,8 +82,16 @@ pub fn decode(args: DecodeArgs) -> Result<(), CliError> {
     let (mut source, map) = args.capture.open()?;
     let info = source.info().clone();
     let bus = map
-        .require_bus()
+        .require_bus(&info)
         .map_err(|why| usage(format!("{}: {why}", args.capture.capture.display())))?;
+    let mut inverted;
+    let source: &mut dyn LogicSource = match map.inverted() {
+        0 => source.as_mut(),
+        _ => {
+            inverted = crate::logic::map::Inverted::new(source.as_mut(), &map);
+            &mut inverted
+        }
+    };
     let mut d = BusDecoder::new(bus, &info, args.capture.glitch.as_nanos() * 1000);
     outln!(
         "# {} ({}), decoded by ppmc: replay with `ppmc console`",
@@ -169,17 +180,27 @@ pub struct JudgeArgs {
     /// capture file's name without its extension).
     #[arg(long, value_name = "NAME", requires = "trace")]
     scenario: Option<String>,
+    /// Judge what the capture holds though it is not whole: it ends
+    /// mid-line, during a register access or while the board is still
+    /// moving, or it has no channel for POUT while the chip pulses. The
+    /// verdict then says what was not judged. Without it such a capture
+    /// is the capture's problem (exit 4), never a pass.
+    #[arg(long)]
+    partial: bool,
 }
 
 pub fn run(args: JudgeArgs) -> Result<(), CliError> {
     let started = std::time::Instant::now();
-    let (mut source, map) = args.capture.open()?;
+    let (source, map) = args.capture.open()?;
     let info = source.info().clone();
+    drop(source);
     let opts = JudgeOptions {
         straps: args.chip.straps().map_err(usage)?,
         model: args.chip.model(),
         tolerances: args.tolerance.tolerances().map_err(usage)?,
         glitch_ps: args.capture.glitch.as_nanos() * 1000,
+        partial: args.partial,
+        ..JudgeOptions::default()
     };
     super::run::prepare_reports(
         args.junit.as_deref(),
@@ -209,7 +230,11 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
     }
     let mut store = super::run::open_store(args.store.as_deref())?;
     describe(&info, &args.capture.capture);
-    let (j, trace) = judge_traced(source.as_mut(), &map, &opts, name.as_deref())
+    // The capture is read again only where the board diverged, to hold
+    // the divergence against the map (judge::judge_reopening).
+    let path = args.capture.capture.clone();
+    let mut open = move || crate::logic::open::open(&path);
+    let (j, trace) = judge_reopening(&mut open, &map, &opts, name.as_deref())
         .map_err(|e| CliError::BadInput(format!("ppmc: {e}")))?;
     let mut problems = Vec::new();
     if let (Some(dir), Some(t)) = (&args.trace, &trace) {
@@ -316,6 +341,7 @@ fn records(
         .map(|n| format!("not judged: {n}"))
         .collect();
     notes.push(counts(j));
+    notes.extend(j.hints.iter().map(|h| format!("hint: {h}")));
     let (verdict, blame, message) = match &j.verdict {
         Verdict::Passed => (ScenarioVerdict::Passed, None, None),
         Verdict::Failed(d) => (
@@ -410,6 +436,9 @@ fn say(j: &Judgement) -> Result<(), CliError> {
     outln!("{}", counts(j));
     for h in &j.host {
         outln!("{}", finding(h));
+    }
+    for h in &j.hints {
+        outln!("hint: {h}");
     }
     let word = |w: &str| super::out::verdict_word(w, 0);
     match &j.verdict {

@@ -24,11 +24,12 @@ use crate::judge::{judge, JudgeOptions, Verdict};
 use crate::logic::map::ChannelMap;
 use crate::logic::source::LogicSource;
 use crate::logic::vcd::VcdReader;
-use crate::protocol::{Record, Straps};
+use crate::protocol::{Flag, Record, Straps};
 use crate::scenario::{run_scenario, DriverOptions, Scenario};
 use crate::time::Duration;
 use crate::trace::{BusEvent, Event, EventKind, Trace};
 use crate::vcd_export::{export_with, Export, BUS_CYCLE};
+use ppmc_core::bus::HostTiming;
 use std::path::Path;
 use std::time::Instant as WallClock;
 
@@ -138,14 +139,34 @@ pub fn judge_captures(
 /// access the chip served and everything it put out. With how long it
 /// ran. What `ppmc export --scenario` writes, and what this column judges.
 pub fn analyzer_trace(model: &ModelConfig, s: &Scenario) -> Result<(Trace, Duration), String> {
+    analyzer_trace_with(model, s, HostTiming::Polling)
+}
+
+/// [`analyzer_trace`] with a host that times its waited accesses as
+/// `host` says (`ppmc export --host exact`: each byte written the instant
+/// the chip allows it).
+pub fn analyzer_trace_with(
+    model: &ModelConfig,
+    s: &Scenario,
+    host: HostTiming,
+) -> Result<(Trace, Duration), String> {
     let emu = EmuTarget::new(Straps::default(), model.clone())
         .map_err(|e| format!("the emulator: {e}"))?
-        .with_bus_cycle(Duration::from_nanos(BUS_CYCLE));
+        .with_bus_cycle(Duration::from_nanos(BUS_CYCLE))
+        .with_host_timing(host);
     let mut target = Analyzer {
         emu,
         bus: Vec::new(),
     };
     let r = run_scenario(&mut target, s, DriverOptions::default());
+    // The analyzer is stopped once the board is at rest, as an engineer
+    // stops it: a scenario that ends while its move runs on is recorded
+    // to the move's end (at most LONGEST on), with no access of the host
+    // (the wait is the emulator's, not a poll on the bus). A capture that
+    // stops mid-move is the capture's problem (`ppmc judge --partial`).
+    let _ = target
+        .emu
+        .execute(&[Op::await_flag(Flag::Busy, false, LONGEST)]);
     let trace = target
         .trace(s)
         .map_err(|e| format!("the emulator's capture: {e}"))?;

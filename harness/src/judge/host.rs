@@ -39,7 +39,7 @@ pub struct HostFinding {
 }
 
 /// The rules, and what they remember of the accesses so far.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(super) struct HostRules {
     /// The last byte written, until the chip has taken it: what the chip
     /// answered it with is judged then.

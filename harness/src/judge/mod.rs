@@ -20,7 +20,7 @@
 use crate::compare::Tolerances;
 use crate::emu::{Board, ModelConfig};
 use crate::logic::decode::{Access, BusDecoder, Transaction, GLITCH_PS};
-use crate::logic::map::{ChannelMap, Signal};
+use crate::logic::map::{ChannelMap, Inverted, Signal};
 use crate::logic::source::{Change, LogicError, LogicSource};
 use crate::protocol::{Direction, Input, Status, Straps};
 use crate::time::{Duration, Instant};
@@ -28,9 +28,11 @@ use std::fmt;
 
 mod host;
 mod outputs;
+mod suspect;
 pub mod trace;
 pub use host::HostFinding;
 use host::HostRules;
+pub use suspect::{judge_reopening, Opener};
 
 /// How to judge.
 #[derive(Debug, Clone)]
@@ -40,6 +42,22 @@ pub struct JudgeOptions {
     pub tolerances: Tolerances,
     /// Strobes shorter than this are glitches, in picoseconds.
     pub glitch_ps: u64,
+    /// Judge what a capture holds though it was cut short (it ends
+    /// mid-line, mid-access, or while the board is still moving) or has
+    /// no channel for POUT while the model pulses: a pass then says what
+    /// was not judged. Without it, such a capture is the capture's
+    /// problem, never a pass.
+    pub partial: bool,
+    /// Stop at the first divergence: the verdict and nothing after it
+    /// (the counts, host findings and end checks are then partial). For
+    /// trying another channel map ([`suspect`]).
+    pub stop_at_divergence: bool,
+    /// Where the capture cannot order a host access against a change of
+    /// IBF, OBF or BUSY, follow both orders ([`Branch`]; the default).
+    /// Off, the model takes every access at its captured time, as the
+    /// judge did before issue 40: for measuring what the capture's
+    /// uncertainty costs a verdict.
+    pub follow_orders: bool,
 }
 
 impl Default for JudgeOptions {
@@ -49,6 +67,9 @@ impl Default for JudgeOptions {
             model: ModelConfig::default(),
             tolerances: Tolerances::default(),
             glitch_ps: GLITCH_PS,
+            partial: false,
+            stop_at_divergence: false,
+            follow_orders: true,
         }
     }
 }
@@ -91,6 +112,9 @@ pub struct Judgement {
     pub changes: u64,
     /// What could not be judged, and why (a signal with no channel).
     pub not_judged: Vec<String>,
+    /// What the capture suggests of its own map where the board diverged
+    /// (`POUT looks inverted: ...`), for the user to weigh.
+    pub hints: Vec<String>,
 }
 
 impl fmt::Display for Divergence {
@@ -111,7 +135,10 @@ impl fmt::Display for Divergence {
 }
 
 /// The model beside the capture, and what has been compared.
+#[derive(Clone)]
 struct Bench {
+    /// The capture has POUT: the pulses are compared.
+    pulses_judged: bool,
     board: Board,
     /// The capture's time of the model's time zero, in picoseconds.
     zero_ps: u64,
@@ -209,6 +236,23 @@ impl Bench {
         probe.read_status().0
     }
 
+    /// Where IBF, OBF or BUSY first change after capture time `ps`
+    /// within its uncertainty ([`Bench::latency_window`]): the capture
+    /// time just after the change, if any. The model itself stays.
+    fn flag_change_within(&self, ps: u64) -> Option<u64> {
+        let mut probe = self.board.clone();
+        let before = probe.read_status().0 & ORDERED_FLAGS;
+        let limit = self.model_time(ps.saturating_add(self.latency_window(ps)));
+        loop {
+            let now = probe.now();
+            let next = probe.poll_at().filter(|&t| t <= limit)?;
+            probe.advance_to(next.max(now + Duration::from_nanos(1)));
+            if probe.read_status().0 & ORDERED_FLAGS != before {
+                return Some(self.capture_ps(probe.now()));
+            }
+        }
+    }
+
     /// The model as the outputs are compared with it.
     fn frame(&self) -> outputs::Frame<'_> {
         outputs::Frame {
@@ -290,6 +334,10 @@ impl Bench {
     /// `horizon_ps` by more than their tolerance: the model has been run
     /// up to `horizon_ps`, so nothing earlier can still change.
     fn compare_pulses(&mut self, horizon_ps: u64) -> Result<(), Divergence> {
+        // A signal with no channel is never a reason to fail the board.
+        if !self.pulses_judged {
+            return Ok(());
+        }
         loop {
             let model = self.next_model_pulse();
             let board_dir = self.edges.front().and_then(|e| e.1);
@@ -380,7 +428,7 @@ impl Bench {
 
 /// The model's status at the capture's recent changes, for a status read
 /// that may have seen it as its strobe began.
-#[derive(Default)]
+#[derive(Default, Clone)]
 struct StatusLog(std::collections::VecDeque<(u64, u8)>);
 
 impl StatusLog {
@@ -453,6 +501,227 @@ impl<'a> Lookahead<'a> {
     }
 }
 
+/// The most orders of the host's accesses followed at once; past it the
+/// orders found last (the accesses as captured) are dropped first.
+const MAX_BRANCHES: usize = 8;
+
+/// The flags whose change a host access may not be ordered against, as
+/// far as the capture can tell: IBF, OBF and BUSY.
+const ORDERED_FLAGS: u8 = Status::IBF | Status::OBF | Status::BUSY;
+
+/// The model beside the capture under one order of the host's accesses
+/// against the chip's flags (issue 40). Where an access lies within the
+/// capture's uncertainty (two samples, the floor and the latency
+/// tolerance) before a change of IBF, OBF or BUSY, the capture cannot say
+/// whether the chip saw it before the change or after: the judge follows
+/// both, a branch each, and the board's later behaviour rules one out. No
+/// board fails, and no host finding is made, because the judge's own
+/// model picked an order the capture cannot prove.
+#[derive(Clone)]
+struct Branch {
+    bench: Bench,
+    outputs: outputs::Outputs,
+    rules: HostRules,
+    host: Vec<HostFinding>,
+    status_log: StatusLog,
+    failed: Option<Divergence>,
+}
+
+impl Branch {
+    /// A change of the capture, the model run up to it.
+    fn change(&mut self, c: &Change, prev: Option<&Change>, map: &ChannelMap, pout: Option<usize>) {
+        let bench = &mut self.bench;
+        // The model up to now: every access before this change is in it.
+        bench.run_to(c.time_ps);
+        self.status_log.push(c.time_ps, bench.board.read_status().0);
+        if self.failed.is_none() {
+            if let Err(d) = bench.compare_pulses(c.time_ps) {
+                self.failed = Some(d);
+            }
+        }
+        // Past the first divergence nothing more is compared: nothing
+        // more is kept for it either.
+        if self.failed.is_none() {
+            self.outputs.observe(c);
+            let after = bench.last_access.map(|a| a.to_string());
+            if let Err(d) = self.outputs.compare(&bench.frame(), c.time_ps, after) {
+                self.failed = Some(d);
+            }
+        }
+        if let Some(ch) = pout.filter(|_| self.failed.is_none()) {
+            if c.high(ch) && prev.is_some_and(|q| !q.high(ch)) {
+                let dir = map.get(Signal::Dir).map(|d| c.high(d));
+                bench.edges.push_back((c.time_ps, dir));
+            }
+        }
+    }
+
+    /// A register access: the branch that takes it as captured, and,
+    /// where the capture cannot order it against a change of IBF, OBF or
+    /// BUSY that follows within its uncertainty, the other order too:
+    /// this branch takes the access just after the change (the host's
+    /// findings then as the chip saw it), and the one returned as
+    /// captured, with no host finding for it.
+    fn access(&mut self, t: &Transaction, follow_orders: bool) -> Option<Branch> {
+        self.bench.run_to(t.end_ps);
+        let mut fork = None;
+        if follow_orders && self.failed.is_none() && t.access != Access::ReadStatus {
+            if let Some(after) = self.bench.flag_change_within(t.end_ps) {
+                let mut captured = self.clone();
+                captured.apply(t, true);
+                fork = Some(captured);
+                self.bench.run_to(after);
+                self.apply(t, false);
+                return fork;
+            }
+        }
+        self.apply(t, false);
+        fork
+    }
+
+    /// The access taken by the model where it stands; with `unsure`, the
+    /// host rules see it but its findings are dropped (the capture cannot
+    /// order it).
+    fn apply(&mut self, t: &Transaction, unsure: bool) {
+        let bench = &mut self.bench;
+        // The status as the strobe began (it may change during it), as
+        // the model stood at that change of the capture.
+        let status = bench.board.read_status();
+        let status_then = Status(self.status_log.at(t.start_ps).unwrap_or(status.0));
+        // Past the board's first divergence the model no longer stands
+        // for the chip: its word on the host would be noise.
+        let judging_host = self.failed.is_none();
+        let mut dropped = Vec::new();
+        let findings = if unsure { &mut dropped } else { &mut self.host };
+        if judging_host {
+            self.rules.before(t, &bench.board, findings);
+        }
+        match t.access {
+            Access::WriteCommand => bench.board.write_command(t.byte),
+            Access::WriteData => bench.board.write_data(t.byte),
+            Access::ReadStatus => {
+                // The status may change during the strobe: the model's at
+                // its start or its end will do; and a flag the board
+                // changes a little before or after the model (within the
+                // latency tolerance of the time since what caused it) too.
+                let mask = !t.unknown;
+                let matches = |s: u8| (t.byte & mask) == (s & mask);
+                let w = bench.latency_window(t.start_ps);
+                let log = &self.status_log;
+                let near = || {
+                    log.since(t.start_ps.saturating_sub(w)).any(matches)
+                        || matches(bench.status_after(t.end_ps.saturating_add(w)))
+                };
+                if self.failed.is_none() && !matches(status.0) && !matches(status_then.0) && !near()
+                {
+                    self.failed = Some(Divergence {
+                        at_ps: t.end_ps,
+                        what: "status read".into(),
+                        board: format!("0x{:02X}", t.byte),
+                        model: format!("0x{:02X}", status.0),
+                        after: bench.last_access.map(|a| a.to_string()),
+                    });
+                }
+            }
+            Access::ReadData => {
+                let byte = bench.board.read_data();
+                let mask = !t.unknown;
+                if self.failed.is_none() && status.obf() && (t.byte & mask) != (byte & mask) {
+                    self.failed = Some(Divergence {
+                        at_ps: t.end_ps,
+                        what: "data read".into(),
+                        board: format!("0x{:02X}", t.byte),
+                        model: format!("0x{byte:02X}"),
+                        after: bench.last_access.map(|a| a.to_string()),
+                    });
+                }
+            }
+        }
+        if judging_host {
+            self.rules.after(t, &bench.board, findings);
+        }
+        // What times an output: a write, or the data read that releases
+        // INT* (3-4-1); never the host's status polling.
+        if t.access != Access::ReadStatus {
+            self.outputs.access(t.end_ps);
+            bench.last_cause_ps = bench.last_cause_ps.max(t.end_ps);
+        }
+        bench.last_access = Some(*t);
+    }
+
+    /// The capture has ended at `end`: what the model put out before it,
+    /// the board must have too.
+    fn finish(&mut self, end: u64) {
+        self.bench.run_to(end);
+        if self.failed.is_none() {
+            self.rules.finish(end, &self.bench.board, &mut self.host);
+        }
+        if self.failed.is_none() {
+            if let Err(d) = self.bench.compare_pulses(end) {
+                self.failed = Some(d);
+            }
+        }
+        if self.failed.is_none() {
+            let after = self.bench.last_access.map(|a| a.to_string());
+            if let Err(d) = self.outputs.compare(&self.bench.frame(), end, after) {
+                self.failed = Some(d);
+            }
+        }
+    }
+}
+
+/// Drops the orders the board has ruled out: while one branch has not
+/// diverged, those that have; past [`MAX_BRANCHES`], the last found.
+fn prune(branches: &mut Vec<Branch>) {
+    if branches.iter().any(|b| b.failed.is_none()) {
+        branches.retain(|b| b.failed.is_none());
+    } else if branches.len() > 1 {
+        // Every order diverged: keep the one that followed the board
+        // longest, for the verdict.
+        let best = branches
+            .iter()
+            .enumerate()
+            .max_by_key(|(i, b)| (b.failed.as_ref().map_or(0, |d| d.at_ps), usize::MAX - i))
+            .map_or(0, |(i, _)| i);
+        let keep = branches.swap_remove(best);
+        branches.clear();
+        branches.push(keep);
+    }
+    branches.truncate(MAX_BRANCHES);
+}
+
+/// What a capture that ends while the model is still moving leaves
+/// unjudged: which move, and how many pulses the model has still to put
+/// out (found by running a copy on, a bounded while).
+fn unfinished(board: &Board) -> String {
+    let moves = board.record().moves.len();
+    let mut probe = board.clone();
+    let pulses = |b: &Board| -> u64 { b.record().runs.iter().map(|r| u64::from(r.count)).sum() };
+    let before = pulses(&probe);
+    let limit = probe.now() + Duration::from_secs(3600);
+    while probe.read_status().busy() {
+        match probe.poll_at() {
+            Some(t) if t <= limit => {
+                let t = t.max(probe.now() + Duration::from_nanos(1));
+                probe.advance_to(t);
+            }
+            _ => break,
+        }
+    }
+    let left = pulses(&probe) - before;
+    match probe.read_status().busy() {
+        false if left == 0 => format!(
+            "the recording ends before move {moves} finished (BUSY still 1, its last pulse out): its end is unjudged"
+        ),
+        false => format!(
+            "the recording ends during move {moves}, the board still moving: {left} pulses unjudged"
+        ),
+        true => format!(
+            "the recording ends during move {moves}, the board still moving: {left} pulses unjudged in the hour after it, and more"
+        ),
+    }
+}
+
 /// Why a capture could not be judged at all.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum JudgeError {
@@ -484,8 +753,16 @@ pub fn judge_traced(
     scenario: Option<&str>,
 ) -> Result<(Judgement, Option<crate::trace::Trace>), JudgeError> {
     let info = source.info().clone();
+    let mut inverted;
+    let source: &mut dyn LogicSource = match map.inverted() {
+        0 => source,
+        _ => {
+            inverted = Inverted::new(source, map);
+            &mut inverted
+        }
+    };
     let mut not_judged = Vec::new();
-    let bus = match map.require_bus() {
+    let bus = match map.require_bus(&info) {
         Ok(bus) => bus,
         Err(why) => {
             return Ok((
@@ -496,6 +773,7 @@ pub fn judge_traced(
                     pulses: 0,
                     changes: 0,
                     not_judged,
+                    hints: Vec::new(),
                 },
                 None,
             ))
@@ -525,7 +803,8 @@ pub fn judge_traced(
     let reset = info.channel("reset");
     let board = Board::new(opts.straps, opts.model.clone())
         .map_err(|e| JudgeError::Model(e.to_string()))?;
-    let mut bench = Bench {
+    let bench = Bench {
+        pulses_judged: pout.is_some(),
         board,
         zero_ps: 0,
         tol: opts.tolerances,
@@ -540,7 +819,7 @@ pub fn judge_traced(
         compared: 0,
         last_access: None,
     };
-    let mut outputs = outputs::Outputs::new(map, &bench.board);
+    let outputs = outputs::Outputs::new(map, &bench.board);
     let unwatched: Vec<String> = [Signal::Int, Signal::Busy, Signal::Hold, Signal::Aux]
         .into_iter()
         .chain((0..4).map(Signal::Auxo))
@@ -554,13 +833,17 @@ pub fn judge_traced(
         not_judged.push("the phase outputs S1..S5: not compared yet".into());
     }
     let mut decoder = BusDecoder::new(bus, &info, opts.glitch_ps);
-    let mut host = Vec::new();
-    let mut rules = HostRules::default();
+    let mut branches = vec![Branch {
+        bench,
+        outputs,
+        rules: HostRules::default(),
+        host: Vec::new(),
+        status_log: StatusLog::default(),
+        failed: None,
+    }];
     let mut prev: Option<Change> = None;
     let mut started = reset.is_none();
-    let mut failed = None;
     let mut source = Lookahead::new(source);
-    let mut status_log = StatusLog::default();
     let mut tracer = scenario.map(|_| trace::CaptureTrace::new(map, &info));
     while let Some(c) = source.next()? {
         // The inputs' levels before this change: none at the model's start
@@ -574,7 +857,9 @@ pub fn judge_traced(
                     continue;
                 }
                 started = true;
-                bench.zero_ps = c.time_ps;
+                for b in &mut branches {
+                    b.bench.zero_ps = c.time_ps;
+                }
                 inputs_before = None;
             }
         }
@@ -584,143 +869,71 @@ pub fn judge_traced(
             .filter(|&&(_, ch)| c.high(ch) != inputs_before.is_none_or(|q| q.high(ch)))
             .map(|&(input, ch)| (input, !c.high(ch)))
             .collect();
-        if !changed.is_empty() {
-            // A pulse this close to the change may stand on either side of
-            // it: the pulses' own tolerance, at least a sample.
-            let w = bench.pulse_window(c.time_ps);
-            let board_pulsed = bench.edges.iter().any(|e| e.0.abs_diff(c.time_ps) <= w)
-                || pout.is_some_and(|ch| {
-                    let mut level = prev.is_some_and(|q| q.high(ch));
-                    let this = std::iter::once(&c);
-                    this.chain(source.peek_until(c.time_ps.saturating_add(w)))
-                        .any(|n| {
-                            let rose = n.high(ch) && !level;
-                            level = n.high(ch);
-                            rose
-                        })
-                });
-            bench.give_inputs(c.time_ps, &changed, board_pulsed, w);
-        }
-        // The model up to now: every access before this change is in it.
-        bench.run_to(c.time_ps);
-        status_log.push(c.time_ps, bench.board.read_status().0);
-        if failed.is_none() {
-            if let Err(d) = bench.compare_pulses(c.time_ps) {
-                failed = Some(d);
+        for b in &mut branches {
+            if !changed.is_empty() {
+                // A pulse this close to the change may stand on either
+                // side of it: the pulses' own tolerance, at least a sample.
+                let bench = &mut b.bench;
+                let w = bench.pulse_window(c.time_ps);
+                let board_pulsed = bench.edges.iter().any(|e| e.0.abs_diff(c.time_ps) <= w)
+                    || pout.is_some_and(|ch| {
+                        let mut level = prev.is_some_and(|q| q.high(ch));
+                        let this = std::iter::once(&c);
+                        this.chain(source.peek_until(c.time_ps.saturating_add(w)))
+                            .any(|n| {
+                                let rose = n.high(ch) && !level;
+                                level = n.high(ch);
+                                rose
+                            })
+                    });
+                bench.give_inputs(c.time_ps, &changed, board_pulsed, w);
             }
-        }
-        // Past the first divergence nothing more is compared: nothing
-        // more is kept for it either.
-        if failed.is_none() {
-            outputs.observe(&c);
-        }
-        if failed.is_none() {
-            let after = bench.last_access.map(|a| a.to_string());
-            if let Err(d) = outputs.compare(&bench.frame(), c.time_ps, after) {
-                failed = Some(d);
-            }
+            b.change(&c, prev.as_ref(), map, pout);
         }
         if let Some(tr) = &mut tracer {
+            let bench = &branches[0].bench;
             tr.change(&c, prev.as_ref(), bench.model_time(c.time_ps), &bench.board);
         }
-        if let Some(ch) = pout.filter(|_| failed.is_none()) {
-            if c.high(ch) && prev.is_some_and(|q| !q.high(ch)) {
-                let dir = map.get(Signal::Dir).map(|d| c.high(d));
-                bench.edges.push_back((c.time_ps, dir));
-            }
-        }
         if let Some(t) = decoder.push(c) {
-            // The status as the strobe began (it may change during it),
-            // as the model stood at that change of the capture.
-            bench.run_to(t.end_ps);
-            let status = bench.board.read_status();
-            let status_then = Status(status_log.at(t.start_ps).unwrap_or(status.0));
-            // Past the board's first divergence the model no longer
-            // stands for the chip: its word on the host would be noise.
-            let judging_host = failed.is_none();
-            if judging_host {
-                rules.before(&t, &bench.board, &mut host);
+            let mut forks = Vec::new();
+            for b in &mut branches {
+                forks.extend(b.access(&t, opts.follow_orders));
             }
-            match t.access {
-                Access::WriteCommand | Access::WriteData => {
-                    if t.access == Access::WriteCommand {
-                        bench.board.write_command(t.byte);
-                    } else {
-                        bench.board.write_data(t.byte);
-                    }
-                }
-                Access::ReadStatus => {
-                    // The status may change during the strobe: the model's
-                    // at its start or its end will do; and a flag the
-                    // board changes a little before or after the model
-                    // (within the latency tolerance of the time since
-                    // what caused it) too.
-                    let mask = !t.unknown;
-                    let matches = |s: u8| (t.byte & mask) == (s & mask);
-                    let w = bench.latency_window(t.start_ps);
-                    let near = || {
-                        status_log.since(t.start_ps.saturating_sub(w)).any(matches)
-                            || matches(bench.status_after(t.end_ps.saturating_add(w)))
-                    };
-                    if failed.is_none() && !matches(status.0) && !matches(status_then.0) && !near()
-                    {
-                        failed = Some(Divergence {
-                            at_ps: t.end_ps,
-                            what: "status read".into(),
-                            board: format!("0x{:02X}", t.byte),
-                            model: format!("0x{:02X}", status.0),
-                            after: bench.last_access.map(|a| a.to_string()),
-                        });
-                    }
-                }
-                Access::ReadData => {
-                    let byte = bench.board.read_data();
-                    let mask = !t.unknown;
-                    if failed.is_none() && status.obf() && (t.byte & mask) != (byte & mask) {
-                        failed = Some(Divergence {
-                            at_ps: t.end_ps,
-                            what: "data read".into(),
-                            board: format!("0x{:02X}", t.byte),
-                            model: format!("0x{byte:02X}"),
-                            after: bench.last_access.map(|a| a.to_string()),
-                        });
-                    }
-                }
-            }
-            if judging_host {
-                rules.after(&t, &bench.board, &mut host);
-            }
-            // What times an output: a write, or the data read that
-            // releases INT* (3-4-1); never the host's status polling.
-            if t.access != Access::ReadStatus {
-                outputs.access(t.end_ps);
-                bench.last_cause_ps = bench.last_cause_ps.max(t.end_ps);
-            }
+            branches.extend(forks);
             if let Some(tr) = &mut tracer {
-                tr.access(&t, bench.model_time(t.end_ps));
+                tr.access(&t, branches[0].bench.model_time(t.end_ps));
             }
-            bench.last_access = Some(t);
+            prune(&mut branches);
         }
         prev = Some(c);
+        if opts.stop_at_divergence && branches.iter().all(|b| b.failed.is_some()) {
+            break;
+        }
     }
+    let stopped = opts.stop_at_divergence && branches.iter().all(|b| b.failed.is_some());
+    let cut = source.src.cut_short();
     let end = source.src.end_ps();
-    bench.run_to(end);
-    if failed.is_none() {
-        rules.finish(end, &bench.board, &mut host);
+    for b in &mut branches {
+        b.finish(end);
     }
-    if failed.is_none() {
-        // Past the capture's end nothing more can be seen: what the model
-        // put out before it, the board must have too.
-        if let Err(d) = bench.compare_pulses(end) {
-            failed = Some(d);
-        }
-    }
-    if failed.is_none() {
-        let after = bench.last_access.map(|a| a.to_string());
-        if let Err(d) = outputs.compare(&bench.frame(), end, after) {
-            failed = Some(d);
-        }
-    }
+    // The order the board's behaviour bears out: a branch that never
+    // diverged (the one with the fewest host findings), else the one that
+    // followed the board longest.
+    let chosen = branches
+        .iter()
+        .enumerate()
+        .min_by_key(|(i, b)| match &b.failed {
+            None => (0, b.host.len() as u64, *i),
+            Some(d) => (1, u64::MAX - d.at_ps, *i),
+        })
+        .map_or(0, |(i, _)| i);
+    let Branch {
+        bench,
+        outputs,
+        host,
+        failed,
+        ..
+    } = branches.swap_remove(chosen);
     let summary = decoder.summary();
     let held = (!started).then(|| {
         "the `reset` channel never falls: the chip is held in reset for the whole capture"
@@ -730,7 +943,51 @@ pub fn judge_traced(
         "no register access on the bus: nothing to judge (are the probes on CS*, RD*, WR*? did the recording start after the host's accesses?)"
             .to_string()
     });
-    let problem = summary.rate_problem(&info).or(held).or(quiet);
+    // Where the recording ends before the board is done, or lacks what
+    // the model's moves need: the capture's problem, or with `partial`
+    // what was not judged.
+    let mut short = Vec::new();
+    if !stopped {
+        short.extend(cut);
+        if let Some(c) = prev.filter(|c| !c.high(bus.rd) || !c.high(bus.wr)) {
+            short.push(format!(
+                "the recording ends during a register access ({} low at its last change, {})",
+                if c.high(bus.rd) { "WR*" } else { "RD*" },
+                Instant::from_nanos(c.time_ps / 1000)
+            ));
+        }
+        if started && bench.board.read_status().busy() {
+            short.push(unfinished(&bench.board));
+        }
+        let made = bench
+            .board
+            .record()
+            .runs
+            .iter()
+            .map(|r| u64::from(r.count))
+            .sum::<u64>();
+        if pout.is_none() && made > 0 {
+            short.push(format!(
+                "the model put out {made} POUT pulses and the capture has no channel for POUT: none of them judged (map it: --map POUT=CHANNEL)"
+            ));
+        }
+    }
+    let partial_problem = match (short.is_empty(), opts.partial) {
+        (true, _) => None,
+        (false, true) => {
+            not_judged.extend(short);
+            None
+        }
+        (false, false) => Some(format!(
+            "{} (judge what it holds with --partial)",
+            short.join("; ")
+        )),
+    };
+    let problem = summary
+        .rate_problem(&info)
+        .or(held)
+        .or(quiet)
+        .or(partial_problem);
     let verdict = match (failed, problem) {
         (_, Some(why)) => Verdict::Capture(why),
         (Some(d), None) => Verdict::Failed(d),
@@ -747,6 +1004,7 @@ pub fn judge_traced(
             pulses: bench.compared,
             changes: outputs.compared(),
             not_judged,
+            hints: Vec::new(),
         },
         trace,
     ))

@@ -28,6 +28,7 @@ pub(super) struct Frame<'a> {
 }
 
 /// The outputs compared, as a judge holds them.
+#[derive(Clone)]
 pub(super) struct Outputs {
     watches: Vec<Watch>,
     /// Recent register accesses, in capture time (the newest last).
@@ -36,6 +37,7 @@ pub(super) struct Outputs {
 }
 
 /// One output pin and its two sides.
+#[derive(Clone)]
 struct Watch {
     signal: Signal,
     channel: usize,

@@ -4,8 +4,16 @@
 //! (`CS*`, `nRD`, `D3`, `POUT`, ...). A signal with no channel narrows
 //! what can be judged; [`ChannelMap::missing`] says which, and
 //! [`ChannelMap::bus`] whether the bus can be decoded at all.
+//!
+//! A map names each signal once and each channel once: a signal given
+//! twice, or one channel given for two signals, is refused (which one is
+//! it?). A channel may be inverted (`POUT=~12`): a board whose output
+//! stage inverts a pin, or an analyzer probe on the complement. An
+//! analyzer's own channel names (sigrok's `D0`..`D15`, a Saleae's `0`..)
+//! are never taken for the chip's data lines: when the capture has a
+//! channel named `D8` or above, its `D<n>` names are the analyzer's.
 
-use super::source::LogicInfo;
+use super::source::{Change, LogicError, LogicInfo, LogicSource};
 use crate::protocol::Input;
 use std::fmt;
 
@@ -178,9 +186,83 @@ pub struct BusChannels {
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ChannelMap {
     pairs: Vec<(Signal, usize)>,
+    /// Bit `c`: channel `c` is read inverted (`SIGNAL=~CHANNEL`).
+    inverted: u64,
 }
 
 impl ChannelMap {
+    /// The channels read inverted, one bit each (bit `c`: channel `c`).
+    pub fn inverted(&self) -> u64 {
+        self.inverted
+    }
+
+    /// Whether `signal`'s channel is read inverted.
+    pub fn is_inverted(&self, signal: Signal) -> bool {
+        self.get(signal)
+            .is_some_and(|c| c < super::source::MAX_CHANNELS && self.inverted >> c & 1 == 1)
+    }
+
+    /// This map with `signal`'s channel read inverted (or no longer), for
+    /// a judge that tries the map a capture seems to need.
+    pub fn with_inverted(&self, signal: Signal, on: bool) -> ChannelMap {
+        let mut m = self.clone();
+        if let Some(c) = self
+            .get(signal)
+            .filter(|&c| c < super::source::MAX_CHANNELS)
+        {
+            match on {
+                true => m.inverted |= 1 << c,
+                false => m.inverted &= !(1 << c),
+            }
+        }
+        m
+    }
+
+    /// This map with the channels of `a` and `b` exchanged.
+    pub fn swapped(&self, a: Signal, b: Signal) -> ChannelMap {
+        let mut m = self.clone();
+        let (ca, cb) = (self.get(a), self.get(b));
+        m.pairs.retain(|(s, _)| *s != a && *s != b);
+        if let Some(c) = cb {
+            m.pairs.push((a, c));
+        }
+        if let Some(c) = ca {
+            m.pairs.push((b, c));
+        }
+        m
+    }
+
+    /// The map in `--map` form: `CS=cs,RD=rd,...,POUT=~pout`, each
+    /// channel by its name in the capture.
+    pub fn spelled(&self, info: &LogicInfo) -> String {
+        self.spelled_against(&ChannelMap::default(), info)
+    }
+
+    /// What `--map` must say for this map over `base` (the map the
+    /// channel names give): the pairs that differ from it.
+    pub fn spelled_against(&self, base: &ChannelMap, info: &LogicInfo) -> String {
+        let mut pairs: Vec<(Signal, usize)> = self
+            .pairs
+            .iter()
+            .copied()
+            .filter(|&(s, c)| base.get(s) != Some(c) || base.is_inverted(s) != self.is_inverted(s))
+            .collect();
+        pairs.sort();
+        pairs
+            .iter()
+            .map(|&(s, c)| {
+                let name = info
+                    .channels
+                    .get(c)
+                    .cloned()
+                    .unwrap_or_else(|| c.to_string());
+                let inv = if self.is_inverted(s) { "~" } else { "" };
+                format!("{s}={inv}{name}")
+            })
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+
     /// The channel of `signal`.
     pub fn get(&self, signal: Signal) -> Option<usize> {
         self.pairs
@@ -205,8 +287,9 @@ impl ChannelMap {
     }
 
     /// The bus's channels, or why the bus cannot be decoded: the bus
-    /// signals no channel carries, named.
-    pub fn require_bus(&self) -> Result<BusChannels, String> {
+    /// signals no channel carries, named (and, where the capture's
+    /// channels carry an analyzer's own names, that they do).
+    pub fn require_bus(&self, info: &LogicInfo) -> Result<BusChannels, String> {
         self.bus().ok_or_else(|| {
             let missing: Vec<String> = self
                 .missing()
@@ -219,10 +302,18 @@ impl ChannelMap {
                 })
                 .map(Signal::name)
                 .collect();
-            format!(
+            let why = format!(
                 "the bus cannot be decoded: no channel for {} (give --map SIGNAL=CHANNEL)",
                 missing.join(", ")
-            )
+            );
+            match analyzer_names(info) && missing.iter().any(|m| m.starts_with('D')) {
+                true => format!(
+                    "{why}; the capture's channels are named as the analyzer names them ({}..{}), not as the chip's signals: its `D0`..`D7` are not taken for the data lines without a map (e.g. --map D0-7=D4-D11)",
+                    info.channels.first().map_or("", String::as_str),
+                    info.channels.last().map_or("", String::as_str)
+                ),
+                false => why,
+            }
         })
     }
 
@@ -236,11 +327,17 @@ impl ChannelMap {
 
     /// The map the capture's channel names give: every channel whose name
     /// is one of the chip's signals. Two channels naming one signal are an
-    /// error (which one is it?).
+    /// error (which one is it?). Where the names are an analyzer's own
+    /// (a channel named `D8` or above: sigrok's `D0`..`D15`), no `D<n>`
+    /// is taken for a data line.
     pub fn from_names(info: &LogicInfo) -> Result<ChannelMap, String> {
         let mut map = ChannelMap::default();
+        let analyzer = analyzer_names(info);
         for (c, name) in info.channels.iter().enumerate() {
             if let Some(s) = Signal::parse(name) {
+                if analyzer && matches!(s, Signal::D(_)) {
+                    continue;
+                }
                 map.insert(s, c, info)?;
             }
         }
@@ -253,10 +350,17 @@ impl ChannelMap {
     /// maps a range at once.
     pub fn parse(text: &str, info: &LogicInfo) -> Result<ChannelMap, String> {
         let mut map = ChannelMap::from_names(info).unwrap_or_default();
+        // What the text itself gave, and where: a signal or a channel given
+        // twice there is refused.
+        let mut given: Vec<(Signal, usize, String)> = Vec::new();
+        let one_line = text.trim_end().lines().count() <= 1;
         for (n, line) in text.lines().enumerate() {
             let line = line.split('#').next().unwrap_or_default();
             for pair in line.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-                let at = |what: String| format!("map line {}: `{pair}`: {what}", n + 1);
+                let at = |what: String| match one_line {
+                    true => format!("`{pair}`: {what}"),
+                    false => format!("map line {}: `{pair}`: {what}", n + 1),
+                };
                 let (sig, chan) = pair
                     .split_once('=')
                     .ok_or_else(|| at("write SIGNAL=CHANNEL, e.g. CS=0 or RD=nRD".into()))?;
@@ -268,8 +372,8 @@ impl ChannelMap {
                         .parse()
                         .map_err(|_| at("D0-N with N a digit".into()))?;
                     let (c0, c1) = (
-                        channel(c0, info).map_err(&at)?,
-                        channel(c1, info).map_err(&at)?,
+                        channel(c0, info).map_err(&at)?.0,
+                        channel(c1, info).map_err(&at)?.0,
                     );
                     if usize::from(last) + c0 != c1 || last > 7 {
                         return Err(at(format!(
@@ -278,7 +382,10 @@ impl ChannelMap {
                         )));
                     }
                     for i in 0..=last {
-                        map.replace(Signal::D(i), c0 + usize::from(i));
+                        let c = c0 + usize::from(i);
+                        once(&given, Signal::D(i), c, info).map_err(&at)?;
+                        given.push((Signal::D(i), c, pair.to_string()));
+                        map.replace(Signal::D(i), c, false);
                     }
                     continue;
                 }
@@ -287,7 +394,10 @@ impl ChannelMap {
                         "no signal `{sig}`: use CS, RD, WR, A0, D0..D7, POUT, DIR, INT, BUSY, HOLD, AUX, AUXO0..AUXO3, L1..L4, ALM, CNP or AUXI0..AUXI3"
                     ))
                 })?;
-                map.replace(s, channel(chan, info).map_err(&at)?);
+                let (c, inverted) = channel(chan, info).map_err(&at)?;
+                once(&given, s, c, info).map_err(&at)?;
+                given.push((s, c, pair.to_string()));
+                map.replace(s, c, inverted);
             }
         }
         Ok(map)
@@ -304,19 +414,112 @@ impl ChannelMap {
         Ok(())
     }
 
-    fn replace(&mut self, s: Signal, c: usize) {
-        self.pairs.retain(|(t, _)| *t != s);
+    /// `s` on channel `c`: what the names gave for `s`, or for `c`, gives
+    /// way (a map overrides the names).
+    fn replace(&mut self, s: Signal, c: usize, inverted: bool) {
+        self.pairs.retain(|&(t, d)| t != s && d != c);
         self.pairs.push((s, c));
+        if c < super::source::MAX_CHANNELS {
+            match inverted {
+                true => self.inverted |= 1 << c,
+                false => self.inverted &= !(1 << c),
+            }
+        }
     }
 }
 
-/// A channel given by name or number.
-fn channel(text: &str, info: &LogicInfo) -> Result<usize, String> {
+/// A capture read through a map's inverted channels
+/// ([`ChannelMap::inverted`]): their known levels flipped, so that every
+/// reader of the changes sees the chip's levels.
+pub struct Inverted<'a> {
+    src: &'a mut dyn LogicSource,
+    mask: u64,
+}
+
+impl std::fmt::Debug for Inverted<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Inverted")
+            .field("info", self.src.info())
+            .field("mask", &format_args!("{:#x}", self.mask))
+            .finish()
+    }
+}
+
+impl<'a> Inverted<'a> {
+    pub fn new(src: &'a mut dyn LogicSource, map: &ChannelMap) -> Self {
+        Inverted {
+            src,
+            mask: map.inverted(),
+        }
+    }
+}
+
+impl LogicSource for Inverted<'_> {
+    fn info(&self) -> &LogicInfo {
+        self.src.info()
+    }
+
+    fn next_change(&mut self) -> Result<Option<Change>, LogicError> {
+        Ok(self.src.next_change()?.map(|c| Change {
+            levels: c.levels ^ (self.mask & !c.unknown),
+            ..c
+        }))
+    }
+
+    fn end_ps(&self) -> u64 {
+        self.src.end_ps()
+    }
+
+    fn cut_short(&self) -> Option<String> {
+        self.src.cut_short()
+    }
+}
+
+/// Whether the capture's channel names are an analyzer's own rather than
+/// the chip's: a channel named `D8` or above (sigrok's `D0`..`D15`).
+pub fn analyzer_names(info: &LogicInfo) -> bool {
+    info.channels.iter().any(|n| {
+        n.strip_prefix('D')
+            .and_then(|d| d.parse::<u32>().ok())
+            .is_some_and(|i| i >= 8)
+    })
+}
+
+/// Refuses `s` on `c` when the map's text already gave `s` a channel, or
+/// `c` a signal.
+fn once(
+    given: &[(Signal, usize, String)],
+    s: Signal,
+    c: usize,
+    info: &LogicInfo,
+) -> Result<(), String> {
+    if let Some((_, _, pair)) = given.iter().find(|g| g.0 == s) {
+        return Err(format!(
+            "{s} is given twice (`{pair}` before): one channel a signal"
+        ));
+    }
+    if let Some((t, _, pair)) = given.iter().find(|g| g.1 == c) {
+        let name = info
+            .channels
+            .get(c)
+            .map_or_else(|| c.to_string(), |n| format!("`{n}`"));
+        return Err(format!(
+            "channel {name} is given for {t} already (`{pair}`): one signal a channel"
+        ));
+    }
+    Ok(())
+}
+
+/// A channel given by name or number, `~` before it to read it inverted.
+fn channel(text: &str, info: &LogicInfo) -> Result<(usize, bool), String> {
     if let Some(c) = info.channel(text) {
-        return Ok(c);
+        return Ok((c, false));
+    }
+    if let Some(rest) = text.strip_prefix('~') {
+        return channel(rest.trim(), info).map(|(c, inv)| (c, !inv));
     }
     match text.parse::<usize>() {
-        Ok(c) if c < info.channels.len() => Ok(c),
+        Ok(c) if c < info.channels.len() => Ok((c, false)),
         Ok(c) => Err(format!(
             "channel {c}: the capture has {} (0 to {})",
             info.channels.len(),
@@ -391,7 +594,7 @@ mod tests {
     fn a_bad_map_says_where_and_what() {
         let i = info(&["a", "b"]);
         for (text, says) in [
-            ("CS", "map line 1: `CS`: write SIGNAL=CHANNEL"),
+            ("CS", "`CS`: write SIGNAL=CHANNEL"),
             ("XX=0", "no signal `XX`"),
             ("CS=5", "channel 5: the capture has 2"),
             ("CS=zz", "no channel `zz` in the capture (it has a, b)"),
@@ -402,5 +605,81 @@ mod tests {
         }
         let twice = ChannelMap::from_names(&info(&["CS", "nCS"])).expect_err("two CS");
         assert!(twice.contains("both name CS"), "{twice}");
+    }
+
+    #[test]
+    fn a_signal_or_a_channel_given_twice_is_refused() {
+        let i = info(&["cs", "rd", "wr"]);
+        for (text, says) in [
+            ("CS=cs,CS=rd", "`CS=rd`: CS is given twice (`CS=cs` before)"),
+            (
+                "CS=cs,RD=cs",
+                "`RD=cs`: channel `cs` is given for CS already (`CS=cs`)",
+            ),
+            ("D0-7=0-7,D3=8", "is given twice"),
+            (
+                "CS=0\nWR=~cs",
+                "map line 2: `WR=~cs`: channel `cs` is given for CS",
+            ),
+        ] {
+            let text = text.replace("\\n", "\n");
+            let i = if text.starts_with("D0") {
+                info(&["a"; 9])
+            } else {
+                i.clone()
+            };
+            let e = ChannelMap::parse(&text, &i).expect_err(&text);
+            assert!(e.contains(says), "{text}: {e}");
+        }
+        // Exchanging two named channels is a map, not a double.
+        let m = ChannelMap::parse("CS=RD,RD=CS", &info(&["CS", "RD"])).expect("swap");
+        assert_eq!((m.get(Signal::Cs), m.get(Signal::Rd)), (Some(1), Some(0)));
+    }
+
+    #[test]
+    fn a_tilde_reads_a_channel_inverted() {
+        let i = info(&["pout", "dir", "x"]);
+        let m = ChannelMap::parse("POUT=~pout, DIR=~1", &i).expect("map");
+        assert_eq!(m.inverted(), 0b11);
+        assert!(m.is_inverted(Signal::Pout) && m.is_inverted(Signal::Dir));
+        assert_eq!(
+            m.spelled_against(&ChannelMap::from_names(&i).expect("names"), &i),
+            "POUT=~pout,DIR=~dir"
+        );
+        let mut src = super::super::source::testing::Changes::new(
+            i.clone(),
+            vec![(0, 0b101), (10, 0b100)],
+            20,
+        );
+        let mut inv = Inverted::new(&mut src, &m);
+        let a = inv.next_change().expect("reads").expect("a change");
+        assert_eq!(a.levels, 0b110, "POUT and DIR flipped, x kept");
+        assert!(ChannelMap::parse("POUT=~nope", &i).is_err());
+    }
+
+    #[test]
+    fn an_analyzers_own_names_are_never_the_data_lines() {
+        let names: Vec<String> = (0..16).map(|i| format!("D{i}")).collect();
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        let i = info(&names);
+        let m = ChannelMap::from_names(&i).expect("names");
+        assert_eq!(m.get(Signal::D(0)), None);
+        let e = m.require_bus(&i).expect_err("no bus");
+        assert!(
+            e.contains("named as the analyzer names them (D0..D15)"),
+            "{e}"
+        );
+        // With eight data lines named D0..D7, they are the chip's.
+        let chip = info(&[
+            "cs", "rd", "wr", "a0", "D0", "D1", "D2", "D3", "D4", "D5", "D6", "D7",
+        ]);
+        assert_eq!(
+            ChannelMap::from_names(&chip)
+                .expect("names")
+                .get(Signal::D(7)),
+            Some(11)
+        );
+        let m = ChannelMap::parse("CS=D0,RD=D1,WR=D2,A0=D3,D0-7=D4-D11", &i).expect("map");
+        assert!(m.require_bus(&i).is_ok());
     }
 }

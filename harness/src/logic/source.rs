@@ -91,6 +91,13 @@ pub trait LogicSource {
     /// given `None` (a sampled capture's last sample, a VCD's last
     /// timestamp): a level holds until then.
     fn end_ps(&self) -> u64;
+
+    /// Once `next_change` has given `None`: where the file shows that the
+    /// recording was cut short (a VCD ending in the middle of a line), in
+    /// words; `None` when it ended as its writer ends it.
+    fn cut_short(&self) -> Option<String> {
+        None
+    }
 }
 
 /// A capture that cannot be read: which file, where in it, and what.
@@ -149,6 +156,37 @@ pub(super) mod testing {
         }
         assert_eq!(r.next_change(), Ok(None), "the end stays the end");
         Ok((r.info().clone(), out, r.end_ps()))
+    }
+
+    /// A source of the given changes (time, levels), all known.
+    pub(crate) struct Changes {
+        info: LogicInfo,
+        changes: std::collections::VecDeque<Change>,
+        end: u64,
+    }
+
+    impl Changes {
+        pub(crate) fn new(info: LogicInfo, changes: Vec<(u64, u64)>, end: u64) -> Self {
+            Changes {
+                info,
+                changes: changes.into_iter().map(|(t, l)| ch(t, l, 0)).collect(),
+                end,
+            }
+        }
+    }
+
+    impl LogicSource for Changes {
+        fn info(&self) -> &LogicInfo {
+            &self.info
+        }
+
+        fn next_change(&mut self) -> Result<Option<Change>, LogicError> {
+            Ok(self.changes.pop_front())
+        }
+
+        fn end_ps(&self) -> u64 {
+            self.end
+        }
     }
 
     pub(crate) fn ch(time_ps: u64, levels: u64, unknown: u64) -> Change {

@@ -52,7 +52,7 @@ use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 
-pub use super::vcd_header::MAX_TOKEN;
+pub use super::vcd_header::{MAX_IGNORED, MAX_SCOPE_DEPTH, MAX_TOKEN};
 
 /// A streaming VCD reader.
 pub struct VcdReader<R> {
@@ -104,6 +104,7 @@ impl<R: BufRead> VcdReader<R> {
             tok_line: 1,
             long: false,
             skipped: 0,
+            cut: false,
         };
         let map = read_header(&mut tokens)?;
         Ok(VcdReader {
@@ -325,11 +326,35 @@ impl<R: BufRead> LogicSource for VcdReader<R> {
         if self.done {
             return Ok(None);
         }
-        self.advance()
+        match self.advance() {
+            // The last token of a file that ends in the middle of a line
+            // may be a part of one (`1` cut from `1!`, a code cut short,
+            // `#2` cut from `#2151`): a value without its code, or for a
+            // code not declared, or a time before the last, there is where
+            // the recording ends, as `cut_short` says.
+            Err(e)
+                if self.tokens.cut
+                    && (e.what.starts_with("a value")
+                        || e.what.starts_with("time goes backwards")) =>
+            {
+                self.done = true;
+                Ok(self.flush())
+            }
+            r => r,
+        }
     }
 
     fn end_ps(&self) -> u64 {
         self.now.unwrap_or(0)
+    }
+
+    fn cut_short(&self) -> Option<String> {
+        (self.done && self.tokens.cut).then(|| {
+            format!(
+                "the file ends in the middle of line {}, with no end of line: the recording was cut short",
+                self.tokens.line
+            )
+        })
     }
 }
 
@@ -587,6 +612,54 @@ mod tests {
     }
 
     #[test]
+    fn a_file_cut_in_the_middle_of_a_line_says_so() {
+        // Whole: ends with its line.
+        let text = format!("{HEAD}#0 0! 0\"\n#10 1!\n#20 1\"\n");
+        let mut r = VcdReader::new(text.as_bytes(), Path::new("t.vcd")).expect("header");
+        drain(&mut r).expect("reads");
+        assert_eq!(r.cut_short(), None);
+        // Cut inside the last value: `1` of `1"`, which cannot be read.
+        let cut = &text[..text.len() - 2];
+        let mut r = VcdReader::new(cut.as_bytes(), Path::new("t.vcd")).expect("header");
+        let (_, changes, end) = drain(&mut r).expect("reads what is whole");
+        assert_eq!(changes, [ch(0, 0, 0), ch(10_000, 0b01, 0)]);
+        assert_eq!(end, 20_000);
+        let why = r.cut_short().expect("cut short");
+        assert!(why.contains("ends in the middle of line 8"), "{why}");
+        // Cut inside a timestamp: read, and still said to be cut.
+        let cut = format!("{HEAD}#0 0! 0\"\n#10 1!\n#2");
+        let mut r = VcdReader::new(cut.as_bytes(), Path::new("t.vcd")).expect("header");
+        drain(&mut r).expect("reads");
+        assert!(r.cut_short().is_some());
+    }
+
+    #[test]
+    fn scopes_nested_past_the_limit_are_refused_in_bounded_memory() {
+        let deep = "$scope module m $end\n".repeat(MAX_SCOPE_DEPTH + 1);
+        let text = format!("$timescale 1 ns $end\n{deep}$var wire 1 ! a $end\n");
+        let e = VcdReader::new(text.as_bytes(), Path::new("t.vcd")).expect_err("too deep");
+        assert!(
+            e.to_string().contains(&format!(
+                "line {}: $scope nested deeper than {MAX_SCOPE_DEPTH}",
+                MAX_SCOPE_DEPTH + 2
+            )),
+            "{e}"
+        );
+        let ok = "$scope module m $end\n".repeat(MAX_SCOPE_DEPTH);
+        let text = format!(
+            "$timescale 1 ns $end\n{ok}$var wire 1 ! a $end\n$enddefinitions $end\n#0 1!\n"
+        );
+        assert!(VcdReader::new(text.as_bytes(), Path::new("t.vcd")).is_ok());
+        let reals = "$var real 64 r x $end\n".repeat(MAX_IGNORED + 1);
+        let text = format!("$var wire 1 ! a $end\n{reals}");
+        let e = VcdReader::new(text.as_bytes(), Path::new("t.vcd")).expect_err("too many");
+        assert!(
+            e.to_string().contains("real, string or event variables"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn bad_files_are_errors_naming_the_line() {
         let cases: [(&str, &str); 16] = [
             ("", "t.vcd: empty file"),
@@ -616,10 +689,10 @@ mod tests {
                 "declares no logic signal",
             ),
             (
-                &format!("{HEAD}#10 1!\n#5 0!"),
+                &format!("{HEAD}#10 1!\n#5 0!\n"),
                 "line 7: time goes backwards: #5 after #10",
             ),
-            (&format!("{HEAD}#0 1?"), "line 6: a value for `?`"),
+            (&format!("{HEAD}#0 1?\n"), "line 6: a value for `?`"),
             (
                 &format!("{HEAD}#0 b102 !"),
                 "line 6: bad value `102` for `!`",
@@ -639,7 +712,7 @@ mod tests {
         }
         for (text, want) in [
             (
-                format!("{HEAD}#0 b1"),
+                format!("{HEAD}#0 b1\n"),
                 "line 6: a value `b1` without a code",
             ),
             (format!("{HEAD}#0 garbage"), "line 6: unexpected `garbage`"),

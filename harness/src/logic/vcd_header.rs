@@ -18,6 +18,18 @@ const MAX_SKIPPED: u64 = 1 << 20;
 /// matters: a name, a value, a time).
 pub const MAX_TOKEN: usize = 4096;
 
+/// The deepest nesting of `$scope`s read: deeper is refused, so that the
+/// scopes kept stay bounded whatever the file (a million nested scopes is
+/// no capture).
+pub const MAX_SCOPE_DEPTH: usize = 256;
+
+/// A scope's name is kept to this many bytes (it names channels only).
+const MAX_SCOPE_NAME: usize = 256;
+
+/// The most variables whose values are ignored (real, string, event): more
+/// is refused, so that their codes kept stay bounded.
+pub const MAX_IGNORED: usize = 16_384;
+
 /// Identifier codes of up to this many characters are looked up in a
 /// table; longer ones in a hash map.
 const DENSE_ID_CHARS: usize = 2;
@@ -36,6 +48,10 @@ pub(super) struct Tokens<R> {
     pub(super) long: bool,
     /// The bytes of `tok` read past [`MAX_TOKEN`] and dropped.
     pub(super) skipped: u64,
+    /// The input ended inside a token, with no whitespace after it: a
+    /// file cut short in the middle of a line (every writer ends its last
+    /// line).
+    pub(super) cut: bool,
 }
 
 impl<R: BufRead> Tokens<R> {
@@ -51,6 +67,7 @@ impl<R: BufRead> Tokens<R> {
                 Err(e) => return Err(e),
             };
             if buf.is_empty() {
+                self.cut |= !self.tok.is_empty();
                 return Ok(!self.tok.is_empty());
             }
             let mut i = 0;
@@ -318,10 +335,15 @@ impl<R: BufRead> Tokens<R> {
                 }
                 b"$scope" => {
                     let words = self.body("$scope", 3)?;
-                    let name = words
-                        .get(1)
-                        .or(words.first())
-                        .map(|w| String::from_utf8_lossy(w).into_owned());
+                    if scopes.len() == MAX_SCOPE_DEPTH {
+                        return Err(self.err(
+                            line,
+                            format!("$scope nested deeper than {MAX_SCOPE_DEPTH} levels: not a capture this reader takes"),
+                        ));
+                    }
+                    let name = words.get(1).or(words.first()).map(|w| {
+                        String::from_utf8_lossy(&w[..w.len().min(MAX_SCOPE_NAME)]).into_owned()
+                    });
                     scopes.push(name.unwrap_or_default());
                 }
                 b"$upscope" => {
@@ -377,6 +399,12 @@ impl<R: BufRead> Tokens<R> {
             kind.as_slice(),
             b"real" | b"realtime" | b"string" | b"event" | b"shortreal"
         ) {
+            if h.ignored.len() == MAX_IGNORED {
+                return Err(self.err(
+                    line,
+                    format!("more than {MAX_IGNORED} real, string or event variables: not a capture this reader takes"),
+                ));
+            }
             h.ignored.push(id);
             return Ok(());
         }
