@@ -723,7 +723,11 @@ end
         }
         assert_eq!(stamps.first(), Some(&0), "the initial values at #0");
         assert_eq!(changes_since_timestamp, 0, "a last, empty timestamp");
-        assert_eq!(now, 600_000, "the trace's end: its last event");
+        assert_eq!(
+            now,
+            600_000 + TAIL,
+            "the trace's end: its last event, and the tail"
+        );
         let text = String::from_utf8(buf.clone()).expect("utf-8");
         assert!(
             text.contains(POUT_WIDTH_NOTE),

@@ -236,18 +236,27 @@ impl Bench {
         probe.read_status().0
     }
 
-    /// Where IBF, OBF or BUSY first change after capture time `ps`
-    /// within its uncertainty ([`Bench::latency_window`]): the capture
-    /// time just after the change, if any. The model itself stays.
-    fn flag_change_within(&self, ps: u64) -> Option<u64> {
+    /// Where an access of kind `access` at capture time `ps`, which the
+    /// model's flags forbid there (a write while IBF or BUSY is 1, a data
+    /// read while OBF is 0), would be allowed within the capture's
+    /// uncertainty after it ([`Bench::latency_window`]): the capture time
+    /// just after the flag's change, if any. The model itself stays.
+    fn allowed_within(&self, ps: u64, access: Access) -> Option<u64> {
+        let forbids = |s: Status| match access {
+            Access::WriteCommand | Access::WriteData => s.ibf() || s.busy(),
+            Access::ReadData => !s.obf(),
+            Access::ReadStatus => false,
+        };
         let mut probe = self.board.clone();
-        let before = probe.read_status().0 & ORDERED_FLAGS;
+        if !forbids(probe.read_status()) {
+            return None;
+        }
         let limit = self.model_time(ps.saturating_add(self.latency_window(ps)));
         loop {
             let now = probe.now();
             let next = probe.poll_at().filter(|&t| t <= limit)?;
             probe.advance_to(next.max(now + Duration::from_nanos(1)));
-            if probe.read_status().0 & ORDERED_FLAGS != before {
+            if !forbids(probe.read_status()) {
                 return Some(self.capture_ps(probe.now()));
             }
         }
@@ -505,10 +514,6 @@ impl<'a> Lookahead<'a> {
 /// orders found last (the accesses as captured) are dropped first.
 const MAX_BRANCHES: usize = 8;
 
-/// The flags whose change a host access may not be ordered against, as
-/// far as the capture can tell: IBF, OBF and BUSY.
-const ORDERED_FLAGS: u8 = Status::IBF | Status::OBF | Status::BUSY;
-
 /// The model beside the capture under one order of the host's accesses
 /// against the chip's flags (issue 40). Where an access lies within the
 /// capture's uncertainty (two samples, the floor and the latency
@@ -557,8 +562,9 @@ impl Branch {
     }
 
     /// A register access: the branch that takes it as captured, and,
-    /// where the capture cannot order it against a change of IBF, OBF or
-    /// BUSY that follows within its uncertainty, the other order too:
+    /// where the model's flags forbid it there (IBF or BUSY 1 for a
+    /// write, OBF 0 for a data read) but allow it within the capture's
+    /// uncertainty after, the other order too:
     /// this branch takes the access just after the change (the host's
     /// findings then as the chip saw it), and the one returned as
     /// captured, with no host finding for it.
@@ -566,7 +572,7 @@ impl Branch {
         self.bench.run_to(t.end_ps);
         let mut fork = None;
         if follow_orders && self.failed.is_none() && t.access != Access::ReadStatus {
-            if let Some(after) = self.bench.flag_change_within(t.end_ps) {
+            if let Some(after) = self.bench.allowed_within(t.end_ps, t.access) {
                 let mut captured = self.clone();
                 captured.apply(t, true);
                 fork = Some(captured);
