@@ -9,30 +9,11 @@ use ppmc::emu::ModelConfig;
 use ppmc::fault_matrix::capture::analyzer_trace;
 use ppmc::judge::{judge, JudgeOptions, Verdict};
 use ppmc::logic::map::ChannelMap;
-use ppmc::logic::source::{Change, LogicError, LogicInfo, LogicSource};
+use ppmc::logic::source::{Change, LogicInfo, LogicSource, Recorded};
 use ppmc::logic::vcd::VcdReader;
 use ppmc::protocol::Straps;
 use ppmc::vcd_export::{export_with, Export};
 use std::path::Path;
-
-/// A capture as a list of changes.
-struct Changes {
-    info: LogicInfo,
-    changes: std::vec::IntoIter<Change>,
-    end_ps: u64,
-}
-
-impl LogicSource for Changes {
-    fn info(&self) -> &LogicInfo {
-        &self.info
-    }
-    fn next_change(&mut self) -> Result<Option<Change>, LogicError> {
-        Ok(self.changes.next())
-    }
-    fn end_ps(&self) -> u64 {
-        self.end_ps
-    }
-}
 
 /// A capture's edges, one channel at a time: (time, channel, level).
 struct Edges {
@@ -81,7 +62,7 @@ impl Edges {
     }
 
     /// The capture put together again, its edges in time order.
-    fn capture(mut self) -> Changes {
+    fn capture(mut self) -> Recorded {
         self.edges.sort_by_key(|e| e.0);
         let mut changes: Vec<Change> = Vec::new();
         let mut levels = 0u64;
@@ -97,15 +78,11 @@ impl Edges {
             }
         }
         let end_ps = self.end_ps.max(changes.last().map_or(0, |c| c.time_ps));
-        Changes {
-            info: self.info,
-            changes: changes.into_iter(),
-            end_ps,
-        }
+        Recorded::new(self.info, changes, end_ps)
     }
 }
 
-fn judged(mut cap: Changes) -> ppmc::judge::Judgement {
+fn judged(mut cap: Recorded) -> ppmc::judge::Judgement {
     let map = ChannelMap::from_names(cap.info()).expect("our names");
     judge(&mut cap, &map, &JudgeOptions::default()).expect("judged")
 }
@@ -113,7 +90,7 @@ fn judged(mut cap: Changes) -> ppmc::judge::Judgement {
 /// POUT's edges after the move's first pulse stretched by `ppm` parts
 /// per million, and the outputs after them (BUSY, INT*, HOLD, which the
 /// chip times from its final POUT) moved as the last pulse moved.
-fn clock_off(scenario: &str, ppm: u64) -> Changes {
+fn clock_off(scenario: &str, ppm: u64) -> Recorded {
     let mut e = Edges::of(scenario);
     let pout = e.channel("pout");
     let first = e

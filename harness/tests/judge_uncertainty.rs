@@ -11,36 +11,17 @@ use ppmc::emu::ModelConfig;
 use ppmc::fault_matrix::capture::analyzer_trace_with;
 use ppmc::judge::{judge, JudgeOptions, Verdict};
 use ppmc::logic::map::ChannelMap;
-use ppmc::logic::source::{Change, LogicError, LogicInfo, LogicSource};
+use ppmc::logic::source::{Change, LogicInfo, LogicSource, Recorded};
 use ppmc::logic::vcd::VcdReader;
 use ppmc::vcd_export::{export_with, Export};
 use ppmc_core::bus::HostTiming;
 use std::path::Path;
 
-/// A capture held in memory.
-struct Held {
-    info: LogicInfo,
-    changes: std::vec::IntoIter<Change>,
-    end: u64,
-}
-
-impl LogicSource for Held {
-    fn info(&self) -> &LogicInfo {
-        &self.info
-    }
-    fn next_change(&mut self) -> Result<Option<Change>, LogicError> {
-        Ok(self.changes.next())
-    }
-    fn end_ps(&self) -> u64 {
-        self.end
-    }
-}
-
 /// Scenario `name` recorded with a host timed as `host` says, as a 1 ns
 /// VCD, then as an analyzer sampling every `period_ps` sees it: each
 /// change at the last sample at or before it (as sigrok-cli's VCD input
 /// downsamples), two changes in one sample merged.
-fn sampled(name: &str, host: HostTiming, period_ps: u64) -> Held {
+fn sampled(name: &str, host: HostTiming, period_ps: u64) -> Recorded {
     let suite = ppmc_scenarios::all();
     let s = suite.iter().find(|s| s.name == name).expect("scenario");
     let (trace, _) = analyzer_trace_with(&ModelConfig::default(), s, host).expect("a capture");
@@ -66,14 +47,10 @@ fn sampled(name: &str, host: HostTiming, period_ps: u64) -> Held {
         format: "sampled".into(),
         ..r.info().clone()
     };
-    Held {
-        info,
-        changes: out.into_iter(),
-        end: r.end_ps() / period_ps * period_ps,
-    }
+    Recorded::new(info, out, r.end_ps() / period_ps * period_ps)
 }
 
-fn judged(mut cap: Held, opts: &JudgeOptions) -> ppmc::judge::Judgement {
+fn judged(mut cap: Recorded, opts: &JudgeOptions) -> ppmc::judge::Judgement {
     let map = ChannelMap::from_names(cap.info()).expect("the chip's names");
     judge(&mut cap, &map, opts).expect("judged")
 }

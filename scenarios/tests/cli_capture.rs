@@ -608,16 +608,18 @@ fn a_capture_with_nothing_on_the_bus_is_the_captures_problem() {
     assert!(said.contains("no register access on the bus"), "{said}");
 }
 
-/// `ppmc judge` on `capture` with `args`: its exit status and everything
-/// it said.
-fn judge_with(capture: &str, args: &[&str]) -> (Option<i32>, String) {
+/// `ppmc judge` on `capture` with `args` exits with `code` and says each
+/// of `says`; what it said.
+fn judge_says(capture: &str, args: &[&str], code: i32, says: &[&str]) -> String {
     let mut all = vec!["judge", capture];
     all.extend_from_slice(args);
     let out = ppmc(&all);
-    (
-        out.status.code(),
-        format!("{}{}", text(&out.stdout), text(&out.stderr)),
-    )
+    let said = format!("{}{}", text(&out.stdout), text(&out.stderr));
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {said}");
+    for s in says {
+        assert!(said.contains(s), "{args:?}: `{s}` not in\n{said}");
+    }
+    said
 }
 
 /// The VCD `src` with each line passed through `f` (`None` drops it).
@@ -643,33 +645,37 @@ fn a_capture_cut_short_is_the_captures_problem() {
     let cut = text[..cut].rfind('\n').expect("lines") + 4;
     std::fs::write(&half, &text[..cut]).expect("write");
     let half = half.to_str().expect("utf-8");
-    let (code, said) = judge_with(half, &[]);
-    assert_eq!(code, Some(4), "{said}");
-    assert!(said.contains("ERROR the capture"), "{said}");
-    assert!(
-        said.contains("the file ends in the middle of line"),
-        "{said}"
+    judge_says(
+        half,
+        &[],
+        4,
+        &[
+            "ERROR the capture",
+            "the file ends in the middle of line",
+            "the recording ends during move 1, the board still moving",
+            "pulses unjudged",
+        ],
     );
-    assert!(
-        said.contains("the recording ends during move 1, the board still moving"),
-        "{said}"
+    judge_says(
+        half,
+        &["--partial"],
+        0,
+        &[
+            "not judged: the recording ends during move 1",
+            "PASS the board",
+        ],
     );
-    assert!(said.contains("pulses unjudged"), "{said}");
-    let (code, said) = judge_with(half, &["--partial"]);
-    assert_eq!(code, Some(0), "{said}");
-    assert!(
-        said.contains("not judged: the recording ends during move 1"),
-        "{said}"
-    );
-    assert!(said.contains("PASS the board"), "{said}");
     // Cut at a line's end, mid-move: the move alone says it.
     let at_line = &text[..text[..text.len() / 2].rfind('\n').expect("lines") + 1];
     let line_cut = dir.path().join("line.vcd");
     std::fs::write(&line_cut, at_line).expect("write");
-    let (code, said) = judge_with(line_cut.to_str().expect("utf-8"), &[]);
-    assert_eq!(code, Some(4), "{said}");
+    let said = judge_says(
+        line_cut.to_str().expect("utf-8"),
+        &[],
+        4,
+        &["the board still moving"],
+    );
     assert!(!said.contains("middle of line"), "{said}");
-    assert!(said.contains("the board still moving"), "{said}");
 }
 
 /// A map names each signal once and each channel once: bad usage (exit
@@ -679,14 +685,18 @@ fn a_capture_cut_short_is_the_captures_problem() {
 fn a_doubled_map_and_a_million_scopes_are_refused() {
     let dir = scratch("judge-refused");
     let vcd = export(dir.path(), "c.vcd", "s3_3_5_constant_speed_100_steps", &[]);
-    for (map, says) in [
-        ("CS=cs,CS=rd", "CS is given twice (`CS=cs` before)"),
-        ("CS=cs,RD=cs", "channel `cs` is given for CS already"),
-    ] {
-        let (code, said) = judge_with(&vcd, &["--map", map]);
-        assert_eq!(code, Some(2), "{map}: {said}");
-        assert!(said.contains(says), "{map}: {said}");
-    }
+    judge_says(
+        &vcd,
+        &["--map", "CS=cs,CS=rd"],
+        2,
+        &["CS is given twice (`CS=cs` before)"],
+    );
+    judge_says(
+        &vcd,
+        &["--map", "CS=cs,RD=cs"],
+        2,
+        &["channel `cs` is given for CS already"],
+    );
     let deep = dir.path().join("deep.vcd");
     let mut f = std::io::BufWriter::new(std::fs::File::create(&deep).expect("create"));
     use std::io::Write;
@@ -696,11 +706,11 @@ fn a_doubled_map_and_a_million_scopes_are_refused() {
     }
     writeln!(f, "$var wire 1 ! cs $end\n$enddefinitions $end\n#0 1!").expect("write");
     drop(f);
-    let (code, said) = judge_with(deep.to_str().expect("utf-8"), &[]);
-    assert_eq!(code, Some(2), "{said}");
-    assert!(
-        said.contains("line 258: $scope nested deeper than 256 levels"),
-        "{said}"
+    judge_says(
+        deep.to_str().expect("utf-8"),
+        &[],
+        2,
+        &["line 258: $scope nested deeper than 256 levels"],
     );
 }
 
@@ -715,16 +725,20 @@ fn a_wrong_map_is_the_captures_problem_naming_the_signal() {
     let no_pout = rewrite(&vcd, &dir.path().join("nopout.vcd"), |l| {
         Some(l.replace(" pout $end", " probe7 $end"))
     });
-    let (code, said) = judge_with(&no_pout, &[]);
-    assert_eq!(code, Some(4), "{said}");
-    assert!(said.contains("no channel for POUT"), "{said}");
+    let said = judge_says(&no_pout, &[], 4, &["no channel for POUT"]);
     assert!(!said.contains("FAIL the board"), "{said}");
-    let (code, said) = judge_with(&vcd, &["--map", "D0=d1,D1=d0"]);
-    assert_eq!(code, Some(4), "{said}");
-    assert!(said.contains("but D0 and D1 look exchanged"), "{said}");
-    let (code, said) = judge_with(&vcd, &["--map", "CS=rd,RD=cs"]);
-    assert_eq!(code, Some(4), "{said}");
-    assert!(said.contains("but CS and RD look exchanged"), "{said}");
+    judge_says(
+        &vcd,
+        &["--map", "D0=d1,D1=d0"],
+        4,
+        &["but D0 and D1 look exchanged"],
+    );
+    judge_says(
+        &vcd,
+        &["--map", "CS=rd,RD=cs"],
+        4,
+        &["but CS and RD look exchanged"],
+    );
     let n = std::cell::Cell::new(0);
     let default_names = rewrite(&vcd, &dir.path().join("names.vcd"), |l| {
         let w: Vec<&str> = l.split(' ').collect();
@@ -735,11 +749,11 @@ fn a_wrong_map_is_the_captures_problem_naming_the_signal() {
         }
         Some(l.to_string())
     });
-    let (code, said) = judge_with(&default_names, &[]);
-    assert_eq!(code, Some(4), "{said}");
-    assert!(
-        said.contains("named as the analyzer names them (D0..D37)"),
-        "{said}"
+    judge_says(
+        &default_names,
+        &[],
+        4,
+        &["named as the analyzer names them (D0..D37)"],
     );
 }
 
@@ -769,13 +783,16 @@ fn inverted_pout_and_dir_are_judged_with_a_tilde_and_hinted_without() {
         }
         Some(l.to_string())
     });
-    let (code, said) = judge_with(&inverted, &["--map", "POUT=~pout,DIR=~dir"]);
-    assert_eq!(code, Some(0), "{said}");
-    assert!(said.contains("1000 POUT pulses compared"), "{said}");
-    let (code, said) = judge_with(&inverted, &[]);
-    assert_eq!(code, Some(1), "{said}");
-    assert!(
-        said.contains("hint: POUT looks inverted and DIR looks inverted: judged with `--map POUT=~pout,DIR=~dir` the board passes"),
-        "{said}"
+    judge_says(
+        &inverted,
+        &["--map", "POUT=~pout,DIR=~dir"],
+        0,
+        &["1000 POUT pulses compared"],
+    );
+    judge_says(
+        &inverted,
+        &[],
+        1,
+        &["hint: POUT looks inverted and DIR looks inverted: judged with `--map POUT=~pout,DIR=~dir` the board passes"],
     );
 }

@@ -43,8 +43,17 @@ pub struct ExportArgs {
     /// 3-3's times instead, and each access ends the instant the chip is
     /// ready (IBF falls, OBF rises), the edge case for a logic analyzer's
     /// sampling (docs/capture.md).
-    #[arg(long, value_name = "HOW", default_value = "polling", value_parser = ["polling", "exact"], requires = "scenario")]
-    host: String,
+    #[arg(long, value_name = "HOW", default_value = "polling", value_parser = parse_host, requires = "scenario")]
+    host: HostTiming,
+}
+
+/// `--host`: `polling` or `exact`.
+fn parse_host(text: &str) -> Result<HostTiming, String> {
+    match text {
+        "polling" => Ok(HostTiming::Polling),
+        "exact" => Ok(HostTiming::Exact),
+        _ => Err(format!("`{text}`: say `polling` or `exact`")),
+    }
 }
 
 /// The trace of `name` run on the emulator with `faults`, every register
@@ -69,13 +78,10 @@ fn scenario_trace(
 
 pub fn run(args: ExportArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let (trace, input) = match (&args.trace, &args.scenario) {
-        (_, Some(name)) => {
-            let host = match args.host.as_str() {
-                "exact" => HostTiming::Exact,
-                _ => HostTiming::Polling,
-            };
-            (scenario_trace(name, &args.chip_faults, host, suite)?, None)
-        }
+        (_, Some(name)) => (
+            scenario_trace(name, &args.chip_faults, args.host, suite)?,
+            None,
+        ),
         (Some(path), None) => {
             let text = files::read_text(path, files::MAX_TRACE_BYTES)?;
             match Trace::parse(&text) {

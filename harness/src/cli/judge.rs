@@ -84,14 +84,7 @@ pub fn decode(args: DecodeArgs) -> Result<(), CliError> {
     let bus = map
         .require_bus(&info)
         .map_err(|why| usage(format!("{}: {why}", args.capture.capture.display())))?;
-    let mut inverted;
-    let source: &mut dyn LogicSource = match map.inverted() {
-        0 => source.as_mut(),
-        _ => {
-            inverted = crate::logic::map::Inverted::new(source.as_mut(), &map);
-            &mut inverted
-        }
-    };
+    let mut source = crate::logic::map::Inverted::new(source.as_mut(), &map);
     let mut d = BusDecoder::new(bus, &info, args.capture.glitch.as_nanos() * 1000);
     outln!(
         "# {} ({}), decoded by ppmc: replay with `ppmc console`",
@@ -191,9 +184,8 @@ pub struct JudgeArgs {
 
 pub fn run(args: JudgeArgs) -> Result<(), CliError> {
     let started = std::time::Instant::now();
-    let (source, map) = args.capture.open()?;
+    let (mut source, map) = args.capture.open()?;
     let info = source.info().clone();
-    drop(source);
     let opts = JudgeOptions {
         straps: args.chip.straps().map_err(usage)?,
         model: args.chip.model(),
@@ -233,8 +225,8 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
     // The capture is read again only where the board diverged, to hold
     // the divergence against the map (judge::judge_reopening).
     let path = args.capture.capture.clone();
-    let mut open = move || crate::logic::open::open(&path);
-    let (j, trace) = judge_reopening(&mut open, &map, &opts, name.as_deref())
+    let mut reopen = move || crate::logic::open::open(&path);
+    let (j, trace) = judge_reopening(source.as_mut(), &mut reopen, &map, &opts, name.as_deref())
         .map_err(|e| CliError::BadInput(format!("ppmc: {e}")))?;
     let mut problems = Vec::new();
     if let (Some(dir), Some(t)) = (&args.trace, &trace) {

@@ -247,19 +247,12 @@ impl Bench {
             Access::ReadData => !s.obf(),
             Access::ReadStatus => false,
         };
-        let mut probe = self.board.clone();
-        if !forbids(probe.read_status()) {
+        if !forbids(self.board.read_status()) {
             return None;
         }
+        let mut probe = self.board.clone();
         let limit = self.model_time(ps.saturating_add(self.latency_window(ps)));
-        loop {
-            let now = probe.now();
-            let next = probe.poll_at().filter(|&t| t <= limit)?;
-            probe.advance_to(next.max(now + Duration::from_nanos(1)));
-            if !forbids(probe.read_status()) {
-                return Some(self.capture_ps(probe.now()));
-            }
-        }
+        run_until(&mut probe, limit, |s| !forbids(s)).then(|| self.capture_ps(probe.now()))
     }
 
     /// The model as the outputs are compared with it.
@@ -288,14 +281,12 @@ impl Bench {
     /// pulse if the board pulsed, before it if not (notes N53).
     fn give_inputs(&mut self, ps: u64, changes: &[(Input, bool)], board_pulsed: bool, w: u64) {
         self.run_to(ps.saturating_sub(w));
-        let pulses =
-            |b: &Board| -> u64 { b.record().runs.iter().map(|r| u64::from(r.count)).sum() };
         let mut probe = self.board.clone();
         let late = self.model_time(ps.saturating_add(w));
         if late > probe.now() {
             probe.advance_to(late);
         }
-        let model_pulsed = pulses(&probe) > pulses(&self.board);
+        let model_pulsed = probe.record().pulse_count() > self.board.record().pulse_count();
         if !model_pulsed {
             self.run_to(ps);
         } else if board_pulsed {
@@ -570,19 +561,17 @@ impl Branch {
     /// captured, with no host finding for it.
     fn access(&mut self, t: &Transaction, follow_orders: bool) -> Option<Branch> {
         self.bench.run_to(t.end_ps);
-        let mut fork = None;
-        if follow_orders && self.failed.is_none() && t.access != Access::ReadStatus {
-            if let Some(after) = self.bench.allowed_within(t.end_ps, t.access) {
-                let mut captured = self.clone();
-                captured.apply(t, true);
-                fork = Some(captured);
-                self.bench.run_to(after);
-                self.apply(t, false);
-                return fork;
-            }
-        }
+        let after = (follow_orders && self.failed.is_none())
+            .then(|| self.bench.allowed_within(t.end_ps, t.access))
+            .flatten();
+        let captured = after.map(|after| {
+            let mut captured = self.clone();
+            captured.apply(t, true);
+            self.bench.run_to(after);
+            captured
+        });
         self.apply(t, false);
-        fork
+        captured
     }
 
     /// The access taken by the model where it stands; with `unsure`, the
@@ -684,16 +673,25 @@ fn prune(branches: &mut Vec<Branch>) {
     } else if branches.len() > 1 {
         // Every order diverged: keep the one that followed the board
         // longest, for the verdict.
-        let best = branches
-            .iter()
-            .enumerate()
-            .max_by_key(|(i, b)| (b.failed.as_ref().map_or(0, |d| d.at_ps), usize::MAX - i))
-            .map_or(0, |(i, _)| i);
-        let keep = branches.swap_remove(best);
+        let keep = branches.swap_remove(best(branches));
         branches.clear();
         branches.push(keep);
     }
     branches.truncate(MAX_BRANCHES);
+}
+
+/// The order the board's behaviour bears out best: one that never
+/// diverged (the one with the fewest host findings), else the one that
+/// followed the board longest; the first found where they tie.
+fn best(branches: &[Branch]) -> usize {
+    branches
+        .iter()
+        .enumerate()
+        .min_by_key(|(i, b)| match &b.failed {
+            None => (0, b.host.len() as u64, *i),
+            Some(d) => (1, u64::MAX - d.at_ps, *i),
+        })
+        .map_or(0, |(i, _)| i)
 }
 
 /// What a capture that ends while the model is still moving leaves
@@ -702,29 +700,37 @@ fn prune(branches: &mut Vec<Branch>) {
 fn unfinished(board: &Board) -> String {
     let moves = board.record().moves.len();
     let mut probe = board.clone();
-    let pulses = |b: &Board| -> u64 { b.record().runs.iter().map(|r| u64::from(r.count)).sum() };
-    let before = pulses(&probe);
     let limit = probe.now() + Duration::from_secs(3600);
-    while probe.read_status().busy() {
-        match probe.poll_at() {
-            Some(t) if t <= limit => {
-                let t = t.max(probe.now() + Duration::from_nanos(1));
-                probe.advance_to(t);
-            }
-            _ => break,
-        }
-    }
-    let left = pulses(&probe) - before;
-    match probe.read_status().busy() {
-        false if left == 0 => format!(
+    let rests = run_until(&mut probe, limit, |s| !s.busy());
+    let left = probe.record().pulse_count() - board.record().pulse_count();
+    match (rests, left) {
+        (true, 0) => format!(
             "the recording ends before move {moves} finished (BUSY still 1, its last pulse out): its end is unjudged"
         ),
-        false => format!(
+        (true, _) => format!(
             "the recording ends during move {moves}, the board still moving: {left} pulses unjudged"
         ),
-        true => format!(
+        (false, 0) => format!(
+            "the recording ends during move {moves}, BUSY still 1: the model puts out no pulse in the hour after it and is still BUSY then"
+        ),
+        (false, _) => format!(
             "the recording ends during move {moves}, the board still moving: {left} pulses unjudged in the hour after it, and more"
         ),
+    }
+}
+
+/// Runs `probe` on, from one event of the model to the next, until `done`
+/// holds of its status or `limit` has passed: whether it held.
+fn run_until(probe: &mut Board, limit: Instant, done: impl Fn(Status) -> bool) -> bool {
+    loop {
+        if done(probe.read_status()) {
+            return true;
+        }
+        let now = probe.now();
+        match probe.poll_at() {
+            Some(t) if t <= limit => probe.advance_to(t.max(now + Duration::from_nanos(1))),
+            _ => return false,
+        }
     }
 }
 
@@ -759,14 +765,8 @@ pub fn judge_traced(
     scenario: Option<&str>,
 ) -> Result<(Judgement, Option<crate::trace::Trace>), JudgeError> {
     let info = source.info().clone();
-    let mut inverted;
-    let source: &mut dyn LogicSource = match map.inverted() {
-        0 => source,
-        _ => {
-            inverted = Inverted::new(source, map);
-            &mut inverted
-        }
-    };
+    // The map's inverted channels read as the chip's levels.
+    let mut source = Inverted::new(source, map);
     let mut not_judged = Vec::new();
     let bus = match map.require_bus(&info) {
         Ok(bus) => bus,
@@ -849,7 +849,7 @@ pub fn judge_traced(
     }];
     let mut prev: Option<Change> = None;
     let mut started = reset.is_none();
-    let mut source = Lookahead::new(source);
+    let mut source = Lookahead::new(&mut source);
     let mut tracer = scenario.map(|_| trace::CaptureTrace::new(map, &info));
     while let Some(c) = source.next()? {
         // The inputs' levels before this change: none at the model's start
@@ -922,17 +922,7 @@ pub fn judge_traced(
     for b in &mut branches {
         b.finish(end);
     }
-    // The order the board's behaviour bears out: a branch that never
-    // diverged (the one with the fewest host findings), else the one that
-    // followed the board longest.
-    let chosen = branches
-        .iter()
-        .enumerate()
-        .min_by_key(|(i, b)| match &b.failed {
-            None => (0, b.host.len() as u64, *i),
-            Some(d) => (1, u64::MAX - d.at_ps, *i),
-        })
-        .map_or(0, |(i, _)| i);
+    let chosen = best(&branches);
     let Branch {
         bench,
         outputs,
@@ -965,13 +955,7 @@ pub fn judge_traced(
         if started && bench.board.read_status().busy() {
             short.push(unfinished(&bench.board));
         }
-        let made = bench
-            .board
-            .record()
-            .runs
-            .iter()
-            .map(|r| u64::from(r.count))
-            .sum::<u64>();
+        let made = bench.board.record().pulse_count();
         if pout.is_none() && made > 0 {
             short.push(format!(
                 "the model put out {made} POUT pulses and the capture has no channel for POUT: none of them judged (map it: --map POUT=CHANNEL)"

@@ -32,24 +32,24 @@ struct Suspect {
     map: ChannelMap,
 }
 
-/// [`judge_traced`], and where the board diverges, the maps a probing
-/// mistake would have needed tried in turn (this module's doc): the
-/// verdict the capture's when a bus line looks exchanged or a strobe
-/// inverted, a hint when POUT or DIR looks inverted.
+/// [`judge_traced`] on `source`, and where the board diverges, the maps
+/// a probing mistake would have needed tried in turn on the capture read
+/// again (`reopen`; this module's doc): the verdict the capture's when a
+/// bus line looks exchanged or a strobe inverted, a hint when POUT or DIR
+/// looks inverted.
 pub fn judge_reopening(
-    open: &mut Opener<'_>,
+    source: &mut dyn LogicSource,
+    reopen: &mut Opener<'_>,
     map: &ChannelMap,
     opts: &JudgeOptions,
     scenario: Option<&str>,
 ) -> Result<(Judgement, Option<Trace>), JudgeError> {
-    let mut source = open()?;
-    let (mut j, trace) = judge_traced(source.as_mut(), map, opts, scenario)?;
-    drop(source);
+    let info = source.info().clone();
+    let (mut j, trace) = judge_traced(source, map, opts, scenario)?;
     let Verdict::Failed(d) = &j.verdict else {
         return Ok((j, trace));
     };
-    if let Some(s) = suspect(open, map, opts, &j)? {
-        let info = open()?.info().clone();
+    if let Some(s) = suspect(reopen, map, opts, &j)? {
         let base = ChannelMap::from_names(&info).unwrap_or_default();
         let spelled = match s.map.spelled_against(&base, &info) {
             m if m.is_empty() => "the channels as named (no --map)".to_string(),

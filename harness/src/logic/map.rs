@@ -430,7 +430,8 @@ impl ChannelMap {
 
 /// A capture read through a map's inverted channels
 /// ([`ChannelMap::inverted`]): their known levels flipped, so that every
-/// reader of the changes sees the chip's levels.
+/// reader of the changes sees the chip's levels (with none inverted, the
+/// changes as they are).
 pub struct Inverted<'a> {
     src: &'a mut dyn LogicSource,
     mask: u64,
@@ -534,6 +535,8 @@ fn channel(text: &str, info: &LogicInfo) -> Result<(usize, bool), String> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::source::testing::ch;
+    use super::super::source::Recorded;
     use super::*;
 
     fn info(names: &[&str]) -> LogicInfo {
@@ -646,11 +649,8 @@ mod tests {
             m.spelled_against(&ChannelMap::from_names(&i).expect("names"), &i),
             "POUT=~pout,DIR=~dir"
         );
-        let mut src = super::super::source::testing::Changes::new(
-            i.clone(),
-            vec![(0, 0b101), (10, 0b100)],
-            20,
-        );
+        let changes = vec![ch(0, 0b101, 0), ch(10, 0b100, 0)];
+        let mut src = Recorded::new(i.clone(), changes, 20);
         let mut inv = Inverted::new(&mut src, &m);
         let a = inv.next_change().expect("reads").expect("a change");
         assert_eq!(a.levels, 0b110, "POUT and DIR flipped, x kept");

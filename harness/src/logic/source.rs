@@ -100,6 +100,42 @@ pub trait LogicSource {
     }
 }
 
+/// A capture held in memory, its changes given whole: one a program made
+/// (a test's capture with a board's difference put in, a capture
+/// resampled as an analyzer would see it), read as any other.
+#[derive(Debug, Clone)]
+pub struct Recorded {
+    info: LogicInfo,
+    changes: std::vec::IntoIter<Change>,
+    end_ps: u64,
+}
+
+impl Recorded {
+    /// `changes` in time order (the first the levels at the start), the
+    /// capture ending at `end_ps`.
+    pub fn new(info: LogicInfo, changes: Vec<Change>, end_ps: u64) -> Self {
+        Recorded {
+            info,
+            changes: changes.into_iter(),
+            end_ps,
+        }
+    }
+}
+
+impl LogicSource for Recorded {
+    fn info(&self) -> &LogicInfo {
+        &self.info
+    }
+
+    fn next_change(&mut self) -> Result<Option<Change>, LogicError> {
+        Ok(self.changes.next())
+    }
+
+    fn end_ps(&self) -> u64 {
+        self.end_ps
+    }
+}
+
 /// A capture that cannot be read: which file, where in it, and what.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LogicError {
@@ -156,37 +192,6 @@ pub(super) mod testing {
         }
         assert_eq!(r.next_change(), Ok(None), "the end stays the end");
         Ok((r.info().clone(), out, r.end_ps()))
-    }
-
-    /// A source of the given changes (time, levels), all known.
-    pub(crate) struct Changes {
-        info: LogicInfo,
-        changes: std::collections::VecDeque<Change>,
-        end: u64,
-    }
-
-    impl Changes {
-        pub(crate) fn new(info: LogicInfo, changes: Vec<(u64, u64)>, end: u64) -> Self {
-            Changes {
-                info,
-                changes: changes.into_iter().map(|(t, l)| ch(t, l, 0)).collect(),
-                end,
-            }
-        }
-    }
-
-    impl LogicSource for Changes {
-        fn info(&self) -> &LogicInfo {
-            &self.info
-        }
-
-        fn next_change(&mut self) -> Result<Option<Change>, LogicError> {
-            Ok(self.changes.pop_front())
-        }
-
-        fn end_ps(&self) -> u64 {
-            self.end
-        }
     }
 
     pub(crate) fn ch(time_ps: u64, levels: u64, unknown: u64) -> Change {
