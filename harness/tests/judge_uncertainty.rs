@@ -68,6 +68,9 @@ fn s3_1_1_a_write_sampled_across_ibfs_fall_fails_neither_board_nor_host() {
         "s3_3_5_constant_speed_100_steps",
         "s3_4_1_finish_read_releases_int",
         "s3_2_1_four_phase_two_phase_excitation",
+        // A status read that ends as IBF falls, then OBF rises within the
+        // latency window: the read may show any status in that window.
+        "s3_2_2_init_processing_with_pa_4",
     ] {
         let j = judged(
             sampled(name, HostTiming::Exact, 42_000),

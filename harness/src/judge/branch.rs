@@ -122,7 +122,7 @@ impl Branch {
                 let log = &self.status_log;
                 let near = || {
                     log.since(t.start_ps.saturating_sub(w)).any(matches)
-                        || matches(bench.status_after(t.end_ps.saturating_add(w)))
+                        || bench.status_until(t.end_ps.saturating_add(w), matches)
                 };
                 if self.failed.is_none() && !matches(status.0) && !matches(status_then.0) && !near()
                 {

@@ -227,15 +227,13 @@ impl Bench {
             .saturating_add(self.pulse_offset_ps)
     }
 
-    /// The model's status at capture time `ps`, ahead of the model (a
-    /// copy run there; the model itself stays).
-    fn status_after(&self, ps: u64) -> u8 {
+    /// Whether the model takes a status `matches` accepts at some time
+    /// from now to capture time `ps`, ahead of the model (a copy run on,
+    /// event by event; the model itself stays): every status in force in
+    /// that window, not only the last.
+    fn status_until(&self, ps: u64, matches: impl Fn(u8) -> bool) -> bool {
         let mut probe = self.board.clone();
-        let t = self.model_time(ps);
-        if t > probe.now() {
-            probe.advance_to(t);
-        }
-        probe.read_status().0
+        run_until(&mut probe, self.model_time(ps), |s| matches(s.0))
     }
 
     /// Where an access of kind `access` at capture time `ps`, which the
