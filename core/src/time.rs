@@ -92,6 +92,10 @@ impl Duration {
         Duration(u64::try_from(wide).unwrap_or(u64::MAX))
     }
 
+    pub fn saturating_add(self, other: Duration) -> Duration {
+        Duration(self.0.saturating_add(other.0))
+    }
+
     pub fn saturating_sub(self, other: Duration) -> Duration {
         Duration(self.0.saturating_sub(other.0))
     }

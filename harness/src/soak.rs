@@ -338,6 +338,7 @@ mod tests {
                 hi: Duration::MAX,
                 marginal_lo: Duration::ZERO,
                 marginal_hi: Duration::MAX,
+                u: Duration::ZERO,
                 grade,
                 at: crate::time::Instant::ZERO,
             }];

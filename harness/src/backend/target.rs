@@ -4,6 +4,7 @@
 pub use ppmc_core::bus::{Op, Reply, SelfTestPlan, SelfTestReply};
 
 use crate::protocol::{Record, RecordMark, Straps};
+use crate::time::Duration;
 use std::fmt;
 
 /// A bridge's self-test as it ran: what the bridge says it generated, and
@@ -154,6 +155,14 @@ pub trait Target: Send {
             TargetErrorKind::Unsupported,
             "this target has no bus bridge to self-test: give a board's --target",
         ))
+    }
+
+    /// How sure one time this target gives is (±): the emulator's are
+    /// exact (0); a board's are as fine as its bridge's timer (one tick).
+    /// An interval between two of its times is twice as unsure. Every
+    /// Table 3-3 measurement carries it ([`crate::scenario::Measurement`]).
+    fn time_uncertainty(&self) -> Duration {
+        Duration::ZERO
     }
 
     /// The bus bridge's serial number, where it gives one (its HELLO) or

@@ -9,7 +9,8 @@ use crate::golden::{self};
 use crate::report::{self, BoardInfo, Figures, Listing, Record, RunInfo, RunOptions, Tally};
 use crate::runner::{Farm, Spread};
 use crate::scenario::{
-    DriverOptions, Failure, Grading, HarnessError, NotRun, Retry, Scenario, ScenarioResult, Verdict,
+    DriverOptions, Failure, Grade, Grading, HarnessError, NotRun, Retry, Scenario, ScenarioResult,
+    Verdict,
 };
 use crate::soak::{Kept, Soak};
 use crate::store::Store;
@@ -115,6 +116,12 @@ pub(super) fn verdict_line(r: &ScenarioResult, board: Option<&str>) -> String {
     if let Some(d) = r.verdict.detail() {
         s.push_str("\n         ");
         s.push_str(&d);
+    }
+    // Which measurement, against what, and how sure it is.
+    if r.verdict == Verdict::Marginal {
+        for m in r.measurements.iter().filter(|m| m.grade == Grade::Marginal) {
+            s.push_str(&format!("\n         {m}"));
+        }
     }
     for (n, a) in r.attempts.iter().enumerate() {
         s.push_str(&format!("\n         attempt {}: ", n + 1));

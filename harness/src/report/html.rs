@@ -266,7 +266,10 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64), budg
                 s,
                 r#"<tr><td>{}</td><td>{}</td><td><span class="chip {}">{}</span></td><td>{}</td></tr>"#,
                 esc(&m.name),
-                esc(&plots::us(m.value_ns)),
+                esc(&match m.u_ns {
+                    0 => plots::us(m.value_ns),
+                    u => format!("{} ±{}", plots::us(m.value_ns), plots::human(u)),
+                }),
                 esc(&m.grade),
                 esc(&m.grade),
                 plots::measurement(m)

@@ -16,6 +16,8 @@ struct JsonMeasurement<'a> {
     hi_ns: Option<u64>,
     marginal_lo_ns: u64,
     marginal_hi_ns: Option<u64>,
+    /// The measurement's uncertainty (±), the instrument's.
+    u_ns: u64,
     grade: &'static str,
     at_ns: u64,
 }
@@ -277,6 +279,7 @@ pub fn json_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> 
                         hi_ns: finite(m.hi),
                         marginal_lo_ns: m.marginal_lo.as_nanos(),
                         marginal_hi_ns: finite(m.marginal_hi),
+                        u_ns: m.u.as_nanos(),
                         grade: m.grade.name(),
                         at_ns: m.at.as_nanos(),
                     })

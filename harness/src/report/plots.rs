@@ -15,8 +15,8 @@ use std::fmt::Write as _;
 const PROFILE: (f64, f64) = (470.0, 210.0);
 
 /// A measurement's band as a strip: red outside the limits, amber in the
-/// marginal zones, green between, the value a dark tick; `data-*` give
-/// the numbers.
+/// marginal zones, green between, the value a dark tick, its uncertainty
+/// (± U, where not 0) a bar across it; `data-*` give the numbers.
 pub fn measurement(m: &MeasurementRecord) -> String {
     let (w, h) = (380.0, 34.0);
     let (l, r) = (8.0, 8.0);
@@ -27,8 +27,9 @@ pub fn measurement(m: &MeasurementRecord) -> String {
     let mut s = String::new();
     let _ = write!(
         s,
-        r#"<svg class="measure" width="{w}" height="{h}" viewBox="0 0 {w} {h}" role="img" data-value-ns="{}" data-lo-ns="{}" data-hi-ns="{}" data-grade="{}">"#,
+        r#"<svg class="measure" width="{w}" height="{h}" viewBox="0 0 {w} {h}" role="img" data-value-ns="{}" data-u-ns="{}" data-lo-ns="{}" data-hi-ns="{}" data-grade="{}">"#,
         m.value_ns,
+        m.u_ns,
         m.lo_ns,
         m.hi_ns.map_or("inf".to_string(), |v| v.to_string()),
         esc(&m.grade)
@@ -52,6 +53,17 @@ pub fn measurement(m: &MeasurementRecord) -> String {
         }
     }
     let xv = x(m.value_ns);
+    if m.u_ns > 0 {
+        let (xa, xb) = (
+            x(m.value_ns.saturating_sub(m.u_ns)),
+            x(m.value_ns.saturating_add(m.u_ns)),
+        );
+        let _ = write!(
+            s,
+            r#"<line class="uncertainty" x1="{xa:.1}" y1="12" x2="{:.1}" y2="12"/>"#,
+            xb.max(xa + 1.0)
+        );
+    }
     let _ = write!(
         s,
         r#"<line class="value" x1="{xv:.1}" y1="2" x2="{xv:.1}" y2="22"/><text class="tick" x="{:.1}" y="31" text-anchor="start">{}</text><text class="tick" x="{:.1}" y="31" text-anchor="end">{}</text></svg>"#,

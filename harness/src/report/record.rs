@@ -99,6 +99,9 @@ pub struct MeasurementRecord {
     pub hi_ns: Option<u64>,
     pub marginal_lo_ns: u64,
     pub marginal_hi_ns: Option<u64>,
+    /// The uncertainty (±); 0 in records written before it was kept.
+    #[serde(default)]
+    pub u_ns: u64,
     pub grade: String,
     pub at_ns: u64,
 }

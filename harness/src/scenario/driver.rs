@@ -34,6 +34,9 @@ pub struct Driver<'t> {
     pub(super) measurements: Vec<Measurement>,
     pub(super) init: Option<Init>,
     pub(super) straps: Straps,
+    /// How sure an interval between two of the target's times is (±):
+    /// twice its [`Target::time_uncertainty`].
+    pub(super) interval_u: Duration,
 }
 
 impl std::fmt::Debug for Driver<'_> {
@@ -48,6 +51,7 @@ impl std::fmt::Debug for Driver<'_> {
 impl<'t> Driver<'t> {
     pub fn new(target: &'t mut dyn Target, opts: DriverOptions) -> Self {
         let straps = target.straps();
+        let interval_u = target.time_uncertainty().saturating_mul(2);
         let opts = DriverOptions {
             ibf_timeout: straps.stretch(opts.ibf_timeout),
             obf_timeout: straps.stretch(opts.obf_timeout),
@@ -63,6 +67,7 @@ impl<'t> Driver<'t> {
         };
         Driver {
             straps,
+            interval_u,
             batch: Batch::new(target, limits),
             opts,
             measurements: Vec::new(),
@@ -381,18 +386,22 @@ impl<'t> Driver<'t> {
                 ));
             };
             let slack = want.scale(1, 100) + step;
-            let m =
-                self.opts
-                    .grading
-                    .grade_in(name, want.saturating_sub(slack), want + slack, got, at);
+            let m = self.opts.grading.grade_in(
+                name,
+                want.saturating_sub(slack),
+                want + slack,
+                got,
+                self.interval_u,
+                at,
+            );
             let grade = m.grade;
-            let (lo, hi) = (m.lo, m.hi);
+            let (lo, hi, m_shown) = (m.lo, m.hi, m.shown());
             self.measurements.push(m);
             if grade == Grade::Fail {
                 return Err(fail(
                     format!("{name} (Equations 3-5..3-8)"),
                     format!("{lo}..={hi}"),
-                    got,
+                    m_shown,
                     at,
                 ));
             }

@@ -1,11 +1,25 @@
-//! PASS / MARGINAL / FAIL grading of measured latencies against Table 3-3.
+//! PASS / MARGINAL / FAIL grading of measured latencies against Table 3-3,
+//! by the decision rule of `docs/conformance.md` (ISO 14253-1's: a
+//! measurement proves conformance only when its value plus or minus its
+//! uncertainty lies inside the band, and non-conformance only when it lies
+//! outside).
 //!
 //! The limits are the datasheet's band (`[min, max]`, or the single typical
-//! figure) widened by its 1 % footnote. A value outside fails. A value
-//! inside but within [`Grading::marginal_bp`] of an edge (default
-//! 0.25 % of the edge value, a quarter of the footnote's tolerance) is
-//! MARGINAL: it passes, but a hardware test station would flag the board
-//! for a look, as OpenHTF's marginal limits do.
+//! figure) widened by its 1 % footnote. Each measurement carries its
+//! uncertainty `U` (±), the instrument's: 0 on the emulator, the target's
+//! own on a board ([`crate::backend::Target::time_uncertainty`], twice for
+//! an interval between two of its times). Then:
+//!
+//! - FAIL: the whole interval `value ± U` lies outside the band;
+//! - MARGINAL: it straddles a limit (the instrument cannot tell: "within
+//!   the instrument's uncertainty"), or it lies inside but reaches into
+//!   the zone within [`Grading::marginal_bp`] of an edge (default 0.25 %
+//!   of the edge value, a quarter of the footnote's tolerance), where a
+//!   hardware test station would flag the board for a look, as OpenHTF's
+//!   marginal limits do;
+//! - PASS: otherwise.
+//!
+//! With `U` = 0 this is the band and the marginal zone alone.
 
 use crate::protocol::{Straps, TimingId};
 use crate::time::{Duration, Instant, Limit};
@@ -54,32 +68,37 @@ pub struct Measurement {
     /// (but inside `lo..=hi`) are MARGINAL.
     pub marginal_lo: Duration,
     pub marginal_hi: Duration,
+    /// The measurement's uncertainty (±): the instrument's.
+    pub u: Duration,
     pub grade: Grade,
     /// When the measured interval ended, on the target's clock.
     pub at: Instant,
 }
 
 impl Grading {
-    /// Grades `value` against the Table 3-3 row `id` on a board with
-    /// `straps`.
+    /// Grades `value` (± `u`) against the Table 3-3 row `id` on a board
+    /// with `straps`.
     pub fn grade(
         &self,
         id: TimingId,
         straps: &Straps,
         value: Duration,
+        u: Duration,
         at: Instant,
     ) -> Measurement {
         let (lo, hi) = id.row().band_for(straps);
-        self.grade_in(id.name(), lo, hi, value, at)
+        self.grade_in(id.name(), lo, hi, value, u, at)
     }
 
-    /// Grades `value` against explicit limits.
+    /// Grades `value` (± `u`) against explicit limits, by the decision
+    /// rule (this module's doc).
     pub fn grade_in(
         &self,
         name: &str,
         lo: Duration,
         hi: Duration,
         value: Duration,
+        u: Duration,
         at: Instant,
     ) -> Measurement {
         let margin = |edge: Duration| edge.scale(self.marginal_bp, 10_000);
@@ -89,9 +108,11 @@ impl Grading {
         } else {
             hi.saturating_sub(margin(hi))
         };
-        let grade = if value < lo || value > hi {
+        let (low, high) = (value.saturating_sub(u), value.saturating_add(u));
+        let grade = if high < lo || low > hi {
             Grade::Fail
-        } else if value < marginal_lo || value > marginal_hi {
+        } else if low < marginal_lo || high > marginal_hi {
+            // Straddling a limit, or reaching into the marginal zone.
             Grade::Marginal
         } else {
             Grade::Pass
@@ -103,8 +124,29 @@ impl Grading {
             hi,
             marginal_lo,
             marginal_hi,
+            u,
             grade,
             at,
+        }
+    }
+}
+
+impl Measurement {
+    /// The interval `value ± u` straddles a limit: the instrument cannot
+    /// tell whether the value is inside.
+    pub fn within_uncertainty(&self) -> bool {
+        let (low, high) = (
+            self.value.saturating_sub(self.u),
+            self.value.saturating_add(self.u),
+        );
+        (low < self.lo && high >= self.lo) || (high > self.hi && low <= self.hi)
+    }
+
+    /// The value as measured: `112.000us`, or `112.400us ±0.020us`.
+    pub fn shown(&self) -> String {
+        match self.u == Duration::ZERO {
+            true => self.value.to_string(),
+            false => format!("{} ±{}", self.value, self.u),
         }
     }
 }
@@ -115,10 +157,14 @@ impl fmt::Display for Measurement {
             f,
             "{} {} [{}..={}]",
             self.name,
-            self.value,
+            self.shown(),
             self.lo,
             Limit(self.hi)
-        )
+        )?;
+        if self.within_uncertainty() {
+            write!(f, " (within the instrument's uncertainty, ±{})", self.u)?;
+        }
+        Ok(())
     }
 }
 
@@ -127,14 +173,48 @@ mod tests {
     use super::*;
 
     fn grade(id: TimingId, ns: u64) -> Grade {
-        Grading::default()
-            .grade(
-                id,
-                &Straps::default(),
-                Duration::from_nanos(ns),
-                Instant::ZERO,
-            )
-            .grade
+        graded(id, ns, 0).grade
+    }
+
+    fn graded(id: TimingId, ns: u64, u_ns: u64) -> Measurement {
+        Grading::default().grade(
+            id,
+            &Straps::default(),
+            Duration::from_nanos(ns),
+            Duration::from_nanos(u_ns),
+            Instant::ZERO,
+        )
+    }
+
+    /// The decision rule (docs/conformance.md): BUSY rise, 27..112 us,
+    /// accepted from 26.73 to 113.12 us, marginal above 112.84 us. A
+    /// value is FAIL only when value ± U lies wholly outside, PASS only
+    /// when wholly inside and clear of the marginal zone.
+    #[test]
+    fn s3_6_a_value_within_its_uncertainty_of_a_limit_is_marginal() {
+        // 113.20 us ± 0.02 us: wholly outside, FAIL.
+        assert_eq!(graded(TimingId::BusyRise, 113_200, 20).grade, Grade::Fail);
+        // 113.20 us ± 0.10 us: straddles 113.12 us, MARGINAL, and says so.
+        let m = graded(TimingId::BusyRise, 113_200, 100);
+        assert_eq!(m.grade, Grade::Marginal);
+        assert!(m.within_uncertainty());
+        assert!(
+            m.to_string()
+                .contains("within the instrument's uncertainty, ±0.100us"),
+            "{m}"
+        );
+        // 112.00 us ± 1 us: reaches into the marginal zone, MARGINAL, but
+        // inside the band.
+        let m = graded(TimingId::BusyRise, 112_000, 1_000);
+        assert_eq!(m.grade, Grade::Marginal);
+        assert!(!m.within_uncertainty());
+        // 60 us ± 1 us: wholly inside, PASS.
+        assert_eq!(graded(TimingId::BusyRise, 60_000, 1_000).grade, Grade::Pass);
+        // 26.70 us ± 0.05 us: straddles 26.73 us from below.
+        let m = graded(TimingId::BusyRise, 26_700, 50);
+        assert_eq!((m.grade, m.within_uncertainty()), (Grade::Marginal, true));
+        // U = 0: the band alone.
+        assert_eq!(graded(TimingId::BusyRise, 113_200, 0).grade, Grade::Fail);
     }
 
     #[test]

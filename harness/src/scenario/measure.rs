@@ -9,15 +9,18 @@ use crate::time::{Duration, Instant, Limit};
 
 impl Driver<'_> {
     fn record_measure(&mut self, id: TimingId, value: Duration, at: Instant) -> Outcome<Grade> {
-        let m = self.opts.grading.grade(id, &self.straps, value, at);
+        let m = self
+            .opts
+            .grading
+            .grade(id, &self.straps, value, self.interval_u, at);
         let grade = m.grade;
-        let (lo, hi) = (m.lo, m.hi);
+        let (lo, hi, got) = (m.lo, m.hi, m.shown());
         self.measurements.push(m);
         if grade == Grade::Fail {
             return Err(Stop::Failed(Failure {
                 expectation: format!("{} (Table 3-3)", id.name()),
                 expected: format!("{lo}..={}", Limit(hi)),
-                got: value.to_string(),
+                got,
                 at,
             }));
         }

@@ -57,7 +57,10 @@ impl Verdict {
     pub fn detail(&self) -> Option<String> {
         match self {
             Verdict::Passed => None,
-            Verdict::Marginal => Some("a measurement is near its limit".into()),
+            Verdict::Marginal => Some(
+                "a measurement is near its limit, or within the instrument's uncertainty of it"
+                    .into(),
+            ),
             Verdict::Failed(f) => Some(f.to_string()),
             Verdict::Error(e) => Some(e.to_string()),
             Verdict::NotRun(why) => Some(why.to_string()),

@@ -278,6 +278,14 @@ impl<L: Link> SerialTarget<L> {
 }
 
 impl<L: Link> Target for SerialTarget<L> {
+    /// One tick of the bridge's timer (rounded up to a nanosecond): no
+    /// time it stamps is surer. (The paths a bridge samples with its CPU
+    /// are less sure; the protocol does not say yet by how much.)
+    fn time_uncertainty(&self) -> crate::time::Duration {
+        let hz = self.hello.timer_hz.max(1);
+        crate::time::Duration::from_nanos(1_000_000_000u64.div_ceil(hz))
+    }
+
     /// The serial number the bridge gives in its HELLO, else the USB
     /// serial number the operating system read from the device.
     fn bridge_serial(&self) -> Option<String> {
