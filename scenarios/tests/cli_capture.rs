@@ -218,6 +218,21 @@ fn sigrok_sessions_at_three_sample_rates_are_judged() {
         assert_eq!(out.status.code(), Some(code), "{downsample}: {said}");
         assert!(said.contains(says), "{downsample}: {said}");
         assert!(said.contains("sigrok session"), "{said}");
+        // Every access of the VCD is in the session, the last one too
+        // (issue 40: sigrok-cli drops the changes at a file's last
+        // timestamp, and the export ends 1 us after its last event).
+        if code == 0 {
+            let accesses = |capture: &str| {
+                let out = ppmc(&["decode", capture]);
+                let said = text(&out.stdout);
+                said.lines().last().unwrap_or_default().to_string()
+            };
+            assert_eq!(
+                accesses(sr.to_str().expect("utf-8")),
+                accesses(&vcd),
+                "{downsample}"
+            );
+        }
     }
 }
 
@@ -716,8 +731,9 @@ fn a_doubled_map_and_a_million_scopes_are_refused() {
 
 /// A wrong map is the capture's problem, naming the signal, never the
 /// board's: POUT with no channel while the chip pulses; D0 and D1
-/// exchanged; CS and RD exchanged; channels named as sigrok names them
-/// (`D0`..`D37`), never taken for the data lines.
+/// exchanged; CS and RD exchanged; WR* inverted (strobes that overlap);
+/// channels named as sigrok names them (`D0`..`D37`), never taken for the
+/// data lines.
 #[test]
 fn a_wrong_map_is_the_captures_problem_naming_the_signal() {
     let dir = scratch("judge-wrong-map");
@@ -738,6 +754,13 @@ fn a_wrong_map_is_the_captures_problem_naming_the_signal() {
         &["--map", "CS=rd,RD=cs"],
         4,
         &["but CS and RD look exchanged"],
+    );
+    // WR* read inverted: it idles low, so every read has both strobes low.
+    judge_says(
+        &vcd,
+        &["--map", "WR=~wr"],
+        4,
+        &["RD* and WR* were low together with CS*"],
     );
     let n = std::cell::Cell::new(0);
     let default_names = rewrite(&vcd, &dir.path().join("names.vcd"), |l| {

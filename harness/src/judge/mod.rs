@@ -782,6 +782,7 @@ pub fn judge_traced(
     };
     let problem = summary
         .rate_problem(&info)
+        .or_else(|| summary.strobe_problem())
         .or(held)
         .or(quiet)
         .or(partial_problem);

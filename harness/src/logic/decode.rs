@@ -66,6 +66,8 @@ pub struct Summary {
     pub glitches: u64,
     /// Times RD* and WR* were low together with CS*: a bus fight.
     pub conflicts: u64,
+    /// When the first of them began, in picoseconds.
+    pub first_conflict_ps: Option<u64>,
     /// The narrowest strobe decoded, in picoseconds.
     pub narrowest_ps: Option<u64>,
     /// Strobes that lasted one sample or less.
@@ -73,6 +75,19 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// Why the capture contradicts its map, if RD* and WR* were ever low
+    /// together with CS*: no host drives both strobes of one access (a
+    /// probe on the wrong line, or a host that fights the bus).
+    pub fn strobe_problem(&self) -> Option<String> {
+        let at = self.first_conflict_ps?;
+        Some(format!(
+            "RD* and WR* were low together with CS* {} time{}, the first at {}: no access drives both strobes (a probe on the wrong line, a map that names RD or WR wrongly, or a host that fights the bus)",
+            self.conflicts,
+            if self.conflicts == 1 { "" } else { "s" },
+            crate::time::Instant::from_nanos(at / 1000)
+        ))
+    }
+
     /// Why the capture's sample rate is too low for its strobes, if it is:
     /// a strobe seen in a single sample may as well have fallen between
     /// two and been lost; two samples a strobe are the least to trust.
@@ -148,6 +163,7 @@ impl BusDecoder {
                 .is_none_or(|p| !(low(&p, b.cs) && low(&p, b.rd) && low(&p, b.wr)));
             if fighting {
                 self.summary.conflicts += 1;
+                self.summary.first_conflict_ps.get_or_insert(c.time_ps);
             }
         }
         let mut done = None;
@@ -364,5 +380,13 @@ mod tests {
             (Access::WriteData, 0x12, 200_000)
         );
         assert_eq!(s.conflicts, 1);
+        let why = s
+            .strobe_problem()
+            .expect("a fight is the capture's problem");
+        assert!(
+            why.contains("RD* and WR* were low together with CS* 1 time, the first at 0.300us"),
+            "{why}"
+        );
+        assert_eq!(Summary::default().strobe_problem(), None);
     }
 }
