@@ -283,3 +283,76 @@ fn a_flag_a_little_late_passes_a_status_read_and_one_far_late_fails() {
         }
     }
 }
+
+/// The capture of `scenario` with its first move's pulses (and the
+/// outputs after its first pulse: BUSY, INT*, HOLD) late by `late(latency)`
+/// picoseconds, `latency` the first pulse's from the write that started
+/// the move; and a resolution of `resolution_ps`.
+fn first_pout_late(scenario: &str, late: impl Fn(u64) -> u64, resolution_ps: u64) -> Recorded {
+    let mut e = Edges::of(scenario);
+    let (pout, wr) = (e.channel("pout"), e.channel("wr"));
+    let first = e
+        .edges
+        .iter()
+        .find(|x| x.1 == pout && x.2)
+        .map(|x| x.0)
+        .expect("a pulse");
+    let cause = e
+        .edges
+        .iter()
+        .filter(|x| x.1 == wr && x.2 && x.0 < first)
+        .map(|x| x.0)
+        .max()
+        .expect("the write that started the move");
+    let late = late(first - cause);
+    e.info.resolution_ps = resolution_ps;
+    let outputs: Vec<usize> = ["pout", "busy", "int", "hold"]
+        .iter()
+        .map(|n| e.channel(n))
+        .collect();
+    for x in &mut e.edges {
+        if outputs.contains(&x.1) && x.0 >= first {
+            x.0 += late;
+        }
+    }
+    e.end_ps += late;
+    e.capture()
+}
+
+/// Table 3-3: the first POUT after a move command, within its 1 %. A board
+/// whose first pulse comes 0.5 % of that latency late (0.8 us of 164 us)
+/// passes: a move's first pulse is held to the latency tolerance of the
+/// time since the write that started it, not to the floor alone; 2 % late
+/// fails at that pulse.
+#[test]
+fn s3_6_a_first_pout_within_table_3_3s_one_percent_passes() {
+    let scenario = "s3_3_4_accel_1000_steps_cw";
+    let j = judged(first_pout_late(scenario, |l| l * 5 / 1000, 1000));
+    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert_eq!(j.pulses, 1000);
+    assert_eq!(j.marginal.count, 0, "{:?}", j.marginal);
+    let j = judged(first_pout_late(scenario, |l| l * 20 / 1000, 1000));
+    match &j.verdict {
+        Verdict::Failed(d) => assert_eq!(d.what, "POUT pulse 1", "{d}"),
+        other => panic!("{other:?}"),
+    }
+}
+
+/// The decision rule (docs/conformance.md) on a capture sampled every
+/// 42 ns (its uncertainty two samples, 84 ns): a first POUT 40 ns inside
+/// its tolerance (1 % of its latency and the 100 ns floor) passes, but
+/// MARGINAL, within the capture's uncertainty of its limit; 300 ns inside
+/// it passes clean. (Table 3-3, the first POUT.)
+#[test]
+fn s3_6_a_first_pout_within_the_captures_uncertainty_of_its_limit_is_marginal() {
+    let scenario = "s3_3_4_accel_1000_steps_cw";
+    let limit = |l: u64| l / 100 + 100_000;
+    let j = judged(first_pout_late(scenario, |l| limit(l) - 40_000, 42_000));
+    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert_eq!(j.marginal.count, 1, "{:?}", j.marginal);
+    let first = j.marginal.first.as_deref().expect("described");
+    assert!(first.starts_with("POUT pulse 1 at "), "{first}");
+    let j = judged(first_pout_late(scenario, |l| limit(l) - 300_000, 42_000));
+    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert_eq!(j.marginal.count, 0, "{:?}", j.marginal);
+}

@@ -781,8 +781,9 @@ fn a_wrong_map_is_the_captures_problem_naming_the_signal() {
 }
 
 /// POUT and DIR inverted by the board's output stage: `~` in the map
-/// judges them (3-3-4's pulses and direction); without it, the board's
-/// divergence comes with a hint naming the map that passes.
+/// judges them (3-3-4's pulses and direction); without it, a POUT that
+/// idles high is the capture's problem naming the map, and a DIR
+/// opposite at every pulse a hint naming the map that passes.
 #[test]
 fn inverted_pout_and_dir_are_judged_with_a_tilde_and_hinted_without() {
     let dir = scratch("judge-inverted");
@@ -812,10 +813,23 @@ fn inverted_pout_and_dir_are_judged_with_a_tilde_and_hinted_without() {
         0,
         &["1000 POUT pulses compared"],
     );
+    // Without the map: POUT idles high, the capture's problem, naming the
+    // map that reads it.
     judge_says(
         &inverted,
         &[],
+        4,
+        &[
+            "POUT is high where the model starts (the chip idles it low): it looks inverted",
+            "--map POUT=~pout",
+        ],
+    );
+    // POUT read inverted, DIR not: the board diverges at DIR, with the
+    // hint that names the map that passes.
+    judge_says(
+        &inverted,
+        &["--map", "POUT=~pout"],
         1,
-        &["hint: POUT looks inverted and DIR looks inverted: judged with `--map POUT=~pout,DIR=~dir` the board passes"],
+        &["hint: DIR looks inverted: judged with `--map POUT=~pout,DIR=~dir` the board passes"],
     );
 }

@@ -16,7 +16,9 @@
 //! export --host exact`: each write's strobe ends as IBF falls). Sampling
 //! then moves a write to either side of IBF's fall, and the judge must
 //! follow both orders rather than fail the board for the one its model
-//! picked.
+//! picked. The exact host's board may be MARGINAL (docs/capture.md): a
+//! change within the capture's uncertainty of its limit; the polling
+//! host's never is.
 //!
 //! `cargo test` judges a sample of the suite, one scenario of each kind;
 //! CI sets `PPMC_SUITE_CAPTURES=all` and judges every scenario (`.ci/run`);
@@ -63,7 +65,10 @@ const SR_LIMIT_BYTES: u64 = 50 << 20;
 
 /// Judges `capture` and says what went wrong, if anything: the board must
 /// pass, exit 0, or 3 with host findings.
-fn judge(capture: &Path, partial: bool) -> Result<bool, String> {
+/// And with `marginal_ok`, `MARGINAL the board` will do too (the exact
+/// host's captures: docs/capture.md, "MARGINAL"). Whether the host broke
+/// chapter 3's rules, and whether the board was MARGINAL.
+fn judge(capture: &Path, partial: bool, marginal_ok: bool) -> Result<(bool, bool), String> {
     let mut args = vec!["judge", capture.to_str().expect("utf-8")];
     if partial {
         args.push("--partial");
@@ -71,14 +76,16 @@ fn judge(capture: &Path, partial: bool) -> Result<bool, String> {
     let out = ppmc(&args);
     let said = text(&out.stdout);
     let code = out.status.code();
-    if !said.contains("PASS the board") || !matches!(code, Some(0 | 3)) {
+    let marginal = said.contains("MARGINAL the board");
+    let passed = said.contains("PASS the board") || (marginal_ok && marginal);
+    if !passed || !matches!(code, Some(0 | 3)) {
         return Err(format!(
             "{}: exit {code:?}\n{said}{}",
             capture.display(),
             text(&out.stderr)
         ));
     }
-    Ok(code == Some(3))
+    Ok((code == Some(3), marginal))
 }
 
 /// How the exported host times its waited accesses (`ppmc export --host`).
@@ -95,8 +102,10 @@ const POLLING_ONLY: [&str; 1] = ["s3_3_4_accel_ffffff_is_16777216_steps"];
 const PARTIAL: [&str; 1] = ["s3_2_2_external_clock"];
 
 /// Exports (with a host timed as `host` says), converts and judges
-/// `name`; whether the host broke chapter 3's rules in it.
-fn check(dir: &Path, name: &str, host: &str) -> Result<bool, String> {
+/// `name`; whether the host broke chapter 3's rules in it, and in how
+/// many of its captures the board was MARGINAL (never with the polling
+/// host).
+fn check(dir: &Path, name: &str, host: &str) -> Result<(bool, u32), String> {
     let vcd = dir.join(format!("{name}-{host}.vcd"));
     let out = ppmc(&[
         "export",
@@ -112,7 +121,9 @@ fn check(dir: &Path, name: &str, host: &str) -> Result<bool, String> {
         return Err(format!("{name}: export: {}", text(&out.stderr)));
     }
     let partial = PARTIAL.contains(&name);
-    let found = judge(&vcd, partial)?;
+    let marginal_ok = host == "exact";
+    let (found, marginal) = judge(&vcd, partial, marginal_ok)?;
+    let mut marginals = u32::from(marginal);
     let size = std::fs::metadata(&vcd).map_err(|e| e.to_string())?.len();
     if size <= SR_LIMIT_BYTES {
         for ds in DOWNSAMPLE {
@@ -127,7 +138,9 @@ fn check(dir: &Path, name: &str, host: &str) -> Result<bool, String> {
             if !out.status.success() {
                 return Err(format!("{name}: sigrok-cli: {}", text(&out.stderr)));
             }
-            if judge(&sr, partial)? != found {
+            let (f, marginal) = judge(&sr, partial, marginal_ok)?;
+            marginals += u32::from(marginal);
+            if f != found {
                 return Err(format!(
                     "{name} ({host} host): host findings at 1/{ds} ns and not in the VCD, or the other way"
                 ));
@@ -136,7 +149,7 @@ fn check(dir: &Path, name: &str, host: &str) -> Result<bool, String> {
         }
     }
     let _ = std::fs::remove_file(&vcd);
-    Ok(found)
+    Ok((found, marginals))
 }
 
 #[test]
@@ -182,7 +195,7 @@ fn every_scenarios_capture_passes_at_three_sample_rates() {
     assert!(failed.is_empty(), "{}", failed.join("\n"));
     let mut host: Vec<&str> = results
         .iter()
-        .filter(|(_, r)| r == &Ok(true))
+        .filter(|(_, r)| r.as_ref().is_ok_and(|(h, _)| *h))
         .map(|(n, _)| n.as_str())
         .collect();
     host.sort();
@@ -198,8 +211,12 @@ fn every_scenarios_capture_passes_at_three_sample_rates() {
         host.contains(&"e1_operation_command_while_busy"),
         "{host:?}"
     );
+    let marginal: u32 = results
+        .iter()
+        .filter_map(|(_, r)| r.as_ref().ok().map(|(_, m)| *m))
+        .sum();
     eprintln!(
-        "{} scenarios judged with {} hosts at {} sample rates; host findings in {}",
+        "{} scenarios judged with {} hosts at {} sample rates; host findings in {}; the board MARGINAL in {marginal} of the exact host's captures",
         names.len(),
         HOSTS.len(),
         DOWNSAMPLE.len() + 1,

@@ -334,7 +334,9 @@ fn records(
         .collect();
     notes.push(counts(j));
     notes.extend(j.hints.iter().map(|h| format!("hint: {h}")));
+    notes.extend(marginal(j));
     let (verdict, blame, message) = match &j.verdict {
+        Verdict::Passed if j.marginal.count > 0 => (ScenarioVerdict::Marginal, None, None),
         Verdict::Passed => (ScenarioVerdict::Passed, None, None),
         Verdict::Failed(d) => (
             ScenarioVerdict::Failed(Failure {
@@ -410,6 +412,21 @@ fn counts(j: &Judgement) -> String {
     )
 }
 
+/// The comparisons within the capture's uncertainty of their limits, in
+/// one line, if any.
+fn marginal(j: &Judgement) -> Option<String> {
+    let m = &j.marginal;
+    (m.count > 0).then(|| {
+        format!(
+            "{} comparison{} within the capture's uncertainty of {} limit (docs/conformance.md), the first: {}",
+            m.count,
+            if m.count == 1 { "" } else { "s" },
+            if m.count == 1 { "its" } else { "their" },
+            m.first.as_deref().unwrap_or("-")
+        )
+    })
+}
+
 /// A host finding, in one line.
 fn finding(h: &HostFinding) -> String {
     format!(
@@ -432,6 +449,13 @@ fn say(j: &Judgement) -> Result<(), CliError> {
     for h in &j.hints {
         outln!("hint: {h}");
     }
+    let passed = match marginal(j) {
+        Some(m) if matches!(j.verdict, Verdict::Passed) => {
+            outln!("{m}");
+            "MARGINAL"
+        }
+        _ => "PASS",
+    };
     let word = |w: &str| super::out::verdict_word(w, 0);
     match &j.verdict {
         Verdict::Failed(d) => {
@@ -445,13 +469,13 @@ fn say(j: &Judgement) -> Result<(), CliError> {
         Verdict::Passed if !j.host.is_empty() => {
             outln!(
                 "{} the board; the host firmware broke chapter 3's rules {} times",
-                word("PASS"),
+                word(passed),
                 j.host.len()
             );
             Err(CliError::Code(3))
         }
         Verdict::Passed => {
-            outln!("{} the board", word("PASS"));
+            outln!("{} the board", word(passed));
             Ok(())
         }
     }

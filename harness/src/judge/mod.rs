@@ -101,6 +101,32 @@ pub enum Verdict {
     Capture(String),
 }
 
+/// The comparisons whose difference from the model lies within the
+/// capture's uncertainty of its limit (two samples: each edge is seen up to
+/// a sample from where it was), by the decision rule of
+/// `docs/conformance.md`: neither proven inside the tolerance nor outside
+/// it. The board passes, MARGINAL.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Marginal {
+    pub count: u64,
+    /// The first of them, in words.
+    pub first: Option<String>,
+}
+
+impl Marginal {
+    /// A comparison that passed: `d` from the model, within `allowed`,
+    /// which holds the uncertainty `u` beside the tolerance. Marginal
+    /// unless `d ± u` lies wholly within the tolerance.
+    fn note(&mut self, d: u64, allowed: u64, u: u64, what: impl FnOnce() -> String) {
+        if d.saturating_add(u) > allowed.saturating_sub(u) {
+            self.count += 1;
+            if self.first.is_none() {
+                self.first = Some(what());
+            }
+        }
+    }
+}
+
 /// What judging a capture found.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Judgement {
@@ -117,6 +143,8 @@ pub struct Judgement {
     /// What the capture suggests of its own map where the board diverged
     /// (`POUT looks inverted: ...`), for the user to weigh.
     pub hints: Vec<String>,
+    /// The comparisons within the capture's uncertainty of their limits.
+    pub marginal: Marginal,
 }
 
 impl fmt::Display for Divergence {
@@ -168,6 +196,8 @@ struct Bench {
     last_cause_ps: u64,
     compared: u64,
     last_access: Option<Transaction>,
+    /// The pulses matched within the capture's uncertainty of their limit.
+    marginal: Marginal,
 }
 
 impl Bench {
@@ -204,14 +234,24 @@ impl Bench {
 
     /// How far a pulse may be from the model's, in picoseconds: the
     /// floor, two samples, and the interval tolerance of the time since
-    /// the model's last pulse.
-    fn allowed_ps(&self, model: Instant) -> u64 {
-        let since = self
-            .last_model
-            .map_or(0, |l| model.as_nanos().saturating_sub(l.as_nanos()));
-        let rel = since.saturating_mul(self.tol.interval_bp) / 10_000;
-        (self.tol.floor.as_nanos().saturating_add(rel))
-            .saturating_mul(1000)
+    /// the model's last pulse; for a move's first pulse, the latency
+    /// tolerance of the time since the write that started the move (Table
+    /// 3-3's first POUT, within its 1 %), its cause.
+    fn allowed_ps(&self, model: Instant, first_of_move: bool) -> u64 {
+        let rel_ps = match first_of_move {
+            true => {
+                let since = self.capture_ps(model).saturating_sub(self.last_cause_ps);
+                since.saturating_mul(self.tol.latency_bp) / 10_000
+            }
+            false => {
+                let since = self
+                    .last_model
+                    .map_or(0, |l| model.as_nanos().saturating_sub(l.as_nanos()));
+                since.saturating_mul(self.tol.interval_bp) / 10_000 * 1000
+            }
+        };
+        (self.tol.floor.as_nanos().saturating_mul(1000))
+            .saturating_add(rel_ps)
             .saturating_add(2 * self.resolution_ps)
     }
 
@@ -270,7 +310,8 @@ impl Bench {
     /// either side of it, as far as the capture can tell: the pulses' own
     /// tolerance there, and at least a sample.
     fn pulse_window(&self, ps: u64) -> u64 {
-        self.allowed_ps(self.model_time(ps)).max(self.resolution_ps)
+        self.allowed_ps(self.model_time(ps), false)
+            .max(self.resolution_ps)
     }
 
     /// The inputs changed at capture time `ps`: given to the model. Where
@@ -353,7 +394,7 @@ impl Bench {
             match (board, model) {
                 (None, None) => return Ok(()),
                 (Some(b), None) => {
-                    let allowed = self.allowed_ps(self.model_time(b));
+                    let allowed = self.allowed_ps(self.model_time(b), false);
                     if b.saturating_add(allowed) >= horizon_ps {
                         return Ok(());
                     }
@@ -368,7 +409,7 @@ impl Bench {
                 (b, Some((m, dir, first))) => {
                     let model_ps = self.capture_ps(m);
                     let m_ps = self.expected_ps(model_ps, first);
-                    let allowed = self.allowed_ps(m);
+                    let allowed = self.allowed_ps(m, first);
                     match b {
                         Some(b) if b.abs_diff(m_ps) <= allowed => {
                             let ccw = dir == Direction::Ccw;
@@ -388,6 +429,20 @@ impl Bench {
                                     self,
                                 ));
                             }
+                            let n = self.compared + 1;
+                            self.marginal.note(
+                                b.abs_diff(m_ps),
+                                allowed,
+                                2 * self.resolution_ps,
+                                || {
+                                    format!(
+                                        "POUT pulse {n} at {}: {} from the model's, allowed {} (two samples of it the capture's uncertainty)",
+                                        Instant::from_nanos(b / 1000),
+                                        Duration::from_nanos(b.abs_diff(m_ps) / 1000),
+                                        Duration::from_nanos(allowed / 1000)
+                                    )
+                                },
+                            );
                             self.edges.pop_front();
                             self.take_model_pulse();
                             self.last_model = Some(m);
@@ -587,6 +642,7 @@ pub fn judge_traced(
                     changes: 0,
                     not_judged,
                     hints: Vec::new(),
+                    marginal: Marginal::default(),
                 },
                 None,
             ))
@@ -631,6 +687,7 @@ pub fn judge_traced(
         last_cause_ps: 0,
         compared: 0,
         last_access: None,
+        marginal: Marginal::default(),
     };
     let outputs = outputs::Outputs::new(map, &bench.board);
     let unwatched: Vec<String> = [Signal::Int, Signal::Busy, Signal::Hold, Signal::Aux]
@@ -656,6 +713,8 @@ pub fn judge_traced(
     }];
     let mut prev: Option<Change> = None;
     let mut started = reset.is_none();
+    // POUT's level where the model starts: the chip idles it low.
+    let mut pout_at_start: Option<bool> = None;
     let mut source = Lookahead::new(&mut source);
     let mut tracer = scenario.map(|_| trace::CaptureTrace::new(map, &info));
     while let Some(c) = source.next()? {
@@ -675,6 +734,9 @@ pub fn judge_traced(
                 }
                 inputs_before = None;
             }
+        }
+        if pout_at_start.is_none() {
+            pout_at_start = pout.map(|ch| c.high(ch));
         }
         // The inputs as the board drove them (active low).
         let changed: Vec<(Input, bool)> = inputs
@@ -780,9 +842,19 @@ pub fn judge_traced(
             short.join("; ")
         )),
     };
+    // A POUT that idles high is read inverted: its rising edges are the
+    // ends of the pulses, a pulse width late, which the tolerance may
+    // hide. The capture's, naming the map that reads it.
+    let pout_inverted = pout.filter(|_| pout_at_start == Some(true)).map(|ch| {
+        format!(
+            "POUT is high where the model starts (the chip idles it low): it looks inverted (an inverting or open-collector output stage): read it so with --map POUT=~{}",
+            info.channels.get(ch).map_or("CHANNEL", String::as_str)
+        )
+    });
     let problem = summary
         .rate_problem(&info)
         .or_else(|| summary.strobe_problem())
+        .or(pout_inverted)
         .or(held)
         .or(quiet)
         .or(partial_problem);
@@ -803,6 +875,13 @@ pub fn judge_traced(
             changes: outputs.compared(),
             not_judged,
             hints: Vec::new(),
+            marginal: {
+                let mut m = bench.marginal;
+                let o = outputs.marginal();
+                m.count += o.count;
+                m.first = m.first.or(o.first);
+                m
+            },
         },
         trace,
     ))

@@ -5,7 +5,7 @@
 //! caused it (the last register access or the last pulse before it:
 //! Table 3-3 times INT*, BUSY and HOLD from them).
 
-use super::Divergence;
+use super::{Divergence, Marginal};
 use crate::compare::Tolerances;
 use crate::emu::Board;
 use crate::logic::map::{ChannelMap, Signal};
@@ -34,6 +34,8 @@ pub(super) struct Outputs {
     /// Recent register accesses, in capture time (the newest last).
     accesses: VecDeque<u64>,
     compared: u64,
+    /// The changes matched within the capture's uncertainty of their limit.
+    marginal: Marginal,
 }
 
 /// One output pin and its two sides.
@@ -119,6 +121,7 @@ impl Outputs {
             watches,
             accesses: VecDeque::new(),
             compared: 0,
+            marginal: Marginal::default(),
         }
     }
 
@@ -130,6 +133,11 @@ impl Outputs {
     /// Changes compared so far.
     pub(super) fn compared(&self) -> u64 {
         self.compared
+    }
+
+    /// The changes matched within the capture's uncertainty of their limit.
+    pub(super) fn marginal(&self) -> Marginal {
+        self.marginal.clone()
     }
 
     /// A register access ended at `ps`: what the changes after it are
@@ -229,6 +237,21 @@ impl Outputs {
                         let allowed = allowed(m_ps, &self.accesses);
                         match b {
                             Some((b, bl)) if bl == level && b.abs_diff(m_ps) <= allowed => {
+                                self.marginal.note(
+                                    b.abs_diff(m_ps),
+                                    allowed,
+                                    2 * resolution_ps,
+                                    || {
+                                        format!(
+                                            "{} {} at {}: {} from the model's, allowed {} (two samples of it the capture's uncertainty)",
+                                            w.signal.name(),
+                                            w.word(level),
+                                            at(b),
+                                            Duration::from_nanos(b.abs_diff(m_ps) / 1000),
+                                            Duration::from_nanos(allowed / 1000)
+                                        )
+                                    },
+                                );
                                 w.board.pop_front();
                                 w.model = level;
                                 w.next_event += 1;

@@ -471,7 +471,10 @@ fn testcase(x: &mut String, r: &ScenarioResult, name: &str, extra: &Extra) {
             .filter(|m| m.grade == Grade::Marginal)
             .map(|m| m.to_string())
             .collect();
-        out.push(format!("MARGINAL: {}", near.join("; ")));
+        // A judged capture's marginal comparisons are in its notes.
+        if !near.is_empty() {
+            out.push(format!("MARGINAL: {}", near.join("; ")));
+        }
     }
     out.extend(
         attachments
