@@ -61,6 +61,15 @@ impl Edges {
         self.info.channel(name).expect("a channel of ours")
     }
 
+    /// When channel `ch` first rises.
+    fn first_rise(&self, ch: usize) -> u64 {
+        self.edges
+            .iter()
+            .find(|x| x.1 == ch && x.2)
+            .map(|x| x.0)
+            .expect("a rising edge")
+    }
+
     /// The capture put together again, its edges in time order.
     fn capture(mut self) -> Recorded {
         self.edges.sort_by_key(|e| e.0);
@@ -93,12 +102,7 @@ fn judged(mut cap: Recorded) -> ppmc::judge::Judgement {
 fn clock_off(scenario: &str, ppm: u64) -> Recorded {
     let mut e = Edges::of(scenario);
     let pout = e.channel("pout");
-    let first = e
-        .edges
-        .iter()
-        .find(|x| x.1 == pout && x.2)
-        .map(|x| x.0)
-        .expect("a pulse");
+    let first = e.first_rise(pout);
     let last = e
         .edges
         .iter()
@@ -244,12 +248,7 @@ fn a_flag_a_little_late_passes_a_status_read_and_one_far_late_fails() {
             e.channel("busy"),
         );
         let d2 = e.channel("d2");
-        let rose = e
-            .edges
-            .iter()
-            .find(|x| x.1 == busy && x.2)
-            .map(|x| x.0)
-            .expect("BUSY rises");
+        let rose = e.first_rise(busy);
         // The status read that saw BUSY = 1 first ends just after it
         // rises. On the board, BUSY (pin and status) rises `late_ps` late,
         // and the read, as late but for 100 ns, still sees BUSY = 0.
@@ -291,12 +290,7 @@ fn a_flag_a_little_late_passes_a_status_read_and_one_far_late_fails() {
 fn first_pout_late(scenario: &str, late: impl Fn(u64) -> u64, resolution_ps: u64) -> Recorded {
     let mut e = Edges::of(scenario);
     let (pout, wr) = (e.channel("pout"), e.channel("wr"));
-    let first = e
-        .edges
-        .iter()
-        .find(|x| x.1 == pout && x.2)
-        .map(|x| x.0)
-        .expect("a pulse");
+    let first = e.first_rise(pout);
     let cause = e
         .edges
         .iter()
