@@ -381,6 +381,11 @@ pub fn judge_traced(
         }
         if pout_at_start.is_none() {
             pout_at_start = pout.map(|ch| c.high(ch));
+            // Another map tried (`suspect`): one that reads POUT idling
+            // high is no better, known at once.
+            if opts.stop_at_divergence && pout_at_start == Some(true) {
+                break;
+            }
         }
         // The inputs as the board drove them (active low).
         let changed: Vec<(Input, bool)> = inputs
