@@ -12,7 +12,9 @@
 //! model behind it; a bridge firmware implements it over the real chip.
 
 use crate::emu::{Board, Chip, ChipError, ModelConfig};
-use crate::protocol::{Flag, Input, Pins, PulseSummary, Record, RecordMark, Status, Straps};
+use crate::protocol::{
+    Flag, Input, Pin, Pins, PulseSummary, Record, RecordMark, Status, Straps,
+};
 use crate::time::{Duration, Instant};
 use alloc::string::String;
 
@@ -238,6 +240,62 @@ impl core::fmt::Display for Reply {
     }
 }
 
+/// How sure the times a bus gives are (plus or minus), by the path each
+/// was taken on (`docs/bridge-protocol.md` section 4): a bridge stamps some
+/// edges in hardware as they happen, samples other outputs with its CPU,
+/// and finds a status flag's change by polling the status register. The
+/// reference model's times are exact: all four 0.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Uncertainty {
+    /// An edge the capture stamps as it happens: POUT's pulses, and the
+    /// changes of INT*, HOLD and AUX*.
+    pub edge: Duration,
+    /// An output the bridge samples: the changes of S1..S5 (the phases and
+    /// stop switching), AUXO0..3 and DIR in the capture.
+    pub sampled: Duration,
+    /// A bus access's stamp (the strobe of a write or a read, a pin read)
+    /// and an input's change.
+    pub access: Duration,
+    /// A status flag's change found by polling the status register: BUSY's
+    /// changes in the capture, and the end of a wait for IBF, OBF or BUSY.
+    pub polled: Duration,
+}
+
+impl Uncertainty {
+    /// Exact times (the reference model).
+    pub const ZERO: Uncertainty = Uncertainty {
+        edge: Duration::ZERO,
+        sampled: Duration::ZERO,
+        access: Duration::ZERO,
+        polled: Duration::ZERO,
+    };
+
+    /// The uncertainty of a change of `pin` in the capture.
+    pub fn of_pin(&self, pin: Pin) -> Duration {
+        match pin {
+            Pin::Int | Pin::Hold | Pin::Aux => self.edge,
+            Pin::Auxo | Pin::Dir | Pin::Phases | Pin::Switching => self.sampled,
+            Pin::Busy => self.polled,
+        }
+    }
+
+    /// Each path at least `floor` (a timer's tick: no time on the wire is
+    /// surer than that).
+    pub fn at_least(self, floor: Duration) -> Uncertainty {
+        Uncertainty {
+            edge: self.edge.max(floor),
+            sampled: self.sampled.max(floor),
+            access: self.access.max(floor),
+            polled: self.polled.max(floor),
+        }
+    }
+
+    /// The largest of the four.
+    pub fn worst(&self) -> Duration {
+        self.edge.max(self.sampled).max(self.access).max(self.polled)
+    }
+}
+
 /// A chip bus plus its pins and a pulse capture: what the bridge engine
 /// drives. The reference model implements it ([`EmuBus`]); a bridge
 /// firmware implements it over the real chip's bus, pins and edge capture.
@@ -261,6 +319,13 @@ pub trait Bus {
 
     /// The bus's clock: time since the last reset.
     fn now(&self) -> Instant;
+
+    /// How sure the times this bus gives are, by path (HELLO_REPLY's
+    /// `uncertainty`): exact (0) unless it says otherwise. The bridge
+    /// engine raises each to at least one tick of its timer.
+    fn uncertainty(&self) -> Uncertainty {
+        Uncertainty::ZERO
+    }
 
     /// Whether the capture lost anything since the last reset (a buffer
     /// that filled faster than it was drained): the bridge then answers

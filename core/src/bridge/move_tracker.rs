@@ -295,6 +295,10 @@ impl<B: Bus> Bus for Tracked<B> {
         self.inner.straps()
     }
 
+    fn uncertainty(&self) -> crate::bus::Uncertainty {
+        self.inner.uncertainty()
+    }
+
     fn now(&self) -> Instant {
         self.inner.now()
     }

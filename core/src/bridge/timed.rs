@@ -145,6 +145,10 @@ impl<B: Bus> Bus for Timed<B> {
         self.inner.straps()
     }
 
+    fn uncertainty(&self) -> crate::bus::Uncertainty {
+        self.inner.uncertainty()
+    }
+
     fn now(&self) -> Instant {
         self.inner.now()
     }

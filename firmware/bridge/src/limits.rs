@@ -41,6 +41,15 @@
 //! (its runs' `Vec` to 2,048) takes the heap to about 155 KB of its
 //! 256 KiB.
 
+/// The widest the board code lets the bracket grow in which it stamps a
+/// change of an output it samples (S1..S5, AUXO0..3, DIR): from the last
+/// sight of the old levels to the first of the new, in ns. It samples them
+/// at every poll (between ops, in every wait's loop, while it waits for the
+/// host) and at every pin read; a stamp is halfway, so within half of this
+/// (HELLO_REPLY's `sampled` uncertainty). The twin's tests hold the board
+/// code to it under the suite's busiest loads.
+pub const SAMPLE_BRACKET_NS: u64 = 10_000;
+
 /// The heap: the RP2350 board's, and the QEMU board's with it, so that the
 /// virtual board runs out where the board does. The board has 512 KiB of
 /// RAM for data; the rest is its stack and statics.

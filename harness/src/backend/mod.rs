@@ -55,7 +55,7 @@ pub use self::serial::{
 pub use self::spec::{Address, LinkKind, SpecError, StrapOptions, TargetSpec};
 pub use self::target::{
     Op, Reply, SelfTestPlan, SelfTestReply, SelfTestRun, Target, TargetError, TargetErrorKind,
-    TargetInfo,
+    TargetInfo, Uncertainty,
 };
 
 pub(crate) use self::link::timed_out;

@@ -1,10 +1,9 @@
 //! The [`Target`] trait every backend implements, and what it says and
 //! fails with: [`TargetInfo`], [`TargetError`] and its [`TargetErrorKind`].
 
-pub use ppmc_core::bus::{Op, Reply, SelfTestPlan, SelfTestReply};
+pub use ppmc_core::bus::{Op, Reply, SelfTestPlan, SelfTestReply, Uncertainty};
 
 use crate::protocol::{Record, RecordMark, Straps};
-use crate::time::Duration;
 use std::fmt;
 
 /// A bridge's self-test as it ran: what the bridge says it generated, and
@@ -157,12 +156,14 @@ pub trait Target: Send {
         ))
     }
 
-    /// How sure one time this target gives is (±): the emulator's are
-    /// exact (0); a board's are as fine as its bridge's timer (one tick).
-    /// An interval between two of its times is twice as unsure. Every
-    /// Table 3-3 measurement carries it ([`crate::scenario::Measurement`]).
-    fn time_uncertainty(&self) -> Duration {
-        Duration::ZERO
+    /// How sure the times this target gives are (plus or minus), by the
+    /// path each was taken on: the emulator's are exact (0); a board's are
+    /// what its bridge declares in HELLO (never finer than its timer's
+    /// tick). An interval between two times is as unsure as its two ends
+    /// together. Every Table 3-3 measurement carries it
+    /// ([`crate::scenario::Measurement`]).
+    fn uncertainty(&self) -> Uncertainty {
+        Uncertainty::ZERO
     }
 
     /// The bus bridge's serial number, where it gives one (its HELLO) or

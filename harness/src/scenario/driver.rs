@@ -13,7 +13,7 @@ use super::check::Check;
 use super::grade::{Grade, Measurement};
 use super::outcome::{fail, HarnessError, Outcome, Stop};
 use super::steps::{Done, Role, Step};
-use crate::backend::{Op, Reply, Target};
+use crate::backend::{Op, Reply, Target, Uncertainty};
 use crate::protocol::{
     ClockSource, Direction, ErrorCode, Flag, Input, Pins, Record, Register, Status, Straps,
     TimingId,
@@ -34,9 +34,9 @@ pub struct Driver<'t> {
     pub(super) measurements: Vec<Measurement>,
     pub(super) init: Option<Init>,
     pub(super) straps: Straps,
-    /// How sure an interval between two of the target's times is (±):
-    /// twice its [`Target::time_uncertainty`].
-    pub(super) interval_u: Duration,
+    /// How sure the target's times are, by path
+    /// ([`Target::uncertainty`]): a measurement's is its two ends'.
+    pub(super) u: Uncertainty,
 }
 
 impl std::fmt::Debug for Driver<'_> {
@@ -51,7 +51,7 @@ impl std::fmt::Debug for Driver<'_> {
 impl<'t> Driver<'t> {
     pub fn new(target: &'t mut dyn Target, opts: DriverOptions) -> Self {
         let straps = target.straps();
-        let interval_u = target.time_uncertainty().saturating_mul(2);
+        let u = target.uncertainty();
         let opts = DriverOptions {
             ibf_timeout: straps.stretch(opts.ibf_timeout),
             obf_timeout: straps.stretch(opts.obf_timeout),
@@ -67,7 +67,7 @@ impl<'t> Driver<'t> {
         };
         Driver {
             straps,
-            interval_u,
+            u,
             batch: Batch::new(target, limits),
             opts,
             measurements: Vec::new(),
@@ -391,7 +391,8 @@ impl<'t> Driver<'t> {
                 want.saturating_sub(slack),
                 want + slack,
                 got,
-                self.interval_u,
+                // Each end a pin read's stamp.
+                self.u.access.saturating_mul(2),
                 at,
             );
             let grade = m.grade;

@@ -6,9 +6,10 @@
 //!
 //! The limits are the datasheet's band (`[min, max]`, or the single typical
 //! figure) widened by its 1 % footnote. Each measurement carries its
-//! uncertainty `U` (±), the instrument's: 0 on the emulator, the target's
-//! own on a board ([`crate::backend::Target::time_uncertainty`], twice for
-//! an interval between two of its times). Then:
+//! uncertainty `U` (±), the instrument's: 0 on the emulator, on a board
+//! the sum of its two ends' as the bridge declares them per path
+//! ([`crate::backend::Target::uncertainty`]: an access's stamp, a captured
+//! edge, a sampled output, a polled flag). Then:
 //!
 //! - FAIL: the whole interval `value ± U` lies outside the band;
 //! - MARGINAL: it straddles a limit (the instrument cannot tell: "within

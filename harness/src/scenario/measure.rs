@@ -8,11 +8,15 @@ use crate::protocol::{Flag, Pin, Register, TimingId};
 use crate::time::{Duration, Instant, Limit};
 
 impl Driver<'_> {
-    fn record_measure(&mut self, id: TimingId, value: Duration, at: Instant) -> Outcome<Grade> {
-        let m = self
-            .opts
-            .grading
-            .grade(id, &self.straps, value, self.interval_u, at);
+    /// Grades a measurement whose two ends are as sure as `u`, together.
+    fn record_measure(
+        &mut self,
+        id: TimingId,
+        value: Duration,
+        u: Duration,
+        at: Instant,
+    ) -> Outcome<Grade> {
+        let m = self.opts.grading.grade(id, &self.straps, value, u, at);
         let grade = m.grade;
         let (lo, hi, got) = (m.lo, m.hi, m.shown());
         self.measurements.push(m);
@@ -59,47 +63,51 @@ impl Driver<'_> {
     /// Measures the Table 3-3 quantity `id` from what has happened so far
     /// and grades it. A FAIL stops the scenario; MARGINAL is recorded.
     pub fn expect_latency(&mut self, id: TimingId) -> Outcome<Duration> {
-        let (from, to) = match id {
+        // Each end, and how sure the target is of it: a write or an input
+        // change is an access's stamp, a pulse an edge, a pin change its
+        // pin's path.
+        let u = self.u;
+        let ((from, u_from), (to, u_to)) = match id {
             TimingId::BusyRise => {
                 let a = self.flushed("an operation command", |d| d.batch.anchor())?;
-                (a, self.pin_after(Pin::Busy, Some(1), a)?)
+                ((a, u.access), (self.pin_after(Pin::Busy, Some(1), a)?, u.polled))
             }
             TimingId::AccelFirstPout | TimingId::ConstantFirstPout => {
                 let a = self.flushed("an operation command", |d| d.batch.anchor())?;
                 let (first, _) = self.last_move_pulse_times()?;
-                (a, Some(first))
+                ((a, u.access), (Some(first), u.edge))
             }
             TimingId::SingleStep => {
                 let a = self.flushed("an operation command", |d| d.batch.anchor())?;
-                (a, self.pin_after(Pin::Busy, Some(0), a)?)
+                ((a, u.access), (self.pin_after(Pin::Busy, Some(0), a)?, u.polled))
             }
             TimingId::InterruptOutput => {
                 let (_, last) = self.last_move_pulse_times()?;
-                (last, self.pin_after(Pin::Int, Some(1), last)?)
+                ((last, u.edge), (self.pin_after(Pin::Int, Some(1), last)?, u.edge))
             }
             TimingId::HoldOn => {
                 let (_, last) = self.last_move_pulse_times()?;
-                (last, self.pin_after(Pin::Hold, Some(1), last)?)
+                ((last, u.edge), (self.pin_after(Pin::Hold, Some(1), last)?, u.edge))
             }
             TimingId::AbnormalTermination => {
                 let t = self.flushed("a stop or limit", |d| d.batch.trigger())?;
-                (t, self.pin_after(Pin::Busy, Some(0), t)?)
+                ((t, u.access), (self.pin_after(Pin::Busy, Some(0), t)?, u.polled))
             }
             TimingId::AuxOn => {
                 let t = self.flushed("an AUX ON command", |d| d.batch.trigger())?;
-                (t, self.pin_after(Pin::Aux, Some(1), t)?)
+                ((t, u.access), (self.pin_after(Pin::Aux, Some(1), t)?, u.edge))
             }
             TimingId::AuxOff => {
                 let t = self.flushed("an AUX OFF command", |d| d.batch.trigger())?;
-                (t, self.pin_after(Pin::Aux, Some(0), t)?)
+                ((t, u.access), (self.pin_after(Pin::Aux, Some(0), t)?, u.edge))
             }
             TimingId::ExcitationOff => {
                 let t = self.flushed("a software reset", |d| d.batch.trigger())?;
-                (t, self.pin_after(Pin::Phases, Some(0), t)?)
+                ((t, u.access), (self.pin_after(Pin::Phases, Some(0), t)?, u.sampled))
             }
             TimingId::InitOutputsSet => {
                 let t = self.flushed("an initialization", |d| d.batch.init_write())?;
-                (t, self.pin_after(Pin::Phases, None, t)?)
+                ((t, u.access), (self.pin_after(Pin::Phases, None, t)?, u.sampled))
             }
             TimingId::InitProcessing => return self.measure_init_processing(),
             TimingId::NextCommand => return self.measure_next_command(),
@@ -117,7 +125,7 @@ impl Driver<'_> {
             )
         })?;
         let value = to.saturating_since(from);
-        self.record_measure(id, value, to)?;
+        self.record_measure(id, value, u_from.saturating_add(u_to), to)?;
         Ok(value)
     }
 
@@ -133,7 +141,9 @@ impl Driver<'_> {
         let value = self.batch.clock().saturating_since(t);
         let at = self.batch.clock();
         self.drain_probe()?;
-        self.record_measure(TimingId::InitProcessing, value, at)?;
+        // From the final byte's write to the end of the wait for IBF.
+        let u = self.u.access.saturating_add(self.u.polled);
+        self.record_measure(TimingId::InitProcessing, value, u, at)?;
         Ok(value)
     }
 
@@ -150,7 +160,9 @@ impl Driver<'_> {
         let value = self.batch.clock().saturating_since(last);
         let at = self.batch.clock();
         self.drain_probe()?;
-        self.record_measure(TimingId::NextCommand, value, at)?;
+        // From the last pulse to the end of the wait for IBF.
+        let u = self.u.edge.saturating_add(self.u.polled);
+        self.record_measure(TimingId::NextCommand, value, u, at)?;
         Ok(value)
     }
 

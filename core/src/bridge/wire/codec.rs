@@ -6,7 +6,8 @@ use super::bytes::{Timer, R, W};
 use super::capture::{get_capture, put_capture};
 use super::message::*;
 use super::ops::{get_ops, get_replies, put_ops, put_replies};
-use crate::bus::{SelfTestPlan, SelfTestReply};
+use crate::bus::{SelfTestPlan, SelfTestReply, Uncertainty};
+use crate::time::Duration;
 use crate::protocol::Straps;
 use alloc::vec::Vec;
 
@@ -232,6 +233,10 @@ impl Response {
                 put_straps(&mut w, &h.straps);
                 w.u8(u8::from(h.resumed));
                 w.str(&h.serial);
+                let u = &h.uncertainty;
+                for d in [u.edge, u.sampled, u.access, u.polled] {
+                    w.u32(u32::try_from(d.as_nanos()).unwrap_or(u32::MAX));
+                }
             }
             Response::Batch(replies) => {
                 w.u8(kind::BATCH_REPLY);
@@ -255,6 +260,10 @@ impl Response {
                 w.u8(kind::LINK_REPLY);
                 w.u8(*fragment);
                 w.u16(*pad);
+            }
+            Response::Working { elapsed } => {
+                w.u8(kind::WORKING);
+                w.dur(*elapsed);
             }
             Response::SelfTest(t) => {
                 w.u8(kind::SELF_TEST_REPLY);
@@ -296,6 +305,15 @@ impl Response {
                 straps: get_straps(&mut r)?,
                 resumed: r.bool("resumed flag")?,
                 serial: r.str()?,
+                uncertainty: {
+                    let mut ns = || r.u32().map(|n| Duration::from_nanos(u64::from(n)));
+                    Uncertainty {
+                        edge: ns()?,
+                        sampled: ns()?,
+                        access: ns()?,
+                        polled: ns()?,
+                    }
+                },
             }),
             kind::BATCH_REPLY => Response::Batch(get_replies(&mut r)?),
             kind::CAPTURE_REPLY => Response::Capture(get_capture(&mut r)?),
@@ -310,6 +328,7 @@ impl Response {
                 code: BridgeErrorCode::from_code(r.u8()?),
                 detail: r.str()?,
             },
+            kind::WORKING => Response::Working { elapsed: r.dur()? },
             kind::LINK_REPLY => Response::Link {
                 fragment: r.u8()?,
                 pad: r.u16()?,

@@ -1,7 +1,8 @@
 //! The messages: typed requests and responses, the bridge's errors and
 //! hello, reply fragments, and why bytes do not decode.
 
-use crate::bus::{Op, Reply, SelfTestPlan, SelfTestReply};
+use crate::bus::{Op, Reply, SelfTestPlan, SelfTestReply, Uncertainty};
+use crate::time::Duration;
 use crate::protocol::capture::MoveStart;
 use crate::protocol::{PinEvent, PulseRun, Straps};
 use alloc::string::String;
@@ -9,7 +10,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 /// The protocol version this build speaks.
-pub const PROTOCOL_VERSION: u16 = 8;
+pub const PROTOCOL_VERSION: u16 = 9;
 
 /// Message kinds (the second payload byte).
 pub mod kind {
@@ -27,6 +28,7 @@ pub mod kind {
     pub const BATCH_CAPTURE_REPLY: u8 = 0x85;
     pub const LINK_REPLY: u8 = 0x86;
     pub const SELF_TEST_REPLY: u8 = 0x87;
+    pub const WORKING: u8 = 0x88;
     pub const ERROR: u8 = 0xFF;
 }
 
@@ -129,6 +131,9 @@ pub struct Hello {
     /// descriptor gives too), so that the reports name the bridge across
     /// a network as well; empty when it has none.
     pub serial: String,
+    /// How sure the bridge's times are, by the path each was taken on
+    /// (never finer than a tick of its timer).
+    pub uncertainty: Uncertainty,
 }
 
 /// A host request.
@@ -262,6 +267,12 @@ pub enum Response {
         pad: u16,
     },
     SelfTest(SelfTestReply),
+    /// Not a reply: the bridge is still running the request with this
+    /// sequence number, and its timer has run `elapsed` since it began
+    /// it. A bridge that may run slower than real time (a simulator on a
+    /// busy machine) sends one at least every 100 ms of its host's time,
+    /// so that the host waits by the bridge's clock, not its own.
+    Working { elapsed: Duration },
 }
 
 impl Response {
@@ -275,6 +286,7 @@ impl Response {
             Response::Error { .. } => "ERROR",
             Response::Link { .. } => "LINK_REPLY",
             Response::SelfTest(_) => "SELF_TEST_REPLY",
+            Response::Working { .. } => "WORKING",
         }
     }
 }

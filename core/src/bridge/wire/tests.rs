@@ -4,7 +4,7 @@ use super::bytes::W;
 use super::message::*;
 use super::ops::{op, put_reply};
 use super::*;
-use crate::bus::{Op, Reply, SelfTestPlan, SelfTestReply};
+use crate::bus::{Op, Reply, SelfTestPlan, SelfTestReply, Uncertainty};
 use crate::protocol::capture::MoveStart;
 use crate::protocol::{
     Direction, Input, MoveKind, Pin, PinEvent, Pins, PulseRun, PulseSummary, Status, Straps,
@@ -303,8 +303,21 @@ fn hello_capture_and_error_round_trip() {
         },
         resumed: true,
         serial: "E6614C311B4E5A2F".into(),
+        uncertainty: Uncertainty {
+            edge: Duration::from_nanos(14),
+            sampled: Duration::from_nanos(2_500),
+            access: Duration::from_nanos(14),
+            polled: Duration::from_nanos(1_000),
+        },
     });
     assert_eq!(Response::decode(&hello.encode(1, T), T), Ok((1, hello)));
+    let working = Response::Working {
+        elapsed: Duration::from_nanos(123_456_789),
+    };
+    assert_eq!(
+        Response::decode(&working.encode(7, T), T),
+        Ok((7, working))
+    );
     let cap = Response::Capture(CaptureChunk {
         runs: vec![
             PulseRun::exact(

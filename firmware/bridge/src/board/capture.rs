@@ -47,10 +47,16 @@ impl<H: Hal> Board<H> {
         let sampled = self.now_ticks();
         let before = core::mem::replace(&mut self.last_sample, sampled);
         // A change happened after the outputs were last seen unchanged and
-        // by now: stamped halfway (within half a pass of the loop that
-        // watched them).
+        // by now (or by the pin read that saw it first): stamped halfway,
+        // within half the bracket ([`Board::longest_bracket`]).
         let since = core::mem::replace(&mut self.unchanged, sampled);
-        let changed = self.at(since + sampled.saturating_sub(since) / 2);
+        let seen_changed = self.changed_by.take();
+        let end = match seen_changed {
+            Some(c) if word != self.last_word => c.clamp(since, sampled),
+            _ => sampled,
+        };
+        self.longest_bracket = self.longest_bracket.max(end.saturating_sub(since));
+        let changed = self.at(since + end.saturating_sub(since) / 2);
         self.last_word = word;
         self.drain();
         // A change of S1..S5 is a step when a POUT edge came since the

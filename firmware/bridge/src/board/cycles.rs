@@ -12,6 +12,11 @@ use ppmc_core::bus::Reply;
 use ppmc_core::protocol::{Pin, Status};
 use ppmc_core::time::Duration;
 
+/// Two status reads at most this far apart (ns) are a wait's loop: a flag
+/// that changed between them is stamped halfway, within half of it (the
+/// `polled` uncertainty HELLO_REPLY declares, [`Board::uncertainty`]).
+pub(super) const CLOSE_NS: u64 = 2_000;
+
 /// The longest a bus cycle may take before the bridge calls its player
 /// stuck: 1 ms (a cycle of the longest steps takes 35 us at 150 MHz).
 const CYCLE_DEADLINE_US: u64 = 1_000;
@@ -146,7 +151,7 @@ impl<H: Hal> Board<H> {
             // BUSY changed between the last read and this one: halfway,
             // when the reads are close (a wait's loop); else at this one.
             let gap = t.saturating_sub(prev);
-            let close = gap <= self.timer.to_ticks(2_000);
+            let close = gap <= self.timer.to_ticks(CLOSE_NS);
             let at = self.at(if close { prev + gap / 2 } else { t });
             self.pin(at, Pin::Busy, u8::from(self.busy));
         }
@@ -170,9 +175,12 @@ impl<H: Hal> Board<H> {
             let (t, s) = self.read_status(None);
             if s.0 & mask == value {
                 let end = match prev {
-                    Some(p) if t - p <= self.timer.to_ticks(2_000) => p + (t - p) / 2,
+                    Some(p) if t - p <= self.timer.to_ticks(CLOSE_NS) => p + (t - p) / 2,
                     _ => t,
                 };
+                if let Some(p) = prev {
+                    self.longest_pass = self.longest_pass.max(t - p);
+                }
                 return Ok((end.saturating_sub(start), s));
             }
             prev = Some(t);

@@ -35,13 +35,14 @@ mod selftest;
 
 use crate::bus_cycle::BusTiming;
 use crate::hal::Hal;
+use crate::limits;
 use crate::pins;
 use crate::timebase;
 use alloc::string::String;
 use alloc::vec::Vec;
 use ppmc_core::bridge::move_tracker::MoveTracker;
 use ppmc_core::bridge::wire::Timer;
-use ppmc_core::bus::Op;
+use ppmc_core::bus::{Op, Uncertainty};
 use ppmc_core::protocol::{EdgeRuns, PinEvent, Record, Straps};
 use ppmc_core::time::{Duration, Instant};
 
@@ -91,6 +92,14 @@ pub struct Board<H: Hal> {
     /// were seen so.
     last_word: u16,
     unchanged: u64,
+    /// A pin read between polls saw them changed (ticks), the first.
+    changed_by: Option<u64>,
+    /// The widest bracket a sampled output's change has been stamped in
+    /// (ticks): from the last sight of the old levels to the first of the
+    /// new. Half of it is how sure such a stamp is.
+    longest_bracket: u64,
+    /// The longest pass of a wait's status loop that ended it (ticks).
+    longest_pass: u64,
     edges: EdgeRuns,
     tracker: MoveTracker,
     /// Last sampled S1..S5 levels, AUXO levels and DIR, for changes.
@@ -102,7 +111,7 @@ pub struct Board<H: Hal> {
     /// Stop switching seen: the phases chopping on and off while stopped.
     switching: bool,
     /// When S1..S5 last went all off or came back from it (ticks).
-    last_toggle: u64,
+    last_toggle: Option<u64>,
     /// The bridge's own hardware failed: what.
     fault: Option<String>,
     /// Capture overruns since boot (each restarted the counters).
@@ -155,6 +164,9 @@ impl<H: Hal> Board<H> {
             last_status: epoch,
             last_word: 0,
             unchanged: epoch,
+            changed_by: None,
+            longest_bracket: 0,
+            longest_pass: 0,
             edges: EdgeRuns::new(timer.edge_tolerance()),
             tracker: MoveTracker::new(),
             last_s: 0,
@@ -163,7 +175,7 @@ impl<H: Hal> Board<H> {
             busy: false,
             lost: false,
             switching: false,
-            last_toggle: 0,
+            last_toggle: None,
             fault: None,
             overruns: 0,
         };
@@ -177,6 +189,33 @@ impl<H: Hal> Board<H> {
     /// The timer HELLO_REPLY announces.
     pub fn timer(&self) -> Timer {
         self.timer
+    }
+
+    /// How sure this board's times are, by path (HELLO_REPLY's
+    /// `uncertainty`): an access's stamp and a captured edge to the timer's
+    /// tick (the engine's floor); a sampled output's change within half the
+    /// widest bracket the sampling allows ([`limits::SAMPLE_BRACKET_NS`]);
+    /// a polled flag within half a pass of the status loop
+    /// ([`cycles::CLOSE_NS`]). The twin's tests hold the board code to the
+    /// last two ([`Board::longest_bracket`], [`Board::longest_pass`]).
+    pub fn uncertainty(&self) -> Uncertainty {
+        Uncertainty {
+            edge: Duration::ZERO,
+            access: Duration::ZERO,
+            sampled: Duration::from_nanos(limits::SAMPLE_BRACKET_NS / 2),
+            polled: Duration::from_nanos(cycles::CLOSE_NS / 2),
+        }
+    }
+
+    /// The widest bracket a change of a sampled output was stamped in
+    /// since boot.
+    pub fn longest_bracket(&self) -> Duration {
+        Duration::from_nanos(self.timer.to_nanos_up(self.longest_bracket))
+    }
+
+    /// The longest pass of a wait's status loop, since boot.
+    pub fn longest_pass(&self) -> Duration {
+        Duration::from_nanos(self.timer.to_nanos_up(self.longest_pass))
     }
 
     /// The hardware layer (the twin's tests look through it).

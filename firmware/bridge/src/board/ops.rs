@@ -173,6 +173,7 @@ impl<H: Hal> Board<H> {
         self.lost = false;
         self.busy = false;
         self.switching = false;
+        self.last_toggle = None;
         Reply::ResetDone {
             at: self.at(self.epoch),
         }
@@ -292,6 +293,15 @@ impl<H: Hal> Bus for Board<H> {
                     self.spin_until(t);
                     let word = self.hal.read_high_pins();
                     self.moment = if late { self.now_ticks() } else { t };
+                    // A sight of the sampled outputs between polls: it
+                    // narrows the bracket the next poll stamps a change in.
+                    if word & pins::SAMPLED_HIGH == self.last_word {
+                        if self.changed_by.is_none() {
+                            self.unchanged = self.unchanged.max(self.moment);
+                        }
+                    } else if self.changed_by.is_none() {
+                        self.changed_by = Some(self.moment);
+                    }
                     Reply::Pins {
                         at: self.at(self.moment),
                         pins: self.pins_from(word),
@@ -352,6 +362,10 @@ impl<H: Hal> Bus for Board<H> {
 
     fn record(&self) -> &Record {
         &self.record
+    }
+
+    fn uncertainty(&self) -> ppmc_core::bus::Uncertainty {
+        Board::uncertainty(self)
     }
 
     fn straps(&self) -> Straps {

@@ -48,11 +48,16 @@ impl<H: Hal> Board<H> {
             let toggle = was == 0 || is == 0;
             // Only an initialization that asked for it makes the chip
             // chop (Section 3-2, bit 5), never before the first one.
+            // A toggle before the last chip reset is no partner: the
+            // phases an initialization right after a reset turns on are
+            // not chopping.
             let chopping = toggle
                 && self.tracker.stop_switching()
-                && now.saturating_sub(self.last_toggle) < CHOP_TICKS;
+                && self
+                    .last_toggle
+                    .is_some_and(|t| now.saturating_sub(t) < CHOP_TICKS);
             if toggle {
-                self.last_toggle = now;
+                self.last_toggle = Some(now);
             }
             self.last_s = s;
             if chopping {
@@ -63,7 +68,11 @@ impl<H: Hal> Board<H> {
             } else if !stepped {
                 self.pin(at, Pin::Phases, is);
             }
-        } else if self.switching && now.saturating_sub(self.last_toggle) >= CHOP_TICKS {
+        } else if self.switching
+            && self
+                .last_toggle
+                .is_none_or(|t| now.saturating_sub(t) >= CHOP_TICKS)
+        {
             self.switching = false;
             self.pin(at, Pin::Switching, 0);
         }

@@ -711,3 +711,113 @@ fn changes_shorter_than_the_both_edge_counters_path_are_missed_and_the_selftests
     let seen = int_changes(&b).len();
     assert!(seen < 200, "{seen} of 200 INT* changes 8 cycles apart");
 }
+
+/// The phase outputs' changes (S1..S5, energized) of a record, in order.
+fn phase_changes(r: &ppmc_core::protocol::Record) -> Vec<(u8, u64)> {
+    use ppmc_core::protocol::Pin;
+    r.pins
+        .iter()
+        .filter(|e| e.pin == Pin::Phases)
+        .map(|e| (e.value, e.at.as_nanos()))
+        .collect()
+}
+
+#[test]
+fn sampled_changes_and_polled_waits_are_within_what_hello_declares() {
+    // docs/bridge-protocol.md section 4: HELLO_REPLY's `sampled` and
+    // `polled` uncertainty. The board code stamps a change of S1..S5
+    // halfway between its last sight of the old levels and its first of
+    // the new, and a wait's end halfway through its loop's last pass; under
+    // the loads that stretch those (a tight run of pin samples, delays, a
+    // move awaited by polling), each bracket stays within what the board
+    // declares, and each change of the phases lies within the declared
+    // `sampled` of the chip model's own moment for it: turned on by an
+    // initialization (Section 3-2), off by a software reset (3-5-4).
+    let wait = Some(Duration::from_millis(10));
+    let mut ops = std::vec![Op::Reset];
+    let init = |ops: &mut Vec<Op>| {
+        ops.push(Op::WriteCommand {
+            byte: 0x02,
+            wait_ibf: wait,
+        });
+        for byte in [100, 20, 100, 0] {
+            ops.push(Op::WriteData {
+                byte,
+                wait_ibf: wait,
+            });
+        }
+    };
+    init(&mut ops);
+    for _ in 0..2_000 {
+        ops.extend([Op::ReadPins, Op::Delay(Duration::from_nanos(250))]);
+    }
+    ops.push(Op::Delay(Duration::from_millis(2)));
+    // A CCW move of 100 steps, awaited by polling.
+    ops.push(Op::WriteCommand {
+        byte: 0x4B,
+        wait_ibf: wait,
+    });
+    for byte in [99, 0, 0] {
+        ops.push(Op::WriteData {
+            byte,
+            wait_ibf: wait,
+        });
+    }
+    ops.push(Op::AwaitStatus {
+        mask: Status::BUSY,
+        value: 0,
+        timeout: Duration::from_secs(2),
+    });
+    // Excitation off (a software reset), sampled in a tight run.
+    ops.push(Op::WriteCommand {
+        byte: 0xC0,
+        wait_ibf: wait,
+    });
+    for _ in 0..1_000 {
+        ops.extend([Op::ReadPins, Op::Delay(Duration::from_nanos(250))]);
+    }
+    ops.push(Op::Delay(Duration::from_millis(1)));
+    init(&mut ops);
+    ops.push(Op::Delay(Duration::from_millis(1)));
+    let mut b = twin();
+    for i in 0..ops.len() {
+        b.next_op(ops.get(i + 1).copied());
+        b.run(ops[i]);
+    }
+    assert_eq!(b.fault(), None);
+    let u = crate::board::Board::uncertainty(&b);
+    assert!(
+        b.longest_bracket() <= u.sampled.saturating_mul(2),
+        "a sampled change stamped in a bracket of {} (declared: within {})",
+        b.longest_bracket(),
+        u.sampled
+    );
+    assert!(
+        b.longest_pass() <= u.polled.saturating_mul(2),
+        "a wait's loop took {} a pass (declared: within {})",
+        b.longest_pass(),
+        u.polled
+    );
+    let got = phase_changes(b.record());
+    let want = phase_changes(b.hal().chip.model().record());
+    assert_eq!(
+        got.iter().map(|c| c.0).collect::<Vec<_>>(),
+        want.iter().map(|c| c.0).collect::<Vec<_>>(),
+        "on, off, on: as the model"
+    );
+    assert_eq!(got.len(), 3, "{got:?}");
+    // The model's clock and the record's both start at the chip's reset,
+    // within a tick of the timer.
+    let tick = b.timer().to_nanos_up(1);
+    for (g, w) in got.iter().zip(&want) {
+        let err = g.1.abs_diff(w.1);
+        assert!(
+            err <= u.sampled.as_nanos() + tick,
+            "phases {} at {} ns on the twin, {} ns in the model: {err} ns off, declared {}",
+            g.0,
+            g.1,
+            w.1,
+            u.sampled
+        );
+    }
+}

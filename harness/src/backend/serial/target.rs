@@ -6,6 +6,7 @@ use super::options::*;
 use crate::backend::link::Link;
 use crate::backend::target::{
     Op, Reply, SelfTestPlan, SelfTestRun, Target, TargetError, TargetErrorKind, TargetInfo,
+    Uncertainty,
 };
 use crate::protocol::Record;
 use crate::protocol::Straps;
@@ -116,6 +117,7 @@ impl<L: Link> SerialTarget<L> {
                 straps: Straps::default(),
                 resumed: false,
                 serial: String::new(),
+                uncertainty: Default::default(),
             },
             timer: Timer::NANOS,
             opts,
@@ -278,12 +280,9 @@ impl<L: Link> SerialTarget<L> {
 }
 
 impl<L: Link> Target for SerialTarget<L> {
-    /// One tick of the bridge's timer (rounded up to a nanosecond): no
-    /// time it stamps is surer. (The paths a bridge samples with its CPU
-    /// are less sure; the protocol does not say yet by how much.)
-    fn time_uncertainty(&self) -> crate::time::Duration {
-        let hz = self.hello.timer_hz.max(1);
-        crate::time::Duration::from_nanos(1_000_000_000u64.div_ceil(hz))
+    /// What the bridge declared in its HELLO.
+    fn uncertainty(&self) -> Uncertainty {
+        self.hello.uncertainty
     }
 
     /// The serial number the bridge gives in its HELLO, else the USB

@@ -540,6 +540,7 @@ fn a_bridge_of_another_protocol_version_is_refused() {
                     straps: Straps::default(),
                     resumed: false,
                     serial: String::new(),
+                    uncertainty: Default::default(),
                 });
                 self.0
                     .extend(frame::encode(&hello.encode(seq, Timer::NANOS)));
