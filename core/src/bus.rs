@@ -12,9 +12,7 @@
 //! model behind it; a bridge firmware implements it over the real chip.
 
 use crate::emu::{Board, Chip, ChipError, ModelConfig};
-use crate::protocol::{
-    Flag, Input, Pin, Pins, PulseSummary, Record, RecordMark, Status, Straps,
-};
+use crate::protocol::{Flag, Input, Pin, Pins, PulseSummary, Record, RecordMark, Status, Straps};
 use crate::time::{Duration, Instant};
 use alloc::string::String;
 
@@ -292,7 +290,10 @@ impl Uncertainty {
 
     /// The largest of the four.
     pub fn worst(&self) -> Duration {
-        self.edge.max(self.sampled).max(self.access).max(self.polled)
+        self.edge
+            .max(self.sampled)
+            .max(self.access)
+            .max(self.polled)
     }
 }
 

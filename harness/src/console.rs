@@ -6,10 +6,10 @@
 //! [`run`] executes statements on a [`Target`] and prints one line per
 //! result.
 
-use crate::backend::{Op, Reply, Target, TargetError};
+use crate::backend::{Op, Reply, Target, TargetError, Uncertainty};
 pub use crate::protocol::Flag;
 use crate::protocol::{Direction, Input, Status};
-use crate::time::Duration;
+use crate::time::{Duration, Instant};
 use crate::trace::BusEvent;
 use std::fmt;
 use std::io::{self, Write};
@@ -25,8 +25,11 @@ pub enum Stmt {
     ReadStatus,
     /// `rd` (wait for OBF = 1 first) or `rd!`.
     ReadData { wait: bool },
-    /// `wait <duration>`.
+    /// `wait <duration>`: from the moment of the statement before.
     Wait(Duration),
+    /// `wait at <time>`: until the target's clock reads `time` (since the
+    /// last reset), so that the next statement acts then.
+    WaitAt(Instant),
     /// `await <flag>=<0|1> [<timeout>]`.
     Await {
         flag: Flag,
@@ -124,10 +127,19 @@ fn parse_stmt(text: &str) -> Result<Stmt, String> {
             want(0, "no arguments")?;
             Stmt::ReadData { wait: op == "rd" }
         }
-        "wait" => {
-            want(1, "a duration such as 250us")?;
-            Stmt::Wait(args[0].parse().map_err(|e| format!("{e}"))?)
-        }
+        "wait" => match args.as_slice() {
+            ["at", t] => {
+                let d: Duration = t.parse().map_err(|e| format!("{e}"))?;
+                Stmt::WaitAt(Instant::ZERO + d)
+            }
+            _ => {
+                want(
+                    1,
+                    "a duration such as 250us, or `at` and a time such as 1500us",
+                )?;
+                Stmt::Wait(args[0].parse().map_err(|e| format!("{e}"))?)
+            }
+        },
         "await" => {
             if args.is_empty() || args.len() > 2 {
                 return Err(
@@ -228,6 +240,7 @@ impl fmt::Display for Stmt {
             Stmt::ReadStatus => f.write_str("rs"),
             Stmt::ReadData { wait } => write!(f, "rd{}", bang(wait)),
             Stmt::Wait(d) => write!(f, "wait {}ns", d.as_nanos()),
+            Stmt::WaitAt(t) => write!(f, "wait at {}ns", t.as_nanos()),
             Stmt::Await {
                 flag,
                 value,
@@ -321,6 +334,9 @@ pub fn to_op(stmt: Stmt, opts: &ConsoleOptions) -> Op {
             wait_obf: wait.then_some(opts.obf_timeout),
         },
         Stmt::Wait(d) => Op::Delay(d),
+        // Its delay depends on the time of the statement before: [`run`]
+        // works it out from that statement's reply.
+        Stmt::WaitAt(_) => Op::Delay(Duration::ZERO),
         Stmt::Await {
             flag,
             value,
@@ -374,8 +390,8 @@ pub fn format_reply(stmt: Stmt, reply: &Reply) -> Option<String> {
         (Stmt::Await { flag, value, .. }, Reply::AwaitTimedOut { .. }) => {
             Some(format!("await {}={} timeout", flag.name(), u8::from(value)))
         }
-        (Stmt::AwaitPulse { count, .. }, Reply::PulsesReached { at }) => {
-            Some(format!("await pulse={count} at {at}"))
+        (Stmt::AwaitPulse { count, .. }, Reply::PulsesReached { .. }) => {
+            Some(format!("await pulse={count}"))
         }
         (Stmt::AwaitPulse { count, .. }, Reply::PulsesTimedOut { count: seen, .. }) => {
             Some(format!("await pulse={count} timeout after {seen} pulses"))
@@ -402,9 +418,9 @@ pub fn format_reply(stmt: Stmt, reply: &Reply) -> Option<String> {
             opt_time(s.min_interval),
             opt_time(s.max_interval)
         )),
-        (Stmt::Now, Reply::Delayed { at }) => Some(format!("now {at}")),
+        (Stmt::Now, Reply::Delayed { .. }) => Some("now".into()),
         (Stmt::WriteCommand { .. } | Stmt::WriteData { .. }, Reply::Written { .. })
-        | (Stmt::Wait(_), Reply::Delayed { .. })
+        | (Stmt::Wait(_) | Stmt::WaitAt(_), Reply::Delayed { .. })
         | (Stmt::Set { .. }, Reply::InputSet { .. }) => None,
         _ => Some(format!("?? unexpected reply: {reply}")),
     }
@@ -413,49 +429,123 @@ pub fn format_reply(stmt: Stmt, reply: &Reply) -> Option<String> {
 /// How many statements go to the target in one batch.
 pub const BATCH: usize = 256;
 
-/// Runs `lines` on `target`, writing one line per result to `out`. The
-/// statements go in batches, so a board costs one round trip per batch.
+/// Whether a statement touches the bus or the pins: what `now` stamps.
+fn is_access(stmt: Stmt) -> bool {
+    !matches!(
+        stmt,
+        Stmt::Wait(_) | Stmt::WaitAt(_) | Stmt::Now | Stmt::Pulses | Stmt::AwaitPulse { .. }
+    )
+}
+
+/// How sure the target is of the time a statement's reply carries: a
+/// wait for a flag ends where the bridge's loop saw it change (`polled`),
+/// a pulse is a captured edge, the rest are an access's own stamp.
+fn path(stmt: Stmt, u: &Uncertainty) -> Duration {
+    match stmt {
+        Stmt::Await { .. } => u.polled,
+        Stmt::AwaitPulse { .. } => u.edge,
+        _ => u.access,
+    }
+}
+
+/// ` at <time>`, and ` ±<U>` where the target is not exact.
+fn stamp(at: Instant, u: Duration) -> String {
+    if u == Duration::ZERO {
+        format!(" at {at}")
+    } else {
+        format!(" at {at} \u{b1}{u}")
+    }
+}
+
+/// Runs `lines` on `target`, writing one line per result to `out`, each
+/// with the target's time of it (` at <time>`, and its uncertainty where
+/// the target has one). The statements go in batches, so a board costs
+/// one round trip per batch; a `wait at` starts a batch of its own (its
+/// delay counts from the time of the statement before), and a batch never
+/// ends with a `now` that another statement follows (it shows that one's
+/// time).
 pub fn run(
     target: &mut dyn Target,
     lines: &[Line],
     opts: &ConsoleOptions,
     out: &mut dyn Write,
 ) -> Result<(), ConsoleError> {
-    for chunk in lines.chunks(BATCH) {
-        let ops: Vec<Op> = chunk.iter().map(|l| to_op(l.stmt, opts)).collect();
-        let replies = target
-            .execute(&ops)
-            .map_err(|source| ConsoleError::Target {
-                line: chunk.first().map_or(0, |l| l.line),
-                source,
-            })?;
+    let u = target.uncertainty();
+    // The time of the last statement run: where a `wait` counts from.
+    let mut last: Option<Instant> = None;
+    let mut i = 0;
+    while i < lines.len() {
+        let mut end = i + 1;
+        while end < lines.len() && end - i < BATCH && !matches!(lines[end].stmt, Stmt::WaitAt(_)) {
+            end += 1;
+        }
+        while end < lines.len()
+            && end > i + 1
+            && lines[end - 1].stmt == Stmt::Now
+            && !matches!(lines[end].stmt, Stmt::WaitAt(_))
+        {
+            end -= 1;
+        }
+        let chunk = &lines[i..end];
+        let line = chunk[0].line;
+        let failed = |source| ConsoleError::Target { line, source };
+        let mut ops: Vec<Op> = chunk.iter().map(|l| to_op(l.stmt, opts)).collect();
+        let mut late = None;
+        if let Stmt::WaitAt(t) = chunk[0].stmt {
+            let from = match last {
+                Some(at) => at,
+                None => clock(target).map_err(failed)?,
+            };
+            ops[0] = Op::Delay(t.saturating_since(from));
+            late = (from > t).then(|| from.saturating_since(t));
+        }
+        let replies = target.execute(&ops).map_err(failed)?;
         if replies.len() != ops.len() {
-            return Err(ConsoleError::Target {
-                line: chunk.first().map_or(0, |l| l.line),
-                source: TargetError::new(
-                    crate::backend::TargetErrorKind::Other,
-                    format!(
-                        "target answered {} of {} operations",
-                        replies.len(),
-                        ops.len()
-                    ),
+            return Err(failed(TargetError::new(
+                crate::backend::TargetErrorKind::Other,
+                format!(
+                    "target answered {} of {} operations",
+                    replies.len(),
+                    ops.len()
                 ),
-            });
+            )));
         }
-        for (l, reply) in chunk.iter().zip(&replies) {
-            if let Some(text) = format_reply(l.stmt, reply) {
-                if text.starts_with("??") {
-                    return Err(ConsoleError::Protocol {
-                        line: l.line,
-                        stmt: l.stmt,
-                        reply: reply.to_string(),
-                    });
-                }
-                writeln!(out, "{text}")?;
+        for (k, (l, reply)) in chunk.iter().zip(&replies).enumerate() {
+            if let (Stmt::WaitAt(t), Some(by)) = (l.stmt, late.filter(|_| k == 0)) {
+                writeln!(
+                    out,
+                    "wait at {t} late by {by}{}",
+                    stamp(reply.at(), u.access)
+                )?;
+                continue;
             }
+            let Some(text) = format_reply(l.stmt, reply) else {
+                continue;
+            };
+            if text.starts_with("??") {
+                return Err(ConsoleError::Protocol {
+                    line: l.line,
+                    stmt: l.stmt,
+                    reply: reply.to_string(),
+                });
+            }
+            // `now` shows the time of the access that follows it.
+            let (at, shown) = match (l.stmt, chunk.get(k + 1), replies.get(k + 1)) {
+                (Stmt::Now, Some(next), Some(r)) if is_access(next.stmt) => (r.at(), next.stmt),
+                _ => (reply.at(), l.stmt),
+            };
+            writeln!(out, "{text}{}", stamp(at, path(shown, &u)))?;
         }
+        last = replies.last().map(Reply::at).or(last);
+        i = end;
     }
     Ok(())
+}
+
+/// The target's clock, where a `wait at` opens a script.
+fn clock(target: &mut dyn Target) -> Result<Instant, TargetError> {
+    let r = target.execute(&[Op::Delay(Duration::ZERO)])?;
+    Ok(r.last().map_or(Instant::ZERO, Reply::at))
 }
 
 #[cfg(test)]

@@ -40,7 +40,7 @@ fn example_script_moves_1000_steps_cw() {
         "{stdout}"
     );
     assert!(stdout.contains(" min=42.000us "), "{stdout}");
-    assert!(stdout.trim_end().ends_with("rd 0x83"), "{stdout}");
+    assert!(stdout.contains("\nrd 0x83 at "), "{stdout}");
     insta::assert_snapshot!("accel_1000_steps", stdout);
 }
 
@@ -90,8 +90,9 @@ fn stdin_script_and_result_lines() {
     assert!(out.status.success());
     assert_eq!(
         text(&out.stdout),
-        "rs 0x00\nawait ibf=0 after 6.000us\nrs 0x80\nnow 6.000us\n\
-         pins int=0 hold=0 aux=0 auxo=0b0000 s=0b00000 dir=cw\nrd 0x00\n"
+        "rs 0x00 at 0.000us\nawait ibf=0 after 6.000us at 6.000us\nrs 0x80 at 6.000us\n\
+         now at 6.000us\npins int=0 hold=0 aux=0 auxo=0b0000 s=0b00000 dir=cw at 6.000us\n\
+         rd 0x00 at 6.000us\n"
     );
 }
 
@@ -104,7 +105,7 @@ fn timeouts_are_results_not_errors() {
     assert!(out.status.success());
     assert_eq!(
         text(&out.stdout),
-        "rd timeout obf=0\nawait busy=1 timeout\n"
+        "rd timeout obf=0 at 1000.000us\nawait busy=1 timeout at 3000.000us\n"
     );
 }
 
@@ -130,6 +131,41 @@ fn straps_change_the_pulse_rate() {
     );
     assert!(
         text(&out.stdout).contains("min=80.000us max=80.000us"),
+        "{}",
+        text(&out.stdout)
+    );
+}
+
+/// docs/examples/chop-period.sh as docs/console.md shows it: Diagram 3-5
+/// (Section 3-5-1) from the stamps of the console's pin samples, on the
+/// emulator exactly, and through a bridge (`ppmc bridge-sim`, whose timer
+/// ticks every 1 ns) with the stamps' uncertainty printed and the same
+/// stretches.
+#[test]
+fn the_chop_period_example_measures_diagram_3_5_from_the_stamps() {
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../docs/examples/chop-period.sh"
+    );
+    let run = |args: &[&str]| {
+        let out = Command::new(script)
+            .args(args)
+            .env("PPMC", env!("CARGO_BIN_EXE_ppmc"))
+            .output()
+            .expect("the script runs");
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        text(&out.stdout)
+    };
+    let emu = run(&[]);
+    let want = "off 108.750us\non 65.000us\noff 108.750us\non 65.000us\n";
+    assert!(emu.starts_with(want), "{emu}");
+    let sim = common::BridgeSim::start(&[]);
+    let board = run(&["--target", &sim.target()]);
+    assert!(board.starts_with(want), "{board}");
+    // The stamps a bridge gives carry its U.
+    let out = ppmc(&["console", "--target", &sim.target()], "pins\n");
+    assert!(
+        text(&out.stdout).trim_end().ends_with(" \u{b1}0.001us"),
         "{}",
         text(&out.stdout)
     );

@@ -40,7 +40,11 @@ const FILES: [&str; 14] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 32] = [
+const ELSEWHERE: [(&str, &str); 33] = [
+    (
+        "docs/examples/chop-period.sh",
+        "in scenarios/tests/console_cli.rs (on the emulator and through ppmc bridge-sim, the debug build)",
+    ),
     (
         "scripts/store-figures",
         "in scenarios/tests/results_store.rs (a store of 3 runs, the debug build)",

@@ -388,7 +388,7 @@ fn a_flaky_board_is_on_record_with_every_attempt() {
     );
 }
 
-/// Through a bridge (`ppmc bridge-sim`, protocol version 8): the bridge's
+/// Through a bridge (`ppmc bridge-sim`, protocol version 8 and later): the bridge's
 /// serial number from its HELLO, its firmware, and the link's cost, in
 /// the record, the store and the page.
 #[test]

@@ -345,9 +345,10 @@ impl<B: Bus> BridgeEngine<B> {
                 virtual_time: self.virtual_time,
                 firmware: self.firmware.clone(),
                 straps: self.bus.straps(),
-                uncertainty: self.bus.uncertainty().at_least(Duration::from_nanos(
-                    self.timer.to_nanos_up(1),
-                )),
+                uncertainty: self
+                    .bus
+                    .uncertainty()
+                    .at_least(Duration::from_nanos(self.timer.to_nanos_up(1))),
             }),
             Request::Batch(_) => Response::Error {
                 code: BridgeErrorCode::Malformed,

@@ -9,14 +9,18 @@
 
 use ppmc_bridge_fw::twin;
 use ppmc_core::bridge::engine::BridgeEngine;
+use ppmc_core::bridge::frame::{self, FrameDecoder};
+use ppmc_core::bridge::wire::{Response, Timer};
 use ppmc_core::emu::{faults, ModelConfig};
 use ppmc_core::protocol::Straps;
+use ppmc_core::time::Duration;
 use std::ffi::CStr;
 use std::io::{self, Write};
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 
 const HELP: &str = "\
 ppmc-twin: the RP2350 bridge's board code on a twin of the RP2350, served on a pseudo-terminal
@@ -155,9 +159,63 @@ fn readable(fd: std::os::fd::RawFd) -> bool {
     n > 0 && p.revents & libc::POLLIN != 0
 }
 
+/// The request the engine is running: its sequence number, the twin's
+/// cycle and the wall time when it began.
+struct Running {
+    seq: u8,
+    cycle: u64,
+    since: std::time::Instant,
+    /// When the last WORKING about it went out.
+    said: Option<std::time::Instant>,
+}
+
+impl Running {
+    /// A WORKING is due: none yet, or the last 50 ms ago.
+    fn due(&self) -> bool {
+        self.said
+            .is_none_or(|t| t.elapsed() >= std::time::Duration::from_millis(50))
+    }
+}
+
+/// A lock that a panicked holder does not poison for the rest.
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// While the engine runs one request, a WORKING message
+/// (`docs/bridge-protocol.md` section 5) 10 ms after it began and every
+/// 50 ms after that, with how far the twin's clock has run since it
+/// began: the twin runs slower than real time, more so on a busy machine,
+/// and the host waits by its clock instead of its own.
+fn working(
+    out: Arc<Mutex<std::fs::File>>,
+    running: Arc<Mutex<Option<Running>>>,
+    progress: Arc<AtomicU64>,
+    timer: Timer,
+) {
+    use std::time::Duration as Wall;
+    std::thread::spawn(move || loop {
+        std::thread::sleep(Wall::from_millis(10));
+        // The reply's writer holds `out` while it clears `running`: no
+        // WORKING follows the reply it is about.
+        let mut out = lock(&out);
+        let frame = match &mut *lock(&running) {
+            Some(r) if r.since.elapsed() >= Wall::from_millis(10) && r.due() => {
+                r.said = Some(std::time::Instant::now());
+                let cycles = progress.load(Ordering::Relaxed).saturating_sub(r.cycle);
+                let elapsed = Duration::from_nanos(timer.to_nanos(cycles / 2));
+                frame::encode(&Response::Working { elapsed }.encode(r.seq, timer))
+            }
+            _ => continue,
+        };
+        let _ = out.write_all(&frame).and_then(|_| out.flush());
+    });
+}
+
 fn serve(o: Options) -> Result<(), String> {
     let board = twin::board(o.straps, o.model).map_err(|e| format!("the twin cannot boot: {e}"))?;
     let timer = board.timer();
+    let progress = board.hal().progress.clone();
     let session = std::process::id() ^ 0x7717_0000;
     let firmware = concat!(
         "ppmc-bridge-twin ",
@@ -190,6 +248,13 @@ fn serve(o: Options) -> Result<(), String> {
     println!("run-twin: serving on {path}");
     let _ = io::stdout().flush();
     let mut file = std::fs::File::from(master);
+    let out = Arc::new(Mutex::new(
+        file.try_clone()
+            .map_err(|e| format!("no second handle on {path}: {e}"))?,
+    ));
+    let running: Arc<Mutex<Option<Running>>> = Arc::default();
+    working(out.clone(), running.clone(), progress.clone(), timer);
+    let mut requests = FrameDecoder::new();
     let mut buf = [0u8; 4096];
     let result = loop {
         if STOP.load(Ordering::Relaxed) {
@@ -206,9 +271,31 @@ fn serve(o: Options) -> Result<(), String> {
                 continue;
             }
         };
-        let reply = engine.on_bytes(&buf[..n]);
-        if let Err(e) = file.write_all(&reply).and_then(|_| file.flush()) {
-            break Err(format!("writing to {path}: {e}"));
+        // Frame by frame, so that a long request is known by its sequence
+        // number while it runs (WORKING).
+        let mut failed = None;
+        for chunk in buf[..n].split_inclusive(|b| *b == 0) {
+            requests.extend(chunk);
+            if let Ok(Some(p)) = requests.decode() {
+                if let Some(&seq) = p.first() {
+                    *lock(&running) = Some(Running {
+                        seq,
+                        cycle: progress.load(Ordering::Relaxed),
+                        since: std::time::Instant::now(),
+                        said: None,
+                    });
+                }
+            }
+            let reply = engine.on_bytes(chunk);
+            let mut out = lock(&out);
+            *lock(&running) = None;
+            if let Err(e) = out.write_all(&reply).and_then(|_| out.flush()) {
+                failed = Some(format!("writing to {path}: {e}"));
+                break;
+            }
+        }
+        if let Some(e) = failed {
+            break Err(e);
         }
     };
     if let Some(link) = &o.link {

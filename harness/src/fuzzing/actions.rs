@@ -341,6 +341,12 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus_bytes::BusOp>, Optio
                             run(&mut c, op, &mut ops)?;
                         }
                     }
+                    Stmt::WaitAt(t) => {
+                        let d = t.saturating_since(c.board().now());
+                        for op in bus_bytes::advances(d) {
+                            run(&mut c, op, &mut ops)?;
+                        }
+                    }
                     Stmt::Set { input, asserted } => run(
                         &mut c,
                         bus_bytes::BusOp::Input { input, asserted },

@@ -70,7 +70,10 @@ impl Driver<'_> {
         let ((from, u_from), (to, u_to)) = match id {
             TimingId::BusyRise => {
                 let a = self.flushed("an operation command", |d| d.batch.anchor())?;
-                ((a, u.access), (self.pin_after(Pin::Busy, Some(1), a)?, u.polled))
+                (
+                    (a, u.access),
+                    (self.pin_after(Pin::Busy, Some(1), a)?, u.polled),
+                )
             }
             TimingId::AccelFirstPout | TimingId::ConstantFirstPout => {
                 let a = self.flushed("an operation command", |d| d.batch.anchor())?;
@@ -79,35 +82,59 @@ impl Driver<'_> {
             }
             TimingId::SingleStep => {
                 let a = self.flushed("an operation command", |d| d.batch.anchor())?;
-                ((a, u.access), (self.pin_after(Pin::Busy, Some(0), a)?, u.polled))
+                (
+                    (a, u.access),
+                    (self.pin_after(Pin::Busy, Some(0), a)?, u.polled),
+                )
             }
             TimingId::InterruptOutput => {
                 let (_, last) = self.last_move_pulse_times()?;
-                ((last, u.edge), (self.pin_after(Pin::Int, Some(1), last)?, u.edge))
+                (
+                    (last, u.edge),
+                    (self.pin_after(Pin::Int, Some(1), last)?, u.edge),
+                )
             }
             TimingId::HoldOn => {
                 let (_, last) = self.last_move_pulse_times()?;
-                ((last, u.edge), (self.pin_after(Pin::Hold, Some(1), last)?, u.edge))
+                (
+                    (last, u.edge),
+                    (self.pin_after(Pin::Hold, Some(1), last)?, u.edge),
+                )
             }
             TimingId::AbnormalTermination => {
                 let t = self.flushed("a stop or limit", |d| d.batch.trigger())?;
-                ((t, u.access), (self.pin_after(Pin::Busy, Some(0), t)?, u.polled))
+                (
+                    (t, u.access),
+                    (self.pin_after(Pin::Busy, Some(0), t)?, u.polled),
+                )
             }
             TimingId::AuxOn => {
                 let t = self.flushed("an AUX ON command", |d| d.batch.trigger())?;
-                ((t, u.access), (self.pin_after(Pin::Aux, Some(1), t)?, u.edge))
+                (
+                    (t, u.access),
+                    (self.pin_after(Pin::Aux, Some(1), t)?, u.edge),
+                )
             }
             TimingId::AuxOff => {
                 let t = self.flushed("an AUX OFF command", |d| d.batch.trigger())?;
-                ((t, u.access), (self.pin_after(Pin::Aux, Some(0), t)?, u.edge))
+                (
+                    (t, u.access),
+                    (self.pin_after(Pin::Aux, Some(0), t)?, u.edge),
+                )
             }
             TimingId::ExcitationOff => {
                 let t = self.flushed("a software reset", |d| d.batch.trigger())?;
-                ((t, u.access), (self.pin_after(Pin::Phases, Some(0), t)?, u.sampled))
+                (
+                    (t, u.access),
+                    (self.pin_after(Pin::Phases, Some(0), t)?, u.sampled),
+                )
             }
             TimingId::InitOutputsSet => {
                 let t = self.flushed("an initialization", |d| d.batch.init_write())?;
-                ((t, u.access), (self.pin_after(Pin::Phases, None, t)?, u.sampled))
+                (
+                    (t, u.access),
+                    (self.pin_after(Pin::Phases, None, t)?, u.sampled),
+                )
             }
             TimingId::InitProcessing => return self.measure_init_processing(),
             TimingId::NextCommand => return self.measure_next_command(),

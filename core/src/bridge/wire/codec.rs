@@ -7,8 +7,8 @@ use super::capture::{get_capture, put_capture};
 use super::message::*;
 use super::ops::{get_ops, get_replies, put_ops, put_replies};
 use crate::bus::{SelfTestPlan, SelfTestReply, Uncertainty};
-use crate::time::Duration;
 use crate::protocol::Straps;
+use crate::time::Duration;
 use alloc::vec::Vec;
 
 /// Strap flags in HELLO_REPLY.

@@ -2,9 +2,9 @@
 //! hello, reply fragments, and why bytes do not decode.
 
 use crate::bus::{Op, Reply, SelfTestPlan, SelfTestReply, Uncertainty};
-use crate::time::Duration;
 use crate::protocol::capture::MoveStart;
 use crate::protocol::{PinEvent, PulseRun, Straps};
+use crate::time::Duration;
 use alloc::string::String;
 use alloc::vec;
 use alloc::vec::Vec;
@@ -272,7 +272,9 @@ pub enum Response {
     /// it. A bridge that may run slower than real time (a simulator on a
     /// busy machine) sends one at least every 100 ms of its host's time,
     /// so that the host waits by the bridge's clock, not its own.
-    Working { elapsed: Duration },
+    Working {
+        elapsed: Duration,
+    },
 }
 
 impl Response {

@@ -314,10 +314,7 @@ fn hello_capture_and_error_round_trip() {
     let working = Response::Working {
         elapsed: Duration::from_nanos(123_456_789),
     };
-    assert_eq!(
-        Response::decode(&working.encode(7, T), T),
-        Ok((7, working))
-    );
+    assert_eq!(Response::decode(&working.encode(7, T), T), Ok((7, working)));
     let cap = Response::Capture(CaptureChunk {
         runs: vec![
             PulseRun::exact(

@@ -192,8 +192,9 @@ impl<H: Hal> Board<H> {
     }
 
     /// How sure this board's times are, by path (HELLO_REPLY's
-    /// `uncertainty`): an access's stamp and a captured edge to the timer's
-    /// tick (the engine's floor); a sampled output's change within half the
+    /// `uncertainty`): a captured edge to the timer's tick (the engine's
+    /// floor); an access within a pass of the spin that aims it
+    /// ([`ops::SPIN_TICKS`]); a sampled output's change within half the
     /// widest bracket the sampling allows ([`limits::SAMPLE_BRACKET_NS`]);
     /// a polled flag within half a pass of the status loop
     /// ([`cycles::CLOSE_NS`]). The twin's tests hold the board code to the
@@ -201,7 +202,7 @@ impl<H: Hal> Board<H> {
     pub fn uncertainty(&self) -> Uncertainty {
         Uncertainty {
             edge: Duration::ZERO,
-            access: Duration::ZERO,
+            access: Duration::from_nanos(self.timer.to_nanos_up(ops::SPIN_TICKS)),
             sampled: Duration::from_nanos(limits::SAMPLE_BRACKET_NS / 2),
             polled: Duration::from_nanos(cycles::CLOSE_NS / 2),
         }

@@ -13,6 +13,13 @@ use ppmc_core::bus::{Bus, Op, Reply, SelfTestPlan, SelfTestReply};
 use ppmc_core::protocol::{Input as ChipInput, Record, Status, Straps};
 use ppmc_core::time::{Duration, Instant};
 
+/// The longest pass of a spin on the clock ([`Board::spin_until`]): a
+/// clock reading, some 6 system clock cycles on the RP2350, rounded up to
+/// 4 ticks (8 cycles). An access aimed at a moment lands within it of the
+/// aim, so it bounds the `access` uncertainty HELLO_REPLY declares; a
+/// pin read that comes later than that is stamped where it was read.
+pub(super) const SPIN_TICKS: u64 = 4;
+
 /// What the code between a delay's end and the next op's moment may take,
 /// beyond the op's bus cycles, so that the op can aim its moment at the
 /// delay's end ([`Board::lead`]).
@@ -128,9 +135,15 @@ impl<H: Hal> Board<H> {
         }
     }
 
-    /// Spins on the clock until tick `t`.
-    fn spin_until(&mut self, t: u64) {
-        while self.now_ticks() < t {}
+    /// Spins on the clock until tick `t`; the clock's last reading (at or
+    /// after `t`: later when the CPU came to it late).
+    fn spin_until(&mut self, t: u64) -> u64 {
+        loop {
+            let now = self.now_ticks();
+            if now >= t {
+                return now;
+            }
+        }
     }
 
     /// The time of pulse `n` (from 1) of the last move, if it came.
@@ -282,17 +295,16 @@ impl<H: Hal> Bus for Board<H> {
                     self.samples += 1;
                     let look = self.samples.is_multiple_of(8)
                         && (self.now_ticks() + LOOK_TICKS < t || self.samples.is_multiple_of(64));
-                    let mut late = false;
-                    if look {
-                        if self.hal.capture_level() >= 2 {
-                            self.refresh();
-                        }
-                        // Past the sample's time: stamped when read.
-                        late = self.now_ticks() > t;
+                    if look && self.hal.capture_level() >= 2 {
+                        self.refresh();
                     }
-                    self.spin_until(t);
+                    // Past the sample's time (a drain, or ops that cost
+                    // the CPU more than the step): stamped when read, not
+                    // where it was aimed, so that a stamp never lies.
+                    // Within a pass of the spin loop it is on time.
+                    let seen = self.spin_until(t);
                     let word = self.hal.read_high_pins();
-                    self.moment = if late { self.now_ticks() } else { t };
+                    self.moment = if seen > t + SPIN_TICKS { seen } else { t };
                     // A sight of the sampled outputs between polls: it
                     // narrows the bracket the next poll stamps a change in.
                     if word & pins::SAMPLED_HIGH == self.last_word {

@@ -88,6 +88,10 @@ pub struct Twin {
     /// Clock readings not yet paid for: the world runs them off at the next
     /// call that spends.
     owed: core::cell::Cell<u64>,
+    /// The system clock cycle the twin has simulated up to, for a thread
+    /// that tells the host how far a long request has got (`ppmc-twin`'s
+    /// WORKING messages): the twin runs slower than real time.
+    pub progress: std::sync::Arc<std::sync::atomic::AtomicU64>,
     /// Cycles a pass of [`Hal::idle`]'s loop takes (read the pins and the
     /// capture FIFOs' levels, compare): how late after a change it returns.
     pub idle_step: u64,
@@ -107,6 +111,7 @@ impl Twin {
             cpu_cycles: CPU_CYCLES,
             gaps: None,
             idle_step: 2 * CPU_CYCLES,
+            progress: Default::default(),
             owed: core::cell::Cell::new(0),
             drains: Drains::default(),
             readers: [Reader::default(); 4],
@@ -188,6 +193,14 @@ impl Twin {
         Ok(())
     }
 
+    /// Runs the hardware to `cycle`, and says how far it got to whoever
+    /// watches [`Twin::progress`].
+    fn run_to(&mut self, cycle: u64) {
+        self.world.run_until(cycle, &mut self.chip);
+        self.progress
+            .store(self.world.cycle, std::sync::atomic::Ordering::Relaxed);
+    }
+
     /// Spends `n` CPU cycles (plus a gap, if any): the hardware runs.
     fn spend(&mut self, n: u64) {
         let mut n = n + self.owed.take();
@@ -200,7 +213,7 @@ impl Twin {
             }
         }
         let until = self.world.cycle + n;
-        self.world.run_until(until, &mut self.chip);
+        self.run_to(until);
     }
 
     /// Stops the bus player, as a stuck state machine would (a test of the
@@ -422,7 +435,7 @@ impl Hal for Twin {
             let mut at = now;
             while at < to {
                 let next = (at + step).min(to);
-                self.world.run_until(next, &mut self.chip);
+                self.run_to(next);
                 let words = self
                     .readers
                     .iter()
@@ -435,7 +448,7 @@ impl Hal for Twin {
             }
             return to;
         }
-        self.world.run_until(to, &mut self.chip);
+        self.run_to(to);
         if to == seen {
             to - step
         } else {

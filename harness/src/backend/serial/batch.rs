@@ -13,11 +13,10 @@ use ppmc_core::bridge::wire::{self, CaptureChunk, Request, Response};
 use std::time::Duration as WallDuration;
 
 impl<L: Link> SerialTarget<L> {
-    /// The wall time a batch may take on a real-time bridge.
+    /// The bridge time a batch's own waits may take: wall time on a
+    /// real-time bridge, the bridge's clock on one in virtual time (which
+    /// says how far it got with WORKING).
     pub(super) fn batch_time(&self, ops: &[Op]) -> WallDuration {
-        if self.hello.virtual_time {
-            return WallDuration::ZERO;
-        }
         let total: u64 = ops
             .iter()
             .map(|o| match *o {
@@ -193,12 +192,8 @@ impl<L: Link> SerialTarget<L> {
         self.captured = Record::default();
         self.captured_current = false;
         self.clock = Instant::ZERO;
-        let extra = if self.hello.virtual_time {
-            WallDuration::ZERO
-        } else {
-            // The chip reset (100 us) and the bursts, each with its gap.
-            WallDuration::from_nanos(plan.length().as_nanos().saturating_add(1_000_000))
-        };
+        // The chip reset (100 us) and the bursts, each with its gap.
+        let extra = WallDuration::from_nanos(plan.length().as_nanos().saturating_add(1_000_000));
         let reply = match self.request(&Request::SelfTest(*plan), "self-test", extra)? {
             Response::SelfTest(r) => r,
             other => return Err(self.unexpected("self-test", &other)),

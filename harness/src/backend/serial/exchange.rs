@@ -156,13 +156,23 @@ impl<L: Link> SerialTarget<L> {
     }
 
     /// One request and its reply, asked again as the line needs, within
-    /// the limits of [`SerialOptions`] (fewer while reconnecting).
+    /// the limits of [`SerialOptions`] (fewer while reconnecting). `span`
+    /// is the bridge time the request's own waits may take: wall time on a
+    /// real-time bridge; on a bridge in virtual time, its clock, which its
+    /// WORKING messages report while it runs the request.
     pub(super) fn exchange(
         &mut self,
         req: &Request,
         what: &str,
-        extra: WallDuration,
+        span: WallDuration,
     ) -> Result<Response, SerialError> {
+        let extra = match self.hello.virtual_time {
+            true => WallDuration::ZERO,
+            false => span,
+        };
+        // The most bridge time the request may take, progress or not.
+        let bridge_bound = span + self.opts.request_limit();
+        let mut bridge_elapsed = WallDuration::ZERO;
         let seq = self.next_seq();
         if !self.recovering {
             self.in_flight = Some(seq);
@@ -180,7 +190,7 @@ impl<L: Link> SerialTarget<L> {
         };
         let start = WallInstant::now();
         let stall_limit = extra + self.opts.reply_timeout * (retries + 1);
-        let give_up_at = start + extra + self.opts.request_limit();
+        let mut give_up_at = start + extra + self.opts.request_limit();
         let mut progress_at = start;
         // What the link brought instead of the reply, for the error.
         let mut noise = Noise::default();
@@ -266,8 +276,43 @@ impl<L: Link> SerialTarget<L> {
             let sent = WallInstant::now();
             self.stats.round_trips += 1;
             let had = frags.received();
-            let budget = (wait + extra).min(give_up_at.saturating_duration_since(sent));
-            match self.await_reply(seq, budget, give_up_at, &mut frags, &mut noise) {
+            let mut budget = (wait + extra).min(give_up_at.saturating_duration_since(sent));
+            let reply = loop {
+                match self.await_reply(seq, budget, give_up_at, &mut frags, &mut noise) {
+                    // The bridge has the request and is running it, slower
+                    // than real time: wait by its clock, as long as it
+                    // advances and stays within the request's bound.
+                    Ok(Some(Response::Working { elapsed })) => {
+                        let elapsed = WallDuration::from_nanos(elapsed.as_nanos());
+                        if elapsed > bridge_bound {
+                            return Err(self.no_answer(
+                                what,
+                                attempts,
+                                start,
+                                format!(
+                                    "the bridge says it is still working on it after {:.3} s of its own clock, past the {:.3} s the request may take",
+                                    elapsed.as_secs_f64(),
+                                    bridge_bound.as_secs_f64()
+                                ),
+                            ));
+                        }
+                        self.stats.working += 1;
+                        if elapsed > bridge_elapsed {
+                            bridge_elapsed = elapsed;
+                            (silent, fruitless) = (0, 0);
+                            let now = WallInstant::now();
+                            progress_at = now;
+                            give_up_at = give_up_at.max(now + self.opts.request_limit());
+                        }
+                        budget = self
+                            .opts
+                            .reply_timeout
+                            .min(give_up_at.saturating_duration_since(WallInstant::now()));
+                    }
+                    other => break other,
+                }
+            };
+            match reply {
                 Ok(Some(Response::Error {
                     code: BridgeErrorCode::BadFrame,
                     ..
@@ -510,6 +555,8 @@ impl<L: Link> SerialTarget<L> {
                     noise.bad_frames += 1;
                     self.garbled += 1;
                 }
+                // Still running it: it has the request, not yet a reply.
+                Ok(Some(Response::Working { .. })) => return Ok(Ran::Unknown),
                 Ok(Some(r)) => return Ok(Ran::Yes(r)),
                 Ok(None) if frags.received() > before => return Ok(Ran::Partly),
                 Ok(None) if self.opts.stop.requested() => return Err(self.interrupted()),

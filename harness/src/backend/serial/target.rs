@@ -25,6 +25,9 @@ pub struct LinkStats {
     pub retransmissions: u64,
     pub corrupt_frames: u64,
     pub reopens: u64,
+    /// WORKING messages heard: a bridge slower than real time said it was
+    /// still running a request.
+    pub working: u64,
 }
 
 /// A chip behind a bus bridge.
@@ -300,6 +303,7 @@ impl<L: Link> Target for SerialTarget<L> {
             ("retransmissions", s.retransmissions),
             ("corrupt_frames", s.corrupt_frames),
             ("reopens", s.reopens),
+            ("working", s.working),
         ])
     }
 
