@@ -200,7 +200,6 @@ fn console_stamps_measure_the_chopping_through_the_twin_within_their_uncertainty
     // sample's stamp is where the twin read the pins, so the stretches
     // measured from the stamps are the emulator's within the stamps' U
     // plus the script's own sampling step.
-    const STEP: u64 = 250;
     let samples = "pins; wait 250ns\n".repeat(2_400);
     // After the initialization processing (Table 3-3: at most 162.8 ms).
     let init = "wc 0x22; wd 100; wd 20; wd 100; wd 0; await ibf=0; wait 170ms\n";

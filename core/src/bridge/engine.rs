@@ -19,6 +19,7 @@ use super::wire::{
 };
 use crate::bus::{Bus, Op};
 use crate::time::{Duration, Instant};
+use alloc::boxed::Box;
 use alloc::format;
 use alloc::string::{String, ToString};
 use alloc::vec::Vec;
@@ -332,7 +333,7 @@ impl<B: Bus> BridgeEngine<B> {
                 code: BridgeErrorCode::Version,
                 detail: format!("bridge speaks protocol {PROTOCOL_VERSION}, host {version}"),
             },
-            Request::Hello { host, .. } => Response::Hello(Hello {
+            Request::Hello { host, .. } => Response::Hello(Box::new(Hello {
                 resumed: self.greet(host),
                 serial: self.serial.clone(),
                 version: PROTOCOL_VERSION,
@@ -349,7 +350,7 @@ impl<B: Bus> BridgeEngine<B> {
                     .bus
                     .uncertainty()
                     .at_least(Duration::from_nanos(self.timer.to_nanos_up(1))),
-            }),
+            })),
             Request::Batch(_) => Response::Error {
                 code: BridgeErrorCode::Malformed,
                 detail: "batch handled before dispatch".into(),

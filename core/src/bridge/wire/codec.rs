@@ -9,6 +9,7 @@ use super::ops::{get_ops, get_replies, put_ops, put_replies};
 use crate::bus::{SelfTestPlan, SelfTestReply, Uncertainty};
 use crate::protocol::Straps;
 use crate::time::Duration;
+use alloc::boxed::Box;
 use alloc::vec::Vec;
 
 /// Strap flags in HELLO_REPLY.
@@ -292,7 +293,7 @@ impl Response {
         let mut r = R::new(payload, timer);
         let seq = r.u8()?;
         let resp = match r.u8()? {
-            kind::HELLO_REPLY => Response::Hello(Hello {
+            kind::HELLO_REPLY => Response::Hello(Box::new(Hello {
                 version: r.u16()?,
                 session: r.u32()?,
                 timer_hz: r.u64()?,
@@ -314,7 +315,7 @@ impl Response {
                         polled: ns()?,
                     }
                 },
-            }),
+            })),
             kind::BATCH_REPLY => Response::Batch(get_replies(&mut r)?),
             kind::CAPTURE_REPLY => Response::Capture(get_capture(&mut r)?),
             kind::BATCH_CAPTURE_REPLY => {

@@ -5,6 +5,7 @@ use crate::bus::{Op, Reply, SelfTestPlan, SelfTestReply, Uncertainty};
 use crate::protocol::capture::MoveStart;
 use crate::protocol::{PinEvent, PulseRun, Straps};
 use crate::time::Duration;
+use alloc::boxed::Box;
 use alloc::string::String;
 use alloc::vec;
 use alloc::vec::Vec;
@@ -249,7 +250,8 @@ pub struct CaptureChunk {
 /// A bridge response.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Response {
-    Hello(Hello),
+    /// Boxed: far larger than the other responses.
+    Hello(Box<Hello>),
     Batch(Vec<Reply>),
     Capture(CaptureChunk),
     /// The replies to a BATCH_CAPTURE's ops, then the capture chunk.

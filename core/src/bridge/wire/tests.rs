@@ -11,6 +11,7 @@ use crate::protocol::{
     Winding,
 };
 use crate::time::{Duration, Instant};
+use alloc::boxed::Box;
 use alloc::vec;
 use alloc::vec::Vec;
 use proptest::prelude::*;
@@ -285,7 +286,7 @@ fn every_reply_round_trips() {
 
 #[test]
 fn hello_capture_and_error_round_trip() {
-    let hello = Response::Hello(Hello {
+    let hello = Response::Hello(Box::new(Hello {
         version: 1,
         session: 0xDEAD_BEEF,
         timer_hz: 1_000_000_000,
@@ -309,7 +310,7 @@ fn hello_capture_and_error_round_trip() {
             access: Duration::from_nanos(14),
             polled: Duration::from_nanos(1_000),
         },
-    });
+    }));
     assert_eq!(Response::decode(&hello.encode(1, T), T), Ok((1, hello)));
     let working = Response::Working {
         elapsed: Duration::from_nanos(123_456_789),

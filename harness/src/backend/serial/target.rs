@@ -244,7 +244,7 @@ impl<L: Link> SerialTarget<L> {
                 });
             }
         }
-        Ok(h)
+        Ok(*h)
     }
 
     pub(super) fn unexpected(&self, what: &str, r: &Response) -> SerialError {

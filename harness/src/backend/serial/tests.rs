@@ -527,7 +527,7 @@ fn a_bridge_of_another_protocol_version_is_refused() {
             d.extend(bytes);
             if let Ok(Some(p)) = d.decode() {
                 let seq = p[0];
-                let hello = Response::Hello(Hello {
+                let hello = Response::Hello(Box::new(Hello {
                     version: PROTOCOL_VERSION + 1,
                     session: 1,
                     timer_hz: 1_000_000_000,
@@ -541,7 +541,7 @@ fn a_bridge_of_another_protocol_version_is_refused() {
                     resumed: false,
                     serial: String::new(),
                     uncertainty: Default::default(),
-                });
+                }));
                 self.0
                     .extend(frame::encode(&hello.encode(seq, Timer::NANOS)));
             }
