@@ -360,24 +360,32 @@ impl<'t> Driver<'t> {
         let cycles = (on + off).saturating_mul(3);
         let n = (cycles.as_nanos() / step.as_nanos().max(1)) as usize + 1;
         let samples = self.sample_pins(step, n)?;
-        // Edges of "any phase energized".
-        let mut edges: Vec<(Instant, bool)> = Vec::new();
+        // Edges of "any phase energized", each with the gap from the
+        // sample before it: the change lies somewhere in that gap.
+        let mut edges: Vec<(Instant, bool, Duration)> = Vec::new();
         for w in samples.windows(2) {
             let (a, b) = (w[0].1.phases != 0, w[1].1.phases != 0);
             if a != b {
-                edges.push((w[1].0, b));
+                edges.push((w[1].0, b, w[1].0.saturating_since(w[0].0)));
             }
         }
-        // A full ON stretch (rise .. fall) and a full OFF stretch (fall .. rise).
+        // A full ON stretch (rise .. fall) and a full OFF stretch (fall ..
+        // rise). Its uncertainty: the two samples' stamps, and the larger
+        // of the two gaps its ends lie in (the sampling's own resolution,
+        // on every target).
+        let stamps = self.u.access.saturating_mul(2);
         let stretch = |level: bool| {
             edges
                 .windows(2)
                 .find(|w| w[0].1 == level && w[1].1 != level)
-                .map(|w| (w[1].0.saturating_since(w[0].0), w[1].0))
+                .map(|w| {
+                    let u = stamps.saturating_add(w[0].2.max(w[1].2));
+                    (w[1].0.saturating_since(w[0].0), w[1].0, u)
+                })
         };
         let now = self.batch.clock();
         for (name, level, want) in [("switching_on", true, on), ("switching_off", false, off)] {
-            let Some((got, at)) = stretch(level) else {
+            let Some((got, at, u)) = stretch(level) else {
                 return Err(fail(
                     format!("{name}: stop switching chops the phases"),
                     "ON and OFF stretches",
@@ -391,8 +399,7 @@ impl<'t> Driver<'t> {
                 want.saturating_sub(slack),
                 want + slack,
                 got,
-                // Each end a pin read's stamp.
-                self.u.access.saturating_mul(2),
+                u,
                 at,
             );
             let grade = m.grade;

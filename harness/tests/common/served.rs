@@ -44,15 +44,16 @@ impl Served {
                 }
             }
         });
-        // Building the image the first time takes a minute or two.
-        let first = rx
-            .recv_timeout(Duration::from_secs(400))
-            .unwrap_or_else(|_| panic!("{script} says where it serves within the time limit"));
+        // Held from here on, so that a panic below stops what it started.
         let mut served = Served {
             child,
             link,
             _dir: dir,
         };
+        // Building the image the first time takes a minute or two.
+        let first = rx
+            .recv_timeout(Duration::from_secs(400))
+            .unwrap_or_else(|_| panic!("{script} says where it serves within the time limit"));
         assert!(
             first.starts_with(&format!("{script}: serving on /dev/")),
             "unexpected first line `{first}`"

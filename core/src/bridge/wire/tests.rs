@@ -159,11 +159,11 @@ fn a_hello_of_another_version_is_read_for_its_version() {
     );
     // A later version's, with fields this one does not know.
     assert_eq!(
-        Request::decode(&[3, kind::HELLO, 9, 0, 1, 2, 3, 4, 5, 6, 7], T),
+        Request::decode(&[3, kind::HELLO, 10, 0, 1, 2, 3, 4, 5, 6, 7], T),
         Ok((
             3,
             Request::Hello {
-                version: 9,
+                version: 10,
                 host: 0
             }
         ))
