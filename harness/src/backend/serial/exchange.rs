@@ -15,6 +15,12 @@ use ppmc_core::bridge::wire::{
 use std::io;
 use std::time::{Duration as WallDuration, Instant as WallInstant};
 
+/// The slowest bridge a host waits for by its WORKING messages: 1/200 of
+/// real time over a request (the board twin on a busy machine runs at
+/// about 1/50). A bridge whose clock creeps slower, or one that says it is
+/// working while its clock hardly moves, is given up all the same.
+const SLOWEST_BRIDGE: u32 = 200;
+
 /// What the bridge says of a request that kept arriving garbled.
 #[derive(Debug)]
 pub(super) enum Ran {
@@ -191,6 +197,9 @@ impl<L: Link> SerialTarget<L> {
         let start = WallInstant::now();
         let stall_limit = extra + self.opts.reply_timeout * (retries + 1);
         let mut give_up_at = start + extra + self.opts.request_limit();
+        // However a bridge's WORKING messages stretch that: no longer than
+        // the request's bound in its time, run at 1/SLOWEST of real time.
+        let wall_cap = give_up_at + bridge_bound * SLOWEST_BRIDGE;
         let mut progress_at = start;
         // What the link brought instead of the reply, for the error.
         let mut noise = Noise::default();
@@ -302,7 +311,9 @@ impl<L: Link> SerialTarget<L> {
                             (silent, fruitless) = (0, 0);
                             let now = WallInstant::now();
                             progress_at = now;
-                            give_up_at = give_up_at.max(now + self.opts.request_limit());
+                            give_up_at = give_up_at
+                                .max(now + self.opts.request_limit())
+                                .min(wall_cap);
                         }
                         budget = self
                             .opts

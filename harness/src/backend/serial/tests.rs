@@ -570,3 +570,90 @@ fn a_bridge_of_another_protocol_version_is_refused() {
         "{e}"
     );
 }
+
+/// A bridge in virtual time that runs every request but a batch at once,
+/// and says WORKING about a batch for ever: `creep` ns more of its clock
+/// each time (10 ms of the host's), never a reply.
+#[derive(Debug)]
+struct Working {
+    server: BridgeEngine<EmuBus>,
+    out: Vec<u8>,
+    /// The batch it is "running", and its clock so far.
+    batch: Option<(u8, u64)>,
+    creep: u64,
+    /// Batches are held (after the health check at open).
+    hold: bool,
+}
+
+impl Link for Working {
+    fn send(&mut self, bytes: &[u8]) -> io::Result<()> {
+        let mut d = FrameDecoder::new();
+        d.extend(bytes);
+        while let Ok(Some(p)) = d.decode() {
+            let (seq, kind) = (p[0], p.get(1).copied().unwrap_or(0));
+            if self.hold && (kind == 0x02 || kind == 0x05) {
+                let clock = self.batch.map_or(0, |(_, c)| c);
+                self.batch = Some((seq, clock));
+            } else {
+                let mut f = frame::encode(&p);
+                f.insert(0, 0);
+                self.out.extend(self.server.on_bytes(&f));
+            }
+        }
+        Ok(())
+    }
+    fn recv(&mut self, buf: &mut [u8], wait: WallDuration) -> io::Result<usize> {
+        if self.out.is_empty() {
+            let Some((seq, clock)) = self.batch.as_mut() else {
+                std::thread::sleep(wait);
+                return Ok(0);
+            };
+            std::thread::sleep(wait.min(WallDuration::from_millis(10)));
+            *clock += self.creep;
+            let elapsed = Duration::from_nanos(*clock);
+            self.out.extend(frame::encode(
+                &Response::Working { elapsed }.encode(*seq, Timer::NANOS),
+            ));
+        }
+        let n = self.out.len().min(buf.len());
+        buf[..n].copy_from_slice(&self.out[..n]);
+        self.out.drain(..n);
+        Ok(n)
+    }
+    fn reopen(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+    fn name(&self) -> String {
+        "working".into()
+    }
+}
+
+#[test]
+fn a_bridge_that_says_working_for_ever_is_given_up() {
+    // docs/bridge-protocol.md section 5: the host waits by a WORKING
+    // bridge's clock, up to the request's bound in that clock, and no
+    // longer than that bound run at 1/200 of real time. A bridge whose
+    // clock runs (1 ms of it per WORKING) passes the bound and is given
+    // up; one whose clock creeps (1 ns per WORKING, for ever) is given up
+    // at the wall-clock cap. Either way the request ends, as a link error.
+    let opts = SerialOptions {
+        reply_timeout: WallDuration::from_millis(2),
+        retries: 0,
+        ..quick()
+    };
+    for (creep, says) in [(1_000_000, "past the"), (1, "")] {
+        let link = Working {
+            server: MemLink::bridge(7),
+            out: Vec::new(),
+            batch: None,
+            creep,
+            hold: false,
+        };
+        let mut t = SerialTarget::open(link, opts.clone()).expect("hello");
+        t.link.hold = true;
+        let e = t.execute(&[Op::ReadStatus]).expect_err("no reply");
+        assert_eq!(e.kind, TargetErrorKind::Link, "{e}");
+        assert!(e.to_string().contains(says), "{e}");
+        assert!(t.stats.working > 0, "{:?}", t.stats);
+    }
+}
