@@ -490,14 +490,12 @@ pub fn run(
         let line = chunk[0].line;
         let failed = |source| ConsoleError::Target { line, source };
         let mut ops: Vec<Op> = chunk.iter().map(|l| to_op(l.stmt, opts)).collect();
-        let mut late = None;
         if let Stmt::WaitAt(t) = chunk[0].stmt {
             let from = match last {
                 Some(at) => at,
                 None => clock(target).map_err(failed)?,
             };
             ops[0] = Op::Delay(t.saturating_since(from));
-            late = (from > t).then(|| from.saturating_since(t));
         }
         let replies = target.execute(&ops).map_err(failed)?;
         if replies.len() != ops.len() {
@@ -511,12 +509,21 @@ pub fn run(
             )));
         }
         for (k, (l, reply)) in chunk.iter().zip(&replies).enumerate() {
-            if let (Stmt::WaitAt(t), Some(by)) = (l.stmt, late.filter(|_| k == 0)) {
-                writeln!(
-                    out,
-                    "wait at {t} late by {by}{}",
-                    stamp(reply.at(), u.access)
-                )?;
+            // Where the wait ended, if not at its time (within the
+            // target's uncertainty): the clock was past it already, or the
+            // statement before ended at another time than its reply says.
+            if let (Stmt::WaitAt(t), 0) = (l.stmt, k) {
+                let at = reply.at();
+                let off = if at > t + u.access {
+                    Some(("late", at.saturating_since(t)))
+                } else if at + u.access < t {
+                    Some(("early", t.saturating_since(at)))
+                } else {
+                    None
+                };
+                if let Some((how, by)) = off {
+                    writeln!(out, "wait at {t} {how} by {by}{}", stamp(at, u.access))?;
+                }
                 continue;
             }
             let Some(text) = format_reply(l.stmt, reply) else {

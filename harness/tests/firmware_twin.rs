@@ -116,8 +116,8 @@ fn a_host_waits_by_the_twins_clock_not_its_own() {
     assert_eq!(hello.uncertainty.edge.as_nanos(), 14, "a tick of 13.3 ns");
     assert_eq!(
         hello.uncertainty.access.as_nanos(),
-        54,
-        "a spin's pass: 4 ticks"
+        134,
+        "a spin's pass and a read: 10 ticks"
     );
     assert_eq!(hello.uncertainty.sampled.as_nanos(), 5_000);
     assert_eq!(hello.uncertainty.polled.as_nanos(), 1_000);

@@ -272,8 +272,9 @@ pub enum Response {
     /// Not a reply: the bridge is still running the request with this
     /// sequence number, and its timer has run `elapsed` since it began
     /// it. A bridge that may run slower than real time (a simulator on a
-    /// busy machine) sends one at least every 100 ms of its host's time,
-    /// so that the host waits by the bridge's clock, not its own.
+    /// busy machine) sends one 10 ms into a request and every 50 ms after
+    /// (its host's time), so that the host waits by the bridge's clock, not
+    /// its own (`docs/bridge-protocol.md` section 5).
     Working {
         elapsed: Duration,
     },

@@ -50,19 +50,23 @@ impl<H: Hal> Board<H> {
         // by now (or by the pin read that saw it first): stamped halfway,
         // within half the bracket ([`Board::longest_bracket`]).
         let since = core::mem::replace(&mut self.unchanged, sampled);
-        let seen_changed = self.changed_by.take();
-        let end = match seen_changed {
-            Some(c) if word != self.last_word => c.clamp(since, sampled),
+        let end = match self.changed_by.take() {
+            Some((c, w)) if w == word && word != self.last_word => c.max(since).min(sampled),
             _ => sampled,
         };
-        self.longest_bracket = self.longest_bracket.max(end.saturating_sub(since));
-        let changed = self.at(since + end.saturating_sub(since) / 2);
+        let bracket = end.saturating_sub(since);
+        let changed = self.at(since + bracket / 2);
         self.last_word = word;
         self.drain();
         // A change of S1..S5 is a step when a POUT edge came since the
         // last sample (or just before it, its word then still on its way).
         let stepped = self.last_pulse + SETTLE_TICKS >= before;
+        let recorded = self.pending.len();
         self.sample(word, changed, sampled, stepped);
+        // How sure the stamps of the changes recorded are (steps are not).
+        if self.pending.len() > recorded {
+            self.longest_bracket = self.longest_bracket.max(bracket);
+        }
         let horizon = self.at(sampled.saturating_sub(SETTLE_TICKS));
         let n = self.pending.partition_point(|p| p.at <= horizon);
         self.record.pins.extend(self.pending.drain(..n));
@@ -144,9 +148,36 @@ impl<H: Hal> Board<H> {
     }
 
     /// Lets the hardware idle until tick `until` or a change of the
-    /// outputs it watches.
+    /// outputs it watches. It compares them with their levels when it
+    /// begins: a look before says whether those are the levels last
+    /// polled (then the time it saw no change is a sight of them), and a
+    /// look after whether they changed.
     pub(super) fn idle(&mut self, until: u64) {
+        let entry = self.hal.read_high_pins() & pins::SAMPLED_HIGH;
+        let began = self.now_ticks();
+        self.sighted(entry, began);
         let seen = self.hal.idle(until * 2) / 2;
-        self.unchanged = self.unchanged.max(seen);
+        self.sighted(entry, seen.max(began));
+        let word = self.hal.read_high_pins() & pins::SAMPLED_HIGH;
+        let now = self.now_ticks();
+        self.sighted(word, now);
+    }
+
+    /// A sight of the sampled outputs between polls (`word`, masked, at
+    /// tick `at`): it narrows the bracket the next poll stamps a change
+    /// in. Levels as last polled move the last sight of them; new levels
+    /// are first seen here, unless seen already; levels other than those
+    /// seen last start again from the sight before.
+    pub(super) fn sighted(&mut self, word: u16, at: u64) {
+        match self.changed_by {
+            None if word == self.last_word => self.unchanged = self.unchanged.max(at),
+            Some((_, w)) if w == word => {}
+            Some(_) => {
+                self.unchanged = self.unchanged.max(self.last_read);
+                self.changed_by = Some((at, word));
+            }
+            None => self.changed_by = Some((at, word)),
+        }
+        self.last_read = at;
     }
 }

@@ -92,8 +92,11 @@ pub struct Board<H: Hal> {
     /// were seen so.
     last_word: u16,
     unchanged: u64,
-    /// A pin read between polls saw them changed (ticks), the first.
-    changed_by: Option<u64>,
+    /// Pin reads between polls saw them changed: the first sight of the
+    /// levels they saw last (ticks), and those levels.
+    changed_by: Option<(u64, u16)>,
+    /// The time of the last pin read (ticks).
+    last_read: u64,
     /// The widest bracket a sampled output's change has been stamped in
     /// (ticks): from the last sight of the old levels to the first of the
     /// new. Half of it is how sure such a stamp is.
@@ -165,6 +168,7 @@ impl<H: Hal> Board<H> {
             last_word: 0,
             unchanged: epoch,
             changed_by: None,
+            last_read: epoch,
             longest_bracket: 0,
             longest_pass: 0,
             edges: EdgeRuns::new(timer.edge_tolerance()),
@@ -194,7 +198,7 @@ impl<H: Hal> Board<H> {
     /// How sure this board's times are, by path (HELLO_REPLY's
     /// `uncertainty`): a captured edge to the timer's tick (the engine's
     /// floor); an access within a pass of the spin that aims it
-    /// ([`ops::SPIN_TICKS`]); a sampled output's change within half the
+    /// and the read itself ([`ops::ACCESS_TICKS`]); a sampled output's change within half the
     /// widest bracket the sampling allows ([`limits::SAMPLE_BRACKET_NS`]);
     /// a polled flag within half a pass of the status loop
     /// ([`cycles::CLOSE_NS`]). The twin's tests hold the board code to the
@@ -202,7 +206,7 @@ impl<H: Hal> Board<H> {
     pub fn uncertainty(&self) -> Uncertainty {
         Uncertainty {
             edge: Duration::ZERO,
-            access: Duration::from_nanos(self.timer.to_nanos_up(ops::SPIN_TICKS)),
+            access: Duration::from_nanos(self.timer.to_nanos_up(ops::ACCESS_TICKS)),
             sampled: Duration::from_nanos(limits::SAMPLE_BRACKET_NS / 2),
             polled: Duration::from_nanos(cycles::CLOSE_NS / 2),
         }

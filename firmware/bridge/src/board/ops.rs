@@ -15,10 +15,14 @@ use ppmc_core::time::{Duration, Instant};
 
 /// The longest pass of a spin on the clock ([`Board::spin_until`]): a
 /// clock reading, some 6 system clock cycles on the RP2350, rounded up to
-/// 4 ticks (8 cycles). An access aimed at a moment lands within it of the
-/// aim, so it bounds the `access` uncertainty HELLO_REPLY declares; a
-/// pin read that comes later than that is stamped where it was read.
+/// 4 ticks (8 cycles). A pin read whose spin ended later than that after
+/// its aim came late, and is stamped where the clock then said.
 pub(super) const SPIN_TICKS: u64 = 4;
+
+/// How far a pin read's levels may lie from its stamp: a spin's pass
+/// ([`SPIN_TICKS`]) and the read itself after it (a register access, some
+/// 12 cycles: 6 ticks). The `access` uncertainty HELLO_REPLY declares.
+pub(super) const ACCESS_TICKS: u64 = SPIN_TICKS + 6;
 
 /// What the code between a delay's end and the next op's moment may take,
 /// beyond the op's bus cycles, so that the op can aim its moment at the
@@ -305,15 +309,7 @@ impl<H: Hal> Bus for Board<H> {
                     let seen = self.spin_until(t);
                     let word = self.hal.read_high_pins();
                     self.moment = if seen > t + SPIN_TICKS { seen } else { t };
-                    // A sight of the sampled outputs between polls: it
-                    // narrows the bracket the next poll stamps a change in.
-                    if word & pins::SAMPLED_HIGH == self.last_word {
-                        if self.changed_by.is_none() {
-                            self.unchanged = self.unchanged.max(self.moment);
-                        }
-                    } else if self.changed_by.is_none() {
-                        self.changed_by = Some(self.moment);
-                    }
+                    self.sighted(word & pins::SAMPLED_HIGH, self.moment);
                     Reply::Pins {
                         at: self.at(self.moment),
                         pins: self.pins_from(word),

@@ -56,8 +56,11 @@ impl<H: Hal> Board<H> {
                 && self
                     .last_toggle
                     .is_some_and(|t| now.saturating_sub(t) < CHOP_TICKS);
+            // A toggle while the chip was not asked to chop (before the
+            // initialization that asks, after a software reset) is no
+            // partner either.
             if toggle {
-                self.last_toggle = Some(now);
+                self.last_toggle = self.tracker.stop_switching().then_some(now);
             }
             self.last_s = s;
             if chopping {

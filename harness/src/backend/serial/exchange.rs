@@ -21,6 +21,16 @@ use std::time::{Duration as WallDuration, Instant as WallInstant};
 /// working while its clock hardly moves, is given up all the same.
 const SLOWEST_BRIDGE: u32 = 200;
 
+/// The shortest wait for a reply from a bridge that has said WORKING: its
+/// first WORKING about a request comes within 10 ms, the next 50 ms later.
+const WORKING_WAIT: WallDuration = WallDuration::from_millis(100);
+
+/// `t + d`, or the far future where that does not fit (absurd options).
+fn later(t: WallInstant, d: WallDuration) -> WallInstant {
+    t.checked_add(d)
+        .unwrap_or_else(|| t + WallDuration::from_secs(100 * 365 * 24 * 3600))
+}
+
 /// What the bridge says of a request that kept arriving garbled.
 #[derive(Debug)]
 pub(super) enum Ran {
@@ -196,10 +206,11 @@ impl<L: Link> SerialTarget<L> {
         };
         let start = WallInstant::now();
         let stall_limit = extra + self.opts.reply_timeout * (retries + 1);
-        let mut give_up_at = start + extra + self.opts.request_limit();
-        // However a bridge's WORKING messages stretch that: no longer than
-        // the request's bound in its time, run at 1/SLOWEST of real time.
-        let wall_cap = give_up_at + bridge_bound * SLOWEST_BRIDGE;
+        let base = later(start, extra + self.opts.request_limit());
+        // A bridge's WORKING messages stretch that by its progress alone:
+        // its clock's run, taken at 1/SLOWEST_BRIDGE of real time. A clock
+        // that creeps gains nothing; one that runs is waited for.
+        let mut give_up_at = base;
         let mut progress_at = start;
         // What the link brought instead of the reply, for the error.
         let mut noise = Noise::default();
@@ -222,6 +233,11 @@ impl<L: Link> SerialTarget<L> {
         let mut garbled = 0;
         let mut attempts = 0u32;
         let mut wait = self.rtt.timeout(&self.opts);
+        // A bridge that says WORKING says it 10 ms into a request at the
+        // latest (and every 50 ms): not asked again before it could have.
+        if self.stats.working > 0 {
+            wait = wait.max(WORKING_WAIT);
+        }
         let mut pause = WallDuration::ZERO;
         loop {
             if self.opts.stop.requested() {
@@ -306,19 +322,21 @@ impl<L: Link> SerialTarget<L> {
                             ));
                         }
                         self.stats.working += 1;
+                        let now = WallInstant::now();
                         if elapsed > bridge_elapsed {
                             bridge_elapsed = elapsed;
                             (silent, fruitless) = (0, 0);
-                            let now = WallInstant::now();
                             progress_at = now;
-                            give_up_at = give_up_at
-                                .max(now + self.opts.request_limit())
-                                .min(wall_cap);
+                            let earned = bridge_elapsed.saturating_mul(SLOWEST_BRIDGE);
+                            give_up_at = give_up_at.max(later(base, earned));
+                        } else if now >= progress_at + stall_limit {
+                            // WORKING whose clock stands still: no progress.
+                            break Ok(None);
                         }
                         budget = self
                             .opts
                             .reply_timeout
-                            .min(give_up_at.saturating_duration_since(WallInstant::now()));
+                            .min(give_up_at.saturating_duration_since(now));
                     }
                     other => break other,
                 }
@@ -374,7 +392,7 @@ impl<L: Link> SerialTarget<L> {
                 Ok(Some(r)) => {
                     // Karn's rule: only an exchange that was not repeated
                     // times the link, and only one with no waits of its own.
-                    if attempts == 1 && extra.is_zero() {
+                    if attempts == 1 && extra.is_zero() && bridge_elapsed.is_zero() {
                         self.rtt.sample(sent.elapsed());
                     }
                     return Ok(r);

@@ -283,9 +283,12 @@ impl<L: Link> SerialTarget<L> {
 }
 
 impl<L: Link> Target for SerialTarget<L> {
-    /// What the bridge declared in its HELLO.
+    /// What the bridge declared in its HELLO, never finer than a tick of
+    /// its timer (a bridge that says 0 is not exact).
     fn uncertainty(&self) -> Uncertainty {
-        self.hello.uncertainty
+        let hz = self.hello.timer_hz.max(1);
+        let tick = crate::time::Duration::from_nanos(1_000_000_000u64.div_ceil(hz));
+        self.hello.uncertainty.at_least(tick)
     }
 
     /// The serial number the bridge gives in its HELLO, else the USB

@@ -641,7 +641,7 @@ fn a_bridge_that_says_working_for_ever_is_given_up() {
         retries: 0,
         ..quick()
     };
-    for (creep, says) in [(1_000_000, "past the"), (1, "")] {
+    for (creep, says) in [(1_000_000, "past the"), (1, "no valid reply")] {
         let link = Working {
             server: MemLink::bridge(7),
             out: Vec::new(),
