@@ -40,7 +40,11 @@ const FILES: [&str; 14] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 33] = [
+const ELSEWHERE: [(&str, &str); 34] = [
+    (
+        "scripts/loaded-check",
+        "by hand (an hour of a loaded machine; its figures in docs/performance.md); the script itself in loaded_check_says_how_each_run_ended below",
+    ),
     (
         "docs/examples/chop-period.sh",
         "in scenarios/tests/console_cli.rs (on the emulator and through ppmc bridge-sim, the debug build)",
@@ -617,4 +621,29 @@ fn the_extraction_reads_commands_as_a_shell_would() {
     )
     .expect_err("a file a clean checkout lacks");
     assert!(e.contains("exit status Some(2)"), "{e}");
+}
+
+/// `scripts/loaded-check` (docs/performance.md, "On a loaded machine"),
+/// with no load and a command that passes and one that fails: a row per
+/// run with its exit status, and the script's own status says whether all
+/// passed.
+#[test]
+fn loaded_check_says_how_each_run_ended() {
+    let script = root().join("scripts/loaded-check");
+    let run = |cmd: &str| {
+        Command::new(&script)
+            .args(["--runs", "2", "--load", "0", "--", cmd])
+            .output()
+            .expect("the script runs")
+    };
+    let ok = run("true");
+    assert_eq!(ok.status.code(), Some(0), "{}", text(&ok.stderr));
+    let rows = text(&ok.stdout);
+    assert!(rows.contains("| 1 | `true` | 0 |"), "{rows}");
+    assert!(rows.contains("| 2 | `true` | 0 |"), "{rows}");
+    let bad = run("false");
+    assert_eq!(bad.status.code(), Some(1), "{}", text(&bad.stderr));
+    assert!(text(&bad.stdout).contains("| 1 | `false` | 1 |"));
+    let usage = Command::new(&script).output().expect("runs");
+    assert_eq!(usage.status.code(), Some(2));
 }

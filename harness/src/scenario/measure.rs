@@ -72,7 +72,7 @@ impl Driver<'_> {
                 let a = self.flushed("an operation command", |d| d.batch.anchor())?;
                 (
                     (a, u.access),
-                    (self.pin_after(Pin::Busy, Some(1), a)?, u.polled),
+                    (self.pin_after(Pin::Busy, Some(1), a)?, u.of_pin(Pin::Busy)),
                 )
             }
             TimingId::AccelFirstPout | TimingId::ConstantFirstPout => {
@@ -84,56 +84,62 @@ impl Driver<'_> {
                 let a = self.flushed("an operation command", |d| d.batch.anchor())?;
                 (
                     (a, u.access),
-                    (self.pin_after(Pin::Busy, Some(0), a)?, u.polled),
+                    (self.pin_after(Pin::Busy, Some(0), a)?, u.of_pin(Pin::Busy)),
                 )
             }
             TimingId::InterruptOutput => {
                 let (_, last) = self.last_move_pulse_times()?;
                 (
                     (last, u.edge),
-                    (self.pin_after(Pin::Int, Some(1), last)?, u.edge),
+                    (self.pin_after(Pin::Int, Some(1), last)?, u.of_pin(Pin::Int)),
                 )
             }
             TimingId::HoldOn => {
                 let (_, last) = self.last_move_pulse_times()?;
                 (
                     (last, u.edge),
-                    (self.pin_after(Pin::Hold, Some(1), last)?, u.edge),
+                    (
+                        self.pin_after(Pin::Hold, Some(1), last)?,
+                        u.of_pin(Pin::Hold),
+                    ),
                 )
             }
             TimingId::AbnormalTermination => {
                 let t = self.flushed("a stop or limit", |d| d.batch.trigger())?;
                 (
                     (t, u.access),
-                    (self.pin_after(Pin::Busy, Some(0), t)?, u.polled),
+                    (self.pin_after(Pin::Busy, Some(0), t)?, u.of_pin(Pin::Busy)),
                 )
             }
             TimingId::AuxOn => {
                 let t = self.flushed("an AUX ON command", |d| d.batch.trigger())?;
                 (
                     (t, u.access),
-                    (self.pin_after(Pin::Aux, Some(1), t)?, u.edge),
+                    (self.pin_after(Pin::Aux, Some(1), t)?, u.of_pin(Pin::Aux)),
                 )
             }
             TimingId::AuxOff => {
                 let t = self.flushed("an AUX OFF command", |d| d.batch.trigger())?;
                 (
                     (t, u.access),
-                    (self.pin_after(Pin::Aux, Some(0), t)?, u.edge),
+                    (self.pin_after(Pin::Aux, Some(0), t)?, u.of_pin(Pin::Aux)),
                 )
             }
             TimingId::ExcitationOff => {
                 let t = self.flushed("a software reset", |d| d.batch.trigger())?;
                 (
                     (t, u.access),
-                    (self.pin_after(Pin::Phases, Some(0), t)?, u.sampled),
+                    (
+                        self.pin_after(Pin::Phases, Some(0), t)?,
+                        u.of_pin(Pin::Phases),
+                    ),
                 )
             }
             TimingId::InitOutputsSet => {
                 let t = self.flushed("an initialization", |d| d.batch.init_write())?;
                 (
                     (t, u.access),
-                    (self.pin_after(Pin::Phases, None, t)?, u.sampled),
+                    (self.pin_after(Pin::Phases, None, t)?, u.of_pin(Pin::Phases)),
                 )
             }
             TimingId::InitProcessing => return self.measure_init_processing(),
