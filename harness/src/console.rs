@@ -439,11 +439,12 @@ fn is_access(stmt: Stmt) -> bool {
 
 /// How sure the target is of the time a statement's reply carries: a
 /// wait for a flag ends where the bridge's loop saw it change (`polled`),
-/// a pulse is a captured edge, the rest are an access's own stamp.
-fn path(stmt: Stmt, u: &Uncertainty) -> Duration {
-    match stmt {
-        Stmt::Await { .. } => u.polled,
-        Stmt::AwaitPulse { .. } => u.edge,
+/// a pulse waited for is a captured edge, the rest (a wait for a pulse
+/// that gave up included) are an access's own stamp or the clock.
+fn path(stmt: Stmt, reply: &Reply, u: &Uncertainty) -> Duration {
+    match (stmt, reply) {
+        (Stmt::Await { .. }, _) => u.polled,
+        (Stmt::AwaitPulse { .. }, Reply::PulsesReached { .. }) => u.edge,
         _ => u.access,
     }
 }
@@ -537,11 +538,11 @@ pub fn run(
                 });
             }
             // `now` shows the time of the access that follows it.
-            let (at, shown) = match (l.stmt, chunk.get(k + 1), replies.get(k + 1)) {
-                (Stmt::Now, Some(next), Some(r)) if is_access(next.stmt) => (r.at(), next.stmt),
-                _ => (reply.at(), l.stmt),
+            let (shown, by) = match (l.stmt, chunk.get(k + 1), replies.get(k + 1)) {
+                (Stmt::Now, Some(next), Some(r)) if is_access(next.stmt) => (next.stmt, r),
+                _ => (l.stmt, reply),
             };
-            writeln!(out, "{text}{}", stamp(at, path(shown, &u)))?;
+            writeln!(out, "{text}{}", stamp(by.at(), path(shown, by, &u)))?;
         }
         last = replies.last().map(Reply::at).or(last);
         i = end;
