@@ -287,14 +287,6 @@ impl Uncertainty {
             polled: self.polled.max(floor),
         }
     }
-
-    /// The largest of the four.
-    pub fn worst(&self) -> Duration {
-        self.edge
-            .max(self.sampled)
-            .max(self.access)
-            .max(self.polled)
-    }
 }
 
 /// A chip bus plus its pins and a pulse capture: what the bridge engine

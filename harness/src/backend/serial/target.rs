@@ -286,8 +286,10 @@ impl<L: Link> Target for SerialTarget<L> {
     /// What the bridge declared in its HELLO, never finer than a tick of
     /// its timer (a bridge that says 0 is not exact).
     fn uncertainty(&self) -> Uncertainty {
-        let hz = self.hello.timer_hz.max(1);
-        let tick = crate::time::Duration::from_nanos(1_000_000_000u64.div_ceil(hz));
+        let timer = Timer {
+            hz: self.hello.timer_hz.max(1),
+        };
+        let tick = crate::time::Duration::from_nanos(timer.to_nanos_up(1));
         self.hello.uncertainty.at_least(tick)
     }
 
