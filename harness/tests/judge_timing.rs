@@ -26,9 +26,14 @@ impl Edges {
     /// The clean board's capture of `scenario`, as `ppmc export --scenario
     /// NAME --bus` writes it, read back by the project's VCD reader.
     fn of(scenario: &str) -> Edges {
+        Edges::of_board(scenario, &ModelConfig::default())
+    }
+
+    /// The capture of `scenario` on a board that `model` describes.
+    fn of_board(scenario: &str, model: &ModelConfig) -> Edges {
         let suite = ppmc_scenarios::all();
         let s = suite.iter().find(|s| s.name == scenario).expect("scenario");
-        let (trace, _) = analyzer_trace(&ModelConfig::default(), s).expect("a capture");
+        let (trace, _) = analyzer_trace(model, s).expect("a capture");
         let mut buf = Vec::new();
         let what = Export {
             window: None,
@@ -93,6 +98,11 @@ impl Edges {
 
 fn judged(mut cap: Recorded) -> ppmc::judge::Judgement {
     let map = ChannelMap::from_names(cap.info()).expect("our names");
+    judge(&mut cap, &map, &JudgeOptions::default()).expect("judged")
+}
+
+fn judged_with(mut cap: Recorded, map: &str) -> ppmc::judge::Judgement {
+    let map = ChannelMap::parse(map, cap.info()).expect("a map");
     judge(&mut cap, &map, &JudgeOptions::default()).expect("judged")
 }
 
@@ -349,4 +359,122 @@ fn s3_6_a_first_pout_within_the_captures_uncertainty_of_its_limit_is_marginal() 
     let j = judged(first_pout_late(scenario, |l| limit(l) - 300_000, 42_000));
     assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
     assert_eq!(j.marginal.count, 0, "{:?}", j.marginal);
+}
+
+/// The scenario whose phases stop switching chops (Sections 3-2-1 (2),
+/// 3-5-1: Diagram 3-5's 65 us ON, 108.75 us OFF, from HOLD on).
+const CHOPPING: &str = "s3_5_1_default_switching_chops_the_phases";
+
+/// Sections 3-2-1 and 3-5-1: S1..S5 are compared at their levels, each
+/// step of the excitation sequence and each edge of the chopping. With
+/// the phases' channels the judge compares over a thousand more changes
+/// than without them; a capture whose S1 and S2 are swapped fails the
+/// board at S1 or S2, and one whose S3 reads inverted at S3.
+#[test]
+fn s3_5_1_the_phases_are_compared_step_by_step_and_chop_by_chop() {
+    let j = judged(Edges::of(CHOPPING).capture());
+    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert!(
+        !j.not_judged.iter().any(|n| n.contains("S1")),
+        "{:?}",
+        j.not_judged
+    );
+    // The same capture, its phases' channels named so that no signal is
+    // taken for them.
+    let mut e = Edges::of(CHOPPING);
+    for k in 1..=5 {
+        let ch = e.channel(&format!("s{k}"));
+        e.info.channels[ch] = format!("phase{k}");
+    }
+    let fewer = judged(e.capture());
+    assert_eq!(fewer.verdict, Verdict::Passed, "{fewer:?}");
+    assert!(
+        j.changes > fewer.changes + 1000,
+        "{} changes with S1..S5, {} without",
+        j.changes,
+        fewer.changes
+    );
+    assert!(
+        fewer.not_judged.iter().any(|n| n.contains("S1")),
+        "{:?}",
+        fewer.not_judged
+    );
+    for (map, signals) in [("S1=s2,S2=s1", ["S1", "S2"]), ("S3=~s3", ["S3", "S3"])] {
+        let j = judged_with(Edges::of(CHOPPING).capture(), map);
+        match &j.verdict {
+            Verdict::Failed(d) => {
+                assert!(signals.iter().any(|s| d.what.starts_with(s)), "{map}: {d}")
+            }
+            other => panic!("{map}: {other:?}"),
+        }
+    }
+}
+
+/// The capture of [`CHOPPING`] with its chopping (from HOLD on to
+/// BUSY's rise) stretched by `per_mille` thousandths: a board whose
+/// chopping runs that much slow, each ON and OFF as much long, cut where
+/// the move starts, the phases then on.
+fn chopping_slow(per_mille: u64) -> Recorded {
+    let mut e = Edges::of(CHOPPING);
+    let rise = |e: &Edges, name: &str, after: u64| {
+        let ch = e.channel(name);
+        e.edges
+            .iter()
+            .find(|x| x.1 == ch && x.2 && x.0 > after)
+            .map(|x| x.0)
+            .expect("a rise")
+    };
+    let on = rise(&e, "hold", 0);
+    let moves = rise(&e, "busy", on);
+    for k in 1..=5 {
+        let ch = e.channel(&format!("s{k}"));
+        let level_at = |t: u64| e.edges.iter().rfind(|x| x.1 == ch && x.0 <= t).map(|x| x.2);
+        let energized = level_at(on).expect("a level");
+        let mut last = energized;
+        e.edges.retain_mut(|x| {
+            if x.1 != ch || x.0 <= on || x.0 >= moves {
+                return true;
+            }
+            x.0 = on + (x.0 - on) * (1000 + per_mille) / 1000;
+            let keep = x.0 < moves;
+            if keep {
+                last = x.2;
+            }
+            keep
+        });
+        if last != energized {
+            e.edges.push((moves, ch, energized));
+        }
+    }
+    e.capture()
+}
+
+/// Section 3-5-1 (Diagram 3-5): a board whose chopping runs 0.3 % slow,
+/// every ON and OFF 0.3 % long, passes, though over the capture its edges
+/// drift far past one edge's tolerance from the model's: each edge is
+/// timed from the last one matched, as POUT's pulses are. One 5 % slow
+/// fails at a phase.
+#[test]
+fn s3_5_1_chopping_is_timed_edge_from_edge() {
+    let j = judged(chopping_slow(3));
+    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    let j = judged(chopping_slow(50));
+    match &j.verdict {
+        Verdict::Failed(d) => assert!(d.what.starts_with('S'), "{d}"),
+        other => panic!("{other:?}"),
+    }
+}
+
+/// Section 3-2-1, N15: the catalogue's `phase-step-skipped` board (the
+/// phases miss the first step of every move) fails at a phase: its
+/// second move starts a step behind the model's.
+#[test]
+fn s3_2_1_a_board_whose_phases_miss_a_step_fails_at_a_phase() {
+    let mut model = ModelConfig::default();
+    model.faults.phase_step_skipped = true;
+    let j = judged(Edges::of_board("s3_2_1_three_phase_two_phase_excitation", &model).capture());
+    match &j.verdict {
+        Verdict::Failed(d) => assert!(d.what.starts_with('S'), "{d}"),
+        other => panic!("{other:?}"),
+    }
 }

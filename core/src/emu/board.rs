@@ -275,6 +275,11 @@ impl Board {
         self.chip.poll_at()
     }
 
+    /// [`Chip::phase_outputs`].
+    pub fn phase_outputs(&self) -> crate::protocol::PhaseOutputs {
+        self.chip.phase_outputs()
+    }
+
     /// [`Chip::next_pin_change`].
     pub fn next_pin_change(&self) -> Option<Instant> {
         self.chip.next_pin_change()

@@ -128,6 +128,17 @@ pub enum OutputLogic {
     Positive,
 }
 
+impl OutputLogic {
+    /// The levels of S1..S5 (S1 in bit 4) that drive the `energized`
+    /// phases (Section 3-2-1, Diagram 3-4).
+    pub fn levels(self, energized: u8) -> u8 {
+        match self {
+            OutputLogic::Positive => energized & 0x1F,
+            OutputLogic::Negative => !energized & 0x1F,
+        }
+    }
+}
+
 /// Base clock source, initialization command bit 4 (Section 3-2-1 (1)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ClockSource {

@@ -17,7 +17,7 @@ pub use command::{
     ClockSource, Command, Direction, Excitation, InitCommand, InitData, MotorType, MoveCommand,
     MoveKind, OpFlags, OutputLogic, PulseCount, Register,
 };
-pub use phase::Winding;
+pub use phase::{Chop, PhaseOutputs, Winding};
 pub use rates::{StrapFieldError, Straps, StrapsError, STRAP_KEYS};
 pub use registers::{
     AuxInputStatus, ErrorCode, FinishStatus, Flag, Input, InputSet, InputStatus, OutputStatus,

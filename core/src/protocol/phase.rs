@@ -4,7 +4,53 @@
 //! the phase is energized (independent of the output logic level). CW steps
 //! forward through the sequence, CCW backward.
 
-use super::command::{Direction, Excitation, MotorType};
+use super::command::{Direction, Excitation, MotorType, OutputLogic};
+use crate::time::{Duration, Instant};
+
+/// Stop switching's chopping (Sections 3-2-1 (2) and 3-5-1, Diagram 3-5):
+/// from `since`, the energized phases are on for `on`, then off for
+/// `off`, and again, until the motor moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Chop {
+    pub since: Instant,
+    pub on: Duration,
+    pub off: Duration,
+}
+
+impl Chop {
+    fn cycle(&self) -> u64 {
+        (self.on + self.off).as_nanos().max(1)
+    }
+
+    /// Whether the phases are on at `t` (on from `since`).
+    pub fn is_on(&self, t: Instant) -> bool {
+        t.saturating_since(self.since).as_nanos() % self.cycle() < self.on.as_nanos()
+    }
+
+    /// The first time after `t` at which the phases turn on or off.
+    pub fn next_edge(&self, t: Instant) -> Instant {
+        let cycle = self.cycle();
+        let elapsed = t.saturating_since(self.since).as_nanos();
+        let start = elapsed - elapsed % cycle;
+        let next = if elapsed % cycle < self.on.as_nanos() {
+            start + self.on.as_nanos()
+        } else {
+            start + cycle
+        };
+        self.since + Duration::from_nanos(next)
+    }
+}
+
+/// What sets the levels of S1..S5 beside the step position: the output
+/// logic (and since when: an initialization after a software reset may set
+/// another), and the ON and OFF times stop switching chops with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PhaseOutputs {
+    pub logic: OutputLogic,
+    pub logic_since: Instant,
+    pub on: Duration,
+    pub off: Duration,
+}
 
 /// The winding configuration frozen by the first initialization.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

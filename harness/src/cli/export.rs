@@ -34,7 +34,8 @@ pub struct ExportArgs {
     /// Draw the host's bus too: CS*, RD*, WR*, A0 and D0-D7, one cycle per
     /// register access of the trace (its timing is in the file's header
     /// and docs/capture.md), as a logic analyzer on the chip's bus would
-    /// record it.
+    /// record it; and every pin at its level: S1..S5 under the output
+    /// logic the initialization chose, chopped while stop switching is on.
     #[arg(long)]
     bus: bool,
     /// With --scenario: how the host times an access it waits for.

@@ -57,8 +57,10 @@ enum Command {
     /// and its first divergence.
     Compare(compare::CompareArgs),
     /// Write a trace as a VCD waveform (POUT, DIR, S1..S5, INT, HOLD, AUX,
-    /// BUSY; with --bus the host's bus too) for GTKWave or PulseView, or a
-    /// scenario run on the emulator as a logic analyzer would record it.
+    /// BUSY; with --bus the host's bus too and every pin at its level, the
+    /// phases under the output logic and chopped) for GTKWave or
+    /// PulseView, or a scenario run on the emulator as a logic analyzer
+    /// would record it.
     Export(export::ExportArgs),
     /// Print the register accesses of a logic-analyzer capture of the
     /// chip's bus, in the bus console's language (docs/capture.md).

@@ -12,10 +12,10 @@
 //! 16,777,216-step move's 706 s (665 MB of VCD). The skipped ones are
 //! named in the column's notes.
 //!
-//! For each fault the column misses, [`why_missed`] says why, and says
-//! only what is true: an effect on a pin the capture has but the judge
-//! does not compare yet is [`Unseen::NotCompared`], not something a
-//! capture cannot show.
+//! For each fault the column misses, [`why_missed`] says why. The judge
+//! compares every pin a capture has (the bus, POUT, DIR, INT*, BUSY,
+//! HOLD, AUX*, AUXO0..3 and S1..S5), so a fault it misses is one no
+//! capture of the chip's bus and pins can show.
 
 use super::Catch;
 use crate::backend::{EmuTarget, Op, Reply, Target, TargetError, TargetInfo};
@@ -236,9 +236,6 @@ impl Target for Analyzer {
 /// Why the capture column misses a fault.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Unseen {
-    /// The effect is on pins the capture has, which the judge does not
-    /// compare yet (the phases S1..S5).
-    NotCompared(&'static str),
     /// No capture of the chip's bus and pins shows it.
     CannotShow(&'static str),
 }
@@ -246,7 +243,6 @@ pub enum Unseen {
 impl std::fmt::Display for Unseen {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Unseen::NotCompared(why) => write!(f, "not compared by the judge yet: {why}"),
             Unseen::CannotShow(why) => write!(f, "a capture cannot show it: {why}"),
         }
     }
@@ -264,9 +260,9 @@ pub fn why_missed(fault: &str) -> Option<Unseen> {
 
 /// The faults the column misses, and why: none today. Every one of the
 /// catalogue's 27 shows on the bus or a pin the judge compares (the status
-/// and data reads, POUT's pulses, DIR at each, INT*, BUSY, HOLD, AUX* and
-/// AUXO). A fault added to the catalogue that only the phases S1..S5 show
-/// (not compared yet) would be entered here, with why.
+/// and data reads, POUT's pulses, DIR at each, INT*, BUSY, HOLD, AUX*,
+/// AUXO and S1..S5). A fault added to the catalogue that no capture can
+/// show would be entered here, with why.
 const MISSED: &[(&str, Unseen)] = &[];
 
 /// The capture column's notes under the matrix: the scenarios not judged

@@ -30,6 +30,7 @@ mod bench;
 mod branch;
 mod host;
 mod outputs;
+mod phases;
 mod suspect;
 pub mod trace;
 use bench::{run_until, Bench, StatusLog};
@@ -138,7 +139,7 @@ pub struct Judgement {
     pub accesses: u64,
     pub pulses: u64,
     /// The changes of the other outputs compared (INT*, BUSY, HOLD, AUX*,
-    /// AUXO0..3).
+    /// AUXO0..3, S1..S5 and the chopping's edges).
     pub changes: u64,
     /// What could not be judged, and why (a signal with no channel).
     pub not_judged: Vec<String>,
@@ -337,14 +338,12 @@ pub fn judge_traced(
     let unwatched: Vec<String> = [Signal::Int, Signal::Busy, Signal::Hold, Signal::Aux]
         .into_iter()
         .chain((0..4).map(Signal::Auxo))
+        .chain((1..=5).map(Signal::Phase))
         .filter(|s| !outputs.signals().any(|w| w == *s))
         .map(Signal::name)
         .collect();
     if !unwatched.is_empty() {
         not_judged.push(format!("outputs {}: no channel", unwatched.join(", ")));
-    }
-    if (1..=5).any(|k| info.channel(&format!("s{k}")).is_some()) {
-        not_judged.push("the phase outputs S1..S5: not compared yet".into());
     }
     let mut decoder = BusDecoder::new(bus, &info, opts.glitch_ps);
     let mut branches = vec![Branch {

@@ -3,8 +3,10 @@
 //! against the model's record of its pins, each change within the
 //! capture's resolution and the latency tolerance of the time since what
 //! caused it (the last register access or the last pulse before it:
-//! Table 3-3 times INT*, BUSY and HOLD from them).
+//! Table 3-3 times INT*, BUSY and HOLD from them). S1..S5 have their
+//! own rules ([`super::phases`]).
 
+use super::phases::{self, PhaseLevels, PhaseWatch, Rules};
 use super::{Divergence, Marginal};
 use crate::compare::Tolerances;
 use crate::emu::Board;
@@ -36,6 +38,10 @@ pub(super) struct Outputs {
     compared: u64,
     /// The changes matched within the capture's uncertainty of their limit.
     marginal: Marginal,
+    /// S1..S5, where the capture has channels for them, and their levels
+    /// as the model drove them.
+    phases: Vec<PhaseWatch>,
+    levels: Option<PhaseLevels>,
 }
 
 /// One output pin and its two sides.
@@ -117,17 +123,27 @@ impl Outputs {
             let now = pins.auxo >> k & 1 == 1;
             watch(Signal::Auxo(k), Pin::Auxo, true, k, now);
         }
+        let phases: Vec<PhaseWatch> = (1..=5)
+            .filter_map(|k| {
+                map.get(Signal::Phase(k))
+                    .map(|c| PhaseWatch::new(k, c, board))
+            })
+            .collect();
+        let levels = (!phases.is_empty()).then(|| PhaseLevels::new(board));
         Outputs {
             watches,
             accesses: VecDeque::new(),
             compared: 0,
             marginal: Marginal::default(),
+            phases,
+            levels,
         }
     }
 
     /// The signals compared.
     pub(super) fn signals(&self) -> impl Iterator<Item = Signal> + '_ {
-        self.watches.iter().map(|w| w.signal)
+        let phases = self.phases.iter().map(PhaseWatch::signal);
+        self.watches.iter().map(|w| w.signal).chain(phases)
     }
 
     /// Changes compared so far.
@@ -160,6 +176,9 @@ impl Outputs {
                 _ => w.board.push_back((c.time_ps, asserted)),
             }
             w.seen = Some(asserted);
+        }
+        for w in &mut self.phases {
+            w.observe(c);
         }
     }
 
@@ -286,6 +305,55 @@ impl Outputs {
                 }
             }
         }
+        self.compare_phases(f, horizon_ps, after)
+    }
+
+    /// [`Outputs::compare`] for S1..S5.
+    fn compare_phases(
+        &mut self,
+        f: &Frame<'_>,
+        horizon_ps: u64,
+        after: Option<String>,
+    ) -> Result<(), Divergence> {
+        let Some(levels) = &mut self.levels else {
+            return Ok(());
+        };
+        levels.draw(f.board);
+        let record = f.board.record();
+        let to_ps = |t: Instant| t.as_nanos().saturating_mul(1000).saturating_add(f.zero_ps);
+        let floor = f.tol.floor.as_nanos().saturating_mul(1000);
+        let latency = |ps: u64| ps.saturating_mul(f.tol.latency_bp) / 10_000;
+        let accesses = &self.accesses;
+        // A phase steps with a pulse: its cause is what caused the pulse,
+        // the pulse or the access before it.
+        let allowed = |ps: u64| {
+            let m = Instant::from_nanos(ps.saturating_sub(f.zero_ps) / 1000);
+            let by = Instant::from_nanos(m.as_nanos().saturating_sub(1));
+            let pulse = last_pulse_by(&record.runs, by).map(to_ps);
+            let access = accesses.iter().rev().find(|&&a| a < ps).copied();
+            let cause = pulse.max(access).unwrap_or(f.zero_ps);
+            floor
+                .saturating_add(latency(ps.saturating_sub(cause)))
+                .saturating_add(2 * f.resolution_ps)
+                .saturating_add(f.slack_ps)
+        };
+        let interval = |ps: u64| {
+            floor
+                .saturating_add(latency(ps))
+                .saturating_add(2 * f.resolution_ps)
+        };
+        let rules = Rules {
+            to_ps: &to_ps,
+            allowed: &allowed,
+            interval: &interval,
+            u_ps: 2 * f.resolution_ps,
+            horizon_ps,
+            after,
+        };
+        for w in &mut self.phases {
+            w.compare(levels, &rules, &mut self.marginal, &mut self.compared)?;
+        }
+        phases::taken(levels, &self.phases);
         Ok(())
     }
 }

@@ -42,6 +42,9 @@ pub enum Signal {
     Aux,
     /// AUXO0..AUXO3, active low.
     Auxo(u8),
+    /// The excitation outputs S1..S5 (`Phase(1)` is S1), at the levels
+    /// the initialization's output logic gives them (Section 3-2-1).
+    Phase(u8),
     /// An input the board drives into the chip: the limits L1*..L4*, ALM*,
     /// CNP* and AUXI0..3, all active low (the pin pulled low asserts it).
     /// The judge gives the model what the capture shows on them.
@@ -50,7 +53,7 @@ pub enum Signal {
 
 impl Signal {
     /// Every signal, bus first.
-    pub const ALL: [Signal; 32] = [
+    pub const ALL: [Signal; 37] = [
         Signal::Cs,
         Signal::Rd,
         Signal::Wr,
@@ -73,6 +76,11 @@ impl Signal {
         Signal::Auxo(1),
         Signal::Auxo(2),
         Signal::Auxo(3),
+        Signal::Phase(1),
+        Signal::Phase(2),
+        Signal::Phase(3),
+        Signal::Phase(4),
+        Signal::Phase(5),
         Signal::Input(Input::L1),
         Signal::Input(Input::L2),
         Signal::Input(Input::L3),
@@ -100,6 +108,7 @@ impl Signal {
             Signal::Hold => "HOLD".into(),
             Signal::Aux => "AUX".into(),
             Signal::Auxo(i) => format!("AUXO{i}"),
+            Signal::Phase(k) => format!("S{k}"),
             Signal::Input(i) => i.name().to_ascii_uppercase(),
         }
     }
@@ -152,6 +161,11 @@ impl Signal {
             "DIR" => return Some(Signal::Dir),
             "BUSY" => return Some(Signal::Busy),
             "HOLD" => return Some(Signal::Hold),
+            "S1" => return Some(Signal::Phase(1)),
+            "S2" => return Some(Signal::Phase(2)),
+            "S3" => return Some(Signal::Phase(3)),
+            "S4" => return Some(Signal::Phase(4)),
+            "S5" => return Some(Signal::Phase(5)),
             _ => {}
         }
         let digits = n
@@ -567,10 +581,11 @@ mod tests {
             ("DB3", Signal::D(3)),
             ("pout", Signal::Pout),
             ("INT*", Signal::Int),
+            ("s3", Signal::Phase(3)),
         ] {
             assert_eq!(Signal::parse(name), Some(s), "{name}");
         }
-        for name in ["D8", "CLK", "", "DX"] {
+        for name in ["D8", "CLK", "", "DX", "S6", "S0"] {
             assert_eq!(Signal::parse(name), None, "{name}");
         }
     }

@@ -231,7 +231,10 @@ impl Chip {
                 motor: cmd.motor,
                 excitation: cmd.excitation,
             });
-            self.logic = cmd.logic;
+            if self.logic != cmd.logic {
+                self.logic = cmd.logic;
+                self.logic_since = self.now;
+            }
             self.phase_index = 0;
             self.out_winding = self.winding;
         }

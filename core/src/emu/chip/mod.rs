@@ -18,9 +18,10 @@ use super::config::{ConfigError, ModelConfig};
 use super::motion::{AccelRamp, Motion, Profile, Ramp, Stretch};
 use crate::protocol::capture::{MoveStart, Pin, Pins, Record, RecordMark};
 use crate::protocol::{
-    AuxInputStatus, ClockSource, Command, Direction, ErrorCode, FinishStatus, InitCommand,
+    AuxInputStatus, Chop, ClockSource, Command, Direction, ErrorCode, FinishStatus, InitCommand,
     InitData, Input, InputSet, InputStatus, MoveCommand, MoveKind, OutputLogic, OutputStatus,
-    PulseCount, Register, Status, StatusField, StopCause, Straps, StrapsError, Winding,
+    PhaseOutputs, PulseCount, Register, Status, StatusField, StopCause, Straps, StrapsError,
+    Winding,
 };
 use crate::time::{Duration, Instant};
 use alloc::collections::VecDeque;
@@ -144,6 +145,8 @@ pub struct Chip {
     /// OFF time has passed (note N36).
     out_winding: Option<Winding>,
     logic: OutputLogic,
+    /// When the output logic was last changed.
+    logic_since: Instant,
     setup: Option<Setup>,
     switch_on: Duration,
     switch_off: Duration,
@@ -217,6 +220,7 @@ impl Chip {
             winding: None,
             out_winding: None,
             logic: OutputLogic::Negative,
+            logic_since: Instant::ZERO,
             setup: None,
             config_epoch: 0,
             busy: false,
@@ -377,6 +381,18 @@ impl Chip {
             phase_levels: self.levels(phases),
             dir: self.dir,
             busy: self.busy,
+        }
+    }
+
+    /// The output logic and stop switching's ON and OFF times in force:
+    /// with the record's phase patterns, switching and pulses, what the
+    /// levels of S1..S5 were (the capture judge draws them so).
+    pub fn phase_outputs(&self) -> PhaseOutputs {
+        PhaseOutputs {
+            logic: self.logic,
+            logic_since: self.logic_since,
+            on: self.switch_on,
+            off: self.switch_off,
         }
     }
 

@@ -476,44 +476,31 @@ impl Chip {
         }
     }
 
+    /// Stop switching's chopping now, if it chops.
+    fn chop(&self) -> Option<Chop> {
+        self.switching_since.map(|since| Chop {
+            since,
+            on: self.switch_on,
+            off: self.switch_off,
+        })
+    }
+
     /// Energized phases at `t`, with stop switching chopping them.
     pub(super) fn energized(&self, t: Instant) -> u8 {
-        let p = self.energized_pattern();
-        match self.switching_since {
-            Some(since) => {
-                let cycle = (self.switch_on + self.switch_off).as_nanos().max(1);
-                let phase = t.saturating_since(since).as_nanos() % cycle;
-                if phase < self.switch_on.as_nanos() {
-                    p
-                } else {
-                    0
-                }
-            }
-            None => p,
+        match self.chop() {
+            Some(c) if !c.is_on(t) => 0,
+            _ => self.energized_pattern(),
         }
     }
 
     /// The first time after `t` at which stop switching turns the phases on
     /// or off ([`Chip::energized`]'s next edge), while it chops.
     pub(super) fn next_chop(&self, t: Instant) -> Option<Instant> {
-        let since = self.switching_since?;
-        let (on, off) = (self.switch_on.as_nanos(), self.switch_off.as_nanos());
-        let cycle = (on + off).max(1);
-        let elapsed = t.saturating_since(since).as_nanos();
-        let start = elapsed - elapsed % cycle;
-        let next = if elapsed % cycle < on {
-            start + on
-        } else {
-            start + cycle
-        };
-        Some(since + Duration::from_nanos(next))
+        self.chop().map(|c| c.next_edge(t))
     }
 
     /// Pin levels of S1..S5 for an energized pattern (Section 3-2-1).
     pub(super) fn levels(&self, energized: u8) -> u8 {
-        match self.logic {
-            OutputLogic::Positive => energized,
-            OutputLogic::Negative => !energized & 0x1F,
-        }
+        self.logic.levels(energized)
     }
 }

@@ -5,6 +5,8 @@
 //! as the trace records them, independent of the output logic level),
 //! `int`, `hold`, `aux` (1 = asserted), `busy`, `switching` (stop switching
 //! active; the chopping itself is not expanded), and `auxo0`..`auxo3`.
+//! With the bus, every pin is at its level instead: `s1`..`s5` under the
+//! output logic, chopped while stop switching is on ([`phases`]).
 //! There are no vectors (libsigrok's VCD reader loads a file with a vector
 //! as zero samples, without a word), and a value is written only when it
 //! changes, with a timestamp only where something changes. Timescale 1 ns,
@@ -25,9 +27,12 @@
 //! timing: what a logic analyzer on the chip's bus would record, for
 //! `ppmc decode` and `ppmc judge` to read back (`docs/capture.md`).
 
+mod phases;
+
 use crate::protocol::{Direction, Pin, Winding};
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, EventKind, Trace};
+use phases::PhasePins;
 use std::io::{self, Write};
 use vcd::{IdCode, TimescaleUnit, Value};
 
@@ -89,7 +94,7 @@ const MAX_LAID_OUT: u64 = 8;
 const LOOK_BACK: u64 = MAX_LAID_OUT * BUS_CYCLE + BUS_SETUP + BUS_STROBE;
 
 /// The header's word on the bus's timing.
-pub const BUS_TIMING_NOTE: &str = "bus: one cycle per register access: CS* low 50 ns before the strobe, RD* or WR* low for 100 ns rising at the access's time in the trace (the data held from the strobe's fall to CS* rising 20 ns after it), A0 high for the command and status registers; accesses at one time in the trace are laid out 200 ns apart, the last ending at that time. A status wait (await) is drawn as the one status read that ended it. Every pin is drawn at its level, as a logic analyzer sees it: the active-low outputs (int, aux, auxo0..auxo3) and the inputs the board drives (l1..l4, alm, cnp, auxi0..auxi3) low while asserted. Every time in this file is the trace's plus the lead in the comment below, which makes room for the cycles at the trace's start.";
+pub const BUS_TIMING_NOTE: &str = "bus: one cycle per register access: CS* low 50 ns before the strobe, RD* or WR* low for 100 ns rising at the access's time in the trace (the data held from the strobe's fall to CS* rising 20 ns after it), A0 high for the command and status registers; accesses at one time in the trace are laid out 200 ns apart, the last ending at that time. A status wait (await) is drawn as the one status read that ended it. Every pin is drawn at its level, as a logic analyzer sees it: the active-low outputs (int, aux, auxo0..auxo3) and the inputs the board drives (l1..l4, alm, cnp, auxi0..auxi3) low while asserted; s1..s5 under the output logic of the initialization, chopped edge by edge while stop switching is on. Every time in this file is the trace's plus the lead in the comment below, which makes room for the cycles at the trace's start.";
 
 const POUT: usize = 0;
 const DIR: usize = 1;
@@ -195,14 +200,35 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
             state.values[i] = true;
         }
     }
+    let mut pulses = Pulses::default();
+    if what.bus {
+        let pins = PhasePins::new(trace)?;
+        state.set_bits(Instant::ZERO, S1, 5, pins.levels(Instant::ZERO))?;
+        pulses.pins = Some(pins);
+    }
     if from == Instant::ZERO {
         state.start()?;
     }
-    let mut pulses = Pulses::default();
     for (k, e) in trace.events.iter().enumerate() {
         // A run's pulses come in time order with the events logged after
         // it (a stop written while it runs).
         pulses.draw_until(&mut state, e.at)?;
+        if let Some(pins) = &mut pulses.pins {
+            pins.chop_until(&mut state, e.at)?;
+            // The model takes an access where the file's strobe ends.
+            let (at, bus) = match &e.kind {
+                EventKind::Bus(b) if bus_cycle(b).is_some() => {
+                    let early = laid_before(trace, k) * BUS_CYCLE;
+                    (
+                        Instant::from_nanos(e.at.as_nanos().saturating_sub(early)),
+                        Some(b),
+                    )
+                }
+                EventKind::Bus(b) => (e.at, Some(b)),
+                _ => (e.at, None),
+            };
+            pins.event(&mut state, at, bus)?;
+        }
         state.drain_before((e.at.as_nanos() + state.lead).saturating_sub(LOOK_BACK))?;
         match &e.kind {
             EventKind::Move {
@@ -214,6 +240,7 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
                 pulses.draw_until(&mut state, Instant::from_nanos(u64::MAX))?;
                 state.flush_before(&mut pulses.pending_fall, e.at)?;
                 pulses.winding = *wd;
+                pulses.dir = Some(*dir);
                 pulses.phase = *p;
                 state.set(e.at, DIR, *dir == Direction::Ccw)?;
             }
@@ -235,7 +262,8 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
                 let past = first_at_or_after(&run, *count, late).max(first_in);
                 if first_in > 0 {
                     if let Some(wd) = pulses.winding {
-                        pulses.phase = wd.advance(pulses.phase, *dir, u64::from(first_in));
+                        let step = pulses.dir.unwrap_or(*dir);
+                        pulses.phase = wd.advance(pulses.phase, step, u64::from(first_in));
                     }
                 }
                 pulses.run = Some(RunDrawing {
@@ -256,9 +284,17 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
                     Pin::Int => state.set(e.at, INT, v != what.bus)?,
                     Pin::Hold => state.set(e.at, HOLD, v)?,
                     Pin::Aux => state.set(e.at, AUX, v != what.bus)?,
-                    Pin::Switching => state.set(e.at, SWITCHING, v)?,
+                    Pin::Switching => {
+                        state.set(e.at, SWITCHING, v)?;
+                        if let Some(pins) = &mut pulses.pins {
+                            pins.switching(&mut state, e.at, v)?;
+                        }
+                    }
                     Pin::Dir => state.set(e.at, DIR, v)?,
-                    Pin::Phases => state.set_bits(e.at, S1, 5, *value)?,
+                    Pin::Phases => match &mut pulses.pins {
+                        Some(pins) => pins.pattern(&mut state, e.at, *value)?,
+                        None => state.set_bits(e.at, S1, 5, *value)?,
+                    },
                     // auxo0 is bit 0.
                     Pin::Auxo => {
                         for k in 0..4 {
@@ -276,14 +312,8 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
                 let Some((read, a0, byte)) = bus_cycle(b) else {
                     continue;
                 };
-                // Accesses after this one at the same time come first.
-                let later = trace.events[k + 1..]
-                    .iter()
-                    .take_while(|n| n.at == e.at)
-                    .filter(|n| matches!(&n.kind, EventKind::Bus(nb) if bus_cycle(nb).is_some()))
-                    .count() as u64;
                 let end = (e.at.as_nanos() + state.lead)
-                    .saturating_sub(later.min(MAX_LAID_OUT) * BUS_CYCLE);
+                    .saturating_sub(laid_before(trace, k) * BUS_CYCLE);
                 let strobe = if read { RD } else { WR };
                 let setup = end.saturating_sub(BUS_SETUP + BUS_STROBE);
                 let fall = end.saturating_sub(BUS_STROBE);
@@ -303,7 +333,6 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
     if let Some(f) = pulses.pending_fall.take() {
         state.set(f, POUT, false)?;
     }
-    state.drain_before(u64::MAX)?;
     // The trace's end (or the window's), where nothing changes.
     let end = trace
         .events
@@ -311,6 +340,11 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
         .map(|e| e.at.as_nanos())
         .max()
         .unwrap_or(0);
+    if let Some(pins) = &mut pulses.pins {
+        let last = Instant::from_nanos(end.min(state.to));
+        pins.chop_until(&mut state, last)?;
+    }
+    state.drain_before(u64::MAX)?;
     let end = end.min(state.to).max(state.from);
     if !state.started {
         state.start()?;
@@ -323,6 +357,19 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
 /// How long the file goes on after the trace's last event (and its last
 /// change), in ns: a sampling converter keeps every change before it.
 pub const TAIL: u64 = 1_000;
+
+/// How many bus cycles before its time in the trace the access of event
+/// `k` is laid out: one for each access after it at the same time (they
+/// come first), at most [`MAX_LAID_OUT`].
+fn laid_before(trace: &Trace, k: usize) -> u64 {
+    let at = trace.events[k].at;
+    let later = trace.events[k + 1..]
+        .iter()
+        .take_while(|n| n.at == at)
+        .filter(|n| matches!(&n.kind, EventKind::Bus(nb) if bus_cycle(nb).is_some()))
+        .count() as u64;
+    later.min(MAX_LAID_OUT)
+}
 
 /// How late the bus export writes every time, in ns: the whole
 /// microseconds that the cycles laid out before the earliest accesses
@@ -367,6 +414,11 @@ struct Pulses {
     run: Option<RunDrawing>,
     winding: Option<Winding>,
     phase: u32,
+    /// The move's direction, which the phases step in (a run's is DIR's
+    /// as the capture saw it, which a miswired DIR line inverts).
+    dir: Option<Direction>,
+    /// S1..S5 at their levels (with the bus).
+    pins: Option<PhasePins>,
     /// The falling edge of the last pulse drawn, not yet written.
     pending_fall: Option<Instant>,
 }
@@ -396,15 +448,19 @@ impl Pulses {
             state.flush_before(&mut self.pending_fall, t)?;
             state.set(t, POUT, true)?;
             if let Some(wd) = self.winding {
-                self.phase = wd.advance(self.phase, r.dir, 1);
-                state.set_bits(t, S1, 5, wd.pattern(self.phase))?;
+                self.phase = wd.advance(self.phase, self.dir.unwrap_or(r.dir), 1);
+                match &mut self.pins {
+                    Some(pins) => pins.pattern(state, t, wd.pattern(self.phase))?,
+                    None => state.set_bits(t, S1, 5, wd.pattern(self.phase))?,
+                }
             }
             self.pending_fall = Some(t + r.width.max(Duration::from_nanos(1)));
             r.next += 1;
         }
         if r.past < r.run.count {
             if let Some(wd) = self.winding {
-                self.phase = wd.advance(self.phase, r.dir, u64::from(r.run.count - r.past));
+                let step = self.dir.unwrap_or(r.dir);
+                self.phase = wd.advance(self.phase, step, u64::from(r.run.count - r.past));
             }
         }
         self.run = None;
