@@ -8,6 +8,7 @@ use crate::emu::ModelConfig;
 use crate::protocol::{InitData, PulseCount, Status, Straps};
 use crate::scenario::Scenario;
 use crate::time::Duration;
+use crate::trace::Trace;
 use clap::Args;
 use std::time::Instant as WallClock;
 
@@ -341,8 +342,8 @@ fn noisy_link(seeds: u64, only: &[(String, f64)], suite: &[Scenario]) -> Result<
                             }
                             Verdict::NotRun(_) => {}
                             v if *v == c.verdict
-                                && g.trace.as_ref().map(|t| &t.events)
-                                    == c.trace.as_ref().map(|t| &t.events) =>
+                                && g.trace.as_ref().map(Trace::values)
+                                    == c.trace.as_ref().map(Trace::values) =>
                             {
                                 ok += 1
                             }

@@ -3,14 +3,14 @@
 use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
 use super::progress::Progress;
 use crate::cli::{usage, CliError};
-use crate::compare::{compare, Tolerances};
+use crate::compare::{compare_graded, Tolerances};
 use crate::files;
 use crate::golden::{self};
 use crate::report::{self, BoardInfo, Figures, Listing, Record, RunInfo, RunOptions, Tally};
 use crate::runner::{Farm, Spread};
 use crate::scenario::{
-    DriverOptions, Failure, Grade, Grading, HarnessError, NotRun, Retry, Scenario, ScenarioResult,
-    Verdict,
+    DriverOptions, Failure, Grade, Grading, HarnessError, Measurement, NotRun, Retry, Scenario,
+    ScenarioResult, Verdict,
 };
 use crate::soak::{Kept, Soak};
 use crate::store::Store;
@@ -155,13 +155,35 @@ pub(super) fn check_golden(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances)
     };
     match golden::load_for(dir, r.name, &trace.straps) {
         Ok(g) => {
-            if let Err(d) = compare(&g, trace, tol) {
-                r.verdict = fail(
-                    format!("golden trace: first divergence in {}", d.quantity),
-                    format!("{} (allowed {})", d.golden, d.allowed),
-                    d.got,
-                    d.at,
-                );
+            match compare_graded(&g, trace, tol) {
+                Err(d) => {
+                    r.verdict = fail(
+                        format!("golden trace: first divergence in {}", d.quantity),
+                        format!("{} (allowed {})", d.golden, d.allowed),
+                        d.got,
+                        d.at,
+                    );
+                }
+                // Within the instruments' uncertainty of a limit: the
+                // first such comparison, graded as a measurement is.
+                Ok(graded) => {
+                    if let Some(m) = graded.first {
+                        r.measurements.push(Measurement {
+                            name: format!("golden trace: {}", m.quantity),
+                            value: m.got,
+                            lo: m.lo,
+                            hi: m.hi,
+                            marginal_lo: m.lo,
+                            marginal_hi: m.hi,
+                            u: m.u,
+                            grade: Grade::Marginal,
+                            at: m.at,
+                        });
+                        if r.verdict == Verdict::Passed {
+                            r.verdict = Verdict::Marginal;
+                        }
+                    }
+                }
             }
             Some(g)
         }

@@ -7,6 +7,7 @@ use super::options::DriverOptions;
 use super::outcome::{HarnessError, Outcome, Stop};
 use super::verdict::{NotRun, ScenarioResult, Verdict};
 use crate::backend::{Target, TargetErrorKind};
+use crate::bus::Uncertainty;
 use crate::time::{Duration, Instant};
 use crate::trace::{Event, EventKind, Trace};
 use std::fmt;
@@ -78,6 +79,7 @@ pub fn run_scenario(
     };
     let started = std::time::Instant::now();
     let info = target.info();
+    let uncertainty = target.uncertainty();
     let mut driver = Driver::new(target, opts);
     let outcome = catch_unwind(AssertUnwindSafe(|| {
         driver.reset()?;
@@ -124,19 +126,35 @@ pub fn run_scenario(
         .iter()
         .map(|m| Event {
             at: m.at,
+            // A trace from an exact target (the emulator) writes no `±`, so
+            // that golden traces stay as they were: a chopping stretch's
+            // sampling resolution is in its measurement, not its trace.
             kind: EventKind::Measure {
                 name: m.name.clone(),
                 value: m.value,
+                u: if uncertainty == Uncertainty::ZERO {
+                    Duration::ZERO
+                } else {
+                    m.u
+                },
             },
         })
         .collect();
+    // An instrument that is not exact says how unsure its times are.
+    let mut details = info.extra.clone();
+    if uncertainty != Uncertainty::ZERO {
+        details.push((
+            crate::trace::UNCERTAINTY.to_string(),
+            crate::trace::uncertainty_detail(&uncertainty),
+        ));
+    }
     let trace = capture.map(|c| {
         Trace::new(
             scenario.name,
             scenario.section,
             &info.name,
             info.straps,
-            info.extra.clone(),
+            details,
         )
         .assemble(bus, &c, measures)
     });

@@ -285,6 +285,20 @@ pub fn within(got: Duration, want: Duration, permille: u64) -> bool {
 
 /// The whole conformance suite on the default emulator (default straps and
 /// model), as `ppmc run` runs it.
+/// A trace's events as an exact instrument would give them: each
+/// measurement's value kept, its uncertainty (a bridge's, `±`) dropped;
+/// and how many measurements carried one.
+pub fn values_of(t: &ppmc::trace::Trace) -> (Vec<ppmc::trace::Event>, usize) {
+    let unsure = t
+        .events
+        .iter()
+        .filter(
+            |e| matches!(e.kind, ppmc::trace::EventKind::Measure { u, .. } if u > Duration::ZERO),
+        )
+        .count();
+    (t.values(), unsure)
+}
+
 pub fn suite_in_process() -> Vec<ppmc::scenario::ScenarioResult> {
     let mut t = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
     ppmc::runner::run_suite(

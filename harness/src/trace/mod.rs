@@ -33,6 +33,11 @@ use crate::protocol::{
 use crate::time::{Duration, Instant};
 use std::fmt::{self, Write as _};
 
+mod uncertainty;
+
+use uncertainty::parse_uncertainty;
+pub use uncertainty::{uncertainty_detail, UNCERTAINTY};
+
 /// The format version written in the first line.
 pub const TRACE_VERSION: u32 = 1;
 
@@ -109,9 +114,12 @@ pub enum EventKind {
         value: u8,
     },
     /// A measured latency; `name` is a Table 3-3 row or a scenario's own.
+    /// A Table 3-3 measurement, and its uncertainty (±, the instrument's:
+    /// written `±0.134us` after the value where it is not 0).
     Measure {
         name: String,
         value: Duration,
+        u: Duration,
     },
 }
 
@@ -453,6 +461,9 @@ impl Trace {
                     if STRAP_KEYS.contains(&k) {
                         straps.push((k, v, n));
                     } else {
+                        if k == UNCERTAINTY {
+                            parse_uncertainty(v).map_err(|e| err(n, e))?;
+                        }
                         details.push((k.to_string(), v.to_string()));
                     }
                 } else {
@@ -676,7 +687,18 @@ fn parse_event(line: &str) -> Result<Event, String> {
         "measure" => {
             let name = w.next().ok_or("missing measurement name")?.to_string();
             let value = parse_time(w.next().ok_or("missing value")?)?;
-            EventKind::Measure { name, value }
+            let u = match w.next() {
+                Some(t) => match t.strip_prefix('±') {
+                    Some(u) => parse_time(u)?,
+                    None => {
+                        return Err(format!(
+                            "unexpected `{t}`: a measurement's uncertainty is written `±0.134us`"
+                        ))
+                    }
+                },
+                None => Duration::ZERO,
+            };
+            EventKind::Measure { name, value, u }
         }
         other => return Err(format!("unknown event `{other}`")),
     };
@@ -733,7 +755,10 @@ impl fmt::Display for EventKind {
                 Pin::Auxo => write!(f, "pin {} 0b{value:04b}", pin.name()),
                 _ => write!(f, "pin {} {value}", pin.name()),
             },
-            EventKind::Measure { name, value } => write!(f, "measure {name} {value}"),
+            EventKind::Measure { name, value, u } if *u == Duration::ZERO => {
+                write!(f, "measure {name} {value}")
+            }
+            EventKind::Measure { name, value, u } => write!(f, "measure {name} {value} ±{u}"),
         }
     }
 }
@@ -800,6 +825,7 @@ impl fmt::Display for BusEvent {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bus::Uncertainty;
 
     const SAMPLE: &str = "ppmc-trace 1
 scenario demo
@@ -897,6 +923,37 @@ end
 
         let e = Trace::parse("hello\n").expect_err("not a trace");
         assert!(e.message.contains("not a ppmc trace"), "{e}");
+
+        // An instrument's uncertainty reads back as written, and a
+        // measurement's `±`; a detail that does not read is an error at
+        // its line, never an exact trace.
+        let u = Uncertainty {
+            edge: Duration::from_nanos(14),
+            sampled: Duration::from_nanos(5000),
+            access: Duration::from_nanos(134),
+            polled: Duration::from_nanos(1000),
+        };
+        let line = format!("detail {UNCERTAINTY} {}\nevents\n", uncertainty_detail(&u));
+        let unsure = SAMPLE.replacen("events\n", &line, 1);
+        let t = Trace::parse(&unsure).expect("parses");
+        assert_eq!(t.uncertainty(), u);
+        assert_eq!(Trace::parse(&t.render()).expect("round trip"), t);
+        assert_eq!(
+            Trace::parse(SAMPLE).expect("parses").uncertainty(),
+            Uncertainty::ZERO
+        );
+        let bad = unsure.replace("polled=1000ns", "polled=1us");
+        let e = Trace::parse(&bad).expect_err("bad uncertainty");
+        assert!(
+            e.message.contains("bad `uncertainty` detail `polled=1us`"),
+            "{e}"
+        );
+        let short = unsure.replace(" polled=1000ns", "");
+        let e = Trace::parse(&short).expect_err("a path missing");
+        assert!(e.message.contains("lacks a path"), "{e}");
+        let m = parse_event("5.000us measure busy_rise 25.650us ±0.134us").expect("reads");
+        assert_eq!(m.kind.to_string(), "measure busy_rise 25.650us ±0.134us");
+        assert!(parse_event("5.000us measure busy_rise 25.650us 0.134us").is_err());
 
         // A stray CR inside a line (not a CRLF ending) is refused: it would
         // not survive a render. CRLF files parse as LF ones.

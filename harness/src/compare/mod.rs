@@ -18,11 +18,19 @@
 //! - within Table 3-3 (with its 1 % note): measurements that name a row.
 //!
 //! The report is the first divergence in time, with the quantity, golden
-//! and got, and the allowed band.
+//! and got, and the allowed band. Each timing is as unsure as the
+//! instruments that took the two traces say, and judged by the decision
+//! rule ([`rule`]): a timing within that uncertainty of its limit is no
+//! divergence but MARGINAL ([`Graded`]).
+
+mod rule;
+
+pub use rule::{Graded, MarginalComparison};
 
 use crate::protocol::{Pin, PulseRun, Straps, TimingId};
 use crate::time::{Duration, Instant, Limit};
 use crate::trace::{BusEvent, EventKind, Trace};
+use rule::{fit, shown, Fit, Unsure};
 use std::collections::BTreeMap;
 use std::fmt;
 
@@ -125,7 +133,7 @@ struct Streams {
     moves: Vec<(Instant, EventKind)>,
     pulses: Vec<Run>,
     pins: BTreeMap<Pin, Vec<(Instant, u8, Instant)>>,
-    measures: BTreeMap<String, Vec<(Instant, Duration)>>,
+    measures: BTreeMap<String, Vec<(Instant, Duration, Duration)>>,
     /// The anchor in force at the end.
     anchor: Instant,
 }
@@ -212,11 +220,11 @@ fn streams(t: &Trace, anchor: Instant, view: &View) -> Streams {
             }
             EventKind::Pin { .. } => {}
             EventKind::Measure { .. } if view.capture.is_some() => {}
-            EventKind::Measure { name, value } => {
+            EventKind::Measure { name, value, u } => {
                 s.measures
                     .entry(name.clone())
                     .or_default()
-                    .push((e.at, *value));
+                    .push((e.at, *value, *u));
             }
         }
     }
@@ -224,14 +232,52 @@ fn streams(t: &Trace, anchor: Instant, view: &View) -> Streams {
     s
 }
 
-/// Keeps the earliest divergence.
+/// Keeps the earliest divergence, and the comparisons that were MARGINAL.
 #[derive(Debug, Default)]
-struct First(Option<Divergence>);
+struct First(Option<Divergence>, Graded);
 
 impl First {
     fn offer(&mut self, d: Divergence) {
         if self.0.as_ref().is_none_or(|cur| d.at < cur.at) {
             self.0 = Some(d);
+        }
+    }
+
+    /// Judges the timing `got` (± `u`) against `band` by the decision
+    /// rule: `true` where it is the divergence (offered).
+    fn check(
+        &mut self,
+        at: Instant,
+        quantity: impl FnOnce() -> String,
+        golden: Duration,
+        got: Duration,
+        band: (Duration, Duration),
+        u: Duration,
+    ) -> bool {
+        match fit(got, band, u) {
+            Fit::In => false,
+            Fit::Marginal => {
+                self.1.note(MarginalComparison {
+                    at,
+                    quantity: quantity(),
+                    golden,
+                    got,
+                    lo: band.0,
+                    hi: band.1,
+                    u,
+                });
+                false
+            }
+            Fit::Out => {
+                self.offer(Divergence {
+                    at,
+                    quantity: quantity(),
+                    golden: golden.to_string(),
+                    got: shown(got, u),
+                    allowed: band_text(band),
+                });
+                true
+            }
         }
     }
 
@@ -241,10 +287,6 @@ impl First {
     }
 }
 
-fn within(got: Duration, (lo, hi): (Duration, Duration)) -> bool {
-    got >= lo && got <= hi
-}
-
 fn band_text((lo, hi): (Duration, Duration)) -> String {
     format!("{lo}..={}", Limit(hi))
 }
@@ -252,7 +294,13 @@ fn band_text((lo, hi): (Duration, Duration)) -> String {
 /// Compares `got` with `golden`; `Ok(())` when every quantity is within
 /// its rule, else the first divergence in time.
 pub fn compare(golden: &Trace, got: &Trace, tol: &Tolerances) -> Result<(), Divergence> {
-    compare_from(golden, got, tol, &Resume::default()).map(|_| ())
+    compare_graded(golden, got, tol).map(|_| ())
+}
+
+/// [`compare`], and where it finds no divergence, the comparisons that
+/// were MARGINAL (within the traces' uncertainty of a limit).
+pub fn compare_graded(golden: &Trace, got: &Trace, tol: &Tolerances) -> Result<Graded, Divergence> {
+    graded_from(golden, got, tol, &Resume::default()).map(|(_, g)| g)
 }
 
 /// What two traces compared equal up to a point where both were at rest
@@ -300,18 +348,28 @@ pub fn compare_from(
     tol: &Tolerances,
     from: &Resume,
 ) -> Result<Resume, Divergence> {
+    graded_from(golden, got, tol, from).map(|(r, _)| r)
+}
+
+fn graded_from(
+    golden: &Trace,
+    got: &Trace,
+    tol: &Tolerances,
+    from: &Resume,
+) -> Result<(Resume, Graded), Divergence> {
     let view = View::of(golden, got);
     let g = streams(golden, from.anchors.0, &view);
     let o = streams(got, from.anchors.1, &view);
+    let u = Unsure::of(golden, got);
     let mut first = First::default();
-    compare_bus(&g, &o, tol, from.bus, &mut first);
+    compare_bus(&g, &o, tol, &u, from.bus, &mut first);
     compare_moves(&g, &o, from.moves, &mut first);
-    compare_pulses(&g, &o, tol, from.pulses, &mut first);
-    compare_pins(&g, &o, tol, &from.pins, &mut first);
+    compare_pulses(&g, &o, tol, &u, from.pulses, &mut first);
+    compare_pins(&g, &o, tol, &u, &from.pins, &mut first);
     compare_measures(&g, &o, tol, &got.straps, &from.measures, &mut first);
     match first.0 {
         Some(d) => Err(d),
-        None => Ok(from.after(&g, &o)),
+        None => Ok((from.after(&g, &o), first.1)),
     }
 }
 
@@ -338,7 +396,14 @@ fn count_divergence<T>(
     })
 }
 
-fn compare_bus(g: &Streams, o: &Streams, tol: &Tolerances, before: usize, first: &mut First) {
+fn compare_bus(
+    g: &Streams,
+    o: &Streams,
+    tol: &Tolerances,
+    u: &Unsure,
+    before: usize,
+    first: &mut First,
+) {
     for (i, ((_, ge), (ot, oe))) in g.bus.iter().zip(&o.bus).enumerate() {
         if first.beaten_by(*ot) {
             return;
@@ -361,13 +426,9 @@ fn compare_bus(g: &Streams, o: &Streams, tol: &Tolerances, before: usize, first:
             ) if gf == of && gv == ov => match (gw, ow) {
                 (Some(gw), Some(ow)) => {
                     let band = tol.band(*gw, tol.latency_bp);
-                    if !within(*ow, band) {
-                        Some((
-                            format!("{quantity}: wait"),
-                            gw.to_string(),
-                            ow.to_string(),
-                            band_text(band),
-                        ))
+                    let wait = || format!("{quantity}: wait");
+                    if first.check(*ot, wait, *gw, *ow, band, u.wait()) {
+                        return;
                     } else if gs != os {
                         Some((
                             format!("{quantity}: status"),
@@ -425,14 +486,11 @@ fn compare_bus(g: &Streams, o: &Streams, tol: &Tolerances, before: usize, first:
                         format!("0x{ob:02X}"),
                         "equal".into(),
                     ))
-                } else if !within(*ow, band) {
-                    Some((
-                        format!("{quantity}: wait for IBF/OBF"),
-                        gw.to_string(),
-                        ow.to_string(),
-                        band_text(band),
-                    ))
                 } else {
+                    let wait = || format!("{quantity}: wait for IBF/OBF");
+                    if first.check(*ot, wait, *gw, *ow, band, u.wait()) {
+                        return;
+                    }
                     None
                 }
             }
@@ -488,7 +546,14 @@ struct Cursor {
 /// Compares the pulse streams run by run: a stretch where both traces keep
 /// one period costs one check, so a 16-million-pulse move compares in
 /// O(runs).
-fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, before: u64, first: &mut First) {
+fn compare_pulses(
+    g: &Streams,
+    o: &Streams,
+    tol: &Tolerances,
+    u: &Unsure,
+    before: u64,
+    first: &mut First,
+) {
     let total = |runs: &[Run]| before + runs.iter().map(|r| u64::from(r.run.count)).sum::<u64>();
     let (mut gc, mut oc) = (Cursor::default(), Cursor::default());
     let mut n: u64 = before; // pulses compared so far
@@ -540,13 +605,14 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, before: u64, first
             return;
         }
         let here = gr.jitter() + or.jitter();
-        let (what, gd, od, bp, capture) = match prev {
+        let (what, gd, od, bp, capture, unsure) = match prev {
             Some((gp, op, off)) if !g_first => (
                 "interval",
                 gt.saturating_since(gp),
                 ot.saturating_since(op),
                 tol.interval_bp,
                 off + here,
+                u.interval(),
             ),
             _ => (
                 "delay from the move's start",
@@ -554,16 +620,12 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, before: u64, first
                 ot.saturating_since(or.anchor),
                 tol.latency_bp,
                 here,
+                u.first_pulse(),
             ),
         };
         let band = tol.band_widened(gd, bp, capture);
-        if !within(od, band) {
-            first.offer(diverge(
-                format!("pulse {k} {what}"),
-                gd.to_string(),
-                od.to_string(),
-                band_text(band),
-            ));
+        let quantity = || format!("pulse {k} {what}");
+        if first.check(ot, quantity, gd, od, band, unsure) {
             return;
         }
         // The rest of the stretch both runs share: one period each.
@@ -571,14 +633,8 @@ fn compare_pulses(g: &Streams, o: &Streams, tol: &Tolerances, before: u64, first
         if rest > 0 {
             let (gi, oi) = (gr.run.interval(), or.run.interval());
             let band = tol.band_widened(gi, tol.interval_bp, gr.spread() + or.spread());
-            if !within(oi, band) {
-                first.offer(Divergence {
-                    at: or.at(oc.pos + 1),
-                    quantity: format!("pulse {} interval", k + 1),
-                    golden: gi.to_string(),
-                    got: oi.to_string(),
-                    allowed: band_text(band),
-                });
+            let quantity = || format!("pulse {} interval", k + 1);
+            if first.check(or.at(oc.pos + 1), quantity, gi, oi, band, u.interval()) {
                 return;
             }
         }
@@ -616,6 +672,7 @@ fn compare_pins(
     g: &Streams,
     o: &Streams,
     tol: &Tolerances,
+    u: &Unsure,
     before: &BTreeMap<Pin, usize>,
     first: &mut First,
 ) {
@@ -645,14 +702,8 @@ fn compare_pins(
             let gd = gs[i].0.saturating_since(ga);
             let od = ot.saturating_since(oa);
             let band = tol.band(gd, tol.latency_bp);
-            if !within(od, band) {
-                first.offer(Divergence {
-                    at: ot,
-                    quantity: format!("{quantity}: time from the move's start"),
-                    golden: gd.to_string(),
-                    got: od.to_string(),
-                    allowed: band_text(band),
-                });
+            let what = || format!("{quantity}: time from the move's start");
+            if first.check(ot, what, gd, od, band, u.pin(*pin)) {
                 diverged = true;
                 break;
             }
@@ -682,30 +733,19 @@ fn compare_measures(
         let gs = g.measures.get(name).unwrap_or(&empty);
         let os = o.measures.get(name).unwrap_or(&empty);
         let done = before.get(name).copied().unwrap_or(0);
-        for (i, (&(_, gv), &(ot, ov))) in gs.iter().zip(os).enumerate() {
+        for (i, (&(_, gv, gu), &(ot, ov, ou))) in gs.iter().zip(os).enumerate() {
             let quantity = format!("measurement {name} #{}", done + i + 1);
+            // Each side's own uncertainty, as it was measured.
+            let u = gu + ou;
             if let Some(id) = TimingId::from_name(name) {
                 let band = id.row().band_for(straps);
-                if !within(ov, band) {
-                    first.offer(Divergence {
-                        at: ot,
-                        quantity: format!("{quantity} (Table 3-3)"),
-                        golden: gv.to_string(),
-                        got: ov.to_string(),
-                        allowed: band_text(band),
-                    });
+                let row = || format!("{quantity} (Table 3-3)");
+                if first.check(ot, row, gv, ov, band, u) {
                     break;
                 }
             }
             let band = tol.band(gv, tol.latency_bp);
-            if !within(ov, band) {
-                first.offer(Divergence {
-                    at: ot,
-                    quantity,
-                    golden: gv.to_string(),
-                    got: ov.to_string(),
-                    allowed: band_text(band),
-                });
+            if first.check(ot, || quantity, gv, ov, band, u) {
                 break;
             }
         }
@@ -778,6 +818,59 @@ end
 
     fn golden() -> Trace {
         Trace::parse(GOLDEN).expect("golden parses")
+    }
+
+    /// The decision rule (docs/conformance.md) in a compare: a board's
+    /// trace whose interval lies 0.08 us outside the band (102 us, 1 % and
+    /// the floor: up to 103.12 us) is the divergence when the trace is
+    /// exact, MARGINAL when its bridge declares an edge uncertain by 50 ns
+    /// (the interval's two ends, 0.1 us), and the divergence again at
+    /// 30 ns. A measurement's own `±` counts the same way (Table 3-3).
+    #[test]
+    fn a_timing_within_the_instruments_uncertainty_of_its_limit_is_marginal() {
+        let board = |edge_ns: u64| {
+            let mut t = GOLDEN.replace(
+                "1218.000us pulses cw n=4 dt=102.000us",
+                "1218.000us pulses cw n=4 dt=103.200us",
+            );
+            if edge_ns > 0 {
+                t = t.replace(
+                    "events\n",
+                    &format!("detail uncertainty edge={edge_ns}ns sampled=0ns access=0ns polled=0ns\nevents\n"),
+                );
+            }
+            Trace::parse(&t).expect("parses")
+        };
+        let tol = Tolerances::default();
+        let exact = compare_graded(&golden(), &board(0), &tol).expect_err("exact: outside");
+        assert_eq!(exact.quantity, "pulse 2 interval");
+        assert_eq!(exact.got, "103.200us");
+        let graded =
+            compare_graded(&golden(), &board(50), &tol).expect("marginal, not a divergence");
+        assert_eq!(graded.marginal, 1, "{graded:?}");
+        let first = graded.first.expect("the first");
+        assert_eq!(first.quantity, "pulse 2 interval");
+        assert_eq!(first.u, Duration::from_nanos(100));
+        let far = compare_graded(&golden(), &board(30), &tol).expect_err("outside by more than U");
+        assert_eq!(far.got, "103.200us ±0.060us");
+        // Table 3-3's constant first POUT band tops at 195.94 us, the
+        // golden's (194 us, 1 % and the floor) at 196.04 us: 196 us
+        // measured +-0.1 us straddles both.
+        let measured = |line: &str| {
+            let t = GOLDEN.replace("1600.000us measure constant_first_pout 194.000us", line);
+            compare_graded(&golden(), &Trace::parse(&t).expect("parses"), &tol)
+        };
+        assert!(measured("1600.000us measure constant_first_pout 196.000us").is_err());
+        let m = measured("1600.000us measure constant_first_pout 196.000us ±0.100us")
+            .expect("within its uncertainty of the band");
+        assert_eq!(m.marginal, 2);
+        let first = m.first.expect("the first");
+        assert!(first.quantity.ends_with("(Table 3-3)"), "{first}");
+        // Exact traces grade nothing marginal: the band alone, as before.
+        assert_eq!(
+            compare_graded(&golden(), &golden(), &tol),
+            Ok(Graded::default())
+        );
     }
 
     #[test]

@@ -1,0 +1,145 @@
+//! The decision rule of `docs/conformance.md`, as a compare applies it:
+//! each timing the compared trace holds is as unsure as the instrument
+//! that took it says (its `uncertainty` detail, [`crate::trace::UNCERTAINTY`];
+//! a measurement its own `±`), and so is the golden trace's (exact when it
+//! is the emulator's). A timing whose interval `got ± U` lies wholly inside
+//! its band passes; wholly outside, it is the divergence; straddling a
+//! limit, it is MARGINAL: within the instruments' uncertainty of it.
+//! With `U` = 0 (two emulator traces) this is the band alone, as it was.
+
+use crate::bus::Uncertainty;
+use crate::protocol::Pin;
+use crate::time::{Duration, Instant};
+use crate::trace::Trace;
+
+/// Where a value lies against its band, `± u`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Fit {
+    In,
+    Marginal,
+    Out,
+}
+
+pub(super) fn fit(got: Duration, (lo, hi): (Duration, Duration), u: Duration) -> Fit {
+    let (low, high) = (got.saturating_sub(u), got.saturating_add(u));
+    if high < lo || low > hi {
+        Fit::Out
+    } else if low < lo || high > hi {
+        Fit::Marginal
+    } else {
+        Fit::In
+    }
+}
+
+/// The value as compared: `25.650us`, or `25.650us ±0.134us`.
+pub(super) fn shown(got: Duration, u: Duration) -> String {
+    if u == Duration::ZERO {
+        got.to_string()
+    } else {
+        format!("{got} ±{u}")
+    }
+}
+
+/// The two traces' uncertainty, each kind of timing a compare makes as
+/// unsure as its two ends on both sides.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Unsure {
+    golden: Uncertainty,
+    got: Uncertainty,
+}
+
+impl Unsure {
+    pub(super) fn of(golden: &Trace, got: &Trace) -> Unsure {
+        Unsure {
+            golden: golden.uncertainty(),
+            got: got.uncertainty(),
+        }
+    }
+
+    fn both(&self, f: impl Fn(&Uncertainty) -> Duration) -> Duration {
+        f(&self.golden) + f(&self.got)
+    }
+
+    /// A wait for a flag: from an access to the poll that saw it.
+    pub(super) fn wait(&self) -> Duration {
+        self.both(|u| u.access + u.polled)
+    }
+
+    /// A move's first pulse, from the write that started it.
+    pub(super) fn first_pulse(&self) -> Duration {
+        self.both(|u| u.access + u.edge)
+    }
+
+    /// An interval between two pulses.
+    pub(super) fn interval(&self) -> Duration {
+        self.both(|u| u.edge + u.edge)
+    }
+
+    /// A pin's change, from the write that started the move.
+    pub(super) fn pin(&self, pin: Pin) -> Duration {
+        self.both(|u| u.access + u.of_pin(pin))
+    }
+}
+
+/// A comparison whose value lies within the traces' uncertainty of its
+/// band's limit: neither proven inside nor outside.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MarginalComparison {
+    /// When, on the compared trace's clock.
+    pub at: Instant,
+    /// What: `pulse 42 interval`, `pin busy change 2: time from the move's
+    /// start`.
+    pub quantity: String,
+    pub golden: Duration,
+    pub got: Duration,
+    /// The band, and the uncertainty (±) of the value.
+    pub lo: Duration,
+    pub hi: Duration,
+    pub u: Duration,
+}
+
+impl std::fmt::Display for MarginalComparison {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "at {}: {}: golden {}, got {} ±{} (allowed {}..={}): within the instruments' uncertainty of a limit",
+            self.at, self.quantity, self.golden, self.got, self.u, self.lo, self.hi
+        )
+    }
+}
+
+/// What a compare that found no divergence says besides: the comparisons
+/// that were MARGINAL, how many and the first in time.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Graded {
+    pub marginal: u64,
+    pub first: Option<MarginalComparison>,
+}
+
+impl Graded {
+    pub(super) fn note(&mut self, m: MarginalComparison) {
+        self.marginal += 1;
+        if self.first.as_ref().is_none_or(|f| m.at < f.at) {
+            self.first = Some(m);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_rule_with_no_uncertainty_is_the_band_alone() {
+        let us = Duration::from_micros;
+        let band = (us(10), us(20));
+        assert_eq!(fit(us(10), band, Duration::ZERO), Fit::In);
+        assert_eq!(fit(us(20), band, Duration::ZERO), Fit::In);
+        assert_eq!(fit(us(21), band, Duration::ZERO), Fit::Out);
+        // Within U of a limit, either side of it: MARGINAL.
+        assert_eq!(fit(us(21), band, us(2)), Fit::Marginal);
+        assert_eq!(fit(us(19), band, us(2)), Fit::Marginal);
+        assert_eq!(fit(us(23), band, us(2)), Fit::Out);
+        assert_eq!(fit(us(15), band, us(2)), Fit::In);
+    }
+}
