@@ -12,6 +12,7 @@ use ppmc::logic::map::ChannelMap;
 use ppmc::logic::source::{Change, LogicInfo, LogicSource, Recorded};
 use ppmc::logic::vcd::VcdReader;
 use ppmc::protocol::Straps;
+use ppmc::scenario::{Driver, Init, Outcome, Scenario};
 use ppmc::vcd_export::{export_with, Export};
 use std::path::Path;
 
@@ -33,6 +34,11 @@ impl Edges {
     fn of_board(scenario: &str, model: &ModelConfig) -> Edges {
         let suite = ppmc_scenarios::all();
         let s = suite.iter().find(|s| s.name == scenario).expect("scenario");
+        Edges::of_scenario(s, model)
+    }
+
+    /// The capture of `s` on a board that `model` describes.
+    fn of_scenario(s: &Scenario, model: &ModelConfig) -> Edges {
         let (trace, _) = analyzer_trace(model, s).expect("a capture");
         let mut buf = Vec::new();
         let what = Export {
@@ -476,5 +482,113 @@ fn s3_2_1_a_board_whose_phases_miss_a_step_fails_at_a_phase() {
     match &j.verdict {
         Verdict::Failed(d) => assert!(d.what.starts_with('S'), "{d}"),
         other => panic!("{other:?}"),
+    }
+}
+
+/// Stop switching from HOLD on, then a software reset `after_us` into
+/// the fifth cycle (Diagram 3-5's 173.75 us): Section 3-5-4's excitation
+/// off 18 us later then finds the phases ON or OFF.
+fn chop_then_reset(d: &mut Driver, after_us: u64) -> Outcome {
+    let us = ppmc::time::Duration::from_micros;
+    d.init_and_wait(Init::four_phase().stop_switching())?;
+    d.wait(us(4 * 174 + after_us))?;
+    d.trigger_command(0xC0)?;
+    d.wait(us(300))
+}
+
+fn reset_in_on(d: &mut Driver) -> Outcome {
+    chop_then_reset(d, 10)
+}
+
+fn reset_in_off(d: &mut Driver) -> Outcome {
+    chop_then_reset(d, 80)
+}
+
+fn reset_late_in_off(d: &mut Driver) -> Outcome {
+    chop_then_reset(d, 140)
+}
+
+/// Sections 3-5-1 and 3-5-4: a software reset while the phases chop ends
+/// the chopping where the chip takes it (the phases back on, N36) and
+/// de-energizes them 18 us later. Wherever in a cycle it falls, ON or
+/// OFF, the clean board passes with its phases compared.
+#[test]
+fn s3_5_4_a_software_reset_while_the_phases_chop_passes_wherever_it_falls() {
+    for (name, body) in [
+        ("reset_in_on", reset_in_on as fn(&mut Driver) -> Outcome),
+        ("reset_in_off", reset_in_off),
+        ("reset_late_in_off", reset_late_in_off),
+    ] {
+        let s = Scenario {
+            name,
+            section: "3-5-4",
+            summary: "stop switching, then a software reset",
+            tags: &[],
+            budget: ppmc::time::Duration::from_millis(400),
+            body,
+        };
+        let e = Edges::of_scenario(&s, &ModelConfig::default());
+        let j = judged(e.capture());
+        assert_eq!(j.verdict, Verdict::Passed, "{name}: {j:?}");
+        assert!(j.changes > 20, "{name}: the chopping compared: {j:?}");
+    }
+}
+
+/// The capture of [`CHOPPING`] with the board's chopping in its own phase
+/// (a chip whose chopping starts a little after HOLD turns on): Diagram
+/// 3-5's ON and OFF times kept, the train shifted so that an OFF edge
+/// falls `before_end_ns` before BUSY rises, where the move cuts it and
+/// the phases come back on.
+fn chopping_cut(before_end_ns: u64) -> Recorded {
+    let mut e = Edges::of(CHOPPING);
+    let rise = |e: &Edges, name: &str, after: u64| {
+        let ch = e.channel(name);
+        e.edges
+            .iter()
+            .find(|x| x.1 == ch && x.2 && x.0 > after)
+            .map(|x| x.0)
+            .expect("a rise")
+    };
+    let on = rise(&e, "hold", 0);
+    let moves = rise(&e, "busy", on);
+    let (t_on, t_off) = (65_000_000u64, 108_750_000u64);
+    let cycle = t_on + t_off;
+    // The OFF edges fall at on + shift + t_on + k cycles.
+    let last_off = moves - before_end_ns * 1000;
+    let shift = (last_off - on - t_on) % cycle;
+    assert!(shift < 150_000_000, "within the first edge's tolerance");
+    for k in 1..=5 {
+        let ch = e.channel(&format!("s{k}"));
+        let chops = e.edges.iter().any(|x| x.1 == ch && x.0 > on && x.0 < moves);
+        if !chops {
+            continue;
+        }
+        let energized = e
+            .edges
+            .iter()
+            .rfind(|x| x.1 == ch && x.0 <= on)
+            .map(|x| x.2)
+            .expect("a level");
+        e.edges.retain(|x| x.1 != ch || x.0 <= on || x.0 > moves);
+        let mut t = on + shift + t_on;
+        while t <= last_off {
+            e.edges.push((t, ch, !energized));
+            let back = t + t_off;
+            e.edges.push((back.min(moves), ch, energized));
+            t += cycle;
+        }
+    }
+    e.capture()
+}
+
+/// Section 3-5-1: the board's chopping keeps its rhythm up to the move
+/// that ends it. An OFF edge 0.3 us or 30 us before BUSY rises, the
+/// phases back on as it rises: the clean chopping passes, its last edge
+/// counted as chopping, not taken for the move's first step.
+#[test]
+fn s3_5_1_chopping_cut_by_the_move_passes() {
+    for before in [300, 30_000] {
+        let j = judged(chopping_cut(before));
+        assert_eq!(j.verdict, Verdict::Passed, "{before} ns before: {j:?}");
     }
 }

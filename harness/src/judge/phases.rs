@@ -106,9 +106,15 @@ impl PhaseLevels {
 
     fn levels_now(&mut self, at: Instant) {
         let levels = self.setup.logic.levels(self.pattern);
-        if levels != self.levels {
-            self.levels = levels;
-            self.changes.push_back((at, PhaseChange::Levels(levels)));
+        if levels == self.levels {
+            return;
+        }
+        self.levels = levels;
+        match self.changes.back_mut() {
+            // The chopping ends and the phases change at one instant (a
+            // software reset): the levels after both are where it ends.
+            Some((t, PhaseChange::ChopEnd(v))) if *t == at => *v = levels,
+            _ => self.changes.push_back((at, PhaseChange::Levels(levels))),
         }
     }
 
@@ -312,11 +318,12 @@ impl PhaseWatch {
         let span = |ps: u64| Duration::from_nanos(ps / 1000);
         loop {
             if let Some(mut ch) = self.chopping {
-                // The chopping's end, where the model has drawn it.
+                // The chopping's end, where the model has drawn it, and how
+                // far from it the board's may be.
                 let end = match levels.change(self.next) {
                     Some((t, PhaseChange::ChopEnd(_))) => {
                         let c = (r.to_ps)(t);
-                        Some(c.saturating_sub((r.allowed)(c)))
+                        Some((c, (r.allowed)(c)))
                     }
                     _ => None,
                 };
@@ -326,29 +333,15 @@ impl PhaseWatch {
                 } else {
                     (r.interval)(ch.lasts())
                 };
-                let before_end = |t: u64| end.is_none_or(|e| t < e);
+                let fits = |b: u64| b.abs_diff(expected) <= tol;
+                // At or past the earliest the chopping may end; past the
+                // latest.
+                let ending = |t: u64| end.is_some_and(|(c, a)| t >= c.saturating_sub(a));
+                let ended = |t: u64| end.is_some_and(|(c, a)| t > c.saturating_add(a));
                 match self.board.front().copied() {
-                    Some((b, level)) if before_end(b) => {
-                        if b.abs_diff(expected) > tol {
-                            let what = if ch.level == ch.on_level { "ON" } else { "OFF" };
-                            return Err(self.diverge(
-                                r,
-                                b.min(expected),
-                                level,
-                                format!(
-                                    "at {} ({} after the last edge)",
-                                    at(b),
-                                    span(b - ch.last_ps)
-                                ),
-                                format!(
-                                    "stop switching's {what} time {} from {} (allowed {}): at {}",
-                                    span(ch.lasts()),
-                                    at(ch.last_ps),
-                                    span(tol),
-                                    at(expected)
-                                ),
-                            ));
-                        }
+                    // An edge of the chopping: the board's may run on a
+                    // little past the model's end.
+                    Some((b, level)) if fits(b) && !ended(b) => {
                         marginal.note(b.abs_diff(expected), tol, r.u_ps, || {
                             format!(
                                 "S{} chopping at {}: {} from its ON or OFF time, allowed {} (two samples of it the capture's uncertainty)",
@@ -365,7 +358,27 @@ impl PhaseWatch {
                         self.chopping = Some(ch);
                         *compared += 1;
                     }
-                    _ if before_end(expected.saturating_add(tol)) => {
+                    Some((b, level)) if !ending(b) => {
+                        let what = if ch.level == ch.on_level { "ON" } else { "OFF" };
+                        return Err(self.diverge(
+                            r,
+                            b.min(expected),
+                            level,
+                            format!(
+                                "at {} ({} after the last edge)",
+                                at(b),
+                                span(b - ch.last_ps)
+                            ),
+                            format!(
+                                "stop switching's {what} time {} from {} (allowed {}): at {}",
+                                span(ch.lasts()),
+                                at(ch.last_ps),
+                                span(tol),
+                                at(expected)
+                            ),
+                        ));
+                    }
+                    None if !ending(expected.saturating_add(tol)) => {
                         // The board's edge is due: missed once the capture
                         // is past it.
                         if expected.saturating_add(tol) >= r.horizon_ps {
@@ -383,11 +396,14 @@ impl PhaseWatch {
                             ),
                         ));
                     }
-                    _ if end.is_none() => return Ok(()),
+                    // An edge that may yet come, where the chopping may
+                    // have ended: wait for it.
+                    None if expected.saturating_add(tol) >= r.horizon_ps => return Ok(()),
                     _ => {
                         // The chopping ends: the phase as the board left
                         // it, and the model's level after, compared as
-                        // any change.
+                        // any change (the board's change near the end, if
+                        // it makes one).
                         self.model = ch.level;
                         self.chopping = None;
                     }

@@ -12,13 +12,16 @@
 //! host's status polling; the moves, the pulses and those pins; no
 //! driver's measurement.
 
+use crate::bus::Uncertainty;
 use crate::emu::Board;
 use crate::logic::decode::{Access, Transaction};
 use crate::logic::map::{ChannelMap, Signal};
 use crate::logic::source::{Change, LogicInfo};
 use crate::protocol::{Direction, EdgeRuns, Pin, Record, Straps};
 use crate::time::{Duration, Instant};
-use crate::trace::{BusEvent, Event, EventKind, Trace, CAPTURE_PINS};
+use crate::trace::{
+    uncertainty_detail, BusEvent, Event, EventKind, Trace, CAPTURE_PINS, UNCERTAINTY,
+};
 
 /// An output the capture has, as a trace's pin: its channels (AUXO's
 /// four make one pin), each active low or not.
@@ -138,7 +141,7 @@ impl CaptureTrace {
     ) -> Trace {
         self.record.moves = model.record().moves.clone();
         let pins: Vec<&str> = self.outputs.iter().map(|o| o.pin.name()).collect();
-        let details = vec![
+        let mut details = vec![
             (CAPTURE_PINS.to_string(), pins.join(",")),
             ("capture_format".to_string(), info.format.replace(' ', "_")),
             (
@@ -146,6 +149,18 @@ impl CaptureTrace {
                 info.resolution_ps.to_string(),
             ),
         ];
+        // Each edge the capture holds is seen up to a sample late: every
+        // path as unsure as a sample (a compare widens by it).
+        let sample = Duration::from_nanos(info.resolution_ps.div_ceil(1000));
+        if info.resolution_ps > 1000 {
+            let u = Uncertainty {
+                edge: sample,
+                sampled: sample,
+                access: sample,
+                polled: sample,
+            };
+            details.push((UNCERTAINTY.to_string(), uncertainty_detail(&u)));
+        }
         Trace::new(scenario, "capture", "capture", straps, details).assemble(
             self.bus,
             &self.record,

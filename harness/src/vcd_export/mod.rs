@@ -202,8 +202,13 @@ fn write(trace: &Trace, what: Export, out: impl Write) -> io::Result<()> {
     }
     let mut pulses = Pulses::default();
     if what.bus {
+        // The phases' levels where the file starts (de-energized: all
+        // high in the negative logic a chip starts in).
         let pins = PhasePins::new(trace)?;
-        state.set_bits(Instant::ZERO, S1, 5, pins.levels(Instant::ZERO))?;
+        let start = pins.levels(Instant::ZERO);
+        for k in 0..5 {
+            state.values[S1 + k] = start & (0b1_0000 >> k) != 0;
+        }
         pulses.pins = Some(pins);
     }
     if from == Instant::ZERO {
@@ -879,6 +884,65 @@ end
     /// The bus as a logic analyzer would record it: decoded back (Table
     /// 3-1) it gives every access of the trace, its byte and its time (the
     /// last of those at one time ending at it, all late by the lead).
+    /// Section 3-2-1 (N36): with the bus, S1..S5 are drawn at their
+    /// levels. Before the first initialization the phases are de-energized
+    /// in negative logic, all high from the file's start, however late the
+    /// lead makes the trace's time 0; energized S1 and S2 go low.
+    #[test]
+    fn the_bus_export_draws_the_phases_at_their_levels_from_the_start() {
+        let text = "ppmc-trace 1
+scenario levels
+section 3-2-1
+target emu
+detail sysclk_hz 16000000
+detail csel high
+detail vsel high
+detail ext_clock_hz none
+events
+0.000us reset
+0.000us await busy=0 after 0.000us status=0x00
+0.000us await ibf=0 after 0.000us status=0x00
+0.000us wc 0x02 waited=0.000us
+6.000us wd 0x64 waited=6.000us
+12.000us wd 0x14 waited=6.000us
+18.000us wd 0x64 waited=6.000us
+24.000us wd 0x00 waited=6.000us
+68.000us pin s 0b11000
+100.000us rs 0x00
+end
+";
+        let trace = Trace::parse(text).expect("trace");
+        let mut buf = Vec::new();
+        let what = Export {
+            window: None,
+            bus: true,
+        };
+        export_with(&trace, what, &mut buf).expect("export");
+        assert_eq!(bus_lead(&trace), 1000);
+        let mut parser = Parser::new(&buf[..]);
+        let header = parser.parse_header().expect("header");
+        let phases: Vec<IdCode> = ["s1", "s2", "s3", "s4", "s5"]
+            .iter()
+            .map(|n| header.find_var(&["ppmc", n]).expect("declared").code)
+            .collect();
+        let (mut now, mut levels) = (0u64, Vec::new());
+        for cmd in parser {
+            match cmd.expect("body") {
+                Command::Timestamp(t) => now = t,
+                Command::ChangeScalar(id, v) => {
+                    if let Some(k) = phases.iter().position(|p| *p == id) {
+                        levels.push((now, k + 1, v == Value::V1));
+                    }
+                }
+                _ => {}
+            }
+        }
+        let at_start: Vec<bool> = levels.iter().filter(|l| l.0 == 0).map(|l| l.2).collect();
+        assert_eq!(at_start, [true; 5], "{levels:?}");
+        let later: Vec<(u64, usize, bool)> = levels.into_iter().filter(|l| l.0 > 0).collect();
+        assert_eq!(later, [(69_000, 1, false), (69_000, 2, false)]);
+    }
+
     #[test]
     fn the_bus_export_decodes_to_the_traces_accesses() {
         use crate::logic::decode::{Access, BusDecoder};

@@ -7,7 +7,7 @@
 //! the ON and OFF times: the reference model, run through the trace's
 //! register accesses, says them as it goes.
 
-use super::{Emitter, S1};
+use super::{Emitter, LOOK_BACK, S1};
 use crate::emu::{Board, ModelConfig};
 use crate::protocol::{Chop, PhaseOutputs};
 use crate::time::{Duration, Instant};
@@ -65,6 +65,9 @@ impl PhasePins {
                 break;
             }
             self.chopped = edge;
+            // A long stop chops for long: what is drawn goes out as it
+            // goes, as the pulses do.
+            state.drain_before((edge.as_nanos() + state.lead).saturating_sub(LOOK_BACK))?;
             self.draw(state, edge)?;
         }
         Ok(())
