@@ -108,3 +108,22 @@ fn a_polling_hosts_captures_pass_with_one_order_too() {
     assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
     assert!(j.host.is_empty(), "{:?}", j.host);
 }
+
+/// Sections 3-5-1 and 3-1-1: the exact host writes the move's command as
+/// IBF falls; sampled at 23.8 MHz, the chopping that the move ends passes
+/// the board, every edge compared. (sigrok-cli's own conversion of the
+/// same capture, where the board's move starts before the model's, is in
+/// `scenarios/tests/suite_captures.rs`.)
+#[test]
+fn s3_5_1_chopping_ended_by_a_move_the_capture_cannot_order_passes() {
+    let j = judged(
+        sampled(
+            "s3_5_1_default_switching_chops_the_phases",
+            HostTiming::Exact,
+            42_000,
+        ),
+        &JudgeOptions::default(),
+    );
+    assert!(matches!(j.verdict, Verdict::Passed), "{j:?}");
+    assert!(j.changes > 1000, "the chopping compared: {}", j.changes);
+}

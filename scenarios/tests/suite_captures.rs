@@ -29,11 +29,13 @@ use common::{ppmc, scratch, text};
 use std::path::Path;
 use std::sync::Mutex;
 
-/// One scenario of each kind: inputs that stop a move, a Decelerating
-/// Stop written while the pulses run, the error and host-rule scenarios,
-/// the auxiliary outputs, register reads, and the speed limit.
-const SAMPLE: [&str; 9] = [
+/// One scenario of each kind: inputs that stop a move, stop switching's
+/// chopping ended by a move, a Decelerating Stop written while the pulses
+/// run, the error and host-rule scenarios, the auxiliary outputs,
+/// register reads, and the speed limit.
+const SAMPLE: [&str; 10] = [
     "s3_3_6_continuous_until_l1",
+    "s3_5_1_default_switching_chops_the_phases",
     "s3_3_8_origin_search_stops_at_cnp",
     "s3_6_decel_stop_17us_not_before",
     "s3_3_7_high_speed_until_l3",

@@ -358,6 +358,15 @@ impl PhaseWatch {
                         self.chopping = Some(ch);
                         *compared += 1;
                     }
+                    // Out of rhythm where the model has not reached the
+                    // chopping's end: the board's may come first (its move
+                    // started within the capture's uncertainty before the
+                    // model's). Wait as long as the end may be behind it.
+                    Some((b, _))
+                        if end.is_none() && b.saturating_add((r.allowed)(b)) >= r.horizon_ps =>
+                    {
+                        return Ok(())
+                    }
                     Some((b, level)) if !ending(b) => {
                         let what = if ch.level == ch.on_level { "ON" } else { "OFF" };
                         return Err(self.diverge(
