@@ -81,6 +81,16 @@ impl Edges {
             .expect("a rising edge")
     }
 
+    /// When the channel named `name` first rises after `after`.
+    fn rise_after(&self, name: &str, after: u64) -> u64 {
+        let ch = self.channel(name);
+        self.edges
+            .iter()
+            .find(|x| x.1 == ch && x.2 && x.0 > after)
+            .map(|x| x.0)
+            .expect("a rise")
+    }
+
     /// The capture put together again, its edges in time order.
     fn capture(mut self) -> Recorded {
         self.edges.sort_by_key(|e| e.0);
@@ -422,16 +432,8 @@ fn s3_5_1_the_phases_are_compared_step_by_step_and_chop_by_chop() {
 /// the move starts, the phases then on.
 fn chopping_slow(per_mille: u64) -> Recorded {
     let mut e = Edges::of(CHOPPING);
-    let rise = |e: &Edges, name: &str, after: u64| {
-        let ch = e.channel(name);
-        e.edges
-            .iter()
-            .find(|x| x.1 == ch && x.2 && x.0 > after)
-            .map(|x| x.0)
-            .expect("a rise")
-    };
-    let on = rise(&e, "hold", 0);
-    let moves = rise(&e, "busy", on);
+    let on = e.rise_after("hold", 0);
+    let moves = e.rise_after("busy", on);
     for k in 1..=5 {
         let ch = e.channel(&format!("s{k}"));
         let level_at = |t: u64| e.edges.iter().rfind(|x| x.1 == ch && x.0 <= t).map(|x| x.2);
@@ -543,16 +545,8 @@ fn s3_5_4_a_software_reset_while_the_phases_chop_passes_wherever_it_falls() {
 /// capture's uncertainty of IBF's fall may).
 fn chopping_cut(before_end_ns: u64, cut_early_ns: u64) -> Recorded {
     let mut e = Edges::of(CHOPPING);
-    let rise = |e: &Edges, name: &str, after: u64| {
-        let ch = e.channel(name);
-        e.edges
-            .iter()
-            .find(|x| x.1 == ch && x.2 && x.0 > after)
-            .map(|x| x.0)
-            .expect("a rise")
-    };
-    let on = rise(&e, "hold", 0);
-    let moves = rise(&e, "busy", on);
+    let on = e.rise_after("hold", 0);
+    let moves = e.rise_after("busy", on);
     let (t_on, t_off) = (65_000_000u64, 108_750_000u64);
     let cycle = t_on + t_off;
     // The OFF edges fall at on + shift + t_on + k cycles.

@@ -27,6 +27,15 @@ impl Chop {
         t.saturating_since(self.since).as_nanos() % self.cycle() < self.on.as_nanos()
     }
 
+    /// The energized phases at `t` of `pattern` under `chop`, where
+    /// stop switching chops them (off in its OFF time).
+    pub fn energized(chop: Option<Chop>, pattern: u8, t: Instant) -> u8 {
+        match chop {
+            Some(c) if !c.is_on(t) => 0,
+            _ => pattern,
+        }
+    }
+
     /// The first time after `t` at which the phases turn on or off.
     pub fn next_edge(&self, t: Instant) -> Instant {
         let cycle = self.cycle();

@@ -2,7 +2,7 @@
 //! board's pulses matched with the model's, and the windows within which
 //! the capture cannot tell the board's timing from the model's.
 
-use super::outputs;
+use super::frame::Frame;
 use super::{Divergence, Marginal};
 use crate::compare::Tolerances;
 use crate::emu::Board;
@@ -142,8 +142,8 @@ impl Bench {
     }
 
     /// The model as the outputs are compared with it.
-    pub(super) fn frame(&self) -> outputs::Frame<'_> {
-        outputs::Frame {
+    pub(super) fn frame(&self) -> Frame<'_> {
+        Frame {
             board: &self.board,
             zero_ps: self.zero_ps,
             tol: &self.tol,

@@ -28,6 +28,7 @@ use std::fmt;
 
 mod bench;
 mod branch;
+mod frame;
 mod host;
 mod outputs;
 mod phases;

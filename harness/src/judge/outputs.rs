@@ -6,28 +6,15 @@
 //! Table 3-3 times INT*, BUSY and HOLD from them). S1..S5 have their
 //! own rules ([`super::phases`]).
 
+use super::frame::Frame;
 use super::phases::{self, PhaseLevels, PhaseWatch, Rules};
 use super::{Divergence, Marginal};
-use crate::compare::Tolerances;
 use crate::emu::Board;
 use crate::logic::map::{ChannelMap, Signal};
 use crate::logic::source::Change;
-use crate::protocol::{Pin, PulseRun};
+use crate::protocol::Pin;
 use crate::time::{Duration, Instant};
 use std::collections::VecDeque;
-
-/// The model beside the capture, as the outputs are compared with it.
-#[derive(Clone, Copy)]
-pub(super) struct Frame<'a> {
-    pub(super) board: &'a Board,
-    /// The capture's time of the model's zero.
-    pub(super) zero_ps: u64,
-    pub(super) tol: &'a Tolerances,
-    pub(super) resolution_ps: u64,
-    /// How far the board's last pulse was from the model's: an output
-    /// timed from it may be as far off.
-    pub(super) slack_ps: u64,
-}
 
 /// The outputs compared, as a judge holds them.
 #[derive(Clone)]
@@ -77,21 +64,6 @@ impl Watch {
             (false, false) => "low",
         }
     }
-}
-
-/// The last pulse of `runs` at or before `t`.
-fn last_pulse_by(runs: &[PulseRun], t: Instant) -> Option<Instant> {
-    let run = runs.iter().rev().find(|r| r.count > 0 && r.start <= t)?;
-    let (mut lo, mut hi) = (0u32, run.count - 1);
-    while lo < hi {
-        let mid = lo + (hi - lo).div_ceil(2);
-        if run.at(mid) <= t {
-            lo = mid;
-        } else {
-            hi = mid - 1;
-        }
-    }
-    Some(run.at(lo))
 }
 
 impl Outputs {
@@ -193,15 +165,8 @@ impl Outputs {
         horizon_ps: u64,
         after: Option<String>,
     ) -> Result<(), Divergence> {
-        let Frame {
-            board,
-            zero_ps,
-            tol,
-            resolution_ps,
-            slack_ps,
-        } = *f;
-        let record = board.record();
-        let to_ps = |t: Instant| t.as_nanos().saturating_mul(1000).saturating_add(zero_ps);
+        let record = f.board.record();
+        let resolution_ps = f.resolution_ps;
         for w in &mut self.watches {
             loop {
                 // The model's next change of this pin.
@@ -216,17 +181,8 @@ impl Outputs {
                 // How far the change may be from the model's: the floor,
                 // two samples, and the latency tolerance of the time since
                 // its cause.
-                let allowed = |m_ps: u64, accesses: &VecDeque<u64>| {
-                    let m = Instant::from_nanos(m_ps.saturating_sub(zero_ps) / 1000);
-                    let pulse = last_pulse_by(&record.runs, m).map(to_ps);
-                    let access = accesses.iter().rev().find(|&&a| a <= m_ps).copied();
-                    let cause = pulse.max(access).unwrap_or(zero_ps);
-                    let since = m_ps.saturating_sub(cause);
-                    (tol.floor.as_nanos().saturating_mul(1000))
-                        .saturating_add(since.saturating_mul(tol.latency_bp) / 10_000)
-                        .saturating_add(2 * resolution_ps)
-                        .saturating_add(slack_ps)
-                };
+                let allowed =
+                    |m_ps: u64, accesses: &VecDeque<u64>| f.allowed(m_ps, accesses, false);
                 let diverge =
                     |w: &Watch, at_ps: u64, board: String, model: String, level: bool| Divergence {
                         at_ps,
@@ -252,7 +208,7 @@ impl Outputs {
                         ));
                     }
                     (b, Some((m, level))) => {
-                        let m_ps = to_ps(m);
+                        let m_ps = f.capture_ps(m);
                         let allowed = allowed(m_ps, &self.accesses);
                         match b {
                             Some((b, bl)) if bl == level && b.abs_diff(m_ps) <= allowed => {
@@ -319,34 +275,9 @@ impl Outputs {
             return Ok(());
         };
         levels.draw(f.board);
-        let record = f.board.record();
-        let to_ps = |t: Instant| t.as_nanos().saturating_mul(1000).saturating_add(f.zero_ps);
-        let floor = f.tol.floor.as_nanos().saturating_mul(1000);
-        let latency = |ps: u64| ps.saturating_mul(f.tol.latency_bp) / 10_000;
-        let accesses = &self.accesses;
-        // A phase steps with a pulse: its cause is what caused the pulse,
-        // the pulse or the access before it.
-        let allowed = |ps: u64| {
-            let m = Instant::from_nanos(ps.saturating_sub(f.zero_ps) / 1000);
-            let by = Instant::from_nanos(m.as_nanos().saturating_sub(1));
-            let pulse = last_pulse_by(&record.runs, by).map(to_ps);
-            let access = accesses.iter().rev().find(|&&a| a < ps).copied();
-            let cause = pulse.max(access).unwrap_or(f.zero_ps);
-            floor
-                .saturating_add(latency(ps.saturating_sub(cause)))
-                .saturating_add(2 * f.resolution_ps)
-                .saturating_add(f.slack_ps)
-        };
-        let interval = |ps: u64| {
-            floor
-                .saturating_add(latency(ps))
-                .saturating_add(2 * f.resolution_ps)
-        };
         let rules = Rules {
-            to_ps: &to_ps,
-            allowed: &allowed,
-            interval: &interval,
-            u_ps: 2 * f.resolution_ps,
+            frame: f,
+            accesses: &self.accesses,
             horizon_ps,
             after,
         };

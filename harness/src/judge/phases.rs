@@ -21,6 +21,7 @@
 //! with an edge more or fewer, and passes; one whose ON or OFF is too long
 //! or too short fails at the first such interval.
 
+use super::frame::Frame;
 use super::{Divergence, Marginal};
 use crate::emu::Board;
 use crate::logic::map::Signal;
@@ -200,18 +201,34 @@ impl PhaseLevels {
 /// How the phases are compared: the capture's frame and its tolerances,
 /// lent by the outputs' comparison.
 pub(super) struct Rules<'a> {
-    pub(super) to_ps: &'a dyn Fn(Instant) -> u64,
-    /// How far a change at capture time `ps` may be from the model's: the
-    /// floor, two samples, and the latency tolerance of the time since
-    /// what caused it (a phase steps with a pulse: what caused that).
-    pub(super) allowed: &'a dyn Fn(u64) -> u64,
-    /// The tolerance of an interval `ps` long (the floor, two samples and
-    /// the latency tolerance of it).
-    pub(super) interval: &'a dyn Fn(u64) -> u64,
-    /// Two samples: the capture's uncertainty.
-    pub(super) u_ps: u64,
+    pub(super) frame: &'a Frame<'a>,
+    /// The register accesses an output's change is timed from.
+    pub(super) accesses: &'a VecDeque<u64>,
     pub(super) horizon_ps: u64,
     pub(super) after: Option<String>,
+}
+
+impl Rules<'_> {
+    fn capture_ps(&self, t: Instant) -> u64 {
+        self.frame.capture_ps(t)
+    }
+
+    /// How far a change at capture time `ps` may be from the model's: a
+    /// phase steps with a pulse, so its cause is what caused the pulse,
+    /// the pulse or access before it.
+    fn allowed(&self, ps: u64) -> u64 {
+        self.frame.allowed(ps, self.accesses, true)
+    }
+
+    /// The tolerance of an interval `ps` long.
+    fn interval(&self, ps: u64) -> u64 {
+        self.frame.within(ps)
+    }
+
+    /// Two samples: the capture's uncertainty.
+    fn u_ps(&self) -> u64 {
+        2 * self.frame.resolution_ps
+    }
 }
 
 /// The chopping of one phase, as the board shows it.
@@ -322,16 +339,16 @@ impl PhaseWatch {
                 // far from it the board's may be.
                 let end = match levels.change(self.next) {
                     Some((t, PhaseChange::ChopEnd(_))) => {
-                        let c = (r.to_ps)(t);
-                        Some((c, (r.allowed)(c)))
+                        let c = r.capture_ps(t);
+                        Some((c, r.allowed(c)))
                     }
                     _ => None,
                 };
                 let expected = ch.last_ps.saturating_add(ch.lasts());
                 let tol = if ch.first {
-                    (r.allowed)(expected)
+                    r.allowed(expected)
                 } else {
-                    (r.interval)(ch.lasts())
+                    r.interval(ch.lasts())
                 };
                 let fits = |b: u64| b.abs_diff(expected) <= tol;
                 // At or past the earliest the chopping may end; past the
@@ -342,7 +359,7 @@ impl PhaseWatch {
                     // An edge of the chopping: the board's may run on a
                     // little past the model's end.
                     Some((b, level)) if fits(b) && !ended(b) => {
-                        marginal.note(b.abs_diff(expected), tol, r.u_ps, || {
+                        marginal.note(b.abs_diff(expected), tol, r.u_ps(), || {
                             format!(
                                 "S{} chopping at {}: {} from its ON or OFF time, allowed {} (two samples of it the capture's uncertainty)",
                                 self.k,
@@ -363,7 +380,7 @@ impl PhaseWatch {
                     // started within the capture's uncertainty before the
                     // model's). Wait as long as the end may be behind it.
                     Some((b, _))
-                        if end.is_none() && b.saturating_add((r.allowed)(b)) >= r.horizon_ps =>
+                        if end.is_none() && b.saturating_add(r.allowed(b)) >= r.horizon_ps =>
                     {
                         return Ok(())
                     }
@@ -435,7 +452,7 @@ impl PhaseWatch {
                         on_time,
                         off_time,
                     } if self.bit(on) != self.bit(off) => {
-                        let s = (r.to_ps)(t);
+                        let s = r.capture_ps(t);
                         // A change of the board's before the chopping
                         // starts is one no model change explains.
                         if self.board.front().is_some_and(|&(b, _)| b < s) {
@@ -461,7 +478,7 @@ impl PhaseWatch {
             match (self.board.front().copied(), model) {
                 (None, None) => return Ok(()),
                 (Some((b, level)), None) => {
-                    let allowed = (r.allowed)(b);
+                    let allowed = r.allowed(b);
                     if b.saturating_add(allowed) >= r.horizon_ps {
                         return Ok(());
                     }
@@ -474,11 +491,11 @@ impl PhaseWatch {
                     ));
                 }
                 (b, Some((m, level))) => {
-                    let m_ps = (r.to_ps)(m);
-                    let allowed = (r.allowed)(m_ps);
+                    let m_ps = r.capture_ps(m);
+                    let allowed = r.allowed(m_ps);
                     match b {
                         Some((b, bl)) if bl == level && b.abs_diff(m_ps) <= allowed => {
-                            marginal.note(b.abs_diff(m_ps), allowed, r.u_ps, || {
+                            marginal.note(b.abs_diff(m_ps), allowed, r.u_ps(), || {
                                 format!(
                                     "S{} {} at {}: {} from the model's, allowed {} (two samples of it the capture's uncertainty)",
                                     self.k,

@@ -42,11 +42,9 @@ impl PhasePins {
 
     /// The levels now.
     pub(super) fn levels(&self, at: Instant) -> u8 {
-        let energized = match self.chop {
-            Some(c) if !c.is_on(at) => 0,
-            _ => self.pattern,
-        };
-        self.setup.logic.levels(energized)
+        self.setup
+            .logic
+            .levels(Chop::energized(self.chop, self.pattern, at))
     }
 
     fn draw<W: Write>(&self, state: &mut Emitter<W>, at: Instant) -> io::Result<()> {

@@ -487,10 +487,7 @@ impl Chip {
 
     /// Energized phases at `t`, with stop switching chopping them.
     pub(super) fn energized(&self, t: Instant) -> u8 {
-        match self.chop() {
-            Some(c) if !c.is_on(t) => 0,
-            _ => self.energized_pattern(),
-        }
+        Chop::energized(self.chop(), self.energized_pattern(), t)
     }
 
     /// The first time after `t` at which stop switching turns the phases on
