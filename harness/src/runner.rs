@@ -62,6 +62,12 @@ pub enum ShardError {
 }
 
 /// Parses `I/N` (1 <= I <= N).
+/// The facts of a run starting now, by this harness, on `boards` spread
+/// as `spread` says (`one`, `share`, `each`): what its record carries.
+pub fn run_info(boards: Vec<ppmc_record::BoardInfo>, spread: &str) -> ppmc_record::RunInfo {
+    ppmc_record::RunInfo::new(crate::VERSION, crate::GIT_REV, boards, spread)
+}
+
 pub fn parse_shard(s: &str) -> Result<(usize, usize), ShardError> {
     let (i, n) = s
         .split_once('/')

@@ -7,17 +7,18 @@
 //! (per board): how many runs, their verdicts, the virtual and wall time,
 //! and each measurement's count, minimum, mean, maximum and worst grade.
 //! What is held grows with the suite and the cap, never with the passes.
+//! A listed result is held as its record ([`ScenarioRecord`]); the run's
+//! record is [`Soak::record`].
 
-use crate::report::tally::Tally;
-use crate::report::Figures;
 use crate::runner::BoardResult;
 use crate::scenario::{Grade, NotRun, ScenarioResult, Verdict};
 use crate::time::Duration;
+use ppmc_record::{
+    Figures, RangeRecord, RepeatedRecord, RunInfo, RunRecord, ScenarioRecord, Tally, FORMAT,
+};
 use std::collections::BTreeMap;
 
-/// Most results after the first pass that did not pass and are listed one
-/// by one; those past it are counted in their scenario's [`Repeated`].
-pub const MAX_LISTED: usize = 1_000;
+pub use ppmc_record::MAX_LISTED;
 
 /// A result the reports list one by one.
 #[derive(Debug)]
@@ -26,13 +27,7 @@ pub struct Listed {
     pub slot: usize,
     /// Its pass, from 1.
     pub pass: usize,
-    /// Its board: an index into the run's boards.
-    pub board: Option<usize>,
-    pub result: ScenarioResult,
-    /// The files saved for it (`--artifacts`).
-    pub attachments: Vec<String>,
-    /// What the HTML report draws of it.
-    pub figures: Option<Figures>,
+    pub record: ScenarioRecord,
 }
 
 /// What a run keeps of a result beside it, for the reports: listed with
@@ -102,10 +97,40 @@ impl Repeated {
         self.tally.runs()
     }
 
+    /// As a run record counts them, on the board named `board` (`(none)`
+    /// for runs no board took).
+    pub fn record(&self, board: &str) -> RepeatedRecord {
+        RepeatedRecord {
+            name: self.name.to_string(),
+            board: self.board.map(|_| board.to_string()),
+            section: self.section.to_string(),
+            tags: self.tags.iter().map(|t| t.to_string()).collect(),
+            first_pass: self.first_pass,
+            last_pass: self.last_pass,
+            runs: self.runs(),
+            summary: self.tally,
+            interrupted: self.interrupted,
+            elapsed_ns: self.elapsed.as_nanos(),
+            wall_s: self.wall.as_secs_f64(),
+            measurements: self
+                .measurements
+                .iter()
+                .map(|m| RangeRecord {
+                    name: m.name.clone(),
+                    count: m.count,
+                    min_ns: m.min.as_nanos(),
+                    mean_ns: m.mean().as_nanos(),
+                    max_ns: m.max.as_nanos(),
+                    worst_grade: m.worst,
+                })
+                .collect(),
+        }
+    }
+
     fn add(&mut self, pass: usize, r: &ScenarioResult) {
         self.first_pass = self.first_pass.min(pass);
         self.last_pass = self.last_pass.max(pass);
-        self.tally.count(r);
+        self.tally.add(r.status());
         if r.verdict == Verdict::NotRun(NotRun::Interrupted) {
             self.interrupted += 1;
         }
@@ -173,11 +198,12 @@ impl Soak {
     }
 
     /// Takes one result: `board` is its board as the reports name it (an
-    /// index into the run's boards), `kept` what the run keeps beside it.
-    pub fn add(&mut self, r: BoardResult, board: Option<usize>, kept: Kept) {
+    /// index into the run's boards, named by `names`), `kept` what the
+    /// run keeps beside it.
+    pub fn add(&mut self, r: BoardResult, board: Option<usize>, names: &[String], kept: Kept) {
         let pass = self.pass_of(r.slot);
-        self.tally.count(&r.result);
-        self.boards.entry(board).or_default().count(&r.result);
+        self.tally.add(r.result.status());
+        self.boards.entry(board).or_default().add(r.result.status());
         let listed = pass == 1 || {
             let more =
                 (!r.result.verdict.ok() || r.result.flaky()) && self.listed_later < MAX_LISTED;
@@ -185,13 +211,17 @@ impl Soak {
             more
         };
         if listed {
+            let name = board.and_then(|b| names.get(b)).map(String::as_str);
+            let record = ScenarioRecord {
+                pass: (self.repeats()).then_some(pass as u64),
+                attachments: kept.attachments,
+                figures: kept.figures,
+                ..r.result.record(name)
+            };
             self.listed.push(Listed {
                 slot: r.slot,
                 pass,
-                board,
-                result: r.result,
-                attachments: kept.attachments,
-                figures: kept.figures,
+                record,
             });
             return;
         }
@@ -212,6 +242,11 @@ impl Soak {
                 measurements: Vec::new(),
             })
             .add(pass, s);
+    }
+
+    /// Whether the run repeats its scenarios.
+    fn repeats(&self) -> bool {
+        self.per_queue > self.per_pass
     }
 
     /// Every verdict so far.
@@ -244,6 +279,29 @@ impl Soak {
     pub fn finish(mut self) -> (Vec<Listed>, Vec<Repeated>) {
         self.listed.sort_by_key(|l| l.slot);
         (self.listed, self.repeated.into_values().collect())
+    }
+
+    /// The run's record: `summary` counts every run; under `--repeat`
+    /// each listed result carries its `pass`, and `repeated` holds each
+    /// scenario's other runs after the first pass, counted, with each
+    /// measurement's range (board by board, named as `run` names them).
+    pub fn record(self, run: RunInfo) -> RunRecord {
+        let repeats = self.repeats();
+        let summary = self.tally;
+        let (listed, repeated) = self.finish();
+        let repeated = repeats.then(|| {
+            repeated
+                .iter()
+                .map(|r| r.record(run.board_name(r.board)))
+                .collect()
+        });
+        RunRecord {
+            format: FORMAT.to_string(),
+            summary,
+            scenarios: listed.into_iter().map(|l| l.record).collect(),
+            repeated,
+            run,
+        }
     }
 }
 
@@ -286,7 +344,7 @@ mod tests {
             || false,
             |_, _, _| {},
             |r| {
-                soak.add(r, Some(0), Kept::default());
+                soak.add(r, Some(0), &["emu".to_string()], Kept::default());
                 most = most.max(soak.listed_len());
             },
         );
@@ -298,7 +356,9 @@ mod tests {
         assert_eq!(listed.len(), suite.len() + MAX_LISTED);
         assert!(listed.windows(2).all(|w| w[0].slot < w[1].slot));
         assert_eq!(listed[3].pass, 2);
-        assert_eq!(listed[3].result.name, "b_fails");
+        assert_eq!(listed[3].record.name, "b_fails");
+        assert_eq!(listed[3].record.pass, Some(2));
+        assert_eq!(listed[3].record.board.as_deref(), Some("emu"));
         // One entry per scenario: the passes' counts, and the failures
         // past the cap.
         let runs: Vec<(&str, usize, usize)> = repeated
@@ -347,7 +407,7 @@ mod tests {
                 slot,
                 result,
             };
-            soak.add(r, Some(0), Kept::default());
+            soak.add(r, Some(0), &["emu".to_string()], Kept::default());
         }
         let (listed, repeated) = soak.finish();
         assert_eq!(listed.len(), 1);

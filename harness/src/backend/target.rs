@@ -86,6 +86,12 @@ pub struct TargetInfo {
 }
 
 impl TargetInfo {
+    /// The board a run record names `name` (its label) with revision
+    /// `rev`: this target as reached.
+    pub fn board_info(&self, name: String, rev: Option<String>) -> ppmc_record::BoardInfo {
+        ppmc_record::BoardInfo::new(name, self.name.clone(), self.details(), rev)
+    }
+
     /// The straps' fields, then the other facts: how traces and reports
     /// list them.
     pub fn details(&self) -> Vec<(String, String)> {

@@ -227,7 +227,7 @@ impl SelectArgs {
     }
 
     /// The selection, for the run record.
-    pub fn describe(&self, opts: &mut crate::report::RunOptions) {
+    pub fn describe(&self, opts: &mut crate::record::RunOptions) {
         opts.filter = self.filter.clone();
         opts.tags = self.tags.clone();
         opts.skip_tags = self.skip_tags.clone();

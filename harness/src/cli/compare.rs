@@ -3,7 +3,7 @@
 use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
 use crate::cli::{usage, CliError};
 use crate::golden::{self, GoldenError};
-use crate::report::{self, BoardInfo, RunInfo};
+use crate::record::{BoardInfo, RunOptions, RunRecord, MARGINAL_PCT};
 use crate::scenario::{HarnessError, Scenario, ScenarioResult, Verdict};
 use crate::time::Duration;
 use clap::Args;
@@ -75,7 +75,7 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             retries: 0,
             retry_failures: false,
             flaky_is_failure: false,
-            marginal: 0.25,
+            marginal: MARGINAL_PCT,
         };
         return super::run::run(run_args, suite);
     };
@@ -85,32 +85,21 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             dir.display()
         )));
     }
-    super::run::prepare_reports(
+    super::reports::prepare_reports(
         args.junit.as_deref(),
         args.json.as_deref(),
         args.html.as_deref(),
         args.store.as_deref(),
     )?;
-    let mut store = super::run::open_store(args.store.as_deref())?;
+    let mut store = super::reports::open_store(args.store.as_deref())?;
     // A trace that diverges fails, as in `ppmc run --golden`; a file that
     // cannot be used (missing, unreadable, corrupt, at other straps) is an
     // error of its own: the file is at fault, not the board.
     let started = std::time::Instant::now();
-    let mut info = RunInfo::new(
-        vec![BoardInfo {
-            name: dir.display().to_string(),
-            target: format!("traces:{}", dir.display()),
-            target_details: Default::default(),
-            board_rev: None,
-            board_serial: None,
-            bridge_firmware: None,
-            bridge_serial: None,
-            link: None,
-            error: None,
-        }],
-        "one",
-    );
-    info.options = crate::report::RunOptions {
+    let board = dir.display().to_string();
+    let traces = BoardInfo::new(board.clone(), format!("traces:{board}"), Vec::new(), None);
+    let mut info = crate::runner::run_info(vec![traces], "one");
+    info.options = RunOptions {
         repeat: 1,
         golden: Some(args.golden.display().to_string()),
         marginal_pct: 0.0,
@@ -152,29 +141,13 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
         results.push(r);
     }
     info.wall_s = started.elapsed().as_secs_f64();
-    let on = vec![Some(0); results.len()];
-    let mut problems = Vec::new();
-    if let Some(p) = &args.junit {
-        if let Err(e) = super::run::write_report(p, report::junit(&info, &results, &[], &on)) {
-            problems.push(e);
-        }
-    }
-    let listing = report::Listing::all(&results, &[], &on).with_figures(&figures);
-    if let Some(p) = &args.json {
-        if let Err(e) = super::run::write_report(p, report::json_listing(&info, &listing)) {
-            problems.push(e);
-        }
-    }
-    if let Some(p) = &args.html {
-        if let Err(e) = super::run::write_html(p, report::json_listing(&info, &listing)) {
-            problems.push(e);
-        }
-    }
-    if let Some(store) = &mut store {
-        if let Err(e) = super::run::keep(store, report::json_listing(&info, &listing)) {
-            problems.push(e);
-        }
-    }
+    let scenarios = results.iter().zip(figures).map(|(r, figures)| {
+        let record = r.record(Some(&board));
+        ppmc_record::ScenarioRecord { figures, ..record }
+    });
+    let record = RunRecord::new(info, scenarios.collect());
+    let outputs = super::reports::Outputs::of(&args.junit, &args.json, &args.html);
+    let problems = super::reports::write(&record, outputs, store.as_mut());
     let count = |f: fn(&Verdict) -> bool| results.iter().filter(|r| f(&r.verdict)).count();
     let ok = count(|v| v.ok());
     let bad = count(|v| matches!(v, Verdict::Failed(_)));

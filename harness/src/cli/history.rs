@@ -1,7 +1,7 @@
 //! `ppmc history`: what a results store says across runs, as text.
 
 use crate::cli::CliError;
-use crate::report::printable as p;
+use crate::record::printable as p;
 use crate::store::Store;
 use clap::Args;
 use std::path::PathBuf;

@@ -3,14 +3,11 @@
 //! reference model (`docs/capture.md`).
 
 use super::args::{parse_duration, ChipArgs, ToleranceArgs};
-use crate::backend::TargetInfo;
 use crate::cli::{usage, CliError};
-use crate::judge::{judge_reopening, HostFinding, JudgeOptions, Judgement, Verdict};
+use crate::judge::{judge_reopening, JudgeOptions, Judgement, Verdict};
 use crate::logic::decode::BusDecoder;
 use crate::logic::map::ChannelMap;
 use crate::logic::source::{LogicInfo, LogicSource};
-use crate::report::{self, Blame, BoardInfo, CaptureSource, Judged, Listing, RunInfo};
-use crate::scenario::{Failure, HarnessError, ScenarioResult, Verdict as ScenarioVerdict};
 use crate::time::{Duration, Instant};
 use clap::Args;
 use std::path::PathBuf;
@@ -194,7 +191,7 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         partial: args.partial,
         ..JudgeOptions::default()
     };
-    super::run::prepare_reports(
+    super::reports::prepare_reports(
         args.junit.as_deref(),
         args.json.as_deref(),
         None,
@@ -220,7 +217,7 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         }
         crate::files::prepare_folder(dir)?;
     }
-    let mut store = super::run::open_store(args.store.as_deref())?;
+    let mut store = super::reports::open_store(args.store.as_deref())?;
     describe(&info, &args.capture.capture);
     // The capture is read again only where the board diverged, to hold
     // the divergence against the map (judge::judge_reopening).
@@ -240,27 +237,11 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         }
     }
     if args.junit.is_some() || args.json.is_some() || store.is_some() {
-        let wall = started.elapsed();
-        let (mut run, results, judged) = records(&args.capture.capture, &info, &opts, &j, wall);
-        run.boards[0].board_rev = args.board_rev.clone();
-        run.boards[0].board_serial = args.board_serial.clone();
-        let on = vec![Some(0); results.len()];
-        let listing = Listing::all(&results, &[], &on).judged(&judged);
-        if let Some(p) = &args.junit {
-            if let Err(e) = super::run::write_report(p, report::junit_listing(&run, &listing)) {
-                problems.push(e);
-            }
-        }
-        if let Some(p) = &args.json {
-            if let Err(e) = super::run::write_report(p, report::json_listing(&run, &listing)) {
-                problems.push(e);
-            }
-        }
-        if let Some(store) = &mut store {
-            if let Err(e) = super::run::keep(store, report::json_listing(&run, &listing)) {
-                problems.push(e);
-            }
-        }
+        let mut record = j.record(&args.capture.capture, &info, &opts, started.elapsed());
+        record.run.boards[0].board_rev = args.board_rev.clone();
+        record.run.boards[0].board_serial = args.board_serial.clone();
+        let outputs = super::reports::Outputs::of(&args.junit, &args.json, &None);
+        problems.extend(super::reports::write(&record, outputs, store.as_mut()));
     }
     let verdict = say(&j);
     match problems.into_iter().next() {
@@ -269,187 +250,19 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
     }
 }
 
-/// The judgement as the reports list it (issue 30): the capture stands as
-/// the board; a result for the board (`judge.<file>`), failed when it
-/// diverged, an error when the capture cannot be judged; and one for the
-/// host firmware (`judge.<file>.host-firmware`), failed when it broke a
-/// rule of chapter 3, there whenever the capture was judged or a finding
-/// made. Each result says whom its verdict blames.
-fn records(
-    path: &std::path::Path,
-    info: &LogicInfo,
-    opts: &JudgeOptions,
-    j: &Judgement,
-    wall: std::time::Duration,
-) -> (RunInfo, Vec<ScenarioResult>, Vec<Judged>) {
-    let shown = path.display().to_string();
-    let file = path
-        .file_name()
-        .map_or_else(|| shown.clone(), |f| f.to_string_lossy().into_owned());
-    let target = TargetInfo {
-        name: format!("capture:{shown}"),
-        straps: opts.straps,
-        extra: Vec::new(),
-    };
-    let mut run = RunInfo::new(vec![BoardInfo::new(shown.clone(), &target, None)], "one");
-    let tol = &opts.tolerances;
-    run.options = report::RunOptions {
-        repeat: 1,
-        latency_tol_pct: tol.latency_bp as f64 / 100.0,
-        interval_tol_pct: tol.interval_bp as f64 / 100.0,
-        time_floor_ns: tol.floor.as_nanos(),
-        ..Default::default()
-    };
-    run.wall_s = wall.as_secs_f64();
-    run.source = Some(CaptureSource {
-        kind: "capture",
-        path: shown,
-        format: info.format.clone(),
-        channels: info.channels.clone(),
-        sample_rate_hz: info.sample_rate_hz,
-        resolution_ps: info.resolution_ps,
-        accesses: j.accesses,
-        pulses: j.pulses,
-        changes: j.changes,
-        not_judged: j.not_judged.clone(),
-    });
-    // A result's name and section outlive it in the reports; this process
-    // judges one capture, so the two names are kept for its life.
-    let keep = |s: String| -> &'static str { Box::leak(s.into_boxed_str()) };
-    let result = |name, section, verdict, wall| ScenarioResult {
-        name,
-        section,
-        tags: &["capture"],
-        verdict,
-        measurements: Vec::new(),
-        trace: None,
-        elapsed: Duration::ZERO,
-        wall,
-        attempts: Vec::new(),
-    };
-    let mut notes: Vec<String> = j
-        .not_judged
-        .iter()
-        .map(|n| format!("not judged: {n}"))
-        .collect();
-    notes.push(counts(j));
-    notes.extend(j.hints.iter().map(|h| format!("hint: {h}")));
-    notes.extend(marginal(j));
-    let (verdict, blame, message) = match &j.verdict {
-        Verdict::Passed if j.marginal.count > 0 => (ScenarioVerdict::Marginal, None, None),
-        Verdict::Passed => (ScenarioVerdict::Passed, None, None),
-        Verdict::Failed(d) => (
-            ScenarioVerdict::Failed(Failure {
-                expectation: d.what.clone(),
-                expected: d.model.clone(),
-                got: d.board.clone(),
-                at: Instant::from_nanos(d.at_ps / 1000),
-            }),
-            Some(Blame::Board),
-            Some(d.to_string()),
-        ),
-        Verdict::Capture(why) => (
-            ScenarioVerdict::Error(HarnessError::Capture(why.clone())),
-            Some(Blame::Capture),
-            Some(why.clone()),
-        ),
-    };
-    let mut results = vec![result(keep(format!("judge.{file}")), "3", verdict, wall)];
-    let mut judged = vec![Judged {
-        blame,
-        message,
-        host: None,
-        notes,
-    }];
-    let captured = !matches!(j.verdict, Verdict::Capture(_));
-    if captured || !j.host.is_empty() {
-        let mut sections: Vec<&str> = j.host.iter().map(|h| h.section).collect();
-        sections.sort_unstable();
-        sections.dedup();
-        let section = match sections.is_empty() {
-            true => "3",
-            false => keep(sections.join(", ")),
-        };
-        let name = keep(format!("judge.{file}.host-firmware"));
-        let host = j.host.clone();
-        let (verdict, blame, message) = match host.first() {
-            None => (ScenarioVerdict::Passed, None, None),
-            Some(first) => (
-                ScenarioVerdict::Failed(Failure {
-                    expectation: "the host firmware keeps the rules of chapter 3".into(),
-                    expected: "no access against them".into(),
-                    got: format!(
-                        "{} findings, the first (section {}): {}",
-                        host.len(),
-                        first.section,
-                        first.what
-                    ),
-                    at: Instant::from_nanos(first.at_ps / 1000),
-                }),
-                Some(Blame::Host),
-                Some(format!(
-                    "the host firmware broke chapter 3's rules {} times",
-                    host.len()
-                )),
-            ),
-        };
-        results.push(result(name, section, verdict, std::time::Duration::ZERO));
-        judged.push(Judged {
-            blame,
-            message,
-            notes: host.iter().map(finding).collect(),
-            host: Some(host),
-        });
-    }
-    (run, results, judged)
-}
-
-/// What was compared, in one line.
-fn counts(j: &Judgement) -> String {
-    format!(
-        "{} register accesses, {} POUT pulses compared, {} changes of the other outputs compared",
-        j.accesses, j.pulses, j.changes
-    )
-}
-
-/// The comparisons within the capture's uncertainty of their limits, in
-/// one line, if any.
-fn marginal(j: &Judgement) -> Option<String> {
-    let m = &j.marginal;
-    (m.count > 0).then(|| {
-        format!(
-            "{} comparison{} within the capture's uncertainty of {} limit (docs/conformance.md), the first: {}",
-            m.count,
-            if m.count == 1 { "" } else { "s" },
-            if m.count == 1 { "its" } else { "their" },
-            m.first.as_deref().unwrap_or("-")
-        )
-    })
-}
-
-/// A host finding, in one line.
-fn finding(h: &HostFinding) -> String {
-    format!(
-        "host firmware (section {}): at {}: {}",
-        h.section,
-        Instant::from_nanos(h.at_ps / 1000),
-        h.what
-    )
-}
-
 /// Says the judgement; its kind is the exit status.
 fn say(j: &Judgement) -> Result<(), CliError> {
     for n in &j.not_judged {
         outln!("not judged: {n}");
     }
-    outln!("{}", counts(j));
+    outln!("{}", j.counts_line());
     for h in &j.host {
-        outln!("{}", finding(h));
+        outln!("{}", h.line());
     }
     for h in &j.hints {
         outln!("hint: {h}");
     }
-    let passed = match marginal(j) {
+    let passed = match j.marginal_line() {
         Some(m) if matches!(j.verdict, Verdict::Passed) => {
             outln!("{m}");
             "MARGINAL"

@@ -20,6 +20,7 @@ mod list;
 mod progress;
 mod record;
 mod report;
+mod reports;
 mod run;
 mod selftest;
 mod signals;

@@ -2,7 +2,8 @@
 
 use crate::cli::{usage, CliError};
 use crate::files;
-use crate::report::{self, Record};
+use crate::record::RunRecord;
+use crate::report;
 use crate::store::Store;
 use clap::Args;
 use std::path::PathBuf;
@@ -72,7 +73,7 @@ pub fn run(args: ReportArgs) -> Result<(), CliError> {
                 args.output.display()
             )));
         }
-        records.push(Record::read(path).map_err(|e| CliError::BadInput(format!("ppmc: {e}")))?);
+        records.push(RunRecord::read(path).map_err(|e| CliError::BadInput(format!("ppmc: {e}")))?);
     }
     let page = report::html(&records, &args.title);
     files::write_report(&args.output, page.as_bytes())?;

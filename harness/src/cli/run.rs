@@ -6,14 +6,13 @@ use crate::cli::{usage, CliError};
 use crate::compare::{compare_graded, Tolerances};
 use crate::files;
 use crate::golden::{self};
-use crate::report::{self, BoardInfo, Figures, Listing, Record, RunInfo, RunOptions, Tally};
+use crate::record::{BoardInfo, Figures, RunInfo, RunOptions, RunRecord, Tally};
 use crate::runner::{Farm, Spread};
 use crate::scenario::{
     DriverOptions, Failure, Grade, Grading, HarnessError, Measurement, NotRun, Retry, Scenario,
     ScenarioResult, Verdict,
 };
 use crate::soak::{Kept, Soak};
-use crate::store::Store;
 use crate::trace::Trace;
 use clap::Args;
 use std::cell::RefCell;
@@ -203,7 +202,9 @@ pub(super) fn figures_of(r: &ScenarioResult, golden: Option<&Trace>) -> Option<F
         Verdict::Failed(f) => Some(f.at),
         _ => None,
     };
-    r.trace.as_ref().map(|t| Figures::of(t, golden, failed_at))
+    r.trace
+        .as_ref()
+        .map(|t| crate::trace::figures(t, golden, failed_at))
 }
 
 /// How much of a failed scenario's waveform to keep.
@@ -249,107 +250,6 @@ fn save_artifacts(
     .map_err(|e| e.to_string())?;
     saved.push(vpath.display().to_string());
     Ok(())
-}
-
-pub(super) fn write_report(
-    path: &Path,
-    text: Result<String, report::ReportError>,
-) -> Result<(), String> {
-    let text = text.map_err(|e| format!("{}: {e}", path.display()))?;
-    files::write_report(path, text.as_bytes()).map_err(|e| e.to_string())
-}
-
-/// Tries the `--junit` and `--json` outputs before the work, rather than
-/// finding them unusable after it: each writable, not the same file, at
-/// most one on standard output (the verdict lines then go to standard
-/// error).
-pub(super) fn prepare_reports(
-    junit: Option<&Path>,
-    json: Option<&Path>,
-    html: Option<&Path>,
-    store: Option<&Path>,
-) -> Result<(), CliError> {
-    if store.is_some_and(|s| s.as_os_str() == "-") {
-        return Err(usage(
-            "--store -: a results store is a file, not standard output",
-        ));
-    }
-    // The store is told apart from the reports too: a report written over
-    // it would replace a lab's history.
-    let named = [
-        ("--junit", junit),
-        ("--json", json),
-        ("--html", html),
-        ("--store", store),
-    ];
-    let reports: Vec<(&str, &Path)> = named
-        .into_iter()
-        .filter_map(|(flag, p)| p.map(|p| (flag, p)))
-        .collect();
-    for (_, report) in &reports {
-        files::check_writable(report)?;
-    }
-    for (i, (a, pa)) in reports.iter().enumerate() {
-        for (b, pb) in &reports[i + 1..] {
-            if files::same_file(pa, pb) {
-                return Err(usage(format!(
-                    "{a} {} and {b} {} are the same file: give each report its own",
-                    pa.display(),
-                    pb.display()
-                )));
-            }
-        }
-    }
-    let on_stdout: Vec<&str> = reports
-        .iter()
-        .filter(|(_, p)| p.as_os_str() == "-")
-        .map(|(flag, _)| *flag)
-        .collect();
-    match on_stdout.len() {
-        0 => Ok(()),
-        // Standard output carries the report: the verdicts go to stderr.
-        1 => {
-            super::out::people_to_stderr();
-            Ok(())
-        }
-        _ => Err(usage(format!(
-            "{} - cannot both take standard output",
-            on_stdout.join(" - and ")
-        ))),
-    }
-}
-
-/// Opens the results store a run will keep its record in, before the run:
-/// a store that cannot be used is found before the boards' time is spent.
-pub(super) fn open_store(path: Option<&Path>) -> Result<Option<Store>, CliError> {
-    path.map(|p| Store::open(p).map_err(|e| CliError::BadInput(format!("ppmc: --store {e}"))))
-        .transpose()
-}
-
-/// Keeps a run record in the store.
-pub(super) fn keep(
-    store: &mut Store,
-    record: Result<String, report::ReportError>,
-) -> Result<(), String> {
-    let text = record.map_err(|e| format!("--store {}: {e}", store.path().display()))?;
-    let parsed = Record::parse(&text, "the run record").map_err(|e| e.to_string())?;
-    store.add(&parsed, &text).map(|_| ()).map_err(|e| {
-        format!(
-            "--store {e}: the run's record was not kept in the store (the reports were written)"
-        )
-    })
-}
-
-/// The HTML report of a run record, drawn from the record as `ppmc report`
-/// draws it (one path from a run to its page, whichever command makes it).
-pub(super) fn write_html(
-    path: &Path,
-    record: Result<String, report::ReportError>,
-) -> Result<(), String> {
-    let text = record.map_err(|e| format!("{}: {e}", path.display()))?;
-    let record = Record::parse(&text, "the run record").map_err(|e| e.to_string())?;
-    let page = report::html(std::slice::from_ref(&record), "ppmc run report");
-    files::write_report(path, page.as_bytes()).map_err(|e| e.to_string())
 }
 
 fn summary_lines(t: &Tally, results: usize) {
@@ -424,7 +324,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     if let Some(dir) = &args.artifacts {
         files::prepare_folder(dir)?;
     }
-    prepare_reports(
+    super::reports::prepare_reports(
         args.junit.as_deref(),
         args.json.as_deref(),
         args.html.as_deref(),
@@ -435,7 +335,8 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             "--store with --repeat: a soak's record lists its first pass and what did not pass, and counts the rest, so the store would see its failures and not its passes; store single runs",
         ));
     }
-    let mut store = open_store(args.store.as_deref())?;
+    let mut store = super::reports::open_store(args.store.as_deref())?;
+    let outputs = super::reports::Outputs::of(&args.junit, &args.json, &args.html);
     if let Some(dir) = &args.golden {
         if !dir.is_dir() {
             return Err(usage(format!(
@@ -463,7 +364,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 .or_else(|| args.target.board_serial.clone());
             let name = spec.label().to_string();
             let board = match farm.board(b) {
-                Ok(t) => BoardInfo::new(name, &t, rev),
+                Ok(t) => t.board_info(name, rev),
                 Err(e) => BoardInfo::unreached(name, spec.address.clone(), rev, e.to_string()),
             };
             BoardInfo {
@@ -473,14 +374,13 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             }
         })
         .collect();
-    let mut info = RunInfo::new(boards, spread.name(several_specs));
+    let mut info = crate::runner::run_info(boards, spread.name(several_specs));
     info.options = args.options(&tol);
     if farm.reached_none() {
         // Nothing ran: say so in the reports too, so CI shows an
         // infrastructure problem rather than a bad board.
         let why = farm.unreached_reason();
         let mut results = Vec::new();
-        let mut on = Vec::new();
         farm.stream(
             &scenarios,
             1,
@@ -489,28 +389,15 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             || true,
             |_, _, _| {},
             |r| {
-                results.push(r.result);
-                on.push(r.board);
+                let board = r.board.and_then(|b| info.boards.get(b));
+                results.push(r.result.record(board.map(|b| b.name.as_str())));
             },
         );
-        let _ = args
-            .junit
-            .as_ref()
-            .map(|p| write_report(p, report::junit(&info, &results, &[], &on)));
-        let _ = args
-            .json
-            .as_ref()
-            .map(|p| write_report(p, report::json(&info, &results, &on)));
-        let _ = args
-            .html
-            .as_ref()
-            .map(|p| write_html(p, report::json(&info, &results, &on)));
-        if let Some(store) = &mut store {
-            if let Err(e) = keep(store, report::json(&info, &results, &on)) {
-                errln!("ppmc: {e}");
-            }
+        let record = RunRecord::new(info, results);
+        for e in super::reports::write(&record, outputs, store.as_mut()) {
+            errln!("ppmc: {e}");
         }
-        summary_lines(&Tally::of(&results), results.len());
+        summary_lines(&record.summary, record.scenarios.len());
         if stop.requested() {
             return Err(CliError::Interrupted);
         }
@@ -555,6 +442,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let stopped = || stop.requested() || super::out::stdout_closed();
     let several = info.boards.len() > 1;
     let board_name = |b: Option<usize>| info.board_name(b).to_string();
+    let names: Vec<String> = info.boards.iter().map(|b| b.name.clone()).collect();
     farm.stream(
         &scenarios,
         repeat,
@@ -597,6 +485,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             soak.add(
                 r,
                 board,
+                &names,
                 Kept {
                     attachments,
                     figures,
@@ -617,47 +506,9 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let board_tallies: Vec<Tally> = (0..info.boards.len())
         .map(|b| soak.board_tally(Some(b)))
         .collect();
-    let (listed, repeated) = soak.finish();
-    let on: Vec<Option<usize>> = listed.iter().map(|l| l.board).collect();
-    let passes: Vec<usize> = listed.iter().map(|l| l.pass).collect();
-    let mut figures = Vec::with_capacity(listed.len());
-    let (results, attachments): (Vec<ScenarioResult>, Vec<Vec<String>>) = listed
-        .into_iter()
-        .map(|l| {
-            figures.push(l.figures);
-            (l.result, l.attachments)
-        })
-        .unzip();
-    let listing = Listing {
-        results: &results,
-        attachments: &attachments,
-        boards: &on,
-        passes: &passes,
-        repeated: &repeated,
-        tally,
-        judged: &[],
-        figures: &figures,
-    };
-    if let Some(p) = &args.junit {
-        if let Err(e) = write_report(p, report::junit_listing(&info, &listing)) {
-            problems.push(e);
-        }
-    }
-    if let Some(p) = &args.json {
-        if let Err(e) = write_report(p, report::json_listing(&info, &listing)) {
-            problems.push(e);
-        }
-    }
-    if let Some(p) = &args.html {
-        if let Err(e) = write_html(p, report::json_listing(&info, &listing)) {
-            problems.push(e);
-        }
-    }
-    if let Some(store) = &mut store {
-        if let Err(e) = keep(store, report::json_listing(&info, &listing)) {
-            problems.push(e);
-        }
-    }
+    let record = soak.record(info);
+    problems.extend(super::reports::write(&record, outputs, store.as_mut()));
+    let info = &record.run;
     if unlisted > 0 {
         outln!(
             "{unlisted} runs that did not pass are counted, not listed: the reports list the first {} after the first pass",
@@ -666,7 +517,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     }
     summary_lines(&tally, runs_of(&tally));
     if several {
-        board_lines(&info, &board_tallies);
+        board_lines(info, &board_tallies);
     }
     for p in &problems {
         errln!("ppmc: {p}");

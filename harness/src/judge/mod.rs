@@ -33,6 +33,7 @@ mod host;
 mod outputs;
 mod phases;
 mod suspect;
+mod record;
 pub mod trace;
 use bench::{run_until, Bench, StatusLog};
 use branch::{best, prune, Branch};

@@ -10,7 +10,7 @@
 use super::batch::{Batch, Limits};
 use super::builders::{Init, Move};
 use super::check::Check;
-use super::grade::{Grade, Measurement};
+use ppmc_record::{Grade, Measurement};
 use super::outcome::{fail, HarnessError, Outcome, Stop};
 use super::steps::{Done, Role, Step};
 use crate::backend::{Op, Reply, Target, Uncertainty};

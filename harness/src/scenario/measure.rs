@@ -2,7 +2,7 @@
 //! scenario so far, graded against its band at this board's straps.
 
 use super::driver::Driver;
-use super::grade::Grade;
+use ppmc_record::Grade;
 use super::outcome::{fail, need, Failure, HarnessError, Outcome, Stop};
 use crate::protocol::{Flag, Pin, Register, TimingId};
 use crate::time::{Duration, Instant, Limit};

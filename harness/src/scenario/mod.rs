@@ -10,22 +10,23 @@ mod batch;
 mod builders;
 mod check;
 pub mod driver;
-pub mod grade;
 mod measure;
 mod options;
 mod outcome;
+mod record;
 mod run;
 mod steps;
 mod verdict;
 
 pub use builders::{Init, Move};
 pub use driver::Driver;
-pub use grade::{Grade, Grading, Measurement};
+pub use ppmc_record::{Grade, Grading, Measurement};
 pub use options::DriverOptions;
 pub use outcome::{Failure, HarnessError, Outcome, Stop};
 /// Declares a scenario where it is written; see the `ppmc-macros` crate.
 pub use ppmc_macros::scenario;
 pub use run::{run_scenario, Scenario};
+pub use record::tally;
 pub use verdict::{Attempt, NotRun, Retry, ScenarioResult, Verdict};
 
 /// What scenario files import.

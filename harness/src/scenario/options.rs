@@ -1,7 +1,7 @@
 //! [`DriverOptions`]: the timeouts, budget and grading a driver runs a
 //! scenario with.
 
-use super::grade::Grading;
+use ppmc_record::Grading;
 use crate::time::Duration;
 
 /// Timeouts and limits of a [`Driver`](super::driver::Driver), given for

@@ -2,7 +2,7 @@
 //! from a hardware reset ([`run_scenario`]).
 
 use super::driver::Driver;
-use super::grade::Grade;
+use ppmc_record::Grade;
 use super::options::DriverOptions;
 use super::outcome::{HarnessError, Outcome, Stop};
 use super::verdict::{NotRun, ScenarioResult, Verdict};

@@ -1,7 +1,7 @@
 //! How a scenario ended: its [`Verdict`] (or why it never ran,
 //! [`NotRun`]) and everything the run learned of it, [`ScenarioResult`].
 
-use super::grade::Measurement;
+use ppmc_record::Measurement;
 use super::outcome::{Failure, HarnessError};
 use crate::time::Duration;
 use crate::trace::Trace;

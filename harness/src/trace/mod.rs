@@ -33,9 +33,11 @@ use crate::protocol::{
 use crate::time::{Duration, Instant};
 use std::fmt::{self, Write as _};
 
+mod figures;
 mod uncertainty;
 
 use uncertainty::parse_uncertainty;
+pub use figures::figures;
 pub use uncertainty::{uncertainty_detail, UNCERTAINTY};
 
 /// The format version written in the first line.

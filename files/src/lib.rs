@@ -487,10 +487,10 @@ fn set_permissions(
         .map_err(FileError::io(tmp.path(), Action::Writing))
 }
 
-/// A scratch folder for a unit test, removed when dropped (even by a
-/// failing test).
-#[cfg(test)]
-pub(crate) fn scratch(tag: &str) -> tempfile::TempDir {
+/// A scratch folder for a test, removed when dropped (even by a failing
+/// test).
+#[doc(hidden)]
+pub fn scratch(tag: &str) -> tempfile::TempDir {
     tempfile::Builder::new()
         .prefix(&format!("ppmc-{tag}-"))
         .tempdir()

@@ -16,7 +16,7 @@ mod stats;
 
 pub use stats::{mean_sd, Distribution, History, RevisionYield, ScenarioRate, TrendPoint};
 
-use crate::report::Record;
+use ppmc_record::RunRecord;
 use rusqlite::{params, Connection, OpenFlags, Transaction, TransactionBehavior};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -133,7 +133,7 @@ impl Store {
                 "no results store here (ppmc run --store FILE makes one)".into(),
             ));
         }
-        crate::files::check_replaceable(path).map_err(|e| err(e.to_string()))?;
+        ppmc_files::check_replaceable(path).map_err(|e| err(e.to_string()))?;
         let flags = OpenFlags::SQLITE_OPEN_READ_ONLY
             | OpenFlags::SQLITE_OPEN_NOFOLLOW
             | OpenFlags::SQLITE_OPEN_NO_MUTEX;
@@ -191,7 +191,7 @@ impl Store {
             path: path.to_path_buf(),
             why,
         };
-        crate::files::check_replaceable(path).map_err(|e| err(e.to_string()))?;
+        ppmc_files::check_replaceable(path).map_err(|e| err(e.to_string()))?;
         // A store in a folder not there yet: the folder is made, as a
         // report's would be.
         if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
@@ -281,10 +281,11 @@ impl Store {
 
     /// Adds a run record, in one transaction: the run, its boards, every
     /// result and measurement. Returns the run's id in the store.
-    pub fn add(&mut self, record: &Record, text: &str) -> Result<i64, StoreError> {
+    pub fn add(&mut self, record: &RunRecord) -> Result<i64, StoreError> {
         let path = self.path.clone();
+        let text = stored_text(record).map_err(|e| fail_at(&path, e))?;
         let tx = self.conn.transaction().map_err(|e| fail_at(&path, e))?;
-        let id = insert(&tx, record, text).map_err(|e| fail_at(&path, e))?;
+        let id = insert(&tx, record, &text).map_err(|e| fail_at(&path, e))?;
         tx.commit().map_err(|e| fail_at(&path, e))?;
         Ok(id)
     }
@@ -332,23 +333,15 @@ fn not_a_store(e: rusqlite::Error) -> String {
 /// The record as the store keeps it: without its figures, which only the
 /// run's own report draws, and which would make a lab's store grow by
 /// the pulse runs of every move.
-pub fn stored_text(text: &str) -> String {
-    match serde_json::from_str::<serde_json::Value>(text) {
-        Ok(mut v) => {
-            if let Some(list) = v.get_mut("scenarios").and_then(|s| s.as_array_mut()) {
-                for s in list {
-                    if let Some(o) = s.as_object_mut() {
-                        o.remove("figures");
-                    }
-                }
-            }
-            v.to_string()
-        }
-        Err(_) => text.to_string(),
+fn stored_text(record: &RunRecord) -> Result<String, serde_json::Error> {
+    let mut kept = record.clone();
+    for s in &mut kept.scenarios {
+        s.figures = None;
     }
+    serde_json::to_string(&kept)
 }
 
-fn insert(tx: &Transaction, r: &Record, text: &str) -> rusqlite::Result<i64> {
+fn insert(tx: &Transaction, r: &RunRecord, text: &str) -> rusqlite::Result<i64> {
     let s = &r.summary;
     let source = if r.run.source.is_some() {
         "capture"
@@ -370,9 +363,9 @@ fn insert(tx: &Transaction, r: &Record, text: &str) -> rusqlite::Result<i64> {
             s.marginal,
             s.flaky,
             s.failed,
-            s.error,
+            s.errors,
             s.not_run,
-            stored_text(text),
+            text,
         ],
     )?;
     let run = tx.last_insert_rowid();
@@ -423,8 +416,8 @@ fn insert(tx: &Transaction, r: &Record, text: &str) -> rusqlite::Result<i64> {
             sc.name,
             sc.section,
             sc.pass,
-            sc.verdict,
-            sc.blame,
+            sc.verdict.name(),
+            sc.blame.flatten().map(|b| b.name()),
             sc.attempts.len() as i64 + 1,
             sc.elapsed_ns as i64,
             detail,
@@ -434,12 +427,12 @@ fn insert(tx: &Transaction, r: &Record, text: &str) -> rusqlite::Result<i64> {
             measure.execute(params![
                 rid,
                 m.name,
-                m.value_ns as i64,
-                m.lo_ns as i64,
-                m.hi_ns.map(|v| v as i64),
-                m.marginal_lo_ns as i64,
-                m.marginal_hi_ns.map(|v| v as i64),
-                m.grade,
+                m.value.as_nanos() as i64,
+                m.lo.as_nanos() as i64,
+                m.hi_ns().map(|v| v as i64),
+                m.marginal_lo.as_nanos() as i64,
+                m.marginal_hi_ns().map(|v| v as i64),
+                m.grade.name(),
             ])?;
         }
     }

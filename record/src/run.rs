@@ -1,140 +1,58 @@
-//! A JSON run record read back ([`Record`]): what `ppmc report` draws,
-//! and what the results store keeps. It reads every format this ppmc has
-//! written (`ppmc-run-record/3` and `/4`), taking what it knows and
-//! leaving the rest, so an older record still draws (without what it did
-//! not hold: figures, attempts).
+//! A run record ([`RunRecord`]), written as JSON and read back: what
+//! `ppmc report` draws, and what the results store keeps. It reads every
+//! format this ppmc has written (`ppmc-run-record/3` and `/4`), so an
+//! older record still draws (without what it did not hold: figures,
+//! attempts).
 
-use super::figures::Figures;
-use serde::Deserialize;
-use std::collections::BTreeMap;
+use crate::info::RunInfo;
+use crate::result::{RepeatedRecord, ScenarioRecord};
+use crate::tally::Tally;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+/// The format this ppmc writes.
+pub const FORMAT: &str = "ppmc-run-record/4";
+
 /// The record formats this ppmc reads.
-pub const FORMATS: [&str; 2] = ["ppmc-run-record/3", "ppmc-run-record/4"];
+pub const FORMATS: [&str; 2] = ["ppmc-run-record/3", FORMAT];
 
 /// Largest run record read (a soak's record lists at most 1,000 runs past
 /// its first pass).
 pub const MAX_RECORD_BYTES: u64 = 512 << 20;
 
-#[derive(Debug, Clone, Deserialize)]
-pub struct Record {
+/// A run: its facts, its tally and its results.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
     pub format: String,
-    pub run: RunFacts,
-    pub summary: Summary,
+    pub run: RunInfo,
+    /// Every verdict of the run, listed or not.
+    pub summary: Tally,
+    /// The results listed one by one.
     pub scenarios: Vec<ScenarioRecord>,
+    /// Under `--repeat`: each scenario's runs after the first pass that
+    /// are not in `scenarios`, counted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repeated: Option<Vec<RepeatedRecord>>,
 }
 
-#[derive(Debug, Clone, Default, Deserialize)]
-pub struct Summary {
-    pub passed: u64,
-    pub marginal: u64,
-    pub failed: u64,
-    pub error: u64,
-    pub not_run: u64,
-    /// Passed only on a retry (format 4).
-    #[serde(default)]
-    pub flaky: u64,
-}
+impl RunRecord {
+    /// The record of a run whose results are all listed: `summary` counts
+    /// them.
+    pub fn new(run: RunInfo, scenarios: Vec<ScenarioRecord>) -> RunRecord {
+        RunRecord {
+            format: FORMAT.to_string(),
+            summary: Tally::of(&scenarios),
+            run,
+            scenarios,
+            repeated: None,
+        }
+    }
 
-#[derive(Debug, Clone, Deserialize)]
-pub struct RunFacts {
-    pub harness_version: String,
-    pub git_revision: String,
-    pub boards: Vec<BoardFacts>,
-    pub started: String,
-    pub wall_s: f64,
-    pub host: String,
-    pub options: OptionFacts,
-    /// A capture judged in place of a board (`ppmc judge`).
-    #[serde(default)]
-    pub source: Option<serde_json::Value>,
-}
-
-#[derive(Debug, Clone, Deserialize)]
-pub struct OptionFacts {
-    pub golden: Option<String>,
-    pub marginal_pct: f64,
-    pub interval_tol_pct: f64,
-    pub time_floor_ns: u64,
-    #[serde(default)]
-    pub retries: u32,
-}
-
-#[derive(Debug, Clone, Deserialize)]
-pub struct BoardFacts {
-    pub name: String,
-    pub target: String,
-    #[serde(default)]
-    pub target_details: BTreeMap<String, String>,
-    pub board_rev: Option<String>,
-    #[serde(default)]
-    pub board_serial: Option<String>,
-    pub bridge_firmware: Option<String>,
-    #[serde(default)]
-    pub bridge_serial: Option<String>,
-    #[serde(default)]
-    pub link: Option<BTreeMap<String, u64>>,
-    pub error: Option<String>,
-}
-
-#[derive(Debug, Clone, Deserialize)]
-pub struct FailureFacts {
-    pub expectation: String,
-    pub expected: String,
-    pub got: String,
-    pub at_ns: u64,
-}
-
-#[derive(Debug, Clone, Deserialize)]
-pub struct ErrorFacts {
-    pub kind: String,
-    pub message: String,
-}
-
-#[derive(Debug, Clone, Deserialize)]
-pub struct MeasurementRecord {
-    pub name: String,
-    pub value_ns: u64,
-    pub lo_ns: u64,
-    pub hi_ns: Option<u64>,
-    pub marginal_lo_ns: u64,
-    pub marginal_hi_ns: Option<u64>,
-    /// The uncertainty (±); 0 in records written before it was kept.
-    #[serde(default)]
-    pub u_ns: u64,
-    pub grade: String,
-    pub at_ns: u64,
-}
-
-/// One attempt of a scenario that was tried again (format 4).
-#[derive(Debug, Clone, Deserialize)]
-pub struct AttemptRecord {
-    pub verdict: String,
-    pub detail: Option<String>,
-    #[serde(default)]
-    pub error: Option<ErrorFacts>,
-}
-
-#[derive(Debug, Clone, Deserialize)]
-pub struct ScenarioRecord {
-    pub name: String,
-    #[serde(default)]
-    pub pass: Option<u64>,
-    pub board: Option<String>,
-    pub section: String,
-    /// `passed`, `marginal`, `flaky`, `failed`, `error`, `not_run`.
-    pub verdict: String,
-    pub detail: Option<String>,
-    pub failure: Option<FailureFacts>,
-    pub error: Option<ErrorFacts>,
-    pub elapsed_ns: u64,
-    pub measurements: Vec<MeasurementRecord>,
-    #[serde(default)]
-    pub blame: Option<String>,
-    #[serde(default)]
-    pub figures: Option<Figures>,
-    #[serde(default)]
-    pub attempts: Vec<AttemptRecord>,
+    /// The record as JSON (`--json`; its schema is
+    /// `docs/run-record.schema.json`).
+    pub fn to_json(&self) -> Result<String, serde_json::Error> {
+        serde_json::to_string_pretty(self)
+    }
 }
 
 /// A run record that could not be read: the file, and why.
@@ -167,9 +85,9 @@ pub fn printable(text: &str) -> String {
         .collect()
 }
 
-impl Record {
+impl RunRecord {
     /// The run record in `text`; `path` names it in an error.
-    pub fn parse(text: &str, path: &str) -> Result<Record, RecordError> {
+    pub fn parse(text: &str, path: &str) -> Result<RunRecord, RecordError> {
         // A byte-order mark, as some editors write one: not JSON, but no
         // reason to refuse the record.
         let text = text.strip_prefix('\u{FEFF}').unwrap_or(text);
@@ -209,14 +127,14 @@ impl Record {
     }
 
     /// The run record in the file at `path`.
-    pub fn read(path: &Path) -> Result<Record, RecordError> {
+    pub fn read(path: &Path) -> Result<RunRecord, RecordError> {
         let name = path.display().to_string();
         // The file error names the path itself.
-        let text = crate::files::read_text(path, MAX_RECORD_BYTES).map_err(|e| RecordError {
+        let text = ppmc_files::read_text(path, MAX_RECORD_BYTES).map_err(|e| RecordError {
             path: String::new(),
             why: e.to_string(),
         })?;
-        Record::parse(&text, &name)
+        RunRecord::parse(&text, &name)
     }
 }
 
@@ -233,7 +151,7 @@ mod tests {
     #[test]
     fn formats_are_told_apart() {
         let says = |f: &str| {
-            Record::parse(&format!(r#"{{"format":"{f}"}}"#), "r")
+            RunRecord::parse(&format!(r#"{{"format":"{f}"}}"#), "r")
                 .expect_err("refused")
                 .to_string()
         };
@@ -243,7 +161,7 @@ mod tests {
         assert!(says("something").contains("not a ppmc run record"));
         // A byte-order mark is no reason to refuse a record.
         assert!(
-            Record::parse("\u{FEFF}{\"format\":\"ppmc-run-record/99\"}", "r")
+            RunRecord::parse("\u{FEFF}{\"format\":\"ppmc-run-record/99\"}", "r")
                 .expect_err("refused")
                 .to_string()
                 .contains("newer")

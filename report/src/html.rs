@@ -1,7 +1,7 @@
 //! The HTML report (see [`html`]): one file, offline, from run records.
 
 use super::plots;
-use super::record::{Record, ScenarioRecord};
+use ppmc_record::{RunRecord, ScenarioRecord};
 use super::svg::esc;
 use std::fmt::Write as _;
 
@@ -15,7 +15,7 @@ const STYLE: &str = include_str!("report.css");
 /// Nothing in it reaches the network (its Content-Security-Policy forbids
 /// it too): no script, no font, no style from elsewhere; it opens from
 /// `file://` and as a CI artifact, as it is, years later.
-pub fn html(records: &[Record], title: &str) -> String {
+pub fn html(records: &[RunRecord], title: &str) -> String {
     let mut s = String::with_capacity(64 << 10);
     head(&mut s, title);
     if records.len() > 1 {
@@ -66,7 +66,7 @@ pub(super) fn head(s: &mut String, title: &str) {
 }
 
 /// The verdict counts as coloured chips.
-fn summary_chips(r: &Record) -> String {
+fn summary_chips(r: &RunRecord) -> String {
     let t = &r.summary;
     let mut s = String::new();
     for (class, n, word) in [
@@ -74,7 +74,7 @@ fn summary_chips(r: &Record) -> String {
         ("marginal", t.marginal, "marginal"),
         ("flaky", t.flaky, "flaky"),
         ("failed", t.failed, "failed"),
-        ("error", t.error, "errors"),
+        ("error", t.errors, "errors"),
         ("not_run", t.not_run, "not run"),
     ] {
         if n > 0 || class == "passed" || class == "failed" {
@@ -86,10 +86,10 @@ fn summary_chips(r: &Record) -> String {
 
 /// Whether a scenario is one to look at first: it did not pass cleanly.
 fn noteworthy(sc: &ScenarioRecord) -> bool {
-    !matches!(sc.verdict.as_str(), "passed" | "marginal")
+    !matches!(sc.verdict.name(), "passed" | "marginal")
 }
 
-fn run_section(s: &mut String, r: &Record, i: usize) {
+fn run_section(s: &mut String, r: &RunRecord, i: usize) {
     let _ = write!(
         s,
         r#"<section class="run" id="run-{i}"><h2>Run {} <span class="summary">{}</span></h2>"#,
@@ -118,12 +118,12 @@ fn run_section(s: &mut String, r: &Record, i: usize) {
         let _ = write!(
             s,
             r##"<tr class="{}"><td><a href="#r{i}-s{k}">{}</a></td><td>{}</td><td>{}</td><td><span class="chip {}">{}</span></td><td>{}</td><td>{}</td></tr>"##,
-            esc(&sc.verdict),
+            esc(sc.verdict.name()),
             esc(&display_name(sc)),
             esc(&sc.section),
             esc(sc.board.as_deref().unwrap_or("")),
-            esc(&sc.verdict),
-            esc(&sc.verdict.replace('_', " ")),
+            esc(sc.verdict.name()),
+            esc(&sc.verdict.name().replace('_', " ")),
             sc.attempts.len() + 1,
             esc(&plots::human(sc.elapsed_ns)),
         );
@@ -156,7 +156,7 @@ fn display_name(sc: &ScenarioRecord) -> String {
 }
 
 /// The boards: identity, straps and, through a bridge, the link's health.
-fn boards(s: &mut String, r: &Record) {
+fn boards(s: &mut String, r: &RunRecord) {
     s.push_str(r#"<h3>Boards</h3><table class="boards"><tr><th>board</th><th>target</th><th>revision</th><th>serial</th><th>bridge firmware</th><th>bridge serial</th><th>details</th><th>link</th></tr>"#);
     for b in &r.run.boards {
         let details: Vec<String> = b
@@ -203,15 +203,15 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64), budg
     let _ = write!(
         s,
         r#"<details class="scenario {}" id="{id}" data-scenario="{}"{}><summary><span class="chip {}">{}</span> {} <span class="section">section {}</span></summary>"#,
-        esc(&sc.verdict),
+        esc(sc.verdict.name()),
         esc(&sc.name),
         if noteworthy(sc) {
             " open data-open"
         } else {
             ""
         },
-        esc(&sc.verdict),
-        esc(&sc.verdict.replace('_', " ")),
+        esc(sc.verdict.name()),
+        esc(&sc.verdict.name().replace('_', " ")),
         esc(&display_name(sc)),
         esc(&sc.section),
     );
@@ -228,7 +228,7 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64), budg
         let _ = write!(
             s,
             r#"<p class="error">{} error: {}</p>"#,
-            esc(&e.kind),
+            esc(e.kind.name()),
             esc(&e.message)
         );
     } else if let Some(d) = &sc.detail {
@@ -238,14 +238,14 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64), budg
         s.push_str(r#"<table class="attempts"><tr><th>attempt</th><th>verdict</th><th>what happened</th></tr>"#);
         // The earlier attempts, then the last, which the scenario's own
         // fields are.
-        let last = match sc.verdict.as_str() {
+        let last = match sc.verdict.name() {
             "flaky" => "passed",
             v => v,
         };
         let rows = sc
             .attempts
             .iter()
-            .map(|a| (a.verdict.as_str(), a.detail.as_deref()))
+            .map(|a| (a.verdict.name(), a.detail.as_deref()))
             .chain(std::iter::once((last, sc.detail.as_deref())));
         for (n, (verdict, detail)) in rows.enumerate() {
             let _ = write!(
@@ -266,12 +266,12 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64), budg
                 s,
                 r#"<tr><td>{}</td><td>{}</td><td><span class="chip {}">{}</span></td><td>{}</td></tr>"#,
                 esc(&m.name),
-                esc(&match m.u_ns {
-                    0 => plots::us(m.value_ns),
-                    u => format!("{} ±{}", plots::us(m.value_ns), plots::human(u)),
+                esc(&match m.u.as_nanos() {
+                    0 => plots::us(m.value.as_nanos()),
+                    u => format!("{} ±{}", plots::us(m.value.as_nanos()), plots::human(u)),
                 }),
-                esc(&m.grade),
-                esc(&m.grade),
+                esc(m.grade.name()),
+                esc(m.grade.name()),
                 plots::measurement(m)
             );
         }
@@ -338,7 +338,7 @@ mod tests {
 
     /// A record as a file gives it: one scenario with `moves` moves, a
     /// failure, and a waveform whose window is `window`.
-    fn record(moves: usize, window: (u64, u64)) -> Record {
+    fn record(moves: usize, window: (u64, u64)) -> RunRecord {
         let m = r#"{"at_ns":1000,"kind":"constant","dir":"cw","steps":3,"runs":[[10,3,200]]}"#;
         let text = format!(
             r#"{{"format":"ppmc-run-record/4","run":{{"harness_version":"0","git_revision":"x",
@@ -354,7 +354,7 @@ mod tests {
             window.0,
             window.1
         );
-        Record::parse(&text, "t").expect("a record")
+        RunRecord::parse(&text, "t").expect("a record")
     }
 
     #[test]

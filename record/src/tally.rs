@@ -1,16 +1,17 @@
 //! [`Tally`]: counts of verdicts, for a run, a board or a scenario's
 //! repeated runs.
 
-use crate::scenario::{ScenarioResult, Verdict};
-use serde::Serialize;
+use crate::result::{ScenarioRecord, Status};
+use serde::{Deserialize, Serialize};
 
-/// Counts of verdicts.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+/// Counts of verdicts; a run record's `summary`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Tally {
     pub passed: usize,
     pub marginal: usize,
     /// Passed (or marginal) only on a retry: counted here, not in
-    /// `passed` or `marginal`.
+    /// `passed` or `marginal`. Absent from records of format 3.
+    #[serde(default)]
     pub flaky: usize,
     pub failed: usize,
     /// Spelled as the verdict is in the JSON record.
@@ -20,28 +21,24 @@ pub struct Tally {
 }
 
 impl Tally {
-    pub fn of(results: &[ScenarioResult]) -> Tally {
-        Tally::of_refs(&results.iter().collect::<Vec<_>>())
-    }
-
-    /// [`Tally::of`] some of a run's results.
-    pub fn of_refs(results: &[&ScenarioResult]) -> Tally {
+    /// The tally of `results`.
+    pub fn of<'a>(results: impl IntoIterator<Item = &'a ScenarioRecord>) -> Tally {
         let mut t = Tally::default();
         for r in results {
-            t.count(r);
+            t.add(r.verdict);
         }
         t
     }
 
-    /// Counts one result: a pass on a retry as flaky.
-    pub fn count(&mut self, r: &ScenarioResult) {
-        match r.verdict {
-            _ if r.flaky() => self.flaky += 1,
-            Verdict::Passed => self.passed += 1,
-            Verdict::Marginal => self.marginal += 1,
-            Verdict::Failed(_) => self.failed += 1,
-            Verdict::Error(_) => self.errors += 1,
-            Verdict::NotRun(_) => self.not_run += 1,
+    /// Counts one verdict.
+    pub fn add(&mut self, s: Status) {
+        match s {
+            Status::Passed => self.passed += 1,
+            Status::Marginal => self.marginal += 1,
+            Status::Flaky => self.flaky += 1,
+            Status::Failed => self.failed += 1,
+            Status::Error => self.errors += 1,
+            Status::NotRun => self.not_run += 1,
         }
     }
 

@@ -1,9 +1,10 @@
 //! JUnit XML for CI systems (see [`junit`]).
 
-use super::info::{BoardInfo, RunInfo};
-use super::listing::{error_kind, Blame, Judged, Listing, ReportError};
-use crate::scenario::{Grade, NotRun, ScenarioResult, Verdict};
-use crate::soak::Repeated;
+use ppmc_core::time::Duration;
+use ppmc_record::{
+    AttemptRecord, Blame, BoardInfo, ErrorKind, ErrorRecord, Grade, RepeatedRecord, RunRecord,
+    ScenarioRecord, Status, MAX_LISTED,
+};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -14,115 +15,35 @@ use std::fmt::Write as _;
 /// virtual time as a suite property per case; a failure or error carries
 /// its explanation in `message` and as its text; infrastructure problems
 /// (target unreachable or lost) are errors, an interrupted run's leftovers
-/// are skipped; the files saved for each result (`attachments`, in the
-/// results' order; missing entries mean none) are `[[ATTACHMENT|path]]`
-/// lines in `system-out`.
+/// are skipped; the files saved for each result (its `attachments`) are
+/// `[[ATTACHMENT|path]]` lines in `system-out`.
 ///
-/// `boards` gives each result's board (an index into `info.boards`). A run
-/// on one board is one test suite with the board's facts as properties
-/// (`target`, `board_rev`, `target.*`). A run shared by several boards is
-/// one test suite too: each board's facts are `board.<name>.*` properties,
-/// and each test case names its board in a `board_of.<case>` property and a
-/// `board:` line of its `system-out`. A run with `--each` is one test suite
-/// per board, named after it.
-pub fn junit(
-    info: &RunInfo,
-    results: &[ScenarioResult],
-    attachments: &[Vec<String>],
-    boards: &[Option<usize>],
-) -> Result<String, ReportError> {
-    junit_listing(info, &Listing::all(results, attachments, boards))
-}
-
-/// A test case: a result, or a scenario's repeated runs.
-enum Case<'a> {
-    One(usize),
-    Many(&'a Repeated),
-}
-
-/// The child element a test case's verdict gives it, if any: failure,
-/// error or skipped, with its type and message. A result judged from a
-/// capture is typed by whom it blames: `device` (the board), `host` (the
-/// host firmware) or `capture`, with the judge's line as its message.
-fn verdict_element(
-    v: &Verdict,
-    judged: Option<&Judged>,
-) -> Option<(&'static str, &'static str, String)> {
-    let (tag, kind, message) = own_element(v)?;
-    let Some(j) = judged else {
-        return Some((tag, kind, message));
-    };
-    let kind = match j.blame {
-        Some(Blame::Board) => "device",
-        Some(Blame::Host) => "host",
-        Some(Blame::Capture) => "capture",
-        None => kind,
-    };
-    Some((tag, kind, j.message.clone().unwrap_or(message)))
-}
-
-fn own_element(v: &Verdict) -> Option<(&'static str, &'static str, String)> {
-    match v {
-        Verdict::Passed | Verdict::Marginal => None,
-        Verdict::Failed(f) => Some(("failure", "device", f.to_string())),
-        Verdict::Error(e) => Some(("error", error_kind(e), e.to_string())),
-        Verdict::NotRun(NotRun::Interrupted) => {
-            Some(("skipped", "interrupted", NotRun::Interrupted.to_string()))
-        }
-        Verdict::NotRun(why) => Some(("error", "infrastructure", why.to_string())),
-    }
-}
-
-/// The element of a scenario's repeated runs: a failure or error when runs
-/// that did not pass were counted past the listing's cap.
-fn repeated_element(r: &Repeated) -> Option<(&'static str, &'static str, String)> {
-    let t = &r.tally;
-    let past = format!(
-        "past the first {} results after the first pass that did not pass, which are listed one by one",
-        crate::soak::MAX_LISTED
-    );
-    let lost = t.not_run - r.interrupted;
-    if t.failed > 0 {
-        Some((
-            "failure",
-            "device",
-            format!("{} runs failed {past}", t.failed),
-        ))
-    } else if t.errors > 0 {
-        Some((
-            "error",
-            "harness",
-            format!("{} runs were errors {past}", t.errors),
-        ))
-    } else if lost > 0 {
-        Some((
-            "error",
-            "infrastructure",
-            format!("{lost} runs were not run {past}"),
-        ))
-    } else {
-        None
-    }
-}
-
-/// [`junit`] of what `listing` lists: each listed result a test case (named
-/// ` [pass K]` when the run repeats), and each scenario's repeated runs one
-/// test case, ` [passes A-B]` (with ` on <board>` in a suite several
-/// boards share), whose `system-out` gives their counts and each
+/// A run on one board is one test suite with the board's facts as
+/// properties (`target`, `board_rev`, `target.*`). A run shared by several
+/// boards is one test suite too: each board's facts are
+/// `board.<name>.*` properties, and each test case names its board in a
+/// `board_of.<case>` property and a `board:` line of its `system-out`. A
+/// run with `--each` is one test suite per board, named after it.
+///
+/// Each scenario's repeated runs counted rather than listed (`--repeat`)
+/// are one test case, ` [passes A-B]` (with ` on <board>` in a suite
+/// several boards share), whose `system-out` gives their counts and each
 /// measurement's range, `time` their wall time and `device_time` their
 /// virtual time, summed.
-pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError> {
-    let results = l.results;
-    let repeats = info.options.repeat > 1 && !l.passes.is_empty();
+pub fn junit(record: &RunRecord) -> String {
+    let info = &record.run;
+    let results = &record.scenarios;
+    let repeated: &[RepeatedRecord] = record.repeated.as_deref().unwrap_or(&[]);
+    let board_of = |name: &Option<String>| info.board_index(name.as_deref());
     let in_board = |b: Option<usize>| {
         (0..results.len())
-            .filter(move |&i| l.board_of(i) == b)
+            .filter(move |&i| board_of(&results[i].board) == b)
             .map(Case::One)
     };
     let many_in = |b: Option<usize>| {
-        l.repeated
+        repeated
             .iter()
-            .filter(move |r| r.board == b)
+            .filter(move |r| board_of(&r.board) == b)
             .map(Case::Many)
     };
     // The suites: their board (when they have one) and their cases.
@@ -134,12 +55,12 @@ pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError>
         let board = (info.boards.len() == 1).then_some(0);
         let cases = (0..results.len())
             .map(Case::One)
-            .chain(l.repeated.iter().map(Case::Many))
+            .chain(repeated.iter().map(Case::Many))
             .collect();
         vec![(board, cases)]
     };
     let element = |c: &Case| match c {
-        Case::One(i) => verdict_element(&results[*i].verdict, l.judged_of(*i)),
+        Case::One(i) => verdict_element(&results[*i]),
         Case::Many(r) => repeated_element(r),
     };
     let kind_count = |cases: &[Case], tag: &str| {
@@ -175,15 +96,15 @@ pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError>
             .map(|c| match c {
                 Case::One(i) => {
                     let n = ones.next().unwrap_or_default();
-                    match l.passes.get(*i) {
-                        Some(p) if repeats => format!("{} [pass {p}]", results[*i].name),
-                        _ => n,
+                    match results[*i].pass {
+                        Some(p) => format!("{} [pass {p}]", results[*i].name),
+                        None => n,
                     }
                 }
                 Case::Many(r) => {
                     let mut n = format!("{} [passes {}-{}]", r.name, r.first_pass, r.last_pass);
                     if shared {
-                        n.push_str(&format!(" on {}", info.board_name(r.board)));
+                        n.push_str(&format!(" on {}", board_label(&r.board)));
                     }
                     n
                 }
@@ -192,8 +113,8 @@ pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError>
         let wall: f64 = cases
             .iter()
             .map(|c| match c {
-                Case::One(i) => results[*i].wall.as_secs_f64(),
-                Case::Many(r) => r.wall.as_secs_f64(),
+                Case::One(i) => results[*i].wall_s,
+                Case::Many(r) => r.wall_s,
             })
             .sum();
         let mut suite_name = match info.source {
@@ -232,10 +153,10 @@ pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError>
                 }
                 props.extend(cases.iter().zip(&names).map(|(c, n)| {
                     let b = match c {
-                        Case::One(i) => l.board_of(*i),
-                        Case::Many(r) => r.board,
+                        Case::One(i) => &results[*i].board,
+                        Case::Many(r) => &r.board,
                     };
-                    (format!("board_of.{n}"), info.board_name(b).to_string())
+                    (format!("board_of.{n}"), board_label(b).to_string())
                 }));
             }
         }
@@ -253,12 +174,12 @@ pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError>
         }
         props.extend(cases.iter().zip(&names).map(|(c, n)| {
             let elapsed = match c {
-                Case::One(i) => results[*i].elapsed,
-                Case::Many(r) => r.elapsed,
+                Case::One(i) => results[*i].elapsed_ns,
+                Case::Many(r) => r.elapsed_ns,
             };
             (
                 format!("device_time.{n}"),
-                format!("{:.9}", elapsed.as_nanos() as f64 / 1e9),
+                format!("{:.9}", elapsed as f64 / 1e9),
             )
         }));
         for (k, v) in props {
@@ -273,17 +194,12 @@ pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError>
         for (c, name) in cases.iter().zip(&names) {
             match c {
                 Case::One(i) => {
-                    let shared = board.is_none().then(|| info.board_name(l.board_of(*i)));
                     let r = &results[*i];
-                    let extra = Extra {
-                        attachments: l.attachments.get(*i),
-                        board: shared,
-                        judged: l.judged_of(*i),
-                    };
-                    testcase(&mut x, r, name, &extra);
+                    let shared = board.is_none().then(|| board_label(&r.board));
+                    testcase(&mut x, r, name, shared);
                 }
                 Case::Many(r) => {
-                    let shared = board.is_none().then(|| info.board_name(r.board));
+                    let shared = board.is_none().then(|| board_label(&r.board));
                     repeated_case(&mut x, r, name, shared);
                 }
             }
@@ -291,19 +207,103 @@ pub fn junit_listing(info: &RunInfo, l: &Listing) -> Result<String, ReportError>
         x.push_str("  </testsuite>\n");
     }
     x.push_str("</testsuites>\n");
-    Ok(x)
+    x
+}
+
+/// A test case: a result, or a scenario's repeated runs.
+enum Case<'a> {
+    One(usize),
+    Many(&'a RepeatedRecord),
+}
+
+/// A result's board as a test case names it: `(none)` when no board took
+/// it.
+fn board_label(b: &Option<String>) -> &str {
+    b.as_deref().unwrap_or("(none)")
+}
+
+/// The child element a verdict gives its test case, if any: failure,
+/// error or skipped, with its type and message. The device's failure is
+/// of type `device`; an error is of its kind (`harness`,
+/// `infrastructure`, `capture`); a scenario an interrupted run never
+/// reached is skipped, one a lost target never reached an
+/// `infrastructure` error.
+fn own_element(
+    status: Status,
+    error: Option<&ErrorRecord>,
+    detail: Option<&String>,
+) -> Option<(&'static str, &'static str, String)> {
+    let message = detail.cloned().unwrap_or_default();
+    match status {
+        Status::Passed | Status::Marginal | Status::Flaky => None,
+        Status::Failed => Some(("failure", "device", message)),
+        Status::Error => Some((
+            "error",
+            error.map_or("harness", |e| e.kind.name()),
+            message,
+        )),
+        Status::NotRun => match error.map(|e| e.kind) {
+            Some(ErrorKind::Interrupted) => Some(("skipped", "interrupted", message)),
+            _ => Some(("error", "infrastructure", message)),
+        },
+    }
+}
+
+/// [`own_element`] of a result; one judged from a capture is typed by
+/// whom it blames: `device` (the board), `host` (the host firmware) or
+/// `capture`, with the judge's line as its message.
+fn verdict_element(r: &ScenarioRecord) -> Option<(&'static str, &'static str, String)> {
+    let (tag, kind, message) = own_element(r.verdict, r.error.as_ref(), r.detail.as_ref())?;
+    let kind = match r.blame.flatten() {
+        Some(Blame::Board) => "device",
+        Some(Blame::Host) => "host",
+        Some(Blame::Capture) => "capture",
+        None => kind,
+    };
+    Some((tag, kind, message))
+}
+
+/// The element of a scenario's repeated runs: a failure or error when runs
+/// that did not pass were counted past the listing's cap.
+fn repeated_element(r: &RepeatedRecord) -> Option<(&'static str, &'static str, String)> {
+    let t = &r.summary;
+    let past = format!(
+        "past the first {MAX_LISTED} results after the first pass that did not pass, which are listed one by one"
+    );
+    let lost = t.not_run - r.interrupted;
+    if t.failed > 0 {
+        Some((
+            "failure",
+            "device",
+            format!("{} runs failed {past}", t.failed),
+        ))
+    } else if t.errors > 0 {
+        Some((
+            "error",
+            "harness",
+            format!("{} runs were errors {past}", t.errors),
+        ))
+    } else if lost > 0 {
+        Some((
+            "error",
+            "infrastructure",
+            format!("{lost} runs were not run {past}"),
+        ))
+    } else {
+        None
+    }
 }
 
 /// One `<testcase>` for a scenario's repeated runs.
-fn repeated_case(x: &mut String, r: &Repeated, name: &str, board: Option<&str>) {
-    let t = &r.tally;
+fn repeated_case(x: &mut String, r: &RepeatedRecord, name: &str, board: Option<&str>) {
+    let t = &r.summary;
     let mut out = Vec::new();
     if let Some(b) = board {
         out.push(format!("board: {b}"));
     }
     out.push(format!(
         "repeated: {} runs of passes {}-{} not listed one by one: {} passed, {} marginal, {} flaky, {} failed, {} errors, {} not run ({} interrupted)",
-        r.runs(),
+        r.runs,
         r.first_pass,
         r.last_pass,
         t.passed,
@@ -314,23 +314,24 @@ fn repeated_case(x: &mut String, r: &Repeated, name: &str, board: Option<&str>) 
         t.not_run,
         r.interrupted
     ));
+    let ns = Duration::from_nanos;
     out.extend(r.measurements.iter().map(|m| {
         format!(
             "{}: {} runs, min {}, mean {}, max {}, worst {}",
             m.name,
             m.count,
-            m.min,
-            m.mean(),
-            m.max,
-            m.worst.name()
+            ns(m.min_ns),
+            ns(m.mean_ns),
+            ns(m.max_ns),
+            m.worst_grade.name()
         )
     }));
     let _ = writeln!(
         x,
         "    <testcase name=\"{}\" classname=\"section {}\" time=\"{:.6}\">",
         esc(name),
-        esc(r.section),
-        r.wall.as_secs_f64()
+        esc(&r.section),
+        r.wall_s
     );
     if let Some((tag, kind, message)) = repeated_element(r) {
         let _ = writeln!(
@@ -387,15 +388,16 @@ fn board_props(prefix: &str, b: &BoardInfo) -> Vec<(String, String)> {
 /// beside the last attempt's `failure` or `error`. Each carries its type
 /// (which `junit-10.xsd` requires), its message, and its text in
 /// `stackTrace`.
-fn attempts(body: &mut String, r: &ScenarioResult) {
+fn attempts(body: &mut String, r: &ScenarioRecord) {
     let prefix = if r.verdict.ok() { "flaky" } else { "rerun" };
+    let own = |a: &AttemptRecord| own_element(a.verdict, a.error.as_ref(), a.detail.as_ref());
     // Surefire's own schema takes the failures before the errors.
     let mut earlier: Vec<(usize, &str, &str, String)> = r
         .attempts
         .iter()
         .enumerate()
         .filter_map(|(n, a)| {
-            let (tag, kind, message) = own_element(&a.verdict)?;
+            let (tag, kind, message) = own(a)?;
             let tag = match tag {
                 "failure" => "Failure",
                 _ => "Error",
@@ -415,35 +417,27 @@ fn attempts(body: &mut String, r: &ScenarioResult) {
                 "attempt {} of {}, {:.6} s",
                 n + 1,
                 r.attempts.len() + 1,
-                a.wall.as_secs_f64()
+                a.wall_s
             ))
         );
     }
 }
 
-/// What a `<testcase>` says besides its result: the files saved for it,
-/// its board when the suite is shared, what the judge of a capture adds.
-struct Extra<'a> {
-    attachments: Option<&'a Vec<String>>,
-    board: Option<&'a str>,
-    judged: Option<&'a Judged>,
-}
-
 /// One `<testcase>`. A result judged from a capture has the judge's notes
 /// (what was not judged, what was compared, each finding) after its
-/// failure's or error's message, or in `system-out` when it passed.
-fn testcase(x: &mut String, r: &ScenarioResult, name: &str, extra: &Extra) {
-    let (attachments, board) = (extra.attachments, extra.board);
-    let notes = extra.judged.map_or(&[][..], |j| &j.notes[..]);
+/// failure's or error's message, or in `system-out` when it passed;
+/// `board` names its board in a suite several boards share.
+fn testcase(x: &mut String, r: &ScenarioRecord, name: &str, board: Option<&str>) {
+    let notes = &r.notes;
     let _ = write!(
         x,
         "    <testcase name=\"{}\" classname=\"section {}\" time=\"{:.6}\"",
         esc(name),
-        esc(r.section),
-        r.wall.as_secs_f64()
+        esc(&r.section),
+        r.wall_s
     );
     let mut body = String::new();
-    let element = verdict_element(&r.verdict, extra.judged);
+    let element = verdict_element(r);
     if let Some((tag, kind, message)) = &element {
         let text = std::iter::once(message.as_str())
             .chain(notes.iter().map(String::as_str))
@@ -464,7 +458,7 @@ fn testcase(x: &mut String, r: &ScenarioResult, name: &str, extra: &Extra) {
     if let Some(b) = board {
         out.push(format!("board: {b}"));
     }
-    if r.verdict == Verdict::Marginal {
+    if r.verdict.ok() {
         let near: Vec<String> = r
             .measurements
             .iter()
@@ -476,12 +470,7 @@ fn testcase(x: &mut String, r: &ScenarioResult, name: &str, extra: &Extra) {
             out.push(format!("MARGINAL: {}", near.join("; ")));
         }
     }
-    out.extend(
-        attachments
-            .into_iter()
-            .flatten()
-            .map(|p| format!("[[ATTACHMENT|{p}]]")),
-    );
+    out.extend(r.attachments.iter().map(|p| format!("[[ATTACHMENT|{p}]]")));
     if !out.is_empty() {
         let _ = writeln!(
             body,
@@ -499,21 +488,21 @@ fn testcase(x: &mut String, r: &ScenarioResult, name: &str, extra: &Extra) {
 }
 
 /// Test case names, with ` [pass K]` when a scenario ran more than once.
-fn unique_names(results: &[&ScenarioResult]) -> Vec<String> {
+fn unique_names(results: &[&ScenarioRecord]) -> Vec<String> {
     let mut runs: BTreeMap<&str, usize> = BTreeMap::new();
     for r in results {
-        *runs.entry(r.name).or_default() += 1;
+        *runs.entry(&r.name).or_default() += 1;
     }
     let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
     results
         .iter()
         .map(|r| {
-            let k = seen.entry(r.name).or_default();
+            let k = seen.entry(&r.name).or_default();
             *k += 1;
-            if runs[r.name] > 1 {
+            if runs[r.name.as_str()] > 1 {
                 format!("{} [pass {k}]", r.name)
             } else {
-                r.name.to_string()
+                r.name.clone()
             }
         })
         .collect()

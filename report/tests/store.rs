@@ -2,7 +2,7 @@
 //! older ppmc wrote is still read, unchanged; a store of a newer ppmc, a
 //! file that is no store and a planted symlink are refused by name.
 
-use ppmc::store::{Store, SCHEMA};
+use ppmc_report::store::{Store, SCHEMA};
 use std::path::{Path, PathBuf};
 
 /// A store made from the frozen SQL of schema 1, in a scratch folder.
@@ -72,8 +72,8 @@ fn a_new_store_takes_a_record_and_gives_it_back_in_its_history() {
         "failure":null,"error":null,"elapsed_ns":5,"measurements":[],"figures":{"moves":[]},
         "attempts":[{"verdict":"error","detail":"link","error":{"kind":"infrastructure","message":"link"},
         "elapsed_ns":1,"wall_s":0.0}]}]}"#;
-    let record = ppmc::report::Record::parse(text, "t").expect("parses");
-    store.add(&record, text).expect("kept");
+    let record = ppmc_record::RunRecord::parse(text, "t").expect("parses");
+    store.add(&record).expect("kept");
     let h = store.history().expect("history");
     assert_eq!(
         (h.runs, h.revisions[0].rev.as_str(), h.revisions[0].flaky),

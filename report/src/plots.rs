@@ -2,12 +2,12 @@
 //! band, a move's speed profile over the golden one, and the pins around
 //! a failure.
 
-use super::figures::{MoveFigure, PinWave, Waveform, MAX_WAVE_PULSES};
+use ppmc_core::time::Duration;
+use ppmc_record::{Measurement, MoveFigure, PinWave, Waveform, MAX_WAVE_PULSES};
 
 /// Pins, and changes of each, a waveform draws at most.
 const MAX_WAVE_PINS: usize = 16;
 const MAX_WAVE_CHANGES: usize = 2_000;
-use super::record::MeasurementRecord;
 use super::svg::{esc, reduce, Plot, Segment};
 use std::fmt::Write as _;
 
@@ -17,28 +17,32 @@ const PROFILE: (f64, f64) = (470.0, 210.0);
 /// A measurement's band as a strip: red outside the limits, amber in the
 /// marginal zones, green between, the value a dark tick, its uncertainty
 /// (± U, where not 0) a bar across it; `data-*` give the numbers.
-pub fn measurement(m: &MeasurementRecord) -> String {
+pub fn measurement(m: &Measurement) -> String {
+    let finite = |d: Duration| (d != Duration::MAX).then_some(d.as_nanos());
+    let (value_ns, u_ns, lo_ns) = (m.value.as_nanos(), m.u.as_nanos(), m.lo.as_nanos());
+    let (hi_ns, marginal_lo_ns, marginal_hi_ns) =
+        (finite(m.hi), m.marginal_lo.as_nanos(), finite(m.marginal_hi));
     let (w, h) = (380.0, 34.0);
     let (l, r) = (8.0, 8.0);
-    let hi = m.hi_ns.unwrap_or(u64::MAX);
-    let finite_top = m.hi_ns.unwrap_or(m.lo_ns.max(m.marginal_lo_ns));
-    let top = (finite_top.max(m.value_ns) as f64 * 1.25).max(1.0);
+    let hi = hi_ns.unwrap_or(u64::MAX);
+    let finite_top = hi_ns.unwrap_or(lo_ns.max(marginal_lo_ns));
+    let top = (finite_top.max(value_ns) as f64 * 1.25).max(1.0);
     let x = |ns: u64| l + (ns as f64).min(top) / top * (w - l - r);
     let mut s = String::new();
     let _ = write!(
         s,
         r#"<svg class="measure" width="{w}" height="{h}" viewBox="0 0 {w} {h}" role="img" data-value-ns="{}" data-u-ns="{}" data-lo-ns="{}" data-hi-ns="{}" data-grade="{}">"#,
-        m.value_ns,
-        m.u_ns,
-        m.lo_ns,
-        m.hi_ns.map_or("inf".to_string(), |v| v.to_string()),
-        esc(&m.grade)
+        value_ns,
+        u_ns,
+        lo_ns,
+        hi_ns.map_or("inf".to_string(), |v| v.to_string()),
+        m.grade.name()
     );
-    let mhi = m.marginal_hi_ns.unwrap_or(u64::MAX);
+    let mhi = marginal_hi_ns.unwrap_or(u64::MAX);
     let zones = [
-        ("out", 0, m.lo_ns),
-        ("marginal", m.lo_ns, m.marginal_lo_ns),
-        ("in", m.marginal_lo_ns, mhi),
+        ("out", 0, lo_ns),
+        ("marginal", lo_ns, marginal_lo_ns),
+        ("in", marginal_lo_ns, mhi),
         ("marginal", mhi, hi),
         ("out", hi, u64::MAX),
     ];
@@ -52,11 +56,11 @@ pub fn measurement(m: &MeasurementRecord) -> String {
             );
         }
     }
-    let xv = x(m.value_ns);
-    if m.u_ns > 0 {
+    let xv = x(value_ns);
+    if u_ns > 0 {
         let (xa, xb) = (
-            x(m.value_ns.saturating_sub(m.u_ns)),
-            x(m.value_ns.saturating_add(m.u_ns)),
+            x(value_ns.saturating_sub(u_ns)),
+            x(value_ns.saturating_add(u_ns)),
         );
         let _ = write!(
             s,
@@ -67,10 +71,10 @@ pub fn measurement(m: &MeasurementRecord) -> String {
     let _ = write!(
         s,
         r#"<line class="value" x1="{xv:.1}" y1="2" x2="{xv:.1}" y2="22"/><text class="tick" x="{:.1}" y="31" text-anchor="start">{}</text><text class="tick" x="{:.1}" y="31" text-anchor="end">{}</text></svg>"#,
-        x(m.lo_ns),
-        esc(&us(m.lo_ns)),
+        x(lo_ns),
+        esc(&us(lo_ns)),
         x(finite_top),
-        esc(&m.hi_ns.map_or("no upper limit".to_string(), us)),
+        esc(&hi_ns.map_or("no upper limit".to_string(), us)),
     );
     s
 }

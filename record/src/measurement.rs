@@ -7,9 +7,9 @@
 //! The limits are the datasheet's band (`[min, max]`, or the single typical
 //! figure) widened by its 1 % footnote. Each measurement carries its
 //! uncertainty `U` (±), the instrument's: 0 on the emulator, on a board
-//! the sum of its two ends' as the bridge declares them per path
-//! ([`crate::backend::Target::uncertainty`]: an access's stamp, a captured
-//! edge, a sampled output, a polled flag). Then:
+//! the sum of its two ends' as the bridge declares them per path (an
+//! access's stamp, a captured edge, a sampled output, a polled flag; the
+//! harness's `Target::uncertainty`). Then:
 //!
 //! - FAIL: the whole interval `value ± U` lies outside the band;
 //! - MARGINAL: it straddles a limit (the instrument cannot tell: "within
@@ -22,12 +22,15 @@
 //!
 //! With `U` = 0 this is the band and the marginal zone alone.
 
-use crate::protocol::{Straps, TimingId};
-use crate::time::{Duration, Instant, Limit};
+use ppmc_core::protocol::{Straps, TimingId};
+use ppmc_core::time::{Duration, Instant, Limit};
+use serde::{Deserialize, Serialize};
 use std::fmt;
 
-/// How a measurement compares with its limits.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+/// How a measurement compares with its limits; in a run record `PASS`,
+/// `MARGINAL` or `FAIL`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "UPPERCASE")]
 pub enum Grade {
     Pass,
     Marginal,
@@ -44,7 +47,8 @@ impl Grade {
     }
 }
 
-/// The grading rule.
+/// The grading rule. Its default is the one marginal zone every command
+/// starts from ([`MARGINAL_PCT`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Grading {
     /// Width of the marginal zone inside each edge, in basis points
@@ -52,14 +56,29 @@ pub struct Grading {
     pub marginal_bp: u64,
 }
 
+/// The marginal zone's default width, percent of each limit (`--marginal`).
+pub const MARGINAL_PCT: f64 = 0.25;
+
 impl Default for Grading {
     fn default() -> Self {
-        Grading { marginal_bp: 25 }
+        Grading::percent(MARGINAL_PCT)
     }
 }
 
-/// A graded measurement: value, limits and where it was taken.
-#[derive(Debug, Clone, PartialEq, Eq)]
+impl Grading {
+    /// The rule with a marginal zone `pct` percent of each limit wide.
+    pub fn percent(pct: f64) -> Grading {
+        Grading {
+            marginal_bp: (pct * 100.0).round() as u64,
+        }
+    }
+}
+
+/// A graded measurement: value, limits and where it was taken. In a run
+/// record its times are nanoseconds (`value_ns`, ...; an open upper limit
+/// `null`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(into = "MeasurementFields", from = "MeasurementFields")]
 pub struct Measurement {
     pub name: String,
     pub value: Duration,
@@ -143,11 +162,76 @@ impl Measurement {
         (low < self.lo && high >= self.lo) || (high > self.hi && low <= self.hi)
     }
 
+    /// The upper limit in nanoseconds; `None` when there is none.
+    pub fn hi_ns(&self) -> Option<u64> {
+        finite(self.hi)
+    }
+
+    /// The marginal zone's upper edge in nanoseconds; `None` when the
+    /// band has no upper limit.
+    pub fn marginal_hi_ns(&self) -> Option<u64> {
+        finite(self.marginal_hi)
+    }
+
     /// The value as measured: `112.000us`, or `112.400us ±0.020us`.
     pub fn shown(&self) -> String {
         match self.u == Duration::ZERO {
             true => self.value.to_string(),
             false => format!("{} ±{}", self.value, self.u),
+        }
+    }
+}
+
+/// A [`Measurement`] as a run record spells it.
+#[derive(Serialize, Deserialize)]
+struct MeasurementFields {
+    name: String,
+    value_ns: u64,
+    lo_ns: u64,
+    hi_ns: Option<u64>,
+    marginal_lo_ns: u64,
+    marginal_hi_ns: Option<u64>,
+    /// The uncertainty (±); 0 in records written before it was kept.
+    #[serde(default)]
+    u_ns: u64,
+    grade: Grade,
+    at_ns: u64,
+}
+
+/// An open limit (`Duration::MAX`) is `null`.
+fn finite(d: Duration) -> Option<u64> {
+    (d != Duration::MAX).then_some(d.as_nanos())
+}
+
+impl From<Measurement> for MeasurementFields {
+    fn from(m: Measurement) -> Self {
+        MeasurementFields {
+            value_ns: m.value.as_nanos(),
+            lo_ns: m.lo.as_nanos(),
+            hi_ns: finite(m.hi),
+            marginal_lo_ns: m.marginal_lo.as_nanos(),
+            marginal_hi_ns: finite(m.marginal_hi),
+            u_ns: m.u.as_nanos(),
+            grade: m.grade,
+            at_ns: m.at.as_nanos(),
+            name: m.name,
+        }
+    }
+}
+
+impl From<MeasurementFields> for Measurement {
+    fn from(m: MeasurementFields) -> Self {
+        let open = |ns: Option<u64>| ns.map_or(Duration::MAX, Duration::from_nanos);
+        Measurement {
+            name: m.name,
+            value: Duration::from_nanos(m.value_ns),
+            lo: Duration::from_nanos(m.lo_ns),
+            hi: open(m.hi_ns),
+            marginal_lo: Duration::from_nanos(m.marginal_lo_ns),
+            marginal_hi: open(m.marginal_hi_ns),
+            u: Duration::from_nanos(m.u_ns),
+            grade: m.grade,
+            at: Instant::from_nanos(m.at_ns),
         }
     }
 }

@@ -1,76 +1,93 @@
 //! Facts about a run that every report carries: [`RunInfo`], its boards
 //! ([`BoardInfo`]) and the options it was made with ([`RunOptions`]).
 
-use crate::backend::TargetInfo;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::time::SystemTime;
 
 /// The selection and settings a run was made with, for the record.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct RunOptions {
+    #[serde(default)]
     pub filter: Option<String>,
+    #[serde(default)]
     pub tags: Vec<String>,
+    #[serde(default)]
     pub skip_tags: Vec<String>,
     /// `I/N`, when the run is one shard of the suite.
+    #[serde(default)]
     pub shard: Option<String>,
+    #[serde(default)]
     pub repeat: u32,
     /// The golden directory compared against, if any.
     pub golden: Option<String>,
     /// Width of the MARGINAL zone, percent of each limit.
     pub marginal_pct: f64,
     /// The golden comparison's tolerances.
+    #[serde(default)]
     pub latency_tol_pct: f64,
     pub interval_tol_pct: f64,
     pub time_floor_ns: u64,
     /// `--retries`, `--retry-failures`, `--flaky-is-failure`.
+    #[serde(default)]
     pub retries: u32,
+    #[serde(default)]
     pub retry_failures: bool,
+    #[serde(default)]
     pub flaky_is_failure: bool,
 }
 
 /// A board of a run: what the reports call it and what is known of it.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BoardInfo {
     /// The board's label: the `--target` given, or its `name=`.
     pub name: String,
     /// The target as reached: `serial:/dev/ttyACM0`, or
     /// `labgrid:rig1 (rfc2217://lab:2001)`.
     pub target: String,
+    #[serde(default)]
     pub target_details: BTreeMap<String, String>,
     /// The board revision label (`rev=` or `--board-rev`).
     pub board_rev: Option<String>,
     /// The board's serial number (`board-serial=` or `--board-serial`).
+    #[serde(default)]
     pub board_serial: Option<String>,
     /// The bus bridge's firmware version, when the target is a board.
     pub bridge_firmware: Option<String>,
     /// The bus bridge's serial number, where it is known: what its HELLO
     /// gives (an RP2350's chip ID), else the USB serial number the
     /// operating system read from the device.
+    #[serde(default)]
     pub bridge_serial: Option<String>,
     /// What the link to the bridge cost over the run (round trips,
     /// retransmissions, corrupt frames, reopens); none for the emulator.
+    #[serde(default)]
     pub link: Option<BTreeMap<String, u64>>,
     /// Why the board took no part in the run, or left it early.
     pub error: Option<String>,
 }
 
 impl BoardInfo {
-    pub fn new(name: String, target: &TargetInfo, board_rev: Option<String>) -> BoardInfo {
-        let extra = |key: &str| {
-            target
-                .extra
-                .iter()
-                .find(|(k, _)| k == key)
-                .map(|(_, v)| v.clone())
-        };
+    /// A board that was reached: its label, the target as reached, what the
+    /// target says of itself (`details`: its straps, then facts such as
+    /// `bridge_firmware`) and its revision label.
+    pub fn new(
+        name: String,
+        target: String,
+        details: Vec<(String, String)>,
+        board_rev: Option<String>,
+    ) -> BoardInfo {
+        let bridge_firmware = details
+            .iter()
+            .find(|(k, _)| k == "bridge_firmware")
+            .map(|(_, v)| v.clone());
         BoardInfo {
             name,
-            target: target.name.clone(),
-            target_details: target.details().into_iter().collect(),
+            target,
+            target_details: details.into_iter().collect(),
             board_rev,
             board_serial: None,
-            bridge_firmware: extra("bridge_firmware"),
+            bridge_firmware,
             bridge_serial: None,
             link: None,
             error: None,
@@ -100,15 +117,16 @@ impl BoardInfo {
 }
 
 /// Facts about a run that every report carries.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunInfo {
     pub harness_version: String,
     pub git_revision: String,
-    /// The boards, in the order of `--target`; results name them by index.
+    /// The boards, in the order of `--target`; results name them by name.
     pub boards: Vec<BoardInfo>,
     /// `one` (a single board), `share` (each scenario on one of several
     /// boards) or `each` (every scenario on every board).
-    pub spread: &'static str,
+    #[serde(default = "one")]
+    pub spread: String,
     /// When the run started, UTC, RFC 3339.
     pub started: String,
     /// Wall-clock duration of the whole run, seconds.
@@ -118,16 +136,20 @@ pub struct RunInfo {
     pub options: RunOptions,
     /// What the results were judged from when it is no run of boards: a
     /// logic-analyzer capture (`ppmc judge`). Absent from a run's record.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub source: Option<CaptureSource>,
+}
+
+fn one() -> String {
+    "one".into()
 }
 
 /// A logic-analyzer capture a board was judged from (`ppmc judge`), and
 /// what of it was judged.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CaptureSource {
     /// Always `capture`.
-    pub kind: &'static str,
+    pub kind: String,
     pub path: String,
     /// What the file is, in words: `VCD (ppmc)`, `sigrok session (.sr,
     /// version 2)`.
@@ -148,12 +170,19 @@ pub struct CaptureSource {
 }
 
 impl RunInfo {
-    pub fn new(boards: Vec<BoardInfo>, spread: &'static str) -> RunInfo {
+    /// A run starting now on this machine, by the harness of `version` and
+    /// `git_revision`, on `boards` spread as `spread` says.
+    pub fn new(
+        version: &str,
+        git_revision: &str,
+        boards: Vec<BoardInfo>,
+        spread: &str,
+    ) -> RunInfo {
         RunInfo {
-            harness_version: crate::VERSION.to_string(),
-            git_revision: crate::GIT_REV.to_string(),
+            harness_version: version.to_string(),
+            git_revision: git_revision.to_string(),
             boards,
-            spread,
+            spread: spread.to_string(),
             started: rfc3339(SystemTime::now()),
             wall_s: 0.0,
             host: hostname(),
@@ -166,6 +195,12 @@ impl RunInfo {
     pub fn board_name(&self, b: Option<usize>) -> &str {
         b.and_then(|b| self.boards.get(b))
             .map_or("(none)", |b| b.name.as_str())
+    }
+
+    /// The board named `name`, as a result names it: an index into
+    /// `boards`.
+    pub fn board_index(&self, name: Option<&str>) -> Option<usize> {
+        name.and_then(|n| self.boards.iter().position(|b| b.name == n))
     }
 }
 
