@@ -11,9 +11,9 @@ use crate::protocol::Straps;
 use crate::trace::{Trace, TraceError};
 use std::path::{Path, PathBuf};
 
-/// The front matter insta writes for `harness/tests/golden.rs`; `ppmc
+/// The front matter insta writes for `harness/tests/it/golden.rs`; `ppmc
 /// record` writes the same so both tools agree on the files.
-pub const SNAPSHOT_HEADER: &str = "---\nsource: harness/tests/golden.rs\n---\n";
+pub const SNAPSHOT_HEADER: &str = "---\nsource: harness/tests/it/golden.rs\n---\n";
 
 /// A golden file that cannot be used.
 #[derive(Debug, thiserror::Error)]

@@ -17,15 +17,11 @@
 pub mod backend;
 pub mod bridge;
 pub mod chaos;
-pub mod cli;
 pub mod compare;
 pub mod console;
-pub mod fault_matrix;
 pub mod fuzzing;
 pub mod golden;
 pub mod invariants;
-pub mod judge;
-pub mod logic;
 pub mod plain_model;
 pub mod runner;
 pub mod scenario;
@@ -39,8 +35,6 @@ pub use ppmc_core::emu::faults;
 pub use ppmc_core::{bus, emu, protocol, time};
 pub use ppmc_files as files;
 pub use ppmc_record as record;
-pub use ppmc_report as report;
-pub use ppmc_report::store;
 
 /// The harness's version and git revision, for run records.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -84,4 +84,3 @@ pub struct PinWave {
 /// side of the failure, so only a pulse train far faster than its
 /// neighbours' events reaches this.
 pub const MAX_WAVE_PULSES: usize = 400;
-

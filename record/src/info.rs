@@ -172,12 +172,7 @@ pub struct CaptureSource {
 impl RunInfo {
     /// A run starting now on this machine, by the harness of `version` and
     /// `git_revision`, on `boards` spread as `spread` says.
-    pub fn new(
-        version: &str,
-        git_revision: &str,
-        boards: Vec<BoardInfo>,
-        spread: &str,
-    ) -> RunInfo {
+    pub fn new(version: &str, git_revision: &str, boards: Vec<BoardInfo>, spread: &str) -> RunInfo {
         RunInfo {
             harness_version: version.to_string(),
             git_revision: git_revision.to_string(),

@@ -1,8 +1,8 @@
 //! The HTML report (see [`html`]): one file, offline, from run records.
 
 use super::plots;
-use ppmc_record::{RunRecord, ScenarioRecord};
 use super::svg::esc;
+use ppmc_record::{RunRecord, ScenarioRecord};
 use std::fmt::Write as _;
 
 /// The page's style: inline, like everything else in it.

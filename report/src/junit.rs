@@ -237,11 +237,7 @@ fn own_element(
     match status {
         Status::Passed | Status::Marginal | Status::Flaky => None,
         Status::Failed => Some(("failure", "device", message)),
-        Status::Error => Some((
-            "error",
-            error.map_or("harness", |e| e.kind.name()),
-            message,
-        )),
+        Status::Error => Some(("error", error.map_or("harness", |e| e.kind.name()), message)),
         Status::NotRun => match error.map(|e| e.kind) {
             Some(ErrorKind::Interrupted) => Some(("skipped", "interrupted", message)),
             _ => Some(("error", "infrastructure", message)),

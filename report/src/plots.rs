@@ -20,8 +20,11 @@ const PROFILE: (f64, f64) = (470.0, 210.0);
 pub fn measurement(m: &Measurement) -> String {
     let finite = |d: Duration| (d != Duration::MAX).then_some(d.as_nanos());
     let (value_ns, u_ns, lo_ns) = (m.value.as_nanos(), m.u.as_nanos(), m.lo.as_nanos());
-    let (hi_ns, marginal_lo_ns, marginal_hi_ns) =
-        (finite(m.hi), m.marginal_lo.as_nanos(), finite(m.marginal_hi));
+    let (hi_ns, marginal_lo_ns, marginal_hi_ns) = (
+        finite(m.hi),
+        m.marginal_lo.as_nanos(),
+        finite(m.marginal_hi),
+    );
     let (w, h) = (380.0, 34.0);
     let (l, r) = (8.0, 8.0);
     let hi = hi_ns.unwrap_or(u64::MAX);

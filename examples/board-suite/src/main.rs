@@ -15,5 +15,5 @@ use std::process::ExitCode;
 fn main() -> ExitCode {
     let mut suite = ppmc_scenarios::all();
     suite.extend(x_axis::scenarios());
-    ppmc::cli::main(suite)
+    ppmc_cli::main(suite)
 }

@@ -36,7 +36,7 @@
 //! The capacity it replaces, 4,096 records, did not fit: the pulse runs
 //! alone took the heap past its end as their `Vec` grew from 2,048 to
 //! 4,096 (131,072 bytes), with 2,049 runs in the capture, half the
-//! capacity. `harness/tests/firmware_qemu.rs` shows it on the QEMU board,
+//! capacity. `harness/tests/it/firmware_qemu.rs` shows it on the QEMU board,
 //! which keeps this heap and capacity: there the capture's largest growth
 //! (its runs' `Vec` to 2,048) takes the heap to about 155 KB of its
 //! 256 KiB.

@@ -16,7 +16,7 @@ use crate::time::Duration;
 use std::fmt::Write as _;
 
 /// The fuzz targets whose inputs are bus programs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum InputKind {
     /// A `bus_bytes` input: ops separated by `FUZZ`.
     BusBytes,

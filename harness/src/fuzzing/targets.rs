@@ -3,7 +3,7 @@
 //! `ppmc::fuzzing::targets::<target>`, so that `cargo test` on stable
 //! replays every committed input in `fuzz/corpus/<target>/` and
 //! `fuzz/regressions/<target>/` through the same code
-//! (`harness/tests/fuzz_corpus.rs`, `harness/tests/model_twin.rs`).
+//! (`harness/tests/it/fuzz_corpus.rs`, `harness/tests/it/model_twin.rs`).
 
 use super::actions::{lower, typed_program};
 use super::bus_bytes;

@@ -10,7 +10,6 @@
 use super::batch::{Batch, Limits};
 use super::builders::{Init, Move};
 use super::check::Check;
-use ppmc_record::{Grade, Measurement};
 use super::outcome::{fail, HarnessError, Outcome, Stop};
 use super::steps::{Done, Role, Step};
 use crate::backend::{Op, Reply, Target, Uncertainty};
@@ -20,6 +19,7 @@ use crate::protocol::{
 };
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, Event};
+use ppmc_record::{Grade, Measurement};
 
 // Defined beside the driver, and public here as they always were.
 pub use super::options::DriverOptions;

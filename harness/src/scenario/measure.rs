@@ -2,10 +2,10 @@
 //! scenario so far, graded against its band at this board's straps.
 
 use super::driver::Driver;
-use ppmc_record::Grade;
 use super::outcome::{fail, need, Failure, HarnessError, Outcome, Stop};
 use crate::protocol::{Flag, Pin, Register, TimingId};
 use crate::time::{Duration, Instant, Limit};
+use ppmc_record::Grade;
 
 impl Driver<'_> {
     /// Grades a measurement whose two ends are as sure as `u`, together.

@@ -20,13 +20,13 @@ mod verdict;
 
 pub use builders::{Init, Move};
 pub use driver::Driver;
-pub use ppmc_record::{Grade, Grading, Measurement};
 pub use options::DriverOptions;
 pub use outcome::{Failure, HarnessError, Outcome, Stop};
 /// Declares a scenario where it is written; see the `ppmc-macros` crate.
 pub use ppmc_macros::scenario;
-pub use run::{run_scenario, Scenario};
+pub use ppmc_record::{Grade, Grading, Measurement};
 pub use record::tally;
+pub use run::{run_scenario, Scenario};
 pub use verdict::{Attempt, NotRun, Retry, ScenarioResult, Verdict};
 
 /// What scenario files import.

@@ -1,8 +1,8 @@
 //! [`DriverOptions`]: the timeouts, budget and grading a driver runs a
 //! scenario with.
 
-use ppmc_record::Grading;
 use crate::time::Duration;
+use ppmc_record::Grading;
 
 /// Timeouts and limits of a [`Driver`](super::driver::Driver), given for
 /// the reference board (16 MHz, CSEL high): the driver stretches each for

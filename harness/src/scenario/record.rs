@@ -151,7 +151,10 @@ mod tests {
         .record(Some("tcp://127.0.0.1:2000"));
         assert_eq!(cut.verdict, Status::Error);
         let e = cut.error.expect("an error");
-        assert_eq!((e.kind, e.message.as_str()), (ErrorKind::Infrastructure, "target: link lost"));
+        assert_eq!(
+            (e.kind, e.message.as_str()),
+            (ErrorKind::Infrastructure, "target: link lost")
+        );
         assert_eq!(cut.board.as_deref(), Some("tcp://127.0.0.1:2000"));
         let bug = result("bug", HarnessError::Scenario("panicked".into())).record(None);
         assert_eq!(bug.error.map(|e| e.kind), Some(ErrorKind::Harness));

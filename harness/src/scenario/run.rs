@@ -2,7 +2,6 @@
 //! from a hardware reset ([`run_scenario`]).
 
 use super::driver::Driver;
-use ppmc_record::Grade;
 use super::options::DriverOptions;
 use super::outcome::{HarnessError, Outcome, Stop};
 use super::verdict::{NotRun, ScenarioResult, Verdict};
@@ -10,6 +9,7 @@ use crate::backend::{Target, TargetErrorKind};
 use crate::bus::Uncertainty;
 use crate::time::{Duration, Instant};
 use crate::trace::{Event, EventKind, Trace};
+use ppmc_record::Grade;
 use std::fmt;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 

@@ -1,10 +1,10 @@
 //! How a scenario ended: its [`Verdict`] (or why it never ran,
 //! [`NotRun`]) and everything the run learned of it, [`ScenarioResult`].
 
-use ppmc_record::Measurement;
 use super::outcome::{Failure, HarnessError};
 use crate::time::Duration;
 use crate::trace::Trace;
+use ppmc_record::Measurement;
 
 /// How a scenario ended.
 #[derive(Debug, Clone, PartialEq, Eq)]

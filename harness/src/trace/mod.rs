@@ -36,8 +36,8 @@ use std::fmt::{self, Write as _};
 mod figures;
 mod uncertainty;
 
-use uncertainty::parse_uncertainty;
 pub use figures::figures;
+use uncertainty::parse_uncertainty;
 pub use uncertainty::{uncertainty_detail, UNCERTAINTY};
 
 /// The format version written in the first line.
@@ -893,7 +893,7 @@ end
 
     #[test]
     fn insta_front_matter_is_skipped() {
-        let with = format!("---\nsource: harness/tests/golden.rs\n---\n{SAMPLE}");
+        let with = format!("---\nsource: harness/tests/it/golden.rs\n---\n{SAMPLE}");
         assert_eq!(Trace::parse(&with), Trace::parse(SAMPLE));
     }
 

@@ -945,9 +945,9 @@ end
 
     #[test]
     fn the_bus_export_decodes_to_the_traces_accesses() {
-        use crate::logic::decode::{Access, BusDecoder};
-        use crate::logic::map::BusChannels;
-        use crate::logic::source::{Change, LogicInfo};
+        use ppmc_logic::decode::{Access, BusDecoder};
+        use ppmc_logic::map::BusChannels;
+        use ppmc_logic::source::{Change, LogicInfo};
         let text = "ppmc-trace 1
 scenario bus
 section 3-1

@@ -1,0 +1,279 @@
+//! The argument groups several commands share: the target and its straps,
+//! the scenario selection, the comparison tolerances.
+
+use super::CliError;
+use clap::{Args, ValueEnum};
+use ppmc::backend::{self, OpenError, OpenOptions, StrapOptions, Target, TargetSpec};
+use ppmc::compare::Tolerances;
+use ppmc::emu::{AccelCurve, ModelConfig};
+use ppmc::protocol::Straps;
+use ppmc::runner::{parse_shard, validate_suite, Selection};
+use ppmc::scenario::Scenario;
+use ppmc::stop::Stop;
+use ppmc::time::Duration;
+
+/// Which chip to drive, and how its board is strapped.
+#[derive(Debug, Args)]
+pub struct TargetArgs {
+    /// `emu` (the reference emulator), `serial:<path>[,baud=N]` (a board,
+    /// or `ppmc bridge-sim`, behind the serial bus bridge),
+    /// `tcp://<host>:<port>` (a bridge's serial port served on the network
+    /// in raw mode, as ser2net or socat serve it),
+    /// `rfc2217://<host>:<port>[,baud=N]` (served over telnet with RFC 2217,
+    /// as ser2net's telnet(rfc2217) mode and labgrid's exporter serve it) or
+    /// `labgrid:<place>` (the serial port of a labgrid place you have
+    /// acquired). Any of them may end in options of that board alone:
+    /// `,name=LABEL`, `,rev=LABEL`, `,board-serial=SERIAL`, `,pad=BYTES` (reply padding, default 64
+    /// on a network target, 0 on a serial port) and the straps `,clock-mhz=`, `,csel=`,
+    /// `,vsel=`, `,ext-clock-khz=` (they override the flags below).
+    /// `emu,chip-fault=NAME` (once per fault) makes the emulator a board
+    /// with that fault of the catalogue (`ppmc fault-matrix --list`), and
+    /// `emu,drop-batch=N` fails its Nth batch once, as a lost link would
+    /// (to try `--retries`).
+    /// `ppmc run` takes several, one per board, and spreads the suite over
+    /// them.
+    #[arg(long = "target", value_name = "TARGET", default_value = "emu")]
+    targets: Vec<String>,
+    #[command(flatten)]
+    chip: ChipArgs,
+    /// On a board: how long to wait at most for a reply (beyond the time
+    /// the batch's own waits take), e.g. 1s, 250ms. The host waits less on
+    /// a link it has measured to be fast, and backs off up to this.
+    #[arg(long, value_name = "DURATION", default_value = "1s", value_parser = parse_duration)]
+    link_timeout: Duration,
+    /// On a board: attempts in a row that hear nothing before a request is
+    /// given up as a link error (ten times as many that hear only garbage:
+    /// a noisy line is alive).
+    #[arg(long, value_name = "N", default_value_t = 10)]
+    link_retries: u32,
+    /// The board's serial number, for the reports and the results store
+    /// (a target's own `,board-serial=` overrides it).
+    #[arg(long, value_name = "SERIAL")]
+    pub(super) board_serial: Option<String>,
+    /// The board's revision label, for the reports and the results store
+    /// (a target's own `,rev=` overrides it).
+    #[arg(long, value_name = "REV")]
+    pub(super) board_rev: Option<String>,
+    /// Asked for (a signal), opening a target and every wait on its link
+    /// end early.
+    #[arg(skip)]
+    pub(super) stop: Stop,
+}
+
+/// The chip itself: how its board is strapped, and the emulator's ramp.
+/// On a board, the bridge reports the straps and those given must agree.
+#[derive(Debug, Args)]
+pub struct ChipArgs {
+    /// System clock in MHz, 1 to 40 (fractions allowed, e.g. 12.288).
+    /// Default: 16 on the emulator; on a board, what its bridge reports
+    /// (given, it must agree).
+    #[arg(long, value_name = "MHZ")]
+    clock_mhz: Option<f64>,
+    /// CSEL strap: high = internal clock SysClk/32 (500 kHz at 16 MHz), low =
+    /// SysClk/128. Default: high on the emulator; on a board, the bridge's.
+    #[arg(long, value_enum)]
+    csel: Option<Level>,
+    /// VSEL strap: high = Equations 3-1/3-2, low = 3-3/3-4 (+7.5 us per
+    /// pulse). Default: high on the emulator; on a board, the bridge's.
+    #[arg(long, value_enum)]
+    vsel: Option<Level>,
+    /// Frequency on the CLOCK pin in kHz, if the board has one (used when the
+    /// initialization selects the external clock). Default: none on the
+    /// emulator; on a board, the bridge's.
+    #[arg(long, value_name = "KHZ")]
+    ext_clock_khz: Option<f64>,
+    /// Shape of the acceleration ramp (the datasheet's chapter 1 is not available).
+    #[arg(long, value_enum, default_value_t = Curve::LinearSpeed)]
+    accel_curve: Curve,
+}
+
+impl ChipArgs {
+    /// The strap options given.
+    fn strap_options(&self) -> StrapOptions {
+        let level = |l: Option<Level>| l.map(|l| l == Level::High);
+        StrapOptions {
+            clock_mhz: self.clock_mhz,
+            csel_high: level(self.csel),
+            vsel_high: level(self.vsel),
+            ext_clock_khz: self.ext_clock_khz,
+        }
+    }
+
+    /// The straps given, the emulator's defaults for the rest.
+    pub fn straps(&self) -> Result<Straps, String> {
+        self.strap_options().straps().map_err(String::from)
+    }
+
+    /// The emulator's model: the default, with the ramp chosen.
+    pub fn model(&self) -> ModelConfig {
+        ModelConfig {
+            accel_curve: match self.accel_curve {
+                Curve::LinearSpeed => AccelCurve::LinearSpeed,
+                Curve::LinearRate => AccelCurve::LinearRate,
+            },
+            ..ModelConfig::default()
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Level {
+    High,
+    Low,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Curve {
+    LinearSpeed,
+    LinearRate,
+}
+
+pub fn parse_duration(s: &str) -> Result<Duration, String> {
+    s.parse::<Duration>().map_err(|e| e.to_string())
+}
+
+impl TargetArgs {
+    /// Every `--target`, parsed ([`TargetSpec::parse_all`]).
+    pub fn specs(&self) -> Result<Vec<TargetSpec>, String> {
+        TargetSpec::parse_all(&self.targets).map_err(String::from)
+    }
+
+    /// The one target of a command that drives one board.
+    pub fn single(&self) -> Result<TargetSpec, String> {
+        let mut specs = self.specs()?;
+        if specs.len() != 1 {
+            return Err(format!(
+                "--target given {} times: only `ppmc run` drives several boards",
+                specs.len()
+            ));
+        }
+        Ok(specs.remove(0))
+    }
+
+    /// What the flags say for every target.
+    pub fn open_options(&self) -> OpenOptions {
+        OpenOptions {
+            straps: self.chip.strap_options(),
+            model: self.model(),
+            link_timeout: std::time::Duration::from_nanos(self.link_timeout.as_nanos()),
+            link_retries: self.link_retries,
+            stop: self.stop.clone(),
+        }
+    }
+
+    /// The straps of the single target: those given (on the command line
+    /// or in its spec), the emulator's defaults for the rest.
+    pub fn straps(&self) -> Result<Straps, String> {
+        let spec = self.single()?;
+        self.open_options().straps_of(&spec).map_err(String::from)
+    }
+
+    /// The single target's address (`emu`, `serial:...`); the first one's
+    /// when several were given.
+    pub fn name(&self) -> String {
+        self.specs()
+            .ok()
+            .and_then(|s| s.into_iter().next())
+            .map_or_else(|| self.targets.join(" "), |s| s.address)
+    }
+
+    /// The emulator's model ([`ChipArgs::model`]).
+    pub fn model(&self) -> ModelConfig {
+        self.chip.model()
+    }
+
+    /// Opens the single target ([`backend::open`]).
+    pub fn open(&self) -> Result<Box<dyn Target>, CliError> {
+        let spec = self.single().map_err(CliError::Usage)?;
+        Ok(backend::open(&spec, &self.open_options())?)
+    }
+}
+
+impl From<OpenError> for CliError {
+    fn from(e: OpenError) -> CliError {
+        match e {
+            OpenError::Invalid(m) => CliError::Usage(m),
+            OpenError::Infrastructure(m) => CliError::Infrastructure(m),
+        }
+    }
+}
+
+#[derive(Debug, Args)]
+pub struct SelectArgs {
+    /// Only scenarios whose name contains this text.
+    #[arg(long)]
+    filter: Option<String>,
+    /// Only scenarios with this tag (repeat for several; all must match).
+    #[arg(long = "tag")]
+    tags: Vec<String>,
+    /// Leave out scenarios with this tag (repeat for several), e.g.
+    /// `--skip-tag long` on a board.
+    #[arg(long = "skip-tag", value_name = "TAG")]
+    skip_tags: Vec<String>,
+    /// Run the I-th of N interleaved parts of the suite, e.g. 2/4, to split
+    /// it across CI jobs or boards.
+    #[arg(long, value_parser = parse_shard)]
+    shard: Option<(usize, usize)>,
+}
+
+impl SelectArgs {
+    pub fn selection(&self) -> Selection {
+        Selection {
+            filter: self.filter.clone(),
+            tags: self.tags.clone(),
+            skip_tags: self.skip_tags.clone(),
+            shard: self.shard,
+        }
+    }
+
+    /// The selection, for the run record.
+    pub fn describe(&self, opts: &mut ppmc_record::RunOptions) {
+        opts.filter = self.filter.clone();
+        opts.tags = self.tags.clone();
+        opts.skip_tags = self.skip_tags.clone();
+        opts.shard = self.shard.map(|(i, n)| format!("{i}/{n}"));
+    }
+
+    /// The suite, validated, narrowed to the selection. A filter or tags
+    /// that match nothing are an error (a typo); a shard past the end of a
+    /// small selection is simply empty (N CI jobs over fewer scenarios).
+    pub fn scenarios(&self, suite: &[Scenario]) -> Result<Vec<Scenario>, String> {
+        validate_suite(suite).map_err(|e| e.to_string())?;
+        let selection = self.selection();
+        if selection.matching(suite).is_empty() {
+            return Err("no scenario matches the selection (see `ppmc list`)".into());
+        }
+        Ok(selection.select(suite))
+    }
+}
+
+/// Comparison tolerances, defaulting to the datasheet's 1 %.
+#[derive(Debug, Args)]
+pub struct ToleranceArgs {
+    /// Relative tolerance on latencies, in percent of the golden value.
+    #[arg(long, default_value_t = 1.0)]
+    latency_tol: f64,
+    /// Relative tolerance on each pulse interval, in percent.
+    #[arg(long, default_value_t = 1.0)]
+    interval_tol: f64,
+    /// Absolute slack on every timing (timer resolution).
+    #[arg(long, default_value = "100ns", value_parser = parse_duration)]
+    time_floor: Duration,
+}
+
+impl ToleranceArgs {
+    pub fn tolerances(&self) -> Result<Tolerances, String> {
+        let bp = |pct: f64, name: &str| {
+            if pct.is_finite() && (0.0..=100.0).contains(&pct) {
+                Ok((pct * 100.0).round() as u64)
+            } else {
+                Err(format!("--{name} {pct}: give a percentage from 0 to 100"))
+            }
+        };
+        Ok(Tolerances {
+            latency_bp: bp(self.latency_tol, "latency-tol")?,
+            interval_bp: bp(self.interval_tol, "interval-tol")?,
+            floor: self.time_floor,
+        })
+    }
+}

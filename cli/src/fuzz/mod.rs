@@ -1,0 +1,215 @@
+//! `ppmc fuzz`: turning fuzz findings into something people can read and
+//! keep, and differential runs against a target.
+
+mod coverage;
+mod minimize;
+mod reproduce;
+mod run;
+mod to_scenario;
+mod triage;
+mod twin;
+
+use crate::{usage, CliError};
+use clap::{Args, Subcommand};
+use ppmc::emu::ModelConfig;
+use ppmc::fuzzing::finding::{self, InputKind};
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct FuzzArgs {
+    #[command(subcommand)]
+    command: Option<FuzzCommand>,
+    /// Without a subcommand: a differential run (see `ppmc fuzz run --help`).
+    #[command(flatten)]
+    run: run::DiffArgs,
+}
+
+#[derive(Debug, Subcommand)]
+enum FuzzCommand {
+    /// Print a fuzz input (a crash file from fuzz/artifacts/, or a corpus
+    /// entry) as a bus script in the console language, with the invariant
+    /// it breaks on the emulator. Paste it into `ppmc console` to replay it.
+    /// Exit status 1 when the input breaks an invariant, 0 when it breaks
+    /// none, 2 when the file cannot be read.
+    Reproduce {
+        #[command(flatten)]
+        input: InputArgs,
+    },
+    /// Shrink a fuzz input while the same invariant still breaks: drop ops,
+    /// merge and shorten waits, zero data bytes. Writes the result as a
+    /// `bus_bytes` input (`<file>.min` unless -o) and prints its bus
+    /// script. Exit status 0 when minimized, 1 when the input breaks no
+    /// invariant, 2 on a usage or file error.
+    Minimize {
+        #[command(flatten)]
+        input: InputArgs,
+        /// Where to write the minimized input.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Write a fuzz input (best minimized first) as a Rust scenario file in
+    /// scenarios/src/, named after the invariant it breaks
+    /// (`fuzz_<invariant>_<n>.rs`; never overwrites). The scenario replays
+    /// the bus ops and fails while the invariant breaks. Exit status 0 when
+    /// written, 1 when the input breaks no invariant, 2 on a usage or file
+    /// error.
+    ToScenario {
+        #[command(flatten)]
+        input: InputArgs,
+        /// The scenario directory.
+        #[arg(long, default_value = "scenarios/src")]
+        dir: PathBuf,
+    },
+    /// Bucket findings by the invariant each breaks: a thousand crashes of
+    /// one bug are one line, with the shortest input to minimize. Takes
+    /// files and directories (e.g. fuzz/artifacts/bus_bytes/). Exit status
+    /// 1 when any input breaks an invariant.
+    Triage {
+        /// Input files or directories of inputs.
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        #[command(flatten)]
+        model: ModelArgs,
+    },
+    /// Domain coverage of a corpus: which commands were written in which
+    /// chip state, which error codes and finish causes were reached, which
+    /// inputs changed during a move; and what never was. Markdown on
+    /// standard output.
+    Coverage {
+        /// Corpus files or directories (e.g. fuzz/corpus/bus_bytes/).
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+        /// Which fuzz target the inputs are for.
+        #[arg(long, value_enum, default_value = "bus-bytes")]
+        kind: Kind,
+    },
+    /// Run a `bus_bytes` input (a crash file from fuzz/artifacts/model_twin/,
+    /// or any corpus entry) on the emulator and on the plain model, the
+    /// second model written from the datasheet alone, and show where they
+    /// first differ. When they do, the input is shrunk to the fewest ops
+    /// that still differ, written as `<file>.min` (unless -o) and printed as
+    /// a bus script. Exit status 0 when they agree, 1 when they differ, 2
+    /// on a usage or file error.
+    Twin {
+        /// The input file.
+        file: PathBuf,
+        /// Where to write the shrunk input.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// A differential run: a seeded stream of protocol-respecting actions
+    /// against a target and the emulator side by side (the default when no
+    /// subcommand is given).
+    Run(run::DiffArgs),
+}
+
+/// The fuzz targets whose inputs are bus programs, as `--kind` names them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(super) enum Kind {
+    /// A `bus_bytes` input: ops separated by `FUZZ`.
+    BusBytes,
+    /// A `typed_actions` input: typed actions (derive `Arbitrary`).
+    TypedActions,
+}
+
+impl From<Kind> for InputKind {
+    fn from(k: Kind) -> InputKind {
+        match k {
+            Kind::BusBytes => InputKind::BusBytes,
+            Kind::TypedActions => InputKind::TypedActions,
+        }
+    }
+}
+
+#[derive(Debug, Args)]
+pub(super) struct ModelArgs {
+    /// Which fuzz target the inputs are for.
+    #[arg(long, value_enum, default_value = "bus-bytes")]
+    kind: Kind,
+    /// Judge on an emulator with this board fault (`ppmc fault-matrix
+    /// --list`); repeat to combine. Default: the clean emulator.
+    #[arg(long = "chip-fault", value_name = "FAULT")]
+    chip_faults: Vec<String>,
+}
+
+impl ModelArgs {
+    pub(super) fn model(&self) -> Result<ModelConfig, CliError> {
+        let mut cfg = ModelConfig::default();
+        ppmc::faults::apply_all(&self.chip_faults, &mut cfg)
+            .map_err(|e| usage(format!("--chip-fault: {e}")))?;
+        Ok(cfg)
+    }
+}
+
+/// The inputs under `paths` (files, or the files of directories, sorted),
+/// as bus ops.
+pub(super) fn load_inputs(
+    paths: &[PathBuf],
+    kind: InputKind,
+    cfg: &ModelConfig,
+) -> Result<Vec<(String, Vec<ppmc::fuzzing::bus_bytes::BusOp>)>, CliError> {
+    let mut files = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            let rd = std::fs::read_dir(p)
+                .map_err(|e| usage(format!("cannot read {}: {e}", p.display())))?;
+            let mut v: Vec<PathBuf> = rd
+                .filter_map(Result::ok)
+                .map(|e| e.path())
+                .filter(|f| f.is_file())
+                .collect();
+            v.sort();
+            files.extend(v);
+        } else {
+            files.push(p.clone());
+        }
+    }
+    files
+        .into_iter()
+        .map(|f| {
+            let data = ppmc_files::read(&f, ppmc_files::MAX_INPUT_BYTES)?;
+            Ok((f.display().to_string(), finding::ops_of(&data, kind, cfg)))
+        })
+        .collect()
+}
+
+#[derive(Debug, Args)]
+pub(super) struct InputArgs {
+    /// The input file.
+    file: PathBuf,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+impl InputArgs {
+    /// The model, the input's bytes and its bus ops.
+    pub(super) fn load(
+        &self,
+    ) -> Result<(ModelConfig, Vec<ppmc::fuzzing::bus_bytes::BusOp>), CliError> {
+        let cfg = self.model.model()?;
+        let data = ppmc_files::read(&self.file, ppmc_files::MAX_INPUT_BYTES)?;
+        let ops = finding::ops_of(&data, self.model.kind.into(), &cfg);
+        Ok((cfg, ops))
+    }
+}
+
+pub fn run(args: FuzzArgs) -> Result<(), CliError> {
+    match args.command {
+        None => run::run(args.run),
+        Some(FuzzCommand::Run(a)) => run::run(a),
+        Some(FuzzCommand::Triage { paths, model }) => triage::run(&paths, &model),
+        Some(FuzzCommand::Coverage { paths, kind }) => coverage::run(&paths, kind.into()),
+        Some(FuzzCommand::Reproduce { input }) => reproduce::run(&input),
+        Some(FuzzCommand::Minimize { input, output }) => minimize::run(&input, output),
+        Some(FuzzCommand::ToScenario { input, dir }) => to_scenario::run(&input, &dir),
+        Some(FuzzCommand::Twin { file, output }) => twin::run(&file, output),
+    }
+}
+
+pub(super) fn with_suffix(p: &Path, suffix: &str) -> PathBuf {
+    let mut s = p.as_os_str().to_owned();
+    s.push(".");
+    s.push(suffix);
+    PathBuf::from(s)
+}

@@ -1,0 +1,200 @@
+//! `ppmc record`: golden traces from a run.
+
+use super::args::{SelectArgs, TargetArgs};
+use super::progress::Progress;
+use crate::{usage, CliError};
+use clap::Args;
+use ppmc::golden::{self, GoldenError, Written};
+use ppmc::runner::run_suite;
+use ppmc::scenario::{DriverOptions, Scenario, ScenarioResult, Verdict};
+use ppmc::trace::Trace;
+use ppmc_files as files;
+use std::path::PathBuf;
+
+/// Which scenarios to take.
+#[derive(Debug, Args)]
+pub struct RecordArgs {
+    #[command(flatten)]
+    select: SelectArgs,
+    #[command(flatten)]
+    target: TargetArgs,
+    /// Where the golden files go.
+    #[arg(long, default_value = "golden")]
+    out: PathBuf,
+    /// Replace golden files that exist and differ. Without it, nothing is
+    /// ever overwritten.
+    #[arg(long)]
+    bless: bool,
+    /// Record scenarios the device failed too (normally refused, so that a
+    /// broken board never becomes the reference). Scenarios that ended in a
+    /// harness or link error, or did not run, are never recorded: their
+    /// capture is incomplete.
+    #[arg(long)]
+    allow_failures: bool,
+}
+
+pub fn run(args: RecordArgs, suite: &[Scenario]) -> Result<(), CliError> {
+    let scenarios = match args.select.scenarios(suite) {
+        Ok(s) => s,
+        Err(e) => return Err(usage(e)),
+    };
+    // The folder is made and tried before the run, not found unusable
+    // after it.
+    files::prepare_folder(&args.out)?;
+    let mut target = args.target.open()?;
+    let progress = Progress::new(scenarios.len());
+    let mut tally = Tally::default();
+    run_suite(
+        target.as_mut(),
+        &scenarios,
+        1,
+        DriverOptions::default(),
+        |r| {
+            progress.step(r.name);
+            match admit(r, args.allow_failures) {
+                Err(why) => {
+                    tally.refused += 1;
+                    progress.line(&format!("refused   {}: {why}", r.name));
+                }
+                Ok(t) => match golden::write(&args.out, t, args.bless) {
+                    Ok(w) => {
+                        let word = tally.count(w);
+                        if matches!(r.verdict, Verdict::Failed(_)) {
+                            tally.device_failures += 1;
+                        }
+                        progress.line(&format!(
+                            "{word:<9} {}",
+                            golden::path_for(&args.out, r.name).display()
+                        ));
+                    }
+                    Err(GoldenError::Exists { path }) => {
+                        tally.refused += 1;
+                        progress.line(&format!(
+                            "refused   {}: exists and differs from this run; pass --bless to replace it",
+                            path.display()
+                        ));
+                    }
+                    Err(e) => {
+                        tally.write_errors += 1;
+                        progress.line(&format!("error     {e}"));
+                    }
+                },
+            }
+        },
+    );
+    progress.finish();
+    outln!(
+        "{} created, {} replaced, {} unchanged, {} refused, {} not written (I/O errors)",
+        tally.created,
+        tally.replaced,
+        tally.unchanged,
+        tally.refused,
+        tally.write_errors
+    );
+    if tally.device_failures > 0 {
+        outln!(
+            "{} of the golden traces are of scenarios the device failed (--allow-failures)",
+            tally.device_failures
+        );
+    }
+    if tally.refused + tally.write_errors > 0 {
+        Err(CliError::Verdict)
+    } else {
+        Ok(())
+    }
+}
+
+#[derive(Debug, Default)]
+struct Tally {
+    created: usize,
+    replaced: usize,
+    unchanged: usize,
+    refused: usize,
+    write_errors: usize,
+    device_failures: usize,
+}
+
+impl Tally {
+    /// Counts a file written; the word for its line.
+    fn count(&mut self, w: Written) -> &'static str {
+        let (n, word) = match w {
+            Written::Created => (&mut self.created, "created"),
+            Written::Replaced => (&mut self.replaced, "replaced"),
+            Written::Unchanged => (&mut self.unchanged, "unchanged"),
+        };
+        *n += 1;
+        word
+    }
+}
+
+/// The trace to record from `r`, or why not. Only a complete run is ever a
+/// reference: a scenario that ended in a harness or link error, or never
+/// ran, has an incomplete capture whatever the flags; a device failure is
+/// admitted with `--allow-failures` only.
+fn admit(r: &ScenarioResult, allow_failures: bool) -> Result<&Trace, String> {
+    match (&r.verdict, &r.trace) {
+        (Verdict::Error(e), _) => Err(format!(
+            "not recorded: it ended in an error, so its capture is incomplete ({e})"
+        )),
+        (Verdict::NotRun(why), _) => Err(format!("not recorded: it did not run ({why})")),
+        (Verdict::Failed(_), Some(_)) if !allow_failures => Err(format!(
+            "not recorded: the device failed it ({}); fix it or pass --allow-failures",
+            r.verdict.detail().unwrap_or_default()
+        )),
+        (_, None) => Err("not recorded: the target gave no capture".into()),
+        (Verdict::Passed | Verdict::Marginal | Verdict::Failed(_), Some(t)) => Ok(t),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ppmc::backend::TargetErrorKind;
+    use ppmc::scenario::{Failure, HarnessError, NotRun};
+    use ppmc::time::{Duration, Instant};
+
+    fn result(verdict: Verdict, trace: bool) -> ScenarioResult {
+        let text = "ppmc-trace 1\nscenario x\nsection 3-1\ntarget emu\ndetail sysclk_hz 16000000\n\
+                    detail csel high\ndetail vsel high\ndetail ext_clock_hz none\nevents\n0.000us reset\nend\n";
+        ScenarioResult {
+            name: "x",
+            section: "3-1",
+            tags: &[],
+            verdict,
+            measurements: Vec::new(),
+            trace: trace.then(|| Trace::parse(text).expect("valid trace")),
+            elapsed: Duration::ZERO,
+            wall: std::time::Duration::ZERO,
+            attempts: Vec::new(),
+        }
+    }
+
+    fn failed() -> Verdict {
+        Verdict::Failed(Failure {
+            expectation: "finish status".into(),
+            expected: "0x8E".into(),
+            got: "0x00".into(),
+            at: Instant::ZERO,
+        })
+    }
+
+    #[test]
+    fn only_complete_runs_become_golden_traces() {
+        let link = Verdict::Error(HarnessError::Target {
+            kind: TargetErrorKind::Link,
+            message: "no reply".into(),
+        });
+        for allow in [false, true] {
+            let e = admit(&result(link.clone(), true), allow).expect_err("error refused");
+            assert!(e.contains("capture is incomplete"), "{e}");
+            let lost = Verdict::NotRun(NotRun::TargetLost("gone".into()));
+            assert!(admit(&result(lost, true), allow).is_err());
+            assert!(admit(&result(Verdict::Passed, false), allow).is_err());
+            assert!(admit(&result(Verdict::Passed, true), allow).is_ok());
+            assert!(admit(&result(Verdict::Marginal, true), allow).is_ok());
+        }
+        let e = admit(&result(failed(), true), false).expect_err("failure refused");
+        assert!(e.contains("--allow-failures"), "{e}");
+        assert!(admit(&result(failed(), true), true).is_ok());
+    }
+}

@@ -1,0 +1,143 @@
+//! A command's reports of its run record: the outputs tried before the
+//! work (`--junit`, `--json`, `--html`, `--store`), and written from the
+//! one record after it.
+
+use crate::{usage, CliError};
+use ppmc_files as files;
+use ppmc_record::RunRecord;
+use ppmc_report as report;
+use ppmc_report::store::Store;
+use std::path::{Path, PathBuf};
+
+/// Where a command writes its record: each report, if asked for.
+#[derive(Debug, Default, Clone, Copy)]
+pub(super) struct Outputs<'a> {
+    pub junit: Option<&'a Path>,
+    pub json: Option<&'a Path>,
+    pub html: Option<&'a Path>,
+}
+
+impl<'a> Outputs<'a> {
+    /// The outputs named by three optional paths.
+    pub fn of(
+        junit: &'a Option<PathBuf>,
+        json: &'a Option<PathBuf>,
+        html: &'a Option<PathBuf>,
+    ) -> Outputs<'a> {
+        Outputs {
+            junit: junit.as_deref(),
+            json: json.as_deref(),
+            html: html.as_deref(),
+        }
+    }
+}
+
+/// Writes `record` to every output asked for and keeps it in `store`;
+/// returns what could not be written, each naming where and why (one
+/// report that fails does not keep the others from being written).
+pub(super) fn write(record: &RunRecord, to: Outputs, store: Option<&mut Store>) -> Vec<String> {
+    let mut problems = Vec::new();
+    let mut put = |path: &Path, text: Result<String, String>| {
+        let done = text
+            .map_err(|e| format!("{}: {e}", path.display()))
+            .and_then(|t| files::write_report(path, t.as_bytes()).map_err(|e| e.to_string()));
+        if let Err(e) = done {
+            problems.push(e);
+        }
+    };
+    if let Some(p) = to.junit {
+        put(p, Ok(report::junit(record)));
+    }
+    if let Some(p) = to.json {
+        put(
+            p,
+            record
+                .to_json()
+                .map_err(|e| format!("cannot render the JSON run record: {e}")),
+        );
+    }
+    if let Some(p) = to.html {
+        put(
+            p,
+            Ok(report::html(
+                std::slice::from_ref(record),
+                "ppmc run report",
+            )),
+        );
+    }
+    if let Some(store) = store {
+        if let Err(e) = store.add(record) {
+            problems.push(format!(
+                "--store {e}: the run's record was not kept in the store (the reports were written)"
+            ));
+        }
+    }
+    problems
+}
+
+/// Tries the `--junit` and `--json` outputs before the work, rather than
+/// finding them unusable after it: each writable, not the same file, at
+/// most one on standard output (the verdict lines then go to standard
+/// error).
+pub(super) fn prepare_reports(
+    junit: Option<&Path>,
+    json: Option<&Path>,
+    html: Option<&Path>,
+    store: Option<&Path>,
+) -> Result<(), CliError> {
+    if store.is_some_and(|s| s.as_os_str() == "-") {
+        return Err(usage(
+            "--store -: a results store is a file, not standard output",
+        ));
+    }
+    // The store is told apart from the reports too: a report written over
+    // it would replace a lab's history.
+    let named = [
+        ("--junit", junit),
+        ("--json", json),
+        ("--html", html),
+        ("--store", store),
+    ];
+    let reports: Vec<(&str, &Path)> = named
+        .into_iter()
+        .filter_map(|(flag, p)| p.map(|p| (flag, p)))
+        .collect();
+    for (_, report) in &reports {
+        files::check_writable(report)?;
+    }
+    for (i, (a, pa)) in reports.iter().enumerate() {
+        for (b, pb) in &reports[i + 1..] {
+            if files::same_file(pa, pb) {
+                return Err(usage(format!(
+                    "{a} {} and {b} {} are the same file: give each report its own",
+                    pa.display(),
+                    pb.display()
+                )));
+            }
+        }
+    }
+    let on_stdout: Vec<&str> = reports
+        .iter()
+        .filter(|(_, p)| p.as_os_str() == "-")
+        .map(|(flag, _)| *flag)
+        .collect();
+    match on_stdout.len() {
+        0 => Ok(()),
+        // Standard output carries the report: the verdicts go to stderr.
+        1 => {
+            super::out::people_to_stderr();
+            Ok(())
+        }
+        _ => Err(usage(format!(
+            "{} - cannot both take standard output",
+            on_stdout.join(" - and ")
+        ))),
+    }
+}
+
+/// Opens the results store a run will keep its record in, before the run:
+/// a store that cannot be used is found before the boards' time is spent.
+pub(super) fn open_store(path: Option<&Path>) -> Result<Option<Store>, CliError> {
+    path.map(|p| Store::open(p).map_err(|e| CliError::BadInput(format!("ppmc: --store {e}"))))
+        .transpose()
+}

@@ -1,0 +1,232 @@
+//! `ppmc fuzz reproduce` from the command line.
+
+use crate::common;
+
+use common::{ppmc, scratch, text};
+use std::path::Path;
+
+#[test]
+fn reproduce_prints_a_console_script_of_a_corpus_input() {
+    let seed = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../fuzz/corpus/bus_bytes/e0_decel_stop_while_stopped.bin");
+    let out = ppmc(&["fuzz", "reproduce", seed.to_str().expect("path")]);
+    assert_eq!(out.status.code(), Some(0), "breaks nothing: exit 0");
+    let text = String::from_utf8(out.stdout).expect("utf-8");
+    assert!(text.contains("# breaks no invariant"), "{text}");
+    // The decelerating stop written while stopped (Section 3-3-2) is there.
+    assert!(text.lines().any(|l| l == "wc! 0x41"), "{text}");
+    let lines = ppmc::console::parse_script(&text).expect("a valid console script");
+    assert!(lines.len() > 5);
+}
+
+#[test]
+fn reproduce_of_a_missing_file_is_a_usage_error_naming_it() {
+    let out = ppmc(&["fuzz", "reproduce", "no/such/crash-file"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).expect("utf-8");
+    assert!(err.contains("no/such/crash-file"), "{err}");
+}
+
+const STOP_SEED: &str = "../fuzz/corpus/bus_bytes/s3_3_1_immediate_stop_and_resume.bin";
+
+/// The finding loop of the README on an injected bug (the board fault
+/// `remaining-off-by-one`, Section 3-4-4): minimize shrinks the input and
+/// keeps the break; to-scenario writes a scenario named after it; a second
+/// to-scenario never overwrites the first.
+#[test]
+fn minimize_then_to_scenario_on_an_injected_bug() {
+    let dir_dir = scratch("fuzz-loop");
+    let dir = dir_dir.path();
+    let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join(STOP_SEED);
+    let input = dir.join("crash-1");
+    std::fs::copy(&seed, &input).expect("copy");
+    let inp = input.to_str().expect("path");
+    let fault = ["--chip-fault", "remaining-off-by-one"];
+
+    let out = ppmc(&[&["fuzz", "minimize", inp][..], &fault[..]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("invariant remaining-pulses still breaks"),
+        "{err}"
+    );
+    let min = dir.join("crash-1.min");
+    let before = ppmc::fuzzing::bus_bytes::decode(&std::fs::read(&input).expect("input")).len();
+    let after = ppmc::fuzzing::bus_bytes::decode(&std::fs::read(&min).expect("minimized")).len();
+    assert!(after * 2 < before, "{before} ops -> {after}");
+    let script = String::from_utf8(out.stdout).expect("utf-8");
+    assert!(
+        script.contains("# breaks: invariant remaining-pulses"),
+        "{script}"
+    );
+
+    // On the clean emulator the minimized input breaks nothing: exit 0.
+    let clean = ppmc(&["fuzz", "reproduce", min.to_str().expect("path")]);
+    assert_eq!(clean.status.code(), Some(0));
+
+    let scen = dir.join("scenarios");
+    std::fs::create_dir_all(&scen).expect("dir");
+    let min_s = min.to_str().expect("path");
+    let args = [
+        &[
+            "fuzz",
+            "to-scenario",
+            min_s,
+            "--dir",
+            scen.to_str().expect("p"),
+        ][..],
+        &fault[..],
+    ]
+    .concat();
+    let out = ppmc(&args);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let file = scen.join("fuzz_remaining_pulses_1.rs");
+    let text = std::fs::read_to_string(&file).expect("scenario written");
+    assert!(
+        text.contains("fn fuzz_remaining_pulses_1(d: &mut Driver)"),
+        "{text}"
+    );
+    assert!(text.contains("section = \"3-4-4\""), "{text}");
+    assert!(text.contains("regression(d, OPS)"));
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        said.contains("add `fuzz_remaining_pulses_1` to the suite!"),
+        "{said}"
+    );
+    let again = ppmc(&args);
+    assert_eq!(again.status.code(), Some(0));
+    assert!(scen.join("fuzz_remaining_pulses_2.rs").exists());
+    assert_eq!(
+        std::fs::read_to_string(&file).expect("first"),
+        text,
+        "not overwritten"
+    );
+
+    // An input that breaks nothing makes no scenario.
+    let none = ppmc(&[
+        "fuzz",
+        "to-scenario",
+        min_s,
+        "--dir",
+        scen.to_str().expect("p"),
+    ]);
+    assert_eq!(none.status.code(), Some(1));
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// The structure-aware target's inputs go through the same loop.
+#[test]
+fn typed_inputs_reproduce_as_bus_scripts() {
+    let seed =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/typed_actions/random-00.bin");
+    let out = ppmc(&[
+        "fuzz",
+        "reproduce",
+        "--kind",
+        "typed-actions",
+        seed.to_str().expect("p"),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8(out.stdout).expect("utf-8");
+    // The valid initialization every typed program starts with.
+    assert!(text.contains("wc! 0x02"), "{text}");
+    ppmc::console::parse_script(&text).expect("a console script");
+}
+
+/// `ppmc fuzz` (differential) on the emulator against itself finds
+/// nothing; against an emulator with a board fault it departs, minimizes
+/// and writes a console script that replays. The seed alone replays it.
+#[test]
+fn a_differential_run_finds_a_faulty_emulator_and_writes_a_reproducer() {
+    let out = ppmc(&["fuzz", "--seed", "3", "--ops", "300"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("no departure"));
+
+    let dir_dir = scratch("fuzz-diff");
+    let dir = dir_dir.path();
+    let repro = dir.join("r.ppmc");
+    let run = |path: &Path| {
+        ppmc(&[
+            "fuzz",
+            "--seed",
+            "3",
+            "--ops",
+            "400",
+            "--chip-fault",
+            "remaining-off-by-one",
+            "-o",
+            path.to_str().expect("p"),
+        ])
+    };
+    let out = run(&repro);
+    assert_eq!(out.status.code(), Some(1));
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(said.contains("departs after action"), "{said}");
+    let text = std::fs::read_to_string(&repro).expect("reproducer");
+    assert!(
+        text.starts_with("# differential reproducer: seed 3"),
+        "{text}"
+    );
+    ppmc::console::parse_script(&text).expect("replayable");
+    let again = dir.join("r2.ppmc");
+    run(&again);
+    assert_eq!(
+        std::fs::read_to_string(&again).expect("again"),
+        text,
+        "the seed replays"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// Actions are generated as they run: a billion of them stopped by
+/// `--duration` cost no more memory than a few (generating them up front
+/// would ask for gigabytes and abort), and the run says how far it got.
+#[test]
+fn a_differential_run_of_a_billion_actions_generates_them_as_it_goes() {
+    let out = ppmc(&[
+        "fuzz",
+        "--seed",
+        "5",
+        "--ops",
+        "1000000000",
+        "--duration",
+        "1s",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let said = text(&out.stdout);
+    assert!(said.contains("no departure from the emulator"), "{said}");
+}
+
+/// A directory of findings of one bug is one bucket; the coverage report
+/// names what the corpus never reached.
+#[test]
+fn triage_buckets_and_coverage_reports() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz");
+    let corpus = root.join("corpus/bus_bytes");
+    let c = corpus.to_str().expect("p");
+    let out = ppmc(&["fuzz", "triage", c, "--chip-fault", "remaining-off-by-one"]);
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("| remaining-pulses |"))
+        .collect();
+    assert_eq!(rows.len(), 1, "{text}");
+    assert!(text.contains("in 1 buckets"), "{text}");
+    let clean = ppmc(&["fuzz", "triage", c]);
+    assert_eq!(clean.status.code(), Some(0));
+
+    let out = ppmc(&["fuzz", "coverage", c]);
+    assert_eq!(out.status.code(), Some(0));
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(report.starts_with("# Domain coverage of "), "{report}");
+    assert!(report.contains("| initialization |"), "{report}");
+    assert!(report.contains("## How moves ended"), "{report}");
+    let missing = ppmc(&["fuzz", "coverage", "no/such/dir"]);
+    assert_eq!(missing.status.code(), Some(2));
+}

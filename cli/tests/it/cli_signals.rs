@@ -1,0 +1,133 @@
+//! Reports survive signals as CI sends them: SIGINT from `timeout` during
+//! the 16,777,216-step move on a real-time bridge (11 minutes of it), two
+//! signals in a row, and SIGTERM while the target is still being opened.
+//! Each time the run stops within a few seconds, the scenario under way
+//! and the rest are reported interrupted, and the JUnit and JSON reports
+//! are written, the JSON valid against its schema.
+
+use crate::common;
+
+use common::{check_record, run_record_schema, scratch, wait_bounded, BridgeSim};
+use ppmc::chaos::{Behaviour, ChaosProxy, Upstream};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// How long a stopped run may take to write its reports and end: every
+/// wait on a link looks at the stop request every 100 ms.
+const WIND_DOWN: Duration = Duration::from_secs(10);
+
+/// `ppmc run` with reports in `dir`, started by `prefix` (e.g. `timeout`).
+fn run(prefix: &[&str], target: &str, extra: &[&str], dir: &Path) -> Child {
+    let ppmc = env!("CARGO_BIN_EXE_ppmc");
+    let (program, pre) = match prefix.split_first() {
+        Some((p, rest)) => (*p, [rest, &[ppmc]].concat()),
+        None => (ppmc, Vec::new()),
+    };
+    Command::new(program)
+        .args(pre)
+        .args(["run", "--target", target, "--junit"])
+        .arg(dir.join("report.xml"))
+        .arg("--json")
+        .arg(dir.join("run.json"))
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("ppmc runs")
+}
+
+/// The reports of a run that was stopped: written, the JSON valid, every
+/// scenario interrupted (none blamed on the board or the link).
+fn check_interrupted(dir: &Path, scenarios: usize) {
+    let xml = std::fs::read_to_string(dir.join("report.xml")).expect("the JUnit report");
+    assert_eq!(xml.matches("<testcase ").count(), scenarios, "{xml}");
+    assert_eq!(
+        xml.matches("type=\"interrupted\"").count(),
+        scenarios,
+        "{xml}"
+    );
+    let record: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("run.json")).expect("the JSON record"),
+    )
+    .expect("JSON");
+    check_record(&run_record_schema(), &record);
+    assert_eq!(
+        record["summary"]["not_run"].as_u64(),
+        Some(scenarios as u64),
+        "{}",
+        record["summary"]
+    );
+}
+
+fn signal(child: &Child, sig: &str) {
+    let sent = Command::new("kill")
+        .args([sig, &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(sent.success());
+}
+
+/// `timeout -s INT 2 ppmc run ...` during the long move on a real-time
+/// bridge, ten times: each run ends within seconds of the signal, and
+/// leaves its reports.
+#[test]
+fn sigint_from_timeout_during_the_long_move_leaves_the_reports_every_time() {
+    let sim = BridgeSim::start(&["--realtime"]);
+    for i in 0..10 {
+        let dir = scratch("sigint");
+        let began = Instant::now();
+        let mut child = run(
+            &["timeout", "-s", "INT", "2"],
+            &sim.target(),
+            &["--tag", "long"],
+            dir.path(),
+        );
+        let status = wait_bounded(&mut child, WIND_DOWN + Duration::from_secs(2));
+        // GNU timeout exits 124 when it had to signal its command.
+        assert_eq!(status.code(), Some(124), "try {i}: {status}");
+        assert!(began.elapsed() >= Duration::from_secs(2));
+        check_interrupted(dir.path(), 1);
+    }
+}
+
+/// A second signal, as CI runners send one after the first, hurries the
+/// wind-down but still writes the reports.
+#[test]
+fn two_signals_in_a_row_still_write_the_reports() {
+    let sim = BridgeSim::start(&["--realtime"]);
+    for sig in ["-INT", "-TERM"] {
+        let dir = scratch("twice");
+        let mut child = run(&[], &sim.target(), &["--tag", "long"], dir.path());
+        // Into the long move: the run has opened the bridge and started.
+        std::thread::sleep(Duration::from_millis(1500));
+        signal(&child, sig);
+        // The second as a CI runner sends it, after a moment (two within
+        // 200 ms are one request, as GNU timeout delivers its one twice).
+        std::thread::sleep(Duration::from_millis(300));
+        signal(&child, sig);
+        let status = wait_bounded(&mut child, WIND_DOWN);
+        assert_eq!(status.code(), Some(130), "{sig}: {status}");
+        check_interrupted(dir.path(), 1);
+    }
+}
+
+/// SIGTERM while the target is being opened (here a server that takes
+/// every connection and closes it, so the host keeps reconnecting): the
+/// run ends at once, every scenario interrupted, the reports written.
+#[test]
+fn sigterm_while_the_target_is_opened_still_writes_the_reports() {
+    let sim = BridgeSim::start(&[]);
+    let bridge = Upstream::Serial(sim.target().trim_start_matches("serial:").to_string());
+    let proxy = ChaosProxy::start("127.0.0.1:0", bridge, Behaviour::AcceptClose, 1).expect("proxy");
+    let dir = scratch("open");
+    let target = format!("tcp://{}", proxy.addr());
+    let mut child = run(&[], &target, &["--skip-tag", "long"], dir.path());
+    // The open takes seconds against this server (six reconnects).
+    std::thread::sleep(Duration::from_millis(700));
+    assert!(child.try_wait().expect("wait").is_none(), "still opening");
+    signal(&child, "-TERM");
+    let status = wait_bounded(&mut child, WIND_DOWN);
+    assert_eq!(status.code(), Some(130), "{status}");
+    check_interrupted(dir.path(), 95);
+}

@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# A labgrid board farm in a box, for cli/tests/it/cli_labgrid.rs: run
+# inside a network namespace of its own (`unshare -n`), so the coordinator,
+# the exporter and the ser2net the exporter starts (which binds every
+# address) are reachable from nowhere else. Serves one place, `rig1`,
+# whose serial port is a `ppmc bridge-sim` pseudo-terminal, and runs ppmc
+# against it: first not acquired (it must refuse), then acquired.
+#
+# Arguments: PPMC LABGRID_BIN_DIR SCRATCH_DIR. Prints `MARK name value`
+# lines for the test to check; everything it started is stopped on exit.
+set -uo pipefail
+ppmc=$1 lg=$2 dir=$3
+export PATH="$lg:$PATH" LG_COORDINATOR=127.0.0.1:20408
+
+pids=()
+cleanup() {
+    for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null; done
+    wait 2>/dev/null
+}
+trap cleanup EXIT
+trap 'exit 143' TERM INT
+# The farm's files and logs, as docs/board-farm.md ("Try it on one
+# machine") writes them: in the folder it runs in.
+cd "$dir"
+
+# Only loopback exists here. ser2net 4 refuses to listen on a host with no
+# address but 127.0.0.1 ("Unable to find a valid name"), so loopback gets a
+# second, private one (dummy and veth links need modules).
+ip link set lo up
+ip addr add 10.254.0.1/32 dev lo
+
+"$ppmc" bridge-sim --link "$dir/pty" > "$dir/bridge-sim.log" 2>&1 &
+pids+=($!)
+"$ppmc" bridge-sim --link "$dir/pty2" > "$dir/bridge-sim2.log" 2>&1 &
+pids+=($!)
+labgrid-coordinator -l 127.0.0.1:20408 > coordinator.log 2>&1 &
+pids+=($!)
+for _ in $(seq 100); do [ -L "$dir/pty" ] && [ -L "$dir/pty2" ] && break; sleep 0.1; done
+cat > "$dir/exporter.yaml" <<YAML
+bridge:
+  RawSerialPort:
+    port: $(readlink "$dir/pty")
+    speed: 115200
+bridge2:
+  RawSerialPort:
+    port: $(readlink "$dir/pty2")
+    speed: 115200
+YAML
+# The exporter gives up on a coordinator that is not listening yet.
+for _ in $(seq 150); do
+    (exec 3<>/dev/tcp/127.0.0.1/20408) 2>/dev/null && break
+    sleep 0.2
+done
+labgrid-exporter -c 127.0.0.1:20408 --hostname 127.0.0.1 -n bench1 exporter.yaml > exporter.log 2>&1 &
+pids+=($!)
+for _ in $(seq 150); do
+    [ "$(labgrid-client resources 2>/dev/null | grep -c '^bench1/bridge2\?/')" = 2 ] && break
+    sleep 0.2
+done
+resources=$(labgrid-client resources 2>&1 | tr '\n' ' ')
+echo "MARK resources $resources"
+case $resources in
+*bench1/bridge/*) ;;
+*) echo "the exporter published nothing" >&2; exit 1 ;;
+esac
+
+# The place, as docs/board-farm.md sets it up.
+labgrid-client -p rig1 create
+labgrid-client -p rig1 add-match 'bench1/bridge/*'
+
+"$ppmc" run --target labgrid:rig1 > unacquired.out 2> unacquired.err
+echo "MARK unacquired-exit $?"
+
+# The CI job of docs/board-farm.md: acquire, run, release.
+labgrid-client -p rig1 acquire
+"$ppmc" run --target labgrid:rig1 --junit report.xml > run.out 2> run.err
+echo "MARK run-exit $?"
+# ppmc stopped the labgrid-client it started to learn the port.
+echo "MARK exports-left $(pgrep -fc 'labgrid-client -c .* export' || true)"
+
+# Two places in one run (docs/board-farm.md, several boards).
+labgrid-client -p rig2 create
+labgrid-client -p rig2 add-match 'bench1/bridge2/*'
+labgrid-client -p rig2 acquire
+mkdir two && cd two
+"$ppmc" run --target labgrid:rig1,rev=B2 --target labgrid:rig2,rev=C1 --skip-tag long --junit report.xml > run.out 2> run.err
+echo "MARK two-exit $?"
+cd ..
+echo "MARK exports-left-two $(pgrep -fc 'labgrid-client -c .* export' || true)"
+labgrid-client -p rig2 release
+labgrid-client -p rig1 release

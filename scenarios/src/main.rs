@@ -1,7 +1,0 @@
-//! `ppmc`: the command line over the conformance suite.
-
-use std::process::ExitCode;
-
-fn main() -> ExitCode {
-    ppmc::cli::main(ppmc_scenarios::all())
-}
