@@ -1,13 +1,14 @@
 //! `ppmc compare`: a golden trace set against traces or a fresh run.
 
 use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
+use crate::lines::verdict_line;
+use crate::run::RunArgs;
 use crate::{usage, CliError};
 use clap::Args;
-use ppmc::golden::{self, GoldenError};
-use ppmc::scenario::{HarnessError, Scenario, ScenarioResult, Verdict};
-use ppmc::time::Duration;
-use ppmc_record::{BoardInfo, RunOptions, RunRecord, MARGINAL_PCT};
-use std::path::{Path, PathBuf};
+use ppmc::scenario::Scenario;
+use ppmc::session;
+use ppmc_record::{BoardInfo, RunOptions};
+use std::path::PathBuf;
 
 /// Which scenarios to take.
 #[derive(Debug, Args)]
@@ -43,23 +44,15 @@ pub struct CompareArgs {
 }
 
 pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
-    let tol = match args.tolerance.tolerances() {
-        Ok(t) => t,
-        Err(e) => return Err(usage(e)),
-    };
+    let tol = args.tolerance.tolerances().map_err(usage)?;
     if !args.golden.is_dir() {
-        return Err(usage(format!(
-            "{}: golden directory not found",
-            args.golden.display()
-        )));
+        let dir = args.golden.display();
+        return Err(usage(format!("{dir}: golden directory not found")));
     }
-    let scenarios = match args.select.scenarios(suite) {
-        Ok(s) => s,
-        Err(e) => return Err(usage(e)),
-    };
+    let scenarios = args.select.scenarios(suite).map_err(usage)?;
     let Some(dir) = &args.traces else {
         // Against a target: the run itself, with the golden check.
-        let run_args = super::run::RunArgs {
+        let run = RunArgs {
             select: args.select,
             target: args.target,
             golden: Some(args.golden),
@@ -68,16 +61,9 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             json: args.json,
             html: args.html,
             store: args.store,
-            artifacts: None,
-            artifacts_window: super::run::Window::All,
-            each: false,
-            repeat: 1,
-            retries: 0,
-            retry_failures: false,
-            flaky_is_failure: false,
-            marginal: MARGINAL_PCT,
+            ..RunArgs::defaults().map_err(|e| CliError::Failed(e.to_string()))?
         };
-        return super::run::run(run_args, suite);
+        return super::run::run(run, suite);
     };
     if !dir.is_dir() {
         return Err(usage(format!(
@@ -85,17 +71,13 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             dir.display()
         )));
     }
-    super::reports::prepare_reports(
+    crate::reports::prepare_reports(
         args.junit.as_deref(),
         args.json.as_deref(),
         args.html.as_deref(),
         args.store.as_deref(),
     )?;
-    let mut store = super::reports::open_store(args.store.as_deref())?;
-    // A trace that diverges fails, as in `ppmc run --golden`; a file that
-    // cannot be used (missing, unreadable, corrupt, at other straps) is an
-    // error of its own: the file is at fault, not the board.
-    let started = std::time::Instant::now();
+    let mut store = crate::reports::open_store(args.store.as_deref())?;
     let board = dir.display().to_string();
     let traces = BoardInfo::new(board.clone(), format!("traces:{board}"), Vec::new(), None);
     let mut info = ppmc::runner::run_info(vec![traces], "one");
@@ -109,67 +91,23 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
         ..Default::default()
     };
     args.select.describe(&mut info.options);
-    let mut results = Vec::with_capacity(scenarios.len());
-    let mut figures = Vec::with_capacity(scenarios.len());
-    for s in &scenarios {
-        let mut r = ScenarioResult {
-            name: s.name,
-            section: s.section,
-            tags: s.tags,
-            verdict: Verdict::Passed,
-            measurements: Vec::new(),
-            trace: None,
-            elapsed: Duration::ZERO,
-            wall: std::time::Duration::ZERO,
-            attempts: Vec::new(),
-        };
-        match golden::load(dir, s.name) {
-            Ok(t) => {
-                r.elapsed = Duration::from_nanos(t.events.last().map_or(0, |e| e.at.as_nanos()));
-                r.trace = Some(t);
-                let golden = super::run::check_golden(&mut r, &args.golden, &tol);
-                figures.push(super::run::figures_of(&r, golden.as_ref()));
-                r.trace = None;
-            }
-            Err(GoldenError::Missing { path }) => {
-                r.verdict = Verdict::Error(HarnessError::Golden(missing(dir, &path)));
-            }
-            Err(e) => r.verdict = Verdict::Error(HarnessError::Golden(e.to_string())),
-        }
-        figures.resize(results.len() + 1, None);
-        outln!("{}", super::run::verdict_line(&r, None));
-        results.push(r);
-    }
-    info.wall_s = started.elapsed().as_secs_f64();
-    let scenarios = results.iter().zip(figures).map(|(r, figures)| {
-        let record = r.record(Some(&board));
-        ppmc_record::ScenarioRecord { figures, ..record }
+    let record = session::compare_sets(&scenarios, &args.golden, dir, &tol, info, |r| {
+        outln!("{}", verdict_line(r, None));
     });
-    let record = RunRecord::new(info, scenarios.collect());
-    let outputs = super::reports::Outputs::of(&args.junit, &args.json, &args.html);
-    let problems = super::reports::write(&record, outputs, store.as_mut());
-    let count = |f: fn(&Verdict) -> bool| results.iter().filter(|r| f(&r.verdict)).count();
-    let ok = count(|v| v.ok());
-    let bad = count(|v| matches!(v, Verdict::Failed(_)));
-    let errors = count(|v| matches!(v, Verdict::Error(_)));
-    outln!("compare: {ok} passed, {bad} failed, {errors} errors");
+    let outputs = crate::reports::Outputs::of(&args.junit, &args.json, &args.html);
+    let problems = crate::reports::write(&record, outputs, store.as_mut());
+    let t = record.summary;
+    let ok = t.passed + t.marginal + t.flaky;
+    outln!(
+        "compare: {ok} passed, {} failed, {} errors",
+        t.failed,
+        t.errors
+    );
     if let Some(p) = problems.first() {
         return Err(CliError::Failed(p.clone()));
     }
-    if bad + errors == 0 {
-        Ok(())
-    } else {
-        Err(CliError::Verdict)
+    match t.failed + t.errors {
+        0 => Ok(()),
+        _ => Err(CliError::Verdict),
     }
-}
-
-/// The error of a scenario the compared set has no trace of: the
-/// recording's gap, not the golden set's.
-fn missing(dir: &Path, path: &Path) -> String {
-    format!(
-        "{}: no trace of this scenario in {} (record it there with `ppmc record --out {}`)",
-        path.display(),
-        dir.display(),
-        dir.display()
-    )
 }

@@ -8,14 +8,17 @@ pub(crate) mod out;
 pub(crate) mod args;
 mod bench;
 mod bridge_sim;
+mod capture_args;
 mod chaos_proxy;
 mod compare;
 mod console;
+mod decode;
 mod export;
 mod fault_matrix;
 mod fuzz;
 mod history;
 mod judge;
+mod lines;
 mod list;
 mod progress;
 mod record;
@@ -65,7 +68,7 @@ enum Command {
     Export(export::ExportArgs),
     /// Print the register accesses of a logic-analyzer capture of the
     /// chip's bus, in the bus console's language (docs/capture.md).
-    Decode(judge::DecodeArgs),
+    Decode(decode::DecodeArgs),
     /// Judge a board from a logic-analyzer capture of its bus and pins:
     /// the captured writes replayed into the reference model, the chip's
     /// answers, pulses and outputs compared (docs/capture.md). Exit
@@ -141,7 +144,7 @@ pub fn main(suite: Vec<Scenario>) -> ExitCode {
         Command::Record(args) => record::run(args, suite),
         Command::Compare(args) => compare::run(args, suite),
         Command::Export(args) => export::run(args, suite),
-        Command::Decode(args) => judge::decode(args),
+        Command::Decode(args) => decode::run(args),
         Command::Judge(args) => judge::run(args),
         Command::Console(args) => console::run(args),
         Command::Bench(args) => bench::run(args, suite),

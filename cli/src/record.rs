@@ -6,8 +6,7 @@ use crate::{usage, CliError};
 use clap::Args;
 use ppmc::golden::{self, GoldenError, Written};
 use ppmc::runner::run_suite;
-use ppmc::scenario::{DriverOptions, Scenario, ScenarioResult, Verdict};
-use ppmc::trace::Trace;
+use ppmc::scenario::{DriverOptions, Scenario, Verdict};
 use ppmc_files as files;
 use std::path::PathBuf;
 
@@ -51,7 +50,7 @@ pub fn run(args: RecordArgs, suite: &[Scenario]) -> Result<(), CliError> {
         DriverOptions::default(),
         |r| {
             progress.step(r.name);
-            match admit(r, args.allow_failures) {
+            match golden::admit(r, args.allow_failures) {
                 Err(why) => {
                     tally.refused += 1;
                     progress.line(&format!("refused   {}: {why}", r.name));
@@ -124,77 +123,5 @@ impl Tally {
         };
         *n += 1;
         word
-    }
-}
-
-/// The trace to record from `r`, or why not. Only a complete run is ever a
-/// reference: a scenario that ended in a harness or link error, or never
-/// ran, has an incomplete capture whatever the flags; a device failure is
-/// admitted with `--allow-failures` only.
-fn admit(r: &ScenarioResult, allow_failures: bool) -> Result<&Trace, String> {
-    match (&r.verdict, &r.trace) {
-        (Verdict::Error(e), _) => Err(format!(
-            "not recorded: it ended in an error, so its capture is incomplete ({e})"
-        )),
-        (Verdict::NotRun(why), _) => Err(format!("not recorded: it did not run ({why})")),
-        (Verdict::Failed(_), Some(_)) if !allow_failures => Err(format!(
-            "not recorded: the device failed it ({}); fix it or pass --allow-failures",
-            r.verdict.detail().unwrap_or_default()
-        )),
-        (_, None) => Err("not recorded: the target gave no capture".into()),
-        (Verdict::Passed | Verdict::Marginal | Verdict::Failed(_), Some(t)) => Ok(t),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use ppmc::backend::TargetErrorKind;
-    use ppmc::scenario::{Failure, HarnessError, NotRun};
-    use ppmc::time::{Duration, Instant};
-
-    fn result(verdict: Verdict, trace: bool) -> ScenarioResult {
-        let text = "ppmc-trace 1\nscenario x\nsection 3-1\ntarget emu\ndetail sysclk_hz 16000000\n\
-                    detail csel high\ndetail vsel high\ndetail ext_clock_hz none\nevents\n0.000us reset\nend\n";
-        ScenarioResult {
-            name: "x",
-            section: "3-1",
-            tags: &[],
-            verdict,
-            measurements: Vec::new(),
-            trace: trace.then(|| Trace::parse(text).expect("valid trace")),
-            elapsed: Duration::ZERO,
-            wall: std::time::Duration::ZERO,
-            attempts: Vec::new(),
-        }
-    }
-
-    fn failed() -> Verdict {
-        Verdict::Failed(Failure {
-            expectation: "finish status".into(),
-            expected: "0x8E".into(),
-            got: "0x00".into(),
-            at: Instant::ZERO,
-        })
-    }
-
-    #[test]
-    fn only_complete_runs_become_golden_traces() {
-        let link = Verdict::Error(HarnessError::Target {
-            kind: TargetErrorKind::Link,
-            message: "no reply".into(),
-        });
-        for allow in [false, true] {
-            let e = admit(&result(link.clone(), true), allow).expect_err("error refused");
-            assert!(e.contains("capture is incomplete"), "{e}");
-            let lost = Verdict::NotRun(NotRun::TargetLost("gone".into()));
-            assert!(admit(&result(lost, true), allow).is_err());
-            assert!(admit(&result(Verdict::Passed, false), allow).is_err());
-            assert!(admit(&result(Verdict::Passed, true), allow).is_ok());
-            assert!(admit(&result(Verdict::Marginal, true), allow).is_ok());
-        }
-        let e = admit(&result(failed(), true), false).expect_err("failure refused");
-        assert!(e.contains("--allow-failures"), "{e}");
-        assert!(admit(&result(failed(), true), true).is_ok());
     }
 }

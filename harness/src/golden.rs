@@ -6,14 +6,26 @@
 //! [`crate::files`], so an interrupted write never leaves half a golden
 //! file and a FIFO or a huge file is refused, not read.
 
+use crate::compare::{compare_graded, Tolerances};
 use crate::files::{self, FileError, MAX_TRACE_BYTES};
 use crate::protocol::Straps;
+use crate::scenario::{Failure, Grade, HarnessError, Measurement, ScenarioResult, Verdict};
 use crate::trace::{Trace, TraceError};
 use std::path::{Path, PathBuf};
 
-/// The front matter insta writes for `harness/tests/it/golden.rs`; `ppmc
-/// record` writes the same so both tools agree on the files.
-pub const SNAPSHOT_HEADER: &str = "---\nsource: harness/tests/it/golden.rs\n---\n";
+/// The front matter `ppmc record` writes: insta's, as the golden files
+/// carry it from when the golden check was `harness/tests/golden.rs`
+/// (it is now `harness/tests/it/golden.rs`, and `cargo insta review`
+/// writes that). A file whose trace is the same is the same golden file
+/// whatever its front matter ([`write`] leaves it unchanged).
+pub const SNAPSHOT_HEADER: &str = "---\nsource: harness/tests/golden.rs\n---\n";
+
+/// `text` without insta's front matter (`---` ... `---`), if it has one.
+fn without_front_matter(text: &str) -> &str {
+    text.strip_prefix("---\n")
+        .and_then(|rest| rest.split_once("\n---\n"))
+        .map_or(text, |(_, trace)| trace)
+}
 
 /// A golden file that cannot be used.
 #[derive(Debug, thiserror::Error)]
@@ -127,7 +139,9 @@ pub fn write(dir: &Path, trace: &Trace, bless: bool) -> Result<Written, GoldenEr
             Err(e) => return Err(e.into()),
         };
         match existing {
-            Some(t) if t == text => return Ok(Written::Unchanged),
+            Some(t) if without_front_matter(&t) == without_front_matter(&text) => {
+                return Ok(Written::Unchanged)
+            }
             Some(_) if !bless => return Err(GoldenError::Exists { path }),
             Some(_) => {
                 files::write(&path, text.as_bytes())?;
@@ -141,6 +155,96 @@ pub fn write(dir: &Path, trace: &Trace, bless: bool) -> Result<Written, GoldenEr
         }
     }
     Err(GoldenError::Exists { path })
+}
+
+/// The golden verdict rule, the one every command applies: `r`'s trace
+/// compared with its golden trace in `dir` within `tol`
+/// ([`compare_graded`]). A divergence fails the scenario (the device); a
+/// comparison within the instruments' uncertainty of its limit makes a
+/// pass MARGINAL, kept as a measurement; a missing, corrupt or mismatched
+/// golden file, or no capture to compare, is an error of the harness's
+/// input, never the device's. A result that did not pass is not compared.
+/// Returns the golden trace compared with, for a report to draw.
+pub fn check(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) -> Option<Trace> {
+    if !r.verdict.ok() {
+        // Not compared, but drawn beside the board's all the same.
+        let straps = &r.trace.as_ref()?.straps;
+        return load_for(dir, r.name, straps).ok();
+    }
+    let Some(trace) = &r.trace else {
+        r.verdict = Verdict::Error(HarnessError::Golden(
+            "no capture to compare with the golden trace".into(),
+        ));
+        return None;
+    };
+    let fail = |expectation: String, expected: String, got: String, at| {
+        Verdict::Failed(Failure {
+            expectation,
+            expected,
+            got,
+            at,
+        })
+    };
+    match load_for(dir, r.name, &trace.straps) {
+        Ok(g) => {
+            match compare_graded(&g, trace, tol) {
+                Err(d) => {
+                    r.verdict = fail(
+                        format!("golden trace: first divergence in {}", d.quantity),
+                        format!("{} (allowed {})", d.golden, d.allowed),
+                        d.got,
+                        d.at,
+                    );
+                }
+                // Within the instruments' uncertainty of a limit: the
+                // first such comparison, graded as a measurement is.
+                Ok(graded) => {
+                    if let Some(m) = graded.first {
+                        r.measurements.push(Measurement {
+                            name: format!("golden trace: {}", m.quantity),
+                            value: m.got,
+                            lo: m.lo,
+                            hi: m.hi,
+                            marginal_lo: m.lo,
+                            marginal_hi: m.hi,
+                            u: m.u,
+                            grade: Grade::Marginal,
+                            at: m.at,
+                        });
+                        if r.verdict == Verdict::Passed {
+                            r.verdict = Verdict::Marginal;
+                        }
+                    }
+                }
+            }
+            Some(g)
+        }
+        // A missing, corrupt or mismatched golden file is the harness's
+        // input at fault, never the device.
+        Err(e) => {
+            r.verdict = Verdict::Error(HarnessError::Golden(e.to_string()));
+            None
+        }
+    }
+}
+
+/// The trace to record from `r`, or why not. Only a complete run is ever a
+/// reference: a scenario that ended in a harness or link error, or never
+/// ran, has an incomplete capture whatever the flags; a device failure is
+/// admitted with `--allow-failures` only.
+pub fn admit(r: &ScenarioResult, allow_failures: bool) -> Result<&Trace, String> {
+    match (&r.verdict, &r.trace) {
+        (Verdict::Error(e), _) => Err(format!(
+            "not recorded: it ended in an error, so its capture is incomplete ({e})"
+        )),
+        (Verdict::NotRun(why), _) => Err(format!("not recorded: it did not run ({why})")),
+        (Verdict::Failed(_), Some(_)) if !allow_failures => Err(format!(
+            "not recorded: the device failed it ({}); fix it or pass --allow-failures",
+            r.verdict.detail().unwrap_or_default()
+        )),
+        (_, None) => Err("not recorded: the target gave no capture".into()),
+        (Verdict::Passed | Verdict::Marginal | Verdict::Failed(_), Some(t)) => Ok(t),
+    }
 }
 
 #[cfg(test)]
@@ -182,6 +286,29 @@ mod tests {
             .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
             .collect();
         assert!(leftovers.is_empty());
+    }
+
+    /// A golden file that `cargo insta review` wrote (its front matter
+    /// naming the check where it is now) holds the same trace: recording
+    /// it again leaves it as it is.
+    #[test]
+    fn a_file_with_other_front_matter_and_the_same_trace_is_unchanged() {
+        let dir = scratch("golden");
+        let d = dir.path();
+        let t = trace("a");
+        let insta = format!(
+            "---\nsource: harness/tests/it/golden.rs\n---\n{}",
+            t.render()
+        );
+        fs::write(d.join("a.snap"), &insta).expect("written");
+        assert_eq!(write(d, &t, false).expect("same trace"), Written::Unchanged);
+        assert_eq!(fs::read_to_string(d.join("a.snap")).expect("kept"), insta);
+        let mut other = t.clone();
+        other.section = "3-2".into();
+        assert!(matches!(
+            write(d, &other, false),
+            Err(GoldenError::Exists { .. })
+        ));
     }
 
     /// Writers racing for the same new files: each file is created by
@@ -279,5 +406,58 @@ mod tests {
             .expect_err("truncated")
             .to_string()
             .contains("truncated"));
+    }
+}
+
+#[cfg(test)]
+mod admit_tests {
+    use super::*;
+    use crate::backend::TargetErrorKind;
+    use crate::scenario::{Failure, HarnessError, NotRun};
+    use crate::time::{Duration, Instant};
+
+    fn result(verdict: Verdict, trace: bool) -> ScenarioResult {
+        let text = "ppmc-trace 1\nscenario x\nsection 3-1\ntarget emu\ndetail sysclk_hz 16000000\n\
+                    detail csel high\ndetail vsel high\ndetail ext_clock_hz none\nevents\n0.000us reset\nend\n";
+        ScenarioResult {
+            name: "x",
+            section: "3-1",
+            tags: &[],
+            verdict,
+            measurements: Vec::new(),
+            trace: trace.then(|| Trace::parse(text).expect("valid trace")),
+            elapsed: Duration::ZERO,
+            wall: std::time::Duration::ZERO,
+            attempts: Vec::new(),
+        }
+    }
+
+    fn failed() -> Verdict {
+        Verdict::Failed(Failure {
+            expectation: "finish status".into(),
+            expected: "0x8E".into(),
+            got: "0x00".into(),
+            at: Instant::ZERO,
+        })
+    }
+
+    #[test]
+    fn only_complete_runs_become_golden_traces() {
+        let link = Verdict::Error(HarnessError::Target {
+            kind: TargetErrorKind::Link,
+            message: "no reply".into(),
+        });
+        for allow in [false, true] {
+            let e = admit(&result(link.clone(), true), allow).expect_err("error refused");
+            assert!(e.contains("capture is incomplete"), "{e}");
+            let lost = Verdict::NotRun(NotRun::TargetLost("gone".into()));
+            assert!(admit(&result(lost, true), allow).is_err());
+            assert!(admit(&result(Verdict::Passed, false), allow).is_err());
+            assert!(admit(&result(Verdict::Passed, true), allow).is_ok());
+            assert!(admit(&result(Verdict::Marginal, true), allow).is_ok());
+        }
+        let e = admit(&result(failed(), true), false).expect_err("failure refused");
+        assert!(e.contains("--allow-failures"), "{e}");
+        assert!(admit(&result(failed(), true), true).is_ok());
     }
 }

@@ -1,19 +1,26 @@
 //! ppmc: a hardware-in-the-loop harness, reference emulator and protocol
 //! fuzzer for the PPMC-104BFP stepper-motor pulse controller.
 //!
-//! The std half of ppmc: everything that needs an operating system, on top
-//! of the portable `ppmc-core` (re-exported here as [`time`], [`protocol`],
-//! [`emu`] and [`bus`]). Layers, each depending only on the ones before it:
-//! [`stop`], [`files`] ← [`backend`] (targets: a [`backend::TargetSpec`]
-//! opened into the emulator or a bridge over a byte link), [`trace`],
-//! [`vcd_export`], [`bridge::sim`] ← [`scenario`] (the scenario API) ←
-//! [`runner`] (one target or a [`runner::Farm`] of boards), [`golden`],
-//! [`compare`], [`selftest`], [`console`], [`chaos`] ← [`report`],
-//! [`soak`], [`store`] ← [`fuzzing`] (its oracle in [`invariants`], the second model
-//! of the chip in [`plain_model`]) ← [`fault_matrix`] ← [`cli`] (the
-//! command line: arguments in, results printed, nothing else).
-//! `ARCHITECTURE.md` at the repository root is the map.
+//! The harness library: everything that needs an operating system to
+//! drive a chip, on top of the portable `ppmc-core` (re-exported here as
+//! [`time`], [`protocol`], [`emu`] and [`bus`]). Layers, each depending
+//! only on the ones before it: [`stop`], [`files`] ← [`backend`]
+//! (targets: a [`backend::TargetSpec`] opened into the emulator or a
+//! bridge over a byte link), [`trace`], [`vcd_export`], [`bridge::sim`] ←
+//! [`scenario`] (the scenario language) ← [`runner`] (one target or a
+//! [`runner::Farm`] of boards), [`golden`], [`compare`], [`selftest`],
+//! [`console`], [`chaos`], [`soak`] (a run's results into its
+//! [`record::RunRecord`]), [`artifacts`] ← [`session`] (a run of a suite
+//! on a farm of boards, into its record) ← [`fuzzing`] (its oracle in [`invariants`], the
+//! second model of the chip in [`plain_model`]).
+//!
+//! Reports, the results store, capture readers, the capture judge and the
+//! command line are crates of their own above this one (`ppmc-report`,
+//! `ppmc-logic`, `ppmc-capture`, `ppmc-cli`), so a library user of the
+//! scenario language compiles no SQLite, zip or clap. `ARCHITECTURE.md`
+//! at the repository root is the map.
 
+pub mod artifacts;
 pub mod backend;
 pub mod bridge;
 pub mod chaos;
@@ -26,6 +33,7 @@ pub mod plain_model;
 pub mod runner;
 pub mod scenario;
 pub mod selftest;
+pub mod session;
 pub mod soak;
 pub mod stop;
 pub mod trace;

@@ -122,7 +122,7 @@ pub fn check_board(
         let Some(trace) = r.trace.as_ref() else {
             return;
         };
-        let diverged = match ppmc::golden::load(golden_dir, r.name) {
+        let diverged = match ppmc::golden::load_for(golden_dir, r.name, &trace.straps) {
             Ok(g) => compare(&g, trace, &Tolerances::default()).err().map(|d| {
                 format!(
                     "{}: {} at {}: golden {}, got {}",

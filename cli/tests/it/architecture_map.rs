@@ -8,10 +8,17 @@
 use std::path::{Path, PathBuf};
 
 /// The repository's top-level folders a rooted path starts with.
-const ROOTS: [&str; 11] = [
+const ROOTS: [&str; 18] = [
     "contrib/",
     "core/",
+    "files/",
+    "record/",
+    "report/",
+    "logic/",
     "harness/",
+    "capture/",
+    "cli/",
+    "test-support/",
     "scenarios/",
     "firmware/",
     "docs/",

@@ -18,27 +18,34 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// Every crate's `src/` folder: the workspace's, the firmware's, the fuzz
-/// crate's targets are one-liners and left out.
+/// Every crate's `src/` folder: the workspace's members (as the root
+/// `Cargo.toml` lists them) and the firmware's; the fuzz crate's targets
+/// are one-liners and left out.
 fn source_roots() -> Vec<PathBuf> {
     let r = root();
-    let mut roots = vec![
-        r.join("core/src"),
-        r.join("harness/src"),
-        r.join("harness/macros/src"),
-        r.join("scenarios/src"),
-    ];
-    for parent in ["examples", "firmware"] {
-        if let Ok(entries) = std::fs::read_dir(r.join(parent)) {
-            for e in entries.flatten() {
-                let src = e.path().join("src");
-                if src.is_dir() {
-                    roots.push(src);
-                }
+    let manifest = std::fs::read_to_string(r.join("Cargo.toml")).expect("Cargo.toml");
+    let members = manifest
+        .split_once("members = [")
+        .and_then(|(_, rest)| rest.split_once(']'))
+        .map(|(list, _)| list)
+        .expect("the workspace's members");
+    let mut roots: Vec<PathBuf> = members
+        .split(',')
+        .map(|m| m.trim().trim_matches('"'))
+        .filter(|m| !m.is_empty())
+        .map(|m| r.join(m).join("src"))
+        .collect();
+    assert!(roots.len() > 5, "the members read: {roots:?}");
+    if let Ok(entries) = std::fs::read_dir(r.join("firmware")) {
+        for e in entries.flatten() {
+            let src = e.path().join("src");
+            if src.is_dir() {
+                roots.push(src);
             }
         }
     }
     roots.sort();
+    roots.dedup();
     roots
 }
 

@@ -22,6 +22,7 @@ mod code_shape;
 mod common;
 mod console_cli;
 mod docs_commands;
+mod layers;
 mod report_html;
 mod reports;
 mod results_store;

@@ -206,7 +206,11 @@ pub struct PinEvent {
 /// move begins.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct MoveStart {
-    /// When the final byte of the command was written (as seen by the chip).
+    /// When the final byte of the command was written: the write a bridge
+    /// sees (N47). The move runs from when the chip took that byte, which
+    /// is later when the byte waited in the input buffer (a command written
+    /// during a move the chip finishes first); its pulses are its runs
+    /// from `first_run`, whenever they come.
     pub at: Instant,
     pub kind: MoveKind,
     pub dir: Direction,

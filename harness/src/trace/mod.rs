@@ -893,7 +893,7 @@ end
 
     #[test]
     fn insta_front_matter_is_skipped() {
-        let with = format!("---\nsource: harness/tests/it/golden.rs\n---\n{SAMPLE}");
+        let with = format!("---\nsource: harness/tests/golden.rs\n---\n{SAMPLE}");
         assert_eq!(Trace::parse(&with), Trace::parse(SAMPLE));
     }
 

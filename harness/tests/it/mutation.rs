@@ -4,11 +4,11 @@
 //! every mutant must be caught.
 
 use ppmc::backend::EmuTarget;
-use ppmc::compare::{compare, Tolerances};
+use ppmc::compare::Tolerances;
 use ppmc::emu::{ModelConfig, ModelFaults, WiringFaults};
 use ppmc::protocol::{ErrorCode, Straps};
 use ppmc::runner::run_suite;
-use ppmc::scenario::{DriverOptions, Failure, ScenarioResult, Verdict};
+use ppmc::scenario::{DriverOptions, ScenarioResult, Verdict};
 use ppmc::time::Duration;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -131,19 +131,7 @@ fn run_mutant(cfg: ModelConfig) -> Vec<ScenarioResult> {
     let mut t = EmuTarget::new(Straps::default(), cfg).expect("valid mutant");
     let all = ppmc_scenarios::all();
     run_suite(&mut t, &all, 1, DriverOptions::default(), |r| {
-        if !r.verdict.ok() {
-            return;
-        }
-        let g = ppmc::golden::load(&golden, r.name).expect("golden file");
-        let trace = r.trace.as_ref().expect("captured");
-        if let Err(d) = compare(&g, trace, &Tolerances::default()) {
-            r.verdict = Verdict::Failed(Failure {
-                expectation: format!("golden trace: first divergence in {}", d.quantity),
-                expected: format!("{} (allowed {})", d.golden, d.allowed),
-                got: d.got,
-                at: d.at,
-            });
-        }
+        ppmc::golden::check(r, &golden, &Tolerances::default());
     })
 }
 

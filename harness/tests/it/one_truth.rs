@@ -15,10 +15,10 @@ use ppmc::protocol::{Pin, Pins, Record, Status, Straps, Winding};
 use ppmc::time::{Duration, Instant};
 use proptest::prelude::*;
 
-/// The output pins as the record says they stood at `t` (events at `t`
-/// included), replayed from the record alone: pin changes, move starts
-/// (winding and phase index) and every pulse (one phase step each).
-/// `switching` says whether stop switching was chopping the phases.
+/// The output pins as the record says they stood at an instant, replayed
+/// from the record alone: pin changes and every pulse (one phase step of
+/// its move's winding from the move's phase index). `switching` says
+/// whether stop switching was chopping the phases.
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
 struct Replayed {
     busy: bool,
@@ -31,55 +31,105 @@ struct Replayed {
     switching: bool,
 }
 
-fn replay(rec: &Record, t: Instant) -> Replayed {
-    // (time, order at that time, what): moves, then pulses, then pin changes.
-    enum Ev {
-        Move(usize),
-        Pulse(ppmc::protocol::Direction),
-        Pin(Pin, u8),
-    }
-    let mut evs: Vec<(Instant, u8, Ev)> = Vec::new();
-    for (i, m) in rec.moves.iter().enumerate() {
-        evs.push((m.at, 0, Ev::Move(i)));
-    }
-    for (at, dir) in rec.pulses() {
-        evs.push((at, 1, Ev::Pulse(dir)));
-    }
-    for p in &rec.pins {
-        evs.push((p.at, 2, Ev::Pin(p.pin, p.value)));
-    }
-    evs.sort_by_key(|(at, order, _)| (*at, *order));
-    let mut s = Replayed::default();
-    let mut winding: Option<Winding> = None;
-    let mut index = 0u32;
-    for (at, _, ev) in evs {
-        if at > t {
-            break;
-        }
-        match ev {
-            Ev::Move(i) => {
-                winding = rec.moves[i].winding;
-                index = rec.moves[i].phase_index;
+/// One of the record's events: a pulse (of the move whose runs hold it),
+/// a pin change.
+enum Ev {
+    Pulse(ppmc::protocol::Direction, Option<usize>),
+    Pin(Pin, u8),
+}
+
+/// The record replayed forward, once: [`Replayer::at`] takes the instants
+/// in order (as a program's replies come), so a program of long moves
+/// costs its pulses once, not once per sample.
+struct Replayer<'a> {
+    rec: &'a Record,
+    /// (time, order at that time, what): pulses, then pins.
+    evs: Vec<(Instant, u8, Ev)>,
+    next: usize,
+    last: Instant,
+    s: Replayed,
+    /// The move the last pulse was of, its winding and phase step.
+    stepping: Option<usize>,
+    winding: Option<Winding>,
+    index: u32,
+}
+
+impl<'a> Replayer<'a> {
+    fn new(rec: &'a Record) -> Replayer<'a> {
+        // A pulse is of the move whose runs hold it: a move's `at` is when
+        // its command was written, and a command the chip takes only once
+        // the move before it ends (IBF held) starts later than that.
+        let mut evs: Vec<(Instant, u8, Ev)> = Vec::new();
+        let owner = |run: usize| rec.moves.iter().rposition(|m| m.first_run <= run);
+        for (k, r) in rec.runs.iter().enumerate() {
+            for i in 0..r.count {
+                evs.push((r.at(i), 1, Ev::Pulse(r.dir, owner(k))));
             }
-            Ev::Pulse(dir) => {
-                if let Some(w) = winding {
-                    index = w.advance(index, dir, 1);
-                    s.phases = w.pattern(index);
+        }
+        for p in &rec.pins {
+            evs.push((p.at, 2, Ev::Pin(p.pin, p.value)));
+        }
+        evs.sort_by_key(|(at, order, _)| (*at, *order));
+        Replayer {
+            rec,
+            evs,
+            next: 0,
+            last: Instant::ZERO,
+            s: Replayed::default(),
+            stepping: None,
+            winding: None,
+            index: 0,
+        }
+    }
+
+    /// The pins as the record says they stood at `t` (events at `t`
+    /// included); an instant before the last asked starts over.
+    fn at(&mut self, t: Instant) -> Replayed {
+        if t < self.last {
+            self.next = 0;
+            self.s = Replayed::default();
+            self.stepping = None;
+            self.winding = None;
+            self.index = 0;
+        }
+        self.last = t;
+        while let Some((at, _, ev)) = self.evs.get(self.next) {
+            if *at > t {
+                break;
+            }
+            match ev {
+                Ev::Pulse(dir, of) => {
+                    if *of != self.stepping {
+                        // The move's first pulse: its winding from its
+                        // phase step.
+                        self.stepping = *of;
+                        let m = of.map(|k| self.rec.moves[k]);
+                        self.winding = m.and_then(|m| m.winding);
+                        self.index = m.map_or(0, |m| m.phase_index);
+                    }
+                    if let Some(w) = self.winding {
+                        self.index = w.advance(self.index, *dir, 1);
+                        self.s.phases = w.pattern(self.index);
+                    }
+                }
+                Ev::Pin(pin, v) => {
+                    let on = *v != 0;
+                    match pin {
+                        Pin::Busy => self.s.busy = on,
+                        Pin::Int => self.s.int = on,
+                        Pin::Hold => self.s.hold = on,
+                        Pin::Aux => self.s.aux = on,
+                        Pin::Auxo => self.s.auxo = *v,
+                        Pin::Dir => self.s.dir_ccw = on,
+                        Pin::Phases => self.s.phases = *v,
+                        Pin::Switching => self.s.switching = on,
+                    }
                 }
             }
-            Ev::Pin(pin, v) => match pin {
-                Pin::Busy => s.busy = v != 0,
-                Pin::Int => s.int = v != 0,
-                Pin::Hold => s.hold = v != 0,
-                Pin::Aux => s.aux = v != 0,
-                Pin::Auxo => s.auxo = v,
-                Pin::Dir => s.dir_ccw = v != 0,
-                Pin::Phases => s.phases = v,
-                Pin::Switching => s.switching = v != 0,
-            },
+            self.next += 1;
         }
+        self.s
     }
-    s
 }
 
 /// Where the sampled pins and the replayed record disagree, in words.
@@ -114,15 +164,16 @@ fn check(seed: u64, actions: usize, gaps: &[u64]) -> Vec<String> {
     let replies = t.execute(&ops).expect("the emulator runs");
     let rec = t.capture().expect("capture");
     let mut bad = Vec::new();
+    let mut replay = Replayer::new(&rec);
     for (op, r) in ops.iter().zip(&replies) {
         match (op, r) {
             (Op::ReadPins, Reply::Pins { at, pins }) => {
-                if let Some(d) = disagreement(pins, &replay(&rec, *at)) {
+                if let Some(d) = disagreement(pins, &replay.at(*at)) {
                     bad.push(format!("pins at {at}: {d}"));
                 }
             }
             (Op::ReadStatus, Reply::Status { at, status }) => {
-                let line = replay(&rec, *at).busy;
+                let line = replay.at(*at).busy;
                 if status.0 & Status::BUSY != 0 && !line {
                     bad.push(format!(
                         "status 0x{:02X} at {at} reads BUSY, the BUSY line is low",
@@ -158,9 +209,10 @@ fn software_reset_shows_one_chip_in_pins_and_record() {
     let rec = t.capture().expect("capture");
     let written = replies[write].at();
     let mut went_off = None;
+    let mut replay = Replayer::new(&rec);
     for r in &replies[write..] {
         if let Reply::Pins { at, pins } = r {
-            assert_eq!(disagreement(pins, &replay(&rec, *at)), None, "at {at}");
+            assert_eq!(disagreement(pins, &replay.at(*at)), None, "at {at}");
             if pins.phases == 0 && went_off.is_none() {
                 went_off = Some(at.saturating_since(written));
             }

@@ -1,0 +1,63 @@
+//! `ppmc judge`'s arguments.
+
+use crate::args::{ChipArgs, ToleranceArgs};
+use crate::capture_args::CaptureArgs;
+use clap::Args;
+use std::path::PathBuf;
+
+/// Judge a board from a capture of its bus and pins: the captured writes
+/// replayed into the reference model, the chip's answers, pulses and
+/// outputs compared (docs/capture.md). Exit status: 0 passed; 1 the board
+/// diverged; 3 the board passed but the host firmware broke a rule of
+/// chapter 3; 4 the capture cannot be judged (a channel missing, a sample
+/// rate too low for the bus, nothing on the bus); 2 a file that does not
+/// read, or bad usage.
+#[derive(Debug, Args)]
+pub struct JudgeArgs {
+    #[command(flatten)]
+    pub(crate) capture: CaptureArgs,
+    #[command(flatten)]
+    pub(crate) chip: ChipArgs,
+    #[command(flatten)]
+    pub(crate) tolerance: ToleranceArgs,
+    /// Write a JUnit XML report (a test case for the board, a divergence a
+    /// failure of type device; one for the host firmware, its findings a
+    /// failure of type host; a capture that cannot be judged an error of
+    /// type capture); `-` for standard output (the verdict lines then go
+    /// to standard error).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) junit: Option<PathBuf>,
+    /// Write a JSON run record (docs/run-record.schema.json, as `ppmc run`
+    /// writes it; the capture stands as the board, `run.source` says what
+    /// it is, each result names whom it blames); `-` for standard output.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) json: Option<PathBuf>,
+    /// Keep the run record in a results store (SQLite; made when not
+    /// there), beside the runs of boards behind a bridge
+    /// (docs/results-store.md).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) store: Option<PathBuf>,
+    /// The board's serial number, for the reports and the store.
+    #[arg(long, value_name = "SERIAL")]
+    pub(crate) board_serial: Option<String>,
+    /// The board's revision label, for the reports and the store.
+    #[arg(long, value_name = "REV")]
+    pub(crate) board_rev: Option<String>,
+    /// Also write the capture as a trace in our format, `DIR/<scenario>.snap`
+    /// (never replacing a file there), for `ppmc compare GOLDEN --traces
+    /// DIR`: the writes and data reads, the moves they started, the pulses
+    /// and the outputs the capture has (docs/capture.md).
+    #[arg(long, value_name = "DIR")]
+    pub(crate) trace: Option<PathBuf>,
+    /// The scenario the capture records: the trace's name (default: the
+    /// capture file's name without its extension).
+    #[arg(long, value_name = "NAME", requires = "trace")]
+    pub(crate) scenario: Option<String>,
+    /// Judge what the capture holds though it is not whole: it ends
+    /// mid-line, during a register access or while the board is still
+    /// moving, or it has no channel for POUT while the chip pulses. The
+    /// verdict then says what was not judged. Without it such a capture
+    /// is the capture's problem (exit 4), never a pass.
+    #[arg(long)]
+    pub(crate) partial: bool,
+}
