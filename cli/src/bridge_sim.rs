@@ -6,7 +6,7 @@ use crate::{usage, CliError};
 use clap::Args;
 use ppmc::backend::EmuTarget;
 use std::io::{self, Write};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct BridgeSimArgs {
@@ -71,49 +71,31 @@ pub struct BridgeSimArgs {
 }
 
 pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
-    use ppmc::bridge::sim::{engine, timed_engine};
-    use ppmc::bridge::sim::{serve, LinkFaults, ServeEnd};
+    use ppmc::bridge::sim::{engine, place_link, remove_own_link, timed_engine};
+    use ppmc::bridge::sim::{serve, LinkFaults, LinkRefused, ServeEnd};
     use serialport::SerialPort;
 
-    for (name, rate) in [
-        ("--drop-rate", args.drop_rate),
-        ("--corrupt-rate", args.corrupt_rate),
-        ("--dup-rate", args.dup_rate),
-        ("--reorder-rate", args.reorder_rate),
-    ] {
-        if !(0.0..=1.0).contains(&rate) {
-            return Err(usage(format!(
-                "{name} {rate}: give a probability from 0 to 1"
-            )));
-        }
-    }
-    if let Some(hz) = args.timer_hz {
-        if !(1_000..=500_000_000).contains(&hz) {
-            return Err(usage(format!(
-                "--timer-hz {hz}: give a rate from 1000 to 500000000 Hz"
-            )));
-        }
-    }
-    let straps = match args.chip.straps() {
-        Ok(s) => s,
-        Err(e) => return Err(usage(e)),
+    let faults = LinkFaults {
+        drop_rate: args.drop_rate,
+        corrupt_rate: args.corrupt_rate,
+        dup_rate: args.dup_rate,
+        reorder_rate: args.reorder_rate,
+        stall_after: args.stall_after,
+        disconnect_after: args.disconnect_after,
+        seed: args.seed,
     };
+    faults.check().map_err(usage)?;
+    let hz_ok = |hz: &u64| (1_000..=500_000_000).contains(hz);
+    if let Some(hz) = args.timer_hz.filter(|hz| !hz_ok(hz)) {
+        return Err(usage(format!("--timer-hz {hz}: give 1000 to 500000000 Hz")));
+    }
+    let straps = args.chip.straps().map_err(usage)?;
     let mut model = args.chip.model();
-    if let Err(e) = ppmc::faults::apply_all(&args.chip_faults, &mut model) {
-        return Err(usage(format!("--chip-fault: {e}")));
-    }
-    let emu = match EmuTarget::new(straps, model) {
-        Ok(t) => t,
-        Err(e) => return Err(usage(e)),
-    };
-    let (mut master, slave) = match serialport::TTYPort::pair() {
-        Ok(p) => p,
-        Err(e) => {
-            return Err(CliError::Failed(format!(
-                "cannot open a pseudo-terminal: {e}"
-            )));
-        }
-    };
+    ppmc::faults::apply_all(&args.chip_faults, &mut model)
+        .map_err(|e| usage(format!("--chip-fault: {e}")))?;
+    let emu = EmuTarget::new(straps, model).map_err(usage)?;
+    let (mut master, slave) = serialport::TTYPort::pair()
+        .map_err(|e| CliError::Failed(format!("cannot open a pseudo-terminal: {e}")))?;
     let _ = master.set_timeout(std::time::Duration::from_millis(50));
     let Some(path) = slave.name() else {
         return Err(CliError::Failed(
@@ -125,7 +107,10 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     // where the bridge serves.
     let stop = super::signals::stop_requested();
     if let Some(link) = &args.link {
-        place_link(link, &path)?;
+        place_link(link, &path).map_err(|e| match e {
+            LinkRefused::Taken(why) => usage(why),
+            LinkRefused::Io(why) => CliError::Failed(why),
+        })?;
     }
     let session = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -143,15 +128,6 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     let _ = writeln!(out, "bridge-sim: serving on {path}");
     let _ = writeln!(out, "bridge-sim: run   ppmc run --target serial:{path}");
     let _ = out.flush();
-    let faults = LinkFaults {
-        drop_rate: args.drop_rate,
-        corrupt_rate: args.corrupt_rate,
-        dup_rate: args.dup_rate,
-        reorder_rate: args.reorder_rate,
-        stall_after: args.stall_after,
-        disconnect_after: args.disconnect_after,
-        seed: args.seed,
-    };
     let end = serve(&mut master, &mut server, faults, args.realtime, &stop);
     if let Some(link) = &args.link {
         remove_own_link(link, &path);
@@ -168,45 +144,5 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
         }
         Ok(ServeEnd::Stopped) => Ok(()),
         Err(e) => Err(CliError::Failed(format!("bridge-sim: {e}"))),
-    }
-}
-
-/// Makes `link` a symbolic link to the pty at `pty`. Something already at
-/// `link` is replaced only when it is a stale link of a bridge-sim (a link
-/// to a pseudo-terminal that is gone); anything else is refused.
-fn place_link(link: &Path, pty: &str) -> Result<(), CliError> {
-    match std::fs::symlink_metadata(link) {
-        Err(e) if e.kind() == io::ErrorKind::NotFound => {}
-        Err(e) => return Err(CliError::Failed(format!("{}: {e}", link.display()))),
-        Ok(meta) if meta.file_type().is_symlink() => {
-            let to = std::fs::read_link(link).unwrap_or_default();
-            let stale_pty = to.starts_with("/dev/pts/") && !to.exists();
-            if !stale_pty {
-                return Err(usage(format!(
-                    "--link {}: is a link to {}, not a stale bridge-sim link; \
-                     remove it or choose another path",
-                    link.display(),
-                    to.display()
-                )));
-            }
-            std::fs::remove_file(link)
-                .map_err(|e| CliError::Failed(format!("{}: {e}", link.display())))?;
-        }
-        Ok(_) => {
-            return Err(usage(format!(
-                "--link {}: exists and is not a link; bridge-sim replaces only a \
-                 stale link of its own",
-                link.display()
-            )));
-        }
-    }
-    std::os::unix::fs::symlink(pty, link)
-        .map_err(|e| CliError::Failed(format!("cannot link {} to {pty}: {e}", link.display())))
-}
-
-/// Removes `link` if it is still this bridge's link to `pty`.
-fn remove_own_link(link: &Path, pty: &str) {
-    if std::fs::read_link(link).is_ok_and(|to| to == Path::new(pty)) {
-        let _ = std::fs::remove_file(link);
     }
 }

@@ -5,11 +5,8 @@
 
 use crate::{usage, CliError};
 use clap::Args;
-use ppmc::backend::{EmuTarget, SerialLink, SerialOptions, SerialTarget, Target};
-use ppmc::bridge::sim::{LinkFaults, PtyBridge};
 use ppmc::emu::ModelConfig;
 use ppmc::faults::{self, CATALOGUE};
-use ppmc::protocol::Straps;
 use ppmc::scenario::Scenario;
 use ppmc_capture::fault_matrix::{self, FuzzBudget, Row};
 use std::path::PathBuf;
@@ -81,7 +78,9 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
             use std::io::Write;
             let _ = write!(std::io::stderr(), "[{}/{total}] {name} ... ", i + 1);
         }
-        let row = match board_row(&name, model, args.in_process, suite, &args.golden, budget) {
+        let row =
+            fault_matrix::board_row(&name, model, args.in_process, suite, &args.golden, budget);
+        let row = match row {
             Ok(r) => r,
             Err(e) => {
                 errln!("infrastructure error");
@@ -101,23 +100,7 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
         text.push('\n');
         text.push_str(&notes);
         text.push_str("\nWhat each check saw first:\n\n");
-        for r in &rows {
-            for (check, c) in [
-                ("suite", &r.suite),
-                ("golden", &r.golden),
-                ("fuzz", &r.fuzz),
-                ("oracle", &r.oracle),
-                ("capture", &r.capture),
-            ] {
-                if let Some(c) = c {
-                    text.push_str(&format!(
-                        "- `{}` / {check}: {}\n",
-                        r.board,
-                        c.first.replace('\n', " ")
-                    ));
-                }
-            }
-        }
+        text.push_str(&fault_matrix::first_seen(&rows));
         ppmc_files::write_report(path, text.as_bytes())?;
     }
     if fault_matrix::all_as_expected(&rows) {
@@ -127,53 +110,4 @@ pub fn run(args: MatrixArgs, suite: &[Scenario]) -> Result<(), CliError> {
         outln!("\nthe matrix is NOT as it must be (see MISSED / FALSE ALARM above)");
         Err(CliError::Verdict)
     }
-}
-
-fn board_row(
-    name: &str,
-    model: ModelConfig,
-    in_process: bool,
-    suite: &[ppmc::scenario::Scenario],
-    golden: &std::path::Path,
-    budget: FuzzBudget,
-) -> Result<Row, String> {
-    let emu = EmuTarget::new(Straps::default(), model.clone()).map_err(|e| e.to_string())?;
-    if in_process {
-        let mut t = emu;
-        return fault_matrix::check_board(name, &mut t, &model, suite, golden, budget)
-            .map_err(|e| e.to_string());
-    }
-    let sim = PtyBridge::start(emu, LinkFaults::default()).map_err(|e| e.to_string())?;
-    let t0 = std::time::Instant::now();
-    let link = SerialLink::open(sim.path(), 115_200).map_err(|e| e.to_string())?;
-    let mut t: Box<dyn Target> = match SerialTarget::open(link, SerialOptions::default()) {
-        Ok(t) => Box::new(t),
-        // The run's health check (hello, chip reset, status 0x00) refuses
-        // the board before any scenario: `ppmc run` stops right there.
-        // The captures are judged all the same: a logic analyzer on the
-        // board needs no link.
-        Err(e) if e.to_string().contains("health check") => {
-            let refused = t0.elapsed();
-            let captures = fault_matrix::capture::judge_captures(&model, suite)
-                .map_err(|e| format!("harness error in the capture column: {e}"))?;
-            return Ok(Row {
-                board: name.to_string(),
-                suite: Some(fault_matrix::Catch {
-                    first: format!("refused by the health check: {e}"),
-                    after: refused,
-                }),
-                golden: None,
-                fuzz: None,
-                oracle: None,
-                capture: captures.catch,
-                capture_skipped: captures.skipped,
-            });
-        }
-        Err(e) => return Err(e.to_string()),
-    };
-    let row = fault_matrix::check_board(name, t.as_mut(), &model, suite, golden, budget)
-        .map_err(|e| e.to_string());
-    drop(t);
-    sim.stop();
-    row
 }

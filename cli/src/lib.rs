@@ -131,7 +131,7 @@ enum Command {
 /// ```no_run
 /// fn main() -> std::process::ExitCode {
 ///     let suite: Vec<ppmc::scenario::Scenario> = Vec::new(); // your scenarios
-///     ppmc::cli::main(suite)
+///     ppmc_cli::main(suite)
 /// }
 /// ```
 pub fn main(suite: Vec<Scenario>) -> ExitCode {

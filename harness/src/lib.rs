@@ -11,7 +11,8 @@
 //! [`runner::Farm`] of boards), [`golden`], [`compare`], [`selftest`],
 //! [`console`], [`chaos`], [`soak`] (a run's results into its
 //! [`record::RunRecord`]), [`artifacts`] ← [`session`] (a run of a suite
-//! on a farm of boards, into its record) ← [`fuzzing`] (its oracle in [`invariants`], the
+//! on a farm of boards, into its record), [`bench`] (its wall-clock
+//! figures) ← [`fuzzing`] (its oracle in [`invariants`], the
 //! second model of the chip in [`plain_model`]).
 //!
 //! Reports, the results store, capture readers, the capture judge and the
@@ -22,6 +23,7 @@
 
 pub mod artifacts;
 pub mod backend;
+pub mod bench;
 pub mod bridge;
 pub mod chaos;
 pub mod compare;

@@ -30,7 +30,7 @@ pub use info::{rfc3339, BoardInfo, CaptureSource, RunInfo, RunOptions};
 pub use measurement::{Grade, Grading, Measurement, MARGINAL_PCT};
 pub use result::{
     AttemptRecord, Blame, ErrorKind, ErrorRecord, FailureRecord, HostFindingRecord, RangeRecord,
-    RepeatedRecord, ScenarioRecord, Status, MAX_LISTED,
+    RepeatedRecord, ScenarioRecord, MAX_LISTED,
 };
 pub use run::{printable, RecordError, RunRecord, FORMAT, FORMATS, MAX_RECORD_BYTES};
-pub use tally::Tally;
+pub use tally::{Status, Tally};

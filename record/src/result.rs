@@ -8,46 +8,8 @@
 
 use crate::figures::Figures;
 use crate::measurement::{Grade, Measurement};
-use crate::tally::Tally;
+use crate::tally::{Status, Tally};
 use serde::{Deserialize, Deserializer, Serialize};
-
-/// A result's verdict as the record spells it: the keys of `summary`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Status {
-    Passed,
-    /// Passed, with a measurement near a limit or within the instrument's
-    /// uncertainty of it.
-    Marginal,
-    /// Passed (or marginal) only on a retry.
-    Flaky,
-    /// The device did something wrong.
-    Failed,
-    /// The harness, the link, the capture or a file failed: no verdict on
-    /// the device.
-    Error,
-    /// Never started.
-    NotRun,
-}
-
-impl Status {
-    /// Its one spelling in the record.
-    pub fn name(self) -> &'static str {
-        match self {
-            Status::Passed => "passed",
-            Status::Marginal => "marginal",
-            Status::Flaky => "flaky",
-            Status::Failed => "failed",
-            Status::Error => "error",
-            Status::NotRun => "not_run",
-        }
-    }
-
-    /// Whether it lets a run pass (passed, marginal, or flaky).
-    pub fn ok(self) -> bool {
-        matches!(self, Status::Passed | Status::Marginal | Status::Flaky)
-    }
-}
 
 /// Whose problem an error or a "not run" is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -41,7 +41,7 @@ impl RunRecord {
     pub fn new(run: RunInfo, scenarios: Vec<ScenarioRecord>) -> RunRecord {
         RunRecord {
             format: FORMAT.to_string(),
-            summary: Tally::of(&scenarios),
+            summary: Tally::of(scenarios.iter().map(|s| s.verdict)),
             run,
             scenarios,
             repeated: None,

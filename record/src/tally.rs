@@ -1,8 +1,45 @@
-//! [`Tally`]: counts of verdicts, for a run, a board or a scenario's
-//! repeated runs.
+//! A result's verdict as a record spells it ([`Status`]), and [`Tally`]:
+//! counts of verdicts, for a run, a board or a scenario's repeated runs.
 
-use crate::result::{ScenarioRecord, Status};
 use serde::{Deserialize, Serialize};
+
+/// A result's verdict as the record spells it: the keys of `summary`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    Passed,
+    /// Passed, with a measurement near a limit or within the instrument's
+    /// uncertainty of it.
+    Marginal,
+    /// Passed (or marginal) only on a retry.
+    Flaky,
+    /// The device did something wrong.
+    Failed,
+    /// The harness, the link, the capture or a file failed: no verdict on
+    /// the device.
+    Error,
+    /// Never started.
+    NotRun,
+}
+
+impl Status {
+    /// Its one spelling in the record.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Passed => "passed",
+            Status::Marginal => "marginal",
+            Status::Flaky => "flaky",
+            Status::Failed => "failed",
+            Status::Error => "error",
+            Status::NotRun => "not_run",
+        }
+    }
+
+    /// Whether it lets a run pass (passed, marginal, or flaky).
+    pub fn ok(self) -> bool {
+        matches!(self, Status::Passed | Status::Marginal | Status::Flaky)
+    }
+}
 
 /// Counts of verdicts; a run record's `summary`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -21,11 +58,11 @@ pub struct Tally {
 }
 
 impl Tally {
-    /// The tally of `results`.
-    pub fn of<'a>(results: impl IntoIterator<Item = &'a ScenarioRecord>) -> Tally {
+    /// The tally of `verdicts`.
+    pub fn of(verdicts: impl IntoIterator<Item = Status>) -> Tally {
         let mut t = Tally::default();
-        for r in results {
-            t.add(r.verdict);
+        for s in verdicts {
+            t.add(s);
         }
         t
     }

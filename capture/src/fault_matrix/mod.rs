@@ -221,3 +221,76 @@ pub fn render(rows: &[Row]) -> String {
 pub fn all_as_expected(rows: &[Row]) -> bool {
     rows.iter().all(|r| r.caught() != (r.board == "clean"))
 }
+
+/// A board's row, the clean one or one with a fault of the catalogue
+/// (`name`, `model`): in process, or behind `bridge-sim` on a pty as a
+/// board is reached. A board whose health check refuses it before any
+/// scenario (as `ppmc run` would stop right there) is caught by the suite
+/// column, and judged from captures all the same: a logic analyzer on
+/// the board needs no link.
+pub fn board_row(
+    name: &str,
+    model: ModelConfig,
+    in_process: bool,
+    suite: &[Scenario],
+    golden: &Path,
+    budget: FuzzBudget,
+) -> Result<Row, String> {
+    use ppmc::backend::{EmuTarget, SerialLink, SerialOptions, SerialTarget};
+    use ppmc::bridge::sim::{LinkFaults, PtyBridge};
+    let emu = EmuTarget::new(ppmc::protocol::Straps::default(), model.clone())
+        .map_err(|e| e.to_string())?;
+    if in_process {
+        let mut t = emu;
+        return check_board(name, &mut t, &model, suite, golden, budget).map_err(|e| e.to_string());
+    }
+    let sim = PtyBridge::start(emu, LinkFaults::default()).map_err(|e| e.to_string())?;
+    let t0 = WallClock::now();
+    let link = SerialLink::open(sim.path(), 115_200).map_err(|e| e.to_string())?;
+    let mut t: Box<dyn Target> = match SerialTarget::open(link, SerialOptions::default()) {
+        Ok(t) => Box::new(t),
+        Err(e) if e.to_string().contains("health check") => {
+            let refused = t0.elapsed();
+            let captures = capture::judge_captures(&model, suite)
+                .map_err(|e| format!("harness error in the capture column: {e}"))?;
+            return Ok(Row {
+                board: name.to_string(),
+                suite: Some(Catch {
+                    first: format!("refused by the health check: {e}"),
+                    after: refused,
+                }),
+                golden: None,
+                fuzz: None,
+                oracle: None,
+                capture: captures.catch,
+                capture_skipped: captures.skipped,
+            });
+        }
+        Err(e) => return Err(e.to_string()),
+    };
+    let row =
+        check_board(name, t.as_mut(), &model, suite, golden, budget).map_err(|e| e.to_string());
+    drop(t);
+    sim.stop();
+    row
+}
+
+/// What each check saw first on each board, one Markdown line each.
+pub fn first_seen(rows: &[Row]) -> String {
+    let mut text = String::new();
+    for r in rows {
+        for (check, c) in [
+            ("suite", &r.suite),
+            ("golden", &r.golden),
+            ("fuzz", &r.fuzz),
+            ("oracle", &r.oracle),
+            ("capture", &r.capture),
+        ] {
+            if let Some(c) = c {
+                let first = c.first.replace('\n', " ");
+                text.push_str(&format!("- `{}` / {check}: {first}\n", r.board));
+            }
+        }
+    }
+    text
+}

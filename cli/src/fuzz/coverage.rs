@@ -1,6 +1,10 @@
 //! `ppmc fuzz coverage`: the domain coverage of a corpus.
 
-use super::*;
+use super::inputs::*;
+use crate::CliError;
+use ppmc::emu::ModelConfig;
+use ppmc::fuzzing::finding::InputKind;
+use std::path::PathBuf;
 
 pub fn run(paths: &[PathBuf], kind: InputKind) -> Result<(), CliError> {
     let cfg = ModelConfig::default();

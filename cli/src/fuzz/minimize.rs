@@ -1,6 +1,9 @@
 //! `ppmc fuzz minimize`: a fuzz input shrunk while the same invariant breaks.
 
-use super::*;
+use super::inputs::*;
+use crate::CliError;
+use ppmc::fuzzing::finding::{self};
+use std::path::PathBuf;
 
 pub fn run(input: &InputArgs, output: Option<PathBuf>) -> Result<(), CliError> {
     let (cfg, ops) = input.load()?;
@@ -18,7 +21,7 @@ pub fn run(input: &InputArgs, output: Option<PathBuf>) -> Result<(), CliError> {
         );
         return Err(CliError::Verdict);
     };
-    let out = output.unwrap_or_else(|| super::with_suffix(&input.file, "min"));
+    let out = output.unwrap_or_else(|| with_suffix(&input.file, "min"));
     let bytes = finding::to_bytes(&m.ops);
     ppmc_files::write(&out, &bytes)?;
     errln!(

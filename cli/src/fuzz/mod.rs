@@ -2,6 +2,7 @@
 //! keep, and differential runs against a target.
 
 mod coverage;
+mod inputs;
 mod minimize;
 mod reproduce;
 mod run;
@@ -9,11 +10,10 @@ mod to_scenario;
 mod triage;
 mod twin;
 
-use crate::{usage, CliError};
+use crate::CliError;
 use clap::{Args, Subcommand};
-use ppmc::emu::ModelConfig;
-use ppmc::fuzzing::finding::{self, InputKind};
-use std::path::{Path, PathBuf};
+use inputs::{InputArgs, Kind, ModelArgs};
+use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 #[command(args_conflicts_with_subcommands = true)]
@@ -104,96 +104,6 @@ enum FuzzCommand {
     Run(run::DiffArgs),
 }
 
-/// The fuzz targets whose inputs are bus programs, as `--kind` names them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub(super) enum Kind {
-    /// A `bus_bytes` input: ops separated by `FUZZ`.
-    BusBytes,
-    /// A `typed_actions` input: typed actions (derive `Arbitrary`).
-    TypedActions,
-}
-
-impl From<Kind> for InputKind {
-    fn from(k: Kind) -> InputKind {
-        match k {
-            Kind::BusBytes => InputKind::BusBytes,
-            Kind::TypedActions => InputKind::TypedActions,
-        }
-    }
-}
-
-#[derive(Debug, Args)]
-pub(super) struct ModelArgs {
-    /// Which fuzz target the inputs are for.
-    #[arg(long, value_enum, default_value = "bus-bytes")]
-    kind: Kind,
-    /// Judge on an emulator with this board fault (`ppmc fault-matrix
-    /// --list`); repeat to combine. Default: the clean emulator.
-    #[arg(long = "chip-fault", value_name = "FAULT")]
-    chip_faults: Vec<String>,
-}
-
-impl ModelArgs {
-    pub(super) fn model(&self) -> Result<ModelConfig, CliError> {
-        let mut cfg = ModelConfig::default();
-        ppmc::faults::apply_all(&self.chip_faults, &mut cfg)
-            .map_err(|e| usage(format!("--chip-fault: {e}")))?;
-        Ok(cfg)
-    }
-}
-
-/// The inputs under `paths` (files, or the files of directories, sorted),
-/// as bus ops.
-pub(super) fn load_inputs(
-    paths: &[PathBuf],
-    kind: InputKind,
-    cfg: &ModelConfig,
-) -> Result<Vec<(String, Vec<ppmc::fuzzing::bus_bytes::BusOp>)>, CliError> {
-    let mut files = Vec::new();
-    for p in paths {
-        if p.is_dir() {
-            let rd = std::fs::read_dir(p)
-                .map_err(|e| usage(format!("cannot read {}: {e}", p.display())))?;
-            let mut v: Vec<PathBuf> = rd
-                .filter_map(Result::ok)
-                .map(|e| e.path())
-                .filter(|f| f.is_file())
-                .collect();
-            v.sort();
-            files.extend(v);
-        } else {
-            files.push(p.clone());
-        }
-    }
-    files
-        .into_iter()
-        .map(|f| {
-            let data = ppmc_files::read(&f, ppmc_files::MAX_INPUT_BYTES)?;
-            Ok((f.display().to_string(), finding::ops_of(&data, kind, cfg)))
-        })
-        .collect()
-}
-
-#[derive(Debug, Args)]
-pub(super) struct InputArgs {
-    /// The input file.
-    file: PathBuf,
-    #[command(flatten)]
-    model: ModelArgs,
-}
-
-impl InputArgs {
-    /// The model, the input's bytes and its bus ops.
-    pub(super) fn load(
-        &self,
-    ) -> Result<(ModelConfig, Vec<ppmc::fuzzing::bus_bytes::BusOp>), CliError> {
-        let cfg = self.model.model()?;
-        let data = ppmc_files::read(&self.file, ppmc_files::MAX_INPUT_BYTES)?;
-        let ops = finding::ops_of(&data, self.model.kind.into(), &cfg);
-        Ok((cfg, ops))
-    }
-}
-
 pub fn run(args: FuzzArgs) -> Result<(), CliError> {
     match args.command {
         None => run::run(args.run),
@@ -205,11 +115,4 @@ pub fn run(args: FuzzArgs) -> Result<(), CliError> {
         Some(FuzzCommand::ToScenario { input, dir }) => to_scenario::run(&input, &dir),
         Some(FuzzCommand::Twin { file, output }) => twin::run(&file, output),
     }
-}
-
-pub(super) fn with_suffix(p: &Path, suffix: &str) -> PathBuf {
-    let mut s = p.as_os_str().to_owned();
-    s.push(".");
-    s.push(suffix);
-    PathBuf::from(s)
 }

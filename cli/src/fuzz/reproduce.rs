@@ -1,6 +1,8 @@
 //! `ppmc fuzz reproduce`: a fuzz input as a console script, with the invariant it breaks.
 
-use super::*;
+use super::inputs::*;
+use crate::CliError;
+use ppmc::fuzzing::finding::{self};
 
 pub fn run(input: &InputArgs) -> Result<(), CliError> {
     let (cfg, ops) = input.load()?;

@@ -1,7 +1,10 @@
 //! `ppmc fuzz to-scenario`: a fuzz input as a regression scenario.
 
-use super::*;
+use super::inputs::*;
+use crate::{usage, CliError};
+use ppmc::fuzzing::finding::{self};
 use ppmc_files as files;
+use std::path::Path;
 
 pub fn run(input: &InputArgs, dir: &Path) -> Result<(), CliError> {
     let (cfg, ops) = input.load()?;

@@ -1,6 +1,8 @@
 //! `ppmc fuzz triage`: findings bucketed by the invariant each breaks.
 
-use super::*;
+use super::inputs::*;
+use crate::CliError;
+use std::path::PathBuf;
 
 pub fn run(paths: &[PathBuf], model: &ModelArgs) -> Result<(), CliError> {
     let cfg = model.model()?;

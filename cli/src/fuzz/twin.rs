@@ -3,10 +3,14 @@
 //! difference shown, and the input shrunk to the fewest ops that still
 //! show one.
 
-use super::*;
+use super::inputs::*;
+use crate::CliError;
+use ppmc::emu::ModelConfig;
 use ppmc::fuzzing::bus_bytes;
+use ppmc::fuzzing::finding::{self};
 use ppmc::plain_model::twin;
 use ppmc::protocol::Straps;
+use std::path::{Path, PathBuf};
 
 pub fn run(file: &Path, output: Option<PathBuf>) -> Result<(), CliError> {
     let data = ppmc_files::read(file, ppmc_files::MAX_INPUT_BYTES)?;
@@ -35,7 +39,7 @@ pub fn run(file: &Path, output: Option<PathBuf>) -> Result<(), CliError> {
     let Some((small, found)) = finding::minimize_disagreement(&ops, straps, &cfg) else {
         return Err(CliError::Verdict);
     };
-    let out = output.unwrap_or_else(|| super::with_suffix(file, "min"));
+    let out = output.unwrap_or_else(|| with_suffix(file, "min"));
     ppmc_files::write(&out, &bus_bytes::encode(&small))?;
     errln!(
         "ppmc fuzz twin: {} ops -> {} ops; wrote {}",

@@ -1,9 +1,10 @@
 //! The crates keep the layers ARCHITECTURE.md lists (issue 41): its table
 //! names every workspace crate, with exactly the workspace crates each
 //! depends on (normal dependencies, as `cargo metadata` reads the
-//! manifests), each of a lower layer; and what a crate compiles holds no
-//! more than its place allows: the scenario language (`library-user`, on
-//! `ppmc` alone) and the fuzz crate no SQLite, zip or clap.
+//! manifests), each of a lower layer; and what a crate compiles (`cargo
+//! tree`) holds no more than its place allows: the scenario language
+//! (`library-user`, on `ppmc` alone) and the fuzz crate no SQLite, zip or
+//! clap.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -13,9 +14,9 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// `cargo metadata` of `manifest`, as JSON; `deps`: with the resolved
-/// graph (from the lock file, offline: the tests never fetch).
-fn metadata(manifest: &Path, deps: bool) -> serde_json::Value {
+/// `cargo metadata` of `manifest`, as JSON: its packages as their
+/// manifests declare them.
+fn metadata(manifest: &Path) -> serde_json::Value {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut cmd = Command::new(cargo);
     cmd.args([
@@ -23,14 +24,10 @@ fn metadata(manifest: &Path, deps: bool) -> serde_json::Value {
         "--format-version",
         "1",
         "--offline",
-        "--manifest-path",
+        "--no-deps",
     ])
+    .arg("--manifest-path")
     .arg(manifest);
-    if !deps {
-        cmd.arg("--no-deps");
-    } else {
-        cmd.arg("--locked");
-    }
     let out = cmd.output().expect("cargo metadata runs");
     assert!(
         out.status.success(),
@@ -69,7 +66,7 @@ fn table() -> BTreeMap<String, (u32, BTreeSet<String>)> {
 #[test]
 fn the_crates_keep_the_layers_architecture_md_lists() {
     let rows = table();
-    let meta = metadata(&root().join("Cargo.toml"), false);
+    let meta = metadata(&root().join("Cargo.toml"));
     let packages = meta["packages"].as_array().expect("packages");
     let members: BTreeSet<String> = packages
         .iter()
@@ -105,62 +102,44 @@ fn the_crates_keep_the_layers_architecture_md_lists() {
     }
 }
 
-/// Every package `from` compiles (normal and build dependencies, on any
-/// target), by the resolved graph of `meta`.
-fn compiled(meta: &serde_json::Value, from: &str) -> BTreeSet<String> {
-    let names: BTreeMap<&str, &str> = meta["packages"]
-        .as_array()
-        .expect("packages")
-        .iter()
-        .map(|p| {
-            (
-                p["id"].as_str().expect("id"),
-                p["name"].as_str().expect("name"),
-            )
-        })
-        .collect();
-    let nodes: BTreeMap<&str, Vec<&str>> = meta["resolve"]["nodes"]
-        .as_array()
-        .expect("resolve")
-        .iter()
-        .map(|n| {
-            let deps = n["deps"]
-                .as_array()
-                .expect("deps")
-                .iter()
-                .filter(|d| {
-                    d["dep_kinds"]
-                        .as_array()
-                        .expect("dep_kinds")
-                        .iter()
-                        .any(|k| k["kind"].as_str() != Some("dev"))
-                })
-                .map(|d| d["pkg"].as_str().expect("pkg"))
-                .collect();
-            (n["id"].as_str().expect("id"), deps)
-        })
-        .collect();
-    let start = names
-        .iter()
-        .find(|(_, n)| **n == from)
-        .map(|(id, _)| *id)
-        .expect("the package");
-    let mut seen = BTreeSet::new();
-    let mut todo = vec![start];
-    while let Some(id) = todo.pop() {
-        if seen.insert(id) {
-            todo.extend(nodes.get(id).into_iter().flatten());
-        }
-    }
-    seen.into_iter().map(|id| names[id].to_string()).collect()
+/// Every package `from` compiles for this machine (normal and build
+/// dependencies), as `cargo tree` resolves them from the lock file,
+/// offline: the tests never fetch.
+fn compiled(from: &str) -> BTreeSet<String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo)
+        .args([
+            "tree",
+            "--offline",
+            "--locked",
+            "-e",
+            "normal,build",
+            "--prefix",
+            "none",
+            "-p",
+            from,
+        ])
+        .arg("--manifest-path")
+        .arg(root().join("Cargo.toml"))
+        .output()
+        .expect("cargo tree runs");
+    assert!(
+        out.status.success(),
+        "cargo tree: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .map(str::to_string)
+        .collect()
 }
 
 const HEAVY: [&str; 5] = ["rusqlite", "libsqlite3-sys", "zip", "clap", "indicatif"];
 
 #[test]
 fn the_scenario_language_compiles_no_sqlite_zip_or_clap() {
-    let meta = metadata(&root().join("Cargo.toml"), true);
-    let user = compiled(&meta, "library-user");
+    let user = compiled("library-user");
     assert!(
         user.contains("ppmc"),
         "library-user depends on ppmc: {user:?}"
@@ -172,7 +151,7 @@ fn the_scenario_language_compiles_no_sqlite_zip_or_clap() {
         );
     }
     // The command line does compile them: the check can fail.
-    let cli = compiled(&meta, "ppmc-cli");
+    let cli = compiled("ppmc-cli");
     assert!(cli.contains("rusqlite") && cli.contains("clap"), "{cli:?}");
 }
 
@@ -181,7 +160,7 @@ fn the_scenario_language_compiles_no_sqlite_zip_or_clap() {
 /// targets build without it.
 #[test]
 fn the_fuzz_crate_builds_on_the_harness_alone() {
-    let fuzz = metadata(&root().join("fuzz/Cargo.toml"), false);
+    let fuzz = metadata(&root().join("fuzz/Cargo.toml"));
     let deps: BTreeSet<String> = fuzz["packages"][0]["dependencies"]
         .as_array()
         .expect("dependencies")
@@ -190,8 +169,7 @@ fn the_fuzz_crate_builds_on_the_harness_alone() {
         .filter(|d| d.starts_with("ppmc"))
         .collect();
     assert_eq!(deps, BTreeSet::from(["ppmc".to_string()]));
-    let meta = metadata(&root().join("Cargo.toml"), true);
-    let harness = compiled(&meta, "ppmc");
+    let harness = compiled("ppmc");
     for heavy in HEAVY {
         assert!(!harness.contains(heavy), "ppmc compiles {heavy}");
     }

@@ -388,3 +388,80 @@ fn link_to(pty: &str) -> io::Result<String> {
         }
     }
 }
+
+/// Why `--link` could not be placed: a path of someone else's (the user's
+/// to change), or the file system's refusal.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum LinkRefused {
+    /// Something at the path that is not a stale bridge-sim link.
+    Taken(String),
+    /// The file system refused.
+    Io(String),
+}
+
+impl std::fmt::Display for LinkRefused {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LinkRefused::Taken(why) | LinkRefused::Io(why) => f.write_str(why),
+        }
+    }
+}
+
+/// Makes `link` a symbolic link to the pty at `pty`. Something already at
+/// `link` is replaced only when it is a stale link of a bridge-sim (a link
+/// to a pseudo-terminal that is gone); anything else is refused.
+#[cfg(unix)]
+pub fn place_link(link: &std::path::Path, pty: &str) -> Result<(), LinkRefused> {
+    let io = |e: std::io::Error| LinkRefused::Io(format!("{}: {e}", link.display()));
+    match std::fs::symlink_metadata(link) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(io(e)),
+        Ok(meta) if meta.file_type().is_symlink() => {
+            let to = std::fs::read_link(link).unwrap_or_default();
+            let stale_pty = to.starts_with("/dev/pts/") && !to.exists();
+            if !stale_pty {
+                return Err(LinkRefused::Taken(format!(
+                    "--link {}: is a link to {}, not a stale bridge-sim link; \
+                     remove it or choose another path",
+                    link.display(),
+                    to.display()
+                )));
+            }
+            std::fs::remove_file(link).map_err(io)?;
+        }
+        Ok(_) => {
+            return Err(LinkRefused::Taken(format!(
+                "--link {}: exists and is not a link; bridge-sim replaces only a \
+                 stale link of its own",
+                link.display()
+            )));
+        }
+    }
+    std::os::unix::fs::symlink(pty, link)
+        .map_err(|e| LinkRefused::Io(format!("cannot link {} to {pty}: {e}", link.display())))
+}
+
+/// Removes `link` if it is still this bridge's link to `pty`.
+pub fn remove_own_link(link: &std::path::Path, pty: &str) {
+    if std::fs::read_link(link).is_ok_and(|to| to == std::path::Path::new(pty)) {
+        let _ = std::fs::remove_file(link);
+    }
+}
+
+impl LinkFaults {
+    /// Each rate a probability from 0 to 1: the first that is not, named
+    /// by its option.
+    pub fn check(&self) -> Result<(), String> {
+        for (name, rate) in [
+            ("--drop-rate", self.drop_rate),
+            ("--corrupt-rate", self.corrupt_rate),
+            ("--dup-rate", self.dup_rate),
+            ("--reorder-rate", self.reorder_rate),
+        ] {
+            if !(0.0..=1.0).contains(&rate) {
+                return Err(format!("{name} {rate}: give a probability from 0 to 1"));
+            }
+        }
+        Ok(())
+    }
+}
