@@ -14,6 +14,12 @@ use std::path::{Path, PathBuf};
 /// The most non-test lines a source file may have.
 const MAX_LINES: usize = 800;
 
+/// The most lines a command file of the command line may have: it parses,
+/// calls the library and prints (issue 41). The dispatch (`lib.rs`) and
+/// the argument groups several commands share (`args.rs`) are not
+/// commands.
+const MAX_COMMAND_LINES: usize = 150;
+
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
@@ -400,4 +406,25 @@ fn the_path_reader_sees_groups_parents_and_visibility_is_no_path() {
     assert_eq!(circles(&edges), vec!["a -> x -> x/y -> a".to_string()]);
     edges.entry(words(&["x", "y"])).or_default().clear();
     assert!(circles(&edges).is_empty());
+}
+
+#[test]
+fn no_command_file_has_more_than_150_lines() {
+    let base = root().join("cli/src");
+    let mut files = Vec::new();
+    sources(&base, &base, &mut files);
+    assert!(files.len() > 10, "the command files read: {files:?}");
+    let long: Vec<String> = files
+        .iter()
+        .filter(|f| !matches!(f.to_str(), Some("lib.rs" | "args.rs")))
+        .filter_map(|f| {
+            let text = std::fs::read_to_string(base.join(f)).ok()?;
+            let n = text.lines().count();
+            (n > MAX_COMMAND_LINES).then(|| format!("cli/src/{} ({n} lines)", f.display()))
+        })
+        .collect();
+    assert!(
+        long.is_empty(),
+        "command files over {MAX_COMMAND_LINES} lines (move what decides into a library crate): {long:?}"
+    );
 }

@@ -173,4 +173,12 @@ fn the_fuzz_crate_builds_on_the_harness_alone() {
     for heavy in HEAVY {
         assert!(!harness.contains(heavy), "ppmc compiles {heavy}");
     }
+    // And its own lock file, which `cargo fuzz` builds from, holds none.
+    let lock = std::fs::read_to_string(root().join("fuzz/Cargo.lock")).expect("fuzz/Cargo.lock");
+    for heavy in HEAVY {
+        assert!(
+            !lock.contains(&format!("name = \"{heavy}\"")),
+            "fuzz/Cargo.lock locks {heavy}"
+        );
+    }
 }
