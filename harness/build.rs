@@ -18,20 +18,19 @@ fn main() {
         .unwrap_or_else(|| "unknown".into());
     println!("cargo:rustc-env=PPMC_GIT_REV={rev}");
     // Rebuild the revision when HEAD moves: HEAD itself, the branch it
-    // names, and packed refs.
+    // names, and packed refs. Only files that exist are named: Cargo takes
+    // a missing one as changed on every build, which would rebuild this
+    // crate and everything above it each time.
     let git = manifest.join("../.git");
     let head = git.join("HEAD");
-    if head.exists() {
-        println!("cargo:rerun-if-changed={}", head.display());
-        if let Some(r) = fs::read_to_string(&head)
-            .ok()
-            .and_then(|h| h.strip_prefix("ref: ").map(|r| r.trim().to_string()))
-        {
-            println!("cargo:rerun-if-changed={}", git.join(r).display());
-        }
-        println!(
-            "cargo:rerun-if-changed={}",
-            git.join("packed-refs").display()
-        );
+    let branch = fs::read_to_string(&head)
+        .ok()
+        .and_then(|h| h.strip_prefix("ref: ").map(|r| git.join(r.trim())));
+    for path in [Some(head), branch, Some(git.join("packed-refs"))]
+        .into_iter()
+        .flatten()
+        .filter(|p| p.exists())
+    {
+        println!("cargo:rerun-if-changed={}", path.display());
     }
 }

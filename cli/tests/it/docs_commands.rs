@@ -40,7 +40,11 @@ const FILES: [&str; 14] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 34] = [
+const ELSEWHERE: [(&str, &str); 35] = [
+    (
+        "scripts/rebuild-figures",
+        "in .ci/run (after the tests, on the built workspace)",
+    ),
     (
         "scripts/loaded-check",
         "by hand (an hour of a loaded machine; its figures in docs/performance.md); the script itself in loaded_check_says_how_each_run_ended below",
