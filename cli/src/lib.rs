@@ -149,7 +149,7 @@ pub fn main(suite: Vec<Scenario>) -> ExitCode {
         Command::Console(args) => console::run(args),
         Command::Bench(args) => bench::run(args, suite),
         Command::BridgeSim(args) => bridge_sim::run(args),
-        Command::Fuzz(args) => fuzz::run(args),
+        Command::Fuzz(args) => fuzz::run(args, suite),
         Command::FaultMatrix(args) => fault_matrix::run(args, suite),
         Command::ChaosProxy(args) => chaos_proxy::run(args),
         Command::Selftest(args) => selftest::run(args),

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 /// carry it from when the golden check was `harness/tests/golden.rs`
 /// (it is now `harness/tests/it/golden.rs`, and `cargo insta review`
 /// writes that). A file whose trace is the same is the same golden file
-/// whatever its front matter ([`write`] leaves it unchanged).
+/// whatever its front matter ([`write()`] leaves it unchanged).
 pub const SNAPSHOT_HEADER: &str = "---\nsource: harness/tests/golden.rs\n---\n";
 
 /// `text` without insta's front matter (`---` ... `---`), if it has one.
@@ -112,7 +112,7 @@ pub fn load_for(dir: &Path, scenario: &str, straps: &Straps) -> Result<Trace, Go
     Ok(trace)
 }
 
-/// What [`write`] did.
+/// What [`write()`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Written {
     Created,

@@ -11,7 +11,7 @@
 //! [`runner::Farm`] of boards), [`golden`], [`compare`], [`selftest`],
 //! [`console`], [`chaos`], [`soak`] (a run's results into its
 //! [`record::RunRecord`]), [`artifacts`] ← [`session`] (a run of a suite
-//! on a farm of boards, into its record), [`bench`] (its wall-clock
+//! on a farm of boards, into its record), [`bench`](mod@bench) (its wall-clock
 //! figures) ← [`fuzzing`] (its oracle in [`invariants`], the
 //! second model of the chip in [`plain_model`]).
 //!
@@ -25,6 +25,7 @@ pub mod artifacts;
 pub mod backend;
 pub mod bench;
 pub mod bridge;
+pub mod bus_program;
 pub mod chaos;
 pub mod compare;
 pub mod console;

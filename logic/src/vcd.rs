@@ -25,7 +25,7 @@
 //! capture ends at the last timestamp. A file without `$timescale` is in
 //! nanoseconds, as GTKWave takes it. A first line `META samplerate: N`,
 //! which sigrok-cli 0.7.2 puts before the header when it converts a VCD to
-//! a VCD, is skipped. At most [`MAX_CHANNELS`] 1-bit
+//! a VCD, is skipped. At most [`MAX_CHANNELS`](super::source::MAX_CHANNELS) 1-bit
 //! channels: more is an error that says how many.
 //!
 //! Why not the `vcd` crate (which `vcd_export.rs` writes with): its parser

@@ -6,7 +6,7 @@
 //! It fails while the bug is there; once fixed, record its golden trace
 //! (`ppmc record --filter fuzz_remaining_pulses_1`).
 
-use ppmc::fuzzing::bus_bytes::BusOp::{self, *};
+use ppmc::bus_program::BusOp::{self, *};
 use ppmc::invariants::replay::regression;
 use ppmc::scenario::prelude::*;
 

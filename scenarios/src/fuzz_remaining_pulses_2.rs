@@ -13,7 +13,7 @@
 //! 215 us: still while BUSY, as in the finding, and a microsecond clear of
 //! the boundary.
 
-use ppmc::fuzzing::bus_bytes::BusOp::{self, *};
+use ppmc::bus_program::BusOp::{self, *};
 use ppmc::invariants::replay::regression;
 use ppmc::scenario::prelude::*;
 

@@ -140,7 +140,7 @@ pub fn judge_captures(
 
 /// Scenario `s` run on the emulator with `model` as a host on a real bus
 /// runs it, every register access taking a bus cycle, and recorded as a
-/// logic analyzer on the bus and pins records it ([`Analyzer`]): every
+/// logic analyzer on the bus and pins records it (`Analyzer`): every
 /// access the chip served and everything it put out. With how long it
 /// ran. What `ppmc export --scenario` writes, and what this column judges.
 pub fn analyzer_trace(model: &ModelConfig, s: &Scenario) -> Result<(Trace, Duration), String> {

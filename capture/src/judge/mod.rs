@@ -57,10 +57,10 @@ pub struct JudgeOptions {
     pub partial: bool,
     /// Stop at the first divergence: the verdict and nothing after it
     /// (the counts, host findings and end checks are then partial). For
-    /// trying another channel map ([`suspect`]).
+    /// trying another channel map (`suspect.rs`).
     pub stop_at_divergence: bool,
     /// Where the capture cannot order a host access against a change of
-    /// IBF, OBF or BUSY, follow both orders ([`Branch`]; the default).
+    /// IBF, OBF or BUSY, follow both orders (`Branch`; the default).
     /// Off, the model takes every access at its captured time, as the
     /// judge did before issue 40: for measuring what the capture's
     /// uncertainty costs a verdict.

@@ -51,7 +51,7 @@ pub(crate) fn load_inputs(
     paths: &[PathBuf],
     kind: InputKind,
     cfg: &ModelConfig,
-) -> Result<Vec<(String, Vec<ppmc::fuzzing::bus_bytes::BusOp>)>, CliError> {
+) -> Result<Vec<(String, Vec<ppmc::bus_program::BusOp>)>, CliError> {
     let mut files = Vec::new();
     for p in paths {
         if p.is_dir() {
@@ -87,9 +87,7 @@ pub(crate) struct InputArgs {
 
 impl InputArgs {
     /// The model, the input's bytes and its bus ops.
-    pub(crate) fn load(
-        &self,
-    ) -> Result<(ModelConfig, Vec<ppmc::fuzzing::bus_bytes::BusOp>), CliError> {
+    pub(crate) fn load(&self) -> Result<(ModelConfig, Vec<ppmc::bus_program::BusOp>), CliError> {
         let cfg = self.model.model()?;
         let data = ppmc_files::read(&self.file, ppmc_files::MAX_INPUT_BYTES)?;
         let ops = finding::ops_of(&data, self.model.kind.into(), &cfg);

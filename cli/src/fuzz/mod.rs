@@ -6,6 +6,7 @@ mod inputs;
 mod minimize;
 mod reproduce;
 mod run;
+mod seeds;
 mod to_scenario;
 mod triage;
 mod twin;
@@ -98,14 +99,23 @@ enum FuzzCommand {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Write the fuzz targets' seed corpora, made from the bridge protocol
+    /// and the conformance suite, after a protocol or scenario change;
+    /// a seed that is already as made is left alone.
+    Seeds {
+        /// The corpus folder: one folder per target under it.
+        #[arg(long, default_value = "fuzz/corpus")]
+        out: PathBuf,
+    },
     /// A differential run: a seeded stream of protocol-respecting actions
     /// against a target and the emulator side by side (the default when no
     /// subcommand is given).
     Run(run::DiffArgs),
 }
 
-pub fn run(args: FuzzArgs) -> Result<(), CliError> {
+pub fn run(args: FuzzArgs, suite: &[ppmc::scenario::Scenario]) -> Result<(), CliError> {
     match args.command {
+        Some(FuzzCommand::Seeds { out }) => seeds::run(&out, suite),
         None => run::run(args.run),
         Some(FuzzCommand::Run(a)) => run::run(a),
         Some(FuzzCommand::Triage { paths, model }) => triage::run(&paths, &model),

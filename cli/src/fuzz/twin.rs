@@ -5,8 +5,8 @@
 
 use super::inputs::*;
 use crate::CliError;
+use ppmc::bus_program;
 use ppmc::emu::ModelConfig;
-use ppmc::fuzzing::bus_bytes;
 use ppmc::fuzzing::finding::{self};
 use ppmc::plain_model::twin;
 use ppmc::protocol::Straps;
@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 pub fn run(file: &Path, output: Option<PathBuf>) -> Result<(), CliError> {
     let data = ppmc_files::read(file, ppmc_files::MAX_INPUT_BYTES)?;
-    let ops = bus_bytes::decode(&data);
+    let ops = bus_program::decode(&data);
     let cfg = ModelConfig::default();
     let straps = Straps::default();
     let d = match twin::check(&ops, straps, &cfg) {
@@ -40,7 +40,7 @@ pub fn run(file: &Path, output: Option<PathBuf>) -> Result<(), CliError> {
         return Err(CliError::Verdict);
     };
     let out = output.unwrap_or_else(|| with_suffix(file, "min"));
-    ppmc_files::write(&out, &bus_bytes::encode(&small))?;
+    ppmc_files::write(&out, &bus_program::encode(&small))?;
     errln!(
         "ppmc fuzz twin: {} ops -> {} ops; wrote {}",
         ops.len(),

@@ -51,8 +51,8 @@ fn minimize_then_to_scenario_on_an_injected_bug() {
         "{err}"
     );
     let min = dir.join("crash-1.min");
-    let before = ppmc::fuzzing::bus_bytes::decode(&std::fs::read(&input).expect("input")).len();
-    let after = ppmc::fuzzing::bus_bytes::decode(&std::fs::read(&min).expect("minimized")).len();
+    let before = ppmc::bus_program::decode(&std::fs::read(&input).expect("input")).len();
+    let after = ppmc::bus_program::decode(&std::fs::read(&min).expect("minimized")).len();
     assert!(after * 2 < before, "{before} ops -> {after}");
     let script = String::from_utf8(out.stdout).expect("utf-8");
     assert!(

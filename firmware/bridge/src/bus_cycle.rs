@@ -13,7 +13,7 @@
 //!
 //! so that the bridge never drives the shifter while the shifter drives
 //! the bridge, and the shifter never drives the chip's bus while the chip
-//! does. The tests play every cycle in [`crate::sim`] and check that, and
+//! does. The tests play every cycle on the twin's PIO model and check that, and
 //! the times, cycle by cycle.
 
 /// Bit positions of the bus pins in a step's pin field (and their GPIO

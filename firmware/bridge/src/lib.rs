@@ -6,10 +6,10 @@
 //! the same code on a model of the RP2350's PIO and GPIOs wired to the
 //! reference chip model.
 //!
-//! - [`bus`]: a bus cycle (write command, write data, read status, read
+//! - [`bus_cycle`]: a bus cycle (write command, write data, read status, read
 //!   data) as a few *steps*, each a state of the bus pins held for a number
 //!   of cycles; [`programs::bus_player`] plays them. Setup, strobe and hold
-//!   times are [`bus::BusTiming`], configurable, with conservative defaults
+//!   times are [`bus_cycle::BusTiming`], configurable, with conservative defaults
 //!   (the datasheet's bus-timing chapter is not in our hands:
 //!   `docs/datasheet-notes.md` N46).
 //! - [`programs::edge_counter`]: a state machine that stamps each rising

@@ -177,7 +177,7 @@ pub mod block {
     pub const GPIOBASE: [u32; 3] = [0, 16, 16];
 }
 
-/// The bus player (PIO0, SM0) running `p` ([`programs::bus_player`]): OUT
+/// The bus player (PIO0, SM0) running `p` ([`crate::programs::bus_player`]): OUT
 /// pins GPIO 0-12, IN base GPIO 0 (D0-D7), OUT shift right, IN shift left,
 /// no autopull or autopush, FIFOs not joined (it pushes the bytes it
 /// reads): 4 steps queue in the TX FIFO. Its side-set (to directions,
@@ -202,7 +202,7 @@ pub fn bus_player(p: &Loaded) -> SmRegs {
     }
 }
 
-/// The self-test generator (PIO0, SM1) running `p` ([`programs::test_gen`],
+/// The self-test generator (PIO0, SM1) running `p` ([`crate::programs::test_gen`],
 /// relocated to its origin): SET pin TEST_GEN, FIFOs not joined (a
 /// burst's three words fit the TX FIFO's four), no side-set.
 pub fn test_gen(p: &Loaded) -> SmRegs {
@@ -252,7 +252,7 @@ fn counter(p: &Loaded, block: usize, pin: u32, input: u32, high: bool) -> SmRegs
     }
 }
 
-/// The POUT counter (PIO1, SM0) running `p` ([`programs::edge_counter`]
+/// The POUT counter (PIO1, SM0) running `p` ([`crate::programs::edge_counter`]
 /// `(true)`): rising edges of POUT, with DIR; `pout_high` is POUT's level
 /// now.
 pub fn pout_counter(p: &Loaded, pout_high: bool) -> SmRegs {
@@ -260,7 +260,7 @@ pub fn pout_counter(p: &Loaded, pout_high: bool) -> SmRegs {
 }
 
 /// The INT*, HOLD and AUX* counters (PIO2, SM0-2) running `p`
-/// ([`programs::edge_counter`]`(false)`): both edges, with the new level;
+/// ([`crate::programs::edge_counter`]`(false)`): both edges, with the new level;
 /// `levels` are the three pins' levels now.
 pub fn pin_counters(p: &Loaded, levels: [bool; 3]) -> [SmRegs; 3] {
     [

@@ -58,7 +58,7 @@ impl Loaded {
 
 /// The bus cycle player (PIO0, SM0).
 ///
-/// Each word from the TX FIFO is one *step* ([`crate::bus_cycle::Step`]): the
+/// Each word from the TX FIFO is one *step* ([`crate::bus_cycle::Steps`]): the
 /// directions of D0-D7, then the levels of D0-D7, A0, CS*, DIR (of the
 /// level shifter), RD* and WR* (the 13 OUT pins, GPIO 0-12), then whether
 /// to sample D0-D7 at the end of the step, then how long the step lasts:

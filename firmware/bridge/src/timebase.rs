@@ -1,6 +1,6 @@
 //! The capture's timebase: the edge-capture state machines count down from
 //! all ones, one tick every two system clock cycles, and push the low 31
-//! bits of their count with each edge ([`crate::programs::edge_capture`]).
+//! bits of their count with each edge ([`crate::programs::edge_counter`]).
 //! The firmware turns that into ticks since the timebase started, given a
 //! later time it knows (its own clock, read at the same rate): any edge
 //! drained within 2^30 ticks (14 s at 75 MHz) of happening is placed

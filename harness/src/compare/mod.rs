@@ -20,7 +20,7 @@
 //! The report is the first divergence in time, with the quantity, golden
 //! and got, and the allowed band. Each timing is as unsure as the
 //! instruments that took the two traces say, and judged by the decision
-//! rule ([`rule`]): a timing within that uncertainty of its limit is no
+//! rule (`rule.rs`): a timing within that uncertainty of its limit is no
 //! divergence but MARGINAL ([`Graded`]).
 
 mod rule;

@@ -12,7 +12,7 @@
 //! that ran, so that every finding of `typed_actions` has one bus-level
 //! form.
 
-use super::bus_bytes;
+use crate::bus_program;
 use crate::console::Stmt;
 use crate::emu::{ModelConfig, PA_MIN};
 use crate::invariants::judge::Violation;
@@ -275,18 +275,19 @@ pub fn typed_program(data: &[u8]) -> Vec<Action> {
 /// (the flowchart's waits become the time that passed, to the
 /// microsecond), with the first invariant break. The ops replay as a
 /// `bus_bytes` input, so every finding has one bus-level form.
-pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus_bytes::BusOp>, Option<Violation>) {
+pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus_program::BusOp>, Option<Violation>) {
     let mut ops = Vec::new();
     let Ok(mut c) = oracle::Checker::new(cfg) else {
         return (ops, None);
     };
-    let run = |c: &mut oracle::Checker, op: bus_bytes::BusOp, ops: &mut Vec<bus_bytes::BusOp>| {
-        ops.push(op);
-        c.apply(op)
-    };
+    let run =
+        |c: &mut oracle::Checker, op: bus_program::BusOp, ops: &mut Vec<bus_program::BusOp>| {
+            ops.push(op);
+            c.apply(op)
+        };
     // Lets time pass until `ready` holds or `timeout` is spent.
     let wait = |c: &mut oracle::Checker,
-                ops: &mut Vec<bus_bytes::BusOp>,
+                ops: &mut Vec<bus_program::BusOp>,
                 ready: &dyn Fn(Status) -> bool,
                 timeout: Duration|
      -> Result<(), Violation> {
@@ -295,7 +296,7 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus_bytes::BusOp>, Optio
             let now = c.board().now();
             let next = c.board().poll_at().unwrap_or(deadline).min(deadline);
             let us = next.saturating_since(now).as_nanos().div_ceil(1_000).max(1);
-            for op in bus_bytes::advances(Duration::from_micros(us)) {
+            for op in bus_program::advances(Duration::from_micros(us)) {
                 ops.push(op);
                 c.apply(op)?;
             }
@@ -312,9 +313,9 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus_bytes::BusOp>, Optio
                             wait(&mut c, &mut ops, &|s| !s.ibf(), second)?;
                         }
                         let op = if matches!(s, Stmt::WriteCommand { .. }) {
-                            bus_bytes::BusOp::Command(byte)
+                            bus_program::BusOp::Command(byte)
                         } else {
-                            bus_bytes::BusOp::Data(byte)
+                            bus_program::BusOp::Data(byte)
                         };
                         run(&mut c, op, &mut ops)?;
                     }
@@ -322,7 +323,7 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus_bytes::BusOp>, Optio
                         if w {
                             wait(&mut c, &mut ops, &|s| s.obf(), second)?;
                         }
-                        run(&mut c, bus_bytes::BusOp::ReadData, &mut ops)?;
+                        run(&mut c, bus_program::BusOp::ReadData, &mut ops)?;
                     }
                     Stmt::Await {
                         flag,
@@ -333,23 +334,23 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus_bytes::BusOp>, Optio
                         let want = if value { mask } else { 0 };
                         let t = timeout.unwrap_or(second);
                         wait(&mut c, &mut ops, &|s| s.0 & mask == want, t)?;
-                        run(&mut c, bus_bytes::BusOp::ReadStatus, &mut ops)?;
+                        run(&mut c, bus_program::BusOp::ReadStatus, &mut ops)?;
                     }
-                    Stmt::ReadStatus => run(&mut c, bus_bytes::BusOp::ReadStatus, &mut ops)?,
+                    Stmt::ReadStatus => run(&mut c, bus_program::BusOp::ReadStatus, &mut ops)?,
                     Stmt::Wait(d) => {
-                        for op in bus_bytes::advances(d) {
+                        for op in bus_program::advances(d) {
                             run(&mut c, op, &mut ops)?;
                         }
                     }
                     Stmt::WaitAt(t) => {
                         let d = t.saturating_since(c.board().now());
-                        for op in bus_bytes::advances(d) {
+                        for op in bus_program::advances(d) {
                             run(&mut c, op, &mut ops)?;
                         }
                     }
                     Stmt::Set { input, asserted } => run(
                         &mut c,
-                        bus_bytes::BusOp::Input { input, asserted },
+                        bus_program::BusOp::Input { input, asserted },
                         &mut ops,
                     )?,
                     Stmt::AwaitPulse { count, timeout } => {
@@ -366,7 +367,7 @@ pub fn lower(acts: &[Action], cfg: ModelConfig) -> (Vec<bus_bytes::BusOp>, Optio
                                 break;
                             }
                             let us = at.saturating_since(now).as_nanos().div_ceil(1_000).max(1);
-                            for op in bus_bytes::advances(Duration::from_micros(us)) {
+                            for op in bus_program::advances(Duration::from_micros(us)) {
                                 run(&mut c, op, &mut ops)?;
                             }
                         }

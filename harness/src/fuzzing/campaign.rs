@@ -3,7 +3,7 @@
 //! commands in which chip state, which error codes, finish causes and
 //! inputs it reached), so that a user sees what was not exercised.
 
-use super::bus_bytes::BusOp;
+use crate::bus_program::BusOp;
 use crate::emu::ModelConfig;
 use crate::invariants::ids::Invariant;
 use crate::invariants::judge::Violation;
@@ -265,8 +265,8 @@ fn list(v: &[String]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bus_program;
     use crate::faults;
-    use crate::fuzzing::bus_bytes;
 
     fn seeds() -> Vec<(String, Vec<BusOp>)> {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/bus_bytes");
@@ -277,7 +277,7 @@ mod tests {
                 let name = e.file_name().to_string_lossy().into_owned();
                 (
                     name,
-                    bus_bytes::decode(&std::fs::read(e.path()).expect("seed")),
+                    bus_program::decode(&std::fs::read(e.path()).expect("seed")),
                 )
             })
             .collect();

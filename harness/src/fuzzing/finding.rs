@@ -5,7 +5,7 @@
 //! as a Rust scenario file.
 
 use super::actions::{lower, typed_program};
-use super::bus_bytes::{self, BusOp};
+use crate::bus_program::{self, BusOp};
 use crate::emu::ModelConfig;
 use crate::invariants::ids::Invariant;
 use crate::invariants::judge::Violation;
@@ -27,7 +27,7 @@ pub enum InputKind {
 /// The bus ops an input runs on a model with `cfg`.
 pub fn ops_of(data: &[u8], kind: InputKind, cfg: &ModelConfig) -> Vec<BusOp> {
     match kind {
-        InputKind::BusBytes => bus_bytes::decode(data),
+        InputKind::BusBytes => bus_program::decode(data),
         InputKind::TypedActions => lower(&typed_program(data), cfg.clone()).0,
     }
 }
@@ -196,7 +196,7 @@ pub fn reproducer(data: &[u8], source: &str) -> (String, Option<Violation>) {
 
 /// [`reproducer`], judged on a model with a configuration.
 pub fn reproducer_with(data: &[u8], source: &str, cfg: ModelConfig) -> (String, Option<Violation>) {
-    let ops = bus_bytes::decode(data);
+    let ops = bus_program::decode(data);
     let found = oracle::check(&ops, cfg).ok().flatten();
     let mut out = format!(
         "# reproducer of {source}: {} bytes, {} ops (fuzz target bus_bytes)\n",
@@ -223,11 +223,11 @@ pub fn to_bytes(ops: &[BusOp]) -> Vec<u8> {
     let split: Vec<BusOp> = ops
         .iter()
         .flat_map(|op| match op {
-            BusOp::Advance(d) => bus_bytes::advances(*d),
+            BusOp::Advance(d) => bus_program::advances(*d),
             other => vec![*other],
         })
         .collect();
-    bus_bytes::encode(&split)
+    bus_program::encode(&split)
 }
 
 /// A scenario name for a break of `invariant`: `fuzz_<invariant>_<n>`.
@@ -251,7 +251,7 @@ pub fn scenario_file(stem: &str, ops: &[BusOp], v: &Violation, source: &str) -> 
          //! (`ppmc record --filter {stem}`).\n",
         v.invariant, v.op, detail,
     );
-    s.push_str("use ppmc::fuzzing::bus_bytes::BusOp::{self, *};\n");
+    s.push_str("use ppmc::bus_program::BusOp::{self, *};\n");
     s.push_str("use ppmc::invariants::replay::regression;\n");
     s.push_str("use ppmc::scenario::prelude::*;\n\n");
     let _ = writeln!(
@@ -317,7 +317,7 @@ mod tests {
         // a stop, with noise ops around.
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../fuzz/corpus/bus_bytes/s3_3_1_immediate_stop_and_resume.bin");
-        bus_bytes::decode(&std::fs::read(dir).expect("seed"))
+        bus_program::decode(&std::fs::read(dir).expect("seed"))
     }
 
     /// The minimizer keeps the break, and shrinks a 40-odd op seed to a
@@ -345,7 +345,7 @@ mod tests {
         assert_eq!(first_break(&m.ops, &ModelConfig::default()), None);
         // As bytes it is the same program.
         assert_eq!(
-            merge_waits(&bus_bytes::decode(&to_bytes(&m.ops))),
+            merge_waits(&bus_program::decode(&to_bytes(&m.ops))),
             merge_waits(&m.ops)
         );
         // An input that breaks nothing cannot be minimized for it.
@@ -429,7 +429,7 @@ mod tests {
     /// chip saw (the console runs the same model through the target).
     #[test]
     fn a_reproducer_replays_in_the_console() {
-        let data = bus_bytes::encode(&sample());
+        let data = bus_program::encode(&sample());
         let (script, found) = reproducer(&data, "crash-1");
         assert_eq!(found, None);
         assert!(script.starts_with("# reproducer of crash-1"));
@@ -451,7 +451,7 @@ mod tests {
 
     #[test]
     fn a_reproducer_names_the_break_and_marks_its_op() {
-        let data = bus_bytes::encode(&sample());
+        let data = bus_program::encode(&sample());
         let cfg = ModelConfig {
             board: WiringFaults {
                 status_stuck_high: 0x08,

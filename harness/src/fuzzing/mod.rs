@@ -4,20 +4,23 @@
 //! and its comparison with the emulator in [`crate::plain_model`].
 //!
 //! - [`targets`]: one function per `fuzz/fuzz_targets/*.rs`.
-//! - [`bus`]: the bus-op language (`BusOp`) and the byte-stream grammar of
-//!   a `bus_bytes` input; what the oracle judges and the twin compares.
+//! - The bus-op language (`BusOp`) and the byte-stream grammar of a
+//!   `bus_bytes` input, what the oracle judges and the twin compares, is
+//!   [`crate::bus_program`], below all three rooms.
 //! - [`actions`]: typed host actions (the `typed_actions` target, the
 //!   differential runs), and their lowering to bus ops under the oracle.
 //! - [`finding`]: from a finding to a regression: minimizers,
 //!   reproducers, regression scenario files.
 //! - [`campaign`]: findings bucketed by invariant, a corpus's domain
 //!   coverage.
+//! - [`seeds`]: the targets' seed corpora, made from the protocol and the
+//!   suite (`ppmc fuzz seeds`).
 //! - [`differential`]: seeded runs of typed actions on a target beside the
 //!   reference emulator (`ppmc fuzz run`).
 
 pub mod actions;
-pub mod bus_bytes;
 pub mod campaign;
 pub mod differential;
 pub mod finding;
+pub mod seeds;
 pub mod targets;

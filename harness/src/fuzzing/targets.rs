@@ -6,9 +6,9 @@
 //! (`harness/tests/it/fuzz_corpus.rs`, `harness/tests/it/model_twin.rs`).
 
 use super::actions::{lower, typed_program};
-use super::bus_bytes;
 use crate::bridge::frame::{self, FrameDecoder};
 use crate::bridge::wire::{Request, Response, Timer};
+use crate::bus_program;
 use crate::emu::ModelConfig;
 use crate::invariants::oracle;
 use crate::plain_model::twin;
@@ -53,16 +53,16 @@ pub fn frame_decoder(data: &[u8]) {
     }
 }
 
-/// Bus byte stream (see [`bus`]) into a fresh emulator; every invariant of
+/// Bus byte stream (see [`crate::bus_program`]) into a fresh emulator; every invariant of
 /// `docs/invariants.md` checked after every op. A break panics with the
 /// invariant's id first, so libFuzzer's crash message buckets it.
 pub fn bus_bytes(data: &[u8]) {
     bus_bytes_with(data, ModelConfig::default());
 }
 
-/// [`bus_bytes`] on a model with a configuration (e.g. an injected fault).
+/// [`bus_bytes()`] on a model with a configuration (e.g. an injected fault).
 pub fn bus_bytes_with(data: &[u8], cfg: ModelConfig) {
-    match oracle::check_ops(bus_bytes::ops(data), cfg) {
+    match oracle::check_ops(bus_program::ops(data), cfg) {
         Ok(None) => {}
         Ok(Some(v)) => panic!("invariant {v}"),
         Err(e) => panic!("the model refused its configuration: {e}"),
@@ -73,7 +73,7 @@ pub fn bus_bytes_with(data: &[u8], cfg: ModelConfig) {
 /// [`Action`](super::actions::Action)s
 /// (derive `Arbitrary`) after a valid initialization, run with the
 /// flowchart's waits on a fresh emulator under the same oracle as
-/// [`bus_bytes`].
+/// [`bus_bytes()`].
 pub fn typed_actions(data: &[u8]) {
     typed_actions_with(data, ModelConfig::default());
 }
@@ -109,8 +109,8 @@ pub fn trace_text(data: &[u8]) {
     let Ok(mut chip) = crate::emu::Board::new(Straps::default(), ModelConfig::default()) else {
         return;
     };
-    for op in bus_bytes::decode(data) {
-        bus_bytes::apply(&mut chip, op);
+    for op in bus_program::decode(data) {
+        bus_program::apply(&mut chip, op);
     }
     let t = Trace::new("fuzz", "-", "emu", Straps::default(), Vec::new()).assemble(
         Vec::new(),
@@ -121,11 +121,11 @@ pub fn trace_text(data: &[u8]) {
 }
 
 /// The emulator against the plain model ([`twin::check`]) on one input
-/// in the bus-byte format ([`bus_bytes::decode`]), at the default straps and
+/// in the bus-byte format ([`crate::bus_program::decode`]), at the default straps and
 /// model. Inputs are cut at [`MODEL_TWIN_MAX_OPS`] ops, so that each runs
 /// in bounded time.
 pub fn model_twin(data: &[u8]) {
-    let ops = bus_bytes::decode(data);
+    let ops = bus_program::decode(data);
     let ops = &ops[..ops.len().min(MODEL_TWIN_MAX_OPS)];
     if let Err(d) = twin::check(ops, Straps::default(), &ModelConfig::default()) {
         panic!("model-twin: {d}");

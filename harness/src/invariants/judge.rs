@@ -9,7 +9,7 @@ use super::capture::{
     busy_level, phase_breaks, pulse_outside_busy, record_breaks, shortest_interval_below,
 };
 use super::ids::Invariant;
-use crate::fuzzing::bus_bytes::BusOp;
+use crate::bus_program::BusOp;
 use crate::protocol::capture::{MoveStart, Pin, Record};
 use crate::protocol::{
     ClockSource, Command, FinishStatus, InitData, MoveKind, Register, Status, StatusField, Straps,

@@ -4,8 +4,8 @@
 //! stable id; a finding is bucketed by it.
 
 use super::judge::{Judge, Seen, Violation};
+use crate::bus_program::{self, BusOp};
 use crate::emu::{Board, ChipError, ModelConfig};
-use crate::fuzzing::bus_bytes::{self, BusOp};
 use crate::protocol::{Status, Straps};
 use std::cell::Cell;
 
@@ -93,7 +93,7 @@ impl Checker {
         // has no side effect (Section 3-1-1): the status after one op is
         // the status before the next.
         let before = self.status.unwrap_or_else(|| chip.read_status());
-        let value = bus_bytes::apply(chip, op);
+        let value = bus_program::apply(chip, op);
         // A status read's own value is the status after it.
         let after = match (op, value) {
             (BusOp::ReadStatus, Some(v)) => Status(v),
@@ -118,8 +118,8 @@ impl Checker {
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
+    use crate::bus_program::BusOp::*;
     use crate::emu::{Chip, WiringFaults};
-    use crate::fuzzing::bus_bytes::BusOp::*;
     use crate::invariants::ids::Invariant;
     use crate::time::Duration;
 

@@ -6,7 +6,7 @@
 
 use super::judge::{Judge, Seen, Violation};
 use crate::backend::{Op, Reply, Target, TargetError};
-use crate::fuzzing::bus_bytes::BusOp;
+use crate::bus_program::BusOp;
 use crate::protocol::{Record, Straps};
 use crate::scenario::{Driver, Failure, HarnessError, Outcome, Stop};
 use crate::trace::BusEvent;

@@ -15,8 +15,8 @@
 //! [`crate::fuzzing::finding::minimize_disagreement`] (`ppmc fuzz twin`).
 
 use super::chip::PlainChip;
+use crate::bus_program::{self, BusOp};
 use crate::emu::{Board, ModelConfig};
-use crate::fuzzing::bus_bytes::{self, BusOp};
 use crate::protocol::{Direction, Pin, PinEvent, PulseRun, Straps};
 use crate::time::Instant;
 use std::fmt;
@@ -94,7 +94,7 @@ pub fn check_against(
             what_op: op,
             detail,
         };
-        let a = bus_bytes::apply(&mut fast, op);
+        let a = bus_program::apply(&mut fast, op);
         let b = apply(&mut plain, op);
         if plain.exhausted() {
             seen.cut_short = true;

@@ -6,7 +6,7 @@
 //! `int`, `hold`, `aux` (1 = asserted), `busy`, `switching` (stop switching
 //! active; the chopping itself is not expanded), and `auxo0`..`auxo3`.
 //! With the bus, every pin is at its level instead: `s1`..`s5` under the
-//! output logic, chopped while stop switching is on ([`phases`]).
+//! output logic, chopped while stop switching is on (`phases.rs`).
 //! There are no vectors (libsigrok's VCD reader loads a file with a vector
 //! as zero samples, without a word), and a value is written only when it
 //! changes, with a timestamp only where something changes. Timescale 1 ns,

@@ -21,8 +21,8 @@ fn replay(target: &str, body: fn(&[u8])) -> usize {
 /// on one whose outputs are miswired (the board keeps a record of its own).
 #[test]
 fn a_reset_checker_runs_as_a_fresh_one() {
+    use ppmc::bus_program;
     use ppmc::emu::{ModelConfig, WiringFaults};
-    use ppmc::fuzzing::bus_bytes;
     use ppmc::invariants::oracle::Checker;
     let inputs = common::fuzz_inputs("bus_bytes");
     assert!(inputs.len() > 50, "the corpus is there");
@@ -38,7 +38,7 @@ fn a_reset_checker_runs_as_a_fresh_one() {
     ] {
         let mut reused = Checker::new(cfg.clone()).expect("a valid configuration");
         for (f, data) in &inputs {
-            let ops = bus_bytes::decode(data);
+            let ops = bus_program::decode(data);
             let run = |c: &mut Checker| (c.run(ops.iter().copied()), format!("{c:?}"));
             let mut fresh = Checker::new(cfg.clone()).expect("a valid configuration");
             reused.reset();
@@ -56,8 +56,8 @@ fn a_reset_checker_runs_as_a_fresh_one() {
 /// pulses follow the rate and step counts, not the host's polling).
 #[test]
 fn advancing_in_pieces_changes_nothing() {
+    use ppmc::bus_program::{self, BusOp};
     use ppmc::emu::{Board, ModelConfig};
-    use ppmc::fuzzing::bus_bytes::{self, BusOp};
     use ppmc::protocol::capture::{MoveStart, PulseRun, Record};
     use ppmc::protocol::Straps;
     use ppmc::time::Duration;
@@ -95,7 +95,7 @@ fn advancing_in_pieces_changes_nothing() {
         let mut board = Board::new(Straps::default(), ModelConfig::default()).expect("board");
         let reads: Vec<Option<u8>> = ops
             .iter()
-            .map(|op| bus_bytes::apply(&mut board, *op))
+            .map(|op| bus_program::apply(&mut board, *op))
             .collect();
         (
             reads,
@@ -108,7 +108,7 @@ fn advancing_in_pieces_changes_nothing() {
     assert!(inputs.len() > 50, "the corpus is there");
     let mut cut = 0;
     for (f, data) in &inputs {
-        let ops = bus_bytes::decode(data);
+        let ops = bus_program::decode(data);
         // Each advance in up to 13 pieces of growing length, the piece ends
         // falling anywhere relative to the pulses; a read between the
         // pieces stands for the op's read.
@@ -154,119 +154,6 @@ fn frame_decoder_corpus_replays() {
     assert!(n >= 8, "the seed corpus is there ({n} inputs)");
 }
 
-/// Writes the seed corpus of `frame_decoder`: one framed message of every
-/// kind, long replies in fragments, and some line noise. Run with
-/// `cargo test -p ppmc --test it fuzz_corpus -- --ignored` after a protocol change.
-#[test]
-#[ignore]
-fn write_frame_decoder_seeds() {
-    use ppmc::backend::{EmuTarget, Op};
-    use ppmc::bridge::frame::encode;
-    use ppmc::bridge::sim::engine;
-    use ppmc::bridge::wire::{fragment, Request, Timer};
-    use ppmc::protocol::{Input, Straps};
-    use ppmc::time::Duration;
-
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/frame_decoder");
-    fs::create_dir_all(&dir).expect("corpus dir");
-    let t = Timer::NANOS;
-    let ops = vec![
-        Op::Reset,
-        Op::WriteCommand {
-            byte: 0x02,
-            wait_ibf: Some(Duration::from_secs(1)),
-        },
-        Op::WriteData {
-            byte: 100,
-            wait_ibf: None,
-        },
-        Op::ReadStatus,
-        Op::ReadData {
-            wait_obf: Some(Duration::from_millis(100)),
-        },
-        Op::Delay(Duration::from_millis(200)),
-        Op::AwaitStatus {
-            mask: 4,
-            value: 4,
-            timeout: Duration::from_millis(5),
-        },
-        Op::SetInput {
-            input: Input::L1,
-            asserted: true,
-        },
-        Op::ReadPins,
-        Op::ReadPulses,
-        Op::AwaitPulses {
-            count: 10,
-            timeout: Duration::from_secs(1),
-        },
-    ];
-    let requests = [
-        Request::Hello {
-            version: ppmc::bridge::wire::PROTOCOL_VERSION,
-            host: 0x5EED_0001,
-        },
-        Request::Batch(ops.clone()),
-        // Pin samples: a SAMPLE op, answered with a SAMPLES entry.
-        Request::Batch(
-            (0..40)
-                .flat_map(|_| [Op::ReadPins, Op::Delay(Duration::from_micros(7))])
-                .collect(),
-        ),
-        Request::Capture {
-            runs: 0,
-            pins: 0,
-            moves: 0,
-            max: 40,
-        },
-        Request::Resend {
-            fragments: vec![0, 2],
-        },
-        Request::Link {
-            fragment: 12,
-            pad: 64,
-        },
-    ];
-    let mut server = engine(
-        EmuTarget::new(Straps::default(), Default::default()).expect("emu"),
-        1,
-        true,
-    );
-    let mut n = 0;
-    let mut put = |name: &str, bytes: &[u8]| {
-        fs::write(dir.join(name), bytes).expect("seed written");
-        n += 1;
-    };
-    for (i, r) in requests.iter().enumerate() {
-        let frame = encode(&r.encode(i as u8 + 1, t));
-        put(&format!("request-{i}"), &frame);
-        // The bridge's answer: whole or in fragments.
-        let answer = server.on_bytes(&frame);
-        put(&format!("response-{i}"), &answer);
-    }
-    let big: Vec<u8> = (0..300u16).map(|x| x as u8).collect();
-    let frags: Vec<u8> = fragment(&big, ppmc::bridge::wire::FRAGMENT_DATA)
-        .iter()
-        .flat_map(|f| encode(f))
-        .collect();
-    put("fragments", &frags);
-    let mut bad = encode(
-        &Request::Hello {
-            version: 1,
-            host: 0,
-        }
-        .encode(9, t),
-    );
-    bad[2] ^= 0x10;
-    put("bad-crc", &bad);
-    put(
-        "noise-then-frame",
-        &[&[0x13, 0x77, 0x00][..], &encode(b"\x01\x01\x01\x00")].concat(),
-    );
-    put("empty-frames", &[0, 0, 0]);
-    assert!(n >= 12);
-}
-
 #[test]
 fn bus_bytes_corpus_replays() {
     let n = replay("bus_bytes", ppmc::fuzzing::targets::bus_bytes);
@@ -278,11 +165,11 @@ fn bus_bytes_corpus_replays() {
 /// model across the conformance suite's states.
 #[test]
 fn the_suite_as_fuzz_ops_keeps_every_invariant() {
+    use ppmc::bus_program;
     use ppmc::emu::ModelConfig;
-    use ppmc::fuzzing::bus_bytes;
     use ppmc::invariants::oracle;
     for (name, trace) in suite_traces() {
-        let ops = bus_bytes::from_trace(&trace);
+        let ops = bus_program::from_trace(&trace);
         assert!(!ops.is_empty(), "{name}");
         let v = oracle::check(&ops, ModelConfig::default()).expect("chip");
         assert_eq!(v, None, "{name}");
@@ -294,24 +181,6 @@ fn suite_traces() -> Vec<(&'static str, ppmc::trace::Trace)> {
         .into_iter()
         .filter_map(|r| Some((r.name, r.trace?)))
         .collect()
-}
-
-/// Writes the seed corpus of `bus_bytes`: the bus traffic of every
-/// conformance scenario, as fuzz ops. Run with
-/// `cargo test -p ppmc --test it fuzz_corpus -- --ignored` after a scenario change.
-#[test]
-#[ignore]
-fn write_bus_bytes_seeds() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/bus_bytes");
-    fs::create_dir_all(&dir).expect("corpus dir");
-    for (name, trace) in suite_traces() {
-        let ops = ppmc::fuzzing::bus_bytes::from_trace(&trace);
-        fs::write(
-            dir.join(format!("{name}.bin")),
-            ppmc::fuzzing::bus_bytes::encode(&ops),
-        )
-        .expect("seed written");
-    }
 }
 
 #[test]
@@ -353,35 +222,25 @@ fn typed_seeds_move_the_motor() {
     assert!(moving >= 8, "{moving} typed seeds move the motor");
 }
 
-/// Writes the seed corpus of `typed_actions` (deterministic: seeded random
-/// bytes, each decoding to a few dozen actions) and of `trace_text` (a few
-/// suite traces as text, and a few scenarios' bus traffic as ops, whose
-/// emulator traces it round-trips). Run with `cargo test --test
-/// fuzz_corpus -- --ignored`.
+/// The committed seed corpora are what the seed writers make
+/// (`ppmc::fuzzing::seeds`; `ppmc fuzz seeds` writes them): a protocol or
+/// scenario change that moves a seed shows here, not as a corpus that
+/// quietly stops exercising what it was made for.
 #[test]
-#[ignore]
-fn write_typed_and_trace_seeds() {
-    use rand::{Rng, SeedableRng};
+fn the_committed_seeds_are_what_the_writers_make() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus");
-    let typed = root.join("typed_actions");
-    fs::create_dir_all(&typed).expect("corpus dir");
-    for seed in 0..24u64 {
-        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-        let len = rng.random_range(64..384);
-        let bytes: Vec<u8> = (0..len).map(|_| rng.random()).collect();
-        fs::write(typed.join(format!("random-{seed:02}.bin")), bytes).expect("seed written");
-    }
-    let traces = root.join("trace_text");
-    fs::create_dir_all(&traces).expect("corpus dir");
-    for (name, trace) in suite_traces().into_iter().step_by(10) {
-        fs::write(traces.join(format!("{name}.trace")), trace.render()).expect("seed written");
-    }
-    for (name, trace) in suite_traces().into_iter().skip(5).step_by(16) {
-        let ops = ppmc::fuzzing::bus_bytes::from_trace(&trace);
-        fs::write(
-            traces.join(format!("ops-{name}.bin")),
-            ppmc::fuzzing::bus_bytes::encode(&ops),
-        )
-        .expect("seed written");
-    }
+    let suite = suite_traces();
+    let seeds = ppmc::fuzzing::seeds::all(&suite).expect("the seeds are made");
+    assert!(seeds.len() > 100, "{} seeds", seeds.len());
+    let stale: Vec<String> = seeds
+        .iter()
+        .filter(|(target, name, bytes)| {
+            fs::read(root.join(target).join(name)).ok().as_deref() != Some(&bytes[..])
+        })
+        .map(|(target, name, _)| format!("{target}/{name}"))
+        .collect();
+    assert!(
+        stale.is_empty(),
+        "committed seeds that differ from what `ppmc fuzz seeds` writes (run it): {stale:?}"
+    );
 }

@@ -5,8 +5,8 @@
 
 use ppmc_test_support as common;
 
+use ppmc::bus_program;
 use ppmc::emu::ModelConfig;
-use ppmc::fuzzing::bus_bytes;
 use ppmc::plain_model::twin;
 use ppmc::protocol::Straps;
 use std::fs;
@@ -19,7 +19,7 @@ fn agree_at(straps: Straps, cfg: &ModelConfig) -> usize {
         .into_iter()
         .chain(common::fuzz_inputs("model_twin"));
     for (path, data) in inputs {
-        let ops = bus_bytes::decode(&data);
+        let ops = bus_program::decode(&data);
         match twin::check(&ops, straps, cfg) {
             Ok(a) => compared += a.pulses,
             Err(d) => failures.push(format!("{}: {d}", path.display())),
@@ -89,7 +89,7 @@ fn an_emulator_off_by_one_microsecond_or_one_bit_disagrees() {
             .join("../fuzz/corpus/bus_bytes/s3_3_4_accel_ccw_masked_interrupt.bin"),
     )
     .expect("seed");
-    let ops = bus_bytes::decode(&data);
+    let ops = bus_program::decode(&data);
     let clean = ModelConfig::default();
     assert!(twin::check_against(&ops, Straps::default(), &clean, &clean).is_ok());
     let late = ModelConfig {

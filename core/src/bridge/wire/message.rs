@@ -114,7 +114,7 @@ pub struct Hello {
     pub max_payload: u16,
     /// Pulse runs and pin changes the capture buffer holds.
     pub capture_capacity: u32,
-    /// One bit per [`Input`] (bit = `Input::index`) that is wired.
+    /// One bit per [`Input`](crate::protocol::Input) (bit = `Input::index`) that is wired.
     pub inputs_wired: u16,
     /// The bridge runs in virtual time (a simulator answering at once),
     /// so the host must not expect replies to take as long as their waits.

@@ -198,10 +198,10 @@ impl<H: Hal> Board<H> {
     /// How sure this board's times are, by path (HELLO_REPLY's
     /// `uncertainty`): a captured edge to the timer's tick (the engine's
     /// floor); an access within a pass of the spin that aims it
-    /// and the read itself ([`ops::ACCESS_TICKS`]); a sampled output's change within half the
+    /// and the read itself (`ops::ACCESS_TICKS`); a sampled output's change within half the
     /// widest bracket the sampling allows ([`limits::SAMPLE_BRACKET_NS`]);
     /// a polled flag within half a pass of the status loop
-    /// ([`cycles::CLOSE_NS`]). The twin's tests hold the board code to the
+    /// (`cycles::CLOSE_NS`). The twin's tests hold the board code to the
     /// last two ([`Board::longest_bracket`], [`Board::longest_pass`]).
     pub fn uncertainty(&self) -> Uncertainty {
         Uncertainty {

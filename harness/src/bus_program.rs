@@ -1,5 +1,8 @@
-//! The byte-stream fuzz input: bus operations in the style of QEMU's
-//! generic device fuzzer.
+//! Bus programs: the bus-op language ([`BusOp`]) that the invariant
+//! oracle judges, the two models compare and a fuzz input encodes, and
+//! the byte stream of a `bus_bytes` input, in the style of QEMU's generic
+//! device fuzzer. Every fuzzing room speaks it, so it lives below them
+//! all.
 //!
 //! An input is split at the separator `FUZZ` into ops; each op is an
 //! opcode byte (taken modulo [`OPCODES`]) and up to two operand bytes
