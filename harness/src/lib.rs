@@ -3,17 +3,20 @@
 //!
 //! The harness library: everything that needs an operating system to
 //! drive a chip, on top of the portable `ppmc-core` (re-exported here as
-//! [`time`], [`protocol`], [`emu`] and [`bus`]). Layers, each depending
-//! only on the ones before it: [`stop`], [`files`] ← [`backend`]
+//! [`time`], [`protocol`], [`emu`] and [`bus`]). Its modules from the
+//! lowest up, each naming only those before it (a test holds them to
+//! this order): [`stop`]; [`bridge`] (the bridge simulator); [`backend`]
 //! (targets: a [`backend::TargetSpec`] opened into the emulator or a
-//! bridge over a byte link), [`trace`], [`vcd_export`], [`bridge::sim`] ←
-//! [`scenario`] (the scenario language) ← [`runner`] (one target or a
-//! [`runner::Farm`] of boards), [`golden`], [`compare`], [`selftest`],
-//! [`console`], [`chaos`], [`soak`] (a run's results into its
-//! [`record::RunRecord`]), [`artifacts`] ← [`session`] (a run of a suite
-//! on a farm of boards, into its record), [`bench`](mod@bench) (its wall-clock
-//! figures) ← [`fuzzing`] (its oracle in [`invariants`], the
-//! second model of the chip in [`plain_model`]).
+//! bridge over a byte link); [`trace`], [`compare`], [`vcd_export`];
+//! [`bus_program`] (the bus-op language the fuzzing rooms speak);
+//! [`scenario`] (the scenario language); [`runner`] (one target or a
+//! [`runner::Farm`] of boards); [`console`], [`selftest`], [`chaos`],
+//! [`golden`]; [`soak`] (a run's results into its [`record::RunRecord`]),
+//! [`artifacts`]; [`session`] (a run of a suite on a farm of boards,
+//! into its record), [`bench`](mod@bench) (its wall-clock figures);
+//! then the three fuzzing rooms, [`invariants`] (the oracle),
+//! [`plain_model`] (the second model of the chip) and [`fuzzing`] (the
+//! campaign).
 //!
 //! Reports, the results store, capture readers, the capture judge and the
 //! command line are crates of their own above this one (`ppmc-report`,

@@ -428,3 +428,69 @@ fn no_command_file_has_more_than_150_lines() {
         "command files over {MAX_COMMAND_LINES} lines (move what decides into a library crate): {long:?}"
     );
 }
+
+/// The harness's modules from the lowest up, as its `lib.rs` lists its
+/// layers: a module names (outside comments and tests) only modules
+/// before it. The re-exported crates below it (`bus`, `emu`, `protocol`,
+/// `time`, `faults`, `files`, `record`) are below them all.
+const HARNESS_LAYERS: [&str; 20] = [
+    "stop",
+    "bridge",
+    "backend",
+    "trace",
+    "compare",
+    "vcd_export",
+    "bus_program",
+    "scenario",
+    "runner",
+    "console",
+    "selftest",
+    "chaos",
+    "golden",
+    "soak",
+    "artifacts",
+    "session",
+    "bench",
+    "invariants",
+    "plain_model",
+    "fuzzing",
+];
+
+#[test]
+fn no_module_of_the_harness_imports_one_above_it() {
+    let src = root().join("harness/src");
+    let mut files = Vec::new();
+    sources(&src, &src, &mut files);
+    let rank = |m: &str| HARNESS_LAYERS.iter().position(|l| *l == m);
+    let mut up = Vec::new();
+    let mut seen = BTreeSet::new();
+    for rel in &files {
+        let Some(from) = module_of(rel).first().cloned() else {
+            continue; // lib.rs lists them all
+        };
+        let Some(from_rank) = rank(&from) else {
+            up.push(format!("{from}: not in HARNESS_LAYERS; give it its place"));
+            continue;
+        };
+        seen.insert(from.clone());
+        let text = std::fs::read_to_string(src.join(rel)).expect("source reads");
+        let code: String = without_tests(&text)
+            .iter()
+            .map(|l| l.split("//").next().unwrap_or_default())
+            .collect::<Vec<_>>()
+            .join("\n");
+        for path in paths_named(&code) {
+            if path.first().map(String::as_str) != Some("crate") {
+                continue;
+            }
+            let Some(to) = path.get(1) else { continue };
+            if let Some(to_rank) = rank(to) {
+                if to_rank > from_rank {
+                    up.push(format!("{} names crate::{to}", rel.display()));
+                }
+            }
+        }
+    }
+    assert!(seen.len() >= 15, "the modules read: {seen:?}");
+    assert!(up.is_empty(), "imports that run back up: {up:#?}");
+}
