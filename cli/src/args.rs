@@ -9,7 +9,7 @@ use ppmc::emu::{AccelCurve, ModelConfig};
 use ppmc::protocol::Straps;
 use ppmc::runner::{parse_shard, validate_suite, Selection};
 use ppmc::scenario::Scenario;
-use ppmc::stop::Stop;
+use ppmc::stop::StopRequest;
 use ppmc::time::Duration;
 
 /// Which chip to drive, and how its board is strapped.
@@ -57,7 +57,7 @@ pub struct TargetArgs {
     /// Asked for (a signal), opening a target and every wait on its link
     /// end early.
     #[arg(skip)]
-    pub(super) stop: Stop,
+    pub(super) stop: StopRequest,
 }
 
 /// The chip itself: how its board is strapped, and the emulator's ramp.

@@ -12,7 +12,7 @@
 //! [`stop_requested`] serves commands with nothing to save: a second
 //! signal ends them at once.
 
-use ppmc::stop::Stop;
+use ppmc::stop::StopRequest;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
@@ -20,12 +20,12 @@ use std::sync::Arc;
 /// both the process and its group).
 const SAME_REQUEST: std::time::Duration = std::time::Duration::from_millis(200);
 
-/// Installs the handlers of a command that writes reports; the [`Stop`]
+/// Installs the handlers of a command that writes reports; the [`StopRequest`]
 /// they raise. A thread of its own takes the signals (the handler itself
 /// only wakes it), raises the stop for the first two and ends the process
 /// at the third.
-pub fn install() -> Stop {
-    let stop = Stop::new();
+pub fn install() -> StopRequest {
+    let stop = StopRequest::new();
     #[cfg(unix)]
     {
         use signal_hook::consts::{SIGINT, SIGTERM};

@@ -11,7 +11,7 @@
 //! [`bus_program`] (the bus-op language the fuzzing rooms speak);
 //! [`scenario`] (the scenario language); [`runner`] (one target or a
 //! [`runner::Farm`] of boards); [`console`], [`selftest`], [`chaos`],
-//! [`golden`]; [`soak`] (a run's results into its [`record::RunRecord`]),
+//! [`golden`]; [`sink`] (a run's results into its [`record::RunRecord`]),
 //! [`artifacts`]; [`session`] (a run of a suite on a farm of boards,
 //! into its record), [`bench`](mod@bench) (its wall-clock figures);
 //! then the three fuzzing rooms, [`invariants`] (the oracle),
@@ -40,7 +40,7 @@ pub mod runner;
 pub mod scenario;
 pub mod selftest;
 pub mod session;
-pub mod soak;
+pub mod sink;
 pub mod stop;
 pub mod trace;
 pub mod vcd_export;

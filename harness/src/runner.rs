@@ -7,7 +7,7 @@ use crate::backend::{self, Op, OpenError, OpenOptions, Target, TargetInfo, Targe
 use crate::scenario::{
     run_scenario, Attempt, DriverOptions, NotRun, Scenario, ScenarioResult, Verdict,
 };
-use crate::stop::Stop;
+use crate::stop::StopRequest;
 use crate::time::Duration;
 
 /// Which scenarios a run takes.
@@ -404,7 +404,7 @@ pub struct Farm {
     reached: Vec<usize>,
     /// The specs not reached (their index) and why.
     unreached: Vec<(usize, OpenError)>,
-    stop: Stop,
+    stop: StopRequest,
 }
 
 impl Farm {

@@ -3,14 +3,14 @@
 //! boards and writing the reports. Each result is held to its golden trace
 //! (the golden verdict rule, [`crate::golden::check`]), what a report
 //! draws of it is kept, its artifacts are saved when it did not pass, and
-//! the soak sink ([`crate::soak`]) makes the record in constant memory
+//! the result sink ([`crate::sink`]) makes the record in constant memory
 //! whatever `repeat` is.
 
 use crate::artifacts::{self, Window};
 use crate::compare::Tolerances;
 use crate::runner::{Farm, Spread};
 use crate::scenario::{DriverOptions, Scenario, ScenarioResult, Verdict};
-use crate::soak::{Kept, Soak};
+use crate::sink::{Kept, Sink};
 use ppmc_record::{BoardInfo, Figures, RunInfo, RunRecord, Tally};
 use std::cell::RefCell;
 use std::collections::BTreeMap;
@@ -103,10 +103,10 @@ pub fn run(
     let started = std::time::Instant::now();
     let mut problems = Vec::new();
     // The files saved and what the reports draw of each result, by its
-    // slot, until the soak takes it.
+    // slot, until the sink takes it.
     let saved: RefCell<BTreeMap<usize, Vec<String>>> = RefCell::new(BTreeMap::new());
     let drawn: RefCell<BTreeMap<usize, Figures>> = RefCell::new(BTreeMap::new());
-    let mut soak = Soak::new(plan.scenarios.len(), plan.repeat);
+    let mut sink = Sink::new(plan.scenarios.len(), plan.repeat);
     let names: Vec<String> = info.boards.iter().map(|b| b.name.clone()).collect();
     let name_of = |b: Option<usize>| info.board_name(b).to_string();
     farm.stream(
@@ -145,7 +145,7 @@ pub fn run(
                 attachments: saved.borrow_mut().remove(&r.slot).unwrap_or_default(),
                 figures: drawn.borrow_mut().remove(&r.slot),
             };
-            soak.add(r, board, &names, kept);
+            sink.add(r, board, &names, kept);
         },
     );
     for (b, board) in info.boards.iter_mut().enumerate() {
@@ -155,11 +155,11 @@ pub fn run(
     }
     info.wall_s = started.elapsed().as_secs_f64();
     let board_tallies = (0..info.boards.len())
-        .map(|b| soak.board_tally(Some(b)))
+        .map(|b| sink.board_tally(Some(b)))
         .collect();
-    let unlisted = soak.unlisted();
+    let unlisted = sink.unlisted();
     Ended {
-        record: soak.record(info),
+        record: sink.record(info),
         board_tallies,
         unlisted,
         problems,

@@ -4,7 +4,7 @@
 //! scenarios).
 //!
 //! It has levels: the first request asks every wait to end within about
-//! [`Stop::SLICE`] and the run to wind down (the scenario under way is
+//! [`StopRequest::SLICE`] and the run to wind down (the scenario under way is
 //! interrupted, the rest not run, the reports written); a second one says
 //! hurry: no health checks, no reconnecting, no more waiting on a link.
 
@@ -14,14 +14,14 @@ use std::time::{Duration, Instant};
 
 /// A stop request that any number of clones share.
 #[derive(Debug, Clone, Default)]
-pub struct Stop(Arc<AtomicU8>);
+pub struct StopRequest(Arc<AtomicU8>);
 
-impl Stop {
-    /// The longest any wait that watches a [`Stop`] goes without looking.
+impl StopRequest {
+    /// The longest any wait that watches a [`StopRequest`] goes without looking.
     pub const SLICE: Duration = Duration::from_millis(100);
 
-    pub fn new() -> Stop {
-        Stop::default()
+    pub fn new() -> StopRequest {
+        StopRequest::default()
     }
 
     /// Asks to stop; a second call asks to hurry.
@@ -71,7 +71,7 @@ mod tests {
 
     #[test]
     fn clones_share_the_request_and_a_second_one_hurries() {
-        let a = Stop::new();
+        let a = StopRequest::new();
         let b = a.clone();
         assert!(!b.requested());
         a.request();
@@ -82,10 +82,10 @@ mod tests {
 
     #[test]
     fn a_sleep_ends_at_once_when_a_stop_is_asked_for() {
-        let s = Stop::new();
+        let s = StopRequest::new();
         s.request();
         // Nothing to wait for: the answer comes before any sleep.
         assert!(s.sleep(Duration::from_secs(3600)));
-        assert!(!Stop::new().sleep(Duration::ZERO));
+        assert!(!StopRequest::new().sleep(Duration::ZERO));
     }
 }

@@ -97,7 +97,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         outln!(
             "{} runs that did not pass are counted, not listed: the reports list the first {} after the first pass",
             ended.unlisted,
-            ppmc::soak::MAX_LISTED
+            ppmc::sink::MAX_LISTED
         );
     }
     summary_lines(&record.summary, record.summary.runs());

@@ -447,7 +447,7 @@ const HARNESS_LAYERS: [&str; 20] = [
     "selftest",
     "chaos",
     "golden",
-    "soak",
+    "sink",
     "artifacts",
     "session",
     "bench",

@@ -45,7 +45,7 @@ mod target;
 pub use self::emu::EmuTarget;
 pub use self::link::labgrid::{parse_labgrid, LabgridLink, Place};
 pub use self::link::rfc2217::{parse_rfc2217, Rfc2217Link};
-pub use self::link::serial::{parse_spec, SerialLink};
+pub use self::link::serial::{parse_serial_address, SerialLink};
 pub use self::link::tcp::{parse_tcp, TcpLink};
 pub use self::link::Link;
 pub use self::open::{check, open, OpenError, OpenOptions};

@@ -16,7 +16,7 @@ use super::spec::{Address, SpecError, StrapOptions, TargetSpec};
 use super::target::Target;
 use crate::emu::ModelConfig;
 use crate::protocol::Straps;
-use crate::stop::Stop;
+use crate::stop::StopRequest;
 use std::fmt;
 use std::time::Duration as WallDuration;
 
@@ -35,7 +35,7 @@ pub struct OpenOptions {
     /// as a link error.
     pub link_retries: u32,
     /// Asked for, opening and every wait on the link end early.
-    pub stop: Stop,
+    pub stop: StopRequest,
 }
 
 impl Default for OpenOptions {
@@ -46,7 +46,7 @@ impl Default for OpenOptions {
             model: ModelConfig::default(),
             link_timeout: serial.reply_timeout,
             link_retries: serial.retries,
-            stop: Stop::default(),
+            stop: StopRequest::default(),
         }
     }
 }

@@ -14,7 +14,7 @@
 
 use super::link::labgrid::{parse_labgrid, Place};
 use super::link::rfc2217::parse_rfc2217;
-use super::link::serial::parse_spec;
+use super::link::serial::parse_serial_address;
 use super::link::tcp::parse_tcp;
 use crate::protocol::{Straps, StrapsError};
 use std::fmt;
@@ -423,7 +423,7 @@ impl TargetSpec {
         let v6 = " (an IPv6 address in brackets: [::1])";
         let bad = |hint: &str| SpecError(format!("bad target `{a}`: write {}{hint}", kind.form()));
         match kind {
-            LinkKind::Serial => parse_spec(a)
+            LinkKind::Serial => parse_serial_address(a)
                 .map(|(path, baud)| Address::Serial { path, baud })
                 .ok_or_else(|| bad("")),
             LinkKind::Tcp => parse_tcp(a)

@@ -6,17 +6,17 @@
 //! [`Request::decode`] and [`Response::decode`] check every length and
 //! value and never panic; `docs/bridge-protocol.md` is the specification.
 
+mod bridge_side;
 mod bytes;
 mod capture;
 mod codec;
-mod lean;
 mod message;
 mod ops;
 #[cfg(test)]
 mod tests;
 
+pub use self::bridge_side::{capture_bytes, Incoming, ReplyWriter, WireOp};
 pub use self::bytes::Timer;
-pub use self::lean::{capture_bytes, Incoming, ReplyWriter, WireOp};
 pub use self::message::{
     fragment, kind, parse_fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response,
     WireError, FRAGMENT_DATA, MAX_PAD, MAX_REPLY, MAX_SAMPLES, MIN_FRAGMENT_DATA, PROTOCOL_VERSION,

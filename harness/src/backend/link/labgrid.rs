@@ -18,7 +18,7 @@ use super::serial::SerialLink;
 use super::tcp::TcpLink;
 use super::Link;
 use crate::backend::serial::SerialError;
-use crate::stop::Stop;
+use crate::stop::StopRequest;
 use std::fmt;
 use std::io::{self, BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
@@ -173,12 +173,12 @@ impl LabgridLink {
     /// Asks labgrid where `place`'s serial port is and connects to it.
     /// Every failure is the infrastructure's, and names the place.
     pub fn open(place: Place) -> Result<LabgridLink, String> {
-        Self::open_until(place, Stop::default())
+        Self::open_until(place, StopRequest::default())
     }
 
     /// [`Self::open`], given up (the client's export, a connection
     /// attempt) once `stop` is asked for.
-    pub fn open_until(place: Place, stop: Stop) -> Result<LabgridLink, String> {
+    pub fn open_until(place: Place, stop: StopRequest) -> Result<LabgridLink, String> {
         let who = format!("labgrid:{}", place.name);
         let (export, found) = export(&place, &stop).map_err(|e| format!("{who}: {e}"))?;
         let inner: Box<dyn Link> = match (&found.host, found.protocol.as_deref()) {
@@ -217,7 +217,7 @@ fn err(e: SerialError) -> String {
 }
 
 /// Runs the client's export and waits for the file it writes.
-fn export(place: &Place, stop: &Stop) -> Result<(Export, Exported), String> {
+fn export(place: &Place, stop: &StopRequest) -> Result<(Export, Exported), String> {
     let program = client_program();
     let dir = tempfile::Builder::new()
         .prefix("ppmc-labgrid-")
@@ -265,7 +265,7 @@ fn export(place: &Place, stop: &Stop) -> Result<(Export, Exported), String> {
             return Err("interrupted by a stop request while labgrid exported the port".into());
         }
         let left = deadline.saturating_duration_since(WallInstant::now());
-        match rx.recv_timeout(left.min(Stop::SLICE)) {
+        match rx.recv_timeout(left.min(StopRequest::SLICE)) {
             Ok(line) if line.starts_with("Exported to") => break,
             Ok(line) => said.push(line),
             Err(mpsc::RecvTimeoutError::Timeout) if !left.is_zero() => {}

@@ -15,7 +15,7 @@
 use super::tcp::TcpLink;
 use super::Link;
 use crate::backend::serial::SerialError;
-use crate::stop::Stop;
+use crate::stop::StopRequest;
 use std::fmt;
 use std::io;
 use std::time::Duration as WallDuration;
@@ -205,12 +205,16 @@ impl fmt::Debug for Rfc2217Link {
 
 impl Rfc2217Link {
     pub fn open(addr: &str, baud: u32) -> Result<Rfc2217Link, SerialError> {
-        Self::open_until(addr, baud, Stop::default())
+        Self::open_until(addr, baud, StopRequest::default())
     }
 
     /// [`Self::open`], abandoning a connection attempt once `stop` is
     /// asked for.
-    pub fn open_until(addr: &str, baud: u32, stop: Stop) -> Result<Rfc2217Link, SerialError> {
+    pub fn open_until(
+        addr: &str,
+        baud: u32,
+        stop: StopRequest,
+    ) -> Result<Rfc2217Link, SerialError> {
         let mut link = Rfc2217Link {
             tcp: TcpLink::open_until(addr, stop)?,
             baud,

@@ -119,7 +119,7 @@ impl Link for SerialLink {
 }
 
 /// Parses `serial:<path>[,baud=N]`.
-pub fn parse_spec(spec: &str) -> Option<(String, u32)> {
+pub fn parse_serial_address(spec: &str) -> Option<(String, u32)> {
     let rest = spec.strip_prefix("serial:")?;
     let mut parts = rest.split(',');
     let path = parts.next().filter(|p| !p.is_empty())?.to_string();
@@ -158,15 +158,15 @@ mod tests {
     #[test]
     fn specs_parse() {
         assert_eq!(
-            parse_spec("serial:/dev/ttyACM0"),
+            parse_serial_address("serial:/dev/ttyACM0"),
             Some(("/dev/ttyACM0".into(), 115_200))
         );
         assert_eq!(
-            parse_spec("serial:/dev/pts/3,baud=921600"),
+            parse_serial_address("serial:/dev/pts/3,baud=921600"),
             Some(("/dev/pts/3".into(), 921_600))
         );
-        assert_eq!(parse_spec("serial:"), None);
-        assert_eq!(parse_spec("serial:/x,speed=1"), None);
-        assert_eq!(parse_spec("emu"), None);
+        assert_eq!(parse_serial_address("serial:"), None);
+        assert_eq!(parse_serial_address("serial:/x,speed=1"), None);
+        assert_eq!(parse_serial_address("emu"), None);
     }
 }

@@ -12,7 +12,7 @@
 
 use super::{timed_out, Link};
 use crate::backend::serial::SerialError;
-use crate::stop::Stop;
+use crate::stop::StopRequest;
 use std::fmt;
 use std::io::{self, Read, Write};
 use std::net::{TcpStream, ToSocketAddrs};
@@ -32,7 +32,7 @@ pub struct TcpLink {
     addr: String,
     stream: Option<TcpStream>,
     /// Asked for, a connection attempt under way is abandoned.
-    stop: Stop,
+    stop: StopRequest,
 }
 
 impl fmt::Debug for TcpLink {
@@ -50,12 +50,12 @@ pub fn parse_tcp(spec: &str) -> Option<String> {
 
 impl TcpLink {
     pub fn open(addr: &str) -> Result<TcpLink, SerialError> {
-        Self::open_until(addr, Stop::default())
+        Self::open_until(addr, StopRequest::default())
     }
 
     /// [`Self::open`], abandoning a connection attempt (this one, or a
     /// reconnect's) once `stop` is asked for.
-    pub fn open_until(addr: &str, stop: Stop) -> Result<TcpLink, SerialError> {
+    pub fn open_until(addr: &str, stop: StopRequest) -> Result<TcpLink, SerialError> {
         let mut link = TcpLink {
             addr: addr.to_string(),
             stream: None,
@@ -140,7 +140,7 @@ impl Link for TcpLink {
 /// (the name lookup included, which can take long) runs on a thread of its
 /// own, since neither can be woken, and is left to finish alone when
 /// abandoned.
-fn connect(addr: String, stop: &Stop) -> io::Result<TcpStream> {
+fn connect(addr: String, stop: &StopRequest) -> io::Result<TcpStream> {
     let (tx, rx) = std::sync::mpsc::channel();
     std::thread::spawn(move || {
         let attempt = || {
@@ -162,7 +162,7 @@ fn connect(addr: String, stop: &Stop) -> io::Result<TcpStream> {
                 "connection attempt abandoned: a stop was asked for",
             ));
         }
-        match rx.recv_timeout(Stop::SLICE) {
+        match rx.recv_timeout(StopRequest::SLICE) {
             Ok(r) => return r,
             Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
             Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {

@@ -7,7 +7,7 @@ use super::error::*;
 use super::options::*;
 use super::target::*;
 use crate::backend::link::Link;
-use crate::stop::Stop;
+use crate::stop::StopRequest;
 use ppmc_core::bridge::frame::{self, FrameDecoder};
 use ppmc_core::bridge::wire::{
     parse_fragment, BridgeErrorCode, Request, Response, FRAGMENT_DATA, MIN_FRAGMENT_DATA,
@@ -671,7 +671,9 @@ impl<L: Link> SerialTarget<L> {
             if now >= until || self.opts.stop.requested() {
                 return Ok(None);
             }
-            let n = self.link.recv(&mut buf, (until - now).min(Stop::SLICE))?;
+            let n = self
+                .link
+                .recv(&mut buf, (until - now).min(StopRequest::SLICE))?;
             if n > 0 {
                 self.heard = true;
                 noise.bytes += n as u64;

@@ -2,7 +2,7 @@
 //! round-trip estimate the waits follow, and the sizes and limits the host
 //! keeps to.
 
-use crate::stop::Stop;
+use crate::stop::StopRequest;
 use std::time::Duration as WallDuration;
 
 /// Retry and timeout policy.
@@ -40,9 +40,9 @@ pub struct SerialOptions {
     /// holds a partly filled buffer (ser2net's 64 bytes) sends it at once;
     /// 0 for none.
     pub pad: u16,
-    /// Asked for, every wait on the link ends within [`Stop::SLICE`] with
+    /// Asked for, every wait on the link ends within [`StopRequest::SLICE`] with
     /// [`SerialError::Interrupted`](super::SerialError::Interrupted).
-    pub stop: Stop,
+    pub stop: StopRequest,
 }
 
 impl SerialOptions {
@@ -70,7 +70,7 @@ impl Default for SerialOptions {
             backoff: WallDuration::from_millis(100),
             quiet: WallDuration::from_millis(30),
             pad: 0,
-            stop: Stop::default(),
+            stop: StopRequest::default(),
         }
     }
 }

@@ -5,7 +5,7 @@ use super::options::*;
 use super::target::*;
 use crate::backend::link::Link;
 use crate::backend::target::{Op, Reply, Target, TargetErrorKind};
-use crate::stop::Stop;
+use crate::stop::StopRequest;
 use ppmc_core::bridge::frame::{self, FrameDecoder};
 use ppmc_core::bridge::wire::{Hello, Request, Response, Timer, PROTOCOL_VERSION};
 use std::io;
@@ -167,7 +167,7 @@ fn quick() -> SerialOptions {
         backoff: WallDuration::from_millis(1),
         quiet: WallDuration::from_millis(1),
         pad: 0,
-        stop: Stop::default(),
+        stop: StopRequest::default(),
     }
 }
 

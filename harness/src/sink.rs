@@ -1,5 +1,6 @@
-//! A run under `--repeat` in constant memory: what the reports keep of a
-//! soak run as its results stream in.
+//! Every run's result sink: what the reports keep of a run as its
+//! results stream in, in constant memory however many passes a soak
+//! (`--repeat`) makes.
 //!
 //! The first pass is kept whole, as is every result after it that did not
 //! pass (failed, error, not run), up to [`MAX_LISTED`] of them; every other
@@ -8,7 +9,7 @@
 //! and each measurement's count, minimum, mean, maximum and worst grade.
 //! What is held grows with the suite and the cap, never with the passes.
 //! A listed result is held as its record ([`ScenarioRecord`]); the run's
-//! record is [`Soak::record`].
+//! record is [`Sink::record`].
 
 use crate::runner::BoardResult;
 use crate::scenario::{Grade, NotRun, ScenarioResult, Verdict};
@@ -164,7 +165,7 @@ impl Repeated {
 /// Takes a run's results as they stream in and keeps what the reports
 /// need (see the module's doc).
 #[derive(Debug)]
-pub struct Soak {
+pub struct Sink {
     /// Scenarios in a pass.
     per_pass: usize,
     /// Slots in one queue of the run (`per_pass * repeat`): a board's with
@@ -178,10 +179,10 @@ pub struct Soak {
     boards: BTreeMap<Option<usize>, Tally>,
 }
 
-impl Soak {
+impl Sink {
     /// For a run of `per_pass` scenarios `repeat` times.
-    pub fn new(per_pass: usize, repeat: usize) -> Soak {
-        Soak {
+    pub fn new(per_pass: usize, repeat: usize) -> Sink {
+        Sink {
             per_pass: per_pass.max(1),
             per_queue: (per_pass * repeat.max(1)).max(1),
             listed: Vec::new(),
@@ -333,7 +334,7 @@ mod tests {
             crate::backend::EmuTarget::new(Default::default(), Default::default())
                 .expect("emulator"),
         )];
-        let mut soak = Soak::new(suite.len(), passes);
+        let mut soak = Sink::new(suite.len(), passes);
         let mut most = 0;
         stream_on_boards(
             &mut boards,
@@ -381,7 +382,7 @@ mod tests {
     #[test]
     fn measurements_keep_their_range() {
         let s = Scenario::new("a", "3-1", "", &[], ok);
-        let mut soak = Soak::new(1, 4);
+        let mut soak = Sink::new(1, 4);
         let values = [
             (7, Grade::Pass),
             (5, Grade::Pass),
