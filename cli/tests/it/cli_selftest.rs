@@ -7,79 +7,11 @@
 use crate::common;
 
 use common::{ppmc, text, BridgeSim};
-use std::io::{BufRead, BufReader};
-use std::os::unix::process::CommandExt;
-use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc;
-use std::time::Duration;
+use ppmc_test_support::served::Served;
 
-/// `firmware/run-twin` on a link in a scratch directory, stopped (its
-/// whole process group) when dropped.
-struct Twin {
-    child: Child,
-    link: std::path::PathBuf,
-    _dir: tempfile::TempDir,
-}
-
-impl Twin {
-    fn start(args: &[&str]) -> Twin {
-        let dir = common::scratch("selftest-twin");
-        let link = dir.path().join("bridge");
-        let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let mut child = Command::new(repo.join("firmware/run-twin"))
-            .arg("--link")
-            .arg(&link)
-            .args(args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .process_group(0)
-            .spawn()
-            .expect("run-twin starts");
-        let stdout = child.stdout.take().expect("piped");
-        let (tx, rx) = mpsc::channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(stdout).lines() {
-                if tx.send(line.unwrap_or_default()).is_err() {
-                    break;
-                }
-            }
-        });
-        let twin = Twin {
-            child,
-            link,
-            _dir: dir,
-        };
-        // Building the twin the first time takes a minute or two.
-        let first = rx
-            .recv_timeout(Duration::from_secs(400))
-            .expect("run-twin says where it serves within the time limit");
-        assert!(first.starts_with("run-twin: serving on /dev/"), "{first}");
-        twin
-    }
-
-    fn target(&self) -> String {
-        format!("serial:{}", self.link.display())
-    }
-}
-
-impl Drop for Twin {
-    fn drop(&mut self) {
-        let group = format!("-{}", self.child.id());
-        let _ = Command::new("kill")
-            .args(["-TERM", "--", &group])
-            .stderr(Stdio::null())
-            .status();
-        let deadline = std::time::Instant::now() + Duration::from_secs(10);
-        while self.child.try_wait().ok().flatten().is_none() {
-            if std::time::Instant::now() > deadline {
-                let _ = Command::new("kill").args(["-KILL", "--", &group]).status();
-                let _ = self.child.wait();
-                break;
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-    }
+/// The twin's address as the command line takes it.
+fn target(twin: &Served) -> String {
+    format!("serial:{}", twin.link.display())
 }
 
 #[test]
@@ -87,8 +19,8 @@ fn selftest_passes_on_the_twin_and_says_the_captures_offset_and_jitter() {
     // Issue 28, item 7: the generator's pulses at 10, 100 and 403 kpps and
     // in bursts, all captured on POUT and INT* at their times; a rate
     // beyond the capture reported as an overrun; the next capture on time.
-    let twin = Twin::start(&[]);
-    let out = ppmc(&["selftest", "--target", &twin.target()]);
+    let twin = Served::start("run-twin", &[]);
+    let out = ppmc(&["selftest", "--target", &target(&twin)]);
     let stdout = text(&out.stdout);
     assert_eq!(out.status.code(), Some(0), "{stdout}{}", text(&out.stderr));
     assert!(stdout.contains("ppmc-bridge-twin"), "{stdout}");
@@ -114,7 +46,7 @@ fn selftest_passes_on_the_twin_and_says_the_captures_offset_and_jitter() {
     let out = ppmc(&[
         "selftest",
         "--target",
-        &twin.target(),
+        &target(&twin),
         "--max-offset",
         "20ns",
     ]);

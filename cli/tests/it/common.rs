@@ -123,20 +123,4 @@ pub fn check_record(validator: &jsonschema::Validator, record: &serde_json::Valu
     assert!(errors.is_empty(), "{errors:#?}");
 }
 
-/// Whether sigrok-cli is here to check `what` against. Without it a test
-/// says so and passes, except in CI (`CI` set), where `.ci/run` installs
-/// it and its absence fails.
-pub fn sigrok_cli(what: &str) -> bool {
-    let found = std::process::Command::new("sigrok-cli")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !found {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI must check {what} with sigrok-cli (apt install sigrok-cli)"
-        );
-        eprintln!("sigrok-cli is not installed: {what} is not checked against it");
-    }
-    found
-}
+pub use ppmc_test_support::sigrok_cli;

@@ -25,7 +25,6 @@ pub use outcome::{Failure, HarnessError, Outcome, Stop};
 /// Declares a scenario where it is written; see the `ppmc-macros` crate.
 pub use ppmc_macros::scenario;
 pub use ppmc_record::{Grade, Grading, Measurement};
-pub use record::tally;
 pub use run::{run_scenario, Scenario};
 pub use verdict::{Attempt, NotRun, Retry, ScenarioResult, Verdict};
 

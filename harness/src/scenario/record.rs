@@ -6,9 +6,7 @@
 use super::outcome::{Failure, HarnessError};
 use super::verdict::{Attempt, NotRun, ScenarioResult, Verdict};
 use crate::backend::TargetErrorKind;
-use ppmc_record::{
-    AttemptRecord, ErrorKind, ErrorRecord, FailureRecord, ScenarioRecord, Status, Tally,
-};
+use ppmc_record::{AttemptRecord, ErrorKind, ErrorRecord, FailureRecord, ScenarioRecord, Status};
 
 impl HarnessError {
     /// Whose problem it is, as a report types it: the infrastructure's
@@ -107,19 +105,11 @@ impl ScenarioResult {
     }
 }
 
-/// The tally of `results`: a pass only on a retry as flaky.
-pub fn tally<'a>(results: impl IntoIterator<Item = &'a ScenarioResult>) -> Tally {
-    let mut t = Tally::default();
-    for r in results {
-        t.add(r.status());
-    }
-    t
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::time::Duration;
+    use ppmc_record::Tally;
 
     fn result(name: &'static str, e: HarnessError) -> ScenarioResult {
         ScenarioResult {
@@ -180,6 +170,6 @@ mod tests {
             at: crate::time::Instant::ZERO,
         });
         assert_eq!(r.status(), Status::Failed);
-        assert_eq!(tally([&r]).failed, 1);
+        assert_eq!(Tally::of([r.status()]).failed, 1);
     }
 }
