@@ -15,24 +15,14 @@ use ppmc::time::Duration;
 /// Which chip to drive, and how its board is strapped.
 #[derive(Debug, Args)]
 pub struct TargetArgs {
-    /// `emu` (the reference emulator), `serial:<path>[,baud=N]` (a board,
-    /// or `ppmc bridge-sim`, behind the serial bus bridge),
-    /// `tcp://<host>:<port>` (a bridge's serial port served on the network
-    /// in raw mode, as ser2net or socat serve it),
-    /// `rfc2217://<host>:<port>[,baud=N]` (served over telnet with RFC 2217,
-    /// as ser2net's telnet(rfc2217) mode and labgrid's exporter serve it) or
-    /// `labgrid:<place>` (the serial port of a labgrid place you have
-    /// acquired). Any of them may end in options of that board alone:
-    /// `,name=LABEL`, `,rev=LABEL`, `,board-serial=SERIAL`, `,pad=BYTES` (reply padding, default 64
-    /// on a network target, 0 on a serial port) and the straps `,clock-mhz=`, `,csel=`,
-    /// `,vsel=`, `,ext-clock-khz=` (they override the flags below).
-    /// `emu,chip-fault=NAME` (once per fault) makes the emulator a board
-    /// with that fault of the catalogue (`ppmc fault-matrix --list`), and
-    /// `emu,drop-batch=N` fails its Nth batch once, as a lost link would
-    /// (to try `--retries`).
-    /// `ppmc run` takes several, one per board, and spreads the suite over
-    /// them.
-    #[arg(long = "target", value_name = "TARGET", default_value = "emu")]
+    /// Which chip: `emu` or a bridge's address, each with options of that
+    /// board alone (the full list: --help).
+    #[arg(
+        long = "target",
+        value_name = "TARGET",
+        default_value = "emu",
+        long_help = target_help()
+    )]
     targets: Vec<String>,
     #[command(flatten)]
     chip: ChipArgs,
@@ -130,6 +120,29 @@ enum Curve {
 
 pub fn parse_duration(s: &str) -> Result<Duration, String> {
     s.parse::<Duration>().map_err(|e| e.to_string())
+}
+
+/// The `--target` help: `emu`, then every link kind of
+/// [`backend::DRIVERS`] with its form and what it reaches, then the
+/// options of one board.
+fn target_help() -> String {
+    let mut help = String::from(
+        "Which chip to drive: `emu` (the reference emulator), or a board's bus bridge at an address of one of these forms:\n",
+    );
+    for d in backend::DRIVERS {
+        help.push_str(&format!("\n  {}\n      {}", d.form(), d.about()));
+        help.push_str(&format!(
+            "; reply padding {} bytes unless `,pad=` says",
+            d.default_pad()
+        ));
+        help.push('\n');
+    }
+    help.push_str(
+        "\nAny of them may end in options of that board alone: `,name=LABEL`, `,rev=LABEL`, `,board-serial=SERIAL`, `,pad=BYTES` (reply padding) and the straps `,clock-mhz=`, `,csel=`, `,vsel=`, `,ext-clock-khz=` (they override the flags below). \
+`emu,chip-fault=NAME` (once per fault) makes the emulator a board with that fault of the catalogue (`ppmc fault-matrix --list`), and `emu,drop-batch=N` fails its Nth batch once, as a lost link would (to try `--retries`). \
+`ppmc run` takes several, one per board, and spreads the suite over them.",
+    );
+    help
 }
 
 impl TargetArgs {

@@ -12,7 +12,9 @@
 //! model behind it; a bridge firmware implements it over the real chip.
 
 use crate::emu::{Board, Chip, ChipError, ModelConfig};
-use crate::protocol::{Flag, Input, Pin, Pins, PulseSummary, Record, RecordMark, Status, Straps};
+use crate::protocol::{
+    Flag, Input, OutputMark, OutputRecord, Pin, Pins, PulseSummary, Status, Straps,
+};
 use crate::time::{Duration, Instant};
 use alloc::string::String;
 
@@ -305,7 +307,7 @@ pub trait Bus {
     fn next_op(&mut self, _next: Option<Op>) {}
 
     /// Everything captured on the output side since the last reset.
-    fn record(&self) -> &Record;
+    fn record(&self) -> &OutputRecord;
 
     /// The chip's straps (system clock, CSEL, VSEL, external clock).
     fn straps(&self) -> Straps;
@@ -474,7 +476,7 @@ impl EmuBus {
 
     /// Drops the record before `mark` as far as the model allows
     /// ([`Board::forget_record_before`]); what was dropped.
-    pub fn forget_record_before(&mut self, mark: RecordMark) -> RecordMark {
+    pub fn forget_record_before(&mut self, mark: OutputMark) -> OutputMark {
         self.board.forget_record_before(mark)
     }
 
@@ -655,7 +657,7 @@ impl Bus for EmuBus {
         self.run_op(op)
     }
 
-    fn record(&self) -> &Record {
+    fn record(&self) -> &OutputRecord {
         self.board.record()
     }
 

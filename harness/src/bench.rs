@@ -3,7 +3,9 @@
 //! printed by the command line. Timings live here and never in tests: the
 //! machines are shared and noisy.
 
-use crate::backend::{EmuTarget, Op, Reply, SerialLink, SerialOptions, SerialTarget, Target};
+use crate::backend::{
+    BridgeError, BridgeOptions, BridgeTarget, EmuTarget, Op, Reply, SerialLink, Target,
+};
 use crate::bridge::sim::{LinkFaults, PtyBridge};
 use crate::emu::ModelConfig;
 use crate::protocol::{InitData, PulseCount, Status, Straps};
@@ -182,7 +184,8 @@ pub fn suite_over_bridge(repeat: usize, suite: &[Scenario]) -> Result<BridgeFigu
     let mut round_trips = 0;
     for _ in 0..repeat {
         let mut t = SerialLink::open(&path, 115_200)
-            .and_then(|l| SerialTarget::open(l, SerialOptions::default()))
+            .map_err(BridgeError::from)
+            .and_then(|l| BridgeTarget::open(l, BridgeOptions::default()))
             .map_err(|e| format!("the bridge simulator did not answer: {e}"))?;
         let t0 = WallClock::now();
         run_suite(&mut t, suite, 1, DriverOptions::default(), |_| {});
@@ -257,7 +260,8 @@ pub fn noisy_seed(
     let sim = PtyBridge::start(emu, faults).map_err(|e| format!("no bridge simulator: {e}"))?;
     let t0 = WallClock::now();
     let opened = SerialLink::open(sim.path(), 115_200)
-        .and_then(|l| SerialTarget::open(l, SerialOptions::default()));
+        .map_err(BridgeError::from)
+        .and_then(|l| BridgeTarget::open(l, BridgeOptions::default()));
     let mut seed = NoisySeed {
         complete: 0,
         wrong: 0,

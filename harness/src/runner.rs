@@ -738,7 +738,7 @@ mod tests {
                 extra: Vec::new(),
             }
         }
-        fn capture(&mut self) -> Result<crate::protocol::Record, TargetError> {
+        fn capture(&mut self) -> Result<crate::protocol::OutputRecord, TargetError> {
             Err(TargetError::new(TargetErrorKind::Link, "cable pulled"))
         }
         fn execute(&mut self, _: &[Op]) -> Result<Vec<crate::backend::Reply>, TargetError> {
@@ -792,7 +792,7 @@ mod tests {
         fn info(&self) -> crate::backend::TargetInfo {
             self.0.info()
         }
-        fn capture(&mut self) -> Result<crate::protocol::Record, TargetError> {
+        fn capture(&mut self) -> Result<crate::protocol::OutputRecord, TargetError> {
             self.0.capture()
         }
         fn execute(&mut self, ops: &[Op]) -> Result<Vec<crate::backend::Reply>, TargetError> {
@@ -815,7 +815,7 @@ mod tests {
         fn info(&self) -> crate::backend::TargetInfo {
             Gone.info()
         }
-        fn capture(&mut self) -> Result<crate::protocol::Record, TargetError> {
+        fn capture(&mut self) -> Result<crate::protocol::OutputRecord, TargetError> {
             Gone.capture()
         }
         fn execute(&mut self, ops: &[Op]) -> Result<Vec<crate::backend::Reply>, TargetError> {

@@ -13,7 +13,7 @@
 //! handed over short ([`Check::beyond`]).
 
 use crate::backend::{SelfTestPlan, SelfTestRun};
-use crate::protocol::{Pin, Record};
+use crate::protocol::{OutputRecord, Pin};
 use crate::time::{Duration, Instant};
 
 /// One self-test: a name, what the generator makes, and whether the rate
@@ -264,7 +264,7 @@ pub fn judge(check: &Check, run: &SelfTestRun, limits: &Limits) -> Outcome {
 
 /// POUT's pulses against the rises.
 fn pout(
-    capture: &Record,
+    capture: &OutputRecord,
     rises: &[Instant],
     bursts: usize,
     within: impl Fn(Instant) -> bool,
@@ -294,7 +294,7 @@ fn pout(
 /// INT*'s changes against both edges of every pulse: released (0) at a
 /// rise, asserted (1) at a fall.
 fn int(
-    capture: &Record,
+    capture: &OutputRecord,
     rises: &[Instant],
     bursts: usize,
     high: Duration,
@@ -375,7 +375,7 @@ mod tests {
         let starts: Vec<Instant> = (0..u64::from(plan.bursts))
             .map(|b| Instant::from_nanos(2_000) + burst.saturating_mul(b))
             .collect();
-        let mut rec = Record::default();
+        let mut rec = OutputRecord::default();
         for s in &starts {
             let at = *s + Duration::from_nanos(delay);
             rec.runs
@@ -468,7 +468,7 @@ mod tests {
         assert_eq!(o.faults, ["POUT: jitter 40 ns, over the 30 ns limit"]);
         // Nothing at all: the generator never reached the capture.
         let mut run = perfect(&check.plan, 40);
-        run.capture = Ok(Record::default());
+        run.capture = Ok(OutputRecord::default());
         let o = judge(&check, &run, &limits);
         assert_eq!(
             o.faults,

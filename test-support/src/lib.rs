@@ -350,7 +350,7 @@ pub fn fuzz_inputs(target: &str) -> Vec<(std::path::PathBuf, Vec<u8>)> {
 /// reconnect, must not run again. Returns how many frames a clean run
 /// takes (each a boundary cut at).
 pub fn drop_at_every_frame(bridge: ppmc::chaos::Upstream, names: &[&str]) -> u64 {
-    use ppmc::backend::{SerialOptions, SerialTarget, TcpLink};
+    use ppmc::backend::{BridgeOptions, BridgeTarget, TcpLink};
     use ppmc::chaos::{Behaviour, ChaosProxy};
     use ppmc::scenario::Verdict;
     let suite: Vec<_> = ppmc_scenarios::all()
@@ -362,11 +362,11 @@ pub fn drop_at_every_frame(bridge: ppmc::chaos::Upstream, names: &[&str]) -> u64
         let proxy =
             ChaosProxy::start("127.0.0.1:0", bridge.clone(), behaviour, 1).expect("the proxy");
         let link = TcpLink::open(&proxy.addr().to_string()).expect("the proxy accepts");
-        let opts = SerialOptions {
+        let opts = BridgeOptions {
             reply_timeout: std::time::Duration::from_millis(500),
-            ..SerialOptions::default()
+            ..BridgeOptions::default()
         };
-        let (verdicts, resent): (Vec<Verdict>, u64) = match SerialTarget::open(link, opts) {
+        let (verdicts, resent): (Vec<Verdict>, u64) = match BridgeTarget::open(link, opts) {
             Ok(mut t) => {
                 let v = ppmc::runner::run_suite(
                     &mut t,

@@ -3,7 +3,7 @@
 //! `--link`, reached through the link, stopped with SIGTERM (so that it
 //! stops what it started and removes its link) when dropped.
 
-use ppmc::backend::{SerialLink, SerialOptions, SerialTarget, Target};
+use ppmc::backend::{BridgeOptions, BridgeTarget, SerialLink, Target};
 use ppmc::runner::run_suite;
 use ppmc::scenario::{DriverOptions, Verdict};
 use std::io::{BufRead, BufReader};
@@ -64,14 +64,14 @@ impl Served {
     }
 
     /// A serial target on the link, past HELLO.
-    pub fn target(&self) -> SerialTarget<SerialLink> {
-        self.target_with(SerialOptions::default())
+    pub fn target(&self) -> BridgeTarget<SerialLink> {
+        self.target_with(BridgeOptions::default())
     }
 
     /// [`Served::target`] with `opts`.
-    pub fn target_with(&self, opts: SerialOptions) -> SerialTarget<SerialLink> {
+    pub fn target_with(&self, opts: BridgeOptions) -> BridgeTarget<SerialLink> {
         let path = self.link.to_str().expect("utf-8 path");
-        SerialTarget::open(
+        BridgeTarget::open(
             SerialLink::open(path, 115_200).expect("the pty opens"),
             opts,
         )

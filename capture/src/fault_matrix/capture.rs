@@ -18,10 +18,10 @@
 //! capture of the chip's bus and pins can show.
 
 use super::Catch;
-use crate::judge::{judge, JudgeOptions, Verdict};
+use crate::judge::{judge, CaptureVerdict, JudgeOptions};
 use ppmc::backend::{EmuTarget, Op, Reply, Target, TargetError, TargetInfo};
 use ppmc::emu::ModelConfig;
-use ppmc::protocol::{Flag, Record, Straps};
+use ppmc::protocol::{Flag, OutputRecord, Straps};
 use ppmc::scenario::{run_scenario, DriverOptions, Scenario};
 use ppmc::time::Duration;
 use ppmc::trace::{BusEvent, Event, EventKind, Trace};
@@ -121,8 +121,8 @@ pub fn judge_captures(
         let j = judge(&mut source, &map, &opts).map_err(|e| err(s.name, e.to_string()))?;
         column.judged += 1;
         match j.verdict {
-            Verdict::Passed => {}
-            Verdict::Failed(d) => {
+            CaptureVerdict::Passed => {}
+            CaptureVerdict::Failed(d) => {
                 column.catch = Some(Catch {
                     first: format!("{}: {d}", s.name),
                     after: t0.elapsed(),
@@ -130,7 +130,7 @@ pub fn judge_captures(
                 return Ok(column);
             }
             // Our own export, blamed as a capture: the harness's fault.
-            Verdict::Capture(why) => {
+            CaptureVerdict::Capture(why) => {
                 return Err(err(s.name, format!("judged as a bad capture: {why}")))
             }
         }
@@ -211,7 +211,7 @@ impl Target for Analyzer {
         self.emu.info()
     }
 
-    fn capture(&mut self) -> Result<Record, TargetError> {
+    fn capture(&mut self) -> Result<OutputRecord, TargetError> {
         self.emu.capture()
     }
 

@@ -236,7 +236,7 @@ pub fn board_row(
     golden: &Path,
     budget: FuzzBudget,
 ) -> Result<Row, String> {
-    use ppmc::backend::{EmuTarget, SerialLink, SerialOptions, SerialTarget};
+    use ppmc::backend::{BridgeOptions, BridgeTarget, EmuTarget, SerialLink};
     use ppmc::bridge::sim::{LinkFaults, PtyBridge};
     let emu = EmuTarget::new(ppmc::protocol::Straps::default(), model.clone())
         .map_err(|e| e.to_string())?;
@@ -247,7 +247,7 @@ pub fn board_row(
     let sim = PtyBridge::start(emu, LinkFaults::default()).map_err(|e| e.to_string())?;
     let t0 = WallClock::now();
     let link = SerialLink::open(sim.path(), 115_200).map_err(|e| e.to_string())?;
-    let mut t: Box<dyn Target> = match SerialTarget::open(link, SerialOptions::default()) {
+    let mut t: Box<dyn Target> = match BridgeTarget::open(link, BridgeOptions::default()) {
         Ok(t) => Box::new(t),
         Err(e) if e.to_string().contains("health check") => {
             let refused = t0.elapsed();

@@ -96,7 +96,7 @@ pub struct Divergence {
 
 /// The verdict on a capture.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Verdict {
+pub enum CaptureVerdict {
     /// The board did what the model does, as far as the capture shows.
     Passed,
     /// The board diverged from the model: the board's fault.
@@ -135,7 +135,7 @@ impl Marginal {
 /// What judging a capture found.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Judgement {
-    pub verdict: Verdict,
+    pub verdict: CaptureVerdict,
     pub host: Vec<HostFinding>,
     /// The register accesses decoded and the POUT pulses compared.
     pub accesses: u64,
@@ -282,7 +282,7 @@ pub fn judge_traced(
         Err(why) => {
             return Ok((
                 Judgement {
-                    verdict: Verdict::Capture(why),
+                    verdict: CaptureVerdict::Capture(why),
                     host: Vec::new(),
                     accesses: 0,
                     pulses: 0,
@@ -509,9 +509,9 @@ pub fn judge_traced(
         .or(quiet)
         .or(partial_problem);
     let verdict = match (failed, problem) {
-        (_, Some(why)) => Verdict::Capture(why),
-        (Some(d), None) => Verdict::Failed(d),
-        (None, None) => Verdict::Passed,
+        (_, Some(why)) => CaptureVerdict::Capture(why),
+        (Some(d), None) => CaptureVerdict::Failed(d),
+        (None, None) => CaptureVerdict::Passed,
     };
     let trace = tracer
         .zip(scenario)

@@ -7,7 +7,7 @@
 //! says whom its verdict blames. The one place a judgement becomes
 //! results.
 
-use super::{HostFinding, JudgeOptions, Judgement, Verdict};
+use super::{CaptureVerdict, HostFinding, JudgeOptions, Judgement};
 use ppmc::scenario::{Failure, HarnessError, Verdict as ScenarioVerdict};
 use ppmc::time::Instant;
 use ppmc_logic::source::LogicInfo;
@@ -92,9 +92,11 @@ impl Judgement {
         notes.extend(self.hints.iter().map(|h| format!("hint: {h}")));
         notes.extend(self.marginal_line());
         let (verdict, blame, message) = match &self.verdict {
-            Verdict::Passed if self.marginal.count > 0 => (ScenarioVerdict::Marginal, None, None),
-            Verdict::Passed => (ScenarioVerdict::Passed, None, None),
-            Verdict::Failed(d) => (
+            CaptureVerdict::Passed if self.marginal.count > 0 => {
+                (ScenarioVerdict::Marginal, None, None)
+            }
+            CaptureVerdict::Passed => (ScenarioVerdict::Passed, None, None),
+            CaptureVerdict::Failed(d) => (
                 ScenarioVerdict::Failed(Failure {
                     expectation: d.what.clone(),
                     expected: d.model.clone(),
@@ -104,7 +106,7 @@ impl Judgement {
                 Some(Blame::Board),
                 Some(d.to_string()),
             ),
-            Verdict::Capture(why) => (
+            CaptureVerdict::Capture(why) => (
                 ScenarioVerdict::Error(HarnessError::Capture(why.clone())),
                 Some(Blame::Capture),
                 Some(why.clone()),
@@ -116,7 +118,7 @@ impl Judgement {
             wall_s: wall.as_secs_f64(),
             ..judged(&format!("judge.{file}"), "3", &verdict, blame, message, on)
         }];
-        let captured = !matches!(self.verdict, Verdict::Capture(_));
+        let captured = !matches!(self.verdict, CaptureVerdict::Capture(_));
         if captured || !self.host.is_empty() {
             results.push(self.host_result(&file, on));
         }

@@ -15,7 +15,7 @@
 //!   POUT=~pout` says so), but a board whose DIR is wired inverted is
 //!   faulty, and the capture cannot tell the two apart.
 
-use super::{judge_traced, JudgeError, JudgeOptions, Judgement, Verdict};
+use super::{judge_traced, CaptureVerdict, JudgeError, JudgeOptions, Judgement};
 use ppmc::trace::Trace;
 use ppmc_logic::map::{ChannelMap, Signal};
 use ppmc_logic::source::{LogicError, LogicSource};
@@ -46,7 +46,7 @@ pub fn judge_reopening(
 ) -> Result<(Judgement, Option<Trace>), JudgeError> {
     let info = source.info().clone();
     let (mut j, trace) = judge_traced(source, map, opts, scenario)?;
-    let Verdict::Failed(d) = &j.verdict else {
+    let CaptureVerdict::Failed(d) = &j.verdict else {
         return Ok((j, trace));
     };
     if let Some(s) = suspect(reopen, map, opts, &j)? {
@@ -56,7 +56,7 @@ pub fn judge_reopening(
             m => format!("`--map {m}`"),
         };
         if s.capture {
-            j.verdict = Verdict::Capture(format!(
+            j.verdict = CaptureVerdict::Capture(format!(
                 "the board diverges from the model ({d}), but {}: judged with {spelled} it does not. Check the probes, or give that map",
                 s.what
             ));
@@ -91,7 +91,7 @@ fn suspect(
     for s in candidates(map) {
         let mut source = open()?;
         let (j, _) = judge_traced(source.as_mut(), &s.map, &quick, None)?;
-        if j.verdict == Verdict::Passed
+        if j.verdict == CaptureVerdict::Passed
             && j.host.len() <= given.host.len()
             && j.accesses >= given.accesses
             && j.pulses >= given.pulses

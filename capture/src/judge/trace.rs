@@ -14,7 +14,7 @@
 
 use ppmc::bus::Uncertainty;
 use ppmc::emu::Board;
-use ppmc::protocol::{Direction, EdgeRuns, Pin, Record, Straps};
+use ppmc::protocol::{Direction, EdgeRuns, OutputRecord, Pin, Straps};
 use ppmc::time::{Duration, Instant};
 use ppmc::trace::{
     uncertainty_detail, BusEvent, Event, EventKind, Trace, CAPTURE_PINS, UNCERTAINTY,
@@ -38,7 +38,7 @@ pub(super) struct CaptureTrace {
     dir: Option<usize>,
     outputs: Vec<Output>,
     edges: EdgeRuns,
-    record: Record,
+    record: OutputRecord,
     bus: Vec<Event>,
     /// The model's moves when the last pulse came: a pulse after a new
     /// one starts a run of its own.
@@ -75,7 +75,7 @@ impl CaptureTrace {
             edges: EdgeRuns::new(Duration::from_nanos(
                 (2 * info.resolution_ps).div_ceil(1000),
             )),
-            record: Record::default(),
+            record: OutputRecord::default(),
             bus: Vec::new(),
             moves_at_pulse: 0,
         }

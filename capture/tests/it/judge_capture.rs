@@ -8,7 +8,7 @@ use ppmc::emu::ModelConfig;
 use ppmc::trace::Trace;
 use ppmc::vcd_export::{export_with, Export};
 use ppmc_capture::fault_matrix::capture::analyzer_trace;
-use ppmc_capture::judge::{judge, JudgeOptions, Verdict};
+use ppmc_capture::judge::{judge, CaptureVerdict, JudgeOptions};
 use ppmc_logic::map::ChannelMap;
 use ppmc_logic::source::LogicSource;
 use ppmc_logic::vcd::VcdReader;
@@ -65,7 +65,7 @@ fn a_clean_boards_captures_pass() {
             })
             .sum();
         let j = judged(&trace);
-        assert_eq!(j.verdict, Verdict::Passed, "{name}: {j:?}");
+        assert_eq!(j.verdict, CaptureVerdict::Passed, "{name}: {j:?}");
         assert!(j.accesses > 5, "{name}: {j:?}");
         assert_eq!(j.pulses, pulses, "{name}");
         let sections: Vec<&str> = j.host.iter().map(|h| h.section).collect();
@@ -116,7 +116,7 @@ fn a_faulty_boards_capture_fails_at_its_first_divergence() {
         let trace = trace_of(scenario, cfg);
         let j = judged(&trace);
         match &j.verdict {
-            Verdict::Failed(d) => assert!(d.what.starts_with(what), "{fault}: {d}"),
+            CaptureVerdict::Failed(d) => assert!(d.what.starts_with(what), "{fault}: {d}"),
             other => panic!("{fault}: {other:?}"),
         }
     }

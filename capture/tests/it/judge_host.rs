@@ -9,7 +9,7 @@ use ppmc::emu::{Board, ModelConfig};
 use ppmc::protocol::Straps;
 use ppmc::time::Instant;
 use ppmc::vcd_export::{export_with, Export};
-use ppmc_capture::judge::{judge, JudgeOptions, Judgement, Verdict};
+use ppmc_capture::judge::{judge, CaptureVerdict, JudgeOptions, Judgement};
 use ppmc_logic::map::ChannelMap;
 use ppmc_logic::source::LogicSource;
 use ppmc_logic::vcd::VcdReader;
@@ -137,7 +137,7 @@ fn judged_scenario(name: &str) -> Judgement {
 /// The board passed, and the host's findings are under `sections`, in
 /// order; each message contains `says`.
 fn assert_host(j: &Judgement, sections: &[&str], says: &str) {
-    assert_eq!(j.verdict, Verdict::Passed, "the board: {j:?}");
+    assert_eq!(j.verdict, CaptureVerdict::Passed, "the board: {j:?}");
     let got: Vec<&str> = j.host.iter().map(|h| h.section).collect();
     assert_eq!(got, sections, "{:#?}", j.host);
     for h in &j.host {
@@ -313,7 +313,7 @@ fn a_correct_hosts_captures_give_no_finding() {
         "s3_5_3_aux_output_drives_auxo",
     ] {
         let j = judged_scenario(name);
-        assert_eq!(j.verdict, Verdict::Passed, "{name}: {j:?}");
+        assert_eq!(j.verdict, CaptureVerdict::Passed, "{name}: {j:?}");
         assert!(j.accesses > 5, "{name}: {j:?}");
         assert!(j.host.is_empty(), "{name}: {:#?}", j.host);
     }

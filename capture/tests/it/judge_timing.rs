@@ -10,7 +10,7 @@ use ppmc::protocol::Straps;
 use ppmc::scenario::{Driver, Init, Outcome, Scenario};
 use ppmc::vcd_export::{export_with, Export};
 use ppmc_capture::fault_matrix::capture::analyzer_trace;
-use ppmc_capture::judge::{judge, JudgeOptions, Verdict};
+use ppmc_capture::judge::{judge, CaptureVerdict, JudgeOptions};
 use ppmc_logic::map::ChannelMap;
 use ppmc_logic::source::{Change, LogicInfo, LogicSource, Recorded};
 use ppmc_logic::vcd::VcdReader;
@@ -161,11 +161,11 @@ fn clock_off(scenario: &str, ppm: u64) -> Recorded {
 fn a_chip_clock_a_little_off_passes_and_one_far_off_fails() {
     let scenario = "s3_3_4_accel_1000_steps_cw";
     let j = judged(clock_off(scenario, 300));
-    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert_eq!(j.verdict, CaptureVerdict::Passed, "{j:?}");
     assert_eq!(j.pulses, 1000);
     let j = judged(clock_off(scenario, 30_000));
     match &j.verdict {
-        Verdict::Failed(d) => assert!(d.what.starts_with("POUT pulse"), "{d}"),
+        CaptureVerdict::Failed(d) => assert!(d.what.starts_with("POUT pulse"), "{d}"),
         other => panic!("{other:?}"),
     }
 }
@@ -224,7 +224,7 @@ fn a_status_read_across_a_flags_change_may_show_either_side() {
         cycle(rd, s0, s1, true, byte);
         let j = judged(x.capture());
         assert_eq!(
-            j.verdict == Verdict::Passed,
+            j.verdict == CaptureVerdict::Passed,
             passes,
             "status 0x{byte:02X} (start 0x{start:02X}, end 0x{end:02X}): {j:?}"
         );
@@ -253,7 +253,7 @@ fn an_input_held_through_reset_is_given_to_the_model() {
     e.edges.push((0, reset, true));
     e.edges.push((asserted + 10_000, reset, false));
     let j = judged(e.capture());
-    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert_eq!(j.verdict, CaptureVerdict::Passed, "{j:?}");
     assert!(j.accesses > 3, "{j:?}");
 }
 
@@ -300,8 +300,8 @@ fn a_flag_a_little_late_passes_a_status_read_and_one_far_late_fails() {
         }
         let j = judged(e.capture());
         match (&j.verdict, passes) {
-            (Verdict::Passed, true) => {}
-            (Verdict::Failed(d), false) => {
+            (CaptureVerdict::Passed, true) => {}
+            (CaptureVerdict::Failed(d), false) => {
                 assert!(d.what == "status read" || d.what == "BUSY high", "{d}")
             }
             (v, _) => panic!("BUSY {late_ps} ps late: {v:?}"),
@@ -348,12 +348,12 @@ fn first_pout_late(scenario: &str, late: impl Fn(u64) -> u64, resolution_ps: u64
 fn s3_6_a_first_pout_within_table_3_3s_one_percent_passes() {
     let scenario = "s3_3_4_accel_1000_steps_cw";
     let j = judged(first_pout_late(scenario, |l| l * 5 / 1000, 1000));
-    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert_eq!(j.verdict, CaptureVerdict::Passed, "{j:?}");
     assert_eq!(j.pulses, 1000);
     assert_eq!(j.marginal.count, 0, "{:?}", j.marginal);
     let j = judged(first_pout_late(scenario, |l| l * 20 / 1000, 1000));
     match &j.verdict {
-        Verdict::Failed(d) => assert_eq!(d.what, "POUT pulse 1", "{d}"),
+        CaptureVerdict::Failed(d) => assert_eq!(d.what, "POUT pulse 1", "{d}"),
         other => panic!("{other:?}"),
     }
 }
@@ -368,12 +368,12 @@ fn s3_6_a_first_pout_within_the_captures_uncertainty_of_its_limit_is_marginal() 
     let scenario = "s3_3_4_accel_1000_steps_cw";
     let limit = |l: u64| l / 100 + 100_000;
     let j = judged(first_pout_late(scenario, |l| limit(l) - 40_000, 42_000));
-    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert_eq!(j.verdict, CaptureVerdict::Passed, "{j:?}");
     assert_eq!(j.marginal.count, 1, "{:?}", j.marginal);
     let first = j.marginal.first.as_deref().expect("described");
     assert!(first.starts_with("POUT pulse 1 at "), "{first}");
     let j = judged(first_pout_late(scenario, |l| limit(l) - 300_000, 42_000));
-    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert_eq!(j.verdict, CaptureVerdict::Passed, "{j:?}");
     assert_eq!(j.marginal.count, 0, "{:?}", j.marginal);
 }
 
@@ -389,7 +389,7 @@ const CHOPPING: &str = "s3_5_1_default_switching_chops_the_phases";
 #[test]
 fn s3_5_1_the_phases_are_compared_step_by_step_and_chop_by_chop() {
     let j = judged(Edges::of(CHOPPING).capture());
-    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert_eq!(j.verdict, CaptureVerdict::Passed, "{j:?}");
     assert!(
         !j.not_judged.iter().any(|n| n.contains("S1")),
         "{:?}",
@@ -403,7 +403,7 @@ fn s3_5_1_the_phases_are_compared_step_by_step_and_chop_by_chop() {
         e.info.channels[ch] = format!("phase{k}");
     }
     let fewer = judged(e.capture());
-    assert_eq!(fewer.verdict, Verdict::Passed, "{fewer:?}");
+    assert_eq!(fewer.verdict, CaptureVerdict::Passed, "{fewer:?}");
     assert!(
         j.changes > fewer.changes + 1000,
         "{} changes with S1..S5, {} without",
@@ -418,7 +418,7 @@ fn s3_5_1_the_phases_are_compared_step_by_step_and_chop_by_chop() {
     for (map, signals) in [("S1=s2,S2=s1", ["S1", "S2"]), ("S3=~s3", ["S3", "S3"])] {
         let j = judged_with(Edges::of(CHOPPING).capture(), map);
         match &j.verdict {
-            Verdict::Failed(d) => {
+            CaptureVerdict::Failed(d) => {
                 assert!(signals.iter().any(|s| d.what.starts_with(s)), "{map}: {d}")
             }
             other => panic!("{map}: {other:?}"),
@@ -465,10 +465,10 @@ fn chopping_slow(per_mille: u64) -> Recorded {
 #[test]
 fn s3_5_1_chopping_is_timed_edge_from_edge() {
     let j = judged(chopping_slow(3));
-    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert_eq!(j.verdict, CaptureVerdict::Passed, "{j:?}");
     let j = judged(chopping_slow(50));
     match &j.verdict {
-        Verdict::Failed(d) => assert!(d.what.starts_with('S'), "{d}"),
+        CaptureVerdict::Failed(d) => assert!(d.what.starts_with('S'), "{d}"),
         other => panic!("{other:?}"),
     }
 }
@@ -482,7 +482,7 @@ fn s3_2_1_a_board_whose_phases_miss_a_step_fails_at_a_phase() {
     model.faults.phase_step_skipped = true;
     let j = judged(Edges::of_board("s3_2_1_three_phase_two_phase_excitation", &model).capture());
     match &j.verdict {
-        Verdict::Failed(d) => assert!(d.what.starts_with('S'), "{d}"),
+        CaptureVerdict::Failed(d) => assert!(d.what.starts_with('S'), "{d}"),
         other => panic!("{other:?}"),
     }
 }
@@ -531,7 +531,7 @@ fn s3_5_4_a_software_reset_while_the_phases_chop_passes_wherever_it_falls() {
         };
         let e = Edges::of_scenario(&s, &ModelConfig::default());
         let j = judged(e.capture());
-        assert_eq!(j.verdict, Verdict::Passed, "{name}: {j:?}");
+        assert_eq!(j.verdict, CaptureVerdict::Passed, "{name}: {j:?}");
         assert!(j.changes > 20, "{name}: the chopping compared: {j:?}");
     }
 }
@@ -590,7 +590,7 @@ fn s3_5_1_chopping_cut_by_the_move_passes() {
         let j = judged(chopping_cut(before, early));
         assert_eq!(
             j.verdict,
-            Verdict::Passed,
+            CaptureVerdict::Passed,
             "{before} ns before, {early} ns early: {j:?}"
         );
     }

@@ -10,7 +10,7 @@
 use ppmc::emu::ModelConfig;
 use ppmc::vcd_export::{export_with, Export};
 use ppmc_capture::fault_matrix::capture::analyzer_trace_with;
-use ppmc_capture::judge::{judge, JudgeOptions, Verdict};
+use ppmc_capture::judge::{judge, CaptureVerdict, JudgeOptions};
 use ppmc_core::bus::HostTiming;
 use ppmc_logic::map::ChannelMap;
 use ppmc_logic::source::{Change, LogicInfo, LogicSource, Recorded};
@@ -76,14 +76,14 @@ fn s3_1_1_a_write_sampled_across_ibfs_fall_fails_neither_board_nor_host() {
             sampled(name, HostTiming::Exact, 42_000),
             &JudgeOptions::default(),
         );
-        assert_eq!(j.verdict, Verdict::Passed, "{name}: {j:?}");
+        assert_eq!(j.verdict, CaptureVerdict::Passed, "{name}: {j:?}");
         assert!(j.host.is_empty(), "{name}: {:?}", j.host);
         let single = JudgeOptions {
             follow_orders: false,
             ..JudgeOptions::default()
         };
         let j = judged(sampled(name, HostTiming::Exact, 42_000), &single);
-        if j.verdict != Verdict::Passed || !j.host.is_empty() {
+        if j.verdict != CaptureVerdict::Passed || !j.host.is_empty() {
             across += 1;
         }
     }
@@ -105,7 +105,7 @@ fn a_polling_hosts_captures_pass_with_one_order_too() {
         sampled("s3_3_4_accel_1000_steps_cw", HostTiming::Polling, 42_000),
         &single,
     );
-    assert_eq!(j.verdict, Verdict::Passed, "{j:?}");
+    assert_eq!(j.verdict, CaptureVerdict::Passed, "{j:?}");
     assert!(j.host.is_empty(), "{:?}", j.host);
 }
 
@@ -124,6 +124,6 @@ fn s3_5_1_chopping_ended_by_a_move_the_capture_cannot_order_passes() {
         ),
         &JudgeOptions::default(),
     );
-    assert!(matches!(j.verdict, Verdict::Passed), "{j:?}");
+    assert!(matches!(j.verdict, CaptureVerdict::Passed), "{j:?}");
     assert!(j.changes > 1000, "the chopping compared: {}", j.changes);
 }

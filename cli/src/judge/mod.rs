@@ -9,7 +9,7 @@ pub use args::JudgeArgs;
 
 use crate::capture_args::describe;
 use crate::{usage, CliError};
-use ppmc_capture::judge::{judge_reopening, JudgeOptions, Judgement, Verdict};
+use ppmc_capture::judge::{judge_reopening, CaptureVerdict, JudgeOptions, Judgement};
 
 pub fn run(args: JudgeArgs) -> Result<(), CliError> {
     let started = std::time::Instant::now();
@@ -95,7 +95,7 @@ fn say(j: &Judgement) -> Result<(), CliError> {
         outln!("hint: {h}");
     }
     let passed = match j.marginal_line() {
-        Some(m) if matches!(j.verdict, Verdict::Passed) => {
+        Some(m) if matches!(j.verdict, CaptureVerdict::Passed) => {
             outln!("{m}");
             "MARGINAL"
         }
@@ -103,15 +103,15 @@ fn say(j: &Judgement) -> Result<(), CliError> {
     };
     let word = |w: &str| super::out::verdict_word(w, 0);
     match &j.verdict {
-        Verdict::Failed(d) => {
+        CaptureVerdict::Failed(d) => {
             outln!("{} the board: {d}", word("FAIL"));
             Err(CliError::Verdict)
         }
-        Verdict::Capture(why) => {
+        CaptureVerdict::Capture(why) => {
             outln!("{} the capture: {why}", word("ERROR"));
             Err(CliError::Code(4))
         }
-        Verdict::Passed if !j.host.is_empty() => {
+        CaptureVerdict::Passed if !j.host.is_empty() => {
             outln!(
                 "{} the board; the host firmware broke chapter 3's rules {} times",
                 word(passed),
@@ -119,7 +119,7 @@ fn say(j: &Judgement) -> Result<(), CliError> {
             );
             Err(CliError::Code(3))
         }
-        Verdict::Passed => {
+        CaptureVerdict::Passed => {
             outln!("{} the board", word(passed));
             Ok(())
         }

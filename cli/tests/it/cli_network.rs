@@ -315,3 +315,45 @@ fn the_figures_script_runs_every_row() {
         assert!(line.ends_with("x |") && line.contains(" s |"), "{line}");
     }
 }
+
+/// The `--target` help, docs/board-farm.md's table of targets and the
+/// usage error of an unknown target each list every link kind of
+/// `ppmc::backend::DRIVERS`, in its order, with its form: a new driver
+/// cannot be left out of any of them.
+#[test]
+fn every_link_driver_is_in_the_help_the_docs_and_the_usage_error() {
+    let help = text(&ppmc(&["run", "--help"]).stdout);
+    let docs = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../docs/board-farm.md"
+    ))
+    .expect("docs");
+    let unknown = ppmc(&["run", "--target", "usb:0"]);
+    assert_eq!(unknown.status.code(), Some(2));
+    let usage = text(&unknown.stderr);
+    let drivers = ppmc::backend::DRIVERS;
+    assert!(drivers.len() >= 4);
+    let lines: Vec<&str> = help.lines().map(str::trim).collect();
+    let mut at = (0, 0, 0);
+    for d in drivers {
+        let form = d.form();
+        let in_help = lines[at.0..]
+            .iter()
+            .position(|l| *l == form)
+            .map(|i| at.0 + i);
+        let in_docs = docs[at.1..]
+            .find(&format!("| `{form}` |"))
+            .map(|i| at.1 + i);
+        let in_usage = usage[at.2..].find(&format!("`{form}`")).map(|i| at.2 + i);
+        match (in_help, in_docs, in_usage) {
+            (Some(h), Some(o), Some(u)) => at = (h + 1, o + 1, u + 1),
+            found => panic!(
+                "{form}: in the help, the docs, the usage error (in order): {found:?}\n{usage}"
+            ),
+        }
+        let about = lines[at.0];
+        assert!(about.starts_with(d.about()), "{form}: {about}");
+        let pad = format!("reply padding {} bytes", d.default_pad());
+        assert!(about.contains(&pad), "{form}: {about}");
+    }
+}

@@ -104,7 +104,7 @@ fn without_tests(text: &str) -> Vec<&str> {
     out
 }
 
-/// A file's module path within its crate: `backend/serial/mod.rs` is
+/// A file's module path within its crate: `backend/bridged/mod.rs` is
 /// `["backend", "serial"]`, `lib.rs` is `[]`.
 fn module_of(rel: &Path) -> Vec<String> {
     let mut parts: Vec<String> = rel

@@ -520,6 +520,61 @@ fn tail(s: &str) -> String {
     lines[lines.len().saturating_sub(8)..].join("\n") + "\n"
 }
 
+/// Runs the commands of one documented file in a scratch checkout of its
+/// own: how many ran, and what is wrong with any.
+fn check_file(file: &'static str, ci: &str, labgrid: &str) -> (usize, Vec<String>) {
+    let mut bad = Vec::new();
+    let mut ran = 0;
+    let dir = workspace("docs");
+    let mut boards = [None, None];
+    for doc in commands(file) {
+        if doc.command.contains('<') && !doc.command.contains(" < ") {
+            // A template (`crash-<hash>`): the loop it shows runs in
+            // cli/tests/it/cli_fuzz.rs with a real finding.
+            continue;
+        }
+        if let Some(args) = ppmc_args(&doc.command) {
+            if let Some((_, where_)) = PPMC_ELSEWHERE.iter().find(|(t, _)| args.contains(t)) {
+                let shown = doc.command.replacen("ppmc ", "\"$ppmc\" ", 1);
+                if where_.contains(LABGRID_SCRIPT) && !labgrid.contains(&shown) {
+                    bad.push(format!("{doc}: said to run {where_}, but it does not"));
+                }
+                continue;
+            }
+            ran += 1;
+            if let Err(e) = run(&doc, &args, dir.path(), &mut boards) {
+                bad.push(format!("{doc}: {e}"));
+            }
+            continue;
+        }
+        match ELSEWHERE.iter().find(|(p, _)| doc.command.starts_with(p)) {
+            Some((_, where_)) if where_.starts_with(&format!("in {LABGRID_SCRIPT}")) => {
+                if !labgrid.contains(&doc.command) {
+                    bad.push(format!("{doc}: said to run {where_}, but it does not"));
+                }
+            }
+            Some((_, where_)) if where_.starts_with("in .ci/run") => {
+                let shown = doc.command.trim_start_matches("cd ");
+                let in_ci = ci.contains(shown)
+                    || (doc.command.starts_with("cargo +nightly fuzz run")
+                        && ci.contains(
+                            "cargo +nightly fuzz run $(./flags \"$target\") \"$target\" \"$scratch\" \"$seeds\"",
+                        ))
+                    || (doc.command.starts_with("mkdir -p ../target/fuzz-corpus")
+                        && ci.contains("scratch=\"$PWD/target/fuzz-corpus/$target\""));
+                if !in_ci {
+                    bad.push(format!("{doc}: said to run {where_}, but .ci/run does not"));
+                }
+            }
+            Some(_) => {}
+            None => bad.push(format!(
+                "{doc}: neither a ppmc command nor listed as run elsewhere"
+            )),
+        }
+    }
+    (ran, bad)
+}
+
 #[test]
 fn every_documented_command_runs_as_shown() {
     // `.ci/run` writes `cargo run -q`; the docs show commands without -q.
@@ -527,57 +582,25 @@ fn every_documented_command_runs_as_shown() {
         .expect(".ci/run")
         .replace(" -q ", " ");
     let labgrid = std::fs::read_to_string(root().join(LABGRID_SCRIPT)).expect("the labgrid script");
-    let mut bad = Vec::new();
-    let mut ran = 0;
-    for file in FILES {
-        let dir = workspace("docs");
-        let mut boards = [None, None];
-        for doc in commands(file) {
-            if doc.command.contains('<') && !doc.command.contains(" < ") {
-                // A template (`crash-<hash>`): the loop it shows runs in
-                // cli/tests/it/cli_fuzz.rs with a real finding.
-                continue;
-            }
-            if let Some(args) = ppmc_args(&doc.command) {
-                if let Some((_, where_)) = PPMC_ELSEWHERE.iter().find(|(t, _)| args.contains(t)) {
-                    let shown = doc.command.replacen("ppmc ", "\"$ppmc\" ", 1);
-                    if where_.contains(LABGRID_SCRIPT) && !labgrid.contains(&shown) {
-                        bad.push(format!("{doc}: said to run {where_}, but it does not"));
-                    }
-                    continue;
-                }
-                ran += 1;
-                if let Err(e) = run(&doc, &args, dir.path(), &mut boards) {
-                    bad.push(format!("{doc}: {e}"));
-                }
-                continue;
-            }
-            match ELSEWHERE.iter().find(|(p, _)| doc.command.starts_with(p)) {
-                Some((_, where_)) if where_.starts_with(&format!("in {LABGRID_SCRIPT}")) => {
-                    if !labgrid.contains(&doc.command) {
-                        bad.push(format!("{doc}: said to run {where_}, but it does not"));
-                    }
-                }
-                Some((_, where_)) if where_.starts_with("in .ci/run") => {
-                    let shown = doc.command.trim_start_matches("cd ");
-                    let in_ci = ci.contains(shown)
-                        || (doc.command.starts_with("cargo +nightly fuzz run")
-                            && ci.contains(
-                                "cargo +nightly fuzz run $(./flags \"$target\") \"$target\" \"$scratch\" \"$seeds\"",
-                            ))
-                        || (doc.command.starts_with("mkdir -p ../target/fuzz-corpus")
-                            && ci.contains("scratch=\"$PWD/target/fuzz-corpus/$target\""));
-                    if !in_ci {
-                        bad.push(format!("{doc}: said to run {where_}, but .ci/run does not"));
-                    }
-                }
-                Some(_) => {}
-                None => bad.push(format!(
-                    "{doc}: neither a ppmc command nor listed as run elsewhere"
-                )),
-            }
+    // Each file in a scratch checkout of its own, its commands in order;
+    // the files side by side (most of the time is spent waiting on the
+    // commands' bridges and links, not computing).
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let done = std::sync::Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..3 {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(file) = FILES.get(i) else { return };
+                let r = check_file(file, &ci, &labgrid);
+                done.lock().expect("results").push((i, r));
+            });
         }
-    }
+    });
+    let mut done = done.into_inner().expect("results");
+    done.sort_by_key(|(i, _)| *i);
+    let ran: usize = done.iter().map(|(_, (n, _))| n).sum();
+    let bad: Vec<String> = done.into_iter().flat_map(|(_, (_, b))| b).collect();
     assert!(
         ran >= 40,
         "only {ran} commands found: is the extraction broken?"

@@ -22,8 +22,8 @@
 use crate::bus::{Bus, Op, Reply};
 use crate::emu::{PA_MAX, PA_MIN};
 use crate::protocol::{
-    Command, InitData, MoveCommand, MoveKind, MoveStart, OutputLogic, PulseCount, Record, Status,
-    Straps, Winding,
+    Command, InitData, MoveCommand, MoveKind, MoveStart, OutputLogic, OutputRecord, PulseCount,
+    Status, Straps, Winding,
 };
 use crate::time::Instant;
 
@@ -83,7 +83,14 @@ impl MoveTracker {
     /// The bridge wrote `byte` to the command register (`command`) or the
     /// data register at `at`; `phases` is the energized S1..S5 pattern the
     /// chip shows then (S1 in bit 4).
-    pub fn on_write(&mut self, rec: &mut Record, command: bool, byte: u8, at: Instant, phases: u8) {
+    pub fn on_write(
+        &mut self,
+        rec: &mut OutputRecord,
+        command: bool,
+        byte: u8,
+        at: Instant,
+        phases: u8,
+    ) {
         let (cmd, params) = if command {
             let cmd = Command::decode(byte);
             self.params = None;
@@ -145,7 +152,14 @@ impl MoveTracker {
         }
     }
 
-    fn start(&mut self, rec: &mut Record, m: MoveCommand, p: [u8; 4], at: Instant, phases: u8) {
+    fn start(
+        &mut self,
+        rec: &mut OutputRecord,
+        m: MoveCommand,
+        p: [u8; 4],
+        at: Instant,
+        phases: u8,
+    ) {
         if !self.initialized {
             return; // error 2: the chip starts nothing
         }
@@ -173,7 +187,7 @@ impl MoveTracker {
     }
 
     /// The bridge read the status register.
-    pub fn on_status(&mut self, rec: &mut Record, status: Status) {
+    pub fn on_status(&mut self, rec: &mut OutputRecord, status: Status) {
         self.busy = status.busy();
         let Some(t) = self.tentative.take() else {
             return;
@@ -206,7 +220,7 @@ impl MoveTracker {
 pub struct Tracked<B> {
     inner: B,
     tracker: MoveTracker,
-    record: Record,
+    record: OutputRecord,
 }
 
 impl<B: Bus> Tracked<B> {
@@ -248,7 +262,7 @@ impl<B: Bus> Bus for Tracked<B> {
         let reply = self.inner.run(op);
         if op == Op::Reset {
             self.tracker.reset();
-            self.record = Record::default();
+            self.record = OutputRecord::default();
         }
         // Everything but the moves from the chip's own record, before the
         // tracker looks at it: a write that waited for IBF may have let
@@ -287,7 +301,7 @@ impl<B: Bus> Bus for Tracked<B> {
         reply
     }
 
-    fn record(&self) -> &Record {
+    fn record(&self) -> &OutputRecord {
         &self.record
     }
 
@@ -314,7 +328,7 @@ mod tests {
 
     /// An initialization (4-phase, RL 100, RH 20, PA 100) with code `code`,
     /// then the status the chip answers.
-    fn init(t: &mut MoveTracker, rec: &mut Record, code: u8, status: u8) {
+    fn init(t: &mut MoveTracker, rec: &mut OutputRecord, code: u8, status: u8) {
         t.on_write(rec, true, code, Instant::ZERO, 0);
         for b in [0x64, 0x14, 0x64, 0x00] {
             t.on_write(rec, false, b, Instant::ZERO, 0);
@@ -326,7 +340,7 @@ mod tests {
     /// last accepted initialization asked, never before the first one.
     #[test]
     fn stop_switching_follows_the_last_accepted_initialization() {
-        let (mut t, mut rec) = (MoveTracker::new(), Record::default());
+        let (mut t, mut rec) = (MoveTracker::new(), OutputRecord::default());
         assert!(!t.stop_switching(), "none before the first initialization");
         init(&mut t, &mut rec, 0x22, 0);
         assert!(t.stop_switching());

@@ -10,7 +10,7 @@
 
 use super::wire::Timer;
 use crate::bus::{Bus, Op, Reply};
-use crate::protocol::{EdgeRuns, MoveStart, PinEvent, Record, Straps};
+use crate::protocol::{EdgeRuns, MoveStart, OutputRecord, PinEvent, Straps};
 use crate::time::Instant;
 
 /// A [`Bus`] whose capture is taken edge by edge with a timer of
@@ -21,7 +21,7 @@ pub struct Timed<B> {
     inner: B,
     timer: Timer,
     edges: EdgeRuns,
-    record: Record,
+    record: OutputRecord,
     /// The inner record's runs taken so far: whole runs, then pulses of the
     /// next.
     runs_taken: (usize, u32),
@@ -39,7 +39,7 @@ impl<B: Bus> Timed<B> {
             inner,
             timer,
             edges: EdgeRuns::new(timer.edge_tolerance()),
-            record: Record::default(),
+            record: OutputRecord::default(),
             runs_taken: (0, 0),
             pins_taken: 0,
             moves_taken: 0,
@@ -126,7 +126,7 @@ impl<B: Bus> Bus for Timed<B> {
     fn run(&mut self, op: Op) -> Reply {
         let reply = self.inner.run(op);
         if op == Op::Reset {
-            self.record = Record::default();
+            self.record = OutputRecord::default();
             self.edges.reset();
             self.runs_taken = (0, 0);
             self.pins_taken = 0;
@@ -137,7 +137,7 @@ impl<B: Bus> Bus for Timed<B> {
         reply
     }
 
-    fn record(&self) -> &Record {
+    fn record(&self) -> &OutputRecord {
         &self.record
     }
 

@@ -6,7 +6,7 @@
 
 use super::{Chip, ChipError, ModelConfig};
 use crate::protocol::{
-    Direction, ErrorCode, Input, InputSet, Pin, PinEvent, Pins, PulseRun, Record, RecordMark,
+    Direction, ErrorCode, Input, InputSet, OutputMark, OutputRecord, Pin, PinEvent, Pins, PulseRun,
     Status, Straps,
 };
 use crate::time::Instant;
@@ -118,13 +118,13 @@ pub struct Board {
 /// may take more pulses.
 #[derive(Debug, Clone, Default)]
 struct Seen {
-    record: Record,
+    record: OutputRecord,
     runs: usize,
     pins: usize,
 }
 
 impl Seen {
-    fn take_in(&mut self, chip: &Record, f: &WiringFaults) {
+    fn take_in(&mut self, chip: &OutputRecord, f: &WiringFaults) {
         // The last run taken in may have grown since.
         let from = self.runs.saturating_sub(1);
         self.record.runs.truncate(from);
@@ -227,7 +227,7 @@ impl Board {
 
     /// Everything on the output side since reset, as a capture at the
     /// board's connector sees it.
-    pub fn record(&self) -> &Record {
+    pub fn record(&self) -> &OutputRecord {
         match &self.seen {
             Some(seen) => &seen.record,
             None => self.chip.record(),
@@ -237,20 +237,20 @@ impl Board {
     /// Drops [`Board::record`] before `mark` (a mark of it) as far as the
     /// chip allows ([`Chip::forget_record_before`]); what was dropped of
     /// it.
-    pub fn forget_record_before(&mut self, mark: RecordMark) -> RecordMark {
+    pub fn forget_record_before(&mut self, mark: OutputMark) -> OutputMark {
         let Some(seen) = self.seen.as_mut() else {
             return self.chip.forget_record_before(mark);
         };
         // Runs and moves at the connector are the chip's one to one; the
         // chip's pin changes taken in are all behind the connector's.
-        let chip = self.chip.forget_record_before(RecordMark {
+        let chip = self.chip.forget_record_before(OutputMark {
             runs: mark.runs.min(seen.runs),
             pins: seen.pins,
             moves: mark.moves,
         });
         seen.runs -= chip.runs;
         seen.pins -= chip.pins;
-        let dropped = RecordMark {
+        let dropped = OutputMark {
             pins: mark.pins.min(seen.record.pins.len()),
             ..chip
         };
@@ -359,7 +359,7 @@ mod tests {
     #[test]
     fn the_record_at_the_connector_follows_a_growing_last_run() {
         let f = miswired();
-        let mut chip = Record::default();
+        let mut chip = OutputRecord::default();
         let mut seen = Seen::default();
         let us = crate::time::Duration::from_micros;
         chip.push_pulses(Instant::ZERO + us(10), us(5), 3, Direction::Cw, true);

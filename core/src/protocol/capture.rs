@@ -4,7 +4,7 @@
 //!
 //! Pulses are stored as runs of equally spaced pulses in one direction, so a
 //! constant-rate stretch of any length costs one entry; acceleration ramps
-//! cost one entry per change of period. [`Record::pulses`] expands the runs
+//! cost one entry per change of period. [`OutputRecord::pulses`] expands the runs
 //! into single pulses on request.
 
 use super::command::{Direction, MoveKind};
@@ -217,7 +217,7 @@ pub struct MoveStart {
     pub pout: bool,
     /// Number of steps requested (16,777,216 for the continuous modes).
     pub steps: u32,
-    /// Index into [`Record::runs`] of this move's first run.
+    /// Index into [`OutputRecord::runs`] of this move's first run.
     pub first_run: usize,
     /// Phase step index before the first pulse.
     pub phase_index: u32,
@@ -277,9 +277,9 @@ impl PulseSummary {
     }
 }
 
-/// A point in a [`Record`]: how many runs, pin changes and moves it held.
+/// A point in an [`OutputRecord`]: how many runs, pin changes and moves it held.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct RecordMark {
+pub struct OutputMark {
     pub runs: usize,
     pub pins: usize,
     pub moves: usize,
@@ -287,7 +287,7 @@ pub struct RecordMark {
 
 /// Everything observable on the output side since reset.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct Record {
+pub struct OutputRecord {
     pub runs: Vec<PulseRun>,
     pub pins: Vec<PinEvent>,
     pub moves: Vec<MoveStart>,
@@ -296,7 +296,7 @@ pub struct Record {
     pub overwritten_bytes: u64,
 }
 
-impl Record {
+impl OutputRecord {
     /// Empties the record, keeping the memory it had.
     pub fn clear(&mut self) {
         self.runs.clear();
@@ -337,7 +337,7 @@ impl Record {
     }
 
     /// Appends `count` pulses spaced exactly `interval` apart as
-    /// [`Record::push_pulses`] would record them pushed one at a time: the
+    /// [`OutputRecord::push_pulses`] would record them pushed one at a time: the
     /// first may join the previous run, the rest join it too if they keep
     /// its spacing, else they are a run of their own. Costs O(1).
     pub fn push_pulses_singly(
@@ -372,9 +372,9 @@ impl Record {
         self.pins.push(PinEvent { at, pin, value });
     }
 
-    /// How far the record reaches: where [`Record::since`] starts.
-    pub fn mark(&self) -> RecordMark {
-        RecordMark {
+    /// How far the record reaches: where [`OutputRecord::since`] starts.
+    pub fn mark(&self) -> OutputMark {
+        OutputMark {
             runs: self.runs.len(),
             pins: self.pins.len(),
             moves: self.moves.len(),
@@ -387,13 +387,13 @@ impl Record {
     /// that has compared what came before keeps only a window so, and its
     /// memory does not grow with its length. Returns what was dropped: a
     /// mark taken before counts from the new start once it is subtracted.
-    pub fn forget_before(&mut self, mark: RecordMark) -> RecordMark {
+    pub fn forget_before(&mut self, mark: OutputMark) -> OutputMark {
         let moves = mark.moves.min(self.moves.len().saturating_sub(1));
         let runs = mark
             .runs
             .min(self.runs.len().saturating_sub(1))
             .min(self.moves.get(moves).map_or(usize::MAX, |m| m.first_run));
-        let dropped = RecordMark {
+        let dropped = OutputMark {
             runs,
             pins: mark.pins.min(self.pins.len()),
             moves,
@@ -405,7 +405,7 @@ impl Record {
     /// Drops the first `n.runs` runs, `n.pins` pin changes and `n.moves`
     /// moves (each at most what there is); the moves left count their
     /// runs from the new first.
-    pub fn drop_front(&mut self, n: RecordMark) {
+    pub fn drop_front(&mut self, n: OutputMark) {
         let runs = n.runs.min(self.runs.len());
         self.runs.drain(..runs);
         self.pins.drain(..n.pins.min(self.pins.len()));
@@ -417,8 +417,8 @@ impl Record {
 
     /// The record from `mark` on: the runs, pin changes and moves added
     /// since (a move's `first_run` counted from the mark's first run).
-    pub fn since(&self, mark: RecordMark) -> Record {
-        Record {
+    pub fn since(&self, mark: OutputMark) -> OutputRecord {
+        OutputRecord {
             runs: self.runs.get(mark.runs..).unwrap_or_default().to_vec(),
             pins: self.pins.get(mark.pins..).unwrap_or_default().to_vec(),
             moves: self
@@ -442,7 +442,7 @@ impl Record {
         Some((&self.moves[k], self.runs_of_move(k)))
     }
 
-    /// The pulse runs of move `k` (of [`Record::moves`]): from its first
+    /// The pulse runs of move `k` (of [`OutputRecord::moves`]): from its first
     /// run up to the next move's first; none for a move not recorded.
     pub fn runs_of_move(&self, k: usize) -> &[PulseRun] {
         let Some(m) = self.moves.get(k) else {
@@ -474,14 +474,14 @@ impl Record {
 
     /// The record as it stood at `t`: the pulses, pin changes and moves up
     /// to and including `t`, a pulse run cut at its last pulse by then.
-    pub fn until(&self, t: Instant) -> Record {
+    pub fn until(&self, t: Instant) -> OutputRecord {
         let runs = self
             .runs
             .iter()
             .filter(|r| r.start <= t)
             .map(|r| r.first(r.count_until(t)))
             .collect();
-        Record {
+        OutputRecord {
             runs,
             pins: self.pins.iter().filter(|p| p.at <= t).copied().collect(),
             moves: self.moves.iter().filter(|m| m.at <= t).copied().collect(),
@@ -551,7 +551,7 @@ impl EdgeRuns {
 
     /// Records a pulse at `at` in `dir` into `rec`; `new_move` when it is
     /// the first pulse of a move (a run holds one move's pulses only).
-    pub fn push(&mut self, rec: &mut Record, at: Instant, dir: Direction, new_move: bool) {
+    pub fn push(&mut self, rec: &mut OutputRecord, at: Instant, dir: Direction, new_move: bool) {
         if !new_move && self.open {
             if let Some(last) = rec.runs.last_mut() {
                 if last.dir == dir && at > last.last() && last.count < u32::MAX {
@@ -619,7 +619,7 @@ mod tests {
     /// from the new first, and the last move's pulses read as before.
     #[test]
     fn forgetting_keeps_the_last_move_and_rebases_it() {
-        let mut rec = Record::default();
+        let mut rec = OutputRecord::default();
         for k in 0..3u32 {
             rec.moves.push(MoveStart {
                 at: t(u64::from(k) * 100),
@@ -652,7 +652,7 @@ mod tests {
         let dropped = rec.forget_before(everything);
         assert_eq!(
             dropped,
-            RecordMark {
+            OutputMark {
                 runs: 4,
                 pins: 3,
                 moves: 2
@@ -664,8 +664,8 @@ mod tests {
         // A mark short of that drops only what lies before it.
         let mut again = rec.clone();
         assert_eq!(
-            again.forget_before(RecordMark::default()),
-            RecordMark::default()
+            again.forget_before(OutputMark::default()),
+            OutputMark::default()
         );
         assert_eq!(again, rec);
     }
@@ -681,7 +681,7 @@ mod tests {
             count in 1u32..6,
             new_move: bool,
         ) {
-            let mut rec = Record::default();
+            let mut rec = OutputRecord::default();
             let mut at = 0;
             for (i, (dt, n)) in before.iter().enumerate() {
                 at += 10;
@@ -701,7 +701,7 @@ mod tests {
 
     #[test]
     fn equal_spacing_merges_into_one_run() {
-        let mut r = Record::default();
+        let mut r = OutputRecord::default();
         let d = Duration::from_micros(10);
         r.push_pulses(t(0), d, 1, Direction::Cw, true);
         r.push_pulses(t(10), d, 1, Direction::Cw, false);
@@ -719,7 +719,7 @@ mod tests {
 
     #[test]
     fn until_cuts_the_record_at_an_instant() {
-        let mut r = Record::default();
+        let mut r = OutputRecord::default();
         let d = Duration::from_micros(10);
         r.push_pulses(t(0), d, 100, Direction::Cw, true);
         r.push_pulses(t(2000), d, 5, Direction::Ccw, true);
@@ -743,7 +743,7 @@ mod tests {
 
     #[test]
     fn summary_counts_intervals_across_runs() {
-        let mut r = Record::default();
+        let mut r = OutputRecord::default();
         r.push_pulses(t(0), Duration::from_micros(50), 3, Direction::Ccw, true);
         r.push_pulses(t(130), Duration::from_micros(30), 2, Direction::Ccw, false);
         let s = r.summarize(0);
@@ -757,7 +757,7 @@ mod tests {
 
     /// Each of `times` within its run's jitter of its place on the run's
     /// line, in order, and none lost.
-    fn assert_within_jitter(r: &Record, times: &[u64]) {
+    fn assert_within_jitter(r: &OutputRecord, times: &[u64]) {
         assert_eq!(r.pulse_count(), times.len() as u64);
         let mut k = 0;
         for run in &r.runs {
@@ -780,8 +780,8 @@ mod tests {
     }
 
     /// Pulses at `times`, all one move, through an `EdgeRuns`.
-    fn edge_record(times: &[u64], tolerance: u64) -> Record {
-        let mut r = Record::default();
+    fn edge_record(times: &[u64], tolerance: u64) -> OutputRecord {
+        let mut r = OutputRecord::default();
         let mut e = EdgeRuns::new(Duration::from_nanos(tolerance));
         for (i, t) in times.iter().enumerate() {
             e.push(&mut r, Instant::from_nanos(*t), Direction::Cw, i == 0);
@@ -812,7 +812,7 @@ mod tests {
         assert_eq!(r.runs[0].jitter, Duration::from_nanos(8));
         assert_within_jitter(&r, &times);
         // Equal intervals would have needed a run per wobble.
-        let mut exact = Record::default();
+        let mut exact = OutputRecord::default();
         for (i, w) in times.windows(2).enumerate() {
             exact.push_pulses(
                 Instant::from_nanos(w[0]),

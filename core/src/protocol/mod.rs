@@ -11,7 +11,7 @@ pub mod registers;
 pub mod timing;
 
 pub use capture::{
-    EdgeRuns, MoveStart, Pin, PinEvent, Pins, PulseRun, PulseSummary, Record, RecordMark,
+    EdgeRuns, MoveStart, OutputMark, OutputRecord, Pin, PinEvent, Pins, PulseRun, PulseSummary,
 };
 pub use command::{
     ClockSource, Command, Direction, Excitation, InitCommand, InitData, MotorType, MoveCommand,

@@ -3,7 +3,7 @@
 
 use super::target::{Op, Reply, Target, TargetError, TargetErrorKind, TargetInfo};
 use crate::emu::{Chip, ChipError, ModelConfig};
-use crate::protocol::{Record, RecordMark, Straps};
+use crate::protocol::{OutputMark, OutputRecord, Straps};
 use ppmc_core::bus::{Bus, EmuBus};
 
 /// The in-process emulator. Batches run instantly in wall time; waits are
@@ -101,7 +101,7 @@ impl Target for EmuTarget {
         self.bus.straps()
     }
 
-    fn capture(&mut self) -> Result<Record, TargetError> {
+    fn capture(&mut self) -> Result<OutputRecord, TargetError> {
         Ok(self.bus.record().clone())
     }
 
@@ -122,13 +122,13 @@ impl Target for EmuTarget {
     fn execute_then_capture_since(
         &mut self,
         ops: &[Op],
-        from: RecordMark,
-    ) -> Result<(Vec<Reply>, Record), TargetError> {
+        from: OutputMark,
+    ) -> Result<(Vec<Reply>, OutputRecord), TargetError> {
         let replies = self.execute(ops)?;
         Ok((replies, self.bus.record().since(from)))
     }
 
-    fn forget_capture_before(&mut self, mark: RecordMark) -> RecordMark {
+    fn forget_capture_before(&mut self, mark: OutputMark) -> OutputMark {
         self.bus.forget_record_before(mark)
     }
 }

@@ -31,28 +31,28 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! A new way to reach a bridge is a [`Link`] under `link/` and a
-//! [`LinkKind`]; the protocol, retries, reconnects and verdicts come with
-//! [`SerialTarget`].
+//! A new way to reach a bridge is a file under `link/` with its [`Link`]
+//! and its [`LinkDriver`], and a line in [`link::DRIVERS`]; the protocol,
+//! retries, reconnects and verdicts come with [`BridgeTarget`].
 
+mod bridged;
 mod emu;
 pub mod link;
 mod open;
-mod serial;
 mod spec;
 mod target;
 
+pub use self::bridged::{
+    restart_cause, BridgeError, BridgeOptions, BridgeTarget, LinkStats, MAX_GIVE_UPS,
+};
 pub use self::emu::EmuTarget;
 pub use self::link::labgrid::{parse_labgrid, LabgridLink, Place};
 pub use self::link::rfc2217::{parse_rfc2217, Rfc2217Link};
 pub use self::link::serial::{parse_serial_address, SerialLink};
 pub use self::link::tcp::{parse_tcp, TcpLink};
-pub use self::link::Link;
+pub use self::link::{Link, LinkDriver, DRIVERS};
 pub use self::open::{check, open, OpenError, OpenOptions};
-pub use self::serial::{
-    restart_cause, LinkStats, SerialError, SerialOptions, SerialTarget, MAX_GIVE_UPS,
-};
-pub use self::spec::{Address, LinkKind, SpecError, StrapOptions, TargetSpec};
+pub use self::spec::{forms, Address, SpecError, StrapOptions, TargetSpec};
 pub use self::target::{
     Op, Reply, SelfTestPlan, SelfTestReply, SelfTestRun, Target, TargetError, TargetErrorKind,
     TargetInfo, Uncertainty,

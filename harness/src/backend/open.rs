@@ -5,13 +5,9 @@
 //! ([`OpenError::Invalid`]) or the board, bridge or link
 //! ([`OpenError::Infrastructure`]), never the device's verdict.
 
+use super::bridged::{BridgeError, BridgeOptions, BridgeTarget};
 use super::emu::EmuTarget;
-use super::link::labgrid::LabgridLink;
-use super::link::rfc2217::Rfc2217Link;
-use super::link::serial::SerialLink;
-use super::link::tcp::TcpLink;
-use super::link::Link;
-use super::serial::{SerialError, SerialOptions, SerialTarget};
+use super::link::{Link, LinkDriver};
 use super::spec::{Address, SpecError, StrapOptions, TargetSpec};
 use super::target::Target;
 use crate::emu::ModelConfig;
@@ -40,7 +36,7 @@ pub struct OpenOptions {
 
 impl Default for OpenOptions {
     fn default() -> Self {
-        let serial = SerialOptions::default();
+        let serial = BridgeOptions::default();
         OpenOptions {
             straps: StrapOptions::default(),
             model: ModelConfig::default(),
@@ -87,7 +83,7 @@ impl From<SpecError> for OpenError {
 }
 
 /// A link that fails is the infrastructure's, never the board's.
-fn infra(e: SerialError) -> OpenError {
+fn infra(e: BridgeError) -> OpenError {
     OpenError::Infrastructure(e.to_string())
 }
 
@@ -109,7 +105,6 @@ pub fn check(spec: &TargetSpec, opts: &OpenOptions) -> Result<Address, OpenError
 /// checked and its straps reconciled with those given.
 pub fn open(spec: &TargetSpec, opts: &OpenOptions) -> Result<Box<dyn Target>, OpenError> {
     let address = check(spec, opts)?;
-    let stop = || opts.stop.clone();
     match address {
         Address::Emu => {
             let straps = opts.straps_of(spec)?;
@@ -122,41 +117,31 @@ pub fn open(spec: &TargetSpec, opts: &OpenOptions) -> Result<Box<dyn Target>, Op
                 .with_dropped_batch(spec.drop_batch);
             Ok(Box::new(t))
         }
-        Address::Serial { path, baud } => {
-            let link = SerialLink::open(&path, baud).map_err(infra)?;
-            open_bridge(link, spec, opts)
-        }
-        Address::Tcp(addr) => {
-            let link = TcpLink::open_until(&addr, stop()).map_err(infra)?;
-            open_bridge(link, spec, opts)
-        }
-        Address::Rfc2217 { addr, baud } => {
-            let link = Rfc2217Link::open_until(&addr, baud, stop()).map_err(infra)?;
-            open_bridge(link, spec, opts)
-        }
-        Address::Labgrid(place) => {
-            let link = LabgridLink::open_until(place, stop()).map_err(OpenError::Infrastructure)?;
-            open_bridge(link, spec, opts)
+        Address::Bridge { driver, address } => {
+            let link = driver
+                .open(&address, opts.stop.clone())
+                .map_err(|e| OpenError::Infrastructure(e.to_string()))?;
+            open_bridge(link, driver, spec, opts)
         }
     }
 }
 
 /// A bridge behind `link`: opened, health checked, and its straps
 /// reconciled with those given.
-fn open_bridge<L: Link + 'static>(
-    link: L,
+fn open_bridge(
+    link: Box<dyn Link>,
+    driver: &dyn LinkDriver,
     spec: &TargetSpec,
     opts: &OpenOptions,
 ) -> Result<Box<dyn Target>, OpenError> {
-    let kind = spec.resolve()?.kind();
-    let serial = SerialOptions {
+    let serial = BridgeOptions {
         reply_timeout: opts.link_timeout,
         retries: opts.link_retries,
-        pad: spec.pad.unwrap_or(kind.map_or(0, |k| k.default_pad())),
+        pad: spec.pad.unwrap_or(driver.default_pad()),
         stop: opts.stop.clone(),
-        ..SerialOptions::default()
+        ..BridgeOptions::default()
     };
-    let t = SerialTarget::open(link, serial).map_err(infra)?;
+    let t = BridgeTarget::open(link, serial).map_err(infra)?;
     // The bridge knows how its chip is strapped; the options may only
     // confirm it. A board at 12 MHz judged as one at 16 would fail for the
     // wrong reason.

@@ -12,102 +12,64 @@
 //!              ,clock-mhz=MHZ ,csel=high|low ,vsel=high|low ,ext-clock-khz=KHZ
 //! ```
 
-use super::link::labgrid::{parse_labgrid, Place};
-use super::link::rfc2217::parse_rfc2217;
-use super::link::serial::parse_serial_address;
-use super::link::tcp::parse_tcp;
+use super::link::{driver_for, LinkDriver, DRIVERS};
 use crate::protocol::{Straps, StrapsError};
 use std::fmt;
 use std::str::FromStr;
 
-/// The ways a bridge is reached: the registry of address forms. Adding a
-/// link kind is a variant here (the compiler then asks for its prefix,
-/// its form, whether it crosses a network, and how [`super::open`] opens
-/// it) and its [`super::Link`] under `link/`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum LinkKind {
-    /// A serial port: USB CDC, a UART, a pseudo-terminal.
-    Serial,
-    /// A raw TCP byte stream (ser2net in raw mode, socat).
-    Tcp,
-    /// Telnet with RFC 2217 (ser2net's telnet(rfc2217), labgrid's exporter).
-    Rfc2217,
-    /// The serial port of a labgrid place the user has acquired.
-    Labgrid,
-}
-
-impl LinkKind {
-    /// Every kind, in the order the usage messages list them.
-    pub const ALL: [LinkKind; 4] = [
-        LinkKind::Serial,
-        LinkKind::Tcp,
-        LinkKind::Rfc2217,
-        LinkKind::Labgrid,
-    ];
-
-    /// What an address of this kind starts with.
-    pub fn prefix(self) -> &'static str {
-        match self {
-            LinkKind::Serial => "serial:",
-            LinkKind::Tcp => "tcp://",
-            LinkKind::Rfc2217 => "rfc2217://",
-            LinkKind::Labgrid => "labgrid:",
-        }
-    }
-
-    /// The address form, as the usage messages write it.
-    pub fn form(self) -> &'static str {
-        match self {
-            LinkKind::Serial => "serial:<path>[,baud=N]",
-            LinkKind::Tcp => "tcp://<host>:<port>",
-            LinkKind::Rfc2217 => "rfc2217://<host>:<port>[,baud=N]",
-            LinkKind::Labgrid => "labgrid:<place>",
-        }
-    }
-
-    /// The reply padding asked for when a spec gives none (`pad=`). A
-    /// serial server on the way (ser2net, labgrid's exporter) holds a
-    /// partly filled 64-byte buffer for a millisecond or more; a reply
-    /// padded to fill it goes at once (`docs/bridge-protocol.md`, LINK).
-    /// On a serial port the padding would only cost time.
-    pub fn default_pad(self) -> u16 {
-        match self {
-            LinkKind::Serial => 0,
-            LinkKind::Tcp | LinkKind::Rfc2217 | LinkKind::Labgrid => 64,
-        }
-    }
-}
-
 /// Where a target's chip is, as its backend takes it.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone)]
 pub enum Address {
     /// The reference emulator, in process.
     Emu,
-    Serial {
-        path: String,
-        baud: u32,
+    /// A bridge over a link: the driver of its kind (the first of
+    /// [`DRIVERS`] whose prefix the address starts with) and the address
+    /// as written, which the driver has read.
+    Bridge {
+        driver: &'static dyn LinkDriver,
+        address: String,
     },
-    /// `host:port`.
-    Tcp(String),
-    Rfc2217 {
-        addr: String,
-        baud: u32,
-    },
-    Labgrid(Place),
 }
 
-impl Address {
-    /// The link a bridge at this address is reached over; `None` for the
-    /// emulator.
-    pub fn kind(&self) -> Option<LinkKind> {
-        match self {
-            Address::Emu => None,
-            Address::Serial { .. } => Some(LinkKind::Serial),
-            Address::Tcp(_) => Some(LinkKind::Tcp),
-            Address::Rfc2217 { .. } => Some(LinkKind::Rfc2217),
-            Address::Labgrid(_) => Some(LinkKind::Labgrid),
+impl PartialEq for Address {
+    fn eq(&self, other: &Address) -> bool {
+        match (self, other) {
+            (Address::Emu, Address::Emu) => true,
+            (
+                Address::Bridge { driver, address },
+                Address::Bridge {
+                    driver: d,
+                    address: a,
+                },
+            ) => driver.prefix() == d.prefix() && address == a,
+            _ => false,
         }
     }
+}
+
+impl Eq for Address {}
+
+impl Address {
+    /// The driver of the link a bridge at this address is reached over;
+    /// `None` for the emulator.
+    pub fn driver(&self) -> Option<&'static dyn LinkDriver> {
+        match self {
+            Address::Emu => None,
+            Address::Bridge { driver, .. } => Some(*driver),
+        }
+    }
+}
+
+/// Every address form, as the usage messages list them: `` `emu`,
+/// `serial:<path>[,baud=N]`, ... or `labgrid:<place>[,port=NAME]` ``.
+pub fn forms() -> String {
+    let mut forms = String::from("`emu`");
+    for (i, d) in DRIVERS.iter().enumerate() {
+        let last = i + 1 == DRIVERS.len();
+        forms.push_str(if last { " or " } else { ", " });
+        forms.push_str(&format!("`{}`", d.form()));
+    }
+    forms
 }
 
 /// A target spec or strap option that does not read: the user's typing,
@@ -259,7 +221,7 @@ pub struct TargetSpec {
     /// The board's serial number (`board-serial=`).
     pub serial: Option<String>,
     /// Reply padding to ask the bridge for (`pad=`); default: the link
-    /// kind's ([`LinkKind::default_pad`]).
+    /// kind's ([`LinkDriver::default_pad`]).
     pub pad: Option<u16>,
     /// The board's own strap options (`clock-mhz=`, `csel=`, ...), over
     /// those given for every board.
@@ -408,61 +370,17 @@ impl TargetSpec {
                 "--target `{a}`: chip-fault= makes the emulator a faulty board; a real board brings its own faults (for a faulty board behind a bridge: ppmc bridge-sim --chip-fault)"
             )));
         }
-        let Some(kind) = LinkKind::ALL
-            .into_iter()
-            .find(|k| a.starts_with(k.prefix()))
-        else {
-            let mut forms = String::from("`emu`");
-            for (i, k) in LinkKind::ALL.iter().enumerate() {
-                let last = i + 1 == LinkKind::ALL.len();
-                forms.push_str(if last { " or " } else { ", " });
-                forms.push_str(&format!("`{}`", k.form()));
-            }
-            return Err(SpecError(format!("unknown target `{a}`: use {forms}")));
+        let Some(driver) = driver_for(a) else {
+            return Err(SpecError(format!("unknown target `{a}`: use {}", forms())));
         };
-        let v6 = " (an IPv6 address in brackets: [::1])";
-        let bad = |hint: &str| SpecError(format!("bad target `{a}`: write {}{hint}", kind.form()));
-        match kind {
-            LinkKind::Serial => parse_serial_address(a)
-                .map(|(path, baud)| Address::Serial { path, baud })
-                .ok_or_else(|| bad("")),
-            LinkKind::Tcp => parse_tcp(a)
-                .filter(|addr| host_and_port(addr))
-                .map(Address::Tcp)
-                .ok_or_else(|| bad(v6)),
-            LinkKind::Rfc2217 => parse_rfc2217(a)
-                .filter(|(addr, _)| host_and_port(addr))
-                .map(|(addr, baud)| Address::Rfc2217 { addr, baud })
-                .ok_or_else(|| bad(v6)),
-            LinkKind::Labgrid => parse_labgrid(a)
-                .map(Address::Labgrid)
-                .ok_or_else(|| bad("")),
-        }
+        driver.check(a).map_err(|hint| {
+            SpecError(format!("bad target `{a}`: write {}{hint}", driver.form()))
+        })?;
+        Ok(Address::Bridge {
+            driver,
+            address: a.to_string(),
+        })
     }
-}
-
-/// Whether `addr` reads as `host:port` that a connection can be tried to:
-/// a port from 1 to 65535 after a host name, an IPv4 address or an IPv6
-/// address in brackets (`[::1]:4321`). Anything else (`[::1`, `::1:4321`,
-/// a space in the name) is the user's typing, refused before any
-/// connection, never a network failure.
-fn host_and_port(addr: &str) -> bool {
-    let Some((host, port)) = addr.rsplit_once(':') else {
-        return false;
-    };
-    let port_ok = port.parse::<u16>().is_ok_and(|p| p != 0);
-    let host_ok = match host.strip_prefix('[') {
-        Some(v6) => v6
-            .strip_suffix(']')
-            .is_some_and(|v6| v6.parse::<std::net::Ipv6Addr>().is_ok()),
-        None => {
-            !host.is_empty()
-                && host
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '.' | '_'))
-        }
-    };
-    port_ok && host_ok
 }
 
 #[cfg(test)]
@@ -471,46 +389,22 @@ mod tests {
 
     #[test]
     fn network_addresses_are_host_and_port_or_the_users_mistake() {
-        for good in [
-            "bench1.lab:4321",
-            "127.0.0.1:2001",
-            "[::1]:4321",
-            "[fe80::1]:1",
-            "rig_1:65535",
-        ] {
-            assert!(host_and_port(good), "{good}");
-        }
-        for bad in [
-            "[::1",
-            "[::1]",
-            "[::1:4321",
-            "::1:4321",
-            "[nothost]:4321",
-            "host:0",
-            "host:65536",
-            ":4321",
-            "host name:4321",
-            "host",
-        ] {
-            assert!(!host_and_port(bad), "{bad}");
-        }
         let spec = |t: &str| TargetSpec::parse(t).expect("splits");
         for t in ["tcp://[::1", "tcp://[::1:4321", "rfc2217://[::1,baud=9600"] {
             let e = spec(t).resolve().expect_err("refused").0;
             assert!(e.contains("an IPv6 address in brackets"), "{t}: {e}");
         }
-        assert_eq!(
-            spec("tcp://[::1]:4321").resolve(),
-            Ok(Address::Tcp("[::1]:4321".into()))
-        );
-        assert!(matches!(
-            spec("rfc2217://[::1]:4321,baud=9600").resolve(),
-            Ok(Address::Rfc2217 { baud: 9600, .. })
-        ));
+        for t in ["tcp://[::1]:4321", "rfc2217://[::1]:4321,baud=9600"] {
+            let a = spec(t).resolve().expect("reads");
+            assert!(
+                matches!(&a, Address::Bridge { address, .. } if address == t),
+                "{a:?}"
+            );
+        }
     }
 
     #[test]
-    fn every_link_kind_is_in_the_usage_message_and_resolves_to_itself() {
+    fn every_link_kind_is_in_the_usage_message_and_resolves_to_its_driver() {
         let e = TargetSpec::parse("usb:0")
             .expect("reads")
             .resolve()
@@ -518,20 +412,19 @@ mod tests {
             .0;
         assert_eq!(
             e,
-            "unknown target `usb:0`: use `emu`, `serial:<path>[,baud=N]`, `tcp://<host>:<port>`, `rfc2217://<host>:<port>[,baud=N]` or `labgrid:<place>`"
+            "unknown target `usb:0`: use `emu`, `serial:<path>[,baud=N]`, `tcp://<host>:<port>`, `rfc2217://<host>:<port>[,baud=N]` or `labgrid:<place>[,port=NAME]`"
         );
-        for (text, kind) in [
-            ("serial:/dev/ttyACM0", LinkKind::Serial),
-            ("tcp://bench1:4321", LinkKind::Tcp),
-            ("rfc2217://bench1:4321", LinkKind::Rfc2217),
-            ("labgrid:rig-3", LinkKind::Labgrid),
+        for (text, prefix) in [
+            ("serial:/dev/ttyACM0", "serial:"),
+            ("tcp://bench1:4321", "tcp://"),
+            ("rfc2217://bench1:4321", "rfc2217://"),
+            ("labgrid:rig-3", "labgrid:"),
         ] {
             let a = TargetSpec::parse(text)
                 .expect("reads")
                 .resolve()
                 .expect("reads");
-            assert_eq!(a.kind(), Some(kind), "{text}");
-            assert!(text.starts_with(kind.prefix()));
+            assert_eq!(a.driver().map(|d| d.prefix()), Some(prefix), "{text}");
         }
         assert_eq!(
             TargetSpec::parse("emu").expect("reads").resolve(),

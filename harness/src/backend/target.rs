@@ -3,7 +3,7 @@
 
 pub use ppmc_core::bus::{Op, Reply, SelfTestPlan, SelfTestReply, Uncertainty};
 
-use crate::protocol::{Record, RecordMark, Straps};
+use crate::protocol::{OutputMark, OutputRecord, Straps};
 use std::fmt;
 
 /// A bridge's self-test as it ran: what the bridge says it generated, and
@@ -12,7 +12,7 @@ use std::fmt;
 #[derive(Debug, Clone)]
 pub struct SelfTestRun {
     pub reply: SelfTestReply,
-    pub capture: Result<Record, String>,
+    pub capture: Result<OutputRecord, String>,
 }
 
 /// What kind of failure a target error is, so that generic code can tell a
@@ -34,7 +34,7 @@ pub enum TargetErrorKind {
 /// A failure to run a batch on a target: its [`TargetErrorKind`] for
 /// generic code, and the backend's own error, kept whole. As with
 /// `std::io::Error`, it displays as that error, [`TargetError::get_ref`]
-/// gives it back (to downcast to, say, a `SerialError`), and
+/// gives it back (to downcast to, say, a `BridgeError`), and
 /// [`std::error::Error::source`] continues its chain.
 #[derive(Debug)]
 pub struct TargetError {
@@ -116,26 +116,29 @@ pub trait Target: Send {
 
     /// Everything captured on the output side since the last reset: pulse
     /// runs with the target's timestamps, pin changes, move starts.
-    fn capture(&mut self) -> Result<Record, TargetError>;
+    fn capture(&mut self) -> Result<OutputRecord, TargetError>;
 
     /// Runs `ops` back to back and returns one reply per op, in order.
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError>;
 
     /// Runs `ops`, then returns the capture too: one round trip on a board
     /// where a caller needs both.
-    fn execute_then_capture(&mut self, ops: &[Op]) -> Result<(Vec<Reply>, Record), TargetError> {
+    fn execute_then_capture(
+        &mut self,
+        ops: &[Op],
+    ) -> Result<(Vec<Reply>, OutputRecord), TargetError> {
         let replies = self.execute(ops)?;
         Ok((replies, self.capture()?))
     }
 
     /// [`Target::execute_then_capture`] with the capture from `from` on
-    /// ([`Record::since`]): what a caller that has the rest needs, without
+    /// ([`OutputRecord::since`]): what a caller that has the rest needs, without
     /// copying the whole record on every call.
     fn execute_then_capture_since(
         &mut self,
         ops: &[Op],
-        from: RecordMark,
-    ) -> Result<(Vec<Reply>, Record), TargetError> {
+        from: OutputMark,
+    ) -> Result<(Vec<Reply>, OutputRecord), TargetError> {
         let (replies, capture) = self.execute_then_capture(ops)?;
         Ok((replies, capture.since(from)))
     }
@@ -145,9 +148,9 @@ pub trait Target: Send {
     /// dropped, from which later marks count down. A long differential run
     /// so keeps a window, not its whole history. A target may keep
     /// everything (the default drops nothing) or less than asked.
-    fn forget_capture_before(&mut self, mark: RecordMark) -> RecordMark {
+    fn forget_capture_before(&mut self, mark: OutputMark) -> OutputMark {
         let _ = mark;
-        RecordMark::default()
+        OutputMark::default()
     }
 
     /// Runs a bus bridge's self-test of its capture (`ppmc selftest`,

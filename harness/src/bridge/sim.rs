@@ -6,7 +6,7 @@ use super::engine::BridgeEngine;
 use super::timed::Timed;
 use super::wire::Timer;
 use crate::bus::{Bus, EmuBus, Op, Reply};
-use crate::protocol::{Record, Straps};
+use crate::protocol::{OutputRecord, Straps};
 use crate::time::{Duration, Instant};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -34,7 +34,7 @@ impl Bus for SimBus {
             SimBus::Timed(b) => b.run(op),
         }
     }
-    fn record(&self) -> &Record {
+    fn record(&self) -> &OutputRecord {
         match self {
             SimBus::Exact(b) => b.record(),
             SimBus::Timed(b) => b.record(),
@@ -128,7 +128,7 @@ impl Default for LinkFaults {
 
 /// How the simulated bridge itself behaves, as opposed to its link.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct BridgeOptions {
+pub struct SimOptions {
     /// Hold each reply until the wall clock has caught up with the
     /// emulator's virtual time, and announce real time in HELLO_REPLY.
     pub realtime: bool,
@@ -140,9 +140,9 @@ pub struct BridgeOptions {
     pub timer_hz: Option<u64>,
 }
 
-impl Default for BridgeOptions {
+impl Default for SimOptions {
     fn default() -> Self {
-        BridgeOptions {
+        SimOptions {
             realtime: false,
             capture_capacity: u32::MAX,
             timer_hz: None,
@@ -302,7 +302,7 @@ pub struct PtyBridge {
 impl PtyBridge {
     /// Serves `emu` (in virtual time) with `faults` on the link.
     pub fn start(emu: impl Into<EmuBus>, faults: LinkFaults) -> io::Result<PtyBridge> {
-        Self::start_with(emu, faults, BridgeOptions::default())
+        Self::start_with(emu, faults, SimOptions::default())
     }
 
     /// Serves `emu` as a bridge set up by `bridge`, with `faults` on the
@@ -310,7 +310,7 @@ impl PtyBridge {
     pub fn start_with(
         emu: impl Into<EmuBus>,
         faults: LinkFaults,
-        bridge: BridgeOptions,
+        bridge: SimOptions,
     ) -> io::Result<PtyBridge> {
         use serialport::SerialPort;
         let emu: EmuBus = emu.into();

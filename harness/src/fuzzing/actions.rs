@@ -15,8 +15,8 @@
 use crate::bus_program;
 use crate::console::Stmt;
 use crate::emu::{ModelConfig, PA_MIN};
-use crate::invariants::judge::Violation;
 use crate::invariants::oracle;
+use crate::invariants::rules::Violation;
 use crate::protocol::{
     ClockSource, Command, Direction, Excitation, Flag, InitCommand, Input, MotorType, MoveCommand,
     MoveKind, OpFlags, OutputLogic, PulseCount, Register, Status,

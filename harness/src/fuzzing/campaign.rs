@@ -6,8 +6,8 @@
 use crate::bus_program::BusOp;
 use crate::emu::ModelConfig;
 use crate::invariants::ids::Invariant;
-use crate::invariants::judge::Violation;
 use crate::invariants::oracle::Checker;
+use crate::invariants::rules::Violation;
 use crate::protocol::{Command, ErrorCode, Input, MoveKind, StatusField};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;

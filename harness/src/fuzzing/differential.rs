@@ -9,7 +9,7 @@ use crate::backend::{EmuTarget, Op, Reply, Target, TargetError, TargetErrorKind}
 use crate::compare::{compare_from, Divergence, Resume, Tolerances};
 use crate::console::{self, ConsoleOptions};
 use crate::emu::ModelConfig;
-use crate::protocol::{Record, RecordMark, Status, Straps};
+use crate::protocol::{OutputMark, OutputRecord, Status, Straps};
 use crate::trace::{Event, EventKind, Trace};
 use rand::{Rng, SeedableRng};
 use std::fmt::Write as _;
@@ -143,8 +143,8 @@ struct Side<'a> {
     bus: Vec<Event>,
     /// The capture since the checkpoint, and where the checkpoint cut the
     /// whole.
-    capture: Record,
-    mark: RecordMark,
+    capture: OutputRecord,
+    mark: OutputMark,
 }
 
 impl Side<'_> {
@@ -184,7 +184,7 @@ impl Side<'_> {
     /// The trace since the checkpoint: the bus, and the capture too if
     /// `with_capture`.
     fn trace(&self, name: &str, with_capture: bool) -> Trace {
-        let empty = Record::default();
+        let empty = OutputRecord::default();
         let capture = if with_capture { &self.capture } else { &empty };
         let info = self.target.info();
         Trace::new(name, "-", info.name.as_str(), info.straps, Vec::new()).assemble(
@@ -200,18 +200,18 @@ impl Side<'_> {
     fn checkpoint(&mut self) {
         self.bus.clear();
         let window = self.capture.mark();
-        let mark = RecordMark {
+        let mark = OutputMark {
             runs: self.mark.runs + window.runs,
             pins: self.mark.pins + window.pins,
             moves: self.mark.moves + window.moves,
         };
         let dropped = self.target.forget_capture_before(mark);
-        self.mark = RecordMark {
+        self.mark = OutputMark {
             runs: mark.runs - dropped.runs.min(mark.runs),
             pins: mark.pins - dropped.pins.min(mark.pins),
             moves: mark.moves - dropped.moves.min(mark.moves),
         };
-        self.capture = Record::default();
+        self.capture = OutputRecord::default();
     }
 }
 
@@ -242,14 +242,14 @@ pub fn run(
     let mut got = Side {
         target,
         bus: Vec::new(),
-        capture: Record::default(),
-        mark: RecordMark::default(),
+        capture: OutputRecord::default(),
+        mark: OutputMark::default(),
     };
     let mut want = Side {
         target: &mut reference,
         bus: Vec::new(),
-        capture: Record::default(),
-        mark: RecordMark::default(),
+        capture: OutputRecord::default(),
+        mark: OutputMark::default(),
     };
     // What was compared before the windows begin: each compare looks at
     // what came since the last time both sides were at rest and agreed, so

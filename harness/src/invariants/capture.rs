@@ -2,13 +2,13 @@
 //! line at an instant, every pulse inside BUSY (`busy-covers-pulses`), a
 //! move's shortest pulse interval (for `min-interval`), the phases from
 //! move to move (`phase-pattern`) and the record's own order
-//! (`record-ordered`). The judge ([`super::judge`]) calls them.
+//! (`record-ordered`). The rules ([`super::rules`]) call them.
 
-use crate::protocol::capture::{Pin, PulseRun, Record};
+use crate::protocol::capture::{OutputRecord, Pin, PulseRun};
 use crate::time::{Duration, Instant};
 
 /// The level of the recorded BUSY line at `t` (changes at `t` included).
-pub(super) fn busy_level(rec: &Record, t: Instant) -> bool {
+pub(super) fn busy_level(rec: &OutputRecord, t: Instant) -> bool {
     rec.pins
         .iter()
         .rev()
@@ -20,7 +20,7 @@ pub(super) fn busy_level(rec: &Record, t: Instant) -> bool {
 
 /// Section 3-1-1 (3): BUSY is 1 "in the middle of pulse output", so every
 /// pulse lies in an interval where the BUSY line is 1.
-pub(super) fn pulse_outside_busy(rec: &Record) -> Option<String> {
+pub(super) fn pulse_outside_busy(rec: &OutputRecord) -> Option<String> {
     let mut busy = rec.pins.iter().filter(|p| p.pin == Pin::Busy).peekable();
     let mut level = false;
     let mut since = Instant::ZERO;
@@ -94,7 +94,7 @@ pub(super) fn shortest_interval_below(runs: &[PulseRun], bound: Duration) -> Opt
 /// for a move written before the one before it put out its last pulse, or
 /// while the phases were still being set (a change after its command and
 /// before its first pulse), nor for the move after it.
-pub(super) fn phase_breaks(rec: &Record) -> Option<String> {
+pub(super) fn phase_breaks(rec: &OutputRecord) -> Option<String> {
     let mut pins = rec.pins.iter().filter(|p| p.pin == Pin::Phases).peekable();
     // Where the last stepping move left the phases: its winding, index and
     // last pulse.
@@ -166,7 +166,7 @@ pub(super) fn phase_breaks(rec: &Record) -> Option<String> {
 
 /// Pulse runs do not overlap and come in time order; pin changes and move
 /// starts come in time order.
-pub(super) fn record_breaks(rec: &Record) -> Option<String> {
+pub(super) fn record_breaks(rec: &OutputRecord) -> Option<String> {
     for w in rec.runs.windows(2) {
         if w[1].start <= w[0].last() {
             return Some(format!(
@@ -210,7 +210,7 @@ mod tests {
             motor: MotorType::FourPhase,
             excitation: Excitation::TwoPhase,
         };
-        let mut rec = Record::default();
+        let mut rec = OutputRecord::default();
         rec.pin(Instant::from_nanos(1_000), Pin::Phases, 0b11000);
         rec.moves.push(MoveStart {
             at: Instant::from_nanos(5_000),
@@ -231,7 +231,7 @@ mod tests {
     #[test]
     fn pulses_outside_busy_are_found() {
         use crate::protocol::{Direction, PinEvent};
-        let mut rec = Record::default();
+        let mut rec = OutputRecord::default();
         let busy = |at, value| PinEvent {
             at: Instant::from_nanos(at),
             pin: Pin::Busy,

@@ -5,17 +5,17 @@
 //!
 //! - [`ids`]: the invariants by name, [`Invariant`](ids::Invariant), one
 //!   per row of `docs/invariants.md`.
-//! - [`judge`]: the invariants judged op by op from what the host sees,
-//!   and at the end from the capture; a break is a
-//!   [`Violation`](judge::Violation).
+//! - [`rules`]: the invariants checked op by op from what the host sees,
+//!   and at the end from the capture ([`Rules`](rules::Rules)); a break
+//!   is a [`Violation`](rules::Violation).
 //! - [`capture`]: the checks that read the capture alone.
-//! - [`oracle`]: the judge on the emulator's chip, the fuzz targets'
+//! - [`oracle`]: the rules on the emulator's chip, the fuzz targets'
 //!   oracle.
 //! - [`replay`]: bus ops replayed on any target and judged by the same
 //!   rules, and the body of a regression scenario.
 
 pub mod capture;
 pub mod ids;
-pub mod judge;
 pub mod oracle;
 pub mod replay;
+pub mod rules;

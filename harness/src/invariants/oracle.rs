@@ -1,9 +1,9 @@
 //! The invariant oracle: runs bus ops on a fresh emulator and checks,
 //! after every op, the invariants of `docs/invariants.md` ([`Checker`],
-//! [`check`]), with the judge of [`super::judge`]. Each invariant has a
+//! [`check`]), with the rules of [`super::rules`]. Each invariant has a
 //! stable id; a finding is bucketed by it.
 
-use super::judge::{Judge, Seen, Violation};
+use super::rules::{Rules, Seen, Violation};
 use crate::bus_program::{self, BusOp};
 use crate::emu::{Board, ChipError, ModelConfig};
 use crate::protocol::{Status, Straps};
@@ -44,7 +44,7 @@ pub fn check_ops(
 pub struct Checker {
     /// The model on its board: the oracle reads status as a host does.
     board: Board,
-    judge: Judge,
+    judge: Rules,
     /// The status register after the last op (none before the first).
     status: Option<Status>,
 }
@@ -53,7 +53,7 @@ impl Checker {
     pub fn new(cfg: ModelConfig) -> Result<Checker, ChipError> {
         Ok(Checker {
             board: Board::new(Straps::default(), cfg)?,
-            judge: Judge::new(Straps::default()),
+            judge: Rules::new(Straps::default()),
             status: None,
         })
     }

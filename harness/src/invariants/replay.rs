@@ -1,13 +1,13 @@
 //! Bus ops replayed on any target, judged by the same invariants as on the
-//! emulator ([`super::judge::Judge`]). Around every op the status register
+//! emulator ([`super::rules::Rules`]). Around every op the status register
 //! is read (a read with no side effect, Section 3-1-1), because the judge
 //! needs IBF and OBF as the host saw them: that is how a reproducer runs on
 //! a board, and how a regression scenario made from a finding checks it.
 
-use super::judge::{Judge, Seen, Violation};
+use super::rules::{Rules, Seen, Violation};
 use crate::backend::{Op, Reply, Target, TargetError};
 use crate::bus_program::BusOp;
-use crate::protocol::{Record, Straps};
+use crate::protocol::{OutputRecord, Straps};
 use crate::scenario::{Driver, Failure, HarnessError, Outcome, Stop};
 use crate::trace::BusEvent;
 
@@ -69,7 +69,7 @@ pub struct Found {
 pub fn judge(
     ops: &[BusOp],
     replies: &[Reply],
-    capture: &Record,
+    capture: &OutputRecord,
     straps: Straps,
 ) -> Result<Option<Found>, String> {
     if replies.len() != ops.len() * OPS_PER_BUS_OP {
@@ -83,7 +83,7 @@ pub fn judge(
         Reply::Status { status, .. } => Ok(status),
         other => Err(format!("expected a status reply, got {other}")),
     };
-    let mut judge = Judge::new(straps);
+    let mut judge = Rules::new(straps);
     let mut last_at = crate::time::Instant::ZERO;
     for (op, r) in ops.iter().zip(replies.chunks(OPS_PER_BUS_OP)) {
         let value = match (op, &r[1]) {

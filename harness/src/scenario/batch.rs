@@ -10,7 +10,7 @@ use super::check::Check;
 use super::outcome::{fail, HarnessError, Outcome, Stop};
 use super::steps::{Done, Role, Step};
 use crate::backend::{Op, Reply, Target};
-use crate::protocol::Record;
+use crate::protocol::OutputRecord;
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, Event, EventKind};
 
@@ -51,7 +51,7 @@ pub(super) struct Batch<'t> {
     init_write: Option<Instant>,
     /// The most recent stop write, input edge or auxiliary command write.
     trigger: Option<Instant>,
-    capture: Option<Record>,
+    capture: Option<OutputRecord>,
 }
 
 impl<'t> Batch<'t> {
@@ -112,7 +112,7 @@ impl<'t> Batch<'t> {
 
     /// The capture since reset (fetched once per change, after everything
     /// queued has run).
-    pub(super) fn capture(&mut self) -> Outcome<&Record> {
+    pub(super) fn capture(&mut self) -> Outcome<&OutputRecord> {
         self.flush_then(true)?;
         if self.capture.is_none() {
             let c = self
@@ -443,7 +443,7 @@ mod tests {
         fn info(&self) -> TargetInfo {
             self.emu.info()
         }
-        fn capture(&mut self) -> Result<Record, TargetError> {
+        fn capture(&mut self) -> Result<OutputRecord, TargetError> {
             self.captures += 1;
             self.emu.capture()
         }
@@ -455,7 +455,7 @@ mod tests {
         fn execute_then_capture(
             &mut self,
             ops: &[Op],
-        ) -> Result<(Vec<Reply>, Record), TargetError> {
+        ) -> Result<(Vec<Reply>, OutputRecord), TargetError> {
             self.batches.push(ops.len());
             Ok((self.emu.execute(ops)?, self.emu.capture()?))
         }
@@ -617,7 +617,7 @@ mod tests {
                 extra: Vec::new(),
             }
         }
-        fn capture(&mut self) -> Result<Record, TargetError> {
+        fn capture(&mut self) -> Result<OutputRecord, TargetError> {
             Err(TargetError::new(TargetErrorKind::Link, "cable pulled"))
         }
         fn execute(&mut self, _: &[Op]) -> Result<Vec<Reply>, TargetError> {

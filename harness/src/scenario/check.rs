@@ -4,7 +4,7 @@
 
 use super::outcome::{fail, need, HarnessError, Outcome, Stop};
 use super::steps::Done;
-use crate::protocol::{Direction, ErrorCode, Record, Status, StatusField};
+use crate::protocol::{Direction, ErrorCode, OutputRecord, Status, StatusField};
 use crate::time::{Duration, Instant};
 
 /// A deferred expectation, judged on the replies of its group, or on the
@@ -173,7 +173,7 @@ impl Check {
     /// auxiliary command write.
     pub(super) fn judge_capture(
         &self,
-        rec: &Record,
+        rec: &OutputRecord,
         at: Instant,
         trigger: Option<Instant>,
     ) -> Outcome {
@@ -244,7 +244,7 @@ impl Check {
 }
 
 /// Fails if the most recent move of `rec` has a pulse after `t`.
-fn no_pulses_after(rec: &Record, t: Instant) -> Outcome {
+fn no_pulses_after(rec: &OutputRecord, t: Instant) -> Outcome {
     let from = rec.moves.last().map_or(0, |m| m.first_run);
     let (mut late, mut first) = (0u64, None);
     for r in rec.runs.get(from..).unwrap_or_default() {

@@ -14,7 +14,7 @@ use super::outcome::{fail, HarnessError, Outcome, Stop};
 use super::steps::{Done, Role, Step};
 use crate::backend::{Op, Reply, Target, Uncertainty};
 use crate::protocol::{
-    ClockSource, Direction, ErrorCode, Flag, Input, Pins, Record, Register, Status, Straps,
+    ClockSource, Direction, ErrorCode, Flag, Input, OutputRecord, Pins, Register, Status, Straps,
     TimingId,
 };
 use crate::time::{Duration, Instant};
@@ -419,7 +419,7 @@ impl<'t> Driver<'t> {
 
     /// The capture since reset (fetched once per change, after everything
     /// queued has run).
-    pub fn capture(&mut self) -> Outcome<&Record> {
+    pub fn capture(&mut self) -> Outcome<&OutputRecord> {
         self.batch.capture()
     }
 

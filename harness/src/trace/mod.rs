@@ -27,8 +27,8 @@
 
 use crate::backend::{Op, Reply};
 use crate::protocol::{
-    Direction, Flag, Input, MoveKind, Pin, PulseRun, Record, StrapFieldError, Straps, Winding,
-    STRAP_KEYS,
+    Direction, Flag, Input, MoveKind, OutputRecord, Pin, PulseRun, StrapFieldError, Straps,
+    Winding, STRAP_KEYS,
 };
 use crate::time::{Duration, Instant};
 use std::fmt::{self, Write as _};
@@ -278,7 +278,7 @@ impl Trace {
     /// This trace with the driver's bus events and the target's capture,
     /// merged in time order. At one instant: pin changes and pulses, then
     /// bus transactions, then move starts, then measurements.
-    pub fn assemble(self, bus: Vec<Event>, capture: &Record, measures: Vec<Event>) -> Trace {
+    pub fn assemble(self, bus: Vec<Event>, capture: &OutputRecord, measures: Vec<Event>) -> Trace {
         let mut tagged: Vec<(Instant, u8, usize, EventKind)> = Vec::new();
         let mut seq = 0usize;
         let mut push = |at: Instant, rank: u8, kind: EventKind, v: &mut Vec<_>| {

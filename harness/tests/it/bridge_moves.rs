@@ -13,7 +13,7 @@ use ppmc::backend::{Op, Reply, Target, TargetError, TargetInfo};
 use ppmc::bridge::move_tracker::Tracked;
 use ppmc::bus::{Bus, EmuBus};
 use ppmc::emu::ModelConfig;
-use ppmc::protocol::{Record, Straps};
+use ppmc::protocol::{OutputRecord, Straps};
 use ppmc::runner::run_suite;
 use ppmc::scenario::DriverOptions;
 
@@ -36,7 +36,7 @@ impl Target for TrackedTarget {
         }
     }
 
-    fn capture(&mut self) -> Result<Record, TargetError> {
+    fn capture(&mut self) -> Result<OutputRecord, TargetError> {
         Ok(self.0.record().clone())
     }
 

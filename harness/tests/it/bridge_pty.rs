@@ -3,7 +3,7 @@
 
 use ppmc_test_support as common;
 
-use ppmc::backend::{EmuTarget, SerialError, SerialLink, SerialOptions, SerialTarget};
+use ppmc::backend::{BridgeError, BridgeOptions, BridgeTarget, EmuTarget, SerialLink};
 use ppmc::bridge::sim::{LinkFaults, PtyBridge};
 use ppmc::emu::{ModelConfig, WiringFaults};
 use ppmc::protocol::Straps;
@@ -25,13 +25,13 @@ impl Sim {
         Sim::start(LinkFaults::default(), ModelConfig::default())
     }
 
-    fn target(&self, opts: SerialOptions) -> Result<SerialTarget<SerialLink>, SerialError> {
-        SerialTarget::open(SerialLink::open(self.0.path(), 115_200)?, opts)
+    fn target(&self, opts: BridgeOptions) -> Result<BridgeTarget<SerialLink>, BridgeError> {
+        BridgeTarget::open(SerialLink::open(self.0.path(), 115_200)?, opts)
     }
 }
 
-fn fast() -> SerialOptions {
-    SerialOptions {
+fn fast() -> BridgeOptions {
+    BridgeOptions {
         reply_timeout: WallDuration::from_millis(60),
         min_reply_timeout: WallDuration::from_millis(5),
         retries: 8,
@@ -39,7 +39,7 @@ fn fast() -> SerialOptions {
         backoff: WallDuration::from_millis(20),
         quiet: WallDuration::from_millis(4),
         pad: 0,
-        ..SerialOptions::default()
+        ..BridgeOptions::default()
     }
 }
 
@@ -51,7 +51,7 @@ fn in_process() -> Vec<ScenarioResult> {
 fn the_whole_suite_over_the_pty_equals_the_in_process_run() {
     let sim = Sim::clean();
     let mut t = sim
-        .target(SerialOptions::default())
+        .target(BridgeOptions::default())
         .expect("bridge answers");
     let over_pty = run_suite(
         &mut t,
@@ -102,7 +102,7 @@ fn corrupted_bytes_never_turn_into_wrong_values() {
     };
     let sim = Sim::start(faults, ModelConfig::default());
     let mut t = sim
-        .target(SerialOptions::default())
+        .target(BridgeOptions::default())
         .expect("bridge answers through the noise");
     let noisy = run_suite(
         &mut t,
@@ -200,7 +200,7 @@ fn an_unhealthy_board_is_refused_at_open() {
     let err = sim
         .target(fast())
         .expect_err("status is not 0x00 after reset");
-    assert!(matches!(err, SerialError::Unhealthy { .. }), "{err}");
+    assert!(matches!(err, BridgeError::Unhealthy { .. }), "{err}");
     // A sentence a person reads, not Rust's debug output.
     assert!(
         err.to_string().ends_with(
@@ -254,17 +254,17 @@ fn a_disconnect_mid_run_ends_with_the_rest_not_run() {
 #[test]
 fn a_realtime_bridge_takes_as_long_as_its_waits_and_the_host_waits_for_it() {
     use ppmc::backend::{Op, Reply, Target};
-    use ppmc::bridge::sim::BridgeOptions;
+    use ppmc::bridge::sim::SimOptions;
     use ppmc::time::Duration;
     let emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
-    let bridge = BridgeOptions {
+    let bridge = SimOptions {
         realtime: true,
-        ..BridgeOptions::default()
+        ..SimOptions::default()
     };
     let sim = Sim(PtyBridge::start_with(emu, LinkFaults::default(), bridge).expect("a pty"));
     // A reply timeout shorter than the batch: the host must allow for the
     // batch's own delay on a bridge that says it runs in real time.
-    let opts = SerialOptions {
+    let opts = BridgeOptions {
         reply_timeout: WallDuration::from_millis(100),
         ..fast()
     };
@@ -286,12 +286,12 @@ fn a_realtime_bridge_takes_as_long_as_its_waits_and_the_host_waits_for_it() {
 
 #[test]
 fn a_capture_overrun_is_an_error_of_that_scenario_and_the_run_goes_on() {
-    use ppmc::bridge::sim::BridgeOptions;
+    use ppmc::bridge::sim::SimOptions;
     let emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
     // Room for a few pulse runs: the 1,000-step ramp needs about 80.
-    let bridge = BridgeOptions {
+    let bridge = SimOptions {
         capture_capacity: 40,
-        ..BridgeOptions::default()
+        ..SimOptions::default()
     };
     let sim = Sim(PtyBridge::start_with(emu, LinkFaults::default(), bridge).expect("a pty"));
     let mut t = sim.target(fast()).expect("bridge answers");

@@ -11,7 +11,7 @@
 use ppmc_test_support as common;
 
 use common::served::{only_error_3_fails, Served};
-use ppmc::backend::{Op, Reply, SerialError, Target, TargetError};
+use ppmc::backend::{BridgeError, Op, Reply, Target, TargetError};
 use ppmc::protocol::Direction::{Ccw, Cw};
 use ppmc::protocol::Flag;
 use ppmc::runner::run_suite;
@@ -185,8 +185,8 @@ fn command(code: u8, data: &[u8]) -> Vec<Op> {
 /// capture, not a failure of the device.
 fn is_capture_overrun(e: &TargetError) -> bool {
     matches!(
-        e.get_ref().downcast_ref::<SerialError>(),
-        Some(SerialError::CaptureOverrun { detail, .. })
+        e.get_ref().downcast_ref::<BridgeError>(),
+        Some(BridgeError::CaptureOverrun { detail, .. })
             if detail.contains(&format!("the buffer holds {BOARD_CAPTURE_RECORDS}"))
     )
 }
@@ -198,7 +198,7 @@ fn ramped_move(
     init: Init,
     steps: u32,
     dir: ppmc::protocol::Direction,
-) -> Result<ppmc::protocol::Record, TargetError> {
+) -> Result<ppmc::protocol::OutputRecord, TargetError> {
     let mut ops = command(init.code(), &init.data.to_bytes());
     ops.push(Op::Delay(Duration::from_millis(300)));
     let m = Move::accel(dir, steps);

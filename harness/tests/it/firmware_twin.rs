@@ -93,10 +93,10 @@ fn a_host_waits_by_the_twins_clock_not_its_own() {
     // more): the twin's WORKING messages carry it through, and the verdict
     // is the emulator's.
     let twin = Served::start("run-twin", &[]);
-    let mut t = twin.target_with(ppmc::backend::SerialOptions {
+    let mut t = twin.target_with(ppmc::backend::BridgeOptions {
         reply_timeout: std::time::Duration::from_millis(300),
         retries: 2,
-        ..ppmc::backend::SerialOptions::default()
+        ..ppmc::backend::BridgeOptions::default()
     });
     let chosen: Vec<_> = ppmc_scenarios::all()
         .into_iter()

@@ -58,7 +58,7 @@ fn a_reset_checker_runs_as_a_fresh_one() {
 fn advancing_in_pieces_changes_nothing() {
     use ppmc::bus_program::{self, BusOp};
     use ppmc::emu::{Board, ModelConfig};
-    use ppmc::protocol::capture::{MoveStart, PulseRun, Record};
+    use ppmc::protocol::capture::{MoveStart, OutputRecord, PulseRun};
     use ppmc::protocol::Straps;
     use ppmc::time::Duration;
 
@@ -68,14 +68,14 @@ fn advancing_in_pieces_changes_nothing() {
     // pulses are the same whatever the batching. Compare reads runs pulse
     // by pulse (`compare::compare_pulses`), so the grouping is not part
     // of what a trace says.
-    let canonical = |r: &Record| {
-        let mut c = Record {
+    let canonical = |r: &OutputRecord| {
+        let mut c = OutputRecord {
             pins: r.pins.clone(),
             overwritten_bytes: r.overwritten_bytes,
-            ..Record::default()
+            ..OutputRecord::default()
         };
         let before = r.moves.first().map_or(r.runs.len(), |m| m.first_run);
-        let push = |c: &mut Record, runs: &[PulseRun], new_move: bool| {
+        let push = |c: &mut OutputRecord, runs: &[PulseRun], new_move: bool| {
             for (i, run) in runs.iter().enumerate() {
                 let step = run.interval();
                 c.push_pulses_singly(run.start, step, run.count, run.dir, new_move && i == 0);

@@ -11,7 +11,7 @@ use ppmc::backend::{EmuTarget, Op, Reply, Target};
 use ppmc::console::{self, ConsoleOptions, Stmt};
 use ppmc::emu::ModelConfig;
 use ppmc::fuzzing::differential::program;
-use ppmc::protocol::{Pin, Pins, Record, Status, Straps, Winding};
+use ppmc::protocol::{OutputRecord, Pin, Pins, Status, Straps, Winding};
 use ppmc::time::{Duration, Instant};
 use proptest::prelude::*;
 
@@ -42,7 +42,7 @@ enum Ev {
 /// in order (as a program's replies come), so a program of long moves
 /// costs its pulses once, not once per sample.
 struct Replayer<'a> {
-    rec: &'a Record,
+    rec: &'a OutputRecord,
     /// (time, order at that time, what): pulses, then pins.
     evs: Vec<(Instant, u8, Ev)>,
     next: usize,
@@ -55,7 +55,7 @@ struct Replayer<'a> {
 }
 
 impl<'a> Replayer<'a> {
-    fn new(rec: &'a Record) -> Replayer<'a> {
+    fn new(rec: &'a OutputRecord) -> Replayer<'a> {
         // A pulse is of the move whose runs hold it: a move's `at` is when
         // its command was written, and a command the chip takes only once
         // the move before it ends (IBF held) starts later than that.

@@ -16,7 +16,7 @@
 
 use super::config::{ConfigError, ModelConfig};
 use super::motion::{AccelRamp, Motion, Profile, Ramp, Stretch};
-use crate::protocol::capture::{MoveStart, Pin, Pins, Record, RecordMark};
+use crate::protocol::capture::{MoveStart, OutputMark, OutputRecord, Pin, Pins};
 use crate::protocol::{
     AuxInputStatus, Chop, ClockSource, Command, Direction, ErrorCode, FinishStatus, InitCommand,
     InitData, Input, InputSet, InputStatus, MoveCommand, MoveKind, OutputLogic, OutputStatus,
@@ -175,7 +175,7 @@ pub struct Chip {
     motion: Option<Motion>,
     motion_seq: u64,
 
-    record: Record,
+    record: OutputRecord,
     /// The ramp of the last initialization, kept for the next one with
     /// the same rates, clock and PA, and across [`Chip::reset`]: its steps
     /// are a pure function of those, and fuzz inputs initialize alike.
@@ -238,7 +238,7 @@ impl Chip {
             remaining: 0,
             motion: None,
             motion_seq: 0,
-            record: Record::default(),
+            record: OutputRecord::default(),
             ramp_cache: RampCache::default(),
         })
     }
@@ -301,15 +301,15 @@ impl Chip {
     }
 
     /// The output record since reset.
-    pub fn record(&self) -> &Record {
+    pub fn record(&self) -> &OutputRecord {
         &self.record
     }
 
     /// Drops the record before `mark` as far as the model allows
-    /// ([`Record::forget_before`]: it still reads the last move's pulses);
+    /// ([`OutputRecord::forget_before`]: it still reads the last move's pulses);
     /// what was dropped. For a long differential run, which has compared
     /// everything before its last point of rest.
-    pub fn forget_record_before(&mut self, mark: RecordMark) -> RecordMark {
+    pub fn forget_record_before(&mut self, mark: OutputMark) -> OutputMark {
         self.record.forget_before(mark)
     }
 

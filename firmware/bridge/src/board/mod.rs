@@ -43,7 +43,7 @@ use alloc::vec::Vec;
 use ppmc_core::bridge::move_tracker::MoveTracker;
 use ppmc_core::bridge::wire::Timer;
 use ppmc_core::bus::{Op, Uncertainty};
-use ppmc_core::protocol::{EdgeRuns, PinEvent, Record, Straps};
+use ppmc_core::protocol::{EdgeRuns, PinEvent, OutputRecord, Straps};
 use ppmc_core::time::{Duration, Instant};
 
 pub struct Board<H: Hal> {
@@ -56,7 +56,7 @@ pub struct Board<H: Hal> {
     started: u64,
     /// Bridge ticks at the last chip reset: time zero of the record.
     epoch: u64,
-    record: Record,
+    record: OutputRecord,
     /// Pin changes not yet in the record, in time order: the record keeps
     /// them in time order, and they come from several sources (the edge
     /// counters, the sampled outputs, BUSY in status reads) at different
@@ -153,7 +153,7 @@ impl<H: Hal> Board<H> {
             straps,
             started,
             epoch,
-            record: Record::default(),
+            record: OutputRecord::default(),
             pending: Vec::new(),
             last_sample: 0,
             last_pulse: 0,

@@ -10,7 +10,7 @@ use crate::hal::Hal;
 use crate::pins;
 use alloc::string::String;
 use ppmc_core::bus::{Bus, Op, Reply, SelfTestPlan, SelfTestReply};
-use ppmc_core::protocol::{Input as ChipInput, Record, Status, Straps};
+use ppmc_core::protocol::{Input as ChipInput, OutputRecord, Status, Straps};
 use ppmc_core::time::{Duration, Instant};
 
 /// The longest pass of a spin on the clock ([`Board::spin_until`]): a
@@ -182,7 +182,7 @@ impl<H: Hal> Board<H> {
         self.started = self.hal.start_counters();
         self.epoch = self.now_ticks();
         self.moment = self.epoch;
-        self.record = Record::default();
+        self.record = OutputRecord::default();
         self.pending.clear();
         self.last_pulse = 0;
         self.edges.reset();
@@ -368,7 +368,7 @@ impl<H: Hal> Bus for Board<H> {
         self.next = next;
     }
 
-    fn record(&self) -> &Record {
+    fn record(&self) -> &OutputRecord {
         &self.record
     }
 

@@ -713,7 +713,7 @@ fn changes_shorter_than_the_both_edge_counters_path_are_missed_and_the_selftests
 }
 
 /// The phase outputs' changes (S1..S5, energized) of a record, in order.
-fn phase_changes(r: &ppmc_core::protocol::Record) -> Vec<(u8, u64)> {
+fn phase_changes(r: &ppmc_core::protocol::OutputRecord) -> Vec<(u8, u64)> {
     use ppmc_core::protocol::Pin;
     r.pins
         .iter()

@@ -16,8 +16,7 @@
 use super::rfc2217::Rfc2217Link;
 use super::serial::SerialLink;
 use super::tcp::TcpLink;
-use super::Link;
-use crate::backend::serial::SerialError;
+use super::{bad_address, Link, LinkDriver};
 use crate::stop::StopRequest;
 use std::fmt;
 use std::io::{self, BufRead, BufReader};
@@ -35,6 +34,39 @@ const EXPORT_TIMEOUT: WallDuration = WallDuration::from_secs(60);
 pub struct Place {
     pub name: String,
     pub port: Option<String>,
+}
+
+/// The driver of `labgrid:<place>[,port=NAME]`.
+#[derive(Debug)]
+pub struct LabgridDriver;
+
+pub(super) static DRIVER: LabgridDriver = LabgridDriver;
+
+impl LinkDriver for LabgridDriver {
+    fn prefix(&self) -> &'static str {
+        "labgrid:"
+    }
+
+    fn form(&self) -> &'static str {
+        "labgrid:<place>[,port=NAME]"
+    }
+
+    fn about(&self) -> &'static str {
+        "the serial port of a labgrid place you have acquired"
+    }
+
+    fn default_pad(&self) -> u16 {
+        64
+    }
+
+    fn check(&self, address: &str) -> Result<(), &'static str> {
+        parse_labgrid(address).map(drop).ok_or("")
+    }
+
+    fn open(&self, address: &str, stop: StopRequest) -> io::Result<Box<dyn Link>> {
+        let place = parse_labgrid(address).ok_or_else(|| bad_address(self, address))?;
+        Ok(Box::new(LabgridLink::open_until(place, stop)?))
+    }
 }
 
 /// Reads `labgrid:<place>[,port=NAME]`. A place name is what labgrid
@@ -172,17 +204,18 @@ fn client_program() -> String {
 impl LabgridLink {
     /// Asks labgrid where `place`'s serial port is and connects to it.
     /// Every failure is the infrastructure's, and names the place.
-    pub fn open(place: Place) -> Result<LabgridLink, String> {
+    pub fn open(place: Place) -> io::Result<LabgridLink> {
         Self::open_until(place, StopRequest::default())
     }
 
     /// [`Self::open`], given up (the client's export, a connection
     /// attempt) once `stop` is asked for.
-    pub fn open_until(place: Place, stop: StopRequest) -> Result<LabgridLink, String> {
+    pub fn open_until(place: Place, stop: StopRequest) -> io::Result<LabgridLink> {
         let who = format!("labgrid:{}", place.name);
-        let (export, found) = export(&place, &stop).map_err(|e| format!("{who}: {e}"))?;
+        let (export, found) =
+            export(&place, &stop).map_err(|e| io::Error::other(format!("{who}: {e}")))?;
         let inner: Box<dyn Link> = match (&found.host, found.protocol.as_deref()) {
-            (None, _) => Box::new(SerialLink::open(&found.port, found.speed).map_err(err)?),
+            (None, _) => Box::new(SerialLink::open(&found.port, found.speed)?),
             (Some(host), proto) => {
                 let host = if host.contains(':') && !host.starts_with('[') {
                     format!("[{host}]")
@@ -191,14 +224,15 @@ impl LabgridLink {
                 };
                 let addr = format!("{host}:{}", found.port);
                 match proto {
-                    Some("rfc2217") => {
-                        Box::new(Rfc2217Link::open_until(&addr, found.speed, stop).map_err(err)?)
-                    }
-                    Some("raw") => Box::new(TcpLink::open_until(&addr, stop).map_err(err)?),
+                    Some("rfc2217") => Box::new(Rfc2217Link::open_until(&addr, found.speed, stop)?),
+                    Some("raw") => Box::new(TcpLink::open_until(&addr, stop)?),
                     other => {
-                        return Err(format!(
-                            "{who}: labgrid serves the port as `{}`, which ppmc does not speak (rfc2217 or raw)",
-                            other.unwrap_or("(no protocol)")
+                        return Err(io::Error::new(
+                            io::ErrorKind::Unsupported,
+                            format!(
+                                "{who}: labgrid serves the port as `{}`, which ppmc does not speak (rfc2217 or raw)",
+                                other.unwrap_or("(no protocol)")
+                            ),
                         ))
                     }
                 }
@@ -210,10 +244,6 @@ impl LabgridLink {
             _export: export,
         })
     }
-}
-
-fn err(e: SerialError) -> String {
-    e.to_string()
 }
 
 /// Runs the client's export and waits for the file it writes.

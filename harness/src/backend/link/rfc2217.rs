@@ -12,9 +12,8 @@
 //! terminal or USB CDC the settings change nothing, and the link layer's
 //! health check says whether the bridge is there.
 
-use super::tcp::TcpLink;
-use super::Link;
-use crate::backend::serial::SerialError;
+use super::tcp::{host_and_port, TcpLink, HOST_PORT_HINT};
+use super::{bad_address, Link, LinkDriver};
 use crate::stop::StopRequest;
 use std::fmt;
 use std::io;
@@ -203,28 +202,58 @@ impl fmt::Debug for Rfc2217Link {
     }
 }
 
+/// The driver of `rfc2217://<host>:<port>[,baud=N]`.
+#[derive(Debug)]
+pub struct Rfc2217Driver;
+
+pub(super) static DRIVER: Rfc2217Driver = Rfc2217Driver;
+
+impl LinkDriver for Rfc2217Driver {
+    fn prefix(&self) -> &'static str {
+        "rfc2217://"
+    }
+
+    fn form(&self) -> &'static str {
+        "rfc2217://<host>:<port>[,baud=N]"
+    }
+
+    fn about(&self) -> &'static str {
+        "served over telnet with RFC 2217, as ser2net's telnet(rfc2217) mode and labgrid's exporter serve it"
+    }
+
+    fn default_pad(&self) -> u16 {
+        64
+    }
+
+    fn check(&self, address: &str) -> Result<(), &'static str> {
+        parse_rfc2217(address)
+            .filter(|(addr, _)| host_and_port(addr))
+            .map(drop)
+            .ok_or(HOST_PORT_HINT)
+    }
+
+    fn open(&self, address: &str, stop: StopRequest) -> io::Result<Box<dyn Link>> {
+        let (addr, baud) = parse_rfc2217(address).ok_or_else(|| bad_address(self, address))?;
+        Ok(Box::new(Rfc2217Link::open_until(&addr, baud, stop)?))
+    }
+}
+
 impl Rfc2217Link {
-    pub fn open(addr: &str, baud: u32) -> Result<Rfc2217Link, SerialError> {
+    pub fn open(addr: &str, baud: u32) -> io::Result<Rfc2217Link> {
         Self::open_until(addr, baud, StopRequest::default())
     }
 
     /// [`Self::open`], abandoning a connection attempt once `stop` is
-    /// asked for.
-    pub fn open_until(
-        addr: &str,
-        baud: u32,
-        stop: StopRequest,
-    ) -> Result<Rfc2217Link, SerialError> {
+    /// asked for. The error names the link.
+    pub fn open_until(addr: &str, baud: u32, stop: StopRequest) -> io::Result<Rfc2217Link> {
         let mut link = Rfc2217Link {
             tcp: TcpLink::open_until(addr, stop)?,
             baud,
             telnet: Telnet::default(),
             pending: Vec::new(),
         };
-        link.greet().map_err(|e| SerialError::Io {
-            path: link.name(),
-            source: e,
-        })?;
+        link.greet()
+            .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", link.name())))?;
         Ok(link)
     }
 

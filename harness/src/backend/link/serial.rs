@@ -1,8 +1,8 @@
 //! A serial port (USB CDC, a UART, a pseudo-terminal) as a [`Link`], and
-//! `serial:<path>[,baud=N]` addresses.
+//! its driver: `serial:<path>[,baud=N]` addresses.
 
-use super::{timed_out, Link};
-use crate::backend::serial::SerialError;
+use super::{bad_address, timed_out, Link, LinkDriver};
+use crate::stop::StopRequest;
 use std::fmt;
 use std::io::{self, Read, Write};
 use std::time::Duration as WallDuration;
@@ -23,8 +23,44 @@ impl fmt::Debug for SerialLink {
     }
 }
 
+/// The driver of `serial:<path>[,baud=N]`.
+#[derive(Debug)]
+pub struct SerialDriver;
+
+pub(super) static DRIVER: SerialDriver = SerialDriver;
+
+impl LinkDriver for SerialDriver {
+    fn prefix(&self) -> &'static str {
+        "serial:"
+    }
+
+    fn form(&self) -> &'static str {
+        "serial:<path>[,baud=N]"
+    }
+
+    fn about(&self) -> &'static str {
+        "a board, or `ppmc bridge-sim`, behind the serial bus bridge"
+    }
+
+    fn default_pad(&self) -> u16 {
+        0
+    }
+
+    fn check(&self, address: &str) -> Result<(), &'static str> {
+        parse_serial_address(address).map(drop).ok_or("")
+    }
+
+    fn open(&self, address: &str, _stop: StopRequest) -> io::Result<Box<dyn Link>> {
+        let (path, baud) =
+            parse_serial_address(address).ok_or_else(|| bad_address(self, address))?;
+        Ok(Box::new(SerialLink::open(&path, baud)?))
+    }
+}
+
 impl SerialLink {
-    pub fn open(path: &str, baud: u32) -> Result<SerialLink, SerialError> {
+    /// Opens the port at `path`; the error names it and says whether it
+    /// is missing or held by another program.
+    pub fn open(path: &str, baud: u32) -> io::Result<SerialLink> {
         let mut link = SerialLink {
             path: path.to_string(),
             baud,
@@ -53,22 +89,21 @@ impl SerialLink {
     }
 }
 
-pub(super) fn open_error(path: &str, e: io::Error) -> SerialError {
-    match e.kind() {
-        io::ErrorKind::NotFound => SerialError::PortMissing { path: path.into() },
-        io::ErrorKind::PermissionDenied | io::ErrorKind::ResourceBusy => SerialError::PortBusy {
-            path: path.into(),
-            detail: e.to_string(),
-        },
-        _ if e.raw_os_error() == Some(16) => SerialError::PortBusy {
-            path: path.into(),
-            detail: e.to_string(),
-        },
-        _ => SerialError::Io {
-            path: path.into(),
-            source: e,
-        },
-    }
+/// `e`, from opening the port at `path`, in words that name the port and
+/// say what to check.
+fn open_error(path: &str, e: io::Error) -> io::Error {
+    let busy = matches!(
+        e.kind(),
+        io::ErrorKind::PermissionDenied | io::ErrorKind::ResourceBusy
+    ) || e.raw_os_error() == Some(16);
+    let message = if e.kind() == io::ErrorKind::NotFound {
+        format!("{path}: no such serial port (is the bridge plugged in?)")
+    } else if busy {
+        format!("{path}: port busy or not accessible ({e}); is another program using it?")
+    } else {
+        format!("{path}: {e}")
+    };
+    io::Error::new(e.kind(), message)
 }
 
 impl Link for SerialLink {

@@ -10,8 +10,7 @@
 //! and, where the OS has it, asks for quick acknowledgements before every
 //! read (TCP_QUICKACK, which Linux clears again as it goes).
 
-use super::{timed_out, Link};
-use crate::backend::serial::SerialError;
+use super::{bad_address, timed_out, Link, LinkDriver};
 use crate::stop::StopRequest;
 use std::fmt;
 use std::io::{self, Read, Write};
@@ -41,6 +40,45 @@ impl fmt::Debug for TcpLink {
     }
 }
 
+/// The driver of `tcp://<host>:<port>`.
+#[derive(Debug)]
+pub struct TcpDriver;
+
+pub(super) static DRIVER: TcpDriver = TcpDriver;
+
+/// The hint of a `host:port` that does not read.
+pub(super) const HOST_PORT_HINT: &str = " (an IPv6 address in brackets: [::1])";
+
+impl LinkDriver for TcpDriver {
+    fn prefix(&self) -> &'static str {
+        "tcp://"
+    }
+
+    fn form(&self) -> &'static str {
+        "tcp://<host>:<port>"
+    }
+
+    fn about(&self) -> &'static str {
+        "a bridge's serial port served on the network in raw mode, as ser2net or socat serve it"
+    }
+
+    fn default_pad(&self) -> u16 {
+        64
+    }
+
+    fn check(&self, address: &str) -> Result<(), &'static str> {
+        parse_tcp(address)
+            .filter(|addr| host_and_port(addr))
+            .map(drop)
+            .ok_or(HOST_PORT_HINT)
+    }
+
+    fn open(&self, address: &str, stop: StopRequest) -> io::Result<Box<dyn Link>> {
+        let addr = parse_tcp(address).ok_or_else(|| bad_address(self, address))?;
+        Ok(Box::new(TcpLink::open_until(&addr, stop)?))
+    }
+}
+
 /// `host:port` of a `tcp://host:port` target, if it is one.
 pub fn parse_tcp(spec: &str) -> Option<String> {
     let rest = spec.strip_prefix("tcp://")?;
@@ -48,28 +86,51 @@ pub fn parse_tcp(spec: &str) -> Option<String> {
     (!host.is_empty() && port.parse::<u16>().is_ok_and(|p| p != 0)).then(|| rest.to_string())
 }
 
+/// Whether `addr` reads as `host:port` that a connection can be tried to:
+/// a port from 1 to 65535 after a host name, an IPv4 address or an IPv6
+/// address in brackets (`[::1]:4321`). Anything else (`[::1`, `::1:4321`,
+/// a space in the name) is the user's typing, refused before any
+/// connection, never a network failure.
+pub(super) fn host_and_port(addr: &str) -> bool {
+    let Some((host, port)) = addr.rsplit_once(':') else {
+        return false;
+    };
+    let port_ok = port.parse::<u16>().is_ok_and(|p| p != 0);
+    let host_ok = match host.strip_prefix('[') {
+        Some(v6) => v6
+            .strip_suffix(']')
+            .is_some_and(|v6| v6.parse::<std::net::Ipv6Addr>().is_ok()),
+        None => {
+            !host.is_empty()
+                && host
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '.' | '_'))
+        }
+    };
+    port_ok && host_ok
+}
+
 impl TcpLink {
-    pub fn open(addr: &str) -> Result<TcpLink, SerialError> {
+    pub fn open(addr: &str) -> io::Result<TcpLink> {
         Self::open_until(addr, StopRequest::default())
     }
 
     /// [`Self::open`], abandoning a connection attempt (this one, or a
-    /// reconnect's) once `stop` is asked for.
-    pub fn open_until(addr: &str, stop: StopRequest) -> Result<TcpLink, SerialError> {
+    /// reconnect's) once `stop` is asked for. The error names the link.
+    pub fn open_until(addr: &str, stop: StopRequest) -> io::Result<TcpLink> {
         let mut link = TcpLink {
             addr: addr.to_string(),
             stream: None,
             stop,
         };
-        link.reopen().map_err(|e| SerialError::Io {
-            path: link.name(),
-            source: match e.kind() {
-                io::ErrorKind::ConnectionRefused => io::Error::new(
-                    e.kind(),
-                    format!("{e}: nothing listens there (is the serial port server running?)"),
-                ),
-                _ => e,
-            },
+        link.reopen().map_err(|e| {
+            let why = match e.kind() {
+                io::ErrorKind::ConnectionRefused => {
+                    format!("{e}: nothing listens there (is the serial port server running?)")
+                }
+                _ => e.to_string(),
+            };
+            io::Error::new(e.kind(), format!("{}: {why}", link.name()))
         })?;
         Ok(link)
     }
@@ -177,6 +238,33 @@ fn connect(addr: String, stop: &StopRequest) -> io::Result<TcpStream> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn network_addresses_are_host_and_port_or_the_users_mistake() {
+        for good in [
+            "bench1.lab:4321",
+            "127.0.0.1:2001",
+            "[::1]:4321",
+            "[fe80::1]:1",
+            "rig_1:65535",
+        ] {
+            assert!(host_and_port(good), "{good}");
+        }
+        for bad in [
+            "[::1",
+            "[::1]",
+            "[::1:4321",
+            "::1:4321",
+            "[nothost]:4321",
+            "host:0",
+            "host:65536",
+            ":4321",
+            "host name:4321",
+            "host",
+        ] {
+            assert!(!host_and_port(bad), "{bad}");
+        }
+    }
 
     #[test]
     fn tcp_specs_name_a_host_and_a_port() {

@@ -1,4 +1,4 @@
-//! Why talking to a bridge failed: [`SerialError`], its kind, and what a
+//! Why talking to a bridge failed: [`BridgeError`], its kind, and what a
 //! restarted bridge says restarted it.
 
 use crate::backend::target::{TargetError, TargetErrorKind};
@@ -8,11 +8,11 @@ use std::io;
 
 /// Why talking to a bridge failed.
 #[derive(Debug, thiserror::Error)]
-pub enum SerialError {
-    #[error("{path}: no such serial port (is the bridge plugged in?)")]
-    PortMissing { path: String },
-    #[error("{path}: port busy or not accessible ({detail}); is another program using it?")]
-    PortBusy { path: String, detail: String },
+pub enum BridgeError {
+    /// The link did not open; its error names it and says why (a
+    /// [`super::super::LinkDriver`]'s `open`).
+    #[error(transparent)]
+    Open(#[from] io::Error),
     #[error("{path}: {source}")]
     Io {
         path: String,
@@ -99,11 +99,11 @@ pub enum SerialError {
     Garbled { link: String, len: usize },
 }
 
-impl SerialError {
+impl BridgeError {
     pub fn kind(&self) -> TargetErrorKind {
         match self {
-            SerialError::Version { .. } => TargetErrorKind::Unsupported,
-            SerialError::Interrupted { .. } => TargetErrorKind::Interrupted,
+            BridgeError::Version { .. } => TargetErrorKind::Unsupported,
+            BridgeError::Interrupted { .. } => TargetErrorKind::Interrupted,
             // An error or a reply of the wrong kind to a well-formed
             // request is the bridge's or the link's doing (a firmware bug,
             // something else answering on the port), never the chip's.
@@ -112,8 +112,8 @@ impl SerialError {
     }
 }
 
-impl From<SerialError> for TargetError {
-    fn from(e: SerialError) -> Self {
+impl From<BridgeError> for TargetError {
+    fn from(e: BridgeError) -> Self {
         TargetError::new(e.kind(), e)
     }
 }

@@ -114,7 +114,7 @@ impl std::fmt::Display for Noise {
     }
 }
 
-impl<L: Link> SerialTarget<L> {
+impl<L: Link> BridgeTarget<L> {
     /// Sends a request and waits for its reply, asking again for what was
     /// lost or corrupted (the whole reply, or the missing fragments of a
     /// long one) and reopening a vanished link. Gives up after `retries`
@@ -124,7 +124,7 @@ impl<L: Link> SerialTarget<L> {
         req: &Request,
         what: &str,
         extra: WallDuration,
-    ) -> Result<Response, SerialError> {
+    ) -> Result<Response, BridgeError> {
         if self.want_fragment != self.fragment && self.link_ok && !self.recovering {
             self.set_fragment(self.want_fragment)?;
         }
@@ -150,12 +150,12 @@ impl<L: Link> SerialTarget<L> {
     /// Asks the bridge for reply fragments of `size` data bytes. A bridge
     /// that does not know LINK (UNKNOWN_OP) keeps its own, and is not
     /// asked again.
-    pub(super) fn set_fragment(&mut self, size: u8) -> Result<(), SerialError> {
+    pub(super) fn set_fragment(&mut self, size: u8) -> Result<(), BridgeError> {
         self.set_link(size, self.pad)
     }
 
     /// Sets the reply fragment size and padding (LINK).
-    pub(super) fn set_link(&mut self, fragment: u8, pad: u16) -> Result<(), SerialError> {
+    pub(super) fn set_link(&mut self, fragment: u8, pad: u16) -> Result<(), BridgeError> {
         match self.exchange(&Request::Link { fragment, pad }, "link", WallDuration::ZERO)? {
             Response::Link { fragment, pad } => {
                 self.fragment = fragment;
@@ -172,7 +172,7 @@ impl<L: Link> SerialTarget<L> {
     }
 
     /// One request and its reply, asked again as the line needs, within
-    /// the limits of [`SerialOptions`] (fewer while reconnecting). `span`
+    /// the limits of [`BridgeOptions`] (fewer while reconnecting). `span`
     /// is the bridge time the request's own waits may take: wall time on a
     /// real-time bridge; on a bridge in virtual time, its clock, which its
     /// WORKING messages report while it runs the request.
@@ -181,7 +181,7 @@ impl<L: Link> SerialTarget<L> {
         req: &Request,
         what: &str,
         span: WallDuration,
-    ) -> Result<Response, SerialError> {
+    ) -> Result<Response, BridgeError> {
         let extra = match self.hello.virtual_time {
             true => WallDuration::ZERO,
             false => span,
@@ -257,7 +257,7 @@ impl<L: Link> SerialTarget<L> {
                     Ok(()) => {}
                     // Say what went unanswered, and that reconnecting did
                     // not help.
-                    Err(SerialError::LinkLost {
+                    Err(BridgeError::LinkLost {
                         attempts: reconnects,
                         last,
                         ..
@@ -364,7 +364,7 @@ impl<L: Link> SerialTarget<L> {
                         match self.ran(seq, give_up_at, &mut frags, &mut noise, &mut probe_lost)? {
                             Ran::No if probe_lost => {}
                             Ran::No => {
-                                return Err(SerialError::Garbled {
+                                return Err(BridgeError::Garbled {
                                     link: self.link.name(),
                                     len: payload.len(),
                                 })
@@ -450,8 +450,8 @@ impl<L: Link> SerialTarget<L> {
         tries: u32,
         start: WallInstant,
         heard: String,
-    ) -> SerialError {
-        SerialError::NoAnswer {
+    ) -> BridgeError {
+        BridgeError::NoAnswer {
             link: self.link.name(),
             what: what.into(),
             tries,
@@ -507,7 +507,7 @@ impl<L: Link> SerialTarget<L> {
         tries: u32,
         start: WallInstant,
         e: io::Error,
-    ) -> SerialError {
+    ) -> BridgeError {
         let heard = format!(
             "the connection dropped {} times with nothing gained between (the last: {e})",
             self.opts.reopen_attempts + 1
@@ -523,8 +523,8 @@ impl<L: Link> SerialTarget<L> {
     }
 
     /// The error for a stop request.
-    pub(super) fn interrupted(&self) -> SerialError {
-        SerialError::Interrupted {
+    pub(super) fn interrupted(&self) -> BridgeError {
+        BridgeError::Interrupted {
             link: self.link.name(),
         }
     }
@@ -532,12 +532,12 @@ impl<L: Link> SerialTarget<L> {
     /// After the link failed mid-exchange: reconnects (the exchange then
     /// sends its request again), or, while already reconnecting, fails
     /// this attempt of the reconnect loop.
-    pub(super) fn link_failed(&mut self, e: io::Error) -> Result<(), SerialError> {
+    pub(super) fn link_failed(&mut self, e: io::Error) -> Result<(), BridgeError> {
         if self.opts.stop.requested() {
             return Err(self.interrupted());
         }
         if self.recovering {
-            return Err(SerialError::Io {
+            return Err(BridgeError::Io {
                 path: self.link.name(),
                 source: e,
             });
@@ -559,7 +559,7 @@ impl<L: Link> SerialTarget<L> {
         frags: &mut Fragments,
         noise: &mut Noise,
         probe_lost: &mut bool,
-    ) -> Result<Ran, SerialError> {
+    ) -> Result<Ran, BridgeError> {
         let probe = frame::encode(&Request::Resend { fragments: vec![0] }.encode(seq, self.timer));
         for _ in 0..=self.opts.retries {
             self.stats.retransmissions += 1;
@@ -691,7 +691,7 @@ impl<L: Link> SerialTarget<L> {
     /// opens but fails before the bridge has answered HELLO counts as a
     /// failed attempt. The bridge must still be the same session holding
     /// this host's requests, or the run cannot trust the chip's state.
-    pub(super) fn recover(&mut self, e: io::Error) -> Result<(), SerialError> {
+    pub(super) fn recover(&mut self, e: io::Error) -> Result<(), BridgeError> {
         let mut last = e.to_string();
         // The first attempt at once (a dropped network connection is
         // usually back at once), then with doubling backoff.
@@ -719,13 +719,13 @@ impl<L: Link> SerialTarget<L> {
                     Ok(_) => return Ok(()),
                     // The link failed again, or the bridge said nothing:
                     // another attempt.
-                    Err(e @ (SerialError::Io { .. } | SerialError::NoAnswer { .. })) => {
+                    Err(e @ (BridgeError::Io { .. } | BridgeError::NoAnswer { .. })) => {
                         last = e.to_string()
                     }
                     Err(e) => return Err(e),
                 }
             }
-            Err(SerialError::LinkLost {
+            Err(BridgeError::LinkLost {
                 link: self.link.name(),
                 attempts: self.opts.reopen_attempts,
                 last: last.clone(),

@@ -1,4 +1,4 @@
-//! The retry and timeout policy of a bridge link ([`SerialOptions`]), the
+//! The retry and timeout policy of a bridge link ([`BridgeOptions`]), the
 //! round-trip estimate the waits follow, and the sizes and limits the host
 //! keeps to.
 
@@ -17,7 +17,7 @@ use std::time::Duration as WallDuration;
 /// link error; a line that answers, however garbled, is alive and gets ten
 /// times as many.
 #[derive(Debug, Clone)]
-pub struct SerialOptions {
+pub struct BridgeOptions {
     /// The longest wait for a reply beyond the time the batch itself needs
     /// (the first waits, before the round-trip time is known, and the cap
     /// of the backoff).
@@ -41,11 +41,11 @@ pub struct SerialOptions {
     /// 0 for none.
     pub pad: u16,
     /// Asked for, every wait on the link ends within [`StopRequest::SLICE`] with
-    /// [`SerialError::Interrupted`](super::SerialError::Interrupted).
+    /// [`BridgeError::Interrupted`](super::BridgeError::Interrupted).
     pub stop: StopRequest,
 }
 
-impl SerialOptions {
+impl BridgeOptions {
     /// How long a request may go without progress (no new reply or
     /// fragment), however much noise arrives, before it is given up:
     /// `reply_timeout` for every attempt it may make in silence.
@@ -60,9 +60,9 @@ impl SerialOptions {
     }
 }
 
-impl Default for SerialOptions {
+impl Default for BridgeOptions {
     fn default() -> Self {
-        SerialOptions {
+        BridgeOptions {
             reply_timeout: WallDuration::from_millis(1000),
             min_reply_timeout: WallDuration::from_millis(20),
             retries: 10,
@@ -109,7 +109,7 @@ impl RoundTrip {
     }
 
     /// How long to wait for a reply: `srtt + 4 rttvar`, within the bounds.
-    pub(super) fn timeout(&self, opts: &SerialOptions) -> WallDuration {
+    pub(super) fn timeout(&self, opts: &BridgeOptions) -> WallDuration {
         match self.srtt {
             None => opts.reply_timeout,
             Some(s) => (s + self.rttvar * 4)

@@ -1,4 +1,4 @@
-//! [`SerialTarget`]: the bridge session (HELLO, the health check, the
+//! [`BridgeTarget`]: the bridge session (HELLO, the health check, the
 //! straps its chip reports) and the [`Target`] it is.
 
 use super::error::*;
@@ -8,7 +8,7 @@ use crate::backend::target::{
     Op, Reply, SelfTestPlan, SelfTestRun, Target, TargetError, TargetErrorKind, TargetInfo,
     Uncertainty,
 };
-use crate::protocol::Record;
+use crate::protocol::OutputRecord;
 use crate::protocol::Straps;
 use crate::time::Instant;
 use ppmc_core::bridge::frame::FrameDecoder;
@@ -32,15 +32,15 @@ pub struct LinkStats {
 
 /// A chip behind a bus bridge.
 #[derive(Debug)]
-pub struct SerialTarget<L: Link> {
+pub struct BridgeTarget<L: Link> {
     pub(super) link: L,
     pub(super) decoder: FrameDecoder,
     pub(super) seq: u8,
     pub(super) hello: Hello,
     pub(super) timer: Timer,
-    pub(super) opts: SerialOptions,
+    pub(super) opts: BridgeOptions,
     /// The capture fetched so far (since the last chip reset).
-    pub(super) captured: Record,
+    pub(super) captured: OutputRecord,
     /// `captured` is the whole capture as of now: the last request brought
     /// the rest of it back, and the bridge's chip has not moved on since
     /// (it runs in virtual time, so nothing happens between requests).
@@ -99,11 +99,11 @@ pub(super) fn host_session() -> u32 {
     ((x >> 32) as u32 ^ x as u32).max(1)
 }
 
-impl<L: Link> SerialTarget<L> {
+impl<L: Link> BridgeTarget<L> {
     /// Says hello, then checks the board's health: a chip reset, and the
     /// status register reading 0x00 after it.
-    pub fn open(link: L, opts: SerialOptions) -> Result<Self, SerialError> {
-        let mut t = SerialTarget {
+    pub fn open(link: L, opts: BridgeOptions) -> Result<Self, BridgeError> {
+        let mut t = BridgeTarget {
             link,
             decoder: FrameDecoder::new(),
             seq: 0,
@@ -124,7 +124,7 @@ impl<L: Link> SerialTarget<L> {
             },
             timer: Timer::NANOS,
             opts,
-            captured: Record::default(),
+            captured: OutputRecord::default(),
             captured_current: false,
             clock: Instant::ZERO,
             rtt: RoundTrip::default(),
@@ -158,22 +158,22 @@ impl<L: Link> SerialTarget<L> {
         let replies = t
             .run_batch(&[Op::Reset, Op::ReadStatus])
             .map_err(|e| match e {
-                e @ SerialError::Interrupted { .. } => e,
-                e => SerialError::Unhealthy {
+                e @ BridgeError::Interrupted { .. } => e,
+                e => BridgeError::Unhealthy {
                     link: t.link.name(),
                     detail: e.to_string(),
                 },
             })?;
         match replies.get(1) {
             Some(Reply::Status { status, .. }) if status.0 == 0 => Ok(t),
-            Some(Reply::Status { status, .. }) => Err(SerialError::Unhealthy {
+            Some(Reply::Status { status, .. }) => Err(BridgeError::Unhealthy {
                 link: t.link.name(),
                 detail: format!(
                     "after a chip reset the status register reads 0x{:02X}, not 0x00",
                     status.0
                 ),
             }),
-            other => Err(SerialError::Unhealthy {
+            other => Err(BridgeError::Unhealthy {
                 link: t.link.name(),
                 detail: match other {
                     Some(r) => format!("the status read after a chip reset got `{r}`"),
@@ -191,7 +191,7 @@ impl<L: Link> SerialTarget<L> {
     /// target is open, the bridge must be the same session, and must have
     /// kept this host's cached request (`resumed`): otherwise what the
     /// chip did while the link was down is unknown.
-    pub(super) fn say_hello(&mut self) -> Result<Hello, SerialError> {
+    pub(super) fn say_hello(&mut self) -> Result<Hello, BridgeError> {
         let hello = Request::Hello {
             version: PROTOCOL_VERSION,
             host: self.host,
@@ -200,7 +200,7 @@ impl<L: Link> SerialTarget<L> {
             // A line too noisy for the hello reply's 48-byte fragments:
             // ask for the smallest and say hello again (not while
             // reconnecting, where a silent bridge is told by the loop).
-            Err(SerialError::NoAnswer { .. }) if self.link_ok && !self.recovering => {
+            Err(BridgeError::NoAnswer { .. }) if self.link_ok && !self.recovering => {
                 self.want_fragment = MIN_FRAGMENT_DATA as u8;
                 self.request(&hello, "hello", WallDuration::ZERO)?
             }
@@ -211,7 +211,7 @@ impl<L: Link> SerialTarget<L> {
             // Another bridge behind the same address (reflashed, swapped):
             // the link's doing, not a choice of the user's.
             Response::Hello(h) if self.opened => {
-                return Err(SerialError::Protocol {
+                return Err(BridgeError::Protocol {
                     link: self.link.name(),
                     what: "hello after a reconnect".into(),
                     detail: format!(
@@ -221,7 +221,7 @@ impl<L: Link> SerialTarget<L> {
                 })
             }
             Response::Hello(h) => {
-                return Err(SerialError::Version {
+                return Err(BridgeError::Version {
                     link: self.link.name(),
                     ours: PROTOCOL_VERSION,
                     theirs: h.version,
@@ -231,7 +231,7 @@ impl<L: Link> SerialTarget<L> {
         };
         if self.opened {
             if h.session != self.hello.session {
-                return Err(SerialError::Restarted {
+                return Err(BridgeError::Restarted {
                     link: self.link.name(),
                     old: self.hello.session,
                     new: h.session,
@@ -239,7 +239,7 @@ impl<L: Link> SerialTarget<L> {
                 });
             }
             if !h.resumed {
-                return Err(SerialError::Displaced {
+                return Err(BridgeError::Displaced {
                     link: self.link.name(),
                 });
             }
@@ -247,12 +247,12 @@ impl<L: Link> SerialTarget<L> {
         Ok(*h)
     }
 
-    pub(super) fn unexpected(&self, what: &str, r: &Response) -> SerialError {
+    pub(super) fn unexpected(&self, what: &str, r: &Response) -> BridgeError {
         match r {
             Response::Error {
                 code: BridgeErrorCode::Version,
                 detail,
-            } if !self.opened => SerialError::Version {
+            } if !self.opened => BridgeError::Version {
                 link: self.link.name(),
                 ours: PROTOCOL_VERSION,
                 theirs: detail
@@ -263,17 +263,17 @@ impl<L: Link> SerialTarget<L> {
             Response::Error {
                 code: BridgeErrorCode::CaptureOverrun,
                 detail,
-            } => SerialError::CaptureOverrun {
+            } => BridgeError::CaptureOverrun {
                 link: self.link.name(),
                 detail: detail.clone(),
             },
-            Response::Error { code, detail } => SerialError::Bridge {
+            Response::Error { code, detail } => BridgeError::Bridge {
                 link: self.link.name(),
                 what: what.into(),
                 code: *code,
                 detail: detail.clone(),
             },
-            other => SerialError::Protocol {
+            other => BridgeError::Protocol {
                 link: self.link.name(),
                 what: what.into(),
                 detail: format!("a {} message", other.name()),
@@ -282,7 +282,7 @@ impl<L: Link> SerialTarget<L> {
     }
 }
 
-impl<L: Link> Target for SerialTarget<L> {
+impl<L: Link> Target for BridgeTarget<L> {
     /// What the bridge declared in its HELLO, never finer than a tick of
     /// its timer (a bridge that says 0 is not exact).
     fn uncertainty(&self) -> Uncertainty {
@@ -331,7 +331,7 @@ impl<L: Link> Target for SerialTarget<L> {
     /// changes and moves, and the pulse runs from the last one known on
     /// (the last run may have grown). Costs nothing when the last batch
     /// brought the rest of the capture back with it.
-    fn capture(&mut self) -> Result<Record, TargetError> {
+    fn capture(&mut self) -> Result<OutputRecord, TargetError> {
         Ok(self.counted(Self::fetch_capture)?)
     }
 
@@ -344,18 +344,18 @@ impl<L: Link> Target for SerialTarget<L> {
     }
 }
 
-impl<L: Link> SerialTarget<L> {
+impl<L: Link> BridgeTarget<L> {
     /// Runs `f` unless the link has given up on too many requests already,
     /// and counts it if it gives up too.
     pub(super) fn counted<T>(
         &mut self,
-        f: impl FnOnce(&mut Self) -> Result<T, SerialError>,
-    ) -> Result<T, SerialError> {
+        f: impl FnOnce(&mut Self) -> Result<T, BridgeError>,
+    ) -> Result<T, BridgeError> {
         if self.opts.stop.requested() {
             return Err(self.interrupted());
         }
         if self.give_ups >= MAX_GIVE_UPS {
-            return Err(SerialError::Exhausted {
+            return Err(BridgeError::Exhausted {
                 link: self.link.name(),
                 failures: self.give_ups,
                 last: self.last_give_up.clone(),
@@ -366,7 +366,7 @@ impl<L: Link> SerialTarget<L> {
             // A capture overrun is an answer, not a request given up: the
             // bridge works, and the chip reset of the next scenario empties
             // its capture.
-            if e.kind() == TargetErrorKind::Link && !matches!(e, SerialError::CaptureOverrun { .. })
+            if e.kind() == TargetErrorKind::Link && !matches!(e, BridgeError::CaptureOverrun { .. })
             {
                 self.give_ups += 1;
                 self.last_give_up = e.to_string();

@@ -1,5 +1,6 @@
-//! A board behind the serial bus bridge: the [`Target`] backend that speaks
-//! the bridge protocol (`docs/bridge-protocol.md`) over a [`Link`].
+//! A board behind the bus bridge: the [`Target`] backend that speaks the
+//! bridge protocol (`docs/bridge-protocol.md`) over any [`Link`] (a serial
+//! port, TCP, telnet with RFC 2217, a labgrid place's port).
 //!
 //! Every request carries a sequence number and the bridge answers a
 //! retransmitted request from its cache without running it again, so a
@@ -17,7 +18,7 @@
 //! progress however much noise arrives, and at an absolute deadline; a
 //! reconnection is a loop of at most `reopen_attempts`; after
 //! [`MAX_GIVE_UPS`] requests given up the link is not trusted for the rest
-//! of the run. A [`Stop`] request ends any wait within [`Stop::SLICE`].
+//! of the run. A [`StopRequest`] ends any wait within [`StopRequest::SLICE`].
 
 mod batch;
 mod error;
@@ -27,6 +28,6 @@ mod target;
 #[cfg(test)]
 mod tests;
 
-pub use self::error::{restart_cause, SerialError};
-pub use self::options::{SerialOptions, MAX_GIVE_UPS};
-pub use self::target::{LinkStats, SerialTarget};
+pub use self::error::{restart_cause, BridgeError};
+pub use self::options::{BridgeOptions, MAX_GIVE_UPS};
+pub use self::target::{BridgeTarget, LinkStats};

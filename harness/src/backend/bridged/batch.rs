@@ -6,13 +6,13 @@ use super::options::*;
 use super::target::*;
 use crate::backend::link::Link;
 use crate::backend::target::{Op, Reply, SelfTestPlan, SelfTestRun};
-use crate::protocol::Record;
+use crate::protocol::OutputRecord;
 use crate::time::Instant;
 use ppmc_core::bridge::wire::MAX_BATCH_OPS;
 use ppmc_core::bridge::wire::{self, CaptureChunk, Request, Response};
 use std::time::Duration as WallDuration;
 
-impl<L: Link> SerialTarget<L> {
+impl<L: Link> BridgeTarget<L> {
     /// The bridge time a batch's own waits may take: wall time on a
     /// real-time bridge, the bridge's clock on one in virtual time (which
     /// says how far it got with WORKING).
@@ -84,11 +84,11 @@ impl<L: Link> SerialTarget<L> {
 
     /// Follows the bridge's clock through the replies to `ops`: it restarts
     /// at a chip reset and otherwise never goes back.
-    pub(super) fn check_clock(&mut self, ops: &[Op], replies: &[Reply]) -> Result<(), SerialError> {
+    pub(super) fn check_clock(&mut self, ops: &[Op], replies: &[Reply]) -> Result<(), BridgeError> {
         for (op, r) in ops.iter().zip(replies) {
             let at = r.at();
             if *op != Op::Reset && at < self.clock {
-                return Err(SerialError::ClockWentBack {
+                return Err(BridgeError::ClockWentBack {
                     link: self.link.name(),
                     was: self.clock,
                     now: at,
@@ -104,11 +104,11 @@ impl<L: Link> SerialTarget<L> {
     /// bridge has not sent yet, up to one chunk), so that reading the
     /// capture after a batch, which every scenario does, costs no round
     /// trip of its own.
-    pub(super) fn run_batch(&mut self, ops: &[Op]) -> Result<Vec<Reply>, SerialError> {
+    pub(super) fn run_batch(&mut self, ops: &[Op]) -> Result<Vec<Reply>, BridgeError> {
         self.captured_current = false;
         if ops.contains(&Op::Reset) {
             // A chip reset clears the bridge's capture.
-            self.captured = Record::default();
+            self.captured = OutputRecord::default();
         }
         let mut out = Vec::with_capacity(ops.len());
         let max_ops = usize::from(self.hello.max_batch_ops.clamp(1, MAX_BATCH_OPS.max(1)));
@@ -140,7 +140,7 @@ impl<L: Link> SerialTarget<L> {
                 Request::Batch(chunk.to_vec())
             };
             let reply = match self.request(&req, &what, extra) {
-                Err(e @ SerialError::Garbled { .. }) => {
+                Err(e @ BridgeError::Garbled { .. }) => {
                     // Not run: send the same ops again, in smaller requests
                     // while they can shrink; a line that garbles even the
                     // smallest this often is given up.
@@ -182,14 +182,14 @@ impl<L: Link> SerialTarget<L> {
     }
 }
 
-impl<L: Link> SerialTarget<L> {
+impl<L: Link> BridgeTarget<L> {
     /// SELF_TEST, then the capture it made: the bridge resets its chip
     /// first, so the capture and the bridge's clock start afresh.
     pub(super) fn run_self_test(
         &mut self,
         plan: &SelfTestPlan,
-    ) -> Result<SelfTestRun, SerialError> {
-        self.captured = Record::default();
+    ) -> Result<SelfTestRun, BridgeError> {
+        self.captured = OutputRecord::default();
         self.captured_current = false;
         self.clock = Instant::ZERO;
         // The chip reset (100 us) and the bursts, each with its gap.
@@ -200,13 +200,13 @@ impl<L: Link> SerialTarget<L> {
         };
         let capture = match self.fetch_capture() {
             Ok(r) => Ok(r),
-            Err(SerialError::CaptureOverrun { detail, .. }) => Err(detail),
+            Err(BridgeError::CaptureOverrun { detail, .. }) => Err(detail),
             Err(e) => return Err(e),
         };
         Ok(SelfTestRun { reply, capture })
     }
 
-    pub(super) fn fetch_capture(&mut self) -> Result<Record, SerialError> {
+    pub(super) fn fetch_capture(&mut self) -> Result<OutputRecord, BridgeError> {
         while !self.captured_current {
             let (runs, pins, moves) = self.capture_from();
             let req = Request::Capture {
@@ -226,7 +226,7 @@ impl<L: Link> SerialTarget<L> {
                     let held = self.captured.runs.len() + self.captured.pins.len();
                     let room = (self.hello.capture_capacity as usize).min(MAX_CAPTURE_RECORDS);
                     if more && (brought == 0 || held > room) {
-                        return Err(SerialError::Protocol {
+                        return Err(BridgeError::Protocol {
                             link: self.link.name(),
                             what: "capture".into(),
                             detail: match brought {

@@ -1,7 +1,7 @@
-//! The judge: the invariants of `docs/invariants.md` judged from what the
+//! The rules: the invariants of `docs/invariants.md` checked from what the
 //! host sees of each op (the status register before and after it, the
 //! bytes read) and from the capture, and what a break of one is
-//! ([`Violation`]). The same judge runs on the emulator's chip
+//! ([`Violation`]). The same rules run on the emulator's chip
 //! ([`super::oracle::Checker`]) and on any target's replies
 //! ([`super::replay`]).
 
@@ -10,7 +10,7 @@ use super::capture::{
 };
 use super::ids::Invariant;
 use crate::bus_program::BusOp;
-use crate::protocol::capture::{MoveStart, Pin, Record};
+use crate::protocol::capture::{MoveStart, OutputRecord, Pin};
 use crate::protocol::{
     ClockSource, Command, FinishStatus, InitData, MoveKind, Register, Status, StatusField, Straps,
 };
@@ -74,10 +74,10 @@ pub struct Seen {
 }
 
 /// The invariants, judged from what the host sees of each op and from the
-/// capture (as of each op's time). The same judge runs on the emulator's
+/// capture (as of each op's time). The same rules run on the emulator's
 /// chip ([`super::oracle::Checker`]) and on any target's replies ([`super::replay`]).
 #[derive(Debug, Default)]
-pub struct Judge {
+pub struct Rules {
     /// The board's straps: they fix the pulse clock (`min-interval`).
     straps: Straps,
     pub(super) ops: usize,
@@ -95,25 +95,25 @@ pub struct Judge {
     finish_reads: Vec<Instant>,
 }
 
-impl Judge {
-    /// A judge for a board with these straps.
-    pub fn new(straps: Straps) -> Judge {
-        Judge {
+impl Rules {
+    /// The rules for a board with these straps.
+    pub fn new(straps: Straps) -> Rules {
+        Rules {
             straps,
-            ..Judge::default()
+            ..Rules::default()
         }
     }
 
-    /// Back to a new judge, keeping the memory of its byte lists.
+    /// Back to the start, keeping the memory of its byte lists.
     pub fn reset(&mut self) {
         let mut taken = std::mem::take(&mut self.taken);
         let mut finish_reads = std::mem::take(&mut self.finish_reads);
         taken.clear();
         finish_reads.clear();
-        *self = Judge {
+        *self = Rules {
             taken,
             finish_reads,
-            ..Judge::new(self.straps)
+            ..Rules::new(self.straps)
         };
     }
 
@@ -126,7 +126,7 @@ impl Judge {
 
     /// Judges op number `self.ops` given what was seen of it and the
     /// capture, which may run past `seen.at` (it is looked at as of then).
-    pub fn op(&mut self, op: BusOp, seen: Seen, rec: &Record) -> Result<(), Violation> {
+    pub fn op(&mut self, op: BusOp, seen: Seen, rec: &OutputRecord) -> Result<(), Violation> {
         let i = self.ops;
         self.ops += 1;
         let fail = |invariant, detail: String| Violation {
@@ -208,7 +208,7 @@ impl Judge {
 
     /// The whole capture's invariants, once at the end (per op they would
     /// cost time quadratic in its length).
-    pub fn finish(&self, rec: &Record) -> Result<(), Violation> {
+    pub fn finish(&self, rec: &OutputRecord) -> Result<(), Violation> {
         let at_end = |invariant, detail| Violation {
             invariant,
             op: self.ops.saturating_sub(1),
@@ -240,7 +240,7 @@ impl Judge {
     /// come before INT* rises, taken after). One-sided as the finish flag
     /// is: a read command the chip lost cannot release it, so "still
     /// asserted after a read" is not claimed.
-    fn int_breaks(&self, rec: &Record) -> Option<(Invariant, String)> {
+    fn int_breaks(&self, rec: &OutputRecord) -> Option<(Invariant, String)> {
         let mut asserted_at = None;
         let mut released_at = Instant::ZERO;
         for p in rec.pins.iter().filter(|p| p.pin == Pin::Int) {
@@ -317,7 +317,7 @@ impl Judge {
     /// initialization taken before the move with rates the datasheet allows
     /// (255 > RL > RH > 0), on the clock each selects. A move whose
     /// command bytes it did not see all taken is not judged.
-    fn interval_breaks(&self, rec: &Record) -> Option<String> {
+    fn interval_breaks(&self, rec: &OutputRecord) -> Option<String> {
         // The initializations taken so far, as the moves come (both in time
         // order): the fastest RH period among them, and the clocks they
         // chose. One pass, however many moves and bytes.
@@ -434,7 +434,7 @@ impl Judge {
     /// pulses (Section 3-4-4) and the finish status polling flag (3-4-1).
     /// The chip takes a read command only when BUSY = 0, so the move the
     /// register tells of has ended by `at`.
-    fn register_breaks(&mut self, rec: &Record, at: Instant) -> Option<(Invariant, String)> {
+    fn register_breaks(&mut self, rec: &OutputRecord, at: Instant) -> Option<(Invariant, String)> {
         let Reading {
             command,
             bytes,
@@ -517,16 +517,16 @@ mod tests {
     fn int_released_only_by_a_finish_status_read() {
         let read = then_read(0x80, 1);
         assert_eq!(check(&read, ModelConfig::default()).expect("chip"), None);
-        let mut rec = Record::default();
+        let mut rec = OutputRecord::default();
         rec.pin(Instant::from_nanos(1_000), Pin::Int, 1);
         rec.pin(Instant::from_nanos(5_000), Pin::Int, 0);
-        let v = Judge::default().finish(&rec).expect_err("a break");
+        let v = Rules::default().finish(&rec).expect_err("a break");
         assert_eq!(v.invariant, Invariant::IntRelease, "{v}");
         // Released after a finish status read written since the start
         // (here before INT* rose, taken after): kept.
-        let judge = Judge {
+        let judge = Rules {
             finish_reads: vec![Instant::from_nanos(500)],
-            ..Judge::default()
+            ..Rules::default()
         };
         assert_eq!(judge.finish(&rec), Ok(()));
         // A second release needs a read of its own.
@@ -560,12 +560,12 @@ mod tests {
             (t(502), Written::Data(0)),
             (t(503), Written::Data(0)),
         ];
-        let judge = Judge {
+        let judge = Rules {
             taken: taken.to_vec(),
-            ..Judge::new(Straps::default())
+            ..Rules::new(Straps::default())
         };
         let record = |interval_us| {
-            let mut rec = Record::default();
+            let mut rec = OutputRecord::default();
             rec.pin(t(490), Pin::Busy, 1);
             rec.moves.push(MoveStart {
                 at: t(503),
@@ -604,9 +604,9 @@ mod tests {
                 (t(14), Written::Data(0)),
             ],
         );
-        let judge = Judge {
+        let judge = Rules {
             taken: bad,
-            ..Judge::new(Straps::default())
+            ..Rules::new(Straps::default())
         };
         assert_eq!(
             judge.finish(&record(40)).map_err(|v| v.invariant),

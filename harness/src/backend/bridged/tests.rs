@@ -158,8 +158,8 @@ impl Link for MemLink {
     }
 }
 
-fn quick() -> SerialOptions {
-    SerialOptions {
+fn quick() -> BridgeOptions {
+    BridgeOptions {
         reply_timeout: WallDuration::from_millis(20),
         min_reply_timeout: WallDuration::from_millis(1),
         retries: 2,
@@ -173,8 +173,8 @@ fn quick() -> SerialOptions {
 
 #[test]
 fn asked_to_pad_the_bridge_sends_whole_multiples_of_the_padding() {
-    let opts = SerialOptions { pad: 64, ..quick() };
-    let mut t = SerialTarget::open(MemLink::new(), opts).expect("opens");
+    let opts = BridgeOptions { pad: 64, ..quick() };
+    let mut t = BridgeTarget::open(MemLink::new(), opts).expect("opens");
     let replies = t.execute(&[Op::Reset, Op::ReadStatus]).expect("runs");
     assert_eq!(replies.len(), 2);
     let sent = &t.link.sent;
@@ -184,7 +184,7 @@ fn asked_to_pad_the_bridge_sends_whole_multiples_of_the_padding() {
     assert!(sent.len() >= 3, "{sent:?}");
     assert!(sent[1..].iter().all(|n| n % 64 == 0), "{sent:?}");
     // Unasked, nothing is padded.
-    let mut plain = SerialTarget::open(MemLink::new(), quick()).expect("opens");
+    let mut plain = BridgeTarget::open(MemLink::new(), quick()).expect("opens");
     plain.execute(&[Op::ReadStatus]).expect("runs");
     assert!(
         plain.link.sent.iter().all(|n| n % 64 != 0),
@@ -222,12 +222,12 @@ fn pin_sampling_costs_a_round_trip_per_1500_samples_and_matches_the_emulator() {
         let want = sample_a_move(&mut emu, step, 3_000);
         // Counting round trips: waits long enough that a loaded
         // machine never makes a reply late and asked for again.
-        let patient = SerialOptions {
+        let patient = BridgeOptions {
             reply_timeout: WallDuration::from_secs(5),
             min_reply_timeout: WallDuration::from_secs(2),
             ..quick()
         };
-        let mut t = SerialTarget::open(MemLink::new(), patient).expect("healthy");
+        let mut t = BridgeTarget::open(MemLink::new(), patient).expect("healthy");
         let before = t.stats.round_trips;
         let got = sample_a_move(&mut t, step, 3_000);
         assert_eq!(got, want);
@@ -250,13 +250,13 @@ fn a_connection_dropped_at_any_frame_boundary_changes_no_reply() {
         // Waits long enough that a loaded machine never gives up on a
         // reply (the link never loses one unless cut), short enough
         // that asking again for fragments costs little.
-        let opts = SerialOptions {
+        let opts = BridgeOptions {
             reply_timeout: WallDuration::from_millis(500),
             min_reply_timeout: WallDuration::from_millis(5),
             retries: 10,
             ..quick()
         };
-        let mut t = SerialTarget::open(link, opts).expect("opens");
+        let mut t = BridgeTarget::open(link, opts).expect("opens");
         let mut d = Driver::new(&mut t, DriverOptions::default());
         d.reset().expect("reset");
         d.init_and_wait(Init::four_phase()).expect("init");
@@ -299,7 +299,7 @@ fn a_connection_dropped_at_any_frame_boundary_changes_no_reply() {
 /// only after N was sent again.
 #[test]
 fn a_late_answer_to_a_lost_probe_never_runs_a_request_twice() {
-    let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
     let ms = |n| Op::Delay(Duration::from_millis(n));
     let ops = [ms(5), ms(5), Op::ReadStatus];
     let before = t.link.server.now();
@@ -319,7 +319,7 @@ fn a_late_answer_to_a_lost_probe_never_runs_a_request_twice() {
 /// run as a link error, rather than resend a request it may run again.
 #[test]
 fn a_reconnect_to_a_bridge_another_host_used_is_not_trusted() {
-    let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
     let other = Request::Hello {
         version: PROTOCOL_VERSION,
         host: t.host.wrapping_add(1).max(1),
@@ -332,8 +332,8 @@ fn a_reconnect_to_a_bridge_another_host_used_is_not_trusted() {
     assert_eq!(e.kind, TargetErrorKind::Link);
     assert!(
         matches!(
-            e.get_ref().downcast_ref::<SerialError>(),
-            Some(SerialError::Displaced { .. })
+            e.get_ref().downcast_ref::<BridgeError>(),
+            Some(BridgeError::Displaced { .. })
         ),
         "{e}"
     );
@@ -346,7 +346,7 @@ fn a_reconnect_to_a_bridge_another_host_used_is_not_trusted() {
 fn capture_overruns_do_not_use_up_the_link() {
     let mut link = MemLink::new();
     link.server = MemLink::bridge(1).with_capture_capacity(3);
-    let mut t = SerialTarget::open(link, quick()).expect("healthy");
+    let mut t = BridgeTarget::open(link, quick()).expect("healthy");
     // Initialization (RL 100, RH 20, PA 100) and a single step: more
     // than 3 records.
     let wait_ibf = Some(Duration::from_secs(1));
@@ -370,8 +370,8 @@ fn capture_overruns_do_not_use_up_the_link() {
             .expect_err("the capture overran");
         assert!(
             matches!(
-                e.get_ref().downcast_ref::<SerialError>(),
-                Some(SerialError::CaptureOverrun { .. })
+                e.get_ref().downcast_ref::<BridgeError>(),
+                Some(BridgeError::CaptureOverrun { .. })
             ),
             "{n}: {e}"
         );
@@ -386,7 +386,7 @@ fn capture_overruns_do_not_use_up_the_link() {
 /// link is not used again, so the rest of a run ends at once.
 #[test]
 fn a_link_that_gave_up_three_times_is_not_used_again() {
-    let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
     t.link.mute = true;
     for n in 1..=MAX_GIVE_UPS {
         let e = t.execute(&[Op::ReadStatus]).expect_err("silence");
@@ -413,13 +413,13 @@ fn a_link_that_gave_up_three_times_is_not_used_again() {
 /// interruption, not a link failure.
 #[test]
 fn a_stop_request_ends_a_wait_as_an_interruption() {
-    let opts = SerialOptions {
+    let opts = BridgeOptions {
         reply_timeout: WallDuration::from_secs(30),
         min_reply_timeout: WallDuration::from_secs(30),
         ..quick()
     };
     let stop = opts.stop.clone();
-    let mut t = SerialTarget::open(MemLink::new(), opts).expect("healthy");
+    let mut t = BridgeTarget::open(MemLink::new(), opts).expect("healthy");
     t.link.mute = true;
     let asker = std::thread::spawn(move || {
         std::thread::sleep(WallDuration::from_millis(200));
@@ -433,7 +433,7 @@ fn a_stop_request_ends_a_wait_as_an_interruption() {
 
 #[test]
 fn a_vanished_port_is_reopened_and_the_run_goes_on() {
-    let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
     t.link.fail_sends = 1;
     t.link.fail_reopens = 2;
     let r = t.execute(&[Op::ReadStatus]).expect("recovered");
@@ -443,7 +443,7 @@ fn a_vanished_port_is_reopened_and_the_run_goes_on() {
 
 #[test]
 fn a_port_that_stays_gone_ends_with_link_lost() {
-    let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
     t.link.fail_sends = 1;
     t.link.fail_reopens = 10;
     let e = t.execute(&[Op::ReadStatus]).expect_err("gone");
@@ -455,14 +455,14 @@ fn a_port_that_stays_gone_ends_with_link_lost() {
     );
     // The serial backend's own error is kept, not flattened to text.
     assert!(matches!(
-        e.get_ref().downcast_ref::<SerialError>(),
-        Some(SerialError::LinkLost { .. })
+        e.get_ref().downcast_ref::<BridgeError>(),
+        Some(BridgeError::LinkLost { .. })
     ));
 }
 
 #[test]
 fn a_restarted_bridge_is_not_trusted() {
-    let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
     t.link.fail_sends = 1;
     t.link.restart_on_reopen = true;
     let e = t.execute(&[Op::ReadStatus]).expect_err("restarted");
@@ -478,7 +478,7 @@ fn a_restarted_bridge_is_not_trusted() {
 /// to a panic ends in an infrastructure error naming it.
 #[test]
 fn a_bridge_that_panicked_is_an_infrastructure_error_naming_the_panic() {
-    let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
     t.link.fail_sends = 1;
     t.link.panic_on_reopen =
         Some("ppmc-bridge-rp2350 0.1.0; restarted after a panic at bridge/src/board.rs:442".into());
@@ -498,7 +498,7 @@ fn a_bridge_that_panicked_is_an_infrastructure_error_naming_the_panic() {
 /// run ends as a link error, never as a device failure on a reset chip.
 #[test]
 fn a_bridge_that_restarts_behind_an_open_port_is_caught_by_its_clock() {
-    let mut t = SerialTarget::open(MemLink::new(), quick()).expect("healthy");
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
     let ms = |n| Op::Delay(crate::time::Duration::from_millis(n));
     t.execute(&[ms(5), Op::ReadStatus]).expect("runs");
     // A reset of the host's own moves the clock back, rightly.
@@ -560,11 +560,11 @@ fn a_bridge_of_another_protocol_version_is_refused() {
             "v2".into()
         }
     }
-    let e = SerialTarget::open(V2(Vec::new()), quick()).expect_err("version");
+    let e = BridgeTarget::open(V2(Vec::new()), quick()).expect_err("version");
     assert!(
         matches!(
             e,
-            SerialError::Version { theirs, ours, .. }
+            BridgeError::Version { theirs, ours, .. }
                 if theirs == PROTOCOL_VERSION + 1 && ours == PROTOCOL_VERSION
         ),
         "{e}"
@@ -636,7 +636,7 @@ fn a_bridge_that_says_working_for_ever_is_given_up() {
     // clock runs (1 ms of it per WORKING) passes the bound and is given
     // up; one whose clock creeps (1 ns per WORKING, for ever) is given up
     // at the wall-clock cap. Either way the request ends, as a link error.
-    let opts = SerialOptions {
+    let opts = BridgeOptions {
         reply_timeout: WallDuration::from_millis(2),
         retries: 0,
         ..quick()
@@ -649,7 +649,7 @@ fn a_bridge_that_says_working_for_ever_is_given_up() {
             creep,
             hold: false,
         };
-        let mut t = SerialTarget::open(link, opts.clone()).expect("hello");
+        let mut t = BridgeTarget::open(link, opts.clone()).expect("hello");
         t.link.hold = true;
         let e = t.execute(&[Op::ReadStatus]).expect_err("no reply");
         assert_eq!(e.kind, TargetErrorKind::Link, "{e}");
