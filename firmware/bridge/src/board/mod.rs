@@ -43,7 +43,7 @@ use alloc::vec::Vec;
 use ppmc_core::bridge::move_tracker::MoveTracker;
 use ppmc_core::bridge::wire::Timer;
 use ppmc_core::bus::{Op, Uncertainty};
-use ppmc_core::protocol::{EdgeRuns, PinEvent, OutputRecord, Straps};
+use ppmc_core::protocol::{EdgeRuns, OutputRecord, PinEvent, Straps};
 use ppmc_core::time::{Duration, Instant};
 
 pub struct Board<H: Hal> {
