@@ -2,6 +2,7 @@
 
 use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
 use crate::lines::verdict_line;
+use crate::reports::ReportArgs;
 use crate::run::RunArgs;
 use crate::{usage, CliError};
 use clap::Args;
@@ -25,22 +26,8 @@ pub struct CompareArgs {
     target: TargetArgs,
     #[command(flatten)]
     tolerance: ToleranceArgs,
-    /// Write a JUnit XML report: a test case per scenario, a divergence a
-    /// failure, an unusable file an error (as `ppmc run` writes them).
-    #[arg(long, value_name = "FILE")]
-    junit: Option<PathBuf>,
-    /// Write a JSON run record (docs/run-record.schema.json, as `ppmc run`
-    /// writes it; the compared trace set stands as the board).
-    #[arg(long, value_name = "FILE")]
-    json: Option<PathBuf>,
-    /// Write the HTML report (docs/reports.md): each move's speed profile
-    /// over the golden one with its tolerance band, the first divergence
-    /// marked, the pins around it.
-    #[arg(long, value_name = "FILE")]
-    html: Option<PathBuf>,
-    /// Keep the run record in a results store (docs/results-store.md).
-    #[arg(long, value_name = "FILE")]
-    store: Option<PathBuf>,
+    #[command(flatten)]
+    reports: ReportArgs,
 }
 
 pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
@@ -57,10 +44,7 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             target: args.target,
             golden: Some(args.golden),
             tolerance: args.tolerance,
-            junit: args.junit,
-            json: args.json,
-            html: args.html,
-            store: args.store,
+            reports: args.reports,
             ..RunArgs::defaults().map_err(|e| CliError::Failed(e.to_string()))?
         };
         return super::run::run(run, suite);
@@ -71,13 +55,8 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
             dir.display()
         )));
     }
-    crate::reports::prepare_reports(
-        args.junit.as_deref(),
-        args.json.as_deref(),
-        args.html.as_deref(),
-        args.store.as_deref(),
-    )?;
-    let mut store = crate::reports::open_store(args.store.as_deref())?;
+    args.reports.prepare()?;
+    let mut store = args.reports.open_store()?;
     let board = dir.display().to_string();
     let traces = BoardInfo::new(board.clone(), format!("traces:{board}"), Vec::new(), None);
     let mut info = ppmc::runner::run_info(vec![traces], "one");
@@ -94,8 +73,7 @@ pub fn run(args: CompareArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let record = session::compare_sets(&scenarios, &args.golden, dir, &tol, info, |r| {
         outln!("{}", verdict_line(r, None));
     });
-    let outputs = crate::reports::Outputs::of(&args.junit, &args.json, &args.html);
-    let problems = crate::reports::write(&record, outputs, store.as_mut());
+    let problems = crate::reports::write(&record, args.reports.outputs(), store.as_mut());
     let t = record.summary;
     let ok = t.passed + t.marginal + t.flaky;
     outln!(

@@ -139,9 +139,9 @@ pub struct ScenarioRecord {
     /// the golden's), the pins around the failure.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub figures: Option<Figures>,
-    /// The files saved for it (`--artifacts`): JUnit's attachments. Not
-    /// in the JSON record.
-    #[serde(skip)]
+    /// The files saved for it (`--artifacts`), as the run named them:
+    /// JUnit's attachments, the JSON record's `artifacts`.
+    #[serde(default, rename = "artifacts", skip_serializing_if = "Vec::is_empty")]
     pub attachments: Vec<String>,
     /// What a capture's judge says after its verdict: what was not judged,
     /// what was compared, each finding. JUnit's text; not in the JSON

@@ -2,6 +2,7 @@
 
 use crate::args::{ChipArgs, ToleranceArgs};
 use crate::capture_args::CaptureArgs;
+use crate::reports::ReportArgs;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -20,23 +21,8 @@ pub struct JudgeArgs {
     pub(crate) chip: ChipArgs,
     #[command(flatten)]
     pub(crate) tolerance: ToleranceArgs,
-    /// Write a JUnit XML report (a test case for the board, a divergence a
-    /// failure of type device; one for the host firmware, its findings a
-    /// failure of type host; a capture that cannot be judged an error of
-    /// type capture); `-` for standard output (the verdict lines then go
-    /// to standard error).
-    #[arg(long, value_name = "FILE")]
-    pub(crate) junit: Option<PathBuf>,
-    /// Write a JSON run record (docs/run-record.schema.json, as `ppmc run`
-    /// writes it; the capture stands as the board, `run.source` says what
-    /// it is, each result names whom it blames); `-` for standard output.
-    #[arg(long, value_name = "FILE")]
-    pub(crate) json: Option<PathBuf>,
-    /// Keep the run record in a results store (SQLite; made when not
-    /// there), beside the runs of boards behind a bridge
-    /// (docs/results-store.md).
-    #[arg(long, value_name = "FILE")]
-    pub(crate) store: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) reports: ReportArgs,
     /// The board's serial number, for the reports and the store.
     #[arg(long, value_name = "SERIAL")]
     pub(crate) board_serial: Option<String>,

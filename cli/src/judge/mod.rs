@@ -23,12 +23,7 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         partial: args.partial,
         ..JudgeOptions::default()
     };
-    super::reports::prepare_reports(
-        args.junit.as_deref(),
-        args.json.as_deref(),
-        None,
-        args.store.as_deref(),
-    )?;
+    args.reports.prepare()?;
     let name = match (&args.trace, &args.scenario) {
         (None, _) => None,
         (Some(_), Some(n)) => Some(n.clone()),
@@ -49,7 +44,7 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
         }
         ppmc_files::prepare_folder(dir)?;
     }
-    let mut store = super::reports::open_store(args.store.as_deref())?;
+    let mut store = args.reports.open_store()?;
     describe(&info, &args.capture.capture);
     // The capture is read again only where the board diverged, to hold
     // the divergence against the map (judge::judge_reopening).
@@ -68,12 +63,15 @@ pub fn run(args: JudgeArgs) -> Result<(), CliError> {
             Err(e) => problems.push(format!("--trace: {e}")),
         }
     }
-    if args.junit.is_some() || args.json.is_some() || store.is_some() {
+    if args.reports.any() {
         let mut record = j.record(&args.capture.capture, &info, &opts, started.elapsed());
         record.run.boards[0].board_rev = args.board_rev.clone();
         record.run.boards[0].board_serial = args.board_serial.clone();
-        let outputs = super::reports::Outputs::of(&args.junit, &args.json, &None);
-        problems.extend(super::reports::write(&record, outputs, store.as_mut()));
+        problems.extend(super::reports::write(
+            &record,
+            args.reports.outputs(),
+            store.as_mut(),
+        ));
     }
     let verdict = say(&j);
     match problems.into_iter().next() {

@@ -1,6 +1,7 @@
 //! `ppmc run`'s arguments, and the options they put on record.
 
 use crate::args::{SelectArgs, TargetArgs, ToleranceArgs};
+use crate::reports::ReportArgs;
 use crate::{usage, CliError};
 use clap::Args;
 use ppmc::artifacts::Window;
@@ -18,26 +19,8 @@ pub struct RunArgs {
     pub(crate) golden: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) tolerance: ToleranceArgs,
-    /// Write a JUnit XML report (one test case per scenario); `-` for
-    /// standard output (the verdict lines then go to standard error).
-    #[arg(long, value_name = "FILE")]
-    pub(crate) junit: Option<PathBuf>,
-    /// Write a JSON run record (docs/run-record.schema.json: target, board,
-    /// options, every verdict and measurement with its limits); `-` for
-    /// standard output.
-    #[arg(long, value_name = "FILE")]
-    pub(crate) json: Option<PathBuf>,
-    /// Write the HTML report: one file, offline (docs/reports.md): every
-    /// verdict, each measurement against its Table 3-3 band, each move's
-    /// speed profile over the golden one (with --golden) and the first
-    /// divergence marked, the pins around each failure.
-    #[arg(long, value_name = "FILE")]
-    pub(crate) html: Option<PathBuf>,
-    /// Keep the run record in a results store (SQLite; made when not
-    /// there), for `ppmc history` and `ppmc report --store`
-    /// (docs/results-store.md).
-    #[arg(long, value_name = "FILE")]
-    pub(crate) store: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) reports: ReportArgs,
     /// Keep the trace and VCD of every scenario that did not pass here.
     /// The VCD shows `--artifacts-window` either side of the failure.
     #[arg(long, value_name = "DIR")]
@@ -100,13 +83,8 @@ impl RunArgs {
         if let Some(dir) = &self.artifacts {
             ppmc_files::prepare_folder(dir)?;
         }
-        crate::reports::prepare_reports(
-            self.junit.as_deref(),
-            self.json.as_deref(),
-            self.html.as_deref(),
-            self.store.as_deref(),
-        )?;
-        if self.store.is_some() && self.repeat > 1 {
+        self.reports.prepare()?;
+        if self.reports.store.is_some() && self.repeat > 1 {
             return Err(usage(
                 "--store with --repeat: a soak's record lists its first pass and what did not pass, and counts the rest, so the store would see its failures and not its passes; store single runs",
             ));

@@ -22,8 +22,8 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let scenarios = args.select.scenarios(suite).map_err(usage)?;
     let tol = args.tolerance.tolerances().map_err(usage)?;
     args.check()?;
-    let mut store = crate::reports::open_store(args.store.as_deref())?;
-    let outputs = crate::reports::Outputs::of(&args.junit, &args.json, &args.html);
+    let mut store = args.reports.open_store()?;
+    let outputs = args.reports.outputs();
     let specs = args.target.specs().map_err(usage)?;
     let several_specs = specs.len();
     let spread = match args.each && several_specs > 1 {
@@ -52,7 +52,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             .artifacts
             .as_deref()
             .map(|d| (d, args.artifacts_window)),
-        draw: args.json.is_some() || args.html.is_some(),
+        draw: args.reports.json.is_some() || args.reports.html.is_some(),
     };
     if farm.reached_none() {
         // Nothing ran: say so in the reports too, so CI shows an

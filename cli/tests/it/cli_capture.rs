@@ -344,14 +344,17 @@ fn fifos_and_huge_empty_files_are_refused_by_name() {
     }
 }
 
-/// `ppmc judge CAPTURE --junit J --json R`: the JUnit report and the JSON
-/// run record (checked against `docs/run-record.schema.json`), and the
-/// judgement's exit status.
+/// `ppmc judge CAPTURE --junit J --json R --html H`: the JUnit report and
+/// the JSON run record (checked against `docs/run-record.schema.json`),
+/// and the judgement's exit status; the HTML page, a judge's, names every
+/// result of the record and what a failure expected.
 fn judged(dir: &Path, capture: &str) -> (Option<i32>, quick_junit::Report, String, Value) {
     let junit = dir.join("judge.xml");
     let json = dir.join("judge.json");
-    let _ = std::fs::remove_file(&junit);
-    let _ = std::fs::remove_file(&json);
+    let html = dir.join("judge.html");
+    for f in [&junit, &json, &html] {
+        let _ = std::fs::remove_file(f);
+    }
     let out = ppmc(&[
         "judge",
         capture,
@@ -359,7 +362,10 @@ fn judged(dir: &Path, capture: &str) -> (Option<i32>, quick_junit::Report, Strin
         junit.to_str().expect("utf-8"),
         "--json",
         json.to_str().expect("utf-8"),
+        "--html",
+        html.to_str().expect("utf-8"),
     ]);
+    let page = std::fs::read_to_string(&html).expect("the HTML report is written");
     let xml = std::fs::read_to_string(&junit).expect("the JUnit report is written");
     let report = quick_junit::Report::deserialize_from_str(&xml).expect("the JUnit report parses");
     let record: Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("written"))
@@ -376,6 +382,20 @@ fn judged(dir: &Path, capture: &str) -> (Option<i32>, quick_junit::Report, Strin
         .map(|k| s[k].as_u64().expect("a count"))
         .sum();
     assert_eq!(counted as usize, cases, "{record:#}");
+    assert!(
+        page.contains("<title>ppmc judge report"),
+        "the page's title"
+    );
+    for r in record["scenarios"].as_array().expect("results") {
+        let name = r["name"].as_str().expect("a name");
+        assert!(page.contains(name), "the page names {name}");
+        if let Some(expected) = r["failure"]["expectation"].as_str() {
+            assert!(
+                page.contains(expected),
+                "the page says what {name} expected: {expected}"
+            );
+        }
+    }
     (out.status.code(), report, xml, record)
 }
 

@@ -269,9 +269,42 @@ fn a_corrupt_golden_file_is_a_harness_error_of_its_scenario_alone_with_path_and_
         "1/1",
         "--artifacts",
         s(arts),
+        "--json",
+        s(&arts.join("record.json")),
     ]);
     let stdout = text(&out.stdout);
     assert_eq!(out.status.code(), Some(1), "{stdout}");
+    // The JSON record names the files kept, as JUnit's attachments do.
+    let record: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(arts.join("record.json")).expect("record"))
+            .expect("JSON");
+    let kept = |name: &str| {
+        record["scenarios"]
+            .as_array()
+            .expect("scenarios")
+            .iter()
+            .find(|r| r["name"] == name)
+            .map(|r| r["artifacts"].clone())
+    };
+    let e3 = kept("e3_data_without_a_command").expect("e3 in the record");
+    let e3: Vec<&str> = e3
+        .as_array()
+        .expect("artifacts")
+        .iter()
+        .filter_map(|v| v.as_str())
+        .collect();
+    assert!(
+        e3.iter()
+            .any(|p| p.ends_with("e3_data_without_a_command.trace"))
+            && e3
+                .iter()
+                .any(|p| p.ends_with("e3_data_without_a_command.vcd")),
+        "{e3:?}"
+    );
+    assert_eq!(
+        kept("e0_undefined_command_code"),
+        Some(serde_json::Value::Null)
+    );
     assert!(
         stdout.contains("PASS     e0_undefined_command_code"),
         "{stdout}"
