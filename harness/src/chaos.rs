@@ -255,7 +255,10 @@ impl ChaosProxy {
         listener.set_nonblocking(true)?;
         let addr = listener.local_addr()?;
         let up = match behaviour.forwards() {
-            true => Some(Port::open(&upstream)?),
+            true => Some(match &upstream {
+                Upstream::Serial(path) => Port::open_serial(path)?,
+                tcp => Port::open(tcp)?,
+            }),
             false => None,
         };
         let stop = Arc::new(AtomicBool::new(false));
@@ -321,6 +324,9 @@ enum Port {
 /// at the first try, so that the host asks again into the stall.
 pub const STALL: Duration = Duration::from_millis(1500);
 
+/// How long opening a serial bridge is tried while the port is there.
+const SERIAL_OPEN_PATIENCE: Duration = Duration::from_secs(5);
+
 /// How long one look at a side waits for bytes.
 const POLL: Duration = Duration::from_millis(1);
 
@@ -338,6 +344,28 @@ impl Port {
                 .open()
                 .map(Port::Serial)
                 .map_err(io::Error::from),
+        }
+    }
+
+    /// Opens the serial port at `path`, when the proxy starts. A
+    /// pseudo-terminal just closed by its last opener (the proxy before
+    /// this one, on the same bridge) refuses a new opener's claim for a
+    /// moment on a busy machine (serialport's "Unable to acquire exclusive
+    /// lock"): tried again for up to [`SERIAL_OPEN_PATIENCE`] while the
+    /// port is there.
+    fn open_serial(path: &str) -> io::Result<Port> {
+        let deadline = std::time::Instant::now() + SERIAL_OPEN_PATIENCE;
+        loop {
+            match serialport::new(path, 115_200).timeout(POLL).open() {
+                Ok(p) => return Ok(Port::Serial(p)),
+                Err(e) => {
+                    let gone = !std::path::Path::new(path).exists();
+                    if gone || std::time::Instant::now() >= deadline {
+                        return Err(io::Error::other(format!("{path}: {e}")));
+                    }
+                    std::thread::sleep(Duration::from_millis(20));
+                }
+            }
         }
     }
 

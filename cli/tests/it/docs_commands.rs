@@ -123,7 +123,7 @@ const ELSEWHERE: [(&str, &str); 35] = [
         "in harness/tests/it/firmware_qemu.rs (started, the whole suite run through it, stopped)",
     ),
     (
-        "cargo run --release --locked --manifest-path firmware/Cargo.toml -p ppmc-bridge-fw --features twin --example capture_margin",
+        "cargo run --release --locked --manifest-path firmware/Cargo.toml -p ppmc-twin --bin capture-margin",
         "in .ci/run (the firmware step: the twin's capture margin)",
     ),
     (

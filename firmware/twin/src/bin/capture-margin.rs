@@ -2,14 +2,17 @@
 //! board twin (docs/performance.md):
 //!
 //! ```sh
-//! cd firmware && cargo run -q --release --locked -p ppmc-bridge-fw --features twin --example capture_margin
+//! cargo run --release --locked --manifest-path firmware/Cargo.toml -p ppmc-twin --bin capture-margin
 //! ```
+//!
+//! A binary of the twin's crate, so that it is built with the twin, from
+//! the same release build of the board code.
 
 fn main() -> std::process::ExitCode {
     let m = match ppmc_bridge_fw::twin::capture_margin() {
         Ok(m) => m,
         Err(e) => {
-            eprintln!("capture_margin: {e}");
+            eprintln!("capture-margin: {e}");
             return std::process::ExitCode::FAILURE;
         }
     };
