@@ -11,6 +11,7 @@ use ppmc::runner::{parse_shard, validate_suite, Selection};
 use ppmc::scenario::Scenario;
 use ppmc::stop::StopRequest;
 use ppmc::time::Duration;
+use std::path::PathBuf;
 
 /// Which chip to drive, and how its board is strapped.
 #[derive(Debug, Args)]
@@ -288,5 +289,62 @@ impl ToleranceArgs {
             interval_bp: bp(self.interval_tol, "interval-tol")?,
             floor: self.time_floor,
         })
+    }
+}
+
+/// The reports a command writes of its run record (`ppmc run`, `ppmc
+/// compare`, `ppmc judge`): one group, so each flag means one thing.
+#[derive(Debug, Default, Clone, Args)]
+pub struct ReportArgs {
+    /// Write a JUnit XML report (docs/reports.md: a test case per scenario,
+    /// or for a capture one for the board and one for the host firmware;
+    /// a device failure a failure, anything else an error of its own
+    /// type); `-` for standard output (the verdict lines then go to
+    /// standard error).
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
+    /// Write a JSON run record (docs/run-record.schema.json: the target or
+    /// capture, the board, the options, every verdict and measurement with
+    /// its limits and uncertainty, whom each result blames); `-` for
+    /// standard output.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Write the HTML report: one file, offline (docs/reports.md): every
+    /// verdict, each measurement against its Table 3-3 band, each move's
+    /// speed profile (over the golden one where there is one) with the
+    /// first divergence marked, the pins around each failure.
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<PathBuf>,
+    /// Keep the run record in a results store (SQLite; made when not
+    /// there), for `ppmc history` and `ppmc report --store`
+    /// (docs/results-store.md).
+    #[arg(long, value_name = "FILE")]
+    pub store: Option<PathBuf>,
+}
+
+impl ReportArgs {
+    /// Whether any report is asked for.
+    pub fn any(&self) -> bool {
+        self.junit.is_some() || self.json.is_some() || self.html.is_some() || self.store.is_some()
+    }
+
+    /// Tries every output before the work ([`crate::reports::prepare_reports`]).
+    pub fn prepare(&self) -> Result<(), CliError> {
+        crate::reports::prepare_reports(
+            self.junit.as_deref(),
+            self.json.as_deref(),
+            self.html.as_deref(),
+            self.store.as_deref(),
+        )
+    }
+
+    /// Where the record goes, the store aside.
+    pub fn outputs(&self) -> crate::reports::Outputs<'_> {
+        crate::reports::Outputs::of(&self.junit, &self.json, &self.html)
+    }
+
+    /// Opens the store, if asked for ([`crate::reports::open_store`]).
+    pub fn open_store(&self) -> Result<Option<ppmc_report::store::Store>, CliError> {
+        crate::reports::open_store(self.store.as_deref())
     }
 }

@@ -1,8 +1,8 @@
 //! `ppmc compare`: a golden trace set against traces or a fresh run.
 
 use super::args::{SelectArgs, TargetArgs, ToleranceArgs};
+use crate::args::ReportArgs;
 use crate::lines::verdict_line;
-use crate::reports::ReportArgs;
 use crate::run::RunArgs;
 use crate::{usage, CliError};
 use clap::Args;

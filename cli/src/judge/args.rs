@@ -1,8 +1,8 @@
 //! `ppmc judge`'s arguments.
 
+use crate::args::ReportArgs;
 use crate::args::{ChipArgs, ToleranceArgs};
 use crate::capture_args::CaptureArgs;
-use crate::reports::ReportArgs;
 use clap::Args;
 use std::path::PathBuf;
 

@@ -1,7 +1,7 @@
 //! `ppmc run`'s arguments, and the options they put on record.
 
+use crate::args::ReportArgs;
 use crate::args::{SelectArgs, TargetArgs, ToleranceArgs};
-use crate::reports::ReportArgs;
 use crate::{usage, CliError};
 use clap::Args;
 use ppmc::artifacts::Window;
