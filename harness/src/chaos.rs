@@ -255,10 +255,7 @@ impl ChaosProxy {
         listener.set_nonblocking(true)?;
         let addr = listener.local_addr()?;
         let up = match behaviour.forwards() {
-            true => Some(match &upstream {
-                Upstream::Serial(path) => Port::open_serial(path)?,
-                tcp => Port::open(tcp)?,
-            }),
+            true => Some(Port::open_patiently(&upstream)?),
             false => None,
         };
         let stop = Arc::new(AtomicBool::new(false));
@@ -347,24 +344,23 @@ impl Port {
         }
     }
 
-    /// Opens the serial port at `path`, when the proxy starts. A
+    /// [`Port::open`], when the proxy starts. A serial bridge's
     /// pseudo-terminal just closed by its last opener (the proxy before
     /// this one, on the same bridge) refuses a new opener's claim for a
     /// moment on a busy machine (serialport's "Unable to acquire exclusive
     /// lock"): tried again for up to [`SERIAL_OPEN_PATIENCE`] while the
     /// port is there.
-    fn open_serial(path: &str) -> io::Result<Port> {
+    fn open_patiently(at: &Upstream) -> io::Result<Port> {
         let deadline = std::time::Instant::now() + SERIAL_OPEN_PATIENCE;
         loop {
-            match serialport::new(path, 115_200).timeout(POLL).open() {
-                Ok(p) => return Ok(Port::Serial(p)),
-                Err(e) => {
-                    let gone = !std::path::Path::new(path).exists();
-                    if gone || std::time::Instant::now() >= deadline {
-                        return Err(io::Error::other(format!("{path}: {e}")));
-                    }
+            match Port::open(at) {
+                Err(_)
+                    if matches!(at, Upstream::Serial(path) if std::path::Path::new(path).exists())
+                        && std::time::Instant::now() < deadline =>
+                {
                     std::thread::sleep(Duration::from_millis(20));
                 }
+                opened => return opened,
             }
         }
     }
