@@ -340,7 +340,11 @@ impl ReportArgs {
 
     /// Where the record goes, the store aside.
     pub fn outputs(&self) -> crate::reports::Outputs<'_> {
-        crate::reports::Outputs::of(&self.junit, &self.json, &self.html)
+        crate::reports::Outputs {
+            junit: self.junit.as_deref(),
+            json: self.json.as_deref(),
+            html: self.html.as_deref(),
+        }
     }
 
     /// Opens the store, if asked for ([`crate::reports::open_store`]).

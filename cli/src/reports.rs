@@ -7,7 +7,7 @@ use ppmc_files as files;
 use ppmc_record::RunRecord;
 use ppmc_report as report;
 use ppmc_report::store::Store;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Where a command writes its record: each report, if asked for.
 #[derive(Debug, Default, Clone, Copy)]
@@ -15,21 +15,6 @@ pub(super) struct Outputs<'a> {
     pub junit: Option<&'a Path>,
     pub json: Option<&'a Path>,
     pub html: Option<&'a Path>,
-}
-
-impl<'a> Outputs<'a> {
-    /// The outputs named by three optional paths.
-    pub fn of(
-        junit: &'a Option<PathBuf>,
-        json: &'a Option<PathBuf>,
-        html: &'a Option<PathBuf>,
-    ) -> Outputs<'a> {
-        Outputs {
-            junit: junit.as_deref(),
-            json: json.as_deref(),
-            html: html.as_deref(),
-        }
-    }
 }
 
 /// Writes `record` to every output asked for and keeps it in `store`;
