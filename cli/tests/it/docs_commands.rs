@@ -558,7 +558,7 @@ fn check_file(file: &'static str, ci: &str, labgrid: &str) -> (usize, Vec<String
                 let in_ci = ci.contains(shown)
                     || (doc.command.starts_with("cargo +nightly fuzz run")
                         && ci.contains(
-                            "cargo +nightly fuzz run $(./flags \"$target\") \"$target\" \"$scratch\" \"$seeds\"",
+                            "cargo +nightly fuzz run -s none $(./flags \"$target\") \"$target\" \"$scratch\" \"$seeds\"",
                         ))
                     || (doc.command.starts_with("mkdir -p ../target/fuzz-corpus")
                         && ci.contains("scratch=\"$PWD/target/fuzz-corpus/$target\""));

@@ -182,3 +182,53 @@ fn the_fuzz_crate_builds_on_the_harness_alone() {
         );
     }
 }
+
+/// CI fuzzes without AddressSanitizer (`.ci/run`, fuzz/README.md): the
+/// sanitizer checks unsafe code, and the workspace crates the fuzz
+/// targets reach (the harness and every workspace crate below it) forbid
+/// it. Each must inherit the workspace's lints, and those must forbid
+/// `unsafe_code`.
+#[test]
+fn the_crates_the_fuzz_targets_reach_forbid_unsafe_code() {
+    let manifest =
+        std::fs::read_to_string(root().join("Cargo.toml")).expect("the workspace's Cargo.toml");
+    let rust_lints = manifest
+        .split("[workspace.lints.rust]")
+        .nth(1)
+        .expect("a [workspace.lints.rust] table");
+    let rust_lints = rust_lints.split("\n[").next().unwrap_or_default();
+    assert!(
+        rust_lints
+            .lines()
+            .any(|l| l.replace(' ', "") == "unsafe_code=\"forbid\""),
+        "[workspace.lints.rust] does not forbid unsafe_code:{rust_lints}"
+    );
+    let layers = table();
+    let mut reached = BTreeSet::from(["ppmc".to_string()]);
+    let mut todo = vec!["ppmc".to_string()];
+    while let Some(name) = todo.pop() {
+        let (_, deps) = layers
+            .get(&name)
+            .unwrap_or_else(|| panic!("{name} is not in ARCHITECTURE.md's table"));
+        for dep in deps {
+            if reached.insert(dep.clone()) {
+                todo.push(dep.clone());
+            }
+        }
+    }
+    let workspace = metadata(&root().join("Cargo.toml"));
+    for package in workspace["packages"].as_array().expect("packages") {
+        let name = package["name"].as_str().expect("a name");
+        if !reached.contains(name) {
+            continue;
+        }
+        let path = package["manifest_path"].as_str().expect("a manifest path");
+        let text = std::fs::read_to_string(path).expect("the crate's Cargo.toml");
+        assert!(
+            text.replace(' ', "").contains("[lints]\nworkspace=true"),
+            "{path}: the fuzz targets reach {name}, which does not inherit the workspace's lints (`[lints] workspace = true`)"
+        );
+        reached.remove(name);
+    }
+    assert!(reached.is_empty(), "not workspace members: {reached:?}");
+}
