@@ -123,6 +123,49 @@ pub fn parse_duration(s: &str) -> Result<Duration, String> {
     s.parse::<Duration>().map_err(|e| e.to_string())
 }
 
+/// A wall-clock length, as [`parse_duration`] reads it or in minutes or
+/// hours too (`5m`, `1.5h`): how long a fuzz run or a soak lasts.
+pub fn parse_wall_duration(s: &str) -> Result<Duration, String> {
+    let t = s.trim();
+    let scaled = [("h", 3_600u64), ("m", 60)]
+        .into_iter()
+        .find_map(|(unit, secs)| Some((t.strip_suffix(unit)?, secs)))
+        .filter(|(n, _)| !n.is_empty() && !n.ends_with(['m', 'u', 'n', 'µ']));
+    let Some((n, secs)) = scaled else {
+        return parse_duration(s)
+            .map_err(|e| e.replace("ns, us, ms or s", "ns, us, ms, s, m or h"));
+    };
+    let x: f64 = n
+        .parse()
+        .ok()
+        .filter(|x: &f64| x.is_finite() && *x >= 0.0)
+        .ok_or_else(|| format!("duration `{s}`: `{n}` is not a number"))?;
+    let ns = x * secs as f64 * 1e9;
+    if ns >= u64::MAX as f64 {
+        return Err(format!("duration `{s}` is too long"));
+    }
+    Ok(Duration::from_nanos(ns.round() as u64))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 42: `fuzz --duration 3m` was refused while its help said `5m`.
+    #[test]
+    fn a_wall_duration_reads_minutes_and_hours() {
+        let secs = |s: &str| parse_wall_duration(s).map(|d| d.as_nanos() / 1_000_000_000);
+        assert_eq!(secs("3m"), Ok(180));
+        assert_eq!(secs("1.5h"), Ok(5_400));
+        assert_eq!(secs("90s"), Ok(90));
+        assert_eq!(secs("250ms").map(|_| ()), Ok(()));
+        let e = parse_wall_duration("3x").expect_err("refused");
+        assert!(e.contains("ns, us, ms, s, m or h"), "{e}");
+        assert!(parse_wall_duration("m").is_err());
+        assert!(parse_wall_duration("-1m").is_err());
+    }
+}
+
 /// The `--target` help: `emu`, then every link kind of
 /// [`backend::DRIVERS`] with its form and what it reaches, then the
 /// options of one board.
@@ -224,6 +267,10 @@ pub struct SelectArgs {
     /// `--skip-tag long` on a board.
     #[arg(long = "skip-tag", value_name = "TAG")]
     skip_tags: Vec<String>,
+    /// Leave out the scenario of this name, the whole name as `ppmc list`
+    /// gives it (repeat for several).
+    #[arg(long = "skip", value_name = "NAME")]
+    skip: Vec<String>,
     /// Run the I-th of N interleaved parts of the suite, e.g. 2/4, to split
     /// it across CI jobs or boards.
     #[arg(long, value_parser = parse_shard)]
@@ -236,6 +283,7 @@ impl SelectArgs {
             filter: self.filter.clone(),
             tags: self.tags.clone(),
             skip_tags: self.skip_tags.clone(),
+            skip: self.skip.clone(),
             shard: self.shard,
         }
     }
@@ -245,6 +293,7 @@ impl SelectArgs {
         opts.filter = self.filter.clone();
         opts.tags = self.tags.clone();
         opts.skip_tags = self.skip_tags.clone();
+        opts.skip = self.skip.clone();
         opts.shard = self.shard.map(|(i, n)| format!("{i}/{n}"));
     }
 
@@ -254,6 +303,15 @@ impl SelectArgs {
     pub fn scenarios(&self, suite: &[Scenario]) -> Result<Vec<Scenario>, String> {
         validate_suite(suite).map_err(|e| e.to_string())?;
         let selection = self.selection();
+        if let Some(name) = self
+            .skip
+            .iter()
+            .find(|n| !suite.iter().any(|s| s.name == *n))
+        {
+            return Err(format!(
+                "--skip {name}: no scenario of that name (give the whole name, as `ppmc list` shows it)"
+            ));
+        }
         if selection.matching(suite).is_empty() {
             return Err("no scenario matches the selection (see `ppmc list`)".into());
         }

@@ -19,16 +19,17 @@ pub struct ExportArgs {
     /// Instead of a trace: run this scenario on the emulator, every
     /// register access taking a bus cycle as on a real bus (the golden
     /// traces' accesses take no time), and export what a logic analyzer on
-    /// the board would record (with --bus, the bus too). Needs -o.
-    #[arg(long, value_name = "NAME", requires = "output")]
+    /// the board would record (with --bus, the bus too).
+    #[arg(long, value_name = "NAME")]
     scenario: Option<String>,
     /// With --scenario: run the chip with this fault of the catalogue
     /// (`ppmc fault-matrix --list`), swap-error-A-B or status-stuck-0xNN;
     /// repeat to combine.
     #[arg(long = "chip-fault", value_name = "FAULT", requires = "scenario")]
     chip_faults: Vec<String>,
-    /// The VCD file to write (default: the trace's name with .vcd; `-` for
-    /// standard output).
+    /// The VCD file to write (default: `out/<name>.vcd` in the current
+    /// folder, the trace's or the scenario's name; never beside the input,
+    /// which may be a tracked golden file); `-` for standard output.
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Draw the host's bus too: CS*, RD*, WR*, A0 and D0-D7, one cycle per
@@ -98,10 +99,23 @@ pub fn run(args: ExportArgs, suite: &[Scenario]) -> Result<(), CliError> {
         }
         (None, None) => return Err(usage("give a trace file or --scenario NAME")),
     };
-    let out = match (&args.output, &input) {
-        (Some(o), _) => o.clone(),
-        (None, Some(i)) => i.with_extension("vcd"),
-        (None, None) => return Err(usage("--scenario needs -o FILE (or - for standard output)")),
+    let out = match &args.output {
+        Some(o) => o.clone(),
+        None => {
+            let dir = PathBuf::from("out"); // of the current folder
+            files::prepare_folder(&dir)?;
+            // The name a file gave, only as a plain file name.
+            let stem = input
+                .as_ref()
+                .and_then(|i| i.file_stem())
+                .map(|s| s.to_string_lossy().into_owned());
+            let name = [Some(trace.scenario.clone()), stem]
+                .into_iter()
+                .flatten()
+                .find(|n| files::plain_file_name(n))
+                .unwrap_or_else(|| "export".into());
+            dir.join(format!("{name}.vcd"))
+        }
     };
     let what = ppmc::vcd_export::Export {
         window: None,
@@ -121,7 +135,7 @@ pub fn run(args: ExportArgs, suite: &[Scenario]) -> Result<(), CliError> {
     if input.as_ref().is_some_and(|i| files::same_file(&out, i)) {
         let how = match args.output {
             Some(_) => "-o names the input trace",
-            None => "the default output (the trace's name with .vcd) is the input trace itself",
+            None => "the default output is the input trace itself",
         };
         return Err(usage(format!(
             "{}: {how}; ppmc does not write over its input (give another -o, or - for standard output)",

@@ -16,6 +16,19 @@ pub struct HistoryArgs {
     scenarios: usize,
 }
 
+/// Nanoseconds as microseconds, as every figure of this listing is.
+fn us(ns: f64) -> String {
+    format!("{:.3}us", ns / 1e3)
+}
+
+fn plural<'a>(n: u64, one: &'a str, many: &'a str) -> &'a str {
+    if n == 1 {
+        one
+    } else {
+        many
+    }
+}
+
 pub fn run(args: HistoryArgs) -> Result<(), CliError> {
     let store =
         Store::open_existing(&args.store).map_err(|e| CliError::BadInput(format!("ppmc: {e}")))?;
@@ -36,12 +49,14 @@ pub fn run(args: HistoryArgs) -> Result<(), CliError> {
     outln!("yield per revision (a board test passes when none of its scenarios failed, erred or was not run):");
     for r in &h.revisions {
         outln!(
-            "  {:<12} {:>6.1}%  {} of {} board tests passed, {} boards{}",
+            "  {:<12} {:>6.1}%  {} of {} {} passed, on {} {}{}",
             p(&r.rev),
             r.rate() * 100.0,
             r.passed,
             r.tests,
+            plural(r.tests, "board test", "board tests"),
             r.boards,
+            plural(r.boards, "board", "boards"),
             if r.flaky > 0 {
                 format!(", {} flaky results", r.flaky)
             } else {
@@ -71,18 +86,37 @@ pub fn run(args: HistoryArgs) -> Result<(), CliError> {
             s.boards
         );
     }
-    outln!("measurements by scenario and revision (Cpk of each value's place in its band; none where they all sit at one place):");
-    for d in &h.measurements {
+    // Out of band first (most values out first), then the least capable.
+    let mut ds: Vec<_> = h.measurements.iter().collect();
+    ds.sort_by(|a, b| {
+        b.out_of_band().cmp(&a.out_of_band()).then(
+            a.cpk()
+                .unwrap_or(f64::INFINITY)
+                .total_cmp(&b.cpk().unwrap_or(f64::INFINITY)),
+        )
+    });
+    outln!("measurements by scenario and revision, out of band first, then lowest Cpk (of each value's place in its own band; none where they all sit at one place):");
+    for d in ds {
+        let out = d.out_of_band();
+        let flag = match out {
+            0 => "          ".to_string(),
+            n => format!("OUT {n:>2}/{:<2} ", d.values.len()),
+        };
+        let band = match (d.bands_differ, d.hi_ns) {
+            (true, _) => "band per board (straps differ)".to_string(),
+            (false, Some(hi)) => format!("band {} to {}", us(d.lo_ns as f64), us(hi as f64)),
+            (false, None) => format!("band from {}", us(d.lo_ns as f64)),
+        };
         outln!(
-            "  {} in {} on {}: n={} mean={:.3}us sd={:.1}ns min={:.3}us max={:.3}us Cpk={}",
+            "  {flag}{} in {} on {}: n={} mean={} sd={} min={} max={}, {band}, Cpk={}",
             p(&d.name),
             p(&d.scenario),
             p(&d.rev),
             d.values.len(),
-            d.mean_ns / 1e3,
-            d.sd_ns(),
-            d.min_ns as f64 / 1e3,
-            d.max_ns as f64 / 1e3,
+            us(d.mean_ns),
+            us(d.sd_ns()),
+            us(d.min_ns as f64),
+            us(d.max_ns as f64),
             d.cpk().map_or("none".to_string(), |c| format!("{c:.2}"))
         );
     }

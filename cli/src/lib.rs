@@ -27,6 +27,7 @@ mod reports;
 mod run;
 mod selftest;
 mod signals;
+mod suggest;
 
 use clap::{Parser, Subcommand};
 use ppmc::scenario::Scenario;
@@ -112,7 +113,8 @@ enum Command {
     /// that fails never turns into a verdict on the board. Prints where it
     /// listens; runs until SIGINT.
     ChaosProxy(chaos_proxy::ChaosProxyArgs),
-    /// Draw run records as one offline HTML page: every verdict, each
+    /// Draw run records, or a results store's history (`--store`), as one
+    /// offline HTML page: every verdict, each
     /// measurement against its Table 3-3 band, each move's speed profile
     /// over the golden one with the first divergence marked, the pins
     /// around each failure (docs/reports.md).
@@ -135,7 +137,7 @@ enum Command {
 /// }
 /// ```
 pub fn main(suite: Vec<Scenario>) -> ExitCode {
-    let cli = Cli::parse();
+    let cli: Cli = suggest::parse();
     out::set_color(cli.color);
     let suite = &suite;
     let done = match cli.command {

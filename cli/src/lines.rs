@@ -2,7 +2,7 @@
 //! the run's summary, a line per board.
 
 use ppmc::scenario::{Grade, ScenarioResult, Verdict};
-use ppmc_record::{RunInfo, Tally};
+use ppmc_record::{RunInfo, RunRecord, Tally};
 
 pub(crate) fn verdict_line(r: &ScenarioResult, board: Option<&str>) -> String {
     let tag = match r.verdict {
@@ -38,6 +38,52 @@ pub(crate) fn verdict_line(r: &ScenarioResult, board: Option<&str>) -> String {
         s.push_str(&a.verdict.detail().unwrap_or_else(|| "passed".into()));
     }
     s
+}
+
+/// Rows the recap lists at most; the reports hold the rest.
+const MAX_RECAP: usize = 20;
+
+/// Above the counts, what did not pass again, the board's failures first
+/// ([`RunRecord::not_passed`]), each with its board, the check and by how
+/// much: the end of a long log is what a reader sees first.
+pub(crate) fn not_passed_lines(record: &RunRecord) {
+    let rows = record.not_passed();
+    if rows.is_empty() {
+        return;
+    }
+    outln!("did not pass ({}), the board's failures first:", rows.len());
+    for (_, sc) in rows.iter().take(MAX_RECAP) {
+        let board = sc
+            .board
+            .as_deref()
+            .map_or(String::new(), |b| format!(" on {b}"));
+        let f = sc.shortfall();
+        let what = match (f.expected.is_empty(), f.by) {
+            (true, _) => format!("{}: {}", f.check, f.got),
+            (false, None) => format!("{}: expected {}, got {}", f.check, f.expected, f.got),
+            (false, Some(by)) => {
+                format!("{}: expected {}, got {} [{by}]", f.check, f.expected, f.got)
+            }
+        };
+        let word = match sc.verdict.name() {
+            "failed" => "FAIL",
+            "error" => "ERROR",
+            "flaky" => "FLAKY",
+            _ => "NOT RUN",
+        };
+        outln!(
+            "  {} {}{board}: {}",
+            crate::out::verdict_word(word, 7),
+            sc.name,
+            ppmc_record::printable(&what)
+        );
+    }
+    if rows.len() > MAX_RECAP {
+        outln!(
+            "  and {} more (the reports list them)",
+            rows.len() - MAX_RECAP
+        );
+    }
 }
 
 /// The run's counts: every verdict, then the closing line CI log readers

@@ -30,7 +30,12 @@ pub fn run(mut args: SelftestArgs) -> Result<(), CliError> {
         .iter()
         .find(|(k, _)| k == "bridge_firmware")
         .map_or("", |(_, v)| v.as_str());
-    outln!("selftest of {} (bridge firmware \"{firmware}\")", info.name);
+    // Said once the first check has run: a target without a self-test
+    // (the emulator) gets its error alone, under no heading.
+    let mut heading = Some(format!(
+        "selftest of {} (bridge firmware \"{firmware}\")",
+        info.name
+    ));
     let limits = Limits {
         offset: args.max_offset,
         jitter: args.max_jitter,
@@ -54,6 +59,9 @@ pub fn run(mut args: SelftestArgs) -> Result<(), CliError> {
                 )))
             }
         };
+        if let Some(h) = heading.take() {
+            outln!("{h}");
+        }
         let o = judge(check, &run, &limits);
         let p = &check.plan;
         let what = format!(

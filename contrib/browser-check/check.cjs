@@ -8,7 +8,13 @@
 //     (a box of non-zero size) and every line holds as many points as its
 //     data-points says, as the browser parsed them;
 //   - with --expect-divergence NAME: that scenario's speed profile has the
-//     first divergence marked.
+//     first divergence marked;
+//   - in the first screenful (1400 x 900), the first scenario that did not
+//     pass, with its board, check, expected, measured and by how much;
+//   - every plot's marker names the pulse its scenario's failure text
+//     names (one numbering, from 1, everywhere);
+//   - no two text labels of a plot overlap, and none is cut off by its
+//     plot's edge.
 // Saves the page's top as report.png and, when a scenario did not pass, the
 // first such scenario as report-failure.png, in the folder given.
 //
@@ -37,7 +43,7 @@ async function main() {
   });
   const problems = [];
   try {
-    const page = await browser.newPage({ viewport: { width: 1280, height: 1000 } });
+    const page = await browser.newPage({ viewport: { width: 1400, height: 900 } });
     const requests = [];
     page.on('request', (r) => requests.push(r.url()));
     page.on('console', (m) => {
@@ -82,6 +88,72 @@ async function main() {
       if (marks < 0) problems.push(`no scenario ${expectDivergence} in the report`);
       else if (marks === 0) problems.push(`${expectDivergence}: no divergence marked on its speed profile`);
     }
+    const first = await page.evaluate(() => {
+      const row = document.querySelector('table.first tr[data-scenario]');
+      if (!row) return null;
+      const box = row.getBoundingClientRect();
+      const cells = [...row.querySelectorAll('td')].map((c) => c.textContent.trim());
+      return { bottom: box.bottom, scrollY: window.scrollY, cells, scenario: row.getAttribute('data-scenario') };
+    });
+    const failedAny = await page.evaluate(() => document.querySelectorAll(
+      'details.scenario.failed, details.scenario.error, details.scenario.flaky').length);
+    if (failedAny && !first) problems.push('scenarios did not pass, and the page does not open with them');
+    if (first) {
+      if (first.bottom > 900) {
+        problems.push(`the first scenario that did not pass (${first.scenario}) ends at ${Math.round(first.bottom)} px, below the first screenful (900 px)`);
+      }
+      // scenario, board, verdict, check, expected, measured, by how much
+      const [name, , verdict, check, , measured] = first.cells;
+      if (!name || !verdict || !check || (verdict === 'failed' && !measured)) {
+        problems.push(`the first row says too little: ${JSON.stringify(first.cells)}`);
+      }
+    }
+    const marks = await page.evaluate(() => {
+      const out = [];
+      for (const sc of document.querySelectorAll('details.scenario')) {
+        const text = sc.querySelector('p.failure');
+        // The pulse the board's value names (after "got"), else the one
+        // the check names ("first divergence in pulse 42 interval").
+        const said = text && (text.textContent.match(/got .*?pulse (\d+)/) || text.textContent.match(/pulse (\d+)/));
+        for (const m of sc.querySelectorAll('svg.profile .divergence text, svg.profile text.divergence')) {
+          const drawn = m.textContent.match(/pulse (\d+)/);
+          if (said && drawn) out.push({ scenario: sc.getAttribute('data-scenario'), said: said[1], drawn: drawn[1] });
+        }
+      }
+      return out;
+    });
+    for (const m of marks) {
+      if (m.said !== m.drawn) problems.push(`${m.scenario}: the text says pulse ${m.said}, the plot marks pulse ${m.drawn}`);
+    }
+    const overlaps = await page.evaluate(() => {
+      for (const d of document.querySelectorAll('details')) d.open = true;
+      const bad = [];
+      for (const svg of document.querySelectorAll('svg')) {
+        const frame = svg.getBoundingClientRect();
+        const boxes = [...svg.querySelectorAll('text')]
+          .filter((t) => t.textContent.trim())
+          .map((t) => ({ t: t.textContent.trim(), b: t.getBoundingClientRect() }));
+        for (const { t, b } of boxes) {
+          if (b.left < frame.left - 0.5 || b.right > frame.right + 0.5) {
+            bad.push(`"${t}" is cut off by its plot's edge (svg.${svg.className.baseVal})`);
+          }
+        }
+        for (let i = 0; i < boxes.length; i += 1) {
+          for (let j = i + 1; j < boxes.length; j += 1) {
+            const a = boxes[i].b; const b = boxes[j].b;
+            const w = Math.min(a.right, b.right) - Math.max(a.left, b.left);
+            const h = Math.min(a.bottom, b.bottom) - Math.max(a.top, b.top);
+            if (w > 1 && h > 1) bad.push(`"${boxes[i].t}" and "${boxes[j].t}" overlap (svg.${svg.className.baseVal})`);
+          }
+        }
+        if (bad.length > 20) break;
+      }
+      for (const d of document.querySelectorAll('details.scenario')) d.open = d.hasAttribute('data-open');
+      for (const d of document.querySelectorAll('details.all-scenarios')) d.open = !document.querySelector('table.first');
+      window.scrollTo(0, 0);
+      return [...new Set(bad)];
+    });
+    problems.push(...overlaps);
     await page.screenshot({ path: path.join(outDir, 'report.png') });
     const failed = page.locator('details.scenario.failed, details.scenario.error, details.scenario.flaky').first();
     if (await failed.count()) {

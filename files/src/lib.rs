@@ -357,6 +357,18 @@ fn identity(path: &Path) -> Option<Identity> {
     Some(Identity::Name(folder.join(path.file_name()?)))
 }
 
+/// Whether `name`, a name a file or a record gave, is a plain file name
+/// to write under: letters, digits, `-`, `_` and `.`, not starting with a
+/// dot, at most 200 bytes (no folder, no `..`, nothing hidden).
+pub fn plain_file_name(name: &str) -> bool {
+    !name.is_empty()
+        && name.len() <= 200
+        && !name.starts_with('.')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c))
+}
+
 /// Whether `a` and `b` are one file: the same existing file (by device and
 /// inode, so `./x`, `x`, a hard link and a symlink all match), or the same
 /// name in the same folder when it is not there yet. `-` (standard output)

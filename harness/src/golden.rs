@@ -9,8 +9,11 @@
 use crate::compare::{compare_graded, Tolerances};
 use crate::files::{self, FileError, MAX_TRACE_BYTES};
 use crate::protocol::Straps;
-use crate::scenario::{Failure, Grade, HarnessError, Measurement, ScenarioResult, Verdict};
+use crate::scenario::{
+    deviation_of, Failure, Grade, HarnessError, Measurement, ScenarioResult, Verdict,
+};
 use crate::trace::{Trace, TraceError};
+use ppmc_record::Reference;
 use std::path::{Path, PathBuf};
 
 /// The front matter `ppmc record` writes: insta's, as the golden files
@@ -31,7 +34,10 @@ fn without_front_matter(text: &str) -> &str {
 #[derive(Debug, thiserror::Error)]
 pub enum GoldenError {
     /// No golden file for the scenario.
-    #[error("{path}: no golden trace for this scenario (record one with `ppmc record`)")]
+    #[error(
+        "{path}: no golden trace for this scenario (record one with `{} record`)",
+        crate::program()
+    )]
     Missing { path: PathBuf },
     /// The file could not be read or written.
     #[error(transparent)]
@@ -52,7 +58,7 @@ pub enum GoldenError {
     },
     /// The file was recorded on a chip strapped otherwise than the one it
     /// would judge: every time in it would be off for that reason alone.
-    #[error("{path}: recorded at {recorded}, but the target is strapped {target}; record golden traces at these straps (`ppmc record`) or judge a board strapped as they were")]
+    #[error("{path}: recorded at {recorded}, but the target is strapped {target}; record golden traces at these straps (`{} record`) or judge a board strapped as they were", crate::program())]
     OtherStraps {
         path: PathBuf,
         recorded: Straps,
@@ -177,23 +183,26 @@ pub fn check(r: &mut ScenarioResult, dir: &Path, tol: &Tolerances) -> Option<Tra
         ));
         return None;
     };
-    let fail = |expectation: String, expected: String, got: String, at| {
+    let fail = |expectation: String, expected: String, got: String, at, deviation| {
         Verdict::Failed(Failure {
             expectation,
             expected,
             got,
             at,
+            deviation,
         })
     };
     match load_for(dir, r.name, &trace.straps) {
         Ok(g) => {
             match compare_graded(&g, trace, tol) {
                 Err(d) => {
+                    let deviation = deviation_of(&d.golden, &d.got, Reference::Golden);
                     r.verdict = fail(
                         format!("golden trace: first divergence in {}", d.quantity),
                         format!("{} (allowed {})", d.golden, d.allowed),
                         d.got,
                         d.at,
+                        deviation,
                     );
                 }
                 // Within the instruments' uncertainty of a limit: the
@@ -438,6 +447,7 @@ mod admit_tests {
             expected: "0x8E".into(),
             got: "0x00".into(),
             at: Instant::ZERO,
+            deviation: None,
         })
     }
 

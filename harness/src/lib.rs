@@ -53,3 +53,28 @@ pub use ppmc_record as record;
 /// The harness's version and git revision, for run records.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 pub const GIT_REV: &str = env!("PPMC_GIT_REV");
+
+/// The name this program was run by, for messages that tell the user a
+/// command to type: `ppmc`, or a board team's own binary that hands its
+/// suite to `ppmc_cli::main` (`board-suite record ...`). `ppmc` where the
+/// name cannot be read, is not a plain word, or is a test binary's
+/// (`it-0123456789abcdef`).
+pub fn program() -> String {
+    let arg0 = std::env::args_os().next().unwrap_or_default();
+    let stem = std::path::Path::new(&arg0)
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or_default();
+    let plain = !stem.is_empty()
+        && stem
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c));
+    let test_binary = stem
+        .rsplit_once('-')
+        .is_some_and(|(_, h)| h.len() == 16 && h.chars().all(|c| c.is_ascii_hexdigit()));
+    if plain && !test_binary {
+        stem.to_string()
+    } else {
+        "ppmc".to_string()
+    }
+}

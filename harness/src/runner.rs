@@ -19,6 +19,8 @@ pub struct Selection {
     pub tags: Vec<String>,
     /// No listed tag may be present.
     pub skip_tags: Vec<String>,
+    /// Scenarios left out by name (the whole name).
+    pub skip: Vec<String>,
     /// `(i, n)`: the i-th (1-based) of n interleaved shards.
     pub shard: Option<(usize, usize)>,
 }
@@ -43,6 +45,7 @@ impl Selection {
             })
             .filter(|s| self.tags.iter().all(|t| s.has_tag(t)))
             .filter(|s| !self.skip_tags.iter().any(|t| s.has_tag(t)))
+            .filter(|s| !self.skip.iter().any(|n| n == s.name))
             .copied()
             .collect()
     }
@@ -631,6 +634,7 @@ mod tests {
             filter: f.map(String::from),
             tags: tags.iter().map(|t| t.to_string()).collect(),
             skip_tags: Vec::new(),
+            skip: Vec::new(),
             shard,
         };
         assert_eq!(
@@ -650,6 +654,15 @@ mod tests {
             ..Selection::default()
         };
         assert_eq!(names(skip_y.select(&all)), vec!["a_one", "d_four"]);
+        // Issue 42: one scenario left out by its whole name.
+        let skip_b = Selection {
+            skip: vec!["b_two".into(), "c_thr".into()],
+            ..Selection::default()
+        };
+        assert_eq!(
+            names(skip_b.select(&all)),
+            vec!["a_one", "c_three", "d_four"]
+        );
         // A shard past the end of a small suite is empty, not an error.
         assert!(sel(None, &[], Some((7, 9))).select(&all).is_empty());
         assert_eq!(

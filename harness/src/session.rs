@@ -213,9 +213,10 @@ pub fn compare_sets(
             }
             Err(GoldenError::Missing { path }) => {
                 let why = format!(
-                    "{}: no trace of this scenario in {} (record it there with `ppmc record --out {}`)",
+                    "{}: no trace of this scenario in {} (record it there with `{} record --out {}`)",
                     path.display(),
                     traces.display(),
+                    crate::program(),
                     traces.display()
                 );
                 r.verdict = Verdict::Error(HarnessError::Golden(why));

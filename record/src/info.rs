@@ -14,6 +14,9 @@ pub struct RunOptions {
     pub tags: Vec<String>,
     #[serde(default)]
     pub skip_tags: Vec<String>,
+    /// Scenarios left out by name (`--skip`).
+    #[serde(default)]
+    pub skip: Vec<String>,
     /// `I/N`, when the run is one shard of the suite.
     #[serde(default)]
     pub shard: Option<String>,

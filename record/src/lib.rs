@@ -18,6 +18,7 @@
 //! grades. This crate depends on `ppmc-core`'s time and protocol types and
 //! on nothing of the harness.
 
+mod deviation;
 mod figures;
 mod info;
 pub mod measurement;
@@ -25,6 +26,7 @@ mod result;
 mod run;
 mod tally;
 
+pub use deviation::{human_ns, Bound, Deviation, DeviationUnit, Reference};
 pub use figures::{Figures, MoveFigure, PinWave, Waveform, MAX_WAVE_PULSES};
 pub use info::{rfc3339, BoardInfo, CaptureSource, RunInfo, RunOptions};
 pub use measurement::{Grade, Grading, Measurement, MARGINAL_PCT};
@@ -32,5 +34,5 @@ pub use result::{
     AttemptRecord, Blame, ErrorKind, ErrorRecord, FailureRecord, HostFindingRecord, RangeRecord,
     RepeatedRecord, ScenarioRecord, MAX_LISTED,
 };
-pub use run::{printable, RecordError, RunRecord, FORMAT, FORMATS, MAX_RECORD_BYTES};
+pub use run::{printable, RecordError, RunRecord, Shortfall, FORMAT, FORMATS, MAX_RECORD_BYTES};
 pub use tally::{Status, Tally};

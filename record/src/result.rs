@@ -6,6 +6,7 @@
 //! Everything here is owned and plain: every producer (a run, a
 //! comparison, a capture's judge, a soak) writes it, every report reads it.
 
+use crate::deviation::Deviation;
 use crate::figures::Figures;
 use crate::measurement::{Grade, Measurement};
 use crate::tally::{Status, Tally};
@@ -52,6 +53,9 @@ pub struct FailureRecord {
     pub expected: String,
     pub got: String,
     pub at_ns: u64,
+    /// By how much, where the check has a magnitude (a time, a count).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deviation: Option<Deviation>,
 }
 
 /// The party a result judged from a capture blames (`ppmc judge`): the

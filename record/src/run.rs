@@ -168,3 +168,76 @@ mod tests {
         );
     }
 }
+
+/// What a scenario that did not pass says of itself, in the words every
+/// report uses for its first lines ([`RunRecord::not_passed`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Shortfall {
+    /// The check that failed, or the kind of error.
+    pub check: String,
+    /// What was expected (empty for an error).
+    pub expected: String,
+    /// What was measured, or the error's message.
+    pub got: String,
+    /// By how much ([`crate::Deviation::describe`]), where the check has a
+    /// magnitude.
+    pub by: Option<String>,
+    /// When, on the target's clock (a failure's).
+    pub at_ns: Option<u64>,
+}
+
+impl RunRecord {
+    /// The scenarios that did not pass cleanly (neither passed nor
+    /// MARGINAL), the board's failures first, then errors, flaky passes
+    /// and those not run, each kind in run order: what a report shows
+    /// first. Each with its index in [`RunRecord::scenarios`].
+    pub fn not_passed(&self) -> Vec<(usize, &ScenarioRecord)> {
+        let rank = |sc: &ScenarioRecord| match sc.verdict {
+            crate::Status::Failed => 0,
+            crate::Status::Error => 1,
+            crate::Status::Flaky => 2,
+            _ => 3,
+        };
+        let mut rows: Vec<(usize, &ScenarioRecord)> = self
+            .scenarios
+            .iter()
+            .enumerate()
+            .filter(|(_, sc)| {
+                !matches!(sc.verdict, crate::Status::Passed | crate::Status::Marginal)
+            })
+            .collect();
+        rows.sort_by_key(|(k, sc)| (rank(sc), *k));
+        rows
+    }
+}
+
+impl ScenarioRecord {
+    /// What did not pass, in a report's words: the failure's check,
+    /// expectation, measured value and deviation; or the error's kind and
+    /// message; or the detail.
+    pub fn shortfall(&self) -> Shortfall {
+        match (&self.failure, &self.error) {
+            (Some(f), _) => Shortfall {
+                check: f.expectation.clone(),
+                expected: f.expected.clone(),
+                got: f.got.clone(),
+                by: f.deviation.as_ref().map(|d| d.describe()),
+                at_ns: Some(f.at_ns),
+            },
+            (None, Some(e)) => Shortfall {
+                check: format!("{} error", e.kind.name()),
+                expected: String::new(),
+                got: e.message.clone(),
+                by: None,
+                at_ns: None,
+            },
+            (None, None) => Shortfall {
+                check: self.detail.clone().unwrap_or_default(),
+                expected: String::new(),
+                got: String::new(),
+                by: None,
+                at_ns: None,
+            },
+        }
+    }
+}

@@ -30,6 +30,7 @@ pub fn history_html(h: &History, title: &str, store: &str) -> String {
         ))
     );
     yields(&mut s, h);
+    boards(&mut s, h);
     revisions(&mut s, h);
     scenarios(&mut s, h);
     trend(&mut s, h);
@@ -74,6 +75,55 @@ fn yields(s: &mut String, h: &History) {
     s.push_str("</svg></section>\n");
 }
 
+/// Every board, the ones whose last test failed first: serial, revision,
+/// station, board tests, last verdict and when; each row opens the list
+/// of its board tests.
+fn boards(s: &mut String, h: &History) {
+    let boards = h.boards();
+    let _ = write!(
+        s,
+        r#"<section class="boards"><h2>Boards ({})</h2><p class="detail">Every board the store has seen, those whose last test failed first. A board test is one board in one run.</p><table class="boards"><tr><th>board</th><th>revision</th><th>station</th><th>board tests</th><th>last verdict</th><th>last seen</th></tr>"#,
+        boards.len()
+    );
+    for (k, b) in boards.iter().enumerate() {
+        let verdict = if b.last_passed { "passed" } else { "failed" };
+        let _ = write!(
+            s,
+            r##"<tr class="{verdict}" data-board="{0}"><td><a href="#board-{k}">{0}</a></td><td>{1}</td><td>{2}</td><td>{3}</td><td><span class="chip {verdict}">{verdict}</span></td><td>{4}</td></tr>"##,
+            esc(&b.board),
+            esc(&b.rev),
+            esc(&b.station),
+            b.tests.len(),
+            esc(&b.last_seen),
+        );
+    }
+    s.push_str("</table>");
+    for (k, b) in boards.iter().enumerate() {
+        let _ = write!(
+            s,
+            r#"<details class="board-tests" id="board-{k}"><summary>{} : {} board tests</summary><table><tr><th>run</th><th>started</th><th>revision</th><th>station</th><th>scenarios passed</th><th>verdict</th></tr>"#,
+            esc(&b.board),
+            b.tests.len()
+        );
+        for &i in b.tests.iter().rev() {
+            let t = &h.trend[i];
+            let verdict = if t.passed() { "passed" } else { "failed" };
+            let _ = write!(
+                s,
+                r#"<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{} of {}</td><td><span class="chip {verdict}">{verdict}</span></td></tr>"#,
+                t.run,
+                esc(&t.started),
+                esc(&t.rev),
+                esc(&t.station),
+                t.passed,
+                t.results
+            );
+        }
+        s.push_str("</table></details>");
+    }
+    s.push_str("</section>\n");
+}
+
 /// Each measurement of each scenario, the revisions side by side on one
 /// scale with its band; the lowest Cpk first.
 fn revisions(s: &mut String, h: &History) {
@@ -113,8 +163,22 @@ fn revisions(s: &mut String, h: &History) {
     });
     for ((scenario, name), group) in groups {
         let first = group[0];
+        let band_of = |d: &Distribution| {
+            format!(
+                "{} to {}",
+                us(d.lo_ns),
+                d.hi_ns.map_or("no upper limit".into(), us)
+            )
+        };
+        // Rows of one measurement may be held to other bands (boards
+        // strapped to other clocks): each row then names its own.
+        let rows_differ = group
+            .iter()
+            .any(|d| (d.lo_ns, d.hi_ns) != (first.lo_ns, first.hi_ns));
         let band = if group.iter().any(|d| d.bands_differ) {
             "each value against its own band: the boards' clocks differ".to_string()
+        } else if rows_differ {
+            "each row against its own band, in the table: the boards' straps differ".to_string()
         } else {
             format!(
                 "band {} to {}",
@@ -132,16 +196,24 @@ fn revisions(s: &mut String, h: &History) {
             esc(&band)
         );
         s.push_str(&distribution_svg(&group));
-        s.push_str(r#"<table class="dist"><tr><th>revision</th><th>n</th><th>mean</th><th>sd</th><th>min</th><th>max</th><th>Cpk</th></tr>"#);
+        s.push_str(r#"<table class="dist"><tr><th>revision</th><th>band</th><th>n</th><th>out of band</th><th>mean</th><th>sd</th><th>min</th><th>max</th><th>Cpk</th></tr>"#);
         for d in &group {
+            let out = d.out_of_band();
             let _ = write!(
                 s,
-                r#"<tr data-rev="{}"><td>{}</td><td>{}</td><td>{}</td><td>{:.1} ns</td><td>{}</td><td>{}</td><td>{}</td></tr>"#,
+                r#"<tr data-rev="{}"><td>{}</td><td>{}</td><td>{}</td><td{}>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>"#,
                 esc(&d.rev),
                 esc(&d.rev),
+                esc(&if d.bands_differ {
+                    "per board".to_string()
+                } else {
+                    band_of(d)
+                }),
                 d.values.len(),
+                if out > 0 { r#" class="out""# } else { "" },
+                out,
                 esc(&us(d.mean_ns.round() as u64)),
-                d.sd_ns(),
+                esc(&us(d.sd_ns().round() as u64)),
                 esc(&us(d.min_ns)),
                 esc(&us(d.max_ns)),
                 cpk_text(d.cpk())
@@ -320,7 +392,7 @@ fn scenarios(s: &mut String, h: &History) {
 fn trend(s: &mut String, h: &History) {
     let _ = write!(
         s,
-        r#"<section class="trend"><h2>Over time</h2><p class="detail">Each board test's pass rate, oldest first ({} tests{}).</p>"#,
+        r#"<section class="trend"><h2>Over time</h2><p class="detail">Each revision's yield so far after each of its board tests, oldest first ({} tests{}): a dot per board test, at the share of that revision's tests until then that passed.</p>"#,
         h.trend.len(),
         h.trend
             .first()
@@ -332,34 +404,37 @@ fn trend(s: &mut String, h: &History) {
             ))
     );
     let n = h.trend.len().max(2) as f64;
-    let mut p = Plot::new(940.0, 240.0, (1.0, n), (0.0, 100.0), "trend");
-    p.axes("board test, oldest first", "passed (%)");
+    // 0 % at the bottom, 100 % below the top frame: a line at 100 % is
+    // not drawn on the frame.
+    let mut p = Plot::new(940.0, 240.0, (0.5, n + 0.5), (0.0, 105.0), "trend");
+    p.axes("board test, oldest first", "yield so far (%)");
     let cols = p.columns();
-    let mut series: BTreeMap<&str, Vec<Segment>> = BTreeMap::new();
+    let mut series: BTreeMap<&str, (u64, u64, Vec<Segment>)> = BTreeMap::new();
     for (i, t) in h.trend.iter().enumerate() {
+        let (tests, passed, segs) = series.entry(t.rev.as_str()).or_default();
+        *tests += 1;
+        *passed += u64::from(t.passed());
         let x = (i + 1) as f64;
-        let rate = if t.results == 0 {
-            0.0
-        } else {
-            t.passed as f64 * 100.0 / t.results as f64
-        };
-        series.entry(t.rev.as_str()).or_default().push(Segment {
+        segs.push(Segment {
             x0: x,
             x1: x,
             n: 1,
-            y: rate,
+            y: *passed as f64 * 100.0 / *tests as f64,
         });
     }
     let mut decimated = false;
     let mut legend = Vec::new();
-    for (k, (rev, segs)) in series.iter().enumerate() {
-        let r = reduce(segs, 1.0, n, cols);
+    for (k, (rev, (tests, passed, segs))) in series.iter().enumerate() {
+        let r = reduce(segs, 0.5, n + 0.5, cols);
         decimated |= r.decimated;
-        p.line(&format!("series s{}", k % 6), &r.points);
+        let class = format!("series s{}", k % 6);
+        p.line(&class, &r.points);
+        p.dots(&class, &r.points);
         legend.push(format!(
-            r#"<span class="key s{}">{}</span>"#,
+            r#"<span class="key s{}">{}: {:.1} % of {tests}</span>"#,
             k % 6,
-            esc(rev)
+            esc(rev),
+            *passed as f64 * 100.0 / (*tests).max(1) as f64
         ));
     }
     if decimated {

@@ -96,6 +96,10 @@ fn run_section(s: &mut String, r: &RunRecord, i: usize) {
         i + 1,
         summary_chips(r)
     );
+    // What did not pass first, then the boards, then the run's facts and
+    // everything else.
+    let first = not_passed(s, r, i);
+    boards(s, r);
     let golden = r.run.options.golden.as_deref().unwrap_or("none");
     let _ = write!(
         s,
@@ -110,10 +114,15 @@ fn run_section(s: &mut String, r: &RunRecord, i: usize) {
         r.run.options.time_floor_ns,
         r.run.options.marginal_pct,
     );
-    boards(s, r);
-    // The scenarios: a table of all, then each in full, those that did not
-    // pass first and open.
-    s.push_str(r#"<h3>Scenarios</h3><table class="scenarios"><tr><th>scenario</th><th>section</th><th>board</th><th>verdict</th><th>attempts</th><th>device time</th></tr>"#);
+    // The scenarios: a table of all (folded away when something did not
+    // pass: that is above), then each in full, those that did not pass
+    // first and open.
+    let _ = write!(
+        s,
+        r#"<details class="all-scenarios"{}><summary>All {} scenarios</summary><table class="scenarios"><tr><th>scenario</th><th>section</th><th>board</th><th>verdict</th><th>attempts</th><th>device time</th></tr>"#,
+        if first { "" } else { " open" },
+        r.scenarios.len()
+    );
     for (k, sc) in r.scenarios.iter().enumerate() {
         let _ = write!(
             s,
@@ -128,7 +137,7 @@ fn run_section(s: &mut String, r: &RunRecord, i: usize) {
             esc(&plots::human(sc.elapsed_ns)),
         );
     }
-    s.push_str("</table>");
+    s.push_str("</table></details>");
     let tol = (r.run.options.interval_tol_pct, r.run.options.time_floor_ns);
     let order = r
         .scenarios
@@ -146,6 +155,52 @@ fn run_section(s: &mut String, r: &RunRecord, i: usize) {
         scenario(s, sc, &format!("r{i}-s{k}"), tol, &mut budget);
     }
     s.push_str("</section>\n");
+}
+
+/// Rows a page's "did not pass" table holds at most; the rest are below.
+const MAX_FIRST: usize = 50;
+
+/// The table a page opens with: every scenario that did not pass, the
+/// board's failures first, each with its board, the check, what was
+/// expected against what was measured, and by how much. Whether there was
+/// any.
+fn not_passed(s: &mut String, r: &RunRecord, i: usize) -> bool {
+    let rows = r.not_passed();
+    if rows.is_empty() {
+        return false;
+    }
+    let _ = write!(
+        s,
+        r#"<section class="not-passed"><h3>Did not pass: {}</h3><table class="first"><tr><th>scenario</th><th>board</th><th>verdict</th><th>check</th><th>expected</th><th>measured</th><th>by how much</th><th>at</th></tr>"#,
+        rows.len()
+    );
+    for (k, sc) in rows.iter().take(MAX_FIRST) {
+        let f = sc.shortfall();
+        let _ = write!(
+            s,
+            r##"<tr class="{0}" data-scenario="{1}"><td><a href="#r{i}-s{k}">{2}</a></td><td>{3}</td><td><span class="chip {0}">{4}</span></td><td>{5}</td><td>{6}</td><td class="got">{7}</td><td class="by">{8}</td><td>{9}</td></tr>"##,
+            esc(sc.verdict.name()),
+            esc(&sc.name),
+            esc(&display_name(sc)),
+            esc(sc.board.as_deref().unwrap_or("")),
+            esc(&sc.verdict.name().replace('_', " ")),
+            esc(&f.check),
+            esc(&f.expected),
+            esc(&f.got),
+            esc(f.by.as_deref().unwrap_or("")),
+            esc(&f.at_ns.map(plots::us).unwrap_or_default()),
+        );
+    }
+    s.push_str("</table>");
+    if rows.len() > MAX_FIRST {
+        let _ = write!(
+            s,
+            r#"<p class="detail">{} more below, each in full.</p>"#,
+            rows.len() - MAX_FIRST
+        );
+    }
+    s.push_str("</section>");
+    true
 }
 
 fn display_name(sc: &ScenarioRecord) -> String {
@@ -218,11 +273,15 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64), budg
     if let Some(f) = &sc.failure {
         let _ = write!(
             s,
-            r#"<p class="failure"><b>{}</b> at {}: expected {}, got {}</p>"#,
+            r#"<p class="failure"><b>{}</b> at {}: expected {}, got {}{}</p>"#,
             esc(&f.expectation),
             esc(&plots::us(f.at_ns)),
             esc(&f.expected),
-            esc(&f.got)
+            esc(&f.got),
+            f.deviation
+                .as_ref()
+                .map(|d| format!(": {}", esc(&d.describe())))
+                .unwrap_or_default()
         );
     } else if let Some(e) = &sc.error {
         let _ = write!(
@@ -290,6 +349,17 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64), budg
         // The marked move is drawn whatever the cap.
         let drawn = |n: usize| n < shown || Some(n) == marked;
         let left_out = (0..fig.moves.len()).filter(|n| !drawn(*n)).count();
+        // The scenario's pulses before each move: pulses are numbered over
+        // the scenario, in the plots as in the failure texts.
+        let before: Vec<u64> = fig
+            .moves
+            .iter()
+            .scan(0u64, |sum, m| {
+                let b = *sum;
+                *sum = sum.saturating_add(m.pulses());
+                Some(b)
+            })
+            .collect();
         for (n, m) in fig.moves.iter().enumerate().filter(|(n, _)| drawn(*n)) {
             let _ = write!(
                 s,
@@ -302,14 +372,18 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64), budg
                 m.steps,
                 m.pulses(),
                 if m.golden.is_some() {
-                    " (grey: the golden trace, with its tolerance band)"
+                    r#" <span class="legend"><span class="key board">the board</span><span class="key golden">the golden trace</span><span class="key band">its tolerance band</span></span>"#
                 } else {
                     ""
                 }
             );
             if m.pulses() > 1 || m.golden.is_some() {
                 let mark = mark.filter(|_| marked == Some(n)).map(|at| (at, label));
-                s.push_str(&plots::profiles(m, mark, tol));
+                let (svg, reduced) = plots::profiles(m, before[n], mark, tol);
+                s.push_str(&svg);
+                if reduced {
+                    s.push_str(r#"<p class="detail reduced">Reduced for drawing: the least and the greatest interval in each pixel column.</p>"#);
+                }
             }
             s.push_str("</div>");
         }

@@ -11,6 +11,9 @@ const MAX_WAVE_CHANGES: usize = 2_000;
 use super::svg::{esc, reduce, Plot, Segment};
 use std::fmt::Write as _;
 
+/// Room a band's limit label takes beside its limit, px.
+const LABEL_W: f64 = 80.0;
+
 /// The profiles' pixel size.
 const PROFILE: (f64, f64) = (470.0, 210.0);
 
@@ -29,8 +32,26 @@ pub fn measurement(m: &Measurement) -> String {
     let (l, r) = (8.0, 8.0);
     let hi = hi_ns.unwrap_or(u64::MAX);
     let finite_top = hi_ns.unwrap_or(lo_ns.max(marginal_lo_ns));
-    let top = (finite_top.max(value_ns) as f64 * 1.25).max(1.0);
-    let x = |ns: u64| l + (ns as f64).min(top) / top * (w - l - r);
+    // The view: a band with both ends spans the middle half of the strip,
+    // whatever its width (a +/-1 % band drawn from 0 would be a sliver
+    // with its labels on top of each other), widened to hold the value and
+    // its uncertainty; a band with no upper end is drawn from 0.
+    let (view_lo, view_hi) = match hi_ns {
+        Some(top) => {
+            let width = top.saturating_sub(lo_ns).max(1) as f64;
+            let a = (lo_ns as f64 - width / 2.0)
+                .min(value_ns.saturating_sub(u_ns) as f64 - width / 8.0)
+                .max(0.0);
+            let b =
+                (top as f64 + width / 2.0).max(value_ns.saturating_add(u_ns) as f64 + width / 8.0);
+            (a, b)
+        }
+        None => (0.0, (finite_top.max(value_ns) as f64 * 1.25).max(1.0)),
+    };
+    let x = |ns: u64| {
+        let f = ((ns as f64).clamp(view_lo, view_hi) - view_lo) / (view_hi - view_lo);
+        l + f * (w - l - r)
+    };
     let mut s = String::new();
     let _ = write!(
         s,
@@ -71,12 +92,24 @@ pub fn measurement(m: &Measurement) -> String {
             xb.max(xa + 1.0)
         );
     }
+    // The lower limit's label ends at it, the upper's starts at it: they
+    // cannot meet, as the view keeps the band in its middle half.
     let _ = write!(
         s,
-        r#"<line class="value" x1="{xv:.1}" y1="2" x2="{xv:.1}" y2="22"/><text class="tick" x="{:.1}" y="31" text-anchor="start">{}</text><text class="tick" x="{:.1}" y="31" text-anchor="end">{}</text></svg>"#,
+        r#"<line class="value" x1="{xv:.1}" y1="2" x2="{xv:.1}" y2="22"/><text class="tick" x="{:.1}" y="31" text-anchor="{}">{}</text><text class="tick" x="{:.1}" y="31" text-anchor="{}">{}</text></svg>"#,
         x(lo_ns),
+        if x(lo_ns) > LABEL_W { "end" } else { "start" },
         esc(&us(lo_ns)),
-        x(finite_top),
+        if hi_ns.is_some() {
+            x(finite_top)
+        } else {
+            w - r
+        },
+        if hi_ns.is_some() && x(finite_top) < w - LABEL_W {
+            "start"
+        } else {
+            "end"
+        },
         esc(&hi_ns.map_or("no upper limit".to_string(), us)),
     );
     s
@@ -98,11 +131,17 @@ pub fn human(ns: u64) -> String {
     }
 }
 
-/// A move's pulse intervals as segments: against the pulse number (from
-/// 2: the first pulse has no interval) or against the time from the move.
-fn segments(runs: &[[u64; 3]], by_time: bool, band: impl Fn(f64) -> f64) -> Vec<Segment> {
+/// A move's pulse intervals as segments: against the pulse number (the
+/// scenario's, from 1: the move's first pulse is `before + 1`, and has no
+/// interval) or against the time from the move.
+fn segments(
+    runs: &[[u64; 3]],
+    before: u64,
+    by_time: bool,
+    band: impl Fn(f64) -> f64,
+) -> Vec<Segment> {
     let mut out = Vec::new();
-    let mut pulse = 0u64;
+    let mut pulse = before;
     let mut last: Option<u64> = None;
     for &[from, count, span] in runs.iter().filter(|r| r[1] > 0) {
         let x = |p: u64, t: u64| if by_time { t as f64 / 1e6 } else { p as f64 };
@@ -166,23 +205,41 @@ pub fn mark_in(m: &MoveFigure, at_ns: u64) -> Option<(u64, u64)> {
 
 /// The two speed profiles of a move (interval against pulse number, and
 /// against time), the golden one beneath with its tolerance band, and the
-/// failure marked. `tol` is the interval tolerance, percent, and floor, ns.
-pub fn profiles(m: &MoveFigure, mark: Option<(u64, &str)>, tol: (f64, u64)) -> String {
+/// failure marked. `tol` is the interval tolerance, percent, and floor, ns;
+/// `before`, the scenario's pulses before this move (the pulses are
+/// numbered over the scenario, as its failure texts number them).
+/// Also whether either was reduced for drawing (the page says so under
+/// them: a note inside a plot would cover what it draws).
+pub fn profiles(
+    m: &MoveFigure,
+    before: u64,
+    mark: Option<(u64, &str)>,
+    tol: (f64, u64),
+) -> (String, bool) {
     let mut out = String::new();
+    let mut reduced = false;
     for by_time in [false, true] {
-        out.push_str(&profile(m, mark, tol, by_time));
+        let (svg, r) = profile(m, before, mark, tol, by_time);
+        out.push_str(&svg);
+        reduced |= r;
     }
-    out
+    (out, reduced)
 }
 
-fn profile(m: &MoveFigure, mark: Option<(u64, &str)>, tol: (f64, u64), by_time: bool) -> String {
+fn profile(
+    m: &MoveFigure,
+    before: u64,
+    mark: Option<(u64, &str)>,
+    tol: (f64, u64),
+    by_time: bool,
+) -> (String, bool) {
     let (pct, floor) = (tol.0 / 100.0, tol.1 as f64 / 1000.0);
-    let board = segments(&m.runs, by_time, |y| y);
+    let board = segments(&m.runs, before, by_time, |y| y);
     let golden = m.golden.as_deref().map(|g| {
         (
-            segments(g, by_time, |y| y),
-            segments(g, by_time, |y| (y - y * pct - floor).max(0.0)),
-            segments(g, by_time, |y| y + y * pct + floor),
+            segments(g, before, by_time, |y| y),
+            segments(g, before, by_time, |y| (y - y * pct - floor).max(0.0)),
+            segments(g, before, by_time, |y| y + y * pct + floor),
         )
     });
     let all = board.iter().chain(golden.iter().flat_map(|g| g.2.iter()));
@@ -205,24 +262,29 @@ fn profile(m: &MoveFigure, mark: Option<(u64, &str)>, tol: (f64, u64), by_time: 
         if by_time {
             "time from the move (ms)"
         } else {
-            "pulse number"
+            "pulse number (of the scenario)"
         },
         "interval (us)",
     );
     let cols = p.columns();
     let mut decimated = false;
-    if let Some((line, lo, hi)) = &golden {
+    // The band beneath, the board's line over it, and the golden line,
+    // dashed, on top: where the two agree both still show.
+    if let Some((_, lo, hi)) = &golden {
         let (lo, hi) = (reduce(lo, x_lo, x_hi, cols), reduce(hi, x_lo, x_hi, cols));
         p.band("band", &lo.points, &hi.points);
-        let g = reduce(line, x_lo, x_hi, cols);
-        decimated |= g.decimated;
-        p.line("golden", &g.points);
     }
     let b = reduce(&board, x_lo, x_hi, cols);
     decimated |= b.decimated;
     p.line("board", &b.points);
+    if let Some((line, _, _)) = &golden {
+        let g = reduce(line, x_lo, x_hi, cols);
+        decimated |= g.decimated;
+        p.line("golden", &g.points);
+    }
     if let Some((at, label)) = mark {
         if let Some((pulse, t)) = mark_in(m, at) {
+            let pulse = before + pulse;
             let x = if by_time {
                 t as f64 / 1e6
             } else {
@@ -231,10 +293,7 @@ fn profile(m: &MoveFigure, mark: Option<(u64, &str)>, tol: (f64, u64), by_time: 
             p.mark("divergence", x, &format!("{label}: pulse {pulse}"));
         }
     }
-    if decimated {
-        p.note("reduced: least and greatest per pixel column");
-    }
-    p.finish()
+    (p.finish(), decimated)
 }
 
 /// The pins around a failure: POUT's pulses (and the golden's), each pin,
@@ -266,7 +325,7 @@ pub fn waveform(w: &Waveform) -> String {
     let row = 24.0;
     let rows = 1 + usize::from(w.golden_pout.is_some()) + w.pins.len() + 1;
     let (width, label_w) = (940.0, 90.0);
-    let height = rows as f64 * row + 30.0;
+    let height = rows as f64 * row + 44.0;
     let span = (w.to_ns - w.from_ns) as f64;
     let x = |t: u64| {
         let at = label_w + t.saturating_sub(w.from_ns) as f64 / span * (width - label_w - 10.0);
@@ -359,27 +418,67 @@ pub fn waveform(w: &Waveform) -> String {
         y += row;
     }
     name(&mut s, y, "bus");
+    // Each access a tick; its name where there is room before the next
+    // name (a label is about 6 px a letter), else in its tooltip alone.
+    let mut free_from = 0.0;
     for (t, what) in &w.bus {
+        let xt = x(*t);
+        let room = xt + 2.0 >= free_from && xt + 2.0 + what.len() as f64 * 6.0 <= width;
         let _ = write!(
             s,
-            r#"<g class="access"><line x1="{0:.1}" y1="{1:.1}" x2="{0:.1}" y2="{2:.1}"/><text x="{3:.1}" y="{2:.1}">{4}</text></g>"#,
-            x(*t),
+            r#"<g class="access"><title>{3}</title><line x1="{0:.1}" y1="{1:.1}" x2="{0:.1}" y2="{2:.1}"/>"#,
+            xt,
             y + 3.0,
             y + 18.0,
-            x(*t) + 2.0,
             esc(what)
         );
+        if room {
+            let _ = write!(
+                s,
+                r#"<text x="{:.1}" y="{:.1}">{}</text>"#,
+                xt + 2.0,
+                y + 18.0,
+                esc(what)
+            );
+            free_from = xt + 2.0 + what.len() as f64 * 6.0 + 4.0;
+        }
+        s.push_str("</g>");
     }
     y += row;
+    // The time axis, from the failure: ticks at round steps either side.
     let xm = x(w.mark_ns);
     let _ = write!(
         s,
-        r#"<line class="mark" x1="{xm:.1}" y1="0" x2="{xm:.1}" y2="{y:.1}"/><text class="tick" x="{label_w}" y="{:.1}">{}</text><text class="tick" x="{:.1}" y="{:.1}" text-anchor="end">{}</text></svg>"#,
-        y + 14.0,
-        esc(&us(w.from_ns)),
-        width - 10.0,
-        y + 14.0,
-        esc(&us(w.to_ns)),
+        r#"<line class="mark" x1="{xm:.1}" y1="0" x2="{xm:.1}" y2="{y:.1}"/>"#
+    );
+    let rel = |t: u64| (t as f64 - w.mark_ns as f64) / 1e3;
+    let mut last_end = label_w - 4.0;
+    for tick in super::svg::ticks(rel(w.from_ns), rel(w.to_ns), 8) {
+        let t = (w.mark_ns as f64 + tick * 1e3).max(0.0) as u64;
+        let xt = x(t);
+        let label = match tick {
+            v if v > 0.0 => format!("+{} us", super::svg::tick_label(v)),
+            v => format!("{} us", super::svg::tick_label(v)),
+        };
+        let half = label.len() as f64 * 3.0;
+        if xt - half < last_end || xt + half > width {
+            continue;
+        }
+        last_end = xt + half + 6.0;
+        let _ = write!(
+            s,
+            r#"<line class="grid" x1="{xt:.1}" y1="{:.1}" x2="{xt:.1}" y2="{:.1}"/><text class="tick" x="{xt:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
+            y,
+            y + 4.0,
+            y + 14.0,
+            esc(&label)
+        );
+    }
+    let _ = write!(
+        s,
+        r#"<text class="tick" x="4" y="{:.1}">from the failure, at {}</text></svg>"#,
+        y + 28.0,
+        esc(&us(w.mark_ns)),
     );
     s
 }
@@ -399,7 +498,7 @@ mod tests {
     #[test]
     fn intervals_come_from_the_runs_and_the_gaps_between() {
         // Pulses at 100, 300, 500 (run 1), then 650, 750 (run 2).
-        let s = segments(&[[100, 3, 400], [650, 2, 100]], false, |y| y);
+        let s = segments(&[[100, 3, 400], [650, 2, 100]], 0, false, |y| y);
         let points: Vec<_> = s.iter().map(|s| (s.x0, s.x1, s.n, s.y)).collect();
         assert_eq!(
             points,

@@ -210,11 +210,23 @@ impl Plot {
         }
         for t in ticks(self.x.0, self.x.1, 6) {
             let x = self.px(t);
+            let label = tick_label(t);
+            // A label (about 6 px a character) that would pass the
+            // drawing's edge ends at it instead.
+            let half = label.len() as f64 * 3.0 + 1.0;
+            let (lx, anchor) = if x + half > self.width {
+                (self.width - 1.0, "end")
+            } else if x - half < x0 {
+                // Clear of the y axis's lowest label, at the corner.
+                (x0 + 1.0, "start")
+            } else {
+                (x, "middle")
+            };
             let _ = write!(
                 self.svg,
-                r#"<line class="grid" x1="{x:.1}" y1="{y0:.1}" x2="{x:.1}" y2="{y1:.1}"/><text class="tick" x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
-                y0 + 13.0,
-                tick_label(t)
+                r#"<line class="grid" x1="{x:.1}" y1="{y0:.1}" x2="{x:.1}" y2="{y1:.1}"/><text class="tick" x="{lx:.1}" y="{:.1}" text-anchor="{anchor}">{}</text>"#,
+                y0 + 15.0,
+                label
             );
         }
         let _ = write!(
@@ -246,6 +258,20 @@ impl Plot {
     }
 
     /// The area between two series of the same x (a tolerance band).
+    /// A dot at each point, so that a series of one point shows.
+    pub fn dots(&mut self, class: &str, points: &[(f64, f64)]) {
+        let _ = write!(self.svg, r#"<g class="{}">"#, esc(class));
+        for &(x, y) in points {
+            let _ = write!(
+                self.svg,
+                r#"<circle cx="{:.1}" cy="{:.1}" r="2.5"/>"#,
+                self.px(x),
+                self.py(y)
+            );
+        }
+        self.svg.push_str("</g>");
+    }
+
     pub fn band(&mut self, class: &str, lower: &[(f64, f64)], upper: &[(f64, f64)]) {
         if lower.is_empty() {
             return;

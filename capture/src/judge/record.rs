@@ -102,6 +102,11 @@ impl Judgement {
                     expected: d.model.clone(),
                     got: d.board.clone(),
                     at: Instant::from_nanos(d.at_ps / 1000),
+                    deviation: ppmc::scenario::deviation_of(
+                        &d.model,
+                        &d.board,
+                        ppmc_record::Reference::Expected,
+                    ),
                 }),
                 Some(Blame::Board),
                 Some(d.to_string()),
@@ -148,6 +153,7 @@ impl Judgement {
                         first.what
                     ),
                     at: Instant::from_nanos(first.at_ps / 1000),
+                    deviation: None,
                 }),
                 Some(Blame::Host),
                 Some(format!(

@@ -24,9 +24,9 @@ pub struct DiffArgs {
     /// a departure is replayed from the seed, not from memory.
     #[arg(long, default_value_t = 1_000)]
     ops: usize,
-    /// Stop after this much wall time (e.g. 30s, 5m is 300s) even if
-    /// --ops are not done.
-    #[arg(long, value_parser = crate::args::parse_duration)]
+    /// Stop after this much wall time (e.g. 30s, 5m, 1h) even if --ops
+    /// are not done.
+    #[arg(long, value_parser = crate::args::parse_wall_duration)]
     duration: Option<ppmc::time::Duration>,
     /// Where to write the minimized reproducer (a console script).
     /// Default: fuzz-diff-<seed>.ppmc in the current directory.

@@ -35,9 +35,11 @@ pub struct JudgeArgs {
     /// and the outputs the capture has (docs/capture.md).
     #[arg(long, value_name = "DIR")]
     pub(crate) trace: Option<PathBuf>,
-    /// The scenario the capture records: the trace's name (default: the
-    /// capture file's name without its extension).
-    #[arg(long, value_name = "NAME", requires = "trace")]
+    /// With --trace: the name of the trace it writes, the scenario the
+    /// capture records (default: the capture file's name without its
+    /// extension). The judging itself needs no scenario: it replays the
+    /// accesses the capture holds.
+    #[arg(long, value_name = "NAME")]
     pub(crate) scenario: Option<String>,
     /// Judge what the capture holds though it is not whole: it ends
     /// mid-line, during a register access or while the board is still

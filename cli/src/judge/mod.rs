@@ -12,6 +12,11 @@ use crate::{usage, CliError};
 use ppmc_capture::judge::{judge_reopening, CaptureVerdict, JudgeOptions, Judgement};
 
 pub fn run(args: JudgeArgs) -> Result<(), CliError> {
+    if let (None, Some(n)) = (&args.trace, &args.scenario) {
+        return Err(usage(format!(
+            "--scenario {n} names the trace --trace DIR writes; give --trace DIR too (the judging needs no scenario: it replays the accesses the capture holds)"
+        )));
+    }
     let started = std::time::Instant::now();
     let (mut source, map) = args.capture.open()?;
     let info = source.info().clone();

@@ -6,7 +6,7 @@ mod args;
 
 pub use args::RunArgs;
 
-use crate::lines::{board_lines, summary_lines, verdict_line};
+use crate::lines::{board_lines, not_passed_lines, summary_lines, verdict_line};
 use crate::{usage, CliError};
 use ppmc::compare::Tolerances;
 use ppmc::runner::{Farm, Spread};
@@ -100,6 +100,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
             ppmc::sink::MAX_LISTED
         );
     }
+    not_passed_lines(record);
     summary_lines(&record.summary, record.summary.runs());
     if several {
         board_lines(&record.run, &ended.board_tallies);

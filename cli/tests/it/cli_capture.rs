@@ -182,6 +182,10 @@ fn host_findings_and_capture_problems_are_their_own_kinds() {
 /// into sigrok sessions (`.sr`) at 100 MHz and 24 MHz is judged as
 /// passing, every pulse compared; at 4 MHz the 100 ns strobes last a
 /// single sample, and the capture (exit 4), not the board, is blamed.
+#[cfg_attr(
+    ppmc_missing_sigrok_cli,
+    ignore = "sigrok-cli is not installed (apt install sigrok-cli)"
+)]
 #[test]
 fn sigrok_sessions_at_three_sample_rates_are_judged() {
     if !common::sigrok_cli("judging .sr captures") {
@@ -241,6 +245,10 @@ fn sigrok_sessions_at_three_sample_rates_are_judged() {
 /// debug build): sigrok-cli converts a scenario's capture cut to 0.01 GB
 /// and to a tenth of it, and each row is judged, passes and has its
 /// figures.
+#[cfg_attr(
+    ppmc_missing_sigrok_cli,
+    ignore = "sigrok-cli is not installed (apt install sigrok-cli)"
+)]
 #[test]
 fn the_judge_figures_script_measures_both_lengths() {
     if !common::sigrok_cli("the judge's figures") {

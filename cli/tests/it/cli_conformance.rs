@@ -516,3 +516,69 @@ fn a_golden_file_that_is_a_fifo_or_a_device_is_an_error_not_a_hang() {
         "{stdout}"
     );
 }
+
+/// Issue 42's rough edges of the command line, as a newcomer met them:
+/// each message says what is wrong and what to write instead.
+#[test]
+fn a_newcomers_slips_are_answered_with_what_to_write() {
+    let said = |args: &[&str], code: i32| {
+        let out = ppmc(args);
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {stderr}");
+        stderr
+    };
+    // Two letters swapped: clap's own measure finds nothing near.
+    let e = said(&["rnu"], 2);
+    assert!(e.contains("a similar subcommand exists: 'run'"), "{e}");
+    // An option misspelt is not an unknown target.
+    let e = said(&["run", "--target", "emu,foo=bar"], 2);
+    assert!(e.contains("unknown option `foo=bar`"), "{e}");
+    // A bare device path is shown its form.
+    let e = said(&["run", "--target", "/dev/ttyACM0"], 2);
+    assert!(e.contains("`serial:/dev/ttyACM0`"), "{e}");
+    // --scenario of judge names a trace; the judging needs none.
+    let e = said(&["judge", "x.vcd", "--scenario", "s"], 2);
+    assert!(e.contains("give --trace DIR too"), "{e}");
+    // A duration in minutes, as the help writes it, is read.
+    let e = said(&["fuzz", "run", "--duration", "3m", "--ops", "1"], 0);
+    assert!(!e.contains("--duration"), "{e}");
+    // The main help says what `report --store` draws.
+    let help = text(&ppmc(&["--help"]).stdout);
+    let report = help
+        .lines()
+        .find(|l| l.trim_start().starts_with("report"))
+        .expect("report in the help");
+    assert!(report.contains("--store"), "{report}");
+}
+
+/// `--skip NAME` leaves one scenario out by its whole name (issue 42); a
+/// name that is no scenario's is the user's typo.
+#[test]
+fn skip_leaves_out_a_scenario_by_name() {
+    let all = ppmc(&["run", "--filter", "s3_3_5"]);
+    let skipped = ppmc(&[
+        "run",
+        "--filter",
+        "s3_3_5",
+        "--skip",
+        "s3_3_5_constant_speed_100_steps",
+    ]);
+    let (all, skipped) = (text(&all.stdout), text(&skipped.stdout));
+    assert!(all.contains("s3_3_5_constant_speed_100_steps"), "{all}");
+    assert!(
+        !skipped.contains("s3_3_5_constant_speed_100_steps"),
+        "{skipped}"
+    );
+    assert_eq!(
+        skipped.lines().count() + 1,
+        all.lines().count(),
+        "{all}\n{skipped}"
+    );
+    let out = ppmc(&["run", "--skip", "s3_3_5_constant"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("--skip s3_3_5_constant: no scenario of that name"),
+        "{}",
+        text(&out.stderr)
+    );
+}

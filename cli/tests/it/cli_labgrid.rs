@@ -55,6 +55,10 @@ fn read(dir: &Path, file: &str) -> String {
     std::fs::read_to_string(dir.join(file)).unwrap_or_default()
 }
 
+#[cfg_attr(
+    ppmc_missing_labgrid,
+    ignore = "labgrid is not installed (pip install labgrid, or PPMC_LABGRID_BIN)"
+)]
 #[test]
 fn the_suite_passes_on_a_labgrid_place_and_an_unacquired_place_is_refused() {
     let Some(bin) = labgrid_bin() else {

@@ -151,6 +151,10 @@ fn suite_through(accepter: &str, scheme: &str) {
     assert_eq!(stdout, text(&ppmc(&["run"]).stdout));
 }
 
+#[cfg_attr(
+    ppmc_missing_ser2net,
+    ignore = "ser2net is not installed (apt install ser2net)"
+)]
 #[test]
 fn the_suite_passes_through_ser2net_with_its_defaults() {
     if have_ser2net() {
@@ -160,6 +164,10 @@ fn the_suite_passes_through_ser2net_with_its_defaults() {
 
 /// RFC 2217 is telnet: bridge frames are full of 0xFF, which must be
 /// escaped both ways, and the server negotiates options first.
+#[cfg_attr(
+    ppmc_missing_ser2net,
+    ignore = "ser2net is not installed (apt install ser2net)"
+)]
 #[test]
 fn the_suite_passes_through_ser2net_in_rfc2217_mode() {
     if have_ser2net() {
@@ -171,6 +179,10 @@ fn the_suite_passes_through_ser2net_in_rfc2217_mode() {
 /// as a lab switches between its tools: every suite passes. (A host that
 /// took the session of the HELLO it had not yet heard for a restart once
 /// failed most of these switches.)
+#[cfg_attr(
+    ppmc_missing_ser2net,
+    ignore = "ser2net is not installed (apt install ser2net)"
+)]
 #[test]
 fn alternating_raw_and_rfc2217_through_one_ser2net_passes_every_time() {
     if !have_ser2net() {
@@ -198,6 +210,34 @@ fn alternating_raw_and_rfc2217_through_one_ser2net_passes_every_time() {
     }
 }
 
+/// Issue 42: `tcp://` aimed at an RFC 2217 port failed with "corrupt
+/// frames" and no word of telnet.
+#[cfg_attr(
+    ppmc_missing_ser2net,
+    ignore = "ser2net is not installed (apt install ser2net)"
+)]
+#[test]
+fn a_raw_link_to_an_rfc2217_port_is_told_to_try_rfc2217() {
+    if !have_ser2net() {
+        return;
+    }
+    let served = Served::start("telnet(rfc2217),tcp");
+    let out = ppmc(&[
+        "run",
+        "--filter",
+        "s3_3_5_constant_speed_100_steps",
+        "--target",
+        &served.target("tcp"),
+    ]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("infrastructure error"), "{stderr}");
+    assert!(
+        stderr.contains("try rfc2217:// in place of tcp://"),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn a_server_that_is_not_there_is_an_infrastructure_error() {
     let port = free_port();
@@ -216,6 +256,10 @@ fn a_server_that_is_not_there_is_an_infrastructure_error() {
 
 /// The server goes away mid-run: the scenarios left are not run, blamed on
 /// the infrastructure, never on the board, and the reports are written.
+#[cfg_attr(
+    ppmc_missing_ser2net,
+    ignore = "ser2net is not installed (apt install ser2net)"
+)]
 #[test]
 fn a_connection_cut_mid_run_ends_it_as_an_infrastructure_error() {
     if !have_ser2net() {
@@ -278,6 +322,10 @@ fn a_connection_cut_mid_run_ends_it_as_an_infrastructure_error() {
 /// `scripts/network-figures`, which makes the figures of
 /// `docs/performance.md`, runs every row once (the debug build): each row
 /// is a whole suite that passes, through ser2net and on several boards.
+#[cfg_attr(
+    ppmc_missing_ser2net,
+    ignore = "ser2net is not installed (apt install ser2net)"
+)]
 #[test]
 fn the_figures_script_runs_every_row() {
     if !have_ser2net() {

@@ -117,7 +117,7 @@ fn two_recorders_into_one_folder_create_each_file_once_and_never_replace_one() {
 }
 
 /// `export` never writes over the trace it reads, however the path is
-/// spelled, and an input named `*.vcd` has no default output.
+/// spelled, and without -o it writes into `out/`.
 #[test]
 fn export_refuses_to_write_over_its_input() {
     let dir = scratch("export-self");
@@ -142,23 +142,29 @@ fn export_refuses_to_write_over_its_input() {
     // Relative against absolute, run from the trace's folder.
     let out = ppmc_in(d, &["export", "t.snap", "-o", s(&trace)]);
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
-    // A trace named .vcd, with no -o: the default output is itself.
+    // Without -o (issue 42): into `out/` of the current folder, named by
+    // the trace's scenario; never beside the input, which may be a
+    // tracked golden file, and so never over a trace named `.vcd`.
     let named_vcd = d.join("w.vcd");
     fs::copy(&trace, &named_vcd).expect("copy");
-    let out = ppmc(&["export", s(&named_vcd)]);
+    for input in ["t.snap", "w.vcd"] {
+        let out = ppmc_in(d, &["export", input]);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        assert_eq!(
+            text(&out.stdout),
+            "wrote out/s3_3_5_constant_speed_100_steps.vcd\n"
+        );
+        fs::remove_file(d.join("out/s3_3_5_constant_speed_100_steps.vcd")).expect("written");
+    }
+    assert_eq!(fs::read(&named_vcd).expect("read"), before, "input kept");
+    assert!(!d.join("t.vcd").exists());
+    // `out` that is a file is named, not written through.
+    fs::remove_dir(d.join("out")).expect("an empty out/");
+    fs::write(d.join("out"), "a file").expect("write");
+    let out = ppmc_in(d, &["export", "t.snap"]);
     let err = text(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains(
-            "w.vcd: the default output (the trace's name with .vcd) is the input trace itself"
-        ),
-        "{err}"
-    );
-    assert_eq!(fs::read(&named_vcd).expect("read"), before, "input kept");
-    // Another output is written as before.
-    let out = ppmc_in(d, &["export", "t.snap"]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    assert!(d.join("t.vcd").is_file());
+    assert!(err.contains("out"), "{err}");
 }
 
 /// `--junit X --json X` would keep one report of two: refused before the

@@ -74,4 +74,6 @@ fn selftest_on_a_bridge_without_a_generator_or_on_the_emulator_says_why() {
     let stderr = text(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("no bus bridge to self-test"), "{stderr}");
+    // Issue 42: no heading of a self-test that never ran.
+    assert_eq!(text(&out.stdout), "", "{stderr}");
 }

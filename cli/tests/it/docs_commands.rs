@@ -40,7 +40,7 @@ const FILES: [&str; 14] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 35] = [
+const ELSEWHERE: [(&str, &str); 36] = [
     (
         "scripts/rebuild-figures",
         "in .ci/run (after the tests, on the built workspace)",
@@ -68,6 +68,10 @@ const ELSEWHERE: [(&str, &str); 35] = [
     (
         "timeout -s INT 5 ppmc run",
         "in cli/tests/it/cli_signals.rs (timeout -s INT during the long move on a real-time bridge, ten times)",
+    ),
+    (
+        "scripts/report-images",
+        "in .ci/run (the browser step; it needs node and Chromium)",
     ),
     (
         "scripts/fuzz-figures",
@@ -511,7 +515,7 @@ const EXIT_1: [&str; 4] = [
     "fuzz triage fuzz/artifacts/bus_bytes/",
     "judge out/faulty.vcd",
     // docs/reports.md: a board of the catalogue's faults, on purpose.
-    "chip-fault=decel-stop-slow,rev=B --html faulty.html",
+    "chip-fault=decel-stop-slow,rev=B --html out/faulty.html",
     "chip-fault=accel-first-pout-slow",
 ];
 
@@ -673,4 +677,98 @@ fn loaded_check_says_how_each_run_ended() {
     assert!(text(&bad.stdout).contains("| 1 | `false` | 1 |"));
     let usage = Command::new(&script).output().expect("runs");
     assert_eq!(usage.status.code(), Some(2));
+}
+
+/// The fenced blocks of `lang` in `file`, each as its lines.
+fn blocks(file: &str, lang: &str) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(root().join(file)).expect("the doc");
+    let mut out = Vec::new();
+    let mut inside: Option<Vec<String>> = None;
+    for line in text.lines() {
+        match inside.as_mut() {
+            None if line.trim() == format!("```{lang}") => inside = Some(Vec::new()),
+            Some(_) if line.trim() == "```" => out.extend(inside.take()),
+            Some(b) => b.push(line.to_string()),
+            None => {}
+        }
+    }
+    out
+}
+
+/// Issue 42: writing-scenarios.md showed no Cargo.toml for a crate of a
+/// team's own; the one it shows is the example crate's, its paths moved
+/// to a checkout beside it.
+#[test]
+fn the_external_crates_manifest_is_the_example_crates() {
+    let example = std::fs::read_to_string(root().join("examples/board-suite/Cargo.toml"))
+        .expect("the example's manifest");
+    let expected: Vec<String> = example
+        .lines()
+        .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
+        .map(|l| l.replace("\"../../", "\"../ppmc/"))
+        .collect();
+    let shown = blocks("docs/writing-scenarios.md", "toml");
+    let first: Vec<String> = shown
+        .first()
+        .expect("a toml block")
+        .iter()
+        .filter(|l| !l.trim().is_empty())
+        .cloned()
+        .collect();
+    assert_eq!(first, expected);
+    // The git form names the same three crates.
+    let git = shown.get(1).expect("the git form").join("\n");
+    for krate in ["ppmc =", "ppmc-cli =", "ppmc-scenarios ="] {
+        assert!(git.contains(krate) && git.contains("rev = "), "{git}");
+    }
+    assert!(!git.contains("example.invalid"), "{git}");
+}
+
+/// Issue 42: an install that ignores Cargo.lock locks every package
+/// afresh; every `cargo install --path` the docs show keeps the lock.
+#[test]
+fn every_install_from_a_path_is_locked() {
+    for file in FILES {
+        let text = std::fs::read_to_string(root().join(file)).expect("the doc");
+        for (n, line) in text.lines().enumerate() {
+            for part in line.split("cargo install").skip(1) {
+                let command = part.split('`').next().unwrap_or_default();
+                if command.contains("--path") {
+                    assert!(
+                        command.contains("--locked"),
+                        "{file}:{}: cargo install{command}: without --locked",
+                        n + 1
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Issue 42: docs/reports.md wrote `report.html` and `results.db` into
+/// the repository's root while the README used `out/`. Every file a
+/// report command there or in the README writes goes under `out/`.
+#[test]
+fn the_report_docs_write_into_out() {
+    for file in ["README.md", "docs/reports.md"] {
+        for block in blocks(file, "sh") {
+            for line in block {
+                let line = strip_comment(&line);
+                if !line.trim_start().starts_with("ppmc ") {
+                    continue;
+                }
+                let words: Vec<&str> = line.split_whitespace().collect();
+                for pair in words.windows(2) {
+                    if ["--html", "--json", "--junit", "--store", "-o"].contains(&pair[0]) {
+                        assert!(
+                            pair[1].starts_with("out/") || pair[1] == "-",
+                            "{file}: {line}: {} {} is not under out/",
+                            pair[0],
+                            pair[1]
+                        );
+                    }
+                }
+            }
+        }
+    }
 }

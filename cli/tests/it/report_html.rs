@@ -18,11 +18,18 @@ fn json(p: &Path) -> serde_json::Value {
     serde_json::from_str(&read(p)).expect("JSON")
 }
 
+/// Where the `<details>` element of `scenario` starts in `html` (the
+/// table of what did not pass names it too).
+fn details_at(html: &str, scenario: &str) -> usize {
+    html.match_indices(&format!("data-scenario=\"{scenario}\""))
+        .map(|(i, _)| html[..i].rfind('<').expect("in a tag"))
+        .find(|&tag| html[tag..].starts_with("<details"))
+        .unwrap_or_else(|| panic!("{scenario} not in the page"))
+}
+
 /// The `<details>` section of `scenario` in `html`.
 fn section<'a>(html: &'a str, scenario: &str) -> &'a str {
-    let at = html
-        .find(&format!("data-scenario=\"{scenario}\""))
-        .unwrap_or_else(|| panic!("{scenario} not in the page"));
+    let at = details_at(html, scenario);
     let end = html[at..].find("</details>").expect("closed") + at;
     &html[at..end]
 }
@@ -91,22 +98,32 @@ fn a_faulty_board_has_its_failure_marked_on_the_speed_profile() {
         .filter(|n| n.starts_with('s') || n.starts_with('e') || n.starts_with('f'))
         .collect();
     assert_eq!(names.len(), 96, "{listed}");
+    // Each in full once; the one that failed once more, in the table the
+    // page opens with (issue 42), before everything else.
     let in_page = attrs(&html, "data-scenario");
+    let failed = "s3_6_decel_stop_17us_not_after";
     for n in &names {
-        assert_eq!(in_page.iter().filter(|s| *s == n).count(), 1, "{n}");
+        let want = if *n == failed { 2 } else { 1 };
+        assert_eq!(in_page.iter().filter(|s| *s == n).count(), want, "{n}");
     }
+    let first = html
+        .find("<table class=\"first\">")
+        .expect("the page opens with what failed");
+    assert!(first < html.find("<table class=\"facts\">").expect("the facts"));
+    let row = &html[first..first + html[first..].find("</table>").expect("closed")];
+    assert!(
+        row.contains(&format!("data-scenario=\"{failed}\"")),
+        "{row}"
+    );
+    assert!(row.contains("<td class=\"by\">at least +"), "{row}");
     // The board's identity, as given.
     assert!(html.contains("<td>SN-0042</td>") && html.contains("<td>B</td>"));
     assert!(html.contains("chip_faults decel-stop-slow"));
 
     // The failure: marked on the first move's profiles, by pulse and by
     // time, at the pulse the failure's time falls on.
-    let failed = "s3_6_decel_stop_17us_not_after";
     let s = section(&html, failed);
-    let at = html
-        .find(&format!("data-scenario=\"{failed}\""))
-        .expect("there");
-    let tag = &html[html[..at].rfind("<details").expect("its element")..];
+    let tag = &html[details_at(&html, failed)..];
     let tag = &tag[..tag.find('>').expect("closed")];
     assert!(
         tag.contains("class=\"scenario failed\"") && tag.contains(" open"),
@@ -146,6 +163,17 @@ fn a_faulty_board_has_its_failure_marked_on_the_speed_profile() {
     let xs = attrs(s, "data-x");
     assert_eq!(xs[0], marked.to_string(), "the by-pulse mark");
     assert!(s.contains(&format!("failed here: pulse {marked}")));
+    // Issue 42: the text names the pulse the plot marks (it said one
+    // before: a 0-based index beside a 1-based count).
+    let got = sc["failure"]["got"].as_str().expect("got");
+    assert_eq!(got, format!("from pulse {marked}"), "{sc}");
+    // And it says by how much: the latency is at least the time to the
+    // pulse before, over the band's upper limit.
+    let by = &sc["failure"]["deviation"];
+    assert_eq!(by["unit"], "ns", "{sc}");
+    assert_eq!(by["bound"], "at_least", "{sc}");
+    assert_eq!(by["reference_is"], "limit", "{sc}");
+    assert!(by["measured"].as_i64() > by["reference"].as_i64(), "{sc}");
     // The golden profile beneath, with its band; the pins around it.
     assert!(s.contains("polyline class=\"golden\"") && s.contains("polygon class=\"band\""));
     assert!(s.contains("<svg class=\"waveform\""));
@@ -182,7 +210,7 @@ fn a_faulty_board_has_its_failure_marked_on_the_speed_profile() {
                 assert_eq!(n, intervals, "{}", sc["name"]);
             } else {
                 assert!(n <= 2 * columns && n >= columns / 2, "{}: {n}", sc["name"]);
-                assert!(p.contains("reduced: least and greatest per pixel column"));
+                assert!(p.contains("Reduced for drawing: the least and the greatest interval"));
                 reduced += 1;
             }
         }
@@ -431,5 +459,85 @@ fn a_board_behind_a_bridge_is_named_by_the_bridge_and_its_link_shown() {
     let html = read(&page);
     assert!(html.contains("<td>E6614C311B4E5A2F</td>") && html.contains("round trips"));
     let c = ppmc(&["history", "--store", db.to_str().expect("utf-8")]);
-    assert!(text(&c.stdout).contains("  B             100.0%  1 of 1 board tests passed, 1 boards"));
+    assert!(
+        text(&c.stdout).contains("  B             100.0%  1 of 1 board test passed, on 1 board")
+    );
+}
+
+/// The pulse a scenario's failure text names: the board's (after "got"),
+/// else the check's (`first divergence in pulse 42 interval`).
+fn text_pulse(section: &str) -> Option<u64> {
+    let p = section.split("<p class=\"failure\">").nth(1)?;
+    let p = &p[..p.find("</p>")?];
+    let number = |t: &str| -> Option<u64> {
+        let at = t.find("pulse ")? + "pulse ".len();
+        let digits: String = t[at..].chars().take_while(char::is_ascii_digit).collect();
+        digits.parse().ok()
+    };
+    p.split(", got ")
+        .nth(1)
+        .and_then(number)
+        .or_else(|| number(p))
+}
+
+/// Issue 42: on every failing scenario of every board fault of the
+/// catalogue (the fault matrix's boards), the plot's marker names the
+/// pulse the failure's text names: one numbering, from 1, over the
+/// scenario. (The README's own picture marked pulse 502 where the text
+/// said 501.)
+#[test]
+fn the_marker_names_the_texts_pulse_on_every_fault_of_the_catalogue() {
+    let dir = scratch("marker-pulses");
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("../golden");
+    let (mut compared, mut failing) = (0, 0);
+    for fault in ppmc::faults::CATALOGUE {
+        let page = dir.path().join(format!("{}.html", fault.name));
+        let out = ppmc(&[
+            "run",
+            "--golden",
+            golden.to_str().expect("utf-8"),
+            "--target",
+            &format!("emu,chip-fault={}", fault.name),
+            "--html",
+            page.to_str().expect("utf-8"),
+        ]);
+        assert!(
+            matches!(out.status.code(), Some(0 | 1)),
+            "{}: {}",
+            fault.name,
+            text(&out.stderr)
+        );
+        let html = read(&page);
+        for at in html
+            .match_indices("<details class=\"scenario failed\"")
+            .map(|(i, _)| i)
+        {
+            failing += 1;
+            let s = &html[at..at + html[at..].find("</details>").expect("closed")];
+            let said = text_pulse(s);
+            for drawn in s.split("<g class=\"divergence\"").skip(1) {
+                let label = &drawn[drawn.find("<text").expect("a label")..];
+                let label = &label
+                    [label.find('>').expect("a tag") + 1..label.find("</text>").expect("closed")];
+                let Some(m) = label.split("pulse ").nth(1) else {
+                    continue;
+                };
+                let marked: u64 = m.trim().parse().expect("a pulse number");
+                if let Some(said) = said {
+                    assert_eq!(
+                        marked, said,
+                        "{}: {label} where the text says pulse {said}:\n{s}",
+                        fault.name
+                    );
+                    compared += 1;
+                }
+            }
+        }
+    }
+    assert!(failing > 0, "no fault failed a scenario");
+    assert!(compared >= 2, "{compared} markers compared with their text");
+    eprintln!(
+        "{failing} failing scenarios over {} faults; {compared} markers named the text's pulse",
+        ppmc::faults::CATALOGUE.len()
+    );
 }

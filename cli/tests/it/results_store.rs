@@ -46,12 +46,29 @@ fn the_store_sets_a_faulty_revision_apart_from_a_good_one() {
     assert_eq!(out.status.code(), Some(0), "{said}");
     assert!(said.contains("4 runs, 4 boards"), "{said}");
     assert!(
-        said.contains("  A             100.0%  2 of 2 board tests passed, 2 boards"),
+        said.contains("  A             100.0%  2 of 2 board tests passed, on 2 boards"),
         "{said}"
     );
     assert!(
-        said.contains("  B               0.0%  0 of 2 board tests passed, 2 boards"),
+        said.contains("  B               0.0%  0 of 2 board tests passed, on 2 boards"),
         "{said}"
+    );
+    // Issue 42: the value out of its band comes first, flagged, with its
+    // band, every figure in one unit.
+    let first = said
+        .lines()
+        .skip_while(|l| !l.starts_with("measurements by scenario"))
+        .nth(1)
+        .expect("a measurement line");
+    assert!(
+        first.starts_with(
+            "  OUT  2/2  accel_first_pout in s3_3_4_longest_triangle_first_pout on B:"
+        ),
+        "{said}"
+    );
+    assert!(
+        first.contains(", band ") && first.contains("sd=") && !first.contains("ns"),
+        "{first}"
     );
 
     let page = dir.path().join("history.html");
@@ -176,11 +193,108 @@ fn boards_judged_from_captures_are_kept_with_whom_they_blame() {
     let out = ppmc(&["history", "--store", db_s]);
     let said = text(&out.stdout);
     assert!(
-        said.contains("  C               0.0%  0 of 1 board tests passed, 1 boards"),
+        said.contains("  C               0.0%  0 of 1 board test passed, on 1 board"),
         "{said}"
     );
     assert!(
-        said.contains("  D             100.0%  1 of 1 board tests passed, 1 boards"),
+        said.contains("  D             100.0%  1 of 1 board test passed, on 1 board"),
         "{said}"
     );
+}
+
+/// Issue 42: the store's page names every board, with its last verdict.
+/// A store of 1,000 runs over 40 boards of three revisions, each board
+/// passing or failing by turns (the last run of every fifth board fails):
+/// the page's table lists each board once, with the verdict of its last
+/// test and how many tests it had, the ones last failing first.
+#[test]
+fn the_store_page_lists_every_board_of_a_thousand_runs_with_its_last_verdict() {
+    use ppmc_record::RunRecord;
+    use ppmc_report::store::Store;
+    let dir = scratch("store-boards");
+    let json = dir.path().join("run.json");
+    let out = ppmc(&[
+        "run",
+        "--filter",
+        "s3_3_5_constant_speed_100_steps",
+        "--json",
+        json.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let template: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("written")).expect("JSON");
+    let db = dir.path().join("results.db");
+    let mut store = Store::open(&db).expect("a new store");
+    const BOARDS: usize = 40;
+    let fails_last = |b: usize| b % 5 == 0;
+    for run in 0..1_000usize {
+        let board = run % BOARDS;
+        let last = run + BOARDS >= 1_000;
+        // Every board passes and fails by turns; its last run fails only
+        // for every fifth board.
+        let failed = if last {
+            fails_last(board)
+        } else {
+            (run / BOARDS) % 2 == 1
+        };
+        let mut r = template.clone();
+        let rev = ["A", "B", "C"][board % 3];
+        r["run"]["boards"][0]["board_serial"] = format!("SN-{board:04}").into();
+        r["run"]["boards"][0]["board_rev"] = rev.into();
+        r["run"]["host"] = format!("station-{}", board % 4).into();
+        // A run a minute, in order.
+        r["run"]["started"] = format!("2026-11-01T{:02}:{:02}:00Z", run / 60, run % 60).into();
+        if failed {
+            let sc = &mut r["scenarios"][0];
+            sc["verdict"] = "failed".into();
+            sc["failure"] = serde_json::json!({
+                "expectation": "pulse count", "expected": "100", "got": "99", "at_ns": 1000
+            });
+            r["summary"]["passed"] = 0.into();
+            r["summary"]["failed"] = 1.into();
+        }
+        let record = RunRecord::parse(&r.to_string(), "run.json").expect("a record");
+        store.add(&record).expect("added");
+    }
+    drop(store);
+    let page = dir.path().join("history.html");
+    let out = ppmc(&[
+        "report",
+        "--store",
+        db.to_str().expect("utf-8"),
+        "-o",
+        page.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let html = std::fs::read_to_string(&page).expect("written");
+    let table = html
+        .split("<table class=\"boards\">")
+        .nth(1)
+        .and_then(|t| t.split("</table>").next())
+        .expect("the boards' table");
+    let rows: Vec<&str> = table.split("<tr class=\"").skip(1).collect();
+    assert_eq!(rows.len(), BOARDS, "{table}");
+    let failing = (0..BOARDS).filter(|b| fails_last(*b)).count();
+    for (i, row) in rows.iter().enumerate() {
+        // The ones last failing first.
+        let want = if i < failing { "failed" } else { "passed" };
+        assert!(row.starts_with(want), "row {i}: {row}");
+        assert!(row.contains("<td>25</td>"), "25 tests a board: {row}");
+    }
+    for board in 0..BOARDS {
+        let row = rows
+            .iter()
+            .find(|r| r.contains(&format!("data-board=\"SN-{board:04}\"")))
+            .unwrap_or_else(|| panic!("SN-{board:04} is not listed"));
+        let want = if fails_last(board) {
+            "failed"
+        } else {
+            "passed"
+        };
+        assert!(
+            row.contains(&format!("<span class=\"chip {want}\">")),
+            "{row}"
+        );
+        assert!(row.contains(&format!("station-{}", board % 4)), "{row}");
+    }
 }

@@ -162,6 +162,10 @@ fn check(dir: &Path, name: &str, host: &str, rates: &[u32]) -> Result<(bool, u32
     Ok((found, marginals))
 }
 
+#[cfg_attr(
+    ppmc_missing_sigrok_cli,
+    ignore = "sigrok-cli is not installed (apt install sigrok-cli)"
+)]
 #[test]
 fn every_scenarios_capture_passes_at_three_sample_rates() {
     if !common::sigrok_cli("converting captures to sigrok sessions") {

@@ -67,6 +67,10 @@ fn shown(vcd: &Path) -> String {
     text(&out.stdout) + &text(&out.stderr)
 }
 
+#[cfg_attr(
+    ppmc_missing_sigrok_cli,
+    ignore = "sigrok-cli is not installed (apt install sigrok-cli)"
+)]
 #[test]
 fn sigrok_counts_every_pulse_of_an_exported_trace() {
     if !sigrok() {
@@ -114,6 +118,10 @@ fn sigrok_counts_every_pulse_of_an_exported_trace() {
 /// run by sigrok-cli itself on a capture `ppmc export --scenario --bus`
 /// wrote, names every register access of the scenario (Table 3-1), in
 /// order and with its byte, as the scenario's trace records them.
+#[cfg_attr(
+    ppmc_missing_sigrok_cli,
+    ignore = "sigrok-cli is not installed (apt install sigrok-cli)"
+)]
 #[test]
 fn the_pulseview_decoder_names_every_register_access() {
     use ppmc::trace::{BusEvent, EventKind};

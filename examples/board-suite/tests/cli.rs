@@ -50,3 +50,29 @@ fn its_own_scenarios_run_with_a_junit_report() {
         assert!(xml.contains(&format!("name=\"{name}\"")), "{name} in {xml}");
     }
 }
+
+/// Issue 42: a missing golden trace named `ppmc record`, a command this
+/// crate's user does not have; the help named `ppmc` too.
+#[test]
+fn its_messages_name_its_own_binary() {
+    let dir = std::env::temp_dir().join(format!("board-suite-golden-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let out = board_suite(&[
+        "run",
+        "--filter",
+        "x_axis_homes_on_cnp",
+        "--golden",
+        dir.to_str().expect("utf-8 path"),
+    ]);
+    let _ = std::fs::remove_dir_all(&dir);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    assert!(
+        text.contains("record one with `board-suite record`"),
+        "{text}"
+    );
+    assert!(!text.contains("ppmc record"), "{text}");
+    let help = board_suite(&["--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(help.contains("Usage: board-suite"), "{help}");
+}

@@ -371,7 +371,7 @@ impl TargetSpec {
             )));
         }
         let Some(driver) = driver_for(a) else {
-            return Err(SpecError(format!("unknown target `{a}`: use {}", forms())));
+            return Err(SpecError(unknown(a)));
         };
         driver.check(a).map_err(|hint| {
             SpecError(format!("bad target `{a}`: write {}{hint}", driver.form()))
@@ -382,6 +382,30 @@ impl TargetSpec {
         })
     }
 }
+
+/// Why `address` (no link kind's) is not a target, and what to write.
+fn unknown(address: &str) -> String {
+    let (head, rest) = address.split_once(',').unwrap_or((address, ""));
+    if head == "emu" {
+        // The emulator's options are all the board's or its own: anything
+        // left is an option misspelt, not a target.
+        let option = rest.split(',').next().unwrap_or_default();
+        return format!(
+            "--target `{address}`: unknown option `{option}`: the board's options are {BOARD_OPTIONS}; the emulator's own, chip-fault= and drop-batch="
+        );
+    }
+    if head.starts_with('/') || head.to_ascii_uppercase().starts_with("COM") {
+        return format!(
+            "unknown target `{address}`: a serial port is written `serial:{address}`; the targets are {}",
+            forms()
+        );
+    }
+    format!("unknown target `{address}`: use {}", forms())
+}
+
+/// The options every target takes, as a usage error lists them.
+const BOARD_OPTIONS: &str =
+    "name=, rev=, board-serial=, pad=, clock-mhz=, ext-clock-khz=, csel= and vsel=";
 
 #[cfg(test)]
 mod tests {
@@ -401,6 +425,38 @@ mod tests {
                 "{a:?}"
             );
         }
+    }
+
+    /// Issue 42: a misspelt option of the emulator is named as an option,
+    /// not as an unknown target; a bare device path is shown its form.
+    #[test]
+    fn a_misspelt_option_and_a_bare_port_say_what_to_write() {
+        let refused = |t: &str| {
+            TargetSpec::parse(t)
+                .expect("splits")
+                .resolve()
+                .expect_err("refused")
+                .0
+        };
+        let e = refused("emu,foo=bar");
+        assert!(
+            e.starts_with(
+                "--target `emu,foo=bar`: unknown option `foo=bar`: the board's options are name=,"
+            ),
+            "{e}"
+        );
+        assert!(e.contains("chip-fault="), "{e}");
+        let e = refused("emu,rev=B,colck-mhz=4");
+        assert!(e.contains("unknown option `colck-mhz=4`"), "{e}");
+        let e = refused("/dev/ttyACM0");
+        assert!(
+            e.starts_with(
+                "unknown target `/dev/ttyACM0`: a serial port is written `serial:/dev/ttyACM0`"
+            ),
+            "{e}"
+        );
+        let e = refused("COM3,baud=115200");
+        assert!(e.contains("`serial:COM3,baud=115200`"), "{e}");
     }
 
     #[test]

@@ -39,6 +39,7 @@ pub fn regression(d: &mut Driver, ops: &[BusOp]) -> Outcome {
                 expected: "holds".into(),
                 got: format!("broken after op {}: {}", v.op, v.detail),
                 at: f.at,
+                deviation: None,
             }))
         }
     }

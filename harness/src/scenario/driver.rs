@@ -10,7 +10,7 @@
 use super::batch::{Batch, Limits};
 use super::builders::{Init, Move};
 use super::check::Check;
-use super::outcome::{fail, HarnessError, Outcome, Stop};
+use super::outcome::{fail, fail_outside, outside, HarnessError, Outcome, Stop};
 use super::steps::{Done, Role, Step};
 use crate::backend::{Op, Reply, Target, Uncertainty};
 use crate::protocol::{
@@ -19,7 +19,7 @@ use crate::protocol::{
 };
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, Event};
-use ppmc_record::{Grade, Measurement};
+use ppmc_record::{DeviationUnit, Grade, Measurement};
 
 // Defined beside the driver, and public here as they always were.
 pub use super::options::DriverOptions;
@@ -404,13 +404,22 @@ impl<'t> Driver<'t> {
             );
             let grade = m.grade;
             let (lo, hi, m_shown) = (m.lo, m.hi, m.shown());
+            let ns = |d: Duration| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX);
+            let deviation = outside(
+                ns(lo),
+                ns(hi),
+                ns(m.value),
+                DeviationUnit::Ns,
+                m.u.as_nanos(),
+            );
             self.measurements.push(m);
             if grade == Grade::Fail {
-                return Err(fail(
+                return Err(fail_outside(
                     format!("{name} (Equations 3-5..3-8)"),
-                    format!("{lo}..={hi}"),
+                    format!("{lo} to {hi}"),
                     m_shown,
                     at,
+                    deviation,
                 ));
             }
         }
@@ -654,11 +663,13 @@ impl<'t> Driver<'t> {
         let now = self.batch.clock();
         let s = self.capture()?.last_move_pulses();
         if s.count < lo || s.count > hi {
-            return Err(fail(
+            let n = |v: u64| i64::try_from(v).unwrap_or(i64::MAX);
+            return Err(fail_outside(
                 "pulse count",
-                format!("{lo}..={hi}"),
+                format!("{lo} to {hi}"),
                 s.count,
                 s.last.unwrap_or(now),
+                outside(n(lo), n(hi), n(s.count), DeviationUnit::Count, 0),
             ));
         }
         Ok(s.count)

@@ -5,7 +5,43 @@ use super::driver::Driver;
 use super::outcome::{fail, need, Failure, HarnessError, Outcome, Stop};
 use crate::protocol::{Flag, Pin, Register, TimingId};
 use crate::time::{Duration, Instant, Limit};
-use ppmc_record::Grade;
+use ppmc_record::{Bound, Deviation, DeviationUnit, Grade, Reference};
+
+/// By how much a deceleration that started from pulse index `j1` (of
+/// `times`, after the trigger at `t`) missed its latency band `lo` to
+/// `hi`: one run brackets the latency between the pulse before `j1` and
+/// `j1`, so a late start's latency is at least the time to the pulse
+/// before, an early one's at most the time to `j1` (each as sure as an
+/// edge, `edge`).
+fn bracketed(
+    times: &[Instant],
+    t: Instant,
+    j1: u64,
+    j_hi: u64,
+    lo: Duration,
+    hi: Duration,
+    edge: Duration,
+) -> Deviation {
+    let ns = |d: Duration| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX);
+    let after = |j: u64| {
+        times
+            .get(j as usize)
+            .map_or(Duration::ZERO, |p| p.saturating_since(t))
+    };
+    let (measured, reference, bound) = if j1 > j_hi {
+        (after(j1 - 1), hi, Bound::AtLeast)
+    } else {
+        (after(j1), lo, Bound::AtMost)
+    };
+    Deviation {
+        unit: DeviationUnit::Ns,
+        measured: ns(measured),
+        reference: ns(reference),
+        reference_is: Reference::Limit,
+        u: edge.as_nanos(),
+        bound: Some(bound),
+    }
+}
 
 impl Driver<'_> {
     /// Grades a measurement whose two ends are as sure as `u`, together.
@@ -19,13 +55,25 @@ impl Driver<'_> {
         let m = self.opts.grading.grade(id, &self.straps, value, u, at);
         let grade = m.grade;
         let (lo, hi, got) = (m.lo, m.hi, m.shown());
+        // The limit it fell outside: the upper one if above it.
+        let limit = if m.value > hi { hi } else { lo };
+        let ns = |d: Duration| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX);
+        let deviation = Deviation {
+            unit: DeviationUnit::Ns,
+            measured: ns(m.value),
+            reference: ns(limit),
+            reference_is: Reference::Limit,
+            u: m.u.as_nanos(),
+            bound: None,
+        };
         self.measurements.push(m);
         if grade == Grade::Fail {
             return Err(Stop::Failed(Failure {
                 expectation: format!("{} (Table 3-3)", id.name()),
-                expected: format!("{lo}..={}", Limit(hi)),
+                expected: format!("{lo} to {}", Limit(hi)),
                 got,
                 at,
+                deviation: Some(deviation),
             }));
         }
         Ok(grade)
@@ -225,6 +273,7 @@ impl Driver<'_> {
         })?;
         let rec = self.capture()?;
         let from = rec.moves.last().map_or(0, |m| m.first_run);
+        let before: u64 = rec.runs[..from].iter().map(|r| u64::from(r.count)).sum();
         let times: Vec<Instant> = rec.runs[from..]
             .iter()
             .flat_map(|r| (0..r.count).map(move |i| r.at(i)))
@@ -251,14 +300,23 @@ impl Driver<'_> {
             .copied()
             .unwrap_or(self.batch.clock());
         if j1 < j_lo || j1 > j_hi {
+            // Pulses numbered from 1 over the whole scenario, as every
+            // report numbers them (a golden comparison, the plots): the
+            // move's pulse at index j is the scenario's pulse before + j + 1.
+            let (first, last, got) = (before + j_lo + 1, before + j_hi + 1, before + j1 + 1);
+            let expected = match first == last {
+                true => format!("from pulse {first}"),
+                false => format!("from pulse {first} to {last}"),
+            };
             return Err(Stop::Failed(Failure {
                 expectation: format!(
                     "{} (Table 3-3): deceleration starts at the first pulse after the latency",
                     id.name()
                 ),
-                expected: format!("from pulse {j_lo}..={j_hi} (latency {lo}..={})", Limit(hi)),
-                got: format!("from pulse {j1}"),
+                expected: format!("{expected} (latency {lo} to {})", Limit(hi)),
+                got: format!("from pulse {got}"),
                 at: start_time,
+                deviation: Some(bracketed(&times, t, j1, j_hi, lo, hi, self.u.edge)),
             }));
         }
         // The latency itself lies between the pulse before j1 and j1; what is

@@ -21,7 +21,7 @@ mod verdict;
 pub use builders::{Init, Move};
 pub use driver::Driver;
 pub use options::DriverOptions;
-pub use outcome::{Failure, HarnessError, Outcome, Stop};
+pub use outcome::{deviation_of, Failure, HarnessError, Outcome, Stop};
 /// Declares a scenario where it is written; see the `ppmc-macros` crate.
 pub use ppmc_macros::scenario;
 pub use ppmc_record::{Grade, Grading, Measurement};

@@ -4,6 +4,7 @@
 
 use crate::backend::{TargetError, TargetErrorKind};
 use crate::time::{Duration, Instant};
+use ppmc_record::{Deviation, DeviationUnit, Reference};
 use std::fmt;
 
 /// What a scenario body returns.
@@ -66,6 +67,8 @@ pub struct Failure {
     pub got: String,
     /// When it happened, on the target's clock.
     pub at: Instant,
+    /// By how much, where the check has a magnitude.
+    pub deviation: Option<Deviation>,
 }
 
 impl fmt::Display for Failure {
@@ -119,11 +122,69 @@ pub(super) fn fail(
     got: impl ToString,
     at: Instant,
 ) -> Stop {
+    let (expected, got) = (expected.to_string(), got.to_string());
+    Stop::Failed(Failure {
+        expectation: expectation.into(),
+        deviation: deviation_of(&expected, &got, Reference::Expected),
+        expected,
+        got,
+        at,
+    })
+}
+
+/// A value `got` outside the band `lo` to `hi`, all of `unit`, with its
+/// uncertainty `u`: its deviation from the limit it fell outside.
+pub(super) fn outside(lo: i64, hi: i64, got: i64, unit: DeviationUnit, u: u64) -> Deviation {
+    Deviation {
+        unit,
+        measured: got,
+        reference: if got > hi { hi } else { lo },
+        reference_is: Reference::Limit,
+        u,
+        bound: None,
+    }
+}
+
+/// [`fail`] of a value outside a band, with its [`outside`] deviation.
+pub(super) fn fail_outside(
+    expectation: impl Into<String>,
+    expected: impl ToString,
+    got: impl ToString,
+    at: Instant,
+    deviation: Deviation,
+) -> Stop {
     Stop::Failed(Failure {
         expectation: expectation.into(),
         expected: expected.to_string(),
         got: got.to_string(),
         at,
+        deviation: Some(deviation),
+    })
+}
+
+/// The deviation of `got` from `expected` where both are one number of
+/// the same kind as [`Shown`] writes it: two counts (`100`, `99`) or two
+/// times (`120.000us`); `None` for anything else (a register byte, a
+/// flag, a range), which has no magnitude to subtract.
+pub fn deviation_of(expected: &str, got: &str, reference_is: Reference) -> Option<Deviation> {
+    let count = |s: &str| s.trim().parse::<i64>().ok();
+    let time = |s: &str| {
+        s.trim()
+            .parse::<Duration>()
+            .ok()
+            .and_then(|d| i64::try_from(d.as_nanos()).ok())
+    };
+    let (unit, measured, reference) = match (count(got), count(expected)) {
+        (Some(g), Some(e)) => (DeviationUnit::Count, g, e),
+        _ => (DeviationUnit::Ns, time(got)?, time(expected)?),
+    };
+    Some(Deviation {
+        unit,
+        measured,
+        reference,
+        reference_is,
+        u: 0,
+        bound: None,
     })
 }
 

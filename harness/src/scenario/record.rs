@@ -31,6 +31,7 @@ impl Failure {
             expected: self.expected.clone(),
             got: self.got.clone(),
             at_ns: self.at.as_nanos(),
+            deviation: self.deviation.clone(),
         }
     }
 }
@@ -168,6 +169,7 @@ mod tests {
             expected: "1".into(),
             got: "2".into(),
             at: crate::time::Instant::ZERO,
+            deviation: None,
         });
         assert_eq!(r.status(), Status::Failed);
         assert_eq!(Tally::of([r.status()]).failed, 1);

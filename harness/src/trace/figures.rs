@@ -96,7 +96,10 @@ fn pulses_within(base: u64, runs: &[[u64; 3]], from: u64, to: u64, cap: usize) -
 /// The bus access of `e` in a waveform's words.
 fn bus_label(e: &BusEvent) -> Option<String> {
     Some(match e {
-        BusEvent::WriteCommand { byte, .. } => format!("wc 0x{byte:02X}"),
+        // A command by its name: what the host asked for, at a glance.
+        BusEvent::WriteCommand { byte, .. } => {
+            format!("{} 0x{byte:02X}", crate::protocol::Command::decode(*byte))
+        }
         BusEvent::WriteData { byte, .. } => format!("wd 0x{byte:02X}"),
         BusEvent::ReadStatus(value) => format!("rs 0x{value:02X}"),
         BusEvent::ReadData { byte, .. } => format!("rd 0x{byte:02X}"),

@@ -14,7 +14,9 @@
 
 mod stats;
 
-pub use stats::{mean_sd, Distribution, History, RevisionYield, ScenarioRate, TrendPoint};
+pub use stats::{
+    mean_sd, BoardRecord, Distribution, History, RevisionYield, ScenarioRate, TrendPoint,
+};
 
 use ppmc_record::RunRecord;
 use rusqlite::{params, Connection, OpenFlags, Transaction, TransactionBehavior};

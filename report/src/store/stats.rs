@@ -118,6 +118,14 @@ impl Distribution {
         })
     }
 
+    /// How many values fell outside their own band.
+    pub fn out_of_band(&self) -> usize {
+        self.positions
+            .iter()
+            .filter(|&&p| p < 0.0 || (self.two_sided && p > 1.0))
+            .count()
+    }
+
     /// The standard deviation of the values, ns.
     pub fn sd_ns(&self) -> f64 {
         let xs: Vec<f64> = self.values.iter().map(|&v| v as f64).collect();
@@ -132,6 +140,8 @@ pub struct TrendPoint {
     pub started: String,
     pub rev: String,
     pub board: String,
+    /// The station (host) the run was made on.
+    pub station: String,
     pub results: u64,
     pub passed: u64,
 }
@@ -150,6 +160,60 @@ pub struct History {
     pub measurements: Vec<Distribution>,
     /// Oldest first.
     pub trend: Vec<TrendPoint>,
+}
+
+impl TrendPoint {
+    /// Whether this board test passed: it had results, and every one
+    /// passed.
+    pub fn passed(&self) -> bool {
+        self.results > 0 && self.passed == self.results
+    }
+}
+
+/// One board across the store: where and when it was last tested, and
+/// how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoardRecord {
+    /// Its serial, else its name.
+    pub board: String,
+    /// The revision and the station of its last test.
+    pub rev: String,
+    pub station: String,
+    /// Its board tests, oldest first: indices into [`History::trend`].
+    pub tests: Vec<usize>,
+    pub last_passed: bool,
+    pub last_seen: String,
+}
+
+impl History {
+    /// Every board the store has seen, the one last seen failing first,
+    /// then by serial.
+    pub fn boards(&self) -> Vec<BoardRecord> {
+        let mut by: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
+        for (i, t) in self.trend.iter().enumerate() {
+            by.entry(t.board.as_str()).or_default().push(i);
+        }
+        let mut out: Vec<BoardRecord> = by
+            .into_iter()
+            .filter_map(|(board, tests)| {
+                let last = &self.trend[*tests.last()?];
+                Some(BoardRecord {
+                    board: board.to_string(),
+                    rev: last.rev.clone(),
+                    station: last.station.clone(),
+                    last_passed: last.passed(),
+                    last_seen: last.started.clone(),
+                    tests,
+                })
+            })
+            .collect();
+        out.sort_by(|a, b| {
+            a.last_passed
+                .cmp(&b.last_passed)
+                .then(a.board.cmp(&b.board))
+        });
+        out
+    }
 }
 
 fn ratio(a: u64, b: u64) -> f64 {
@@ -221,7 +285,7 @@ impl Store {
         let mut st = c
             .prepare(&format!(
                 "SELECT run_id, coalesce((SELECT started FROM runs WHERE id = run_id), ''), rev, board,
-                     results, passed
+                     results, passed, coalesce((SELECT host FROM runs WHERE id = run_id), '')
                  FROM ({tests}) ORDER BY 2, run_id, id"
             ))
             .map_err(q)?;
@@ -234,6 +298,7 @@ impl Store {
                     board: r.get(3)?,
                     results: r.get(4)?,
                     passed: r.get(5)?,
+                    station: r.get(6)?,
                 })
             })
             .map_err(q)?

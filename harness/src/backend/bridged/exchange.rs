@@ -101,6 +101,18 @@ pub(super) struct Noise {
     bad_frames: u64,
 }
 
+/// Whether `bytes` hold a telnet negotiation (IAC then WILL, WONT, DO or
+/// DONT): the server speaks telnet, as an RFC 2217 port does (ser2net
+/// opens with `IAC WILL SUPPRESS-GO-AHEAD`).
+pub(super) fn telnet_negotiation(bytes: &[u8]) -> bool {
+    bytes
+        .windows(2)
+        .any(|w| w[0] == 0xFF && (0xFB..=0xFE).contains(&w[1]))
+}
+
+/// What a "no answer" adds when the link spoke telnet.
+const TELNET_HINT: &str = "; among them a telnet negotiation: the server speaks telnet, as an RFC 2217 port does (try rfc2217:// in place of tcp://)";
+
 impl std::fmt::Display for Noise {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         if self.bytes == 0 {
@@ -456,7 +468,10 @@ impl<L: Link> BridgeTarget<L> {
             what: what.into(),
             tries,
             secs: start.elapsed().as_secs_f64(),
-            heard,
+            heard: match self.telnet && self.link.name().starts_with("tcp://") {
+                true => heard + TELNET_HINT,
+                false => heard,
+            },
         }
     }
 
@@ -677,6 +692,9 @@ impl<L: Link> BridgeTarget<L> {
             if n > 0 {
                 self.heard = true;
                 noise.bytes += n as u64;
+                // Only a raw link can bring telnet: an RFC 2217 link reads
+                // it away itself.
+                self.telnet |= telnet_negotiation(&buf[..n]);
                 deadline = deadline.max((WallInstant::now() + gap).min(latest));
             }
             if n > 0 && quiet_by.is_some() {
@@ -733,5 +751,20 @@ impl<L: Link> BridgeTarget<L> {
         })();
         self.recovering = false;
         r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::telnet_negotiation;
+
+    /// Issue 42: `tcp://` aimed at an RFC 2217 port said only "204 corrupt
+    /// frames"; a telnet negotiation among the bytes is noticed (and the
+    /// "no answer" then says what to try: cli_network.rs).
+    #[test]
+    fn a_telnet_negotiation_is_told_from_frame_bytes() {
+        assert!(!telnet_negotiation(&[0x00, 0x12, 0xFF, 0x34]));
+        // As ser2net opens: IAC WILL SUPPRESS-GO-AHEAD, IAC DO ...
+        assert!(telnet_negotiation(&[0xFF, 0xFB, 0x03, 0xFF, 0xFD, 0x03]));
     }
 }

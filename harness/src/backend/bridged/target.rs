@@ -49,6 +49,9 @@ pub struct BridgeTarget<L: Link> {
     pub(super) rtt: RoundTrip,
     /// Whether the last [`Self::await_reply`] received any byte at all.
     pub(super) heard: bool,
+    /// A telnet negotiation came over this link (an RFC 2217 port reached
+    /// as raw TCP): said with every "no answer".
+    pub(super) telnet: bool,
     /// Data bytes per reply fragment in force on the bridge (LINK), and
     /// the size wanted: halved after a request whose reply needed asking
     /// again, doubled back after [`CLEAN_TO_GROW`] clean ones.
@@ -129,6 +132,7 @@ impl<L: Link> BridgeTarget<L> {
             clock: Instant::ZERO,
             rtt: RoundTrip::default(),
             heard: false,
+            telnet: false,
             fragment: FRAGMENT_DATA as u8,
             want_fragment: FRAGMENT_DATA as u8,
             pad: 0,

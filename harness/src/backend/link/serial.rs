@@ -96,8 +96,18 @@ fn open_error(path: &str, e: io::Error) -> io::Error {
         e.kind(),
         io::ErrorKind::PermissionDenied | io::ErrorKind::ResourceBusy
     ) || e.raw_os_error() == Some(16);
+    // ENOTTY: a file or device without a terminal's settings (serialport
+    // words it as nix does, "Not a typewriter", and drops the number).
+    let not_a_tty = e.raw_os_error() == Some(25)
+        || ["typewriter", "Inappropriate ioctl"]
+            .iter()
+            .any(|w| e.to_string().contains(w));
     let message = if e.kind() == io::ErrorKind::NotFound {
         format!("{path}: no such serial port (is the bridge plugged in?)")
+    } else if not_a_tty {
+        format!(
+            "{path}: not a serial port (no terminal settings: {e}); give the bridge's port, such as /dev/ttyACM0, or the pty ppmc bridge-sim prints"
+        )
     } else if busy {
         format!("{path}: port busy or not accessible ({e}); is another program using it?")
     } else {
@@ -188,6 +198,21 @@ mod tests {
         }
         let missing = open_error("/dev/ttyACM9", io::ErrorKind::NotFound.into());
         assert!(missing.to_string().contains("no such serial port"));
+    }
+
+    /// Issue 42: `serial:/dev/null` said only "Not a typewriter".
+    #[cfg(unix)]
+    #[test]
+    fn a_file_that_is_no_terminal_is_said_not_a_serial_port() {
+        let e = match SerialLink::open("/dev/null", 115_200) {
+            Err(e) => e.to_string(),
+            Ok(_) => panic!("/dev/null opened as a serial port"),
+        };
+        assert!(
+            e.starts_with("/dev/null: not a serial port (no terminal settings:"),
+            "{e}"
+        );
+        assert!(e.contains("/dev/ttyACM0"), "{e}");
     }
 
     #[test]
