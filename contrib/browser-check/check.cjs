@@ -126,6 +126,7 @@ async function main() {
       if (m.said !== m.drawn) problems.push(`${m.scenario}: the text says pulse ${m.said}, the plot marks pulse ${m.drawn}`);
     }
     const overlaps = await page.evaluate(() => {
+      const was = [...document.querySelectorAll('details')].map((d) => [d, d.open]);
       for (const d of document.querySelectorAll('details')) d.open = true;
       const bad = [];
       for (const svg of document.querySelectorAll('svg')) {
@@ -148,8 +149,7 @@ async function main() {
         }
         if (bad.length > 20) break;
       }
-      for (const d of document.querySelectorAll('details.scenario')) d.open = d.hasAttribute('data-open');
-      for (const d of document.querySelectorAll('details.all-scenarios')) d.open = !document.querySelector('table.first');
+      for (const [d, open] of was) d.open = open;
       window.scrollTo(0, 0);
       return [...new Set(bad)];
     });

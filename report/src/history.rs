@@ -56,7 +56,7 @@ fn yields(s: &mut String, h: &History) {
         let bar = r.rate() * 360.0;
         let _ = write!(
             s,
-            r#"<g class="rev" data-rev="{0}" data-yield="{1:.4}"><text x="4" y="{2:.1}">{0}</text><rect class="zone out" x="120" y="{3:.1}" width="360" height="16"/><rect class="zone in" x="120" y="{3:.1}" width="{4:.1}" height="16"/><text x="490" y="{2:.1}">{5:.1}% of {6} tests, {7} boards{8}</text></g>"#,
+            r#"<g class="rev" data-rev="{0}" data-yield="{1:.4}"><text x="4" y="{2:.1}">{0}</text><rect class="zone out" x="120" y="{3:.1}" width="360" height="16"/><rect class="zone in" x="120" y="{3:.1}" width="{4:.1}" height="16"/><text x="490" y="{2:.1}">{5:.1}% of {6} board {9}, {7} {10}{8}</text></g>"#,
             esc(&r.rev),
             r.rate(),
             y + 13.0,
@@ -69,7 +69,9 @@ fn yields(s: &mut String, h: &History) {
                 format!(", {} flaky", r.flaky)
             } else {
                 String::new()
-            }
+            },
+            if r.tests == 1 { "test" } else { "tests" },
+            if r.boards == 1 { "board" } else { "boards" },
         );
     }
     s.push_str("</svg></section>\n");

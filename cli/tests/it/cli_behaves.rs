@@ -9,14 +9,21 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 /// `ppmc ARGS | head -0`: standard output closed before anything is read.
+/// The pipe's reading end is closed before ppmc starts: closed after, a
+/// run fast enough to write all its lines into the pipe's buffer first
+/// would never see it closed.
 fn with_closed_stdout(args: &[&str]) -> (std::process::ExitStatus, String) {
+    // A connected pair of sockets stands for the pipe (std's own pipe is
+    // newer than this crate's Rust): writing to one whose peer is closed
+    // fails as a closed pipe does (EPIPE).
+    let (reader, writer) = std::os::unix::net::UnixStream::pair().expect("a socket pair");
+    drop(reader);
     let mut child = Command::new(env!("CARGO_BIN_EXE_ppmc"))
         .args(args)
-        .stdout(Stdio::piped())
+        .stdout(std::os::fd::OwnedFd::from(writer))
         .stderr(Stdio::piped())
         .spawn()
         .expect("ppmc starts");
-    drop(child.stdout.take());
     let mut err = String::new();
     let mut stderr = child.stderr.take().expect("stderr");
     let status = wait_bounded(&mut child, Duration::from_secs(120));

@@ -494,3 +494,65 @@ fn no_module_of_the_harness_imports_one_above_it() {
     assert!(seen.len() >= 15, "the modules read: {seen:?}");
     assert!(up.is_empty(), "imports that run back up: {up:#?}");
 }
+
+/// Issue 42: a test whose outside tool is missing said `ok` (it returned
+/// early, with a line on stderr nobody reads). Every test of this crate
+/// that starts by asking for ser2net, sigrok-cli or labgrid is compiled
+/// ignored when `cli/build.rs` finds the tool missing, so that `cargo
+/// test` counts it as ignored, with the reason.
+#[test]
+fn a_test_that_needs_an_outside_tool_is_ignored_without_it() {
+    let gates = [
+        ("have_ser2net()", "ppmc_missing_ser2net"),
+        ("sigrok_cli(", "ppmc_missing_sigrok_cli"),
+        ("sigrok()", "ppmc_missing_sigrok_cli"),
+        ("labgrid_bin()", "ppmc_missing_labgrid"),
+    ];
+    let dir = root().join("cli/tests/it");
+    let mut bad = Vec::new();
+    let mut gated = 0;
+    for entry in std::fs::read_dir(&dir).expect("cli/tests/it") {
+        let path = entry.expect("an entry").path();
+        if path.extension().is_none_or(|e| e != "rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).expect("a test file");
+        let lines: Vec<&str> = text.lines().collect();
+        for (n, line) in lines.iter().enumerate() {
+            if line.trim() != "#[test]" {
+                continue;
+            }
+            let Some(f) = (n + 1..lines.len()).find(|&k| lines[k].trim_start().starts_with("fn "))
+            else {
+                continue;
+            };
+            // The body's first statement (or the condition it starts with).
+            let first = lines.get(f + 1).map_or("", |l| l.trim());
+            let Some((_, cfg)) = gates.iter().find(|(call, _)| first.contains(call)) else {
+                continue;
+            };
+            gated += 1;
+            // The attributes above `#[test]`, as one line (rustfmt splits
+            // a long one).
+            let attrs: String = lines[n.saturating_sub(6)..n]
+                .iter()
+                .map(|l| l.trim())
+                .collect::<Vec<_>>()
+                .join(" ")
+                .replace("( ", "(");
+            if !attrs.contains(&format!("cfg_attr({cfg}, ignore = ")) {
+                bad.push(format!(
+                    "{}:{}: {}",
+                    path.file_name().unwrap_or_default().to_string_lossy(),
+                    f + 1,
+                    lines[f].trim()
+                ));
+            }
+        }
+    }
+    assert!(gated >= 10, "{gated} tests gated on a tool");
+    assert!(
+        bad.is_empty(),
+        "tests that need a tool and would pass without it (add #[cfg_attr(<cfg>, ignore = \"...\")]): {bad:#?}"
+    );
+}
