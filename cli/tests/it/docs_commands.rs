@@ -772,3 +772,19 @@ fn the_report_docs_write_into_out() {
         }
     }
 }
+
+/// Issue 42: writing-scenarios.md did not say whose band `expect_latency`
+/// grades against; a scenario author must learn it is Table 3-3's, at the
+/// board's straps, and that they give none.
+#[test]
+fn the_scenario_guide_says_expect_latency_grades_against_table_3_3() {
+    let text =
+        std::fs::read_to_string(root().join("docs/writing-scenarios.md")).expect("the guide");
+    let paragraph = text
+        .split("\n\n")
+        .find(|p| p.starts_with("`expect_latency(TimingId::X)`"))
+        .expect("a paragraph on expect_latency");
+    for said in ["Table 3-3", "straps", "MARGINAL", "You give no band"] {
+        assert!(paragraph.contains(said), "{said}: {paragraph}");
+    }
+}
