@@ -3,7 +3,15 @@
 //! report can say "1.030 us late, 6.0 % over the 17.170 us limit" rather
 //! than show two ranges to subtract.
 
+use crate::measurement::Measurement;
+use ppmc_core::time::Duration;
 use serde::{Deserialize, Serialize};
+
+/// A duration as a deviation's signed nanoseconds (saturating: an open
+/// limit, `Duration::MAX`, stays the greatest).
+pub fn signed_ns(d: Duration) -> i64 {
+    i64::try_from(d.as_nanos()).unwrap_or(i64::MAX)
+}
 
 /// The unit a deviation's numbers are in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -56,6 +64,20 @@ pub struct Deviation {
 }
 
 impl Deviation {
+    /// A graded measurement's deviation from the limit of its band it fell
+    /// outside (the upper one if above it), with its uncertainty.
+    pub fn of_measurement(m: &Measurement) -> Deviation {
+        let limit = if m.value > m.hi { m.hi } else { m.lo };
+        Deviation {
+            unit: DeviationUnit::Ns,
+            measured: signed_ns(m.value),
+            reference: signed_ns(limit),
+            reference_is: Reference::Limit,
+            u: m.u.as_nanos(),
+            bound: None,
+        }
+    }
+
     /// `measured - reference`: positive over, negative under.
     pub fn by(&self) -> i64 {
         self.measured.saturating_sub(self.reference)

@@ -26,7 +26,7 @@ mod result;
 mod run;
 mod tally;
 
-pub use deviation::{human_ns, Bound, Deviation, DeviationUnit, Reference};
+pub use deviation::{human_ns, signed_ns, Bound, Deviation, DeviationUnit, Reference};
 pub use figures::{Figures, MoveFigure, PinWave, Waveform, MAX_WAVE_PULSES};
 pub use info::{rfc3339, BoardInfo, CaptureSource, RunInfo, RunOptions};
 pub use measurement::{Grade, Grading, Measurement, MARGINAL_PCT};

@@ -202,9 +202,7 @@ impl RunRecord {
             .scenarios
             .iter()
             .enumerate()
-            .filter(|(_, sc)| {
-                !matches!(sc.verdict, crate::Status::Passed | crate::Status::Marginal)
-            })
+            .filter(|(_, sc)| !sc.passed_cleanly())
             .collect();
         rows.sort_by_key(|(k, sc)| (rank(sc), *k));
         rows
@@ -212,6 +210,15 @@ impl RunRecord {
 }
 
 impl ScenarioRecord {
+    /// Whether it passed, MARGINAL or not, on its first attempt: a report
+    /// shows everything else first.
+    pub fn passed_cleanly(&self) -> bool {
+        matches!(
+            self.verdict,
+            crate::Status::Passed | crate::Status::Marginal
+        )
+    }
+
     /// What did not pass, in a report's words: the failure's check,
     /// expectation, measured value and deviation; or the error's kind and
     /// message; or the detail.

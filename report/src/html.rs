@@ -86,7 +86,7 @@ fn summary_chips(r: &RunRecord) -> String {
 
 /// Whether a scenario is one to look at first: it did not pass cleanly.
 fn noteworthy(sc: &ScenarioRecord) -> bool {
-    !matches!(sc.verdict.name(), "passed" | "marginal")
+    !sc.passed_cleanly()
 }
 
 fn run_section(s: &mut String, r: &RunRecord, i: usize) {
@@ -134,7 +134,7 @@ fn run_section(s: &mut String, r: &RunRecord, i: usize) {
             esc(sc.verdict.name()),
             esc(&sc.verdict.name().replace('_', " ")),
             sc.attempts.len() + 1,
-            esc(&plots::human(sc.elapsed_ns)),
+            esc(&ppmc_record::human_ns(sc.elapsed_ns)),
         );
     }
     s.push_str("</table></details>");
@@ -327,7 +327,11 @@ fn scenario(s: &mut String, sc: &ScenarioRecord, id: &str, tol: (f64, u64), budg
                 esc(&m.name),
                 esc(&match m.u.as_nanos() {
                     0 => plots::us(m.value.as_nanos()),
-                    u => format!("{} ±{}", plots::us(m.value.as_nanos()), plots::human(u)),
+                    u => format!(
+                        "{} ±{}",
+                        plots::us(m.value.as_nanos()),
+                        ppmc_record::human_ns(u)
+                    ),
                 }),
                 esc(m.grade.name()),
                 esc(m.grade.name()),

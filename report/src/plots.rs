@@ -120,17 +120,6 @@ pub fn us(ns: u64) -> String {
     format!("{:.3} us", ns as f64 / 1000.0)
 }
 
-/// A duration in the unit that reads best: `850 ns`, `17.000 us`,
-/// `164.452 ms`, `637.551 s`.
-pub fn human(ns: u64) -> String {
-    match ns {
-        0..=999 => format!("{ns} ns"),
-        1_000..=999_999 => format!("{:.3} us", ns as f64 / 1e3),
-        1_000_000..=999_999_999 => format!("{:.3} ms", ns as f64 / 1e6),
-        _ => format!("{:.3} s", ns as f64 / 1e9),
-    }
-}
-
 /// A move's pulse intervals as segments: against the pulse number (the
 /// scenario's, from 1: the move's first pulse is `before + 1`, and has no
 /// interval) or against the time from the move.

@@ -19,7 +19,7 @@ use crate::protocol::{
 };
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, Event};
-use ppmc_record::{DeviationUnit, Grade, Measurement};
+use ppmc_record::{Deviation, DeviationUnit, Grade, Measurement};
 
 // Defined beside the driver, and public here as they always were.
 pub use super::options::DriverOptions;
@@ -404,14 +404,7 @@ impl<'t> Driver<'t> {
             );
             let grade = m.grade;
             let (lo, hi, m_shown) = (m.lo, m.hi, m.shown());
-            let ns = |d: Duration| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX);
-            let deviation = outside(
-                ns(lo),
-                ns(hi),
-                ns(m.value),
-                DeviationUnit::Ns,
-                m.u.as_nanos(),
-            );
+            let deviation = Deviation::of_measurement(&m);
             self.measurements.push(m);
             if grade == Grade::Fail {
                 return Err(fail_outside(

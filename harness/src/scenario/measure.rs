@@ -5,7 +5,7 @@ use super::driver::Driver;
 use super::outcome::{fail, need, Failure, HarnessError, Outcome, Stop};
 use crate::protocol::{Flag, Pin, Register, TimingId};
 use crate::time::{Duration, Instant, Limit};
-use ppmc_record::{Bound, Deviation, DeviationUnit, Grade, Reference};
+use ppmc_record::{signed_ns, Bound, Deviation, DeviationUnit, Grade, Reference};
 
 /// By how much a deceleration that started from pulse index `j1` (of
 /// `times`, after the trigger at `t`) missed its latency band `lo` to
@@ -22,7 +22,6 @@ fn bracketed(
     hi: Duration,
     edge: Duration,
 ) -> Deviation {
-    let ns = |d: Duration| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX);
     let after = |j: u64| {
         times
             .get(j as usize)
@@ -35,8 +34,8 @@ fn bracketed(
     };
     Deviation {
         unit: DeviationUnit::Ns,
-        measured: ns(measured),
-        reference: ns(reference),
+        measured: signed_ns(measured),
+        reference: signed_ns(reference),
         reference_is: Reference::Limit,
         u: edge.as_nanos(),
         bound: Some(bound),
@@ -55,17 +54,7 @@ impl Driver<'_> {
         let m = self.opts.grading.grade(id, &self.straps, value, u, at);
         let grade = m.grade;
         let (lo, hi, got) = (m.lo, m.hi, m.shown());
-        // The limit it fell outside: the upper one if above it.
-        let limit = if m.value > hi { hi } else { lo };
-        let ns = |d: Duration| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX);
-        let deviation = Deviation {
-            unit: DeviationUnit::Ns,
-            measured: ns(m.value),
-            reference: ns(limit),
-            reference_is: Reference::Limit,
-            u: m.u.as_nanos(),
-            bound: None,
-        };
+        let deviation = Deviation::of_measurement(&m);
         self.measurements.push(m);
         if grade == Grade::Fail {
             return Err(Stop::Failed(Failure {
