@@ -136,7 +136,7 @@ const ELSEWHERE: [(&str, &str); 36] = [
     ),
     (
         "cargo run -p board-suite",
-        "in .ci/run (a board team's own suite)",
+        "in .ci/run (a board team's own suite: the binary the tests' build made, with these arguments)",
     ),
     (
         "cargo install cargo-fuzz",
@@ -559,7 +559,11 @@ fn check_file(file: &'static str, ci: &str, labgrid: &str) -> (usize, Vec<String
             }
             Some((_, where_)) if where_.starts_with("in .ci/run") => {
                 let shown = doc.command.trim_start_matches("cd ");
+                // `.ci/run` runs the binaries its tests' build made, as
+                // `"$ppmc" ARGS` and `"$board_suite" ARGS`.
+                let built = shown.replacen("cargo run -p board-suite -- ", "\"$board_suite\" ", 1);
                 let in_ci = ci.contains(shown)
+                    || ci.contains(&built)
                     || (doc.command.starts_with("cargo +nightly fuzz run")
                         && ci.contains(
                             "cargo +nightly fuzz run -s none $(./flags \"$target\") \"$target\" \"$scratch\" \"$seeds\"",
