@@ -26,6 +26,8 @@
 //!   counter and the always-running timer.
 //! - [`limits`]: the heap and the capture capacity every image keeps (the
 //!   QEMU board's too), and why the capture fills before the heap.
+//! - [`restart`]: why the bridge last restarted (a panic, a hard fault, a
+//!   hang), as the image keeps it across the watchdog's reset.
 
 #![no_std]
 
@@ -41,6 +43,7 @@ pub mod limits;
 pub mod pins;
 pub mod pioregs;
 pub mod programs;
+pub mod restart;
 pub mod ring;
 pub mod timebase;
 #[cfg(any(test, feature = "twin"))]

@@ -55,6 +55,7 @@ use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
 use embedded_alloc::LlffHeap as Heap;
 use ppmc_bridge_fw::board::Board;
 use ppmc_bridge_fw::bus_cycle::BusTiming;
+use ppmc_bridge_fw::restart;
 use ppmc_bridge_fw::{limits, pins, pioregs, programs, usb};
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::protocol::Straps;
@@ -277,11 +278,12 @@ async fn main(_spawner: Spawner) {
     } else {
         (BusTiming::DEFAULT, FIRMWARE_DEFAULT_TIMING)
     };
-    // HELLO_REPLY's firmware text says when the last reset was a panic,
-    // and where: the host prints it with every run's identity.
-    let panicked = last_panic();
-    let firmware: alloc::string::String = match &panicked {
-        Some(at) => alloc::format!("{firmware}; restarted after a panic at {at}"),
+    // HELLO_REPLY's firmware text says why the last reset happened (a
+    // panic and where, a hard fault, a hang): the host prints it with
+    // every run's identity.
+    let restarted = last_restart();
+    let firmware: alloc::string::String = match &restarted {
+        Some(cause) => alloc::format!("{firmware}; restarted after {cause}"),
         None => firmware.into(),
     };
     defmt::info!(
@@ -291,8 +293,8 @@ async fn main(_spawner: Spawner) {
         straps.csel_high,
         straps.vsel_high
     );
-    if let Some(at) = &panicked {
-        defmt::warn!("restarted after a panic at {=str}", at.as_str());
+    if let Some(cause) = &restarted {
+        defmt::warn!("restarted after {=str}", cause.as_str());
     }
     // The engine on core 1, with its own cycle counter (each core has
     // one: the clock the board code reads is core 1's). It feeds the
@@ -447,53 +449,49 @@ fn hex16(id: u64) -> [u8; 16] {
     core::array::from_fn(|i| digits[(id >> (60 - 4 * i) & 0xF) as usize])
 }
 
-/// A panic record in the watchdog's scratch registers, which a watchdog
-/// reset keeps (the bootrom and the SDK use SCRATCH4-7: left alone):
-/// SCRATCH0 says one is there, SCRATCH1 has the line, SCRATCH2-3 the
-/// first 8 bytes of the source file's name (or "hardfault" and the PC).
-const PANIC_MAGIC: u32 = 0x5050_4d43; // "PPMC"
-
-/// The panic record the last reset left, if any, as text; cleared.
-fn last_panic() -> Option<alloc::string::String> {
+/// The restart's cause the last reset left, if any, as text; its record
+/// cleared (`ppmc_bridge_fw::restart`).
+fn last_restart() -> Option<alloc::string::String> {
     let wd = embassy_rp::pac::WATCHDOG;
-    if wd.scratch0().read() != PANIC_MAGIC {
-        return None;
-    }
+    let scratch = [
+        wd.scratch0().read(),
+        wd.scratch1().read(),
+        wd.scratch2().read(),
+        wd.scratch3().read(),
+    ];
+    let reason = wd.reason().read().0;
     wd.scratch0().write_value(0);
-    let line = wd.scratch1().read();
-    let bytes: alloc::vec::Vec<u8> = [wd.scratch2().read(), wd.scratch3().read()]
-        .iter()
-        .flat_map(|w| w.to_le_bytes())
-        .take_while(|b| *b != 0)
-        .collect();
-    let file = core::str::from_utf8(&bytes).unwrap_or("?");
-    if file == "hardfaul" {
-        return Some(alloc::format!("a hard fault at pc {line:#010x}"));
-    }
-    Some(alloc::format!("{file}:{line}"))
+    let cause = restart::cause(scratch, reason, in_flash)?;
+    Some(alloc::format!("{cause}"))
 }
 
-/// Keeps a record (`last_panic`) and resets the chip by its watchdog, set
+/// `len` bytes of the image's flash at `address`, if all of them are in
+/// it (the RP2350's XIP window: 16 MiB from 0x1000_0000).
+fn in_flash(address: u32, len: usize) -> Option<&'static [u8]> {
+    const XIP: core::ops::Range<u32> = 0x1000_0000..0x1100_0000;
+    let end = address.checked_add(u32::try_from(len).ok()?)?;
+    if !XIP.contains(&address) || end > XIP.end {
+        return None;
+    }
+    // SAFETY: the range lies in the XIP window, which is mapped and
+    // read-only for the whole life of the image.
+    Some(unsafe { core::slice::from_raw_parts(address as *const u8, len) })
+}
+
+/// Keeps a record (`last_restart`) and resets the chip by its watchdog, set
 /// up here in full (embassy-rp's `trigger_reset` does the same): a panic
 /// before the watchdog was started would otherwise reset nothing.
-fn record_and_reset(name: &[u8], line: u32) -> ! {
+fn record_and_reset(record: restart::Record) -> ! {
     cortex_m::interrupt::disable();
-    defmt::error!("panic at {=[u8]:a}:{=u32}; restarting", name, line);
     let wd = embassy_rp::pac::WATCHDOG;
-    let mut n = [0u8; 8];
-    for (d, s) in n.iter_mut().zip(name) {
-        *d = *s;
-    }
-    wd.scratch1().write_value(line);
-    wd.scratch2()
-        .write_value(u32::from_le_bytes([n[0], n[1], n[2], n[3]]));
-    wd.scratch3()
-        .write_value(u32::from_le_bytes([n[4], n[5], n[6], n[7]]));
-    wd.scratch0().write_value(PANIC_MAGIC);
-    // Every stage up to the processors (PSM WDSEL, as embassy-rp writes it).
+    let [s0, s1, s2, s3] = record.0;
+    wd.scratch1().write_value(s1);
+    wd.scratch2().write_value(s2);
+    wd.scratch3().write_value(s3);
+    wd.scratch0().write_value(s0);
     embassy_rp::pac::PSM
         .wdsel()
-        .write_value(embassy_rp::pac::psm::regs::Wdsel(0x0001_fffc));
+        .write_value(embassy_rp::pac::psm::regs::Wdsel(restart::PSM_WDSEL));
     wd.ctrl().modify(|w| {
         w.set_enable(true);
         w.set_trigger(true);
@@ -505,17 +503,20 @@ fn record_and_reset(name: &[u8], line: u32) -> ! {
 
 #[cortex_m_rt::exception]
 unsafe fn HardFault(ef: &cortex_m_rt::ExceptionFrame) -> ! {
-    // The faulting PC in the line's place (`last_panic` shows it so).
-    record_and_reset(b"hardfault", ef.pc())
+    defmt::error!("hard fault at pc {=u32:#010x}; restarting", ef.pc());
+    record_and_reset(restart::Record::hard_fault(ef.pc()))
 }
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
-    // Kept across the reset for HELLO to report (`last_panic`), then the
+    // Kept across the reset for HELLO to report (`last_restart`), then the
     // watchdog restarts the bridge: the host sees it come back, not a
     // bridge gone silent.
-    let (file, line) = info.location().map_or(("?", 0), |l| {
-        (l.file().rsplit('/').next().unwrap_or("?"), l.line())
-    });
-    record_and_reset(file.as_bytes(), line)
+    let (file, line) = info.location().map_or(("?", 0), |l| (l.file(), l.line()));
+    defmt::error!("panic at {=str}:{=u32}; restarting", file, line);
+    record_and_reset(restart::Record::panic(
+        file.as_ptr() as u32,
+        file.as_bytes(),
+        line,
+    ))
 }
