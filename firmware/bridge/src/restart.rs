@@ -35,42 +35,52 @@ pub mod psm {
     pub const ALL: u32 = (1 << 25) - 1;
 }
 
-/// What the watchdog resets (as embassy-rp writes it).
-pub const PSM_WDSEL: u32 = 0x0001_fffc;
+/// What the watchdog resets: every stage but the two oscillators, which
+/// keep running so that the restart does not wait for them (what
+/// pico-sdk's `watchdog_reboot` selects on the RP2350).
+pub const PSM_WDSEL: u32 = psm::ALL & !(psm::ROSC | psm::XOSC);
 
 /// WATCHDOG REASON: the timer ran out.
 pub const REASON_TIMER: u32 = 1 << 0;
 /// WATCHDOG REASON: a reset forced through the watchdog.
 pub const REASON_FORCE: u32 = 1 << 1;
 
-/// SCRATCH0 of a [`Record`] ("PPMC").
+/// SCRATCH0 of a [`Record`] of a panic, before it is mixed with the file
+/// name's check ("PPMC").
 const MAGIC: u32 = 0x5050_4d43;
+/// SCRATCH0 of a [`Record`] of a hard fault ("PPHF").
+const HARD_FAULT: u32 = 0x5050_4846;
 
-/// A restart's record in the watchdog's SCRATCH0-3: SCRATCH0 says one is
-/// there, SCRATCH1 has the line, SCRATCH2-3 the first 8 bytes of the
-/// source file's name (or "hardfault" and the PC).
+/// A restart's record in the watchdog's SCRATCH0-3.
+///
+/// A panic keeps where its file's name is in flash and how long it is,
+/// not the name: four words hold no path, and the name of every file the
+/// image was built from is in its read-only data, which a reset keeps.
+/// SCRATCH0 is [`MAGIC`] mixed with a check of the name, so that a record
+/// left by another image (flashed in between) is told from this one's.
+/// A hard fault keeps its PC.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Record(pub [u32; 4]);
 
 impl Record {
-    /// A panic at `line` of the file whose name is `name`.
-    pub fn panic(_address: u32, name: &[u8], line: u32) -> Record {
-        let mut n = [0u8; 8];
-        for (d, s) in n.iter_mut().zip(name) {
-            *d = *s;
-        }
-        Record([
-            MAGIC,
-            line,
-            u32::from_le_bytes([n[0], n[1], n[2], n[3]]),
-            u32::from_le_bytes([n[4], n[5], n[6], n[7]]),
-        ])
+    /// A panic at `line` of the file whose name is `name`, at `address`
+    /// in the image's flash.
+    pub fn panic(address: u32, name: &[u8], line: u32) -> Record {
+        let len = name.len().min(u16::MAX as usize);
+        Record([MAGIC ^ check(&name[..len]), line, address, len as u32])
     }
 
     /// A hard fault at `pc`.
     pub fn hard_fault(pc: u32) -> Record {
-        Record::panic(0, b"hardfault", pc)
+        Record([HARD_FAULT, pc, 0, 0])
     }
+}
+
+/// FNV-1a over `bytes`: the check of a file name in a [`Record`].
+fn check(bytes: &[u8]) -> u32 {
+    bytes.iter().fold(0x811c_9dc5, |h: u32, b| {
+        (h ^ u32::from(*b)).wrapping_mul(0x0100_0193)
+    })
 }
 
 /// Why the bridge restarted.
@@ -85,8 +95,6 @@ pub enum Cause {
     HardFault { pc: u32 },
     /// The watchdog's timer ran out: a loop stopped feeding it.
     Hang,
-    /// A reset forced through the watchdog, with no record of why.
-    Forced,
 }
 
 impl fmt::Display for Cause {
@@ -99,35 +107,46 @@ impl fmt::Display for Cause {
             ),
             Cause::HardFault { pc } => write!(f, "a hard fault at pc {pc:#010x}"),
             Cause::Hang => f.write_str("a hang (the watchdog's timer ran out)"),
-            Cause::Forced => f.write_str("a reset forced through the watchdog"),
         }
     }
 }
 
-/// Why the last reset happened, from the record in SCRATCH0-3; `None`
-/// when there is none.
+/// Why the last reset happened, from SCRATCH0-3 and REASON as the boot
+/// found them; `None` after a power-on, the RUN pin (REASON 0) or a reset
+/// forced with no record of ours. `flash(address, len)` gives the `len` bytes of the image's
+/// flash at `address`, or `None` when they are not all in it.
 pub fn cause<'a>(
     scratch: [u32; 4],
-    _reason: u32,
-    _flash: impl FnOnce(u32, usize) -> Option<&'a [u8]>,
+    reason: u32,
+    flash: impl FnOnce(u32, usize) -> Option<&'a [u8]>,
 ) -> Option<Cause> {
-    if scratch[0] != MAGIC {
-        return None;
-    }
-    let line = scratch[1];
-    let bytes: alloc::vec::Vec<u8> = [scratch[2], scratch[3]]
-        .iter()
-        .flat_map(|w| w.to_le_bytes())
-        .take_while(|b| *b != 0)
-        .collect();
-    let file = core::str::from_utf8(&bytes).unwrap_or("?");
-    if file == "hardfaul" {
+    let [tag, line, address, len] = scratch;
+    if tag == HARD_FAULT {
         return Some(Cause::HardFault { pc: line });
     }
-    Some(Cause::Panic {
-        file: file.into(),
-        line,
-    })
+    if len > 0 && len <= u32::from(u16::MAX) {
+        if let Some(name) = flash(address, len as usize) {
+            if tag == MAGIC ^ check(name) {
+                return Some(match core::str::from_utf8(name) {
+                    Ok(file) => Cause::Panic {
+                        file: file.into(),
+                        line,
+                    },
+                    Err(_) => Cause::PanicElsewhere { line },
+                });
+            }
+        }
+    }
+    if reason & REASON_TIMER != 0 {
+        Some(Cause::Hang)
+    } else if reason & REASON_FORCE != 0 && tag != 0 && len > 0 {
+        // A record whose file name is not where it says: another image's.
+        Some(Cause::PanicElsewhere { line })
+    } else {
+        // A power-on, the RUN pin, or a reset forced with no record of
+        // ours (the bootrom's after a flash, picotool's): nothing failed.
+        None
+    }
 }
 
 #[cfg(test)]
@@ -226,7 +245,9 @@ mod tests {
         let c = cause([0; 4], REASON_TIMER, |_, _| None).expect("a cause");
         assert_eq!(c, Cause::Hang);
         assert_eq!(c.to_string(), "a hang (the watchdog's timer ran out)");
-        // A power-on or the RUN pin: nothing to say.
+        // A power-on or the RUN pin: nothing to say; nor after a reset
+        // forced with no record of ours (the bootrom's after a flash).
         assert_eq!(cause([0; 4], 0, |_, _| None), None);
+        assert_eq!(cause([0; 4], REASON_FORCE, |_, _| None), None);
     }
 }

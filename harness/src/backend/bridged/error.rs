@@ -119,8 +119,9 @@ impl From<BridgeError> for TargetError {
 }
 
 /// What a bridge's firmware text says restarted it: the RP2350 image ends
-/// it in `; restarted after a panic at FILE:LINE` after a panic or a hard
-/// fault (its panic record, kept across the watchdog's reset).
+/// it in `; restarted after CAUSE`, the cause a panic at FILE:LINE, a hard
+/// fault at a PC (its record, kept across the watchdog's reset) or a hang
+/// (the watchdog's timer ran out).
 pub fn restart_cause(firmware: &str) -> Option<String> {
     let (_, cause) = firmware.rsplit_once("restarted after ")?;
     Some(cause.trim().to_string())

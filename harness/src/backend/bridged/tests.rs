@@ -493,6 +493,26 @@ fn a_bridge_that_panicked_is_an_infrastructure_error_naming_the_panic() {
     assert_eq!(restart_cause("ppmc-bridge-rp2350 0.1.0"), None);
 }
 
+/// Issue 43, defect 2: a bridge whose watchdog fired (a loop stopped
+/// feeding it) says so in its next HELLO; the run ends in an
+/// infrastructure error naming the hang, not a plain new session.
+#[test]
+fn a_bridge_that_hung_is_an_infrastructure_error_naming_the_hang() {
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
+    t.link.fail_sends = 1;
+    t.link.panic_on_reopen = Some(
+        "ppmc-bridge-rp2350 0.1.0; restarted after a hang (the watchdog's timer ran out)".into(),
+    );
+    let e = t.execute(&[Op::ReadStatus]).expect_err("restarted");
+    assert_eq!(e.kind, TargetErrorKind::Link, "not the board's failure");
+    assert!(
+        e.to_string().contains(
+            "the bridge restarted (session 00000001 -> 00000003) after a hang (the watchdog's timer ran out)"
+        ),
+        "{e}"
+    );
+}
+
 /// A bridge that reboots while the port stays open (a UART bridge, a
 /// network link) keeps answering, but its clock starts again at 0: the
 /// run ends as a link error, never as a device failure on a reset chip.
