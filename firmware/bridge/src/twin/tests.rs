@@ -821,3 +821,43 @@ fn sampled_changes_and_polled_waits_are_within_what_hello_declares() {
         u.polled
     );
 }
+
+/// Issue 43, defect 6 (RP2350 datasheet 11.4.6.2, PUSH): a `push noblock`
+/// to a full RX FIFO goes on at once, the FIFO unchanged and the ISR
+/// cleared, and sets FDEBUG.RXSTALL, as a blocking push or an autopush to
+/// a full FIFO does, to say a word was lost.
+#[test]
+fn defect_6_a_push_noblock_to_a_full_rx_fifo_sets_rxstall() {
+    use ::pio::{Instruction, InstructionOperands, SideSet};
+    let push_noblock = Instruction {
+        operands: InstructionOperands::PUSH {
+            if_full: false,
+            block: false,
+        },
+        delay: 0,
+        side_set: None,
+    }
+    .encode(SideSet::default());
+    // One instruction, wrapping onto itself; no join: four RX entries.
+    let regs = pioregs::SmRegs {
+        clkdiv: pioregs::CLKDIV_1,
+        execctrl: 0,
+        shiftctrl: 0,
+        pinctrl: 0,
+        start: 0,
+        x: 0,
+        side: None,
+    };
+    let mut w = World::with_program(1, 0, &[push_noblock], 0, &regs);
+    let mut outside = Inputs(|_, _, _| (0, 0));
+    let rxstall = |w: &World| w.blocks[1].fdebug() >> pioregs::fdebug::RXSTALL & 1;
+    for _ in 0..4 {
+        w.step(&mut outside);
+    }
+    assert_eq!(w.blocks[1].rx_level(0), 4, "four pushes fill the FIFO");
+    assert_eq!(rxstall(&w), 0, "no word lost yet");
+    w.step(&mut outside);
+    assert_eq!(w.blocks[1].rx_level(0), 4, "the FIFO unchanged");
+    assert_eq!(rxstall(&w), 1, "the lost word is flagged");
+    assert_eq!(w.blocks[1].sm[0].pc(), 0, "and the program went on");
+}
