@@ -159,9 +159,12 @@ impl Block {
                     || sm.core.isr_count >= Self::thresh(shiftctrl, shiftctrl::PUSH_THRESH);
                 if full_enough {
                     if sm.rx.len() >= sm.rx_depth() {
+                        // Blocking or not, a push to a full FIFO sets
+                        // RXSTALL; `noblock` goes on, the word lost and
+                        // the ISR cleared (11.4.6.2).
+                        self.fdebug |= 1 << (fdebug::RXSTALL + s as u32);
                         if block {
                             stall = true;
-                            self.fdebug |= 1 << (fdebug::RXSTALL + s as u32);
                         } else {
                             sm.core.isr = 0;
                             sm.core.isr_count = 0;
