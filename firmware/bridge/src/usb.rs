@@ -34,6 +34,8 @@ pub trait Pipes {
     fn replies<'a>(&'a self, buf: &'a mut [u8]) -> impl Future<Output = usize> + 'a;
     /// Nothing more from the engine is waiting.
     fn replies_empty(&self) -> bool;
+    /// Forgets the bytes the engine has not taken yet.
+    fn forget_to_engine(&self);
 }
 
 /// A clock that bounds a future.
@@ -85,6 +87,12 @@ pub async fn serve_connection<U: Packets, P: Pipes, D: Deadline>(
             }
         }
     }
+}
+
+/// Between two connections, until `next` (the next connection) is ready.
+pub async fn between_connections<P: Pipes, F: Future>(pipes: &P, next: F) -> F::Output {
+    let _ = pipes;
+    next.await
 }
 
 #[cfg(test)]
@@ -222,6 +230,10 @@ mod tests {
         fn replies_empty(&self) -> bool {
             self.from_engine.lock().expect("pipe").is_empty()
         }
+
+        fn forget_to_engine(&self) {
+            self.to_engine.lock().expect("pipe").clear();
+        }
     }
 
     /// The write deadline on the wall clock.
@@ -349,5 +361,48 @@ mod tests {
             took >= Duration::from_millis(100) && took < Duration::from_secs(10),
             "{took:?}"
         );
+    }
+
+    /// Issue 43, defect 5: a host that closes the port while the engine is
+    /// still answering it. The next host gets its own replies and nothing
+    /// of the old one's, and nothing the old host sent reaches the engine
+    /// after it left.
+    #[test]
+    fn defect_5_the_next_host_gets_no_byte_meant_for_the_last() {
+        // The engine echoes each byte after 20 ms; the first host sends
+        // eight and is gone before the first echo.
+        let cores = TwoCores::start(Duration::from_millis(20), Arc::new(AtomicBool::new(false)));
+        let first = Arc::new(Mutex::new(Host::default()));
+        first
+            .lock()
+            .expect("host")
+            .to_bridge
+            .push_back(std::vec![1; 8]);
+        first.lock().expect("host").closed = true;
+        let deadline = Wall(Duration::from_millis(500));
+        embassy_futures::block_on(serve_connection(&mut Usb(first.clone()), &cores, &deadline));
+        // The next host opens the port 300 ms later (the engine long done
+        // with whatever it took), sends four bytes and reads four back.
+        let opened = Instant::now() + Duration::from_millis(300);
+        let next = Until(move || (Instant::now() >= opened).then_some(()));
+        embassy_futures::block_on(between_connections(&cores, next));
+        let second = host_sends(0);
+        second
+            .lock()
+            .expect("host")
+            .to_bridge
+            .push_back(std::vec![9; 4]);
+        let watcher = second.clone();
+        std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_millis(400));
+            watcher.lock().expect("host").closed = true;
+        });
+        embassy_futures::block_on(serve_connection(
+            &mut Usb(second.clone()),
+            &cores,
+            &deadline,
+        ));
+        assert_eq!(second.lock().expect("host").from_bridge, [9, 9, 9, 9]);
+        assert!(cores.to_engine.lock().expect("pipe").is_empty());
     }
 }

@@ -385,7 +385,7 @@ async fn main(_spawner: Spawner) {
     let serve = async {
         let mut cdc = Cdc(class);
         loop {
-            cdc.0.wait_connection().await;
+            usb::between_connections(&CorePipes, cdc.0.wait_connection()).await;
             defmt::info!("USB: the host opened the port");
             usb::serve_connection(&mut cdc, &CorePipes, &WriteDeadline).await;
             defmt::info!(
@@ -431,6 +431,10 @@ impl usb::Pipes for CorePipes {
 
     fn replies_empty(&self) -> bool {
         TO_HOST.is_empty()
+    }
+
+    fn forget_to_engine(&self) {
+        FROM_HOST.clear();
     }
 }
 
