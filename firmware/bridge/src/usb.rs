@@ -89,10 +89,24 @@ pub async fn serve_connection<U: Packets, P: Pipes, D: Deadline>(
     }
 }
 
-/// Between two connections, until `next` (the next connection) is ready.
+/// Between two connections, until `next` (the next connection) is ready:
+/// what the host that left sent and the engine has not taken is
+/// forgotten, and what the engine still writes for it is thrown away as it
+/// comes. Core 1 so never stays blocked on a full pipe that nobody reads,
+/// and the next host gets no byte of an old reply (but for one the engine
+/// is still writing when it opens the port: its frame decoder drops the
+/// broken frame).
 pub async fn between_connections<P: Pipes, F: Future>(pipes: &P, next: F) -> F::Output {
-    let _ = pipes;
-    next.await
+    pipes.forget_to_engine();
+    let mut next = core::pin::pin!(next);
+    let mut buf = [0u8; PACKET];
+    loop {
+        match select(next.as_mut(), pipes.replies(&mut buf)).await {
+            Either::First(v) => return v,
+            // Meant for the host that left.
+            Either::Second(_) => {}
+        }
+    }
 }
 
 #[cfg(test)]
