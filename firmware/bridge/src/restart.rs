@@ -56,7 +56,7 @@ const HARD_FAULT: u32 = 0x5050_4846;
 /// A panic keeps where its file's name is in flash and how long it is,
 /// not the name: four words hold no path, and the name of every file the
 /// image was built from is in its read-only data, which a reset keeps.
-/// SCRATCH0 is [`MAGIC`] mixed with a check of the name, so that a record
+/// SCRATCH0 is a magic number mixed with a check of the name, so that a record
 /// left by another image (flashed in between) is told from this one's.
 /// A hard fault keeps its PC.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
