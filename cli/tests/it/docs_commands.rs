@@ -559,8 +559,8 @@ fn check_file(file: &'static str, ci: &str, labgrid: &str) -> (usize, Vec<String
             }
             Some((_, where_)) if where_.starts_with("in .ci/run") => {
                 let shown = doc.command.trim_start_matches("cd ");
-                // `.ci/run` runs the binaries its tests' build made, as
-                // `"$ppmc" ARGS` and `"$board_suite" ARGS`.
+                // `.ci/run` runs the board team's binary its tests' build
+                // made, as `"$board_suite" ARGS`.
                 let built = shown.replacen("cargo run -p board-suite -- ", "\"$board_suite\" ", 1);
                 let in_ci = ci.contains(shown)
                     || ci.contains(&built)

@@ -386,7 +386,7 @@ mod tests {
         // The engine echoes each byte after 20 ms; the first host sends
         // eight and is gone before the first echo.
         let cores = TwoCores::start(Duration::from_millis(20), Arc::new(AtomicBool::new(false)));
-        let first = Arc::new(Mutex::new(Host::default()));
+        let first = host_sends(0);
         first
             .lock()
             .expect("host")

@@ -478,14 +478,11 @@ fn a_restarted_bridge_is_not_trusted() {
 /// to a panic ends in an infrastructure error naming it.
 #[test]
 fn a_bridge_that_panicked_is_an_infrastructure_error_naming_the_panic() {
-    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
-    t.link.fail_sends = 1;
-    t.link.panic_on_reopen =
-        Some("ppmc-bridge-rp2350 0.1.0; restarted after a panic at bridge/src/board.rs:442".into());
-    let e = t.execute(&[Op::ReadStatus]).expect_err("restarted");
-    assert_eq!(e.kind, TargetErrorKind::Link, "not the board's failure");
+    let e = restarted_as(
+        "ppmc-bridge-rp2350 0.1.0; restarted after a panic at bridge/src/board.rs:442",
+    );
     assert!(
-        e.to_string().contains(
+        e.contains(
             "the bridge restarted (session 00000001 -> 00000003) after a panic at bridge/src/board.rs:442"
         ),
         "{e}"
@@ -493,20 +490,28 @@ fn a_bridge_that_panicked_is_an_infrastructure_error_naming_the_panic() {
     assert_eq!(restart_cause("ppmc-bridge-rp2350 0.1.0"), None);
 }
 
+/// The error of a run whose bridge drops the link and comes back with
+/// `firmware` as its HELLO's firmware text: a link error, never the
+/// board's failure.
+fn restarted_as(firmware: &str) -> String {
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
+    t.link.fail_sends = 1;
+    t.link.panic_on_reopen = Some(firmware.into());
+    let e = t.execute(&[Op::ReadStatus]).expect_err("restarted");
+    assert_eq!(e.kind, TargetErrorKind::Link, "not the board's failure");
+    e.to_string()
+}
+
 /// Issue 43, defect 2: a bridge whose watchdog fired (a loop stopped
 /// feeding it) says so in its next HELLO; the run ends in an
 /// infrastructure error naming the hang, not a plain new session.
 #[test]
 fn a_bridge_that_hung_is_an_infrastructure_error_naming_the_hang() {
-    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
-    t.link.fail_sends = 1;
-    t.link.panic_on_reopen = Some(
-        "ppmc-bridge-rp2350 0.1.0; restarted after a hang (the watchdog's timer ran out)".into(),
+    let e = restarted_as(
+        "ppmc-bridge-rp2350 0.1.0; restarted after a hang (the watchdog's timer ran out)",
     );
-    let e = t.execute(&[Op::ReadStatus]).expect_err("restarted");
-    assert_eq!(e.kind, TargetErrorKind::Link, "not the board's failure");
     assert!(
-        e.to_string().contains(
+        e.contains(
             "the bridge restarted (session 00000001 -> 00000003) after a hang (the watchdog's timer ran out)"
         ),
         "{e}"
