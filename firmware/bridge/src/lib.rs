@@ -21,6 +21,8 @@
 //!   with a deadline on every packet written.
 //! - [`ring`]: the DMA rings the counters' words go to, and how the CPU
 //!   reads them and tells a ring the DMA came round on.
+//! - [`dma`]: the DMA channels that fill the rings, register by register:
+//!   programmed, read, and re-armed when one stops.
 //! - [`pioregs`]: the state machines' registers, as values.
 //! - [`clock`]: the bridge's 64-bit cycle clock from the core's cycle
 //!   counter and the always-running timer.
@@ -38,6 +40,7 @@ extern crate std;
 pub mod board;
 pub mod bus_cycle;
 pub mod clock;
+pub mod dma;
 pub mod hal;
 pub mod limits;
 pub mod pins;

@@ -46,6 +46,15 @@ pub struct Reader {
 }
 
 impl Reader {
+    /// A reader at the ring's start that has read nothing (as `Default`,
+    /// in a `const`).
+    pub const fn new() -> Reader {
+        Reader {
+            read: 0,
+            last: None,
+        }
+    }
+
     /// Reads from where the DMA writes next, `write`: what the ring holds
     /// is dropped. The caller writes [`CANARY`] at [`Reader::canary_slot`]
     /// first, while the DMA is idle, so that a lap before the first word
@@ -73,7 +82,7 @@ impl Reader {
     /// where the DMA writes next; `None` when every word written is read.
     pub fn next(
         &mut self,
-        word: impl Fn(usize) -> u32,
+        mut word: impl FnMut(usize) -> u32,
         write: usize,
     ) -> Result<Option<u32>, Lapped> {
         let unread = self.read != write % RING_WORDS;

@@ -18,11 +18,12 @@ use embassy_rp::pac::pio::regs::{
     Ctrl, Fdebug, SmClkdiv, SmExecctrl, SmInstr, SmPinctrl, SmShiftctrl,
 };
 use ppmc_bridge_fw::clock::Clock;
+use ppmc_bridge_fw::dma::{self, DmaRegs, Rings};
 use ppmc_bridge_fw::hal::{Counter, Hal};
 use ppmc_bridge_fw::pins;
 use ppmc_bridge_fw::pioregs::{self, fdebug, shiftctrl, SmRegs, START_COUNTERS, STOP_COUNTERS};
 use ppmc_bridge_fw::programs::Loaded;
-use ppmc_bridge_fw::ring::{Lapped, Reader, CANARY, RING_BITS, RING_WORDS};
+use ppmc_bridge_fw::ring::RING_WORDS;
 
 /// The three PIO blocks, by index.
 fn pio(b: usize) -> pac::pio::Pio {
@@ -104,46 +105,58 @@ const _: () = assert!(core::mem::align_of::<Ring>() == RING_WORDS * 4);
 
 static RINGS: [Ring; 4] = [const { Ring(UnsafeCell::new([0; RING_WORDS])) }; 4];
 
-/// The DMA channel of each counter: its place in `Counter::ALL` (channels
-/// 0-3); main.rs claims them from embassy-rp so that nothing else takes
-/// them.
-const fn dma_channel(c: Counter) -> usize {
-    c.index()
+/// The DMA block's registers and the rings, as the board code reaches them
+/// (`ppmc_bridge_fw::dma`, which the board twin runs too): channels 0-3,
+/// one a counter in `Counter::ALL` order; main.rs claims them from
+/// embassy-rp so that nothing else takes them.
+struct RpDma;
+
+impl DmaRegs for RpDma {
+    fn read(&mut self, offset: usize) -> u32 {
+        // SAFETY: `offset` is one of `ppmc_bridge_fw::dma::reg`'s, inside
+        // the DMA block; a register is read whole.
+        unsafe {
+            core::ptr::read_volatile((pac::DMA.as_ptr() as *mut u8).add(offset) as *const u32)
+        }
+    }
+
+    fn write(&mut self, offset: usize, value: u32) {
+        // SAFETY: as `read`; only this module writes channels 0-3.
+        unsafe {
+            core::ptr::write_volatile(
+                (pac::DMA.as_ptr() as *mut u8).add(offset) as *mut u32,
+                value,
+            )
+        }
+    }
+
+    fn ring_word(&mut self, channel: usize, i: usize) -> u32 {
+        let ring = RINGS[channel].0.get() as *const u32;
+        // SAFETY: `i % RING_WORDS` is inside the ring, and a whole aligned
+        // word is read at once, whatever the DMA does.
+        unsafe { core::ptr::read_volatile(ring.add(i % RING_WORDS)) }
+    }
+
+    fn set_ring_word(&mut self, channel: usize, i: usize, value: u32) {
+        let ring = RINGS[channel].0.get() as *mut u32;
+        // SAFETY: inside the ring; the board code writes only the slot the
+        // DMA wrote last (the canary), not the one it writes next.
+        unsafe { core::ptr::write_volatile(ring.add(i % RING_WORDS), value) }
+    }
 }
 
-/// Starts the four DMA channels, each moving its counter's RX FIFO into
-/// its ring for ever, paced by the FIFO's DREQ (RP2350 datasheet, DMA
-/// chapter): the write address wrapped at the ring's 1 KiB, and a ring's
-/// worth of transfers at a time, the channel re-triggering itself at the
-/// end of each (TRANS_COUNT mode TRIGGER_SELF), so that the count says
-/// where the next word goes (`Rp2350::write_index`). The counters need
-/// not run: a channel waits for its DREQ.
+/// The four rings' channels, each from its counter's RX FIFO into its ring
+/// (`ppmc_bridge_fw::dma::counter_channel`).
+fn rings() -> Rings {
+    Rings::new(Counter::ALL.map(|c| dma::counter_channel(c, RINGS[c.index()].0.get() as u32)))
+}
+
+/// Starts the four DMA channels (at boot), each moving its counter's RX
+/// FIFO into its ring for ever, paced by the FIFO's DREQ
+/// (`ppmc_bridge_fw::dma::Rings::start`). The counters need not run: a
+/// channel waits for its DREQ.
 pub fn start_rings() {
-    use pac::dma::vals::{DataSize, TransCountMode, TreqSel};
-    for c in Counter::ALL {
-        let (b, s) = pioregs::counter_sm(c);
-        let n = dma_channel(c);
-        let ch = pac::DMA.ch(n);
-        ch.read_addr().write_value(pio(b).rxf(s).as_ptr() as u32);
-        ch.write_addr().write_value(RINGS[n].0.get() as u32);
-        ch.trans_count().write(|w| {
-            w.set_mode(TransCountMode::TRIGGER_SELF);
-            w.set_count(RING_WORDS as u32);
-        });
-        // PIO1's RX FIFO 0 is DREQ 12, PIO2's RX FIFO s is 20 + s.
-        let dreq = if b == 1 { 12 } else { 20 } + s as u8;
-        ch.ctrl_trig().write(|w| {
-            w.set_data_size(DataSize::SIZE_WORD);
-            w.set_incr_read(false);
-            w.set_incr_write(true);
-            w.set_ring_size(RING_BITS);
-            w.set_ring_sel(true);
-            w.set_chain_to(n as u8);
-            w.set_treq_sel(TreqSel::from_bits(dreq));
-            w.set_irq_quiet(true);
-            w.set_en(true);
-        });
-    }
+    rings().start(&mut RpDma);
 }
 
 /// The RP2350's PIO, SIO and clock as the board code's hardware layer.
@@ -155,10 +168,8 @@ pub struct Rp2350 {
     gen: Loaded,
     /// Core 0's heartbeat as last seen, and when (cycles).
     beat: (u32, u64),
-    /// The CPU's side of each counter's ring, and whether one was lapped
-    /// since the last look.
-    readers: [Reader; 4],
-    lapped: bool,
+    /// The counters' rings: their channels, and the CPU's side of each.
+    rings: Rings,
 }
 
 /// Core 0's heartbeat: it counts up every 100 ms while core 0's executor
@@ -200,44 +211,13 @@ impl Rp2350 {
             counters: [pout, pins_],
             gen,
             beat: (HEARTBEAT.load(Ordering::Relaxed), 0),
-            readers: [Reader::default(); 4],
-            lapped: false,
+            rings: rings(),
         }
-    }
-
-    /// Where counter `c`'s DMA channel writes next, as a ring index: from
-    /// its transfer count, which moves as each write completes (its
-    /// WRITE_ADDR, with the ring's wrap, may run ahead of the data:
-    /// `ppmc_bridge_fw::ring`).
-    fn write_index(c: Counter) -> usize {
-        let left = pac::DMA.ch(dma_channel(c)).trans_count().read().count() as usize;
-        (RING_WORDS - left.min(RING_WORDS)) % RING_WORDS
-    }
-
-    /// Reader `i` from where its channel writes next, the canary where it
-    /// wrote last (`ppmc_bridge_fw::ring::Reader::at`).
-    fn restart_reader(&mut self, c: Counter) {
-        let write = Self::write_index(c);
-        let ring = RINGS[dma_channel(c)].0.get() as *mut u32;
-        // SAFETY: the slot is inside the ring; the DMA writes the slot at
-        // `write` next, not this one.
-        unsafe { core::ptr::write_volatile(ring.add(Reader::canary_slot(write)), CANARY) };
-        self.readers[dma_channel(c)] = Reader::at(write);
     }
 
     /// Whether any ring holds words the CPU has not read.
     fn rings_hold_words(&self) -> bool {
-        Counter::ALL
-            .iter()
-            .any(|c| self.readers[dma_channel(*c)].level(Self::write_index(*c)) > 0)
-    }
-
-    /// Word `i` of counter `c`'s ring, as the DMA left it.
-    fn word(c: Counter, i: usize) -> u32 {
-        let ring = RINGS[dma_channel(c)].0.get() as *const u32;
-        // SAFETY: `i` is below RING_WORDS (the reader's indices are), and
-        // a whole aligned word is read at once, whatever the DMA does.
-        unsafe { core::ptr::read_volatile(ring.add(i % RING_WORDS)) }
+        (0..4).any(|i| self.rings.level(&mut RpDma, i) > 0)
     }
 
     /// The cycle of the register write just before the call: the clock
@@ -312,45 +292,22 @@ impl Hal for Rp2350 {
     }
 
     fn capture_pull(&mut self, c: Counter) -> Option<u32> {
-        let write = Self::write_index(c);
-        let reader = &mut self.readers[dma_channel(c)];
-        match reader.next(|i| Self::word(c, i), write) {
-            Ok(w) => w,
-            Err(Lapped) => {
-                self.lapped = true;
-                self.restart_reader(c);
-                None
-            }
-        }
+        self.rings.pull(&mut RpDma, c.index())
     }
 
     fn capture_level(&mut self) -> usize {
-        Counter::ALL
-            .iter()
-            .map(|c| self.readers[dma_channel(*c)].level(Self::write_index(*c)))
-            .max()
-            .unwrap_or(0)
+        self.rings.fullest(&mut RpDma)
     }
 
     fn capture_stalled(&mut self) -> bool {
-        // A ring the DMA came round on, or (should the DMA ever fall
-        // behind) a counter that stalled on its full FIFO.
-        let lapped = core::mem::take(&mut self.lapped);
-        // A channel a bus error halted (CTRL_TRIG.AHB_ERROR) moves nothing
-        // more: re-armed, and the capture lost (the counters restart).
-        let halted = Counter::ALL.iter().any(|c| {
-            let ctrl = pac::DMA.ch(dma_channel(*c)).ctrl_trig().read();
-            ctrl.ahb_error() || !ctrl.en()
-        });
-        if halted {
-            start_rings();
-        }
+        // A ring the DMA came round on, or a channel that stopped (a bus
+        // error halts one: re-armed, the capture lost), or (should the DMA
+        // ever fall behind) a counter that stalled on its full FIFO.
+        let lost = self.rings.take_lost(&mut RpDma);
         let pout = 1 << fdebug::RXSTALL;
         let others = 0b0111 << fdebug::RXSTALL;
-        let stalled = lapped
-            || halted
-            || pio(1).fdebug().read().0 & pout != 0
-            || pio(2).fdebug().read().0 & others != 0;
+        let stalled =
+            lost || pio(1).fdebug().read().0 & pout != 0 || pio(2).fdebug().read().0 & others != 0;
         pio(1).fdebug().write_value(Fdebug(pout));
         pio(2).fdebug().write_value(Fdebug(others));
         stalled
@@ -393,19 +350,11 @@ impl Hal for Rp2350 {
             .fdebug()
             .write_value(Fdebug(0b0111 << fdebug::RXSTALL));
         // Each channel's DREQ count cleared (the FIFOs are empty): the
-        // handshake starts afresh with the counters.
-        for c in Counter::ALL {
-            pac::DMA
-                .ch(dma_channel(c))
-                .dbg_ctdreq()
-                .write_value(pac::dma::regs::DbgCtdreq(0));
-        }
-        // What the rings held is from before: read from where each DMA
-        // channel writes next, before the first edge can come.
-        for c in Counter::ALL {
-            self.restart_reader(c);
-        }
-        self.lapped = false;
+        // handshake starts afresh with the counters. What the rings held
+        // is from before: read from where each DMA channel writes next,
+        // before the first edge can come.
+        self.rings.clear_dreq_counts(&mut RpDma);
+        self.rings.restart_readers(&mut RpDma);
         cortex_m::interrupt::free(|_| {
             pio(1).ctrl().write_value(Ctrl(START_COUNTERS));
             self.stamp()

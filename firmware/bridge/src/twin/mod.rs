@@ -16,11 +16,12 @@ pub mod pio;
 mod tests;
 
 use crate::bus_cycle::BusTiming;
+use crate::dma::{self, DmaRegs, Rings};
 use crate::hal::{Counter, Hal};
 use crate::pins;
 use crate::pioregs::{self, block, fdebug, START_COUNTERS, STOP_COUNTERS};
 use crate::programs::{self, Loaded};
-use crate::ring::{Lapped, Reader, CANARY, RING_WORDS};
+use crate::ring::RING_WORDS;
 use chip::ChipSide;
 use pio::{Func, World};
 use ppmc_core::emu::{Board as Model, ModelConfig};
@@ -81,10 +82,9 @@ pub struct Twin {
     gaps: Option<(u64, u64)>,
     /// How the board code drained the POUT counter's ring.
     pub drains: Drains,
-    /// The CPU's side of each counter's DMA ring ([`Counter::ALL`]
-    /// order), and whether one was lapped since the last look.
-    readers: [Reader; 4],
-    lapped: bool,
+    /// The counters' DMA rings, as the image programs and reads them
+    /// ([`crate::dma`]), in [`Counter::ALL`] order.
+    rings: Rings,
     /// Clock readings not yet paid for: the world runs them off at the next
     /// call that spends.
     owed: core::cell::Cell<u64>,
@@ -114,8 +114,7 @@ impl Twin {
             progress: Default::default(),
             owed: core::cell::Cell::new(0),
             drains: Drains::default(),
-            readers: [Reader::default(); 4],
-            lapped: false,
+            rings: Rings::new(Counter::ALL.map(|c| dma::counter_channel(c, ring_addr(c.index())))),
         };
         t.boot().map_err(|e| format!("{e:?}"))?;
         Ok(t)
@@ -147,16 +146,12 @@ impl Twin {
             .map_err(|e| std::boxed::Box::new(e) as _)?;
         w.blocks[0].force_pins(1 << pins::TEST_GEN, 0, 0);
         w.func[pins::TEST_GEN as usize] = Func::Pio(0);
-        // A DMA channel a counter, into its ring (the image's `hw::rings`).
+        // A DMA channel a counter, into its ring in RAM, started as the
+        // image starts them.
         for c in Counter::ALL {
-            let (block, sm) = pioregs::counter_sm(c);
-            w.dma.push(pio::RingDma {
-                block,
-                sm,
-                ring: std::vec![0; RING_WORDS],
-                write: 0,
-            });
+            w.dma.add_ram(ring_addr(c.index()), RING_WORDS);
         }
+        self.rings.start(&mut TwinDma(w));
         // SIO outputs: levels first, then directions (issue 28): the chip's
         // inputs released, RESET* high, the buffers off until all is set.
         let mut sio_pins: u64 = 1 << pins::RESET | 1 << pins::CAPTURE_OE | 1 << pins::DRIVE_EN;
@@ -223,13 +218,40 @@ impl Twin {
     }
 }
 
+/// Where the twin puts ring `i` in its RAM: aligned to a ring's size.
+fn ring_addr(i: usize) -> u32 {
+    pio::RAM + (i * RING_WORDS * 4) as u32
+}
+
+/// The twin's DMA block as the board code reaches it.
+struct TwinDma<'a>(&'a mut World);
+
+impl DmaRegs for TwinDma<'_> {
+    fn read(&mut self, offset: usize) -> u32 {
+        self.0.dma.read(offset)
+    }
+
+    fn write(&mut self, offset: usize, value: u32) {
+        let w = &mut *self.0;
+        w.dma.write(offset, value, &w.blocks);
+    }
+
+    fn ring_word(&mut self, channel: usize, i: usize) -> u32 {
+        let addr = ring_addr(channel) + 4 * (i % RING_WORDS) as u32;
+        self.0.dma.ram_word(addr).unwrap_or(0)
+    }
+
+    fn set_ring_word(&mut self, channel: usize, i: usize, value: u32) {
+        let addr = ring_addr(channel) + 4 * (i % RING_WORDS) as u32;
+        self.0.dma.set_ram_word(addr, value);
+    }
+}
+
 impl Twin {
-    /// Reader `i` from where its DMA channel writes next, with the canary
-    /// where it wrote last (`ring::Reader::at`).
-    fn restart_reader(&mut self, i: usize) {
-        let d = &mut self.world.dma[i];
-        d.ring[Reader::canary_slot(d.write)] = CANARY;
-        self.readers[i] = Reader::at(d.write);
+    /// Words the rings hold that the board code has not read.
+    fn rings_hold_words(&mut self) -> bool {
+        let d = &mut TwinDma(&mut self.world);
+        (0..4).any(|i| self.rings.level(d, i) > 0)
     }
 }
 
@@ -275,34 +297,21 @@ impl Hal for Twin {
         self.spend(self.cpu_cycles);
         let i = c.index();
         let cycle = self.world.cycle;
-        let d = &self.world.dma[i];
-        let reader = &mut self.readers[i];
+        let d = &mut TwinDma(&mut self.world);
         if c == Counter::Pout {
-            self.drains.look(cycle, reader.level(d.write));
+            self.drains.look(cycle, self.rings.level(d, i));
         }
-        match reader.next(|k| d.ring[k], d.write) {
-            Ok(w) => w,
-            Err(Lapped) => {
-                self.lapped = true;
-                self.restart_reader(i);
-                None
-            }
-        }
+        self.rings.pull(d, i)
     }
 
     fn capture_level(&mut self) -> usize {
         self.spend(self.cpu_cycles);
-        self.readers
-            .iter()
-            .zip(&self.world.dma)
-            .map(|(r, d)| r.level(d.write))
-            .max()
-            .unwrap_or(0)
+        self.rings.fullest(&mut TwinDma(&mut self.world))
     }
 
     fn capture_stalled(&mut self) -> bool {
         self.spend(self.cpu_cycles);
-        let mut stalled = core::mem::take(&mut self.lapped);
+        let mut stalled = self.rings.take_lost(&mut TwinDma(&mut self.world));
         for b in [block::POUT, block::PINS] {
             let mask = pioregs::COUNTERS[b] << fdebug::RXSTALL;
             stalled |= self.world.blocks[b].fdebug() & mask != 0;
@@ -344,10 +353,9 @@ impl Hal for Twin {
         // What the rings held is from before: read from where each DMA
         // channel writes next, set before the counters start, as the image
         // does.
-        for i in 0..self.readers.len() {
-            self.restart_reader(i);
-        }
-        self.lapped = false;
+        let d = &mut TwinDma(&mut self.world);
+        self.rings.clear_dreq_counts(d);
+        self.rings.restart_readers(d);
         self.spend(self.cpu_cycles);
         self.world.write_ctrl(block::POUT, START_COUNTERS);
         self.world.cycle
@@ -436,12 +444,7 @@ impl Hal for Twin {
             while at < to {
                 let next = (at + step).min(to);
                 self.run_to(next);
-                let words = self
-                    .readers
-                    .iter()
-                    .zip(&self.world.dma)
-                    .any(|(r, d)| r.level(d.write) > 0);
-                if words {
+                if self.rings_hold_words() {
                     return at;
                 }
                 at = next;

@@ -861,3 +861,65 @@ fn defect_6_a_push_noblock_to_a_full_rx_fifo_sets_rxstall() {
     assert_eq!(rxstall(&w), 1, "the lost word is flagged");
     assert_eq!(w.blocks[1].sm[0].pc(), 0, "and the program went on");
 }
+
+/// Each ring's channel is running, and where its count says it writes next
+/// is where it does: the board code reads every word where the DMA put it.
+fn channels_in_place(b: &mut TwinBoard) -> std::vec::Vec<std::string::String> {
+    use crate::dma::{ctrl, reg, trans_count};
+    let dma = &b.hal_mut().world.dma;
+    let mut wrong = Vec::new();
+    for c in Counter::ALL {
+        let n = c.index();
+        let ctl = dma.read(reg::ch(n, reg::CTRL_TRIG));
+        if ctl & ctrl::BUSY == 0 || ctl & ctrl::EN == 0 || ctl & ctrl::AHB_ERROR != 0 {
+            wrong.push(std::format!("{c:?}: CTRL {ctl:#010x}, not running"));
+        }
+        let left = (dma.read(reg::ch(n, reg::TRANS_COUNT)) & trans_count::COUNT) as usize;
+        let by_count = (RING_WORDS - left % (RING_WORDS + 1)) % RING_WORDS;
+        let ring = pio::RAM as usize + n * RING_WORDS * 4;
+        let by_addr = (dma.read(reg::ch(n, reg::WRITE_ADDR)) as usize - ring) / 4;
+        if by_count != by_addr {
+            wrong.push(std::format!(
+                "{c:?}: its count says it writes word {by_count} next, WRITE_ADDR word {by_addr}"
+            ));
+        }
+    }
+    wrong
+}
+
+#[test]
+fn defect_1_a_channel_a_bus_error_halted_is_re_armed_and_the_others_keep_their_place() {
+    // RP2350 datasheet 12.6.7: a bus error halts the channel, which the DMA
+    // refuses to restart until software writes 1 to its error flag; 12.6.3:
+    // a running channel ignores a trigger; 12.6.2: WRITE_ADDR is live.
+    let ops = accel_move(1000);
+    let mut b = twin();
+    run(&mut b, &ops);
+    assert!(!b.capture_lost());
+    assert_eq!(channels_in_place(&mut b), Vec::<std::string::String>::new());
+    // POUT's channel meets a bus error writing the next move's first word.
+    b.hal_mut()
+        .world
+        .dma
+        .inject(Counter::Pout.index(), pio::BusError::Write);
+    run(&mut b, &ops);
+    assert!(
+        b.capture_lost(),
+        "the halted channel's words are lost, and said so"
+    );
+    // Re-armed: every channel runs, each where the board code reads it.
+    assert_eq!(channels_in_place(&mut b), Vec::<std::string::String>::new());
+    // The next move is captured whole, as the model has it.
+    run(&mut b, &ops);
+    assert!(!b.capture_lost(), "the capture after the re-arm is whole");
+    let mut emu = EmuBus::new(Straps::default(), ModelConfig::default()).expect("model");
+    run(&mut emu, &ops);
+    let (t, e) = (pulse_times(&b), pulse_times(&emu));
+    assert_eq!(t.len(), 1000);
+    let offset = t[0] as i64 - e[0] as i64;
+    for (a, m) in t.iter().zip(&e) {
+        assert!((*a as i64 - *m as i64 - offset).abs() <= 27);
+    }
+    let values = |v: Vec<(u64, u8)>| v.into_iter().map(|(_, x)| x).collect::<Vec<_>>();
+    assert_eq!(values(int_changes(&b)), values(int_changes(&emu)));
+}

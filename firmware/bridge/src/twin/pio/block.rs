@@ -51,6 +51,9 @@ pub struct Sm {
     pub(super) rx: VecDeque<u32>,
     /// Stalled on the last cycle it ran.
     pub stalled: bool,
+    /// Words pushed into the RX FIFO, ever: each a pulse of its DREQ
+    /// (`dma.rs`).
+    pub pushed: u64,
 }
 
 impl Sm {
@@ -73,6 +76,7 @@ impl Sm {
             pinctrl: 5 << pinctrl::SET_COUNT,
             tx: VecDeque::new(),
             rx: VecDeque::new(),
+            pushed: 0,
             stalled: false,
         }
     }

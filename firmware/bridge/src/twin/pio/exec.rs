@@ -171,6 +171,7 @@ impl Block {
                         }
                     } else {
                         sm.rx.push_back(sm.core.isr);
+                        sm.pushed += 1;
                         sm.core.isr = 0;
                         sm.core.isr_count = 0;
                     }

@@ -35,13 +35,17 @@
 //!   its state machines' registers and FIFOs, FDEBUG, forced instructions;
 //! - `exec.rs`: the state machines' instructions, cycle by cycle, and the
 //!   test of whether one is quiet (time may skip ahead);
+//! - `dma.rs`: the DMA block's registers as the board code uses them, and
+//!   its channels' transfers, cycle by cycle;
 //! - `world.rs`: the three blocks, the GPIOs (FUNCSEL, pads, the
 //!   synchroniser), what drives the pins from outside, the DMA channels
 //!   from RX FIFOs to rings, and the run to a cycle.
 
 mod block;
+mod dma;
 mod exec;
 mod world;
 
 pub use block::{Block, LoadError, Sm, Unsupported, WORDS};
-pub use world::{Func, Inputs, Outside, RingDma, World, GPIOS};
+pub use dma::{BusError, Channel, Dma, CHANNELS, RAM};
+pub use world::{Func, Inputs, Outside, World, GPIOS};

@@ -1,10 +1,11 @@
 //! The RP2350's PIO blocks and GPIOs together ([`World`]): each GPIO's
 //! FUNCSEL, the pads settled against what the board drives from outside
 //! ([`Outside`]), the inputs' synchroniser, the DMA channels that move
-//! the counters' words into rings ([`RingDma`]), and the run to a cycle,
+//! the counters' words into rings ([`Dma`]), and the run to a cycle,
 //! skipping ahead where nothing can change.
 
 use super::block::Block;
+use super::dma::Dma;
 use crate::pioregs::{ctrl, SmRegs};
 use std::vec::Vec;
 
@@ -33,24 +34,12 @@ pub trait Outside {
     fn next_change(&mut self, cycle: u64) -> Option<u64>;
 }
 
-/// A DMA channel that moves each word a state machine pushes from its RX
-/// FIFO into a ring, endlessly (`crate::ring`): a word a cycle, the
-/// cycle after it was pushed (its DREQ).
-#[derive(Debug, Clone)]
-pub struct RingDma {
-    pub block: usize,
-    pub sm: usize,
-    pub ring: std::vec::Vec<u32>,
-    /// Where it writes next (`WRITE_ADDR`, as an index).
-    pub write: usize,
-}
-
 /// The RP2350's PIO blocks and GPIOs, and the cycle count.
 #[derive(Debug, Clone)]
 pub struct World {
     pub blocks: [Block; 3],
-    /// DMA channels from RX FIFOs to rings.
-    pub dma: std::vec::Vec<RingDma>,
+    /// The DMA block: channels from RX FIFOs to rings (`dma.rs`).
+    pub dma: Dma,
     pub func: [Func; GPIOS as usize],
     pub sio_out: u64,
     pub sio_oe: u64,
@@ -77,7 +66,7 @@ impl World {
     pub fn new() -> World {
         World {
             blocks: [Block::new(0), Block::new(1), Block::new(2)],
-            dma: std::vec::Vec::new(),
+            dma: Dma::new(),
             func: [Func::Null; GPIOS as usize],
             sio_out: 0,
             sio_oe: 0,
@@ -170,16 +159,7 @@ impl World {
                 self.blocks[b].step(s, seen);
             }
         }
-        for d in &mut self.dma {
-            let b = &mut self.blocks[d.block];
-            if b.rx_level(d.sm) > 0 {
-                if let Some(w) = b.rxf_read(d.sm) {
-                    let n = d.ring.len().max(1);
-                    d.ring[d.write % n] = w;
-                    d.write = (d.write + 1) % n;
-                }
-            }
-        }
+        self.dma.step(&mut self.blocks);
         self.cycle += 1;
         self.stepped += 1;
         self.sync2 = self.sync1;
@@ -212,12 +192,8 @@ impl World {
     /// Skips up to `room` cycles if every state machine is quiet.
     fn skip(&mut self, room: u64) -> bool {
         let seen = self.sync2;
-        // A word a DMA channel has yet to move.
-        if self
-            .dma
-            .iter()
-            .any(|d| self.blocks[d.block].rx_level(d.sm) > 0)
-        {
+        // A word a DMA channel has yet to move, a DREQ to count.
+        if !self.dma.quiet(&self.blocks) {
             return false;
         }
         let mut loops: Vec<(usize, usize, u64, u32)> = Vec::new();
