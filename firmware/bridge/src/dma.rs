@@ -114,6 +114,14 @@ pub trait DmaRegs {
     fn set_ring_word(&mut self, channel: usize, i: usize, value: u32);
 }
 
+/// Reads of CHAN_ABORT, then of BUSY, a re-arm waits at most: the datasheet
+/// says "generally only a few cycles" (12.6.8.3).
+pub const REARM_POLLS: usize = 1_000;
+
+/// A channel that did not stop when aborted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Stuck;
+
 /// One counter's channel: which, and what it moves where.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RingChannel {
@@ -168,6 +176,35 @@ impl RingChannel {
         (RING_WORDS - left.min(RING_WORDS)) % RING_WORDS
     }
 
+    /// Stops the channel and starts it afresh at its ring's start, as the
+    /// datasheet has it for a channel in an unknown state (12.6.8.3, with
+    /// erratum RP2350-E5) and after a bus error (12.6.7.2): EN cleared
+    /// first (without a trigger: alias 1's CTRL), so that the abort's
+    /// completion cannot trigger it again; CHAN_ABORT, polled until its bit
+    /// is clear; BUSY polled low (its transfers in flight flushed); 1
+    /// written to both error flags; then programmed and triggered. Only
+    /// this channel is touched: the others run on where they are (a
+    /// trigger would not restart a running channel, and its WRITE_ADDR is
+    /// live, 12.6.3 and 12.6.2). `Err` if the channel did not stop within
+    /// [`REARM_POLLS`] reads; it is left stopped, not reprogrammed.
+    pub fn rearm(&self, d: &mut impl DmaRegs) -> Result<(), Stuck> {
+        let stopped = self.ctrl() & !ctrl::EN;
+        d.write(self.reg(reg::AL1_CTRL), stopped);
+        d.write(reg::CHAN_ABORT, 1 << self.channel);
+        let aborted = (0..REARM_POLLS).any(|_| d.read(reg::CHAN_ABORT) >> self.channel & 1 == 0);
+        let idle =
+            aborted && (0..REARM_POLLS).any(|_| d.read(self.reg(reg::CTRL_TRIG)) & ctrl::BUSY == 0);
+        if !idle {
+            return Err(Stuck);
+        }
+        d.write(
+            self.reg(reg::AL1_CTRL),
+            stopped | ctrl::READ_ERROR | ctrl::WRITE_ERROR,
+        );
+        self.program(d);
+        Ok(())
+    }
+
     /// Whether the channel moves nothing more: a bus error halted it, or
     /// it is not enabled.
     pub fn halted(&self, d: &mut impl DmaRegs) -> bool {
@@ -197,7 +234,9 @@ impl Rings {
     /// Starts every channel (at boot): each waits for its DREQ, so the
     /// counters need not run.
     pub fn start(&mut self, d: &mut impl DmaRegs) {
-        start_rings(d, &self.channels);
+        for c in &self.channels {
+            c.program(d);
+        }
     }
 
     /// Reader `i` from where its channel writes next, with [`CANARY`] where
@@ -257,21 +296,22 @@ impl Rings {
     }
 
     /// Whether the capture lost words since the last look: a ring the DMA
-    /// came round on, or a channel that stopped (re-armed here: what it
-    /// had not moved is lost).
+    /// came round on, or a channel that stopped. A stopped channel is
+    /// re-armed here ([`RingChannel::rearm`]), alone, and its ring read
+    /// afresh; what it had not moved is lost. One that does not stop is
+    /// tried again at the next look, and lost again.
     pub fn take_lost(&mut self, d: &mut impl DmaRegs) -> bool {
-        let halted = self.channels.iter().any(|c| c.halted(d));
-        if halted {
-            start_rings(d, &self.channels);
+        let mut halted = false;
+        for i in 0..self.channels.len() {
+            let ch = self.channels[i];
+            if ch.halted(d) {
+                halted = true;
+                if ch.rearm(d).is_ok() {
+                    self.restart_reader(d, i);
+                }
+            }
         }
         core::mem::take(&mut self.lost) || halted
-    }
-}
-
-/// Programs and triggers every channel.
-fn start_rings(d: &mut impl DmaRegs, channels: &[RingChannel; 4]) {
-    for c in channels {
-        c.program(d);
     }
 }
 

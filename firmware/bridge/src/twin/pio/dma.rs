@@ -21,10 +21,12 @@
 //!   has; or one a test injects) halts the channel: READ_ERROR or
 //!   WRITE_ERROR set, BUSY low, no more transfers, until software writes 1
 //!   to the flag (12.6.7);
-//! - CHAN_ABORT ends a channel's sequence (its count cleared, BUSY low),
-//!   its bit reading 1 for a few cycles more (12.6.8.3); and, erratum
-//!   RP2350-E5, a channel aborted with EN still set may trigger itself
-//!   again (TRIGGER_SELF) as the abort completes.
+//! - CHAN_ABORT ends a channel's sequence (its count cleared, BUSY low)
+//!   at once: the model has no transfer in flight between cycles (a word
+//!   is read and written in the cycle it is issued), so the bit, which
+//!   on the chip reads 1 until those finish (12.6.8.3), reads 0 again;
+//!   and, erratum RP2350-E5, a channel aborted with EN still set
+//!   triggers itself again (TRIGGER_SELF) as the abort completes.
 //!
 //! What the board code does not use (the other aliases, chaining to
 //! another channel, interrupts, sniffing, byte or halfword transfers,
@@ -59,10 +61,6 @@ pub enum BusError {
 /// CTRL's bits software writes and reads back (EN through SNIFF_EN).
 const CTRL_RW: u32 = 0x03ff_ffff;
 
-/// Cycles a CHAN_ABORT bit reads 1 after the write: transfers in flight
-/// finishing (12.6.8.3: "generally only a few cycles").
-const ABORT_CYCLES: u32 = 3;
-
 /// One channel.
 #[derive(Debug, Clone, Default)]
 pub struct Channel {
@@ -81,8 +79,6 @@ pub struct Channel {
     credit: u32,
     /// The pushes of its DREQ's FIFO counted so far.
     pushes_seen: u64,
-    /// Cycles until its CHAN_ABORT bit reads 0 again.
-    aborting: u32,
     /// A bus error its next transfer meets.
     inject: Option<BusError>,
     /// The RX FIFO (block, state machine) its TREQ_SEL names, if one.
@@ -140,7 +136,7 @@ pub struct Dma {
     pub ch: [Channel; CHANNELS],
     /// RAM regions: (address, words).
     ram: Vec<(u32, Vec<u32>)>,
-    /// The channels a cycle may change: paced by a FIFO, or aborting.
+    /// The channels a cycle may change: those paced by a FIFO.
     active: Vec<usize>,
 }
 
@@ -194,9 +190,8 @@ impl Dma {
     /// A register read by the CPU.
     pub fn read(&self, offset: usize) -> u32 {
         if offset == reg::CHAN_ABORT {
-            return (0..CHANNELS)
-                .filter(|&n| self.ch[n].aborting > 0)
-                .fold(0, |a, n| a | 1 << n);
+            // Every abort is complete (above).
+            return 0;
         }
         if offset >= reg::DBG_CTDREQ {
             let (n, r) = Self::split(offset - reg::DBG_CTDREQ);
@@ -218,7 +213,7 @@ impl Dma {
     pub fn write(&mut self, offset: usize, value: u32, blocks: &[Block; 3]) {
         self.write_reg(offset, value, blocks);
         self.active = (0..CHANNELS)
-            .filter(|&n| self.ch[n].paced_by.is_some() || self.ch[n].aborting > 0)
+            .filter(|&n| self.ch[n].paced_by.is_some())
             .collect();
     }
 
@@ -228,7 +223,6 @@ impl Dma {
                 let c = &mut self.ch[n];
                 c.busy = false;
                 c.count = 0;
-                c.aborting = ABORT_CYCLES;
                 // RP2350-E5: the abort completes the sequence, and a
                 // channel still enabled triggers itself again.
                 if c.ctrl & ctrl::EN != 0 && c.mode() == trans_count::TRIGGER_SELF {
@@ -307,13 +301,12 @@ impl Dma {
         }
     }
 
-    /// Whether a cycle could change anything: a transfer to make, a DREQ
-    /// not yet counted, an abort finishing.
+    /// Whether a cycle could change anything: a transfer to make, or a
+    /// DREQ not yet counted.
     pub fn quiet(&self, blocks: &[Block; 3]) -> bool {
         self.active.iter().all(|&n| {
             let c = &self.ch[n];
-            c.aborting == 0
-                && self.pushes(n, blocks) == c.pushes_seen
+            self.pushes(n, blocks) == c.pushes_seen
                 && !(c.busy && c.ctrl & ctrl::EN != 0 && c.credit > 0)
         })
     }
@@ -325,7 +318,6 @@ impl Dma {
             let n = self.active[k];
             let pushes = self.pushes(n, blocks);
             let c = &mut self.ch[n];
-            c.aborting = c.aborting.saturating_sub(1);
             let new = pushes.saturating_sub(c.pushes_seen);
             c.pushes_seen = pushes;
             c.credit = (c.credit + new.min(63) as u32).min(63);
