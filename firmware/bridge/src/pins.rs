@@ -22,20 +22,22 @@ pub const WR: u32 = 12;
 pub const BUS_COUNT: u32 = 13;
 
 /// The chip's inputs, in `ppmc_core::protocol::Input::ALL`'s order:
-/// L1*..L4*, ALM*, CNP*, AUXI0..3 (GPIO 13-22), through the 74HCT244s.
+/// L1*..L4*, ALM*, CNP*, AUXI0..3 (GPIO 13-22), through the 74AHCT244s.
 pub const INPUTS: [u32; 10] = [13, 14, 15, 16, 17, 18, 19, 20, 21, 22];
-/// RESET* of the chip, through a 74HCT244.
+/// RESET* of the chip, through a 74AHCT244.
 pub const RESET: u32 = 23;
 /// OE* of the 74LVC245s that bring the chip's outputs in (pulled up: the
 /// chip's outputs are cut off until the firmware pulls it low). High
 /// during the self-test, so that the test generator drives the capture
 /// inputs instead of the chip.
 pub const CAPTURE_OE: u32 = 24;
-/// The self-test generator: through 1 kOhm onto the capture inputs of POUT
-/// and INT* (the bridge side of the 74LVC245), which it drives only while
-/// [`CAPTURE_OE`] is high.
+/// The self-test generator: through a 74LVC2G126's two buffers, each with
+/// 1 kOhm, onto the capture inputs of POUT and INT* (the bridge side of the
+/// 74LVC245); the buffers are on only while [`CAPTURE_OE`] is high, so that
+/// nothing joins the two capture nets while the capture runs. Pulled down:
+/// undriven, it puts a low on them.
 pub const TEST_GEN: u32 = 25;
-/// Enables the 74HCT244s' outputs towards the chip (through an N-MOSFET on
+/// Enables the 74AHCT244s' outputs towards the chip (through an N-MOSFET on
 /// their OE*, pulled down at this pin): low while the bridge boots or is
 /// unpowered, when pull-ups and pull-downs on the chip side hold RESET*
 /// low and L1*..L4*, ALM*, CNP* released.

@@ -190,7 +190,7 @@ struct Placed {
 }
 
 impl Placed {
-    /// The library symbol's name without its library: "74HCT244".
+    /// The library symbol's name without its library: "74AHCT244".
     fn part(&self) -> &str {
         self.lib_id.rsplit(':').next().unwrap_or(&self.lib_id)
     }
@@ -562,7 +562,7 @@ impl Netlist {
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Way {
-    /// Bridge to chip, through a 74HCT244 (A in, Y out).
+    /// Bridge to chip, through a 74AHCT244 (A in, Y out).
     ToChip,
     /// Chip to bridge, through a 74LVC245 (A in from the chip, B out).
     FromChip,
@@ -623,11 +623,11 @@ fn gpios() -> Vec<(String, u32)> {
     v
 }
 
-/// The other end of a buffer channel: 1A3 <-> 1Y3 on a 74HCT244, A3 <-> B3
+/// The other end of a buffer channel: 1A3 <-> 1Y3 on a 74AHCT244, A3 <-> B3
 /// on a 74LVC245 or 74LVC8T245. None for a pin that is no channel's end.
 fn channel_partner(part: &str, name: &str) -> Option<String> {
     match part {
-        "74HCT244" => {
+        "74AHCT244" => {
             let (group, rest) = name.split_at(1);
             let n = rest.strip_prefix('A').or_else(|| rest.strip_prefix('Y'))?;
             if !matches!(group, "1" | "2") || !matches!(n, "1" | "2" | "3" | "4") {
@@ -685,7 +685,7 @@ fn check_signal(
         .symbol(&buf_pin.reference)
         .ok_or(format!("{buf_pin}: no such symbol"))?;
     let (want_part, gpio_side) = match way {
-        Way::ToChip => ("74HCT244", 'A'),
+        Way::ToChip => ("74AHCT244", 'A'),
         Way::FromChip => ("74LVC245", 'B'),
         Way::Data => ("74LVC8T245", 'A'),
     };
@@ -696,7 +696,7 @@ fn check_signal(
         ));
     }
     let side_ok = match buf.part() {
-        "74HCT244" => buf_pin.name.chars().nth(1) == Some(gpio_side),
+        "74AHCT244" => buf_pin.name.chars().nth(1) == Some(gpio_side),
         _ => buf_pin.name.starts_with(gpio_side),
     };
     if !side_ok {
@@ -877,9 +877,10 @@ fn the_control_pins_reach_their_parts() {
     let net = |p: &PinRef| nl.net(p).map(str::to_string).unwrap_or_else(|e| e);
     let set = |v: Vec<PinRef>| v.into_iter().collect::<BTreeSet<PinRef>>();
     let shifter = nl.only("74LVC8T245").expect("one 74LVC8T245");
-    let hcts = nl.all("74HCT244");
+    let hcts = nl.all("74AHCT244");
     let lvcs = nl.all("74LVC245");
     let fet = nl.only("Q_NMOS_GSD").expect("one N-MOSFET");
+    let tg_buf = nl.only("74LVC2G126").expect("one 74LVC2G126");
     let mut expect_active = |what: &str, net: &str, want: BTreeSet<PinRef>| {
         let got = nl.active(net);
         if got != want {
@@ -907,13 +908,17 @@ fn the_control_pins_reach_their_parts() {
             nl.pin(shifter, "DIR").expect("DIR"),
         ]),
     );
-    // CAPTURE_OE: OE* of every 74LVC245, pulled up to 3.3 V.
+    // CAPTURE_OE: OE* of every 74LVC245 (low: on), and OE of both of the
+    // 74LVC2G126's buffers (high: on), pulled up to 3.3 V: TEST_GEN reaches
+    // the capture inputs only while the chip's outputs are cut off.
     let oe_net = net(&gp(pins::CAPTURE_OE));
     let mut want = vec![gp(pins::CAPTURE_OE)];
     want.extend(lvcs.iter().map(|u| nl.pin(u, "OE*").expect("OE*")));
+    want.push(nl.pin(tg_buf, "1OE").expect("1OE"));
+    want.push(nl.pin(tg_buf, "2OE").expect("2OE"));
     expect_active("CAPTURE_OE", &oe_net, set(want));
     // DRIVE_EN: the MOSFET's gate (pulled down); its drain holds OE* of every
-    // 74HCT244 (pulled up to the chip's 5 V); its source is on GND.
+    // 74AHCT244 (pulled up to the chip's 5 V); its source is on GND.
     let en_net = net(&gp(pins::DRIVE_EN));
     expect_active(
         "DRIVE_EN",
@@ -927,28 +932,50 @@ fn the_control_pins_reach_their_parts() {
         want.push(nl.pin(u, "1OE*").expect("1OE*"));
         want.push(nl.pin(u, "2OE*").expect("2OE*"));
     }
-    expect_active("the 74HCT244s' OE*", &drain_net, set(want));
-    // TEST_GEN: two 1 kOhm resistors, to POUT's and INT*'s capture inputs.
+    expect_active("the 74AHCT244s' OE*", &drain_net, set(want));
+    // TEST_GEN: the inputs of the 74LVC2G126's two buffers, each buffer's
+    // output through 1 kOhm to one capture input (1Y to POUT's, 2Y to
+    // INT*'s), so that nothing joins the two capture nets: TEST_GEN's
+    // resistors straight to both (earlier revisions) joined them through
+    // 2 kOhm whenever TEST_GEN was undriven.
     let tg_net = net(&gp(pins::TEST_GEN));
-    expect_active("TEST_GEN", &tg_net, set(vec![gp(pins::TEST_GEN)]));
-    let mut ends: Vec<(String, String)> = nl.across(&tg_net, "R");
-    ends.sort_by(|a, b| a.1.cmp(&b.1));
-    let mut want_ends = vec![net(&gp(pins::POUT)), net(&gp(pins::INT))];
-    want_ends.sort();
-    let got_ends: Vec<String> = ends.iter().map(|(_, n)| n.clone()).collect();
-    if got_ends != want_ends {
-        problems.push(format!(
-            "TEST_GEN's resistors end on {got_ends:?}, not on POUT's and INT*'s GPIO nets {want_ends:?}"
-        ));
-    }
-    for (r, _) in &ends {
-        let value = nl.symbol(r).map(|s| s.value.clone()).unwrap_or_default();
-        if value != "1k" {
-            problems.push(format!(
-                "{r} from TEST_GEN is {value}, not 1k: the 74LVC245s must win"
-            ));
+    expect_active(
+        "TEST_GEN",
+        &tg_net,
+        set(vec![
+            gp(pins::TEST_GEN),
+            nl.pin(tg_buf, "1A").expect("1A"),
+            nl.pin(tg_buf, "2A").expect("2A"),
+        ]),
+    );
+    let mut extra = Vec::new();
+    for (out, signal, g) in [("1Y", "POUT", pins::POUT), ("2Y", "INT*", pins::INT)] {
+        let y = nl.pin(tg_buf, out).expect("an output");
+        let y_net = net(&y);
+        expect_active(&format!("the 74LVC2G126's {out}"), &y_net, set(vec![y]));
+        let ends = nl.across(&y_net, "R");
+        match ends.as_slice() {
+            [(r, end)] if *end == net(&gp(g)) => {
+                let value = nl.symbol(r).map(|s| s.value.clone()).unwrap_or_default();
+                if value != "1k" {
+                    extra.push(format!(
+                        "{r} from the 74LVC2G126's {out} is {value}, not 1k: a firmware that drove TEST_GEN with the capture on would meet the 74LVC245s"
+                    ));
+                }
+            }
+            other => extra.push(format!(
+                "the 74LVC2G126's {out} reaches {other:?} through resistors, not {signal}'s GPIO net alone"
+            )),
         }
     }
+    if nl
+        .across(&tg_net, "R")
+        .iter()
+        .any(|(_, end)| *end == net(&gp(pins::POUT)) || *end == net(&gp(pins::INT)))
+    {
+        extra.push("a resistor joins TEST_GEN to a capture input directly".into());
+    }
+    problems.extend(extra);
     if nl.net(&nl.pin(fet, "S").expect("S")).ok() != Some(GND) {
         problems.push("the MOSFET's source is not on GND".into());
     }
@@ -967,7 +994,7 @@ fn the_control_pins_reach_their_parts() {
     report("the control pins", problems);
 }
 
-/// While DRIVE_EN is low or the bridge is off, the 74HCT244s are off and
+/// While DRIVE_EN is low or the bridge is off, the 74AHCT244s are off and
 /// resistors hold the chip's inputs: RESET* low, every other one high.
 #[test]
 fn the_chip_is_held_safe_while_the_bridge_boots_or_is_off() {
@@ -996,12 +1023,20 @@ fn the_chip_is_held_safe_while_the_bridge_boots_or_is_off() {
             ));
         }
     };
-    want_pull("the 74HCT244s' OE*", &net_of_pin(fet, "D"), V5_CHIP);
+    want_pull("the 74AHCT244s' OE*", &net_of_pin(fet, "D"), V5_CHIP);
     want_pull("DRIVE_EN", &net_of_pin(fet, "G"), GND);
     want_pull(
         "CAPTURE_OE",
         &net_of_pin(module, &format!("GP{}", pins::CAPTURE_OE)),
         V3,
+    );
+    // TEST_GEN is undriven but in the self-test, and the 74LVC2G126 is on
+    // whenever the capture is off (the bridge booting, too): held low, its
+    // inputs do not float.
+    want_pull(
+        "TEST_GEN",
+        &net_of_pin(module, &format!("GP{}", pins::TEST_GEN)),
+        GND,
     );
     want_pull(
         "SHIFT_DIR",
@@ -1036,9 +1071,10 @@ fn farads(value: &str) -> Option<f64> {
 fn every_ic_has_its_supplies_and_a_decoupling_capacitor() {
     let nl = load();
     let mut problems = Vec::new();
-    let supplies: [(&str, &[(&str, &str)]); 4] = [
-        ("74HCT244", &[("VCC", V5_CHIP)]),
+    let supplies: [(&str, &[(&str, &str)]); 5] = [
+        ("74AHCT244", &[("VCC", V5_CHIP)]),
         ("74LVC245", &[("VCC", V3)]),
+        ("74LVC2G126", &[("VCC", V3)]),
         ("74LVC8T245", &[("VCCA", V3), ("VCCB", V5_CHIP)]),
         ("PGA2350", &[("VB", VBUS), ("3V3", V3)]),
     ];
@@ -1340,4 +1376,53 @@ fn the_usb_socket_and_the_buttons_reach_the_module() {
         }
     }
     report("USB and the buttons", problems);
+}
+
+/// The PGA2350 symbol's pin numbers are hardware/README.md's table of the
+/// module's pins (traced from Pimoroni's pinout diagram), pin by pin: a
+/// layout drawn from the symbol puts every signal where the module has it.
+#[test]
+fn the_modules_pins_are_where_the_readmes_table_puts_them() {
+    let nl = load();
+    let module = nl.only("PGA2350").expect("one PGA2350");
+    let readme = read("hardware/README.md");
+    let section = readme
+        .split("\n## ")
+        .find(|s| s.starts_with("The PGA2350's pins"))
+        .expect("hardware/README.md has a section \"## The PGA2350's pins\"");
+    let mut from_doc: BTreeMap<String, String> = BTreeMap::new();
+    for line in section.lines().filter(|l| l.starts_with('|')) {
+        let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+        let Some((row, pins)) = cells.split_first() else {
+            continue;
+        };
+        if row.len() != 1 || !row.chars().all(|c| c.is_ascii_uppercase()) {
+            continue;
+        }
+        for (col, name) in pins.iter().enumerate() {
+            if !name.is_empty() {
+                from_doc.insert(format!("{row}{}", col + 1), name.to_string());
+            }
+        }
+    }
+    assert_eq!(from_doc.len(), 64, "the table names 64 pins");
+    let from_sch: BTreeMap<String, String> = module
+        .pins
+        .iter()
+        .map(|(n, name, _)| (n.clone(), name.clone()))
+        .collect();
+    let mut problems = Vec::new();
+    for (pin, name) in &from_sch {
+        match from_doc.get(pin) {
+            Some(d) if d == name => {}
+            Some(d) => problems.push(format!("pin {pin}: {name} in the symbol, {d} in the table")),
+            None => problems.push(format!("pin {pin} ({name}) is not in the table")),
+        }
+    }
+    for (pin, name) in from_doc.iter().filter(|(p, _)| !from_sch.contains_key(*p)) {
+        problems.push(format!(
+            "pin {pin} ({name}) is in the table but not on the symbol"
+        ));
+    }
+    report("the PGA2350's pins", problems);
 }
