@@ -1426,3 +1426,59 @@ fn the_modules_pins_are_where_the_readmes_table_puts_them() {
     }
     report("the PGA2350's pins", problems);
 }
+
+/// The wiring table of docs/bridge-hardware.md ("A bridge from
+/// off-the-shelf parts") as the netlist gives it: a row a net, every point
+/// on it. The module's pins are named by GPIO (a breakout or core board
+/// labels them so), the others `part.pin`. What a person wires by hand is
+/// then the schematic, which the other tests hold to `pins.rs`.
+fn wiring_table(nl: &Netlist) -> String {
+    let mut out = String::from("| net | wire together |\n|---|---|\n");
+    for (net, pins) in &nl.nets {
+        // In natural order: R2 before R10, U1.2 before U1.10.
+        let natural = |t: &str| {
+            let digits = t.trim_start_matches(|c: char| !c.is_ascii_digit());
+            let n = digits.parse::<u32>().unwrap_or(0);
+            (t[..t.len() - digits.len()].to_string(), n)
+        };
+        let mut points: Vec<((String, u32), (String, u32), String)> = pins
+            .iter()
+            .map(|p| match nl.symbol(&p.reference).map(Placed::part) {
+                Some("PGA2350") => (
+                    (String::new(), 0),
+                    natural(&p.name),
+                    format!("module {}", p.name),
+                ),
+                _ => (
+                    natural(&p.reference),
+                    natural(&p.number),
+                    format!("{}.{}", p.reference, p.number),
+                ),
+            })
+            .collect();
+        points.sort();
+        let points: Vec<String> = points.into_iter().map(|(_, _, t)| t).collect();
+        out += &format!("| `{net}` | {} |\n", points.join(", "));
+    }
+    out
+}
+
+#[test]
+fn the_wiring_table_is_the_schematics_netlist() {
+    let nl = load();
+    let want = wiring_table(&nl);
+    let doc = read("docs/bridge-hardware.md");
+    let (begin, end) = (
+        "<!-- wiring table: begin -->\n",
+        "<!-- wiring table: end -->",
+    );
+    let got = doc
+        .split_once(begin)
+        .and_then(|(_, rest)| rest.split_once(end))
+        .map(|(table, _)| table)
+        .expect("docs/bridge-hardware.md has the wiring table between its two markers");
+    assert!(
+        got == want,
+        "docs/bridge-hardware.md's wiring table differs from the schematic's netlist; the netlist's:\n{want}"
+    );
+}
