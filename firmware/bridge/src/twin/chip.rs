@@ -2,7 +2,7 @@
 //! `docs/bridge-hardware.md`, and the reference chip model behind them,
 //! pin by pin.
 //!
-//! - Towards the chip, the 74HCT244s pass A0, CS*, RD*, WR*, the inputs and
+//! - Towards the chip, the 74AHCT244s pass A0, CS*, RD*, WR*, the inputs and
 //!   RESET* only while DRIVE_EN is high; otherwise the chip side's pulls
 //!   hold CS*, RD*, WR* and the inputs high and RESET* low. A line the
 //!   RP2350 leaves undriven while the buffers pass it floats: counted in
@@ -15,7 +15,9 @@
 //!   CS* low until RD* or CS* rises (A0 high: status), Section 3-1.
 //! - The chip's outputs reach GPIO 32-45 through the 74LVC245s while
 //!   CAPTURE_OE is low; while it is high (or undriven: pulled up) they are
-//!   cut off, and TEST_GEN drives the POUT and INT* nets through 1 kOhm.
+//!   cut off, and TEST_GEN drives the POUT and INT* nets through the
+//!   74LVC2G126 that CAPTURE_OE enables and 1 kOhm each (low while TEST_GEN
+//!   is undriven: its pull-down).
 //! - POUT pulses are 1 us wide (the chapter does not give their width;
 //!   the edge counters only need a few cycles of each level).
 
@@ -216,7 +218,7 @@ impl ChipSide {
 
 impl Outside for ChipSide {
     fn drive(&mut self, cycle: u64, out: u64, oe: u64) -> (u64, u64) {
-        // What the 74HCT244s pass to the chip.
+        // What the 74AHCT244s pass to the chip.
         let drive_en = bit(oe, pins::DRIVE_EN) && bit(out, pins::DRIVE_EN);
         let buffered = |g: u32, safe: bool, floating: &mut u64| -> bool {
             if !drive_en {
@@ -334,8 +336,10 @@ impl Outside for ChipSide {
             let pout = u64::from(cycle < self.pout_until) << pins::POUT;
             levels |= (self.outputs | pout) & chip_nets;
             driven |= chip_nets;
-        } else if bit(oe, pins::TEST_GEN) {
-            let g = bit(out, pins::TEST_GEN);
+        } else {
+            // The 74LVC2G126 is on: it passes TEST_GEN, or the low its
+            // pull-down holds when the RP2350 does not drive it.
+            let g = bit(oe, pins::TEST_GEN) && bit(out, pins::TEST_GEN);
             let nets = 1u64 << pins::POUT | 1 << pins::INT;
             if g {
                 levels |= nets;
