@@ -958,3 +958,24 @@ fn the_twins_dma_follows_the_datasheets_trigger_error_and_abort_rules() {
     assert!(running(d));
     assert_eq!(d.read(reg::ch(n, reg::WRITE_ADDR)), ch.ring);
 }
+
+#[test]
+fn defect_6_b_an_undriven_pad_with_no_pull_floats() {
+    // RP2350 datasheet, the pads (a pad that nothing drives and neither
+    // pull holds is left floating) and erratum RP2350-E9 (such an input
+    // drifts): HOLD's capture input with the 74LVC245s off and no pull-up
+    // must not read one level for ever, as a bus hold would keep it.
+    let mut w = World::new();
+    let mut nothing = Inputs(|_, _, _| (0u64, 0u64));
+    let mut levels = std::collections::BTreeSet::new();
+    for _ in 0..64 {
+        let until = w.cycle + 20_000;
+        w.run_until(until, &mut nothing);
+        levels.insert(w.pads() >> pins::HOLD & 1);
+    }
+    assert_eq!(
+        levels.len(),
+        2,
+        "HOLD's pad, undriven and unpulled, kept one level for 1.28 M cycles"
+    );
+}
