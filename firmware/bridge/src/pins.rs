@@ -57,6 +57,14 @@ pub const AUX: u32 = 36;
 pub const S: [u32; 5] = [37, 38, 39, 40, 41];
 /// AUXO0..3, sampled (GPIO 42-45).
 pub const AUXO: [u32; 4] = [42, 43, 44, 45];
+/// The capture inputs that nothing drives during the self-test, when the
+/// 74LVC245s' outputs are off (POUT's and INT*'s are the generator's):
+/// pulled up meanwhile, so that they hold still (a floating input drifts,
+/// RP2350-E9; both the image and the board twin pull them).
+pub const SELF_TEST_PULLED: [u32; 12] = [
+    DIR, HOLD, AUX, S[0], S[1], S[2], S[3], S[4], AUXO[0], AUXO[1], AUXO[2], AUXO[3],
+];
+
 /// The CSEL strap, sensed at boot through a spare channel of the
 /// 74LVC245 (GPIO 46 is an ADC pin of the RP2350B, not 5 V tolerant).
 pub const CSEL: u32 = 46;

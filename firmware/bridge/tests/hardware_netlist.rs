@@ -1441,7 +1441,9 @@ fn wiring_table(nl: &Netlist) -> String {
             let n = digits.parse::<u32>().unwrap_or(0);
             (t[..t.len() - digits.len()].to_string(), n)
         };
-        let mut points: Vec<((String, u32), (String, u32), String)> = pins
+        // (the part's sort key, the pin's, the point as written)
+        type Entry = ((String, u32), (String, u32), String);
+        let mut points: Vec<Entry> = pins
             .iter()
             .map(|p| match nl.symbol(&p.reference).map(Placed::part) {
                 Some("PGA2350") => (

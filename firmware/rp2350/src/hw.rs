@@ -235,11 +235,7 @@ impl Rp2350 {
     /// off, so that they hold still (RP2350-E9: a floating input pad
     /// drifts; a pull-up still holds it); off again after.
     fn hold_undriven(on: bool) {
-        let undriven = [pins::DIR, pins::HOLD, pins::AUX]
-            .into_iter()
-            .chain(pins::S)
-            .chain(pins::AUXO);
-        for g in undriven {
+        for g in pins::SELF_TEST_PULLED {
             pac::PADS_BANK0.gpio(g as usize).modify(|w| {
                 w.set_pue(on);
                 w.set_pde(false);

@@ -364,7 +364,12 @@ impl Hal for Twin {
     fn gen_connect(&mut self, on: bool) {
         let g = pioregs::TEST_GEN_SM;
         self.spend(self.cpu_cycles);
+        let pulled = pins::SELF_TEST_PULLED.iter().fold(0u64, |m, g| m | 1 << g);
         if on {
+            // As the image: the pull-ups first, then the buffers off.
+            self.world.pull_up |= pulled;
+            self.world.cpu_wrote(&mut self.chip);
+            self.spend(self.cpu_cycles);
             self.world.sio_out |= 1 << pins::CAPTURE_OE;
             self.world.cpu_wrote(&mut self.chip);
             self.spend(self.cpu_cycles);
@@ -377,6 +382,9 @@ impl Hal for Twin {
             self.world.cpu_wrote(&mut self.chip);
             self.spend(self.cpu_cycles);
             self.world.sio_out &= !(1 << pins::CAPTURE_OE);
+            self.world.cpu_wrote(&mut self.chip);
+            self.spend(self.cpu_cycles);
+            self.world.pull_up &= !pulled;
         }
         self.world.cpu_wrote(&mut self.chip);
     }

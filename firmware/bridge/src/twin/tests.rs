@@ -342,7 +342,8 @@ fn idle_pushes(words: &[u16], regs: &pioregs::SmRegs, x: u32, cycles: u64) -> us
     // X as a long run leaves it (`set x` takes 5 bits only).
     w.blocks[1].sm[0].set_x(x);
     let mut n = 0;
-    let mut outside = Inputs(|_, _, _| (0, 1 << pins::POUT | 0xFFFF << 16));
+    // Every input driven low: no edge at all (an undriven one would float).
+    let mut outside = Inputs(|_, _, _| (0, 0xFFFF_FFFF << 16));
     for _ in 0..cycles {
         w.step(&mut outside);
         while w.pull(1, 0).is_some() {
@@ -978,4 +979,33 @@ fn defect_6_b_an_undriven_pad_with_no_pull_floats() {
         2,
         "HOLD's pad, undriven and unpulled, kept one level for 1.28 M cycles"
     );
+}
+
+#[test]
+fn a_pull_holds_an_undriven_pad_and_the_self_test_pulls_what_it_leaves_undriven() {
+    // The pads' pulls (PADS_BANK0 PUE/PDE): an undriven pad reads its
+    // pull, and the board code pulls up every capture input the self-test
+    // leaves undriven (pins::SELF_TEST_PULLED), as the image does.
+    let mut w = World::new();
+    w.pull_up |= 1 << pins::HOLD;
+    w.pull_down |= 1 << pins::AUX;
+    let mut nothing = Inputs(|_, _, _| (0u64, 0u64));
+    for _ in 0..16 {
+        let until = w.cycle + 20_000;
+        w.run_until(until, &mut nothing);
+        assert_eq!(w.pads() >> pins::HOLD & 1, 1, "pulled up");
+        assert_eq!(w.pads() >> pins::AUX & 1, 0, "pulled down");
+    }
+    let mut b = twin();
+    let hw = b.hal_mut();
+    hw.gen_connect(true);
+    for g in pins::SELF_TEST_PULLED {
+        assert_eq!(
+            hw.world.pull_up >> g & 1,
+            1,
+            "GPIO {g} pulled up in the self-test"
+        );
+    }
+    hw.gen_connect(false);
+    assert_eq!(hw.world.pull_up, 0, "and released after it");
 }

@@ -12,6 +12,18 @@ use std::vec::Vec;
 /// GPIOs of an RP2350B.
 pub const GPIOS: u32 = 48;
 
+/// The pads whose floating the twin models: those the board code reads
+/// (the capture inputs, GPIO 32-46, and VSEL's, GPIO 27). A pad nobody
+/// reads (GPIO 28-31, 47) is left at its level, as if held: what it reads
+/// changes nothing.
+pub const READ_PADS: u64 = 0x7FFF << 32 | 1 << 27;
+
+/// Cycles a floating pad keeps a level: it then reads a level of its own,
+/// drawn afresh every such span (a model's choice: the datasheet gives no
+/// rate for a floating input's drift, RP2350-E9, only that it is not
+/// held).
+pub const DRIFT_CYCLES: u64 = 1 << 14;
+
 /// What a GPIO's output comes from (its FUNCSEL).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Func {
@@ -43,6 +55,13 @@ pub struct World {
     pub func: [Func; GPIOS as usize],
     pub sio_out: u64,
     pub sio_oe: u64,
+    /// The pads' pull-ups and pull-downs (PADS_BANK0 GPIOx PUE, PDE): a
+    /// pad nothing drives reads its pull, floats with none, and keeps
+    /// its level with both (the bus keeper).
+    pub pull_up: u64,
+    pub pull_down: u64,
+    /// The pads that float now (no driver, no pull, read by the board).
+    floating: u64,
     /// Pad levels now, and one and two cycles ago (the synchroniser).
     pads: u64,
     sync1: u64,
@@ -70,6 +89,9 @@ impl World {
             func: [Func::Null; GPIOS as usize],
             sio_out: 0,
             sio_oe: 0,
+            pull_up: 0,
+            pull_down: 0,
+            floating: 0,
             pads: 0,
             sync1: 0,
             sync2: 0,
@@ -141,14 +163,41 @@ impl World {
     fn settle(&mut self, outside: &mut dyn Outside) {
         let (out, oe) = self.driven();
         let (ext, ext_driven) = outside.drive(self.cycle, out, oe);
-        // A pad nobody drives keeps its level (bus hold); one both sides
-        // drive reads what the RP2350 drives (the outside reports the
-        // contention itself).
-        let pads = (out & oe) | (ext & ext_driven & !oe) | (self.pads & !oe & !ext_driven);
+        // A pad nobody drives reads its pull, keeps its level with both
+        // pulls (the bus keeper) or when nobody reads it, and floats
+        // otherwise; one both sides drive reads what the RP2350 drives
+        // (the outside reports the contention itself).
+        let undriven = !oe & !ext_driven;
+        let up = undriven & self.pull_up & !self.pull_down;
+        let kept = undriven & (self.pull_up & self.pull_down | !READ_PADS);
+        self.floating = undriven & !self.pull_up & !self.pull_down & READ_PADS;
+        let drift = if self.floating != 0 { self.drift() } else { 0 };
+        let pads = (out & oe)
+            | (ext & ext_driven & !oe)
+            | up
+            | (self.pads & kept)
+            | (drift & self.floating);
         if pads != self.pads {
             self.steady = 0;
         }
         self.pads = pads;
+    }
+
+    /// What each floating pad reads in this span of [`DRIFT_CYCLES`]:
+    /// drawn from the pad's number and the span's (a hash), so that runs
+    /// repeat.
+    fn drift(&self) -> u64 {
+        let span = self.cycle / DRIFT_CYCLES;
+        let mut x = span.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
+        x ^= x >> 31;
+        x = x.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        x ^= x >> 29;
+        x
+    }
+
+    /// The next cycle at which a floating pad may read another level.
+    fn next_drift(&self) -> Option<u64> {
+        (self.floating != 0).then(|| (self.cycle / DRIFT_CYCLES + 1) * DRIFT_CYCLES)
     }
 
     /// One system clock cycle.
@@ -180,6 +229,8 @@ impl World {
                 let horizon = outside
                     .next_change(self.cycle)
                     .map_or(until, |c| c.min(until));
+                // A floating pad drifts at a span's end.
+                let horizon = self.next_drift().map_or(horizon, |d| d.min(horizon));
                 if horizon > self.cycle + 8 && self.skip(horizon - self.cycle) {
                     self.settle(outside);
                     continue;
