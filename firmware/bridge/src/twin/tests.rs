@@ -1009,3 +1009,34 @@ fn a_pull_holds_an_undriven_pad_and_the_self_test_pulls_what_it_leaves_undriven(
     hw.gen_connect(false);
     assert_eq!(hw.world.pull_up, 0, "and released after it");
 }
+
+#[test]
+fn a_re_armed_channel_moves_the_words_its_fifo_still_holds() {
+    // RP2350 datasheet 12.6.7.3: a faulting read is suppressed, so its word
+    // stays in the FIFO, yet it took its DREQ credit when it was issued
+    // (12.6.4.2). The re-arm must start the DREQ handshake afresh
+    // (DBG_CTDREQ), or the words the FIFO holds wait for the next push.
+    use crate::dma::{counter_channel, DmaRegs};
+    let mut t = Twin::new(Straps::default(), ModelConfig::default()).expect("boots");
+    let c = Counter::Int;
+    let (b, s) = pioregs::counter_sm(c);
+    let ch = counter_channel(c, ring_addr(c.index()));
+    t.world.dma.inject(ch.channel, pio::BusError::Read);
+    t.world.blocks[b].push_rx(s, 0x1234_5678);
+    t.world.dma.step(&mut t.world.blocks);
+    assert_eq!(
+        t.world.blocks[b].rx_level(s),
+        1,
+        "the faulting read took nothing"
+    );
+    ch.rearm(&mut TwinDma(&mut t.world)).expect("stops");
+    for _ in 0..4 {
+        t.world.dma.step(&mut t.world.blocks);
+    }
+    assert_eq!(
+        t.world.blocks[b].rx_level(s),
+        0,
+        "the word still in the FIFO was moved after the re-arm"
+    );
+    assert_eq!(TwinDma(&mut t.world).ring_word(ch.channel, 0), 0x1234_5678);
+}

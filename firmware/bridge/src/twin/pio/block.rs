@@ -316,6 +316,13 @@ impl Block {
         w
     }
 
+    /// Puts `word` in the RX FIFO of `s` as a `push` would (a DREQ pulse
+    /// with it): for tests of what takes words from it.
+    pub fn push_rx(&mut self, s: usize, word: u32) {
+        self.sm[s].rx.push_back(word);
+        self.sm[s].pushed += 1;
+    }
+
     /// FSTAT.TXFULL of `s`.
     pub fn tx_full(&self, s: usize) -> bool {
         self.sm[s].tx.len() >= self.sm[s].tx_depth()
