@@ -182,7 +182,10 @@ impl RingChannel {
     /// first (without a trigger: alias 1's CTRL), so that the abort's
     /// completion cannot trigger it again; CHAN_ABORT, polled until its bit
     /// is clear; BUSY polled low (its transfers in flight flushed); 1
-    /// written to both error flags; then programmed and triggered. Only
+    /// written to both error flags; its DREQ handshake started afresh
+    /// (DBG_CTDREQ: a faulting read was suppressed but took its credit,
+    /// 12.6.7.3 and 12.6.4.2, so the count no longer matches what the FIFO
+    /// holds); then programmed and triggered. Only
     /// this channel is touched: the others run on where they are (a
     /// trigger would not restart a running channel, and its WRITE_ADDR is
     /// live, 12.6.3 and 12.6.2). `Err` if the channel did not stop within
@@ -201,6 +204,7 @@ impl RingChannel {
             self.reg(reg::AL1_CTRL),
             stopped | ctrl::READ_ERROR | ctrl::WRITE_ERROR,
         );
+        d.write(self.reg(reg::DBG_CTDREQ), 0);
         self.program(d);
         Ok(())
     }
@@ -299,16 +303,19 @@ impl Rings {
     /// came round on, or a channel that stopped. A stopped channel is
     /// re-armed here ([`RingChannel::rearm`]), alone, and its ring read
     /// afresh; what it had not moved is lost. One that does not stop is
-    /// tried again at the next look, and lost again.
+    /// tried again at the next look, and lost again (its ring read afresh
+    /// each time, so that nothing stale is read meanwhile).
     pub fn take_lost(&mut self, d: &mut impl DmaRegs) -> bool {
         let mut halted = false;
         for i in 0..self.channels.len() {
             let ch = self.channels[i];
             if ch.halted(d) {
                 halted = true;
-                if ch.rearm(d).is_ok() {
-                    self.restart_reader(d, i);
-                }
+                // Stopped or not, the channel's count no longer says where
+                // its ring was written: read it afresh, so that no word of
+                // a lap ago passes for a new one.
+                let _ = ch.rearm(d);
+                self.restart_reader(d, i);
             }
         }
         core::mem::take(&mut self.lost) || halted

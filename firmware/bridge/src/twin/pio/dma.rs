@@ -13,7 +13,10 @@
 //!   one, and one with an error flag set ignore it (12.6.3, 12.6.7.1);
 //! - each transfer spends one of the channel's DREQ credits: a push into
 //!   the RX FIFO its TREQ_SEL names is one more, at most 63 (12.6.4.2);
-//!   writing DBG_CTDREQ clears them; a channel with none moves nothing;
+//!   writing DBG_CTDREQ clears them and starts the handshake afresh, which
+//!   the twin takes to count the words the FIFO holds then (the datasheet
+//!   says only "re-initiate DREQ handshake"); a channel with none moves
+//!   nothing;
 //! - one word a cycle a channel: read from a PIO RX FIFO (an empty one
 //!   reads 0: the channel and the FIFO out of step), written to RAM, the
 //!   write address wrapped at 2^RING_SIZE bytes when RING_SEL is set;
@@ -234,8 +237,13 @@ impl Dma {
         if offset >= reg::DBG_CTDREQ {
             let (n, r) = Self::split(offset - reg::DBG_CTDREQ);
             assert_eq!(r, 0, "DMA debug register {offset:#x} is not modelled");
-            self.ch[n].credit = 0;
-            self.ch[n].pushes_seen = self.pushes(n, blocks);
+            // The handshake afresh: the FIFO's words are the credits.
+            let pushes = self.pushes(n, blocks);
+            let c = &mut self.ch[n];
+            c.credit = c
+                .paced_by
+                .map_or(0, |(b, s)| blocks[b].rx_level(s).min(63) as u32);
+            c.pushes_seen = pushes;
             return;
         }
         let (n, r) = Self::split(offset);
