@@ -16,7 +16,10 @@
 //! (Until issue 28 both counters shared PIO1: 13 + 23 words, which
 //! embassy-rp's `load_program` refuses with a panic at boot.)
 
-use pio::Program;
+use pio::{
+    Assembler, InSource, JmpCondition, MovDestination, MovOperation, MovSource, OutDestination,
+    Program, SetDestination, SideSet,
+};
 
 /// Instructions a PIO block holds.
 pub const SIZE: usize = 32;
@@ -82,24 +85,29 @@ impl Loaded {
 /// takes effect even while `pull` stalls. It costs no cycle; the price is
 /// the delay field, which side-set takes whole (the program uses none).
 pub fn bus_player() -> Loaded {
-    let p = pio::pio_asm!(
-        ".side_set 5 pindirs",
-        ".wrap_target",
-        "step:",
-        "    pull block         side 0b11111",
-        "    out pindirs, 8     side 0b11111",
-        "    out pins, 13       side 0b11111",
-        "    out y, 1           side 0b11111",
-        "    out x, 10          side 0b11111",
-        "hold:",
-        "    jmp x-- hold       side 0b11111",
-        "    jmp !y step        side 0b11111",
-        "    in pins, 8         side 0b11111",
-        "    push block         side 0b11111",
-        ".wrap",
+    let s = PLAYER_SIDE;
+    let mut a = Assembler::<SIZE>::new_with_side_set(SideSet::new(false, 5, true));
+    let (mut wrap_target, mut wrap_source) = (a.label(), a.label());
+    let (mut step, mut hold) = (a.label(), a.label());
+    a.bind(&mut wrap_target);
+    a.bind(&mut step);
+    a.pull_with_side_set(false, true, s);
+    a.out_with_side_set(OutDestination::PINDIRS, 8, s);
+    a.out_with_side_set(OutDestination::PINS, 13, s);
+    a.out_with_side_set(OutDestination::Y, 1, s);
+    a.out_with_side_set(OutDestination::X, 10, s);
+    a.bind(&mut hold);
+    a.jmp_with_side_set(JmpCondition::XDecNonZero, &mut hold, s);
+    a.jmp_with_side_set(JmpCondition::YIsZero, &mut step, s);
+    a.in_with_side_set(InSource::PINS, 8, s);
+    a.push_with_side_set(false, true, s);
+    a.bind(&mut wrap_source);
+    Loaded::new(
+        a.assemble_with_wrap(wrap_source, wrap_target),
+        0,
+        0,
+        Some(PLAYER_SIDE),
     )
-    .program;
-    Loaded::new(p, 0, 0, Some(PLAYER_SIDE))
 }
 
 /// The bus player's side-set: A0, CS*, DIR, RD* and WR* driven.
@@ -137,72 +145,55 @@ pub const PLAYER_SIDE: u8 = 0b11111;
 /// The chip's outputs change microseconds apart; `ppmc selftest` makes no
 /// level shorter than 18 cycles.
 pub fn edge_counter(rising_only: bool) -> Loaded {
+    let mut a = Assembler::<SIZE>::new();
+    let (mut wrap_target, mut wrap_source) = (a.label(), a.label());
+    let (mut rise, mut still_high, mut high, mut low) =
+        (a.label(), a.label(), a.label(), a.label());
+    let next = |a: &mut Assembler<SIZE>| {
+        // `jmp x-- next`: the next instruction either way.
+        let mut l = a.label();
+        a.jmp(JmpCondition::XDecNonZero, &mut l);
+        a.bind(&mut l);
+    };
+    a.bind(&mut rise);
+    next(&mut a);
     if rising_only {
-        let p = pio::pio_asm!(
-            "rise:",
-            "    jmp x-- r1",
-            "r1:",
-            "    in pins, 1",
-            "    jmp x-- r2",
-            "r2:",
-            "    in x, 31",
-            "    jmp x-- r3",
-            "r3:",
-            "    push block",
-            "still_high:",
-            "    jmp x-- high",
-            "public high:",
-            "    jmp pin still_high",
-            "    jmp x-- low",
-            ".wrap_target",
-            "public low:",
-            "    jmp pin rise",
-            "    jmp x-- low",
-            ".wrap",
-        );
-        let d = p.public_defines;
-        Loaded::new(p.program, d.high as u8, d.low as u8, None)
+        a.r#in(InSource::PINS, 1);
     } else {
-        let p = pio::pio_asm!(
-            "rise:",
-            "    jmp x-- r1",
-            "r1:",
-            "    set y, 1",
-            "    jmp x-- r2",
-            "r2:",
-            "    in y, 1",
-            "    jmp x-- r3",
-            "r3:",
-            "    in x, 31",
-            "    jmp x-- r4",
-            "r4:",
-            "    push block",
-            "still_high:",
-            "    jmp x-- high",
-            "public high:",
-            "    jmp pin still_high",
-            "    jmp x-- fall",
-            "fall:",
-            "    set y, 0",
-            "    jmp x-- f1",
-            "f1:",
-            "    in y, 1",
-            "    jmp x-- f2",
-            "f2:",
-            "    in x, 31",
-            "    jmp x-- f3",
-            "f3:",
-            "    push block",
-            "    jmp x-- low",
-            ".wrap_target",
-            "public low:",
-            "    jmp pin rise",
-            "    jmp x-- low",
-            ".wrap",
-        );
-        let d = p.public_defines;
-        Loaded::new(p.program, d.high as u8, d.low as u8, None)
+        a.set(SetDestination::Y, 1);
+        next(&mut a);
+        a.r#in(InSource::Y, 1);
     }
+    next(&mut a);
+    a.r#in(InSource::X, 31);
+    next(&mut a);
+    a.push(false, true);
+    a.bind(&mut still_high);
+    a.jmp(JmpCondition::XDecNonZero, &mut high);
+    a.bind(&mut high);
+    a.jmp(JmpCondition::PinHigh, &mut still_high);
+    if rising_only {
+        a.jmp(JmpCondition::XDecNonZero, &mut low);
+    } else {
+        let mut fall = a.label();
+        a.jmp(JmpCondition::XDecNonZero, &mut fall);
+        a.bind(&mut fall);
+        a.set(SetDestination::Y, 0);
+        next(&mut a);
+        a.r#in(InSource::Y, 1);
+        next(&mut a);
+        a.r#in(InSource::X, 31);
+        next(&mut a);
+        a.push(false, true);
+        a.jmp(JmpCondition::XDecNonZero, &mut low);
+    }
+    a.bind(&mut wrap_target);
+    a.bind(&mut low);
+    a.jmp(JmpCondition::PinHigh, &mut rise);
+    a.jmp(JmpCondition::XDecNonZero, &mut low);
+    a.bind(&mut wrap_source);
+    let (h, l) = (a.label_offset(&high), a.label_offset(&low));
+    Loaded::new(a.assemble_with_wrap(wrap_source, wrap_target), h, l, None)
 }
 
 /// What each PIO block is loaded with, in block order, at address 0. PIO0
@@ -225,27 +216,27 @@ pub fn layout() -> [Loaded; 3] {
 ///
 /// Assembled for address 0; [`test_gen_origin`] relocates it.
 pub fn test_gen() -> Loaded {
-    let p = pio::pio_asm!(
-        ".wrap_target",
-        "    pull block",
-        "    out y, 32",
-        "    pull block",
-        "    mov isr, osr",
-        "    pull block",
-        "pulse:",
-        "    set pins, 1",
-        "    mov x, osr",
-        "high:",
-        "    jmp x-- high",
-        "    set pins, 0",
-        "    mov x, isr",
-        "low:",
-        "    jmp x-- low",
-        "    jmp y-- pulse",
-        ".wrap",
-    )
-    .program;
-    Loaded::new(p, 0, 0, None)
+    let mut a = Assembler::<SIZE>::new();
+    let (mut wrap_target, mut wrap_source) = (a.label(), a.label());
+    let (mut pulse, mut high, mut low) = (a.label(), a.label(), a.label());
+    a.bind(&mut wrap_target);
+    a.pull(false, true);
+    a.out(OutDestination::Y, 32);
+    a.pull(false, true);
+    a.mov(MovDestination::ISR, MovOperation::None, MovSource::OSR);
+    a.pull(false, true);
+    a.bind(&mut pulse);
+    a.set(SetDestination::PINS, 1);
+    a.mov(MovDestination::X, MovOperation::None, MovSource::OSR);
+    a.bind(&mut high);
+    a.jmp(JmpCondition::XDecNonZero, &mut high);
+    a.set(SetDestination::PINS, 0);
+    a.mov(MovDestination::X, MovOperation::None, MovSource::ISR);
+    a.bind(&mut low);
+    a.jmp(JmpCondition::XDecNonZero, &mut low);
+    a.jmp(JmpCondition::YDecNonZero, &mut pulse);
+    a.bind(&mut wrap_source);
+    Loaded::new(a.assemble_with_wrap(wrap_source, wrap_target), 0, 0, None)
 }
 
 /// Cycles from enabling [`test_gen`] to its pin's first rise.
@@ -404,22 +395,25 @@ mod tests {
         // The player until issue 28: `out pindirs, 8` writes zeroes to the
         // directions of the five OUT pins above D0-D7 (RP2350 datasheet
         // 11.4.5.2, 11.5.6), which nothing set again.
-        let old = pio::pio_asm!(
-            ".wrap_target",
-            "step:",
-            "    pull block",
-            "    out pindirs, 8",
-            "    out pins, 13",
-            "    out y, 1",
-            "    out x, 10",
-            "hold:",
-            "    jmp x-- hold",
-            "    jmp !y step",
-            "    in pins, 8",
-            "    push block",
-            ".wrap",
-        )
-        .program;
+        let old = {
+            let mut a = Assembler::<SIZE>::new();
+            let (mut wrap_target, mut wrap_source) = (a.label(), a.label());
+            let (mut step, mut hold) = (a.label(), a.label());
+            a.bind(&mut wrap_target);
+            a.bind(&mut step);
+            a.pull(false, true);
+            a.out(OutDestination::PINDIRS, 8);
+            a.out(OutDestination::PINS, 13);
+            a.out(OutDestination::Y, 1);
+            a.out(OutDestination::X, 10);
+            a.bind(&mut hold);
+            a.jmp(JmpCondition::XDecNonZero, &mut hold);
+            a.jmp(JmpCondition::YIsZero, &mut step);
+            a.r#in(InSource::PINS, 8);
+            a.push(false, true);
+            a.bind(&mut wrap_source);
+            a.assemble_with_wrap(wrap_source, wrap_target)
+        };
         let old = control_enables(&Loaded::new(old, 0, 0, None));
         assert_eq!(old[0], 0b11111, "driven until the first `out pindirs`");
         assert!(

@@ -197,78 +197,73 @@ fn an_overrun_is_reported_and_the_next_capture_is_on_time() {
 
 /// The image before issue 28, kept to show the model catches its defects.
 mod before {
-    use pio::Program;
+    use pio::{Assembler, InSource, JmpCondition, MovDestination, MovOperation, MovSource};
+    use pio::{Program, SetDestination};
 
-    /// PIO1 held both counters: 13 + 23 words.
+    /// `jmp x-- next`: the next instruction either way.
+    fn next(a: &mut Assembler<32>) {
+        let mut l = a.label();
+        a.jmp(JmpCondition::XDecNonZero, &mut l);
+        a.bind(&mut l);
+    }
+
+    /// PIO1 held both counters: 13 + 23 words. `mov x, ~null`, then a low
+    /// loop, the edge code, and a high loop; `both` also pushes falls.
+    fn counter(both: bool) -> Program<32> {
+        let mut a = Assembler::<32>::new();
+        let (mut wrap_target, mut wrap_source) = (a.label(), a.label());
+        let (mut low, mut rise, mut high, mut still_high) =
+            (a.label(), a.label(), a.label(), a.label());
+        a.mov(MovDestination::X, MovOperation::Invert, MovSource::NULL);
+        a.bind(&mut wrap_target);
+        a.bind(&mut low);
+        a.jmp(JmpCondition::PinHigh, &mut rise);
+        a.jmp(JmpCondition::XDecNonZero, &mut low);
+        a.bind(&mut rise);
+        next(&mut a);
+        if both {
+            a.set(SetDestination::Y, 1);
+            next(&mut a);
+            a.r#in(InSource::Y, 1);
+        } else {
+            a.r#in(InSource::PINS, 1);
+        }
+        next(&mut a);
+        a.r#in(InSource::X, 31);
+        next(&mut a);
+        a.push(false, true);
+        a.jmp(JmpCondition::XDecNonZero, &mut high);
+        a.bind(&mut high);
+        a.jmp(JmpCondition::PinHigh, &mut still_high);
+        if both {
+            let mut fall = a.label();
+            a.jmp(JmpCondition::XDecNonZero, &mut fall);
+            a.bind(&mut still_high);
+            a.jmp(JmpCondition::XDecNonZero, &mut high);
+            a.bind(&mut fall);
+            a.set(SetDestination::Y, 0);
+            next(&mut a);
+            a.r#in(InSource::Y, 1);
+            next(&mut a);
+            a.r#in(InSource::X, 31);
+            next(&mut a);
+            a.push(false, true);
+            a.jmp(JmpCondition::XDecNonZero, &mut low);
+        } else {
+            a.jmp(JmpCondition::XDecNonZero, &mut low);
+            a.bind(&mut still_high);
+            a.jmp(JmpCondition::XDecNonZero, &mut high);
+        }
+        a.bind(&mut wrap_source);
+        a.assemble_with_wrap(wrap_source, wrap_target)
+    }
+
     pub fn rising() -> Program<32> {
-        pio::pio_asm!(
-            "    mov x, ~null",
-            ".wrap_target",
-            "low:",
-            "    jmp pin rise",
-            "    jmp x-- low",
-            "rise:",
-            "    jmp x-- r1",
-            "r1:",
-            "    in pins, 1",
-            "    jmp x-- r2",
-            "r2:",
-            "    in x, 31",
-            "    jmp x-- r3",
-            "r3:",
-            "    push block",
-            "    jmp x-- high",
-            "high:",
-            "    jmp pin still_high",
-            "    jmp x-- low",
-            "still_high:",
-            "    jmp x-- high",
-            ".wrap",
-        )
-        .program
+        counter(false)
     }
 
     pub fn both() -> Program<32> {
-        pio::pio_asm!(
-            "    mov x, ~null",
-            ".wrap_target",
-            "low:",
-            "    jmp pin rise",
-            "    jmp x-- low",
-            "rise:",
-            "    jmp x-- r1",
-            "r1:",
-            "    set y, 1",
-            "    jmp x-- r2",
-            "r2:",
-            "    in y, 1",
-            "    jmp x-- r3",
-            "r3:",
-            "    in x, 31",
-            "    jmp x-- r4",
-            "r4:",
-            "    push block",
-            "    jmp x-- high",
-            "high:",
-            "    jmp pin still_high",
-            "    jmp x-- fall",
-            "still_high:",
-            "    jmp x-- high",
-            "fall:",
-            "    set y, 0",
-            "    jmp x-- f1",
-            "f1:",
-            "    in y, 1",
-            "    jmp x-- f2",
-            "f2:",
-            "    in x, 31",
-            "    jmp x-- f3",
-            "f3:",
-            "    push block",
-            "    jmp x-- low",
-            ".wrap",
-        )
-        .program
+        counter(true)
     }
 }
 
