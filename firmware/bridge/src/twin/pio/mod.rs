@@ -20,8 +20,9 @@
 //! - one CTRL write enables state machines of a block and, through
 //!   NEXT_PIO_MASK, of the next block, on the same cycle.
 //!
-//! The instructions are decoded by the `pio` crate. What the bridge does
-//! not use (optional side-set, autopush and autopull, IRQs, the RX FIFO as
+//! The instructions are decoded by pio-core (the `pio` crates'
+//! instruction types, with which the board crate also assembles its
+//! programs). What the bridge does not use (optional side-set, autopush and autopull, IRQs, the RX FIFO as
 //! registers, clock dividers other than 1) is refused when configured,
 //! not modelled approximately.
 //!
