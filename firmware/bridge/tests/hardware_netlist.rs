@@ -1242,20 +1242,71 @@ fn the_parts_list_and_the_schematic_name_the_same_parts() {
     report("hardware/bom.csv against the schematic", problems);
 }
 
+/// The section of `file` under the heading `## {heading}`.
+fn doc_section(file: &str, heading: &str) -> String {
+    read(file)
+        .split("\n## ")
+        .find(|s| s.starts_with(heading))
+        .unwrap_or_else(|| panic!("{file} has a section \"## {heading}\""))
+        .to_string()
+}
+
+/// The cells of each row of the tables in `section`, trimmed.
+fn table_rows(section: &str) -> Vec<Vec<&str>> {
+    section
+        .lines()
+        .filter(|l| l.starts_with('|'))
+        .map(|l| l.trim_matches('|').split('|').map(str::trim).collect())
+        .collect()
+}
+
+/// Where `sym`'s pins (number and name) and `table`'s (number to name)
+/// differ, either way.
+fn pins_against_table(
+    sym: &Placed,
+    table: &BTreeMap<String, String>,
+    table_name: &str,
+) -> Vec<String> {
+    let on_sym: BTreeMap<&str, &str> = sym
+        .pins
+        .iter()
+        .map(|(n, name, _)| (n.as_str(), name.as_str()))
+        .collect();
+    let mut problems = Vec::new();
+    for (pin, name) in &on_sym {
+        match table.get(*pin) {
+            Some(d) if d == name => {}
+            Some(d) => problems.push(format!(
+                "pin {pin}: {name} on {}, {d} in {table_name}",
+                sym.reference
+            )),
+            None => problems.push(format!("pin {pin} ({name}) is not in {table_name}")),
+        }
+    }
+    for (pin, name) in table
+        .iter()
+        .filter(|(p, _)| !on_sym.contains_key(p.as_str()))
+    {
+        problems.push(format!(
+            "pin {pin} ({name}) is in {table_name} but not on {}",
+            sym.reference
+        ));
+    }
+    problems
+}
+
 /// The connector table of docs/bridge-hardware.md (rows "| 1 | +5V_CHIP | 2 |
 /// GND |") is the schematic's header, pin by pin.
 #[test]
 fn the_doc_shows_the_schematics_header() {
     let nl = load();
     let header = nl.only("ChipHeader_2x25").expect("one header");
-    let doc = read("docs/bridge-hardware.md");
-    let section = doc
-        .split("\n## ")
-        .find(|s| s.starts_with("The connector to the chip's board"))
-        .expect("docs/bridge-hardware.md has a section \"## The connector to the chip's board\"");
+    let section = doc_section(
+        "docs/bridge-hardware.md",
+        "The connector to the chip's board",
+    );
     let mut from_doc: BTreeMap<String, String> = BTreeMap::new();
-    for line in section.lines().filter(|l| l.starts_with('|')) {
-        let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+    for cells in table_rows(&section) {
         for pair in cells.chunks(2) {
             if let [pin, signal] = pair {
                 if pin.parse::<u32>().is_ok() {
@@ -1264,26 +1315,7 @@ fn the_doc_shows_the_schematics_header() {
             }
         }
     }
-    let from_sch: BTreeMap<String, String> = header
-        .pins
-        .iter()
-        .map(|(n, name, _)| (n.clone(), name.clone()))
-        .collect();
-    let mut problems = Vec::new();
-    for (pin, name) in &from_sch {
-        match from_doc.get(pin) {
-            Some(d) if d == name => {}
-            Some(d) => problems.push(format!(
-                "pin {pin}: {name} in the schematic, {d} in the doc"
-            )),
-            None => problems.push(format!("pin {pin} ({name}) is not in the doc's table")),
-        }
-    }
-    for pin in from_doc.keys().filter(|p| !from_sch.contains_key(*p)) {
-        problems.push(format!(
-            "pin {pin} is in the doc's table but not on the header"
-        ));
-    }
+    let mut problems = pins_against_table(header, &from_doc, "the doc's table");
     // Every header pin that carries a signal, and its power pins, are on a net.
     for (number, name, _) in &header.pins {
         let net = nl.net_of.get(&(header.reference.clone(), number.clone()));
@@ -1385,14 +1417,9 @@ fn the_usb_socket_and_the_buttons_reach_the_module() {
 fn the_modules_pins_are_where_the_readmes_table_puts_them() {
     let nl = load();
     let module = nl.only("PGA2350").expect("one PGA2350");
-    let readme = read("hardware/README.md");
-    let section = readme
-        .split("\n## ")
-        .find(|s| s.starts_with("The PGA2350's pins"))
-        .expect("hardware/README.md has a section \"## The PGA2350's pins\"");
+    let section = doc_section("hardware/README.md", "The PGA2350's pins");
     let mut from_doc: BTreeMap<String, String> = BTreeMap::new();
-    for line in section.lines().filter(|l| l.starts_with('|')) {
-        let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+    for cells in table_rows(&section) {
         let Some((row, pins)) = cells.split_first() else {
             continue;
         };
@@ -1406,24 +1433,7 @@ fn the_modules_pins_are_where_the_readmes_table_puts_them() {
         }
     }
     assert_eq!(from_doc.len(), 64, "the table names 64 pins");
-    let from_sch: BTreeMap<String, String> = module
-        .pins
-        .iter()
-        .map(|(n, name, _)| (n.clone(), name.clone()))
-        .collect();
-    let mut problems = Vec::new();
-    for (pin, name) in &from_sch {
-        match from_doc.get(pin) {
-            Some(d) if d == name => {}
-            Some(d) => problems.push(format!("pin {pin}: {name} in the symbol, {d} in the table")),
-            None => problems.push(format!("pin {pin} ({name}) is not in the table")),
-        }
-    }
-    for (pin, name) in from_doc.iter().filter(|(p, _)| !from_sch.contains_key(*p)) {
-        problems.push(format!(
-            "pin {pin} ({name}) is in the table but not on the symbol"
-        ));
-    }
+    let problems = pins_against_table(module, &from_doc, "the table");
     report("the PGA2350's pins", problems);
 }
 
