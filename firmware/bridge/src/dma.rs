@@ -275,6 +275,12 @@ impl Rings {
         self.readers[i].level(self.channels[i].write_index(d))
     }
 
+    /// Whether any ring holds words the CPU has not read (at the first
+    /// that does: an idle loop asks on every pass).
+    pub fn hold_words(&self, d: &mut impl DmaRegs) -> bool {
+        (0..self.readers.len()).any(|i| self.level(d, i) > 0)
+    }
+
     /// The fullest ring's words not read.
     pub fn fullest(&self, d: &mut impl DmaRegs) -> usize {
         (0..self.readers.len())

@@ -149,25 +149,9 @@ pub fn edge_counter(rising_only: bool) -> Loaded {
     let (mut wrap_target, mut wrap_source) = (a.label(), a.label());
     let (mut rise, mut still_high, mut high, mut low) =
         (a.label(), a.label(), a.label(), a.label());
-    let next = |a: &mut Assembler<SIZE>| {
-        // `jmp x-- next`: the next instruction either way.
-        let mut l = a.label();
-        a.jmp(JmpCondition::XDecNonZero, &mut l);
-        a.bind(&mut l);
-    };
     a.bind(&mut rise);
-    next(&mut a);
-    if rising_only {
-        a.r#in(InSource::PINS, 1);
-    } else {
-        a.set(SetDestination::Y, 1);
-        next(&mut a);
-        a.r#in(InSource::Y, 1);
-    }
-    next(&mut a);
-    a.r#in(InSource::X, 31);
-    next(&mut a);
-    a.push(false, true);
+    jmp_x_next(&mut a);
+    push_edge(&mut a, (!rising_only).then_some(1));
     a.bind(&mut still_high);
     a.jmp(JmpCondition::XDecNonZero, &mut high);
     a.bind(&mut high);
@@ -178,13 +162,7 @@ pub fn edge_counter(rising_only: bool) -> Loaded {
         let mut fall = a.label();
         a.jmp(JmpCondition::XDecNonZero, &mut fall);
         a.bind(&mut fall);
-        a.set(SetDestination::Y, 0);
-        next(&mut a);
-        a.r#in(InSource::Y, 1);
-        next(&mut a);
-        a.r#in(InSource::X, 31);
-        next(&mut a);
-        a.push(false, true);
+        push_edge(&mut a, Some(0));
         a.jmp(JmpCondition::XDecNonZero, &mut low);
     }
     a.bind(&mut wrap_target);
@@ -194,6 +172,31 @@ pub fn edge_counter(rising_only: bool) -> Loaded {
     a.bind(&mut wrap_source);
     let (h, l) = (a.label_offset(&high), a.label_offset(&low));
     Loaded::new(a.assemble_with_wrap(wrap_source, wrap_target), h, l, None)
+}
+
+/// `jmp x-- next`: X counts down, and the next instruction runs either way.
+pub(crate) fn jmp_x_next(a: &mut Assembler<SIZE>) {
+    let mut l = a.label();
+    a.jmp(JmpCondition::XDecNonZero, &mut l);
+    a.bind(&mut l);
+}
+
+/// An edge counter's push path: its bit (`level` into the ISR through Y,
+/// or the IN pin when `None`), then X's low 31 bits, then `push block`,
+/// X counting down on the way as on every path.
+pub(crate) fn push_edge(a: &mut Assembler<SIZE>, level: Option<u8>) {
+    match level {
+        Some(v) => {
+            a.set(SetDestination::Y, v);
+            jmp_x_next(a);
+            a.r#in(InSource::Y, 1);
+        }
+        None => a.r#in(InSource::PINS, 1),
+    }
+    jmp_x_next(a);
+    a.r#in(InSource::X, 31);
+    jmp_x_next(a);
+    a.push(false, true);
 }
 
 /// What each PIO block is loaded with, in block order, at address 0. PIO0

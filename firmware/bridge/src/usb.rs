@@ -315,6 +315,13 @@ mod tests {
         Arc::new(Mutex::new(h))
     }
 
+    /// A host that sends one packet, `packet`.
+    fn host_sending(packet: std::vec::Vec<u8>) -> Arc<Mutex<Host>> {
+        let mut h = Host::default();
+        h.to_bridge.push_back(packet);
+        Arc::new(Mutex::new(h))
+    }
+
     #[test]
     fn defect_6_a_long_op_kept_the_usb_stack_waiting_and_on_core_1_it_does_not() {
         // Counted, not timed: whether the USB stack was polled at all
@@ -386,12 +393,7 @@ mod tests {
         // The engine echoes each byte after 20 ms; the first host sends
         // eight and is gone before the first echo.
         let cores = TwoCores::start(Duration::from_millis(20), Arc::new(AtomicBool::new(false)));
-        let first = host_sends(0);
-        first
-            .lock()
-            .expect("host")
-            .to_bridge
-            .push_back(std::vec![1; 8]);
+        let first = host_sending(std::vec![1; 8]);
         first.lock().expect("host").closed = true;
         let deadline = Wall(Duration::from_millis(500));
         embassy_futures::block_on(serve_connection(&mut Usb(first.clone()), &cores, &deadline));
@@ -400,12 +402,7 @@ mod tests {
         let opened = Instant::now() + Duration::from_millis(300);
         let next = Until(move || (Instant::now() >= opened).then_some(()));
         embassy_futures::block_on(between_connections(&cores, next));
-        let second = host_sends(0);
-        second
-            .lock()
-            .expect("host")
-            .to_bridge
-            .push_back(std::vec![9; 4]);
+        let second = host_sending(std::vec![9; 4]);
         let watcher = second.clone();
         std::thread::spawn(move || {
             std::thread::sleep(Duration::from_millis(400));

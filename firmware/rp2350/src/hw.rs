@@ -215,11 +215,6 @@ impl Rp2350 {
         }
     }
 
-    /// Whether any ring holds words the CPU has not read.
-    fn rings_hold_words(&self) -> bool {
-        (0..4).any(|i| self.rings.level(&mut RpDma, i) > 0)
-    }
-
     /// The cycle of the register write just before the call: the clock
     /// now, less the cycles since. The counters' start and the
     /// generator's are stamped alike, so that what the self-test measures
@@ -435,7 +430,7 @@ impl Hal for Rp2350 {
         let mut quiet = start;
         let mut passes: u32 = 0;
         loop {
-            if pac::SIO.gpio_in(1).read() & sampled != seen || self.rings_hold_words() {
+            if pac::SIO.gpio_in(1).read() & sampled != seen || self.rings.hold_words(&mut RpDma) {
                 let now = self.cycles();
                 return now - u64::from(DWT::cycle_count().wrapping_sub(quiet));
             }

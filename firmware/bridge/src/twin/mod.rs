@@ -223,6 +223,11 @@ fn ring_addr(i: usize) -> u32 {
     pio::RAM + (i * RING_WORDS * 4) as u32
 }
 
+/// The address of word `i` (taken round the ring) of ring `channel`.
+fn ring_slot(channel: usize, i: usize) -> u32 {
+    ring_addr(channel) + 4 * (i % RING_WORDS) as u32
+}
+
 /// The twin's DMA block as the board code reaches it.
 struct TwinDma<'a>(&'a mut World);
 
@@ -237,21 +242,11 @@ impl DmaRegs for TwinDma<'_> {
     }
 
     fn ring_word(&mut self, channel: usize, i: usize) -> u32 {
-        let addr = ring_addr(channel) + 4 * (i % RING_WORDS) as u32;
-        self.0.dma.ram_word(addr).unwrap_or(0)
+        self.0.dma.ram_word(ring_slot(channel, i)).unwrap_or(0)
     }
 
     fn set_ring_word(&mut self, channel: usize, i: usize, value: u32) {
-        let addr = ring_addr(channel) + 4 * (i % RING_WORDS) as u32;
-        self.0.dma.set_ram_word(addr, value);
-    }
-}
-
-impl Twin {
-    /// Words the rings hold that the board code has not read.
-    fn rings_hold_words(&mut self) -> bool {
-        let d = &mut TwinDma(&mut self.world);
-        (0..4).any(|i| self.rings.level(d, i) > 0)
+        self.0.dma.set_ram_word(ring_slot(channel, i), value);
     }
 }
 
@@ -452,7 +447,7 @@ impl Hal for Twin {
             while at < to {
                 let next = (at + step).min(to);
                 self.run_to(next);
-                if self.rings_hold_words() {
+                if self.rings.hold_words(&mut TwinDma(&mut self.world)) {
                     return at;
                 }
                 at = next;

@@ -197,15 +197,8 @@ fn an_overrun_is_reported_and_the_next_capture_is_on_time() {
 
 /// The image before issue 28, kept to show the model catches its defects.
 mod before {
-    use pio::{Assembler, InSource, JmpCondition, MovDestination, MovOperation, MovSource};
-    use pio::{Program, SetDestination};
-
-    /// `jmp x-- next`: the next instruction either way.
-    fn next(a: &mut Assembler<32>) {
-        let mut l = a.label();
-        a.jmp(JmpCondition::XDecNonZero, &mut l);
-        a.bind(&mut l);
-    }
+    use crate::programs::{jmp_x_next, push_edge};
+    use pio::{Assembler, JmpCondition, MovDestination, MovOperation, MovSource, Program};
 
     /// PIO1 held both counters: 13 + 23 words. `mov x, ~null`, then a low
     /// loop, the edge code, and a high loop; `both` also pushes falls.
@@ -220,18 +213,8 @@ mod before {
         a.jmp(JmpCondition::PinHigh, &mut rise);
         a.jmp(JmpCondition::XDecNonZero, &mut low);
         a.bind(&mut rise);
-        next(&mut a);
-        if both {
-            a.set(SetDestination::Y, 1);
-            next(&mut a);
-            a.r#in(InSource::Y, 1);
-        } else {
-            a.r#in(InSource::PINS, 1);
-        }
-        next(&mut a);
-        a.r#in(InSource::X, 31);
-        next(&mut a);
-        a.push(false, true);
+        jmp_x_next(&mut a);
+        push_edge(&mut a, both.then_some(1));
         a.jmp(JmpCondition::XDecNonZero, &mut high);
         a.bind(&mut high);
         a.jmp(JmpCondition::PinHigh, &mut still_high);
@@ -241,13 +224,7 @@ mod before {
             a.bind(&mut still_high);
             a.jmp(JmpCondition::XDecNonZero, &mut high);
             a.bind(&mut fall);
-            a.set(SetDestination::Y, 0);
-            next(&mut a);
-            a.r#in(InSource::Y, 1);
-            next(&mut a);
-            a.r#in(InSource::X, 31);
-            next(&mut a);
-            a.push(false, true);
+            push_edge(&mut a, Some(0));
             a.jmp(JmpCondition::XDecNonZero, &mut low);
         } else {
             a.jmp(JmpCondition::XDecNonZero, &mut low);
@@ -861,19 +838,19 @@ fn defect_6_a_push_noblock_to_a_full_rx_fifo_sets_rxstall() {
 /// Each ring's channel is running, and where its count says it writes next
 /// is where it does: the board code reads every word where the DMA put it.
 fn channels_in_place(b: &mut TwinBoard) -> std::vec::Vec<std::string::String> {
-    use crate::dma::{ctrl, reg, trans_count};
-    let dma = &b.hal_mut().world.dma;
+    use crate::dma::{counter_channel, ctrl, reg, DmaRegs};
+    let d = &mut TwinDma(&mut b.hal_mut().world);
     let mut wrong = Vec::new();
     for c in Counter::ALL {
-        let n = c.index();
-        let ctl = dma.read(reg::ch(n, reg::CTRL_TRIG));
+        let ch = counter_channel(c, ring_addr(c.index()));
+        let ctl = d.read(reg::ch(ch.channel, reg::CTRL_TRIG));
         if ctl & ctrl::BUSY == 0 || ctl & ctrl::EN == 0 || ctl & ctrl::AHB_ERROR != 0 {
             wrong.push(std::format!("{c:?}: CTRL {ctl:#010x}, not running"));
         }
-        let left = (dma.read(reg::ch(n, reg::TRANS_COUNT)) & trans_count::COUNT) as usize;
-        let by_count = (RING_WORDS - left % (RING_WORDS + 1)) % RING_WORDS;
-        let ring = pio::RAM as usize + n * RING_WORDS * 4;
-        let by_addr = (dma.read(reg::ch(n, reg::WRITE_ADDR)) as usize - ring) / 4;
+        // Where the board code reads the next word, against where the
+        // model's DMA writes it.
+        let by_count = ch.write_index(d);
+        let by_addr = (d.read(reg::ch(ch.channel, reg::WRITE_ADDR)) - ch.ring) as usize / 4;
         if by_count != by_addr {
             wrong.push(std::format!(
                 "{c:?}: its count says it writes word {by_count} next, WRITE_ADDR word {by_addr}"
