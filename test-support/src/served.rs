@@ -51,9 +51,16 @@ impl Served {
             _dir: dir,
         };
         // Building the image the first time takes a minute or two.
-        let first = rx
-            .recv_timeout(Duration::from_secs(400))
-            .unwrap_or_else(|_| panic!("{script} says where it serves within the time limit"));
+        let first = match rx.recv_timeout(Duration::from_secs(400)) {
+            Ok(line) => line,
+            Err(mpsc::RecvTimeoutError::Timeout) => {
+                panic!("{script} did not say where it serves within 400 s")
+            }
+            Err(mpsc::RecvTimeoutError::Disconnected) => panic!(
+                "{script} ended before saying where it serves ({:?}; its stderr is above)",
+                served.child.wait()
+            ),
+        };
         assert!(
             first.starts_with(&format!("{script}: serving on /dev/")),
             "unexpected first line `{first}`"
