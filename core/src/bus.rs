@@ -11,6 +11,7 @@
 //! chip bus plus its pins and a pulse capture. [`EmuBus`] is the reference
 //! model behind it; a bridge firmware implements it over the real chip.
 
+use crate::bridge::abort::AbortLine;
 use crate::emu::{Board, Chip, ChipError, ModelConfig};
 use crate::protocol::{
     Flag, Input, OutputMark, OutputRecord, Pin, Pins, PulseSummary, Status, Straps,
@@ -347,6 +348,13 @@ pub trait Bus {
     fn self_test(&mut self, _plan: &SelfTestPlan) -> Result<SelfTestReply, String> {
         Err("this bridge has no self-test generator".into())
     }
+
+    /// The line an ABORT raises ([`AbortLine`]): a bus whose ops can take
+    /// long on a wall clock (a board's waits, a simulator paced to real
+    /// time) ends a wait early once it is [pending](AbortLine::pending),
+    /// with any reply (the request's answer is ERROR `ABORTED`). A bus in
+    /// virtual time, done in an instant, need not look.
+    fn watch_abort(&mut self, _line: AbortLine) {}
 }
 
 /// What a bridge's self-test generates: `bursts` bursts of `count`

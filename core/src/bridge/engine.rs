@@ -12,12 +12,14 @@
 //! dropped connection and sends its request again is answered from it too
 //! (at most once, `docs/bridge-protocol.md` section 3).
 
+use super::abort::AbortLine;
 use super::frame::{self, FrameDecoder, FrameError};
 use super::wire::{
     self, capture_bytes, fragment, BridgeErrorCode, CaptureChunk, Hello, Incoming, ReplyWriter,
     Request, Response, Timer, WireError, WireOp, MAX_BATCH_OPS, MAX_REPLY, PROTOCOL_VERSION,
 };
-use crate::bus::{Bus, Op};
+use crate::bus::{Bus, Op, Reply};
+use crate::protocol::{Command, OpFlags, Status};
 use crate::time::{Duration, Instant};
 use alloc::boxed::Box;
 use alloc::format;
@@ -81,6 +83,10 @@ pub struct BridgeEngine<B> {
     pad: usize,
     /// Frames handled so far (for fault injection by the caller).
     pub frames: u64,
+    /// Raised by the receive path when an ABORT arrives ([`AbortLine`]).
+    abort: Option<AbortLine>,
+    /// Whether the last request was stopped by an abort (ABORT_REPLY).
+    stopped: bool,
 }
 
 impl<B: Bus> BridgeEngine<B> {
@@ -103,7 +109,19 @@ impl<B: Bus> BridgeEngine<B> {
             fragment: wire::FRAGMENT_DATA,
             pad: 0,
             frames: 0,
+            abort: None,
+            stopped: false,
         }
+    }
+
+    /// A bridge that stops a request in flight when `line` is raised (by
+    /// an [`AbortWatch`](super::abort::AbortWatch) on its receive path):
+    /// between ops, and inside a bus's long waits ([`Bus::watch_abort`]).
+    /// Without one, an ABORT is read only after the request it meant.
+    pub fn with_abort(mut self, line: AbortLine) -> Self {
+        self.bus.watch_abort(line.clone());
+        self.abort = Some(line);
+        self
     }
 
     /// Gives the bridge a serial number, which HELLO_REPLY carries (an
@@ -149,6 +167,10 @@ impl<B: Bus> BridgeEngine<B> {
             match self.decoder.decode() {
                 Ok(Some(payload)) => {
                     self.frames += 1;
+                    if let Some(line) = &self.abort {
+                        // The watch counts the same frames (wrapping alike).
+                        line.begin(self.frames as u32);
+                    }
                     self.on_payload(&payload, &mut out);
                 }
                 Ok(None) => break,
@@ -228,13 +250,14 @@ impl<B: Bus> BridgeEngine<B> {
             decoded,
             Ok((
                 _,
-                Incoming::Other(Request::Hello { .. } | Request::Link { .. })
+                Incoming::Other(Request::Hello { .. } | Request::Link { .. } | Request::Abort)
             ))
         );
         if !control {
             // Replaced by this request's answer: free while it runs.
             self.last = None;
             self.control = None;
+            self.stopped = false;
         }
         let mut reply = match decoded {
             Ok((_, req)) => self.respond(seq, req),
@@ -387,6 +410,9 @@ impl<B: Bus> BridgeEngine<B> {
                     },
                 }
             }
+            Request::Abort => Response::Abort {
+                stopped: self.stopped,
+            },
             Request::Link { fragment, pad } => {
                 self.fragment =
                     usize::from(fragment).clamp(wire::MIN_FRAGMENT_DATA, wire::FRAGMENT_DATA);
@@ -426,8 +452,12 @@ impl<B: Bus> BridgeEngine<B> {
             });
         }
         let mut full = None;
+        let mut ran = 0;
         let mut ops = WireOp::ops(ops).peekable();
         while let Some(op) = ops.next() {
+            if self.abort_pending() {
+                return Err(self.abort_request(ran));
+            }
             let held = self.held();
             if op != Op::Reset && held > self.capture_capacity as usize {
                 full = Some(held);
@@ -435,6 +465,11 @@ impl<B: Bus> BridgeEngine<B> {
             }
             self.bus.next_op(ops.peek().copied());
             replies.push(self.bus.run(op));
+            ran += 1;
+        }
+        // Stopped inside the last op's wait, perhaps.
+        if self.abort_pending() {
+            return Err(self.abort_request(ran.saturating_sub(1)));
         }
         match (self.bus.fault(), full) {
             (Some(what), _) => Err(Response::Error {
@@ -443,6 +478,52 @@ impl<B: Bus> BridgeEngine<B> {
             }),
             (None, Some(held)) => Err(self.overrun_error(held)),
             (None, None) => Ok(()),
+        }
+    }
+
+    fn abort_pending(&self) -> bool {
+        self.abort.as_ref().is_some_and(AbortLine::pending)
+    }
+
+    /// Stops the request in flight, which had run `ran` ops in full, and
+    /// the chip with it: an Immediate Stop where a move runs (datasheet
+    /// 3-3-1; not otherwise, where it would be Error #0), so that the chip
+    /// is left stopped with the capture so far, for the host to fetch.
+    fn abort_request(&mut self, ran: usize) -> Response {
+        if let Some(line) = &self.abort {
+            line.acknowledge();
+        }
+        self.stopped = true;
+        let busy =
+            matches!(self.bus.run(Op::ReadStatus), Reply::Status { status, .. } if status.busy());
+        let stop = if busy {
+            // The command register frees within microseconds (Table 3-3);
+            // a chip that keeps IBF for a millisecond is left as it is.
+            let byte = Command::ImmediateStop(OpFlags::PLAIN).encode();
+            let written = self.bus.run(Op::WriteCommand {
+                byte,
+                wait_ibf: Some(Duration::from_millis(1)),
+            });
+            if !matches!(written, Reply::Written { .. }) {
+                "; the chip kept IBF set, so the Immediate Stop could not be written"
+            } else {
+                // Processed within microseconds (Table 3-3): the reply
+                // goes once the chip has stopped.
+                match self.bus.run(Op::AwaitStatus {
+                    mask: Status::BUSY,
+                    value: 0,
+                    timeout: Duration::from_millis(10),
+                }) {
+                    Reply::Awaited { .. } => "; the move was stopped (Immediate Stop)",
+                    _ => "; the chip was still BUSY 10 ms after an Immediate Stop",
+                }
+            }
+        } else {
+            ""
+        };
+        Response::Error {
+            code: BridgeErrorCode::Aborted,
+            detail: format!("stopped by ABORT after {ran} ops{stop}"),
         }
     }
 
@@ -921,6 +1002,104 @@ mod tests {
         let st = Straps::default();
         let tclock = st.tclock(ClockSource::Internal).expect("internal clock");
         (ops, st.pulse_interval(100, tclock))
+    }
+
+    /// The reference model, with an ABORT arriving (through an
+    /// [`AbortWatch`](crate::bridge::abort::AbortWatch) on the receive
+    /// path) as the `at`th op of a batch ends: as a host's Ctrl-C
+    /// lands while a board waits out a move.
+    struct AbortingBus {
+        emu: EmuBus,
+        watch: Option<crate::bridge::abort::AbortWatch>,
+        /// The frames the bridge has received by then: the batch, ABORT.
+        stream: Vec<u8>,
+        ops: usize,
+        at: usize,
+    }
+
+    impl Bus for AbortingBus {
+        fn run(&mut self, op: Op) -> Reply {
+            let reply = self.emu.run(op);
+            self.ops += 1;
+            if self.ops == self.at {
+                if let Some(w) = &mut self.watch {
+                    w.on_bytes(&self.stream);
+                }
+            }
+            reply
+        }
+        fn record(&self) -> &crate::protocol::OutputRecord {
+            self.emu.record()
+        }
+        fn straps(&self) -> Straps {
+            self.emu.straps()
+        }
+        fn now(&self) -> crate::time::Instant {
+            self.emu.now()
+        }
+        fn watch_abort(&mut self, line: AbortLine) {
+            self.watch = Some(line.watch());
+        }
+    }
+
+    /// The ABORT of `docs/bridge-protocol.md` section 5: a move that would
+    /// take 16,777,216 pulses (datasheet 3-3-4) is stopped where the
+    /// batch had got to, the chip with it (an Immediate Stop, 3-3-1), the
+    /// capture so far is kept, and ABORT_REPLY says the request was
+    /// stopped.
+    #[test]
+    fn abort_stops_the_batch_and_the_move_and_keeps_the_capture() {
+        let (mut ops, period) = moving_ops(16_777_216);
+        let started = ops.len();
+        ops.push(Op::Delay(Duration::from_nanos(period.as_nanos() * 50)));
+        ops.push(Op::AwaitStatus {
+            mask: crate::protocol::Status::BUSY,
+            value: 0,
+            timeout: Duration::from_secs(7_200),
+        });
+        let batch = Request::Batch(ops.clone()).encode(1, Timer::NANOS);
+        let mut stream = frame::encode(&batch);
+        stream.extend(frame::encode(&Request::Abort.encode(2, Timer::NANOS)));
+        let bus = AbortingBus {
+            emu: EmuBus::new(Straps::default(), ModelConfig::default()).expect("model"),
+            watch: None,
+            stream: stream.clone(),
+            ops: 0,
+            // After the move's 50 periods, before the wait for its end.
+            at: started + 1,
+        };
+        let mut s = BridgeEngine::new(bus, 1, true, "test").with_abort(AbortLine::new());
+        let out = s.on_bytes(&frame::encode(&batch));
+        match collect(&out).1 {
+            Response::Error {
+                code: BridgeErrorCode::Aborted,
+                detail,
+            } => assert_eq!(
+                detail,
+                format!(
+                    "stopped by ABORT after {} ops; the move was stopped (Immediate Stop)",
+                    started + 1
+                )
+            ),
+            other => panic!("not ABORTED: {other:?}"),
+        }
+        let emu = &s.bus().emu;
+        assert!(!emu.board().read_status().busy(), "the chip is stopped");
+        let pulses = emu.record().last_move_pulses().count;
+        assert!(
+            (50..=52).contains(&pulses),
+            "the capture keeps the move's pulses so far: {pulses}"
+        );
+        // The ABORT itself, read after the batch's reply.
+        let out = s.on_bytes(&frame::encode(&Request::Abort.encode(2, Timer::NANOS)));
+        assert_eq!(collect(&out).1, Response::Abort { stopped: true });
+        // A request after it runs in full; an ABORT then stops nothing.
+        let out = s.on_bytes(&frame::encode(
+            &Request::Batch(vec![Op::ReadStatus]).encode(3, Timer::NANOS),
+        ));
+        assert!(matches!(collect(&out).1, Response::Batch(r) if r.len() == 1));
+        let out = s.on_bytes(&frame::encode(&Request::Abort.encode(4, Timer::NANOS)));
+        assert_eq!(collect(&out).1, Response::Abort { stopped: false });
     }
 
     /// `pairs` pin samples `step` apart.

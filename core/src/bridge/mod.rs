@@ -8,8 +8,9 @@
 //! the bridge's request executor over any [`crate::bus::Bus`]; [`timed`]
 //! captures a bus's outputs again with a bridge timer's resolution;
 //! [`move_tracker`] keeps a capture's move records from the bus traffic, as a
-//! bridge firmware must.
+//! bridge firmware must; [`abort`] lets a bridge hear ABORT while it is busy.
 
+pub mod abort;
 pub mod engine;
 pub mod frame;
 pub mod move_tracker;

@@ -123,6 +123,7 @@ impl Request {
                 w.u16(p.bursts);
                 w.dur(p.gap);
             }
+            Request::Abort => w.u8(kind::ABORT),
             Request::Resend { fragments } => {
                 w.u8(kind::RESEND);
                 w.u8(fragments.len().min(255) as u8);
@@ -172,6 +173,7 @@ impl Request {
                 fragment: r.u8()?,
                 pad: r.u16()?,
             },
+            kind::ABORT => Request::Abort,
             kind::RESEND => {
                 let n = usize::from(r.u8()?);
                 Request::Resend {
@@ -266,6 +268,10 @@ impl Response {
                 w.u8(kind::WORKING);
                 w.dur(*elapsed);
             }
+            Response::Abort { stopped } => {
+                w.u8(kind::ABORT_REPLY);
+                w.u8(u8::from(*stopped));
+            }
             Response::SelfTest(t) => {
                 w.u8(kind::SELF_TEST_REPLY);
                 w.dur(t.high);
@@ -330,6 +336,9 @@ impl Response {
                 detail: r.str()?,
             },
             kind::WORKING => Response::Working { elapsed: r.dur()? },
+            kind::ABORT_REPLY => Response::Abort {
+                stopped: r.bool("stopped flag")?,
+            },
             kind::LINK_REPLY => Response::Link {
                 fragment: r.u8()?,
                 pad: r.u16()?,

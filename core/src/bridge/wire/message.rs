@@ -22,6 +22,7 @@ pub mod kind {
     pub const BATCH_CAPTURE: u8 = 0x05;
     pub const LINK: u8 = 0x06;
     pub const SELF_TEST: u8 = 0x07;
+    pub const ABORT: u8 = 0x08;
     pub const HELLO_REPLY: u8 = 0x81;
     pub const BATCH_REPLY: u8 = 0x82;
     pub const CAPTURE_REPLY: u8 = 0x83;
@@ -30,6 +31,7 @@ pub mod kind {
     pub const LINK_REPLY: u8 = 0x86;
     pub const SELF_TEST_REPLY: u8 = 0x87;
     pub const WORKING: u8 = 0x88;
+    pub const ABORT_REPLY: u8 = 0x89;
     pub const ERROR: u8 = 0xFF;
 }
 
@@ -51,6 +53,9 @@ pub enum BridgeErrorCode {
     /// 7: the bridge's own hardware failed (a stuck state machine); the
     /// detail says what. The bridge must be reset.
     Hardware,
+    /// 8: the request was stopped before its end by the host's ABORT, or
+    /// by another host's HELLO (`docs/bridge-protocol.md` section 5).
+    Aborted,
     /// Any other code, kept as received.
     Unknown(u8),
 }
@@ -65,6 +70,7 @@ impl BridgeErrorCode {
             BridgeErrorCode::Malformed => 5,
             BridgeErrorCode::Version => 6,
             BridgeErrorCode::Hardware => 7,
+            BridgeErrorCode::Aborted => 8,
             BridgeErrorCode::Unknown(c) => c,
         }
     }
@@ -78,6 +84,7 @@ impl BridgeErrorCode {
             5 => BridgeErrorCode::Malformed,
             6 => BridgeErrorCode::Version,
             7 => BridgeErrorCode::Hardware,
+            8 => BridgeErrorCode::Aborted,
             other => BridgeErrorCode::Unknown(other),
         }
     }
@@ -94,6 +101,7 @@ impl core::fmt::Display for BridgeErrorCode {
             BridgeErrorCode::Malformed => f.write_str("MALFORMED"),
             BridgeErrorCode::Version => f.write_str("VERSION"),
             BridgeErrorCode::Hardware => f.write_str("HARDWARE"),
+            BridgeErrorCode::Aborted => f.write_str("ABORTED"),
             BridgeErrorCode::Unknown(c) => write!(f, "error code {c}"),
         }
     }
@@ -178,6 +186,10 @@ pub enum Request {
     /// reset, the generator's bursts, and the capture of them from the
     /// reset on, fetched with CAPTURE as usual.
     SelfTest(SelfTestPlan),
+    /// Stop the request in flight at its next step and leave the chip
+    /// stopped (`docs/bridge-protocol.md` section 5, ABORT). Sent while a
+    /// request runs; it changes nothing when none does.
+    Abort,
 }
 
 /// Largest response payload sent as one frame; longer ones go as
@@ -278,6 +290,11 @@ pub enum Response {
     Working {
         elapsed: Duration,
     },
+    /// The answer to ABORT: whether the request before it was stopped by
+    /// it (its own reply is then ERROR `ABORTED`).
+    Abort {
+        stopped: bool,
+    },
 }
 
 impl Response {
@@ -292,6 +309,7 @@ impl Response {
             Response::Link { .. } => "LINK_REPLY",
             Response::SelfTest(_) => "SELF_TEST_REPLY",
             Response::Working { .. } => "WORKING",
+            Response::Abort { .. } => "ABORT_REPLY",
         }
     }
 }
