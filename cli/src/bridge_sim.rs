@@ -72,7 +72,7 @@ pub struct BridgeSimArgs {
 
 pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     use ppmc::bridge::sim::{engine, place_link, remove_own_link, timed_engine};
-    use ppmc::bridge::sim::{serve, LinkFaults, LinkRefused, ServeEnd};
+    use ppmc::bridge::sim::{serve_tty, LinkFaults, LinkRefused, ServeEnd};
     use serialport::SerialPort;
 
     let faults = LinkFaults {
@@ -128,7 +128,7 @@ pub fn run(args: BridgeSimArgs) -> Result<(), CliError> {
     let _ = writeln!(out, "bridge-sim: serving on {path}");
     let _ = writeln!(out, "bridge-sim: run   ppmc run --target serial:{path}");
     let _ = out.flush();
-    let end = serve(&mut master, &mut server, faults, args.realtime, &stop);
+    let end = serve_tty(&mut master, &mut server, faults, args.realtime, &stop);
     if let Some(link) = &args.link {
         remove_own_link(link, &path);
     }

@@ -131,3 +131,45 @@ fn sigterm_while_the_target_is_opened_still_writes_the_reports() {
     assert_eq!(status.code(), Some(130), "{status}");
     check_interrupted(dir.path(), 95);
 }
+
+/// Ctrl-C during the 16,777,216-step move (eleven minutes on a real-time
+/// bridge), then the next run on the same bridge: the first host's ABORT
+/// (`docs/bridge-protocol.md` section 5) stopped the move, so the next
+/// run opens at once and passes, where before it found the bridge busy
+/// for the rest of the move and gave up ("no bridge answering"). A host
+/// killed outright sends no ABORT: the next host's HELLO, from another
+/// host session, stops the move instead. How soon it opens is printed
+/// (`docs/performance.md`); what is asserted is that it works at all.
+#[test]
+fn after_ctrl_c_in_the_long_move_the_next_run_on_the_bridge_opens_at_once() {
+    let sim = BridgeSim::start(&["--realtime"]);
+    for sig in ["-INT", "-KILL"] {
+        let dir = scratch("abort");
+        let mut child = run(&[], &sim.target(), &["--tag", "long"], dir.path());
+        // Into the long move: the run has opened the bridge and started.
+        std::thread::sleep(Duration::from_millis(1500));
+        signal(&child, sig);
+        let status = wait_bounded(&mut child, WIND_DOWN);
+        if sig == "-INT" {
+            assert_eq!(status.code(), Some(130), "{status}");
+            // The record says the host stopped the bridge.
+            let record: serde_json::Value = serde_json::from_str(
+                &std::fs::read_to_string(dir.path().join("run.json")).expect("record"),
+            )
+            .expect("JSON");
+            let stats = &record["run"]["boards"][0]["link"];
+            assert_eq!(stats["aborts"].as_u64(), Some(1), "{record}");
+        }
+        let next = scratch("next");
+        let began = Instant::now();
+        let mut second = run(
+            &[],
+            &sim.target(),
+            &["--filter", "s3_3_4_pout_mode_holds_the_phases"],
+            next.path(),
+        );
+        let status = wait_bounded(&mut second, Duration::from_secs(60));
+        eprintln!("after {sig}: the next run took {:?}", began.elapsed());
+        assert_eq!(status.code(), Some(0), "after {sig}: {status}");
+    }
+}

@@ -158,6 +158,13 @@ impl<B: Bus> BridgeEngine<B> {
         &self.bus
     }
 
+    /// The line an ABORT raises, if the bridge has one
+    /// ([`BridgeEngine::with_abort`]): its receive path watches for ABORT
+    /// with [`AbortLine::watch`].
+    pub fn abort_line(&self) -> Option<&AbortLine> {
+        self.abort.as_ref()
+    }
+
     /// Handles received bytes; returns the bytes to send back (whole
     /// frames, possibly none).
     pub fn on_bytes(&mut self, bytes: &[u8]) -> Vec<u8> {

@@ -3,6 +3,7 @@
 //! adds what needs an operating system: the bridge simulator's I/O loop on
 //! a pseudo-terminal ([`sim`]).
 
-pub use ppmc_core::bridge::{engine, frame, move_tracker, timed, wire};
+pub use ppmc_core::bridge::{abort, engine, frame, move_tracker, timed, wire};
 
 pub mod sim;
+pub mod sim_bus;

@@ -2,63 +2,23 @@
 //! model ([`SimEngine`]) on a byte port (the master side of a
 //! pseudo-terminal), with optional line faults and pacing to the wall clock.
 
+use super::abort::{AbortLine, AbortWatch};
 use super::engine::BridgeEngine;
 use super::timed::Timed;
 use super::wire::Timer;
-use crate::bus::{Bus, EmuBus, Op, Reply};
-use crate::protocol::{OutputRecord, Straps};
-use crate::time::{Duration, Instant};
+use crate::bus::EmuBus;
+use crate::time::Duration;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use std::io::{self, Read, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::sync::{mpsc, Arc};
 use std::time::{Duration as WallDuration, Instant as WallInstant};
 
 /// What `ppmc bridge-sim` runs: the bridge engine over the reference model.
 pub type SimEngine = BridgeEngine<SimBus>;
 
-/// The reference model as the simulated bridge sees it: exactly, to the
-/// nanosecond, or through a timer of its own ([`Timed`]), as a bridge
-/// whose timer is not locked to the chip sees a board.
-#[derive(Debug, Clone)]
-pub enum SimBus {
-    Exact(EmuBus),
-    Timed(Timed<EmuBus>),
-}
-
-impl Bus for SimBus {
-    fn run(&mut self, op: Op) -> Reply {
-        match self {
-            SimBus::Exact(b) => b.run(op),
-            SimBus::Timed(b) => b.run(op),
-        }
-    }
-    fn record(&self) -> &OutputRecord {
-        match self {
-            SimBus::Exact(b) => b.record(),
-            SimBus::Timed(b) => b.record(),
-        }
-    }
-    fn straps(&self) -> Straps {
-        match self {
-            SimBus::Exact(b) => b.straps(),
-            SimBus::Timed(b) => b.straps(),
-        }
-    }
-    fn now(&self) -> Instant {
-        match self {
-            SimBus::Exact(b) => b.now(),
-            SimBus::Timed(b) => b.now(),
-        }
-    }
-    fn capture_lost(&self) -> bool {
-        match self {
-            SimBus::Exact(b) => b.capture_lost(),
-            SimBus::Timed(b) => b.capture_lost(),
-        }
-    }
-}
+pub use super::sim_bus::{SimBus, SimChip};
 
 /// The simulator's engine in front of the emulated chip `emu` (an
 /// [`EmuBus`], or anything that becomes one, such as an `EmuTarget`);
@@ -66,11 +26,12 @@ impl Bus for SimBus {
 /// nanoseconds, in step with the chip.
 pub fn engine(emu: impl Into<EmuBus>, session: u32, virtual_time: bool) -> SimEngine {
     BridgeEngine::new(
-        SimBus::Exact(emu.into()),
+        SimBus::new(SimChip::Exact(emu.into()), !virtual_time),
         session,
         virtual_time,
         format!("ppmc-bridge-sim {}", crate::VERSION),
     )
+    .with_abort(AbortLine::new())
 }
 
 /// The simulator's engine with a timer of `timer_hz` that is not locked to
@@ -84,12 +45,13 @@ pub fn timed_engine(
 ) -> SimEngine {
     let timer = Timer { hz: timer_hz };
     BridgeEngine::new(
-        SimBus::Timed(Timed::new(emu.into(), timer)),
+        SimBus::new(SimChip::Timed(Timed::new(emu.into(), timer)), !virtual_time),
         session,
         virtual_time,
         format!("ppmc-bridge-sim {} (timer {timer_hz} Hz)", crate::VERSION),
     )
     .with_timer(timer)
+    .with_abort(AbortLine::new())
 }
 
 /// How the simulated link or board misbehaves.
@@ -202,30 +164,122 @@ impl Faulty {
     }
 }
 
-/// Serves the bridge protocol on `port` until `stop` is set or the
-/// disconnect fault fires.
+/// Serves the bridge protocol until `stop` is set or the disconnect fault
+/// fires: requests read from `reader` (on a thread of its own, so that an
+/// ABORT is heard while a request runs), replies written to `writer`.
 ///
 /// With `realtime`, the chip's clock follows the wall clock, as a board's
 /// does: the time between requests passes on the chip too (a move goes on
-/// while the host is away), and each reply is held back until the request
-/// has taken as long on the wall clock as its ops took on the chip. Runs
-/// are then no longer repeatable, exactly as on a board.
-pub fn serve<P: Read + Write>(
-    port: &mut P,
+/// while the host is away), and each op returns when the wall clock has
+/// caught up with it, so a request takes as long as its ops take on the
+/// chip and an ABORT stops it within a few milliseconds. Runs are then no
+/// longer repeatable, exactly as on a board.
+///
+/// The line's faults are drawn per direction, each from its own generator
+/// seeded by the fault seed, so a seed replays the same line.
+pub fn serve<R: Read + Send + 'static, W: Write>(
+    reader: R,
+    writer: &mut W,
     server: &mut SimEngine,
     faults: LinkFaults,
     realtime: bool,
     stop: &Arc<AtomicBool>,
 ) -> io::Result<ServeEnd> {
-    let mut faulty = Faulty {
+    let mut outgoing = Faulty {
         f: faults,
-        rng: StdRng::seed_from_u64(faults.seed),
+        rng: StdRng::seed_from_u64(faults.seed ^ OUTGOING_SEED),
+    };
+    let (tx, rx) = mpsc::channel();
+    // Ends the reader when this returns, however it returns.
+    let done = Arc::new(AtomicBool::new(false));
+    let _reader = ReaderGuard {
+        done: Arc::clone(&done),
+        handle: Some(std::thread::spawn({
+            let watch = server.abort_line().map(AbortLine::watch);
+            let (stop, done) = (Arc::clone(stop), Arc::clone(&done));
+            move || receive(reader, faults, watch, tx, &stop, &done)
+        })),
     };
     // When the chip's clock last caught up with the wall clock.
     let mut synced = WallInstant::now();
-    let mut buf = [0u8; 4096];
     while !stop.load(Ordering::Relaxed) {
-        let n = match port.read(&mut buf) {
+        let incoming = match rx.recv_timeout(WallDuration::from_millis(20)) {
+            Ok(bytes) => bytes,
+            Err(mpsc::RecvTimeoutError::Timeout) => continue,
+            Err(mpsc::RecvTimeoutError::Disconnected) => break,
+        };
+        if realtime {
+            let began = WallInstant::now();
+            server.pass_time(Duration::from_nanos(
+                began.saturating_duration_since(synced).as_nanos() as u64,
+            ));
+            server.bus_mut().anchor_now();
+        }
+        let reply = server.on_bytes(&incoming);
+        if faults.disconnect_after.is_some_and(|k| server.frames >= k) {
+            return Ok(ServeEnd::Disconnected);
+        }
+        if realtime {
+            synced = server.bus().due().unwrap_or_else(WallInstant::now);
+        }
+        if faults.stall_after.is_some_and(|k| server.frames >= k) {
+            continue;
+        }
+        writer.write_all(&outgoing.apply(&reply))?;
+        writer.flush()?;
+    }
+    Ok(ServeEnd::Stopped)
+}
+
+/// [`serve`] on the master side of a pseudo-terminal, read through a
+/// second handle of its own.
+pub fn serve_tty(
+    master: &mut serialport::TTYPort,
+    server: &mut SimEngine,
+    faults: LinkFaults,
+    realtime: bool,
+    stop: &Arc<AtomicBool>,
+) -> io::Result<ServeEnd> {
+    let reader = master.try_clone_native().map_err(io::Error::other)?;
+    serve(reader, master, server, faults, realtime, stop)
+}
+
+/// Mixed into the outgoing direction's seed, so that the two directions
+/// draw different faults from one seed.
+const OUTGOING_SEED: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// Stops the reader thread (at its next read timeout) when dropped.
+struct ReaderGuard {
+    done: Arc<AtomicBool>,
+    handle: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Drop for ReaderGuard {
+    fn drop(&mut self) {
+        self.done.store(true, Ordering::Relaxed);
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+/// The receive path: reads what arrives, puts the line's faults on it,
+/// shows it to the abort watch, and queues it for the engine.
+fn receive<R: Read>(
+    mut reader: R,
+    faults: LinkFaults,
+    mut watch: Option<AbortWatch>,
+    tx: mpsc::Sender<Vec<u8>>,
+    stop: &AtomicBool,
+    done: &AtomicBool,
+) {
+    let mut incoming = Faulty {
+        f: faults,
+        rng: StdRng::seed_from_u64(faults.seed),
+    };
+    let mut buf = [0u8; 4096];
+    while !stop.load(Ordering::Relaxed) && !done.load(Ordering::Relaxed) {
+        let n = match reader.read(&mut buf) {
             Ok(n) => n,
             Err(e)
                 if matches!(
@@ -247,40 +301,14 @@ pub fn serve<P: Read + Write>(
         if n == 0 {
             continue;
         }
-        let incoming = faulty.apply(&buf[..n]);
-        let began = WallInstant::now();
-        if realtime {
-            server.pass_time(Duration::from_nanos(
-                began.saturating_duration_since(synced).as_nanos() as u64,
-            ));
+        let bytes = incoming.apply(&buf[..n]);
+        if let Some(w) = &mut watch {
+            w.on_bytes(&bytes);
         }
-        let before = server.now();
-        let reply = server.on_bytes(&incoming);
-        if faults.disconnect_after.is_some_and(|k| server.frames >= k) {
-            return Ok(ServeEnd::Disconnected);
+        if tx.send(bytes).is_err() {
+            return;
         }
-        if faults.stall_after.is_some_and(|k| server.frames >= k) {
-            continue;
-        }
-        if realtime {
-            // A chip reset restarts the clock at zero: count from there.
-            let after = server.now();
-            let ran = if after >= before {
-                after.saturating_since(before)
-            } else {
-                after.saturating_since(Instant::ZERO)
-            };
-            let due = began + WallDuration::from_nanos(ran.as_nanos());
-            if let Some(wait) = due.checked_duration_since(WallInstant::now()) {
-                std::thread::sleep(wait);
-            }
-            synced = due;
-        }
-        let outgoing = faulty.apply(&reply);
-        port.write_all(&outgoing)?;
-        port.flush()?;
     }
-    Ok(ServeEnd::Stopped)
 }
 
 /// A bridge simulator serving an emulator on its own thread, on a fresh
@@ -332,7 +360,18 @@ impl PtyBridge {
                 None => engine(emu, 0x5EED, !bridge.realtime),
             };
             let mut server = server.with_capture_capacity(bridge.capture_capacity);
-            let end = serve(&mut master, &mut server, faults, bridge.realtime, &flag).ok();
+            let end = match master.try_clone_native() {
+                Ok(reader) => serve(
+                    reader,
+                    &mut master,
+                    &mut server,
+                    faults,
+                    bridge.realtime,
+                    &flag,
+                )
+                .ok(),
+                Err(_) => None,
+            };
             // Gone before the pty is: a host reconnecting now finds nothing.
             let _ = std::fs::remove_file(&link);
             end

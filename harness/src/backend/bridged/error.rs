@@ -80,8 +80,17 @@ pub enum BridgeError {
         last: String,
     },
     /// A stop was asked for (SIGINT, SIGTERM) while waiting on the link.
-    #[error("{link}: interrupted by a stop request")]
-    Interrupted { link: String },
+    #[error("{link}: interrupted by a stop request{}", match aborted {
+        Some(true) => "; the bridge stopped the request in flight (ABORT)",
+        Some(false) => "; the bridge had no request running (ABORT)",
+        None => "",
+    })]
+    Interrupted {
+        link: String,
+        /// What the bridge answered the ABORT sent for the request in
+        /// flight: whether it stopped it (`None`: none sent, or no answer).
+        aborted: Option<bool>,
+    },
     /// A reply came back timed before an earlier one, with no chip reset
     /// in between: the bridge restarted behind the open port (a watchdog,
     /// a brown-out) and the chip's state was lost with it.

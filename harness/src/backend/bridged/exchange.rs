@@ -141,7 +141,9 @@ impl<L: Link> BridgeTarget<L> {
             self.set_fragment(self.want_fragment)?;
         }
         let garbled = self.garbled;
-        let r = self.exchange(req, what, extra);
+        let r = self
+            .exchange(req, what, extra)
+            .map_err(|e| self.abort_after(req, e));
         if !matches!(req, Request::Link { .. }) {
             // Only a garbled frame says the line is noisy: a lost reply, a
             // stall or a dropped connection does not ask for smaller ones.
@@ -541,6 +543,7 @@ impl<L: Link> BridgeTarget<L> {
     pub(super) fn interrupted(&self) -> BridgeError {
         BridgeError::Interrupted {
             link: self.link.name(),
+            aborted: None,
         }
     }
 

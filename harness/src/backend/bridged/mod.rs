@@ -20,6 +20,7 @@
 //! [`MAX_GIVE_UPS`] requests given up the link is not trusted for the rest
 //! of the run. A [`StopRequest`] ends any wait within [`StopRequest::SLICE`].
 
+mod abort;
 mod batch;
 mod error;
 mod exchange;

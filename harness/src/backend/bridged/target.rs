@@ -28,6 +28,9 @@ pub struct LinkStats {
     /// WORKING messages heard: a bridge slower than real time said it was
     /// still running a request.
     pub working: u64,
+    /// ABORTs sent: requests this host stopped waiting for while the
+    /// bridge may still have been running them.
+    pub aborts: u64,
 }
 
 /// A chip behind a bus bridge.
@@ -313,6 +316,7 @@ impl<L: Link> Target for BridgeTarget<L> {
             ("corrupt_frames", s.corrupt_frames),
             ("reopens", s.reopens),
             ("working", s.working),
+            ("aborts", s.aborts),
         ])
     }
 

@@ -1,0 +1,86 @@
+//! Telling a bridge to stop (`docs/bridge-protocol.md` section 5, ABORT):
+//! when this host stops waiting for a request that may still be running
+//! (a stop request, SIGINT or SIGTERM; a request given up), so that the
+//! bridge does not go on with a ten-minute move for nobody, and the next
+//! run on it opens at once.
+
+use super::error::BridgeError;
+use super::target::BridgeTarget;
+use crate::backend::link::Link;
+use crate::stop::StopRequest;
+use ppmc_core::bridge::frame;
+use ppmc_core::bridge::wire::{Request, Response};
+use std::time::{Duration as WallDuration, Instant as WallInstant};
+
+/// How long the host waits for ABORT_REPLY: a bridge stops a wait within
+/// milliseconds and answers after its Immediate Stop (10 ms at most).
+const ABORT_WAIT: WallDuration = WallDuration::from_millis(500);
+
+impl<L: Link> BridgeTarget<L> {
+    /// `error` ended `req`: if the bridge may still be running it, tell it
+    /// to stop, and say in the error what it answered.
+    pub(super) fn abort_after(&mut self, req: &Request, error: BridgeError) -> BridgeError {
+        let runs_ops = matches!(
+            req,
+            Request::Batch(_) | Request::BatchCapture { .. } | Request::SelfTest(_)
+        );
+        if !runs_ops || self.opts.stop.urgent() {
+            return error;
+        }
+        match error {
+            BridgeError::Interrupted { link, .. } => BridgeError::Interrupted {
+                link,
+                aborted: self.send_abort(),
+            },
+            BridgeError::NoAnswer {
+                link,
+                what,
+                tries,
+                secs,
+                mut heard,
+            } => {
+                heard.push_str(match self.send_abort() {
+                    Some(true) => "; the bridge stopped the request on ABORT",
+                    Some(false) => "; the bridge answered ABORT with nothing running",
+                    None => "; ABORT sent, unanswered",
+                });
+                BridgeError::NoAnswer {
+                    link,
+                    what,
+                    tries,
+                    secs,
+                    heard,
+                }
+            }
+            other => other,
+        }
+    }
+
+    /// Sends ABORT and waits a little for ABORT_REPLY: whether the bridge
+    /// stopped a request (`None`: no answer, or a bridge that does not
+    /// know ABORT). Never fails: the host is giving up already.
+    fn send_abort(&mut self) -> Option<bool> {
+        let seq = self.next_seq();
+        let bytes = frame::encode(&Request::Abort.encode(seq, self.timer));
+        self.link.send(&bytes).ok()?;
+        self.stats.aborts += 1;
+        let end = WallInstant::now() + ABORT_WAIT;
+        let mut buf = [0u8; 512];
+        loop {
+            while let Ok(Some(payload)) = self.decoder.decode() {
+                if let Ok((s, Response::Abort { stopped })) = Response::decode(&payload, self.timer)
+                {
+                    if s == seq {
+                        return Some(stopped);
+                    }
+                }
+            }
+            let left = end.checked_duration_since(WallInstant::now())?;
+            let n = self
+                .link
+                .recv(&mut buf, left.min(StopRequest::SLICE))
+                .ok()?;
+            self.decoder.extend(&buf[..n]);
+        }
+    }
+}
