@@ -125,3 +125,64 @@ pub fn only_error_3_fails(t: &mut dyn Target) {
         .collect();
     assert_eq!(failed, ["e3_data_without_a_command"], "{results:#?}");
 }
+
+/// A host stopped (as by Ctrl-C) in the 16,777,216-step move on the
+/// bridge `served`, then the next host on the same bridge: the first
+/// host's ABORT stopped the bridge's batch
+/// (`docs/bridge-protocol.md` section 5), so the next one opens at once
+/// and runs. `short` names the scenario the next host runs. How long the
+/// next host took to open is printed and returned; what is asserted is
+/// that it opens and passes at all (a bridge left running the move
+/// answers nothing for the rest of it, and the host gives up).
+pub fn stopped_in_the_long_move_then_reopened(served: &Served, short: &str) -> Duration {
+    use ppmc::stop::StopRequest;
+    let stop = StopRequest::new();
+    let mut first = served.target_with(BridgeOptions {
+        stop: stop.clone(),
+        ..BridgeOptions::default()
+    });
+    let long: Vec<_> = ppmc_scenarios::all()
+        .into_iter()
+        .filter(|s| s.name == "s3_3_4_accel_ffffff_is_16777216_steps")
+        .collect();
+    assert_eq!(long.len(), 1);
+    let running = std::thread::spawn(move || {
+        let r = run_suite(&mut first, &long, 1, DriverOptions::default(), |_| {});
+        (r, first.link_stats())
+    });
+    // Into the move (or, on a slow bridge, still in its initialization:
+    // a batch either way).
+    std::thread::sleep(Duration::from_secs(3));
+    stop.request();
+    let (results, stats) = running.join().expect("the first host ends");
+    let aborts = stats
+        .unwrap_or_default()
+        .into_iter()
+        .find(|(k, _)| *k == "aborts")
+        .map(|(_, v)| v);
+    match &results[0].verdict {
+        // A bridge in virtual time that is fast (the QEMU board: the
+        // chip's ten minutes take it a second or two) was done before
+        // the stop: nothing to abort.
+        Verdict::Passed => assert_eq!(aborts, Some(0), "nothing ran to abort"),
+        Verdict::NotRun(_) | Verdict::Error(_) => {
+            assert_eq!(aborts, Some(1), "the first host sent ABORT")
+        }
+        other => panic!("the first host: {other:?}"),
+    }
+    let began = std::time::Instant::now();
+    let mut next = served.target();
+    let opened = began.elapsed();
+    eprintln!(
+        "{}: the next host opened in {opened:?}",
+        served.link.display()
+    );
+    let short: Vec<_> = ppmc_scenarios::all()
+        .into_iter()
+        .filter(|s| s.name == short)
+        .collect();
+    assert_eq!(short.len(), 1);
+    let results = run_suite(&mut next, &short, 1, DriverOptions::default(), |_| {});
+    assert_eq!(results[0].verdict, Verdict::Passed, "{results:#?}");
+    opened
+}

@@ -9,30 +9,36 @@
 //! [`BridgeEngine`](super::engine::BridgeEngine) checks between ops and a
 //! bus checks in its long waits.
 //!
-//! Which request an abort stops is decided by frame order, not by timing:
-//! both sides count the frames they decode from the same bytes, the watch
-//! notes the index of the ABORT (or of a HELLO that changes the host), the
-//! engine the index of the request it runs, and only a request that came
-//! before the abort is stopped. An ABORT that overtakes nothing (the
-//! request it meant had ended) stops nothing, and one that is read before
-//! the engine has even begun the request before it still stops that one.
+//! Which request an abort stops is named, not timed: ABORT carries the
+//! sequence number of the request it means, so it stops that request
+//! whether the engine is already running it or has yet to begin it, and
+//! never another. A HELLO from another host session stops whatever runs.
+//! Bytes a bridge drops (a connection that ends mid-frame) cannot make the
+//! watch and the engine disagree: nothing is counted.
 
 use super::frame::FrameDecoder;
 use super::wire::{kind, Request, Timer, PROTOCOL_VERSION};
 use alloc::sync::Arc;
-use core::sync::atomic::{AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
-/// What the receive path and the engine share: the index of the newest
-/// frame that aborts, and of the request running. Cheap to clone (both
-/// ends hold one) and to check (two atomic loads).
+/// A request's sequence number, tagged so that 0 means none.
+const fn tag(seq: u8) -> u32 {
+    0x100 | seq as u32
+}
+
+/// What the receive path and the engine share: which request an ABORT
+/// named, whether a new host took over, and which request runs. Cheap to
+/// clone (both ends hold one) and to check (three atomic loads).
 #[derive(Debug, Clone, Default)]
-pub struct AbortLine(Arc<Indices>);
+pub struct AbortLine(Arc<Flags>);
 
 #[derive(Debug, Default)]
-struct Indices {
-    /// The index (from 1) of the newest ABORT, or HELLO of another host.
-    seen: AtomicU32,
-    /// The index of the request the engine runs (0: none yet).
+struct Flags {
+    /// The request the newest ABORT named (tagged; 0: none).
+    named: AtomicU32,
+    /// A HELLO of another host session arrived: stop whatever runs.
+    any: AtomicBool,
+    /// The request the engine runs (tagged; 0: none).
     running: AtomicU32,
 }
 
@@ -41,30 +47,58 @@ impl AbortLine {
         AbortLine::default()
     }
 
-    /// The receive path decoded an aborting frame, the `index`th frame.
-    pub fn raise(&self, index: u32) {
-        self.0.seen.store(index, Ordering::Release);
+    /// The receive path read an ABORT naming request `seq`.
+    pub fn raise(&self, seq: u8) {
+        self.0.named.store(tag(seq), Ordering::Release);
     }
 
-    /// The engine begins the request that was frame `index`.
-    pub fn begin(&self, index: u32) {
-        self.0.running.store(index, Ordering::Release);
+    /// The receive path read a HELLO of another host session.
+    pub fn raise_any(&self) {
+        self.0.any.store(true, Ordering::Release);
     }
 
-    /// Whether an abort came after the request running: stop it at the
-    /// next step. Frame indices wrap after 2^32 frames; they are compared
-    /// as a window, as TCP compares sequence numbers.
+    /// The engine begins request `seq`.
+    pub fn begin(&self, seq: u8) {
+        self.0.running.store(tag(seq), Ordering::Release);
+    }
+
+    /// The engine has answered the request it ran.
+    pub fn end(&self) {
+        self.0.running.store(0, Ordering::Release);
+    }
+
+    /// Whether the request running is to stop at its next step.
     pub fn pending(&self) -> bool {
-        let seen = self.0.seen.load(Ordering::Acquire);
         let running = self.0.running.load(Ordering::Acquire);
-        running != 0 && (seen.wrapping_sub(running) as i32) > 0
+        running != 0
+            && (self.0.any.load(Ordering::Acquire)
+                || self.0.named.load(Ordering::Acquire) == running)
     }
 
-    /// The engine has stopped the request: what it does now (stopping the
-    /// chip) must not be cut short by the same abort.
+    /// The engine has stopped the request running: what it does now
+    /// (stopping the chip) must not be cut short by the same abort.
     pub fn acknowledge(&self) {
-        let seen = self.0.seen.load(Ordering::Acquire);
-        self.0.running.store(seen, Ordering::Release);
+        let running = self.0.running.load(Ordering::Acquire);
+        let _ = self
+            .0
+            .named
+            .compare_exchange(running, 0, Ordering::AcqRel, Ordering::Acquire);
+        self.0.any.store(false, Ordering::Release);
+    }
+
+    /// The engine has read, in its turn, the ABORT that named `seq`: a
+    /// later request that happens to reuse the number runs.
+    pub fn read_abort(&self, seq: u8) {
+        let _ = self
+            .0
+            .named
+            .compare_exchange(tag(seq), 0, Ordering::AcqRel, Ordering::Acquire);
+    }
+
+    /// The engine has read, in its turn, a HELLO of another host session:
+    /// the new host's own requests run.
+    pub fn read_takeover(&self) {
+        self.0.any.store(false, Ordering::Release);
     }
 
     /// A watch on the receive path that raises this line.
@@ -72,7 +106,6 @@ impl AbortLine {
         AbortWatch {
             line: self.clone(),
             decoder: FrameDecoder::new(),
-            frames: 0,
             host: 0,
         }
     }
@@ -84,14 +117,10 @@ impl AbortLine {
 /// old host's request is nobody's). A HELLO of the same host session is a
 /// reconnect (section 3): the request runs on and its reply waits in the
 /// cache.
-///
-/// It must see exactly the bytes the engine is given, in the same order,
-/// so that the two count the same frames.
 #[derive(Debug)]
 pub struct AbortWatch {
     line: AbortLine,
     decoder: FrameDecoder,
-    frames: u32,
     host: u32,
 }
 
@@ -103,32 +132,32 @@ impl AbortWatch {
         let mut raised = false;
         loop {
             match self.decoder.decode() {
-                Ok(Some(payload)) => {
-                    self.frames = self.frames.wrapping_add(1);
-                    if self.aborts(&payload) {
-                        self.line.raise(self.frames);
-                        raised = true;
-                    }
-                }
+                Ok(Some(payload)) => raised |= self.look(&payload),
                 Ok(None) => return raised,
-                // The engine answers it; it counts no frame there either.
+                // The engine answers it.
                 Err(_) => {}
             }
         }
     }
 
-    fn aborts(&mut self, payload: &[u8]) -> bool {
-        match payload.get(1).copied() {
-            Some(kind::ABORT) => true,
-            Some(kind::HELLO) => match Request::decode(payload, Timer::NANOS) {
-                Ok((_, Request::Hello { version, host })) if version == PROTOCOL_VERSION => {
-                    // As the engine greets (`greet`): 0 is nobody's.
-                    let new = host == 0 || host != self.host;
-                    self.host = host;
-                    new
+    fn look(&mut self, payload: &[u8]) -> bool {
+        if !matches!(payload.get(1).copied(), Some(kind::ABORT | kind::HELLO)) {
+            return false;
+        }
+        match Request::decode(payload, Timer::NANOS) {
+            Ok((_, Request::Abort { request })) => {
+                self.line.raise(request);
+                true
+            }
+            Ok((_, Request::Hello { version, host })) if version == PROTOCOL_VERSION => {
+                // As the engine greets: 0 is nobody's, and always new.
+                let new = host == 0 || host != self.host;
+                self.host = host;
+                if new {
+                    self.line.raise_any();
                 }
-                _ => false,
-            },
+                new
+            }
             _ => false,
         }
     }
@@ -151,22 +180,26 @@ mod tests {
     }
 
     #[test]
-    fn an_abort_stops_the_request_before_it_and_no_later_one() {
+    fn an_abort_stops_the_request_it_names_and_no_other() {
         let line = AbortLine::new();
         let mut watch = line.watch();
-        // HELLO (frame 1), a batch (2), then ABORT (3).
-        assert!(watch.on_bytes(&framed(&hello(7), 1)));
-        assert!(!watch.on_bytes(&framed(&Request::Batch(alloc::vec![]), 2)));
-        line.begin(1);
-        assert!(!line.pending(), "the HELLO is the request itself");
         line.begin(2);
         assert!(!line.pending());
-        assert!(watch.on_bytes(&framed(&Request::Abort, 3)));
-        assert!(line.pending(), "the batch, frame 2, came before the abort");
+        assert!(watch.on_bytes(&framed(&Request::Abort { request: 2 }, 3)));
+        assert!(line.pending(), "request 2 runs and is named");
         line.acknowledge();
         assert!(!line.pending(), "acknowledged: the chip's stop runs");
+        line.end();
+        // An ABORT for a request that has ended stops no later one.
+        assert!(watch.on_bytes(&framed(&Request::Abort { request: 4 }, 5)));
+        line.begin(6);
+        assert!(!line.pending());
+        line.end();
+        // Until the engine reads it, request 4 would still be stopped;
+        // after, a request that reuses the number runs.
+        line.read_abort(4);
         line.begin(4);
-        assert!(!line.pending(), "a request after the abort runs");
+        assert!(!line.pending());
     }
 
     #[test]
@@ -174,35 +207,28 @@ mod tests {
         let line = AbortLine::new();
         let mut watch = line.watch();
         let mut bytes = framed(&Request::Batch(alloc::vec![]), 1);
-        bytes.extend(framed(&Request::Abort, 2));
+        bytes.extend(framed(&Request::Abort { request: 1 }, 2));
         assert!(watch.on_bytes(&bytes));
         line.begin(1);
         assert!(line.pending());
     }
 
     #[test]
-    fn only_a_hello_of_another_host_aborts() {
+    fn only_a_hello_of_another_host_stops_what_runs() {
         let line = AbortLine::new();
         let mut watch = line.watch();
         assert!(watch.on_bytes(&framed(&hello(7), 1)));
-        assert!(!watch.on_bytes(&framed(&hello(7), 2)), "a reconnect");
-        assert!(watch.on_bytes(&framed(&hello(9), 3)), "another host");
-        assert!(watch.on_bytes(&framed(&hello(0), 4)), "nobody's session");
-        // Garbage and bad frames count no frame, as in the engine.
+        line.read_takeover();
+        line.begin(2);
+        assert!(!watch.on_bytes(&framed(&hello(7), 3)), "a reconnect");
+        assert!(!line.pending());
+        // Garbage and bad frames are the engine's to answer.
         assert!(!watch.on_bytes(&[0x55, 0x13, 0x00]));
-        line.begin(5);
-        assert!(!line.pending());
-        assert!(watch.on_bytes(&framed(&Request::Abort, 5)) && !line.pending());
-        assert!(watch.on_bytes(&framed(&Request::Abort, 6)) && line.pending());
-    }
-
-    #[test]
-    fn frame_indices_compare_across_their_wrap() {
-        let line = AbortLine::new();
-        line.begin(u32::MAX);
-        line.raise(2);
+        assert!(watch.on_bytes(&framed(&hello(9), 4)), "another host");
         assert!(line.pending());
-        line.begin(3);
+        line.acknowledge();
         assert!(!line.pending());
+        assert!(watch.on_bytes(&framed(&hello(0), 5)), "nobody's session");
+        assert!(line.pending());
     }
 }

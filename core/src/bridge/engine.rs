@@ -85,8 +85,11 @@ pub struct BridgeEngine<B> {
     pub frames: u64,
     /// Raised by the receive path when an ABORT arrives ([`AbortLine`]).
     abort: Option<AbortLine>,
-    /// Whether the last request was stopped by an abort (ABORT_REPLY).
-    stopped: bool,
+    /// The request an abort stopped last, if the last request was it
+    /// (ABORT_REPLY).
+    stopped: Option<u8>,
+    /// The sequence number of the request running.
+    current: u8,
 }
 
 impl<B: Bus> BridgeEngine<B> {
@@ -110,7 +113,8 @@ impl<B: Bus> BridgeEngine<B> {
             pad: 0,
             frames: 0,
             abort: None,
-            stopped: false,
+            stopped: None,
+            current: 0,
         }
     }
 
@@ -174,10 +178,6 @@ impl<B: Bus> BridgeEngine<B> {
             match self.decoder.decode() {
                 Ok(Some(payload)) => {
                     self.frames += 1;
-                    if let Some(line) = &self.abort {
-                        // The watch counts the same frames (wrapping alike).
-                        line.begin(self.frames as u32);
-                    }
                     self.on_payload(&payload, &mut out);
                 }
                 Ok(None) => break,
@@ -257,17 +257,29 @@ impl<B: Bus> BridgeEngine<B> {
             decoded,
             Ok((
                 _,
-                Incoming::Other(Request::Hello { .. } | Request::Link { .. } | Request::Abort)
+                Incoming::Other(
+                    Request::Hello { .. } | Request::Link { .. } | Request::Abort { .. }
+                )
             ))
         );
         if !control {
             // Replaced by this request's answer: free while it runs.
             self.last = None;
             self.control = None;
-            self.stopped = false;
+            self.stopped = None;
         }
         let mut reply = match decoded {
-            Ok((_, req)) => self.respond(seq, req),
+            Ok((_, req)) => {
+                self.current = seq;
+                if let Some(line) = &self.abort {
+                    line.begin(seq);
+                }
+                let reply = self.respond(seq, req);
+                if let Some(line) = &self.abort {
+                    line.end();
+                }
+                reply
+            }
             Err(e) => Response::Error {
                 code: match e {
                     WireError::UnknownKind(_) | WireError::UnknownCode { .. } => {
@@ -417,9 +429,15 @@ impl<B: Bus> BridgeEngine<B> {
                     },
                 }
             }
-            Request::Abort => Response::Abort {
-                stopped: self.stopped,
-            },
+            Request::Abort { request } => {
+                // Read in its turn: the request it named has ended.
+                if let Some(line) = &self.abort {
+                    line.read_abort(request);
+                }
+                Response::Abort {
+                    stopped: self.stopped == Some(request),
+                }
+            }
             Request::Link { fragment, pad } => {
                 self.fragment =
                     usize::from(fragment).clamp(wire::MIN_FRAGMENT_DATA, wire::FRAGMENT_DATA);
@@ -442,6 +460,10 @@ impl<B: Bus> BridgeEngine<B> {
         if !resumed {
             self.last = None;
             self.host = host;
+            // The takeover the receive path saw has stopped what ran.
+            if let Some(line) = &self.abort {
+                line.read_takeover();
+            }
         }
         resumed
     }
@@ -500,7 +522,7 @@ impl<B: Bus> BridgeEngine<B> {
         if let Some(line) = &self.abort {
             line.acknowledge();
         }
-        self.stopped = true;
+        self.stopped = Some(self.current);
         let busy =
             matches!(self.bus.run(Op::ReadStatus), Reply::Status { status, .. } if status.busy());
         let stop = if busy {
@@ -1066,7 +1088,9 @@ mod tests {
         });
         let batch = Request::Batch(ops.clone()).encode(1, Timer::NANOS);
         let mut stream = frame::encode(&batch);
-        stream.extend(frame::encode(&Request::Abort.encode(2, Timer::NANOS)));
+        stream.extend(frame::encode(
+            &Request::Abort { request: 1 }.encode(2, Timer::NANOS),
+        ));
         let bus = AbortingBus {
             emu: EmuBus::new(Straps::default(), ModelConfig::default()).expect("model"),
             watch: None,
@@ -1098,14 +1122,16 @@ mod tests {
             "the capture keeps the move's pulses so far: {pulses}"
         );
         // The ABORT itself, read after the batch's reply.
-        let out = s.on_bytes(&frame::encode(&Request::Abort.encode(2, Timer::NANOS)));
+        let abort = Request::Abort { request: 1 };
+        let out = s.on_bytes(&frame::encode(&abort.encode(2, Timer::NANOS)));
         assert_eq!(collect(&out).1, Response::Abort { stopped: true });
         // A request after it runs in full; an ABORT then stops nothing.
         let out = s.on_bytes(&frame::encode(
             &Request::Batch(vec![Op::ReadStatus]).encode(3, Timer::NANOS),
         ));
         assert!(matches!(collect(&out).1, Response::Batch(r) if r.len() == 1));
-        let out = s.on_bytes(&frame::encode(&Request::Abort.encode(4, Timer::NANOS)));
+        let abort = Request::Abort { request: 3 };
+        let out = s.on_bytes(&frame::encode(&abort.encode(4, Timer::NANOS)));
         assert_eq!(collect(&out).1, Response::Abort { stopped: false });
     }
 

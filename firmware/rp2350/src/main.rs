@@ -57,6 +57,7 @@ use ppmc_bridge_fw::board::Board;
 use ppmc_bridge_fw::bus_cycle::BusTiming;
 use ppmc_bridge_fw::restart;
 use ppmc_bridge_fw::{limits, pins, pioregs, programs, usb};
+use ppmc_core::bridge::abort::{AbortLine, AbortWatch};
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::protocol::Straps;
 use static_cell::StaticCell;
@@ -306,6 +307,10 @@ async fn main(_spawner: Spawner) {
     // bridges are told apart on a host (/dev/serial/by-id) and across a
     // network alike.
     let chip_serial = hex16(embassy_rp::otp::get_chipid().unwrap_or(0));
+    // Raised by core 0 as an ABORT arrives, checked by core 1 between ops
+    // and in its waits (`docs/bridge-protocol.md` section 5).
+    let abort = AbortLine::new();
+    let watch = abort.watch();
     spawn_core1(p.CORE1, CORE1_STACK.init(Stack::new()), move || {
         // SAFETY: core 1's own DCB and DWT, set up once here.
         let mut core1 = unsafe { cortex_m::Peripherals::steal() };
@@ -317,7 +322,8 @@ async fn main(_spawner: Spawner) {
         let mut engine = BridgeEngine::new(board, session, false, firmware)
             .with_serial(core::str::from_utf8(&chip_serial).unwrap_or(""))
             .with_timer(timer)
-            .with_capture_capacity(limits::CAPTURE_RECORDS);
+            .with_capture_capacity(limits::CAPTURE_RECORDS)
+            .with_abort(abort);
         let mut buf = [0u8; 64];
         // What the log has said about the board code so far.
         let (mut overruns, mut faulted) = (0u32, false);
@@ -384,10 +390,13 @@ async fn main(_spawner: Spawner) {
     // host against the loop it replaced: defect 6).
     let serve = async {
         let mut cdc = Cdc(class);
+        let pipes = CorePipes {
+            watch: core::cell::RefCell::new(watch),
+        };
         loop {
-            usb::between_connections(&CorePipes, cdc.0.wait_connection()).await;
+            usb::between_connections(&pipes, cdc.0.wait_connection()).await;
             defmt::info!("USB: the host opened the port");
-            usb::serve_connection(&mut cdc, &CorePipes, &WriteDeadline).await;
+            usb::serve_connection(&mut cdc, &pipes, &WriteDeadline).await;
             defmt::info!(
                 "USB: the host closed the port, or stopped reading for {=u64} ms",
                 WRITE_DEADLINE.as_millis()
@@ -417,12 +426,18 @@ impl usb::Packets for Cdc<'_> {
     }
 }
 
-/// The pipes between the cores as `usb::Pipes`.
-struct CorePipes;
+/// The pipes between the cores as `usb::Pipes`, and the abort watch on
+/// the way in: an ABORT is seen as it arrives, while core 1 is busy.
+struct CorePipes {
+    watch: core::cell::RefCell<AbortWatch>,
+}
 
 impl usb::Pipes for CorePipes {
     async fn to_engine(&self, data: &[u8]) -> usize {
-        FROM_HOST.write(data).await
+        let n = FROM_HOST.write(data).await;
+        // What went into the pipe, as the engine will read it.
+        self.watch.borrow_mut().on_bytes(&data[..n]);
+        n
     }
 
     async fn replies(&self, buf: &mut [u8]) -> usize {

@@ -8,6 +8,7 @@
 //! anything happens, so runs are repeatable.
 
 use ppmc_bridge_fw::twin;
+use ppmc_core::bridge::abort::{AbortLine, AbortWatch};
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::bridge::frame::{self, FrameDecoder};
 use ppmc_core::bridge::wire::{Response, Timer};
@@ -20,7 +21,7 @@ use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::{mpsc, Arc, Mutex};
 
 const HELP: &str = "\
 ppmc-twin: the RP2350 bridge's board code on a twin of the RP2350, served on a pseudo-terminal
@@ -212,6 +213,36 @@ fn working(
     });
 }
 
+/// The receive path, on a thread of its own as a board's USB is on its
+/// own core: what arrives is shown to the abort watch at once (an ABORT
+/// stops the request the engine runs, `docs/bridge-protocol.md`
+/// section 5), then queued for the engine.
+fn receive(mut pty: std::fs::File, mut watch: AbortWatch) -> mpsc::Receiver<Vec<u8>> {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let mut buf = [0u8; 4096];
+        while !STOP.load(Ordering::Relaxed) {
+            if !readable(pty.as_raw_fd()) {
+                continue;
+            }
+            let n = match io::Read::read(&mut pty, &mut buf) {
+                Ok(n) => n,
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                // No host on the other end: wait for one.
+                Err(_) => {
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                    continue;
+                }
+            };
+            watch.on_bytes(&buf[..n]);
+            if tx.send(buf[..n].to_vec()).is_err() {
+                return;
+            }
+        }
+    });
+    rx
+}
+
 fn serve(o: Options) -> Result<(), String> {
     let board = twin::board(o.straps, o.model).map_err(|e| format!("the twin cannot boot: {e}"))?;
     let timer = board.timer();
@@ -222,9 +253,11 @@ fn serve(o: Options) -> Result<(), String> {
         env!("CARGO_PKG_VERSION"),
         " (the RP2350 board code on a twin of the RP2350)"
     );
+    let abort = AbortLine::new();
     let mut engine = BridgeEngine::new(board, session, true, firmware)
         .with_timer(timer)
-        .with_capture_capacity(ppmc_bridge_fw::limits::CAPTURE_RECORDS);
+        .with_capture_capacity(ppmc_bridge_fw::limits::CAPTURE_RECORDS)
+        .with_abort(abort.clone());
     let (master, path) = open_pty().map_err(|e| format!("no pseudo-terminal: {e}"))?;
     if let Some(link) = &o.link {
         let _ = std::fs::remove_file(link);
@@ -247,34 +280,31 @@ fn serve(o: Options) -> Result<(), String> {
     });
     println!("run-twin: serving on {path}");
     let _ = io::stdout().flush();
-    let mut file = std::fs::File::from(master);
+    let file = std::fs::File::from(master);
     let out = Arc::new(Mutex::new(
         file.try_clone()
             .map_err(|e| format!("no second handle on {path}: {e}"))?,
     ));
     let running: Arc<Mutex<Option<Running>>> = Arc::default();
     working(out.clone(), running.clone(), progress.clone(), timer);
+    let reader = file
+        .try_clone()
+        .map_err(|e| format!("no third handle on {path}: {e}"))?;
+    let arrived = receive(reader, abort.watch());
     let mut requests = FrameDecoder::new();
-    let mut buf = [0u8; 4096];
     let result = loop {
         if STOP.load(Ordering::Relaxed) {
             break Ok(());
         }
-        if !readable(file.as_raw_fd()) {
-            continue;
-        }
-        let n = match io::Read::read(&mut file, &mut buf) {
-            Ok(n) => n,
-            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
-            Err(_) => {
-                std::thread::sleep(std::time::Duration::from_millis(20));
-                continue;
-            }
+        let bytes = match arrived.recv_timeout(std::time::Duration::from_millis(50)) {
+            Ok(bytes) => bytes,
+            Err(mpsc::RecvTimeoutError::Timeout) => continue,
+            Err(mpsc::RecvTimeoutError::Disconnected) => break Ok(()),
         };
         // Frame by frame, so that a long request is known by its sequence
         // number while it runs (WORKING).
         let mut failed = None;
-        for chunk in buf[..n].split_inclusive(|b| *b == 0) {
+        for chunk in bytes.split_inclusive(|b| *b == 0) {
             requests.extend(chunk);
             if let Ok(Some(p)) = requests.decode() {
                 if let Some(&seq) = p.first() {

@@ -290,3 +290,14 @@ fn a_capture_heavy_run_fills_the_capture_before_the_heap_and_the_board_serves_on
     // The same board: it did not restart.
     assert_eq!(board.target().hello().session, session);
 }
+
+/// Ctrl-C during the 16,777,216-step move, then the next host on the
+/// QEMU board: it opens at once (`docs/bridge-protocol.md` section 5).
+#[test]
+fn after_a_stop_in_the_long_move_the_next_host_opens_the_qemu_board_at_once() {
+    if !available() {
+        return;
+    }
+    let board = Served::start("run-qemu", &[]);
+    common::served::stopped_in_the_long_move_then_reopened(&board, "e3_data_without_a_command");
+}

@@ -283,3 +283,13 @@ fn console_stamps_measure_a_single_steps_processing_time_within_their_uncertaint
         "{got} ns on the twin (U {u} ns), {want} ns on the emulator"
     );
 }
+
+/// Ctrl-C during the 16,777,216-step move (ten minutes of the chip's
+/// time, hours of the twin's), then the next host: the board code stops
+/// its wait on the host's ABORT and the move with an Immediate Stop, so
+/// the next host opens at once (`docs/bridge-protocol.md` section 5).
+#[test]
+fn after_a_stop_in_the_long_move_the_next_host_opens_the_twin_at_once() {
+    let twin = Served::start("run-twin", &[]);
+    common::served::stopped_in_the_long_move_then_reopened(&twin, "e3_data_without_a_command");
+}

@@ -123,7 +123,10 @@ impl Request {
                 w.u16(p.bursts);
                 w.dur(p.gap);
             }
-            Request::Abort => w.u8(kind::ABORT),
+            Request::Abort { request } => {
+                w.u8(kind::ABORT);
+                w.u8(*request);
+            }
             Request::Resend { fragments } => {
                 w.u8(kind::RESEND);
                 w.u8(fragments.len().min(255) as u8);
@@ -173,7 +176,7 @@ impl Request {
                 fragment: r.u8()?,
                 pad: r.u16()?,
             },
-            kind::ABORT => Request::Abort,
+            kind::ABORT => Request::Abort { request: r.u8()? },
             kind::RESEND => {
                 let n = usize::from(r.u8()?);
                 Request::Resend {

@@ -186,10 +186,10 @@ pub enum Request {
     /// reset, the generator's bursts, and the capture of them from the
     /// reset on, fetched with CAPTURE as usual.
     SelfTest(SelfTestPlan),
-    /// Stop the request in flight at its next step and leave the chip
-    /// stopped (`docs/bridge-protocol.md` section 5, ABORT). Sent while a
-    /// request runs; it changes nothing when none does.
-    Abort,
+    /// Stop request `request` (its sequence number) at its next step and
+    /// leave the chip stopped (`docs/bridge-protocol.md` section 5,
+    /// ABORT). It changes nothing when that request is not running.
+    Abort { request: u8 },
 }
 
 /// Largest response payload sent as one frame; longer ones go as
@@ -290,7 +290,7 @@ pub enum Response {
     Working {
         elapsed: Duration,
     },
-    /// The answer to ABORT: whether the request before it was stopped by
+    /// The answer to ABORT: whether the request it named was stopped by
     /// it (its own reply is then ERROR `ABORTED`).
     Abort {
         stopped: bool,

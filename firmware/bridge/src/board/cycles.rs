@@ -184,7 +184,7 @@ impl<H: Hal> Board<H> {
                 return Ok((end.saturating_sub(start), s));
             }
             prev = Some(t);
-            if t >= deadline {
+            if t >= deadline || self.aborted() {
                 return Err((t, s));
             }
             self.refresh();

@@ -40,6 +40,7 @@ use crate::pins;
 use crate::timebase;
 use alloc::string::String;
 use alloc::vec::Vec;
+use ppmc_core::bridge::abort::AbortLine;
 use ppmc_core::bridge::move_tracker::MoveTracker;
 use ppmc_core::bridge::wire::Timer;
 use ppmc_core::bus::{Op, Uncertainty};
@@ -119,6 +120,9 @@ pub struct Board<H: Hal> {
     fault: Option<String>,
     /// Capture overruns since boot (each restarted the counters).
     pub overruns: u32,
+    /// Raised when the host's ABORT arrives: every wait ends at its next
+    /// pass (`docs/bridge-protocol.md` section 5).
+    abort: Option<AbortLine>,
 }
 
 impl<H: Hal> core::fmt::Debug for Board<H> {
@@ -136,6 +140,11 @@ impl<H: Hal> core::fmt::Debug for Board<H> {
 }
 
 impl<H: Hal> Board<H> {
+    /// Whether the host's ABORT came for the request running: a wait ends.
+    pub(super) fn aborted(&self) -> bool {
+        self.abort.as_ref().is_some_and(AbortLine::pending)
+    }
+
     /// The board code over `hal`: starts the edge counters and samples the
     /// outputs.
     pub fn new(mut hal: H, timing: BusTiming, straps: Straps) -> Board<H> {
@@ -182,6 +191,7 @@ impl<H: Hal> Board<H> {
             last_toggle: None,
             fault: None,
             overruns: 0,
+            abort: None,
         };
         let word = bus.hal.read_high_pins() & pins::SAMPLED_HIGH;
         let now = bus.now_ticks();

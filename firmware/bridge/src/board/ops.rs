@@ -9,6 +9,7 @@ use crate::bus_cycle::{self, Cycle};
 use crate::hal::Hal;
 use crate::pins;
 use alloc::string::String;
+use ppmc_core::bridge::abort::AbortLine;
 use ppmc_core::bus::{Bus, Op, Reply, SelfTestPlan, SelfTestReply};
 use ppmc_core::protocol::{Input as ChipInput, OutputRecord, Status, Straps};
 use ppmc_core::time::{Duration, Instant};
@@ -120,7 +121,7 @@ impl<H: Hal> Board<H> {
         let until = target.saturating_sub(kind.map_or(0, |k| self.lead(k)));
         loop {
             let now = self.now_ticks();
-            if now >= until {
+            if now >= until || self.aborted() {
                 break;
             }
             // No poll that would end past `until`: the capture waits in
@@ -341,7 +342,7 @@ impl<H: Hal> Bus for Board<H> {
                         self.moment = self.epoch + self.timer.to_ticks(at.as_nanos());
                         break Reply::PulsesReached { at };
                     }
-                    if t >= deadline {
+                    if t >= deadline || self.aborted() {
                         break Reply::PulsesTimedOut {
                             at: self.at(t),
                             count: n,
@@ -394,5 +395,9 @@ impl<H: Hal> Bus for Board<H> {
 
     fn self_test(&mut self, plan: &SelfTestPlan) -> Result<SelfTestReply, String> {
         self.run_self_test(plan)
+    }
+
+    fn watch_abort(&mut self, line: AbortLine) {
+        self.abort = Some(line);
     }
 }

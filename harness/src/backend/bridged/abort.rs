@@ -17,9 +17,15 @@ use std::time::{Duration as WallDuration, Instant as WallInstant};
 const ABORT_WAIT: WallDuration = WallDuration::from_millis(500);
 
 impl<L: Link> BridgeTarget<L> {
-    /// `error` ended `req`: if the bridge may still be running it, tell it
-    /// to stop, and say in the error what it answered.
-    pub(super) fn abort_after(&mut self, req: &Request, error: BridgeError) -> BridgeError {
+    /// `error` ended `req`, sent as sequence `seq`: if the bridge may
+    /// still be running it, tell it to stop, and say in the error what it
+    /// answered.
+    pub(super) fn abort_after(
+        &mut self,
+        req: &Request,
+        seq: u8,
+        error: BridgeError,
+    ) -> BridgeError {
         let runs_ops = matches!(
             req,
             Request::Batch(_) | Request::BatchCapture { .. } | Request::SelfTest(_)
@@ -30,7 +36,7 @@ impl<L: Link> BridgeTarget<L> {
         match error {
             BridgeError::Interrupted { link, .. } => BridgeError::Interrupted {
                 link,
-                aborted: self.send_abort(),
+                aborted: self.send_abort(seq),
             },
             BridgeError::NoAnswer {
                 link,
@@ -39,7 +45,7 @@ impl<L: Link> BridgeTarget<L> {
                 secs,
                 mut heard,
             } => {
-                heard.push_str(match self.send_abort() {
+                heard.push_str(match self.send_abort(seq) {
                     Some(true) => "; the bridge stopped the request on ABORT",
                     Some(false) => "; the bridge answered ABORT with nothing running",
                     None => "; ABORT sent, unanswered",
@@ -59,9 +65,9 @@ impl<L: Link> BridgeTarget<L> {
     /// Sends ABORT and waits a little for ABORT_REPLY: whether the bridge
     /// stopped a request (`None`: no answer, or a bridge that does not
     /// know ABORT). Never fails: the host is giving up already.
-    fn send_abort(&mut self) -> Option<bool> {
+    fn send_abort(&mut self, request: u8) -> Option<bool> {
         let seq = self.next_seq();
-        let bytes = frame::encode(&Request::Abort.encode(seq, self.timer));
+        let bytes = frame::encode(&Request::Abort { request }.encode(seq, self.timer));
         self.link.send(&bytes).ok()?;
         self.stats.aborts += 1;
         let end = WallInstant::now() + ABORT_WAIT;

@@ -141,9 +141,10 @@ impl<L: Link> BridgeTarget<L> {
             self.set_fragment(self.want_fragment)?;
         }
         let garbled = self.garbled;
-        let r = self
-            .exchange(req, what, extra)
-            .map_err(|e| self.abort_after(req, e));
+        let r = self.exchange(req, what, extra).map_err(|e| {
+            let seq = self.in_flight.unwrap_or(self.seq);
+            self.abort_after(req, seq, e)
+        });
         if !matches!(req, Request::Link { .. }) {
             // Only a garbled frame says the line is noisy: a lost reply, a
             // stall or a dropped connection does not ask for smaller ones.
