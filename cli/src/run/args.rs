@@ -57,6 +57,13 @@ pub struct RunArgs {
     /// A scenario that passed only on a retry fails the run (exit 1).
     #[arg(long)]
     pub(crate) flaky_is_failure: bool,
+    /// On a board: the longest one scenario may take on the wall clock,
+    /// e.g. 90s, 20m. Past it the host tells the bridge to stop (ABORT:
+    /// the move is stopped, the chip left idle), the scenario is an error
+    /// naming the limit, and the run goes on. Default: no limit but each
+    /// scenario's own budget of chip time.
+    #[arg(long, value_name = "DURATION", value_parser = crate::args::parse_duration)]
+    pub(crate) timeout: Option<ppmc::time::Duration>,
     /// Width of the MARGINAL zone inside each Table 3-3 limit, in percent of
     /// the limit.
     #[arg(long, default_value_t = ppmc_record::MARGINAL_PCT)]

@@ -44,6 +44,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 times: args.retries,
                 failures: args.retry_failures,
             },
+            timeout: (args.timeout).map(|d| std::time::Duration::from_nanos(d.as_nanos())),
             ..DriverOptions::default()
         },
         spread,

@@ -173,3 +173,42 @@ fn after_ctrl_c_in_the_long_move_the_next_run_on_the_bridge_opens_at_once() {
         assert_eq!(status.code(), Some(0), "after {sig}: {status}");
     }
 }
+
+/// `--timeout` on a real-time bridge: the 16,777,216-step move runs past
+/// it, so the host tells the bridge to stop (ABORT) and the scenario is an
+/// error naming the limit, not a failure of the board; the run goes on,
+/// and the scenarios after it pass on the same bridge.
+#[test]
+fn a_scenario_past_its_timeout_is_stopped_on_the_bridge_and_the_run_goes_on() {
+    let sim = BridgeSim::start(&["--realtime"]);
+    let dir = scratch("timeout");
+    let mut child = run(
+        &[],
+        &sim.target(),
+        &["--filter", "s3_3_4_a", "--timeout", "2s"],
+        dir.path(),
+    );
+    let status = wait_bounded(&mut child, Duration::from_secs(120));
+    assert_eq!(status.code(), Some(1), "{status}");
+    let record: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("run.json")).expect("the JSON record"),
+    )
+    .expect("JSON");
+    check_record(&run_record_schema(), &record);
+    let scenarios = record["scenarios"].as_array().expect("scenarios");
+    assert!(scenarios.len() > 3, "{}", scenarios.len());
+    for s in scenarios {
+        let name = s["name"].as_str().unwrap_or_default();
+        if name == "s3_3_4_accel_ffffff_is_16777216_steps" {
+            assert_eq!(s["verdict"], "error", "{s}");
+            let message = s["error"]["message"].as_str().unwrap_or_default();
+            assert!(
+                message.contains("--timeout passed") && message.contains("stopped it (ABORT)"),
+                "{message}"
+            );
+        } else {
+            assert_eq!(s["verdict"], "passed", "{s}");
+        }
+    }
+    assert_eq!(record["summary"]["error"], 1, "{}", record["summary"]);
+}

@@ -189,6 +189,13 @@ pub trait Target: Send {
         None
     }
 
+    /// The wall-clock moment past which a batch is not waited for (a
+    /// scenario's `--timeout`): a board's host then tells its bridge to
+    /// stop (ABORT) and ends the batch with an error naming the limit.
+    /// `None` lifts it. A target in virtual time (the emulator), done in
+    /// an instant, has nothing to cut short.
+    fn set_deadline(&mut self, _at: Option<std::time::Instant>) {}
+
     /// Runs one op.
     fn execute_one(&mut self, op: Op) -> Result<Reply, TargetError> {
         let mut replies = self.execute(std::slice::from_ref(&op))?;

@@ -25,6 +25,11 @@ pub struct DriverOptions {
     /// When the runner tries a scenario again (the driver itself never
     /// does).
     pub retry: super::verdict::Retry,
+    /// The longest one scenario may take on the wall clock (`ppmc run
+    /// --timeout`): past it, a board's host tells the bridge to stop
+    /// (ABORT) and the scenario is an error naming the limit. `None`: no
+    /// limit but the scenario's own (its virtual-time budget).
+    pub timeout: Option<std::time::Duration>,
 }
 
 impl Default for DriverOptions {
@@ -37,6 +42,7 @@ impl Default for DriverOptions {
             budget: Duration::from_secs(120),
             grading: Grading::default(),
             retry: super::verdict::Retry::default(),
+            timeout: None,
         }
     }
 }

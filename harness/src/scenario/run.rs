@@ -78,6 +78,7 @@ pub fn run_scenario(
         ..opts
     };
     let started = std::time::Instant::now();
+    target.set_deadline(opts.timeout.map(|limit| started + limit));
     let info = target.info();
     let uncertainty = target.uncertainty();
     let mut driver = Driver::new(target, opts);
@@ -104,6 +105,8 @@ pub fn run_scenario(
     let elapsed = driver.clock().saturating_since(Instant::ZERO);
     let capture = driver.capture().cloned();
     let (bus, measurements) = driver.into_parts();
+    // The health check and the next scenario have limits of their own.
+    target.set_deadline(None);
     let verdict = match (outcome, &capture) {
         // Without the capture the run cannot be shown or compared: the link
         // failed, whatever the expectations said.

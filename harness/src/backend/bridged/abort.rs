@@ -1,6 +1,7 @@
 //! Telling a bridge to stop (`docs/bridge-protocol.md` section 5, ABORT):
 //! when this host stops waiting for a request that may still be running
-//! (a stop request, SIGINT or SIGTERM; a request given up), so that the
+//! (a stop request, SIGINT or SIGTERM; a scenario's `--timeout`; a request
+//! given up), so that the
 //! bridge does not go on with a ten-minute move for nobody, and the next
 //! run on it opens at once.
 
@@ -34,6 +35,11 @@ impl<L: Link> BridgeTarget<L> {
             return error;
         }
         match error {
+            BridgeError::PastDeadline { link, what, .. } => BridgeError::PastDeadline {
+                link,
+                what,
+                aborted: self.send_abort(seq),
+            },
             BridgeError::Interrupted { link, .. } => BridgeError::Interrupted {
                 link,
                 aborted: self.send_abort(seq),

@@ -94,6 +94,17 @@ pub enum BridgeError {
     /// A reply came back timed before an earlier one, with no chip reset
     /// in between: the bridge restarted behind the open port (a watchdog,
     /// a brown-out) and the chip's state was lost with it.
+    #[error("{link}: the scenario's --timeout passed while the bridge ran {what}{}", match aborted {
+        Some(true) => "; the bridge stopped it (ABORT)",
+        Some(false) => "; the bridge had no request running (ABORT)",
+        None => "; ABORT went unanswered",
+    })]
+    PastDeadline {
+        link: String,
+        what: String,
+        /// What the bridge answered the ABORT (`None`: no answer).
+        aborted: Option<bool>,
+    },
     #[error("{link}: the bridge's clock went back from {was} to {now} without a chip reset: the bridge restarted behind the open port and the chip's state is unknown")]
     ClockWentBack {
         link: String,
@@ -113,6 +124,8 @@ impl BridgeError {
         match self {
             BridgeError::Version { .. } => TargetErrorKind::Unsupported,
             BridgeError::Interrupted { .. } => TargetErrorKind::Interrupted,
+            // The user's limit, not a verdict on the board or the link.
+            BridgeError::PastDeadline { .. } => TargetErrorKind::Other,
             // An error or a reply of the wrong kind to a well-formed
             // request is the bridge's or the link's doing (a firmware bug,
             // something else answering on the port), never the chip's.

@@ -258,6 +258,13 @@ impl<L: Link> BridgeTarget<L> {
             if self.opts.stop.requested() {
                 return Err(self.interrupted());
             }
+            if self.past_deadline() {
+                return Err(BridgeError::PastDeadline {
+                    link: self.link.name(),
+                    what: what.to_string(),
+                    aborted: None,
+                });
+            }
             let now = WallInstant::now();
             let stalled = now >= progress_at + stall_limit || now >= give_up_at;
             let out_of_tries = silent > retries || fruitless > retries * NOISY_RETRIES;
@@ -540,6 +547,12 @@ impl<L: Link> BridgeTarget<L> {
         noise.corrupt += 1;
     }
 
+    /// Whether a scenario's `--timeout` has passed
+    /// ([`Target::set_deadline`](crate::backend::Target::set_deadline)).
+    pub(super) fn past_deadline(&self) -> bool {
+        self.deadline.is_some_and(|d| WallInstant::now() >= d)
+    }
+
     /// The error for a stop request.
     pub(super) fn interrupted(&self) -> BridgeError {
         BridgeError::Interrupted {
@@ -687,7 +700,7 @@ impl<L: Link> BridgeTarget<L> {
             }
             let now = WallInstant::now();
             let until = quiet_by.map_or(deadline, |q| q.min(deadline));
-            if now >= until || self.opts.stop.requested() {
+            if now >= until || self.opts.stop.requested() || self.past_deadline() {
                 return Ok(None);
             }
             let n = self

@@ -84,6 +84,9 @@ pub struct BridgeTarget<L: Link> {
     pub(super) recovering: bool,
     /// The sequence number of the request whose reply is awaited.
     pub(super) in_flight: Option<u8>,
+    /// Past this moment no request is waited for (a scenario's
+    /// `--timeout`, [`Target::set_deadline`]).
+    pub(super) deadline: Option<WallInstant>,
     /// Frames that arrived garbled, either way (corrupt frames here,
     /// bad-frame errors from the bridge): what makes the host shrink its
     /// requests and the bridge's reply fragments.
@@ -146,6 +149,7 @@ impl<L: Link> BridgeTarget<L> {
             opened: false,
             recovering: false,
             in_flight: None,
+            deadline: None,
             garbled: 0,
             give_ups: 0,
             last_give_up: String::new(),
@@ -306,6 +310,10 @@ impl<L: Link> Target for BridgeTarget<L> {
         Some(self.hello.serial.clone())
             .filter(|s| !s.is_empty())
             .or_else(|| self.link.device_serial())
+    }
+
+    fn set_deadline(&mut self, at: Option<std::time::Instant>) {
+        self.deadline = at;
     }
 
     fn link_stats(&self) -> Option<Vec<(&'static str, u64)>> {
