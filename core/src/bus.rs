@@ -11,7 +11,7 @@
 //! chip bus plus its pins and a pulse capture. [`EmuBus`] is the reference
 //! model behind it; a bridge firmware implements it over the real chip.
 
-use crate::bridge::abort::AbortLine;
+use crate::bridge::abort_line::AbortLine;
 use crate::emu::{Board, Chip, ChipError, ModelConfig};
 use crate::protocol::{
     Flag, Input, OutputMark, OutputRecord, Pin, Pins, PulseSummary, Status, Straps,

@@ -16,100 +16,9 @@
 //! Bytes a bridge drops (a connection that ends mid-frame) cannot make the
 //! watch and the engine disagree: nothing is counted.
 
+pub use super::abort_line::AbortLine;
 use super::frame::FrameDecoder;
 use super::wire::{kind, Request, Timer, PROTOCOL_VERSION};
-use alloc::sync::Arc;
-use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
-
-/// A request's sequence number, tagged so that 0 means none.
-const fn tag(seq: u8) -> u32 {
-    0x100 | seq as u32
-}
-
-/// What the receive path and the engine share: which request an ABORT
-/// named, whether a new host took over, and which request runs. Cheap to
-/// clone (both ends hold one) and to check (three atomic loads).
-#[derive(Debug, Clone, Default)]
-pub struct AbortLine(Arc<Flags>);
-
-#[derive(Debug, Default)]
-struct Flags {
-    /// The request the newest ABORT named (tagged; 0: none).
-    named: AtomicU32,
-    /// A HELLO of another host session arrived: stop whatever runs.
-    any: AtomicBool,
-    /// The request the engine runs (tagged; 0: none).
-    running: AtomicU32,
-}
-
-impl AbortLine {
-    pub fn new() -> AbortLine {
-        AbortLine::default()
-    }
-
-    /// The receive path read an ABORT naming request `seq`.
-    pub fn raise(&self, seq: u8) {
-        self.0.named.store(tag(seq), Ordering::Release);
-    }
-
-    /// The receive path read a HELLO of another host session.
-    pub fn raise_any(&self) {
-        self.0.any.store(true, Ordering::Release);
-    }
-
-    /// The engine begins request `seq`.
-    pub fn begin(&self, seq: u8) {
-        self.0.running.store(tag(seq), Ordering::Release);
-    }
-
-    /// The engine has answered the request it ran.
-    pub fn end(&self) {
-        self.0.running.store(0, Ordering::Release);
-    }
-
-    /// Whether the request running is to stop at its next step.
-    pub fn pending(&self) -> bool {
-        let running = self.0.running.load(Ordering::Acquire);
-        running != 0
-            && (self.0.any.load(Ordering::Acquire)
-                || self.0.named.load(Ordering::Acquire) == running)
-    }
-
-    /// The engine has stopped the request running: what it does now
-    /// (stopping the chip) must not be cut short by the same abort.
-    pub fn acknowledge(&self) {
-        let running = self.0.running.load(Ordering::Acquire);
-        let _ = self
-            .0
-            .named
-            .compare_exchange(running, 0, Ordering::AcqRel, Ordering::Acquire);
-        self.0.any.store(false, Ordering::Release);
-    }
-
-    /// The engine has read, in its turn, the ABORT that named `seq`: a
-    /// later request that happens to reuse the number runs.
-    pub fn read_abort(&self, seq: u8) {
-        let _ = self
-            .0
-            .named
-            .compare_exchange(tag(seq), 0, Ordering::AcqRel, Ordering::Acquire);
-    }
-
-    /// The engine has read, in its turn, a HELLO of another host session:
-    /// the new host's own requests run.
-    pub fn read_takeover(&self) {
-        self.0.any.store(false, Ordering::Release);
-    }
-
-    /// A watch on the receive path that raises this line.
-    pub fn watch(&self) -> AbortWatch {
-        AbortWatch {
-            line: self.clone(),
-            decoder: FrameDecoder::new(),
-            host: 0,
-        }
-    }
-}
 
 /// Looks at the bytes a bridge receives, as they arrive, for frames that
 /// stop the request in flight: ABORT, and a HELLO from another host
@@ -125,6 +34,15 @@ pub struct AbortWatch {
 }
 
 impl AbortWatch {
+    /// A watch on the receive path that raises `line`.
+    pub fn new(line: AbortLine) -> AbortWatch {
+        AbortWatch {
+            line,
+            decoder: FrameDecoder::new(),
+            host: 0,
+        }
+    }
+
     /// Takes bytes as they arrive (before they are queued for the
     /// engine); whether they held an aborting frame.
     pub fn on_bytes(&mut self, bytes: &[u8]) -> bool {
@@ -182,7 +100,7 @@ mod tests {
     #[test]
     fn an_abort_stops_the_request_it_names_and_no_other() {
         let line = AbortLine::new();
-        let mut watch = line.watch();
+        let mut watch = AbortWatch::new(line.clone());
         line.begin(2);
         assert!(!line.pending());
         assert!(watch.on_bytes(&framed(&Request::Abort { request: 2 }, 3)));
@@ -205,7 +123,7 @@ mod tests {
     #[test]
     fn an_abort_read_before_the_engine_begins_the_request_still_stops_it() {
         let line = AbortLine::new();
-        let mut watch = line.watch();
+        let mut watch = AbortWatch::new(line.clone());
         let mut bytes = framed(&Request::Batch(alloc::vec![]), 1);
         bytes.extend(framed(&Request::Abort { request: 1 }, 2));
         assert!(watch.on_bytes(&bytes));
@@ -216,7 +134,7 @@ mod tests {
     #[test]
     fn only_a_hello_of_another_host_stops_what_runs() {
         let line = AbortLine::new();
-        let mut watch = line.watch();
+        let mut watch = AbortWatch::new(line.clone());
         assert!(watch.on_bytes(&framed(&hello(7), 1)));
         line.read_takeover();
         line.begin(2);

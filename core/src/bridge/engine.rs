@@ -164,7 +164,7 @@ impl<B: Bus> BridgeEngine<B> {
 
     /// The line an ABORT raises, if the bridge has one
     /// ([`BridgeEngine::with_abort`]): its receive path watches for ABORT
-    /// with [`AbortLine::watch`].
+    /// with an [`AbortWatch`](super::abort::AbortWatch) of it.
     pub fn abort_line(&self) -> Option<&AbortLine> {
         self.abort.as_ref()
     }
@@ -1067,7 +1067,7 @@ mod tests {
             self.emu.now()
         }
         fn watch_abort(&mut self, line: AbortLine) {
-            self.watch = Some(line.watch());
+            self.watch = Some(crate::bridge::abort::AbortWatch::new(line));
         }
     }
 

@@ -11,6 +11,7 @@
 //! bridge firmware must; [`abort`] lets a bridge hear ABORT while it is busy.
 
 pub mod abort;
+pub mod abort_line;
 pub mod engine;
 pub mod frame;
 pub mod move_tracker;

@@ -310,7 +310,7 @@ async fn main(_spawner: Spawner) {
     // Raised by core 0 as an ABORT arrives, checked by core 1 between ops
     // and in its waits (`docs/bridge-protocol.md` section 5).
     let abort = AbortLine::new();
-    let watch = abort.watch();
+    let watch = AbortWatch::new(abort.clone());
     spawn_core1(p.CORE1, CORE1_STACK.init(Stack::new()), move || {
         // SAFETY: core 1's own DCB and DWT, set up once here.
         let mut core1 = unsafe { cortex_m::Peripherals::steal() };

@@ -290,7 +290,7 @@ fn serve(o: Options) -> Result<(), String> {
     let reader = file
         .try_clone()
         .map_err(|e| format!("no third handle on {path}: {e}"))?;
-    let arrived = receive(reader, abort.watch());
+    let arrived = receive(reader, AbortWatch::new(abort.clone()));
     let mut requests = FrameDecoder::new();
     let result = loop {
         if STOP.load(Ordering::Relaxed) {

@@ -195,7 +195,7 @@ pub fn serve<R: Read + Send + 'static, W: Write>(
     let _reader = ReaderGuard {
         done: Arc::clone(&done),
         handle: Some(std::thread::spawn({
-            let watch = server.abort_line().map(AbortLine::watch);
+            let watch = server.abort_line().cloned().map(AbortWatch::new);
             let (stop, done) = (Arc::clone(stop), Arc::clone(&done));
             move || receive(reader, faults, watch, tx, &stop, &done)
         })),

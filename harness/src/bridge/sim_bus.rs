@@ -41,7 +41,7 @@ impl SimChip {
 
 /// [`SimChip`], in virtual time (every op done at once) or paced: each op
 /// returns when the wall clock has caught up with the chip's, and a wait
-/// runs in slices of [`SLICE`], each checked against the abort line.
+/// runs in slices of 10 ms, each checked against the abort line.
 #[derive(Debug, Clone)]
 pub struct SimBus {
     chip: SimChip,
