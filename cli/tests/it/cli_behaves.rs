@@ -39,12 +39,18 @@ fn a_closed_pipe_ends_list_and_run_quietly_and_run_still_writes_its_reports() {
 
     let dir = scratch("behaves");
     let junit = dir.path().join("r.xml");
+    // Passes enough that the run cannot end before its first line is
+    // written: the scenarios run on a thread of their own, which on a busy
+    // machine finished one pass of the suite (7 ms) before the line that
+    // finds the pipe closed was written (CI, 2026-11-29).
     let (status, err) = with_closed_stdout(&[
         "run",
         "--junit",
         junit.to_str().expect("utf-8"),
         "--skip-tag",
         "long",
+        "--repeat",
+        "1000",
     ]);
     assert!(!err.contains("panicked"), "{err}");
     // Nobody reads: the run stops as on SIGINT, the rest not run.

@@ -203,7 +203,8 @@ fn a_scenario_past_its_timeout_is_stopped_on_the_bridge_and_the_run_goes_on() {
             assert_eq!(s["verdict"], "error", "{s}");
             let message = s["error"]["message"].as_str().unwrap_or_default();
             assert!(
-                message.contains("--timeout passed") && message.contains("stopped it (ABORT)"),
+                message.contains("--timeout passed")
+                    && message.contains("the bridge stopped the request in flight (ABORT)"),
                 "{message}"
             );
         } else {

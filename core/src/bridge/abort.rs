@@ -43,6 +43,11 @@ impl AbortWatch {
         }
     }
 
+    /// Forgets a frame cut short (the connection it came on ended).
+    pub fn forget(&mut self) {
+        self.decoder = FrameDecoder::new();
+    }
+
     /// Takes bytes as they arrive (before they are queued for the
     /// engine); whether they held an aborting frame.
     pub fn on_bytes(&mut self, bytes: &[u8]) -> bool {
@@ -101,7 +106,7 @@ mod tests {
     fn an_abort_stops_the_request_it_names_and_no_other() {
         let line = AbortLine::new();
         let mut watch = AbortWatch::new(line.clone());
-        line.begin(2);
+        line.begin(2, true);
         assert!(!line.pending());
         assert!(watch.on_bytes(&framed(&Request::Abort { request: 2 }, 3)));
         assert!(line.pending(), "request 2 runs and is named");
@@ -110,13 +115,17 @@ mod tests {
         line.end();
         // An ABORT for a request that has ended stops no later one.
         assert!(watch.on_bytes(&framed(&Request::Abort { request: 4 }, 5)));
-        line.begin(6);
+        line.begin(6, true);
         assert!(!line.pending());
         line.end();
-        // Until the engine reads it, request 4 would still be stopped;
-        // after, a request that reuses the number runs.
-        line.read_abort(4);
-        line.begin(4);
+        // Request 6 began after it: the ABORT for 4 is stale and gone,
+        // and a later request that reuses the number runs.
+        line.begin(4, true);
+        assert!(!line.pending());
+        // Read by the engine in its turn, it is gone too.
+        assert!(watch.on_bytes(&framed(&Request::Abort { request: 8 }, 9)));
+        line.read_abort(8);
+        line.begin(8, true);
         assert!(!line.pending());
     }
 
@@ -127,7 +136,9 @@ mod tests {
         let mut bytes = framed(&Request::Batch(alloc::vec![]), 1);
         bytes.extend(framed(&Request::Abort { request: 1 }, 2));
         assert!(watch.on_bytes(&bytes));
-        line.begin(1);
+        // A LINK read before it leaves the ABORT in place.
+        line.begin(7, false);
+        line.begin(1, true);
         assert!(line.pending());
     }
 
@@ -137,7 +148,7 @@ mod tests {
         let mut watch = AbortWatch::new(line.clone());
         assert!(watch.on_bytes(&framed(&hello(7), 1)));
         line.read_takeover();
-        line.begin(2);
+        line.begin(2, true);
         assert!(!watch.on_bytes(&framed(&hello(7), 3)), "a reconnect");
         assert!(!line.pending());
         // Garbage and bad frames are the engine's to answer.

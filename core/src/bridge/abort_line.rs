@@ -42,8 +42,20 @@ impl AbortLine {
         self.0.any.store(true, Ordering::Release);
     }
 
-    /// The engine begins request `seq`.
-    pub fn begin(&self, seq: u8) {
+    /// The engine begins request `seq`; `runs_ops` when it is one that
+    /// drives the chip (a batch, a self-test). An ABORT that named another
+    /// request is then stale (a host has one such request out at a time,
+    /// and the one it named has ended or never came) and is forgotten, so
+    /// that a later request that reuses the number runs.
+    pub fn begin(&self, seq: u8, runs_ops: bool) {
+        if runs_ops {
+            let _ = self
+                .0
+                .named
+                .fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| {
+                    (n != tag(seq) && n != 0).then_some(0)
+                });
+        }
         self.0.running.store(tag(seq), Ordering::Release);
     }
 

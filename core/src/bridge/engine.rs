@@ -15,8 +15,9 @@
 use super::abort::AbortLine;
 use super::frame::{self, FrameDecoder, FrameError};
 use super::wire::{
-    self, capture_bytes, fragment, BridgeErrorCode, CaptureChunk, Hello, Incoming, ReplyWriter,
-    Request, Response, Timer, WireError, WireOp, MAX_BATCH_OPS, MAX_REPLY, PROTOCOL_VERSION,
+    self, capture_bytes, fragment, kind, BridgeErrorCode, CaptureChunk, Hello, Incoming,
+    ReplyWriter, Request, Response, Timer, WireError, WireOp, MAX_BATCH_OPS, MAX_REPLY,
+    PROTOCOL_VERSION,
 };
 use crate::bus::{Bus, Op, Reply};
 use crate::protocol::{Command, OpFlags, Status};
@@ -223,6 +224,16 @@ impl<B: Bus> BridgeEngine<B> {
     /// resends the request whose reply it lost gets that reply; a HELLO
     /// with another host session (another host) clears the cache.
     fn on_payload(&mut self, payload: &[u8], out: &mut Vec<u8>) {
+        // Read in its turn, even when answered from the cache: what it
+        // raised on the receive path is done with (the request an ABORT
+        // named has ended; a new host's HELLO has stopped what ran).
+        if let Some(line) = &self.abort {
+            match payload.get(1).copied() {
+                Some(kind::ABORT) => payload.get(2).map_or((), |&r| line.read_abort(r)),
+                Some(kind::HELLO) => line.read_takeover(),
+                _ => {}
+            }
+        }
         for cached in [&self.control, &self.last].into_iter().flatten() {
             if cached.payload == payload {
                 return put_frames(out, &cached.frames);
@@ -272,7 +283,11 @@ impl<B: Bus> BridgeEngine<B> {
             Ok((_, req)) => {
                 self.current = seq;
                 if let Some(line) = &self.abort {
-                    line.begin(seq);
+                    let runs_ops = match &req {
+                        Incoming::Other(r) => matches!(r, Request::SelfTest(_)),
+                        Incoming::Batch(_) | Incoming::BatchCapture { .. } => true,
+                    };
+                    line.begin(seq, runs_ops);
                 }
                 let reply = self.respond(seq, req);
                 if let Some(line) = &self.abort {
@@ -429,15 +444,9 @@ impl<B: Bus> BridgeEngine<B> {
                     },
                 }
             }
-            Request::Abort { request } => {
-                // Read in its turn: the request it named has ended.
-                if let Some(line) = &self.abort {
-                    line.read_abort(request);
-                }
-                Response::Abort {
-                    stopped: self.stopped == Some(request),
-                }
-            }
+            Request::Abort { request } => Response::Abort {
+                stopped: self.stopped == Some(request),
+            },
             Request::Link { fragment, pad } => {
                 self.fragment =
                     usize::from(fragment).clamp(wire::MIN_FRAGMENT_DATA, wire::FRAGMENT_DATA);
@@ -460,10 +469,6 @@ impl<B: Bus> BridgeEngine<B> {
         if !resumed {
             self.last = None;
             self.host = host;
-            // The takeover the receive path saw has stopped what ran.
-            if let Some(line) = &self.abort {
-                line.read_takeover();
-            }
         }
         resumed
     }
@@ -523,6 +528,8 @@ impl<B: Bus> BridgeEngine<B> {
             line.acknowledge();
         }
         self.stopped = Some(self.current);
+        // No op of the batch follows: nothing to aim the stop's at.
+        self.bus.next_op(None);
         let busy =
             matches!(self.bus.run(Op::ReadStatus), Reply::Status { status, .. } if status.busy());
         let stop = if busy {

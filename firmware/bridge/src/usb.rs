@@ -36,6 +36,11 @@ pub trait Pipes {
     fn replies_empty(&self) -> bool;
     /// Forgets the bytes the engine has not taken yet.
     fn forget_to_engine(&self);
+    /// Sees a packet as it arrives, before any of it goes towards the
+    /// engine: where the image watches for ABORT
+    /// (`docs/bridge-protocol.md` section 5), so that the engine cannot
+    /// read a frame before the watch has seen it.
+    fn arrived(&self, _packet: &[u8]) {}
 }
 
 /// A clock that bounds a future.
@@ -63,6 +68,7 @@ pub async fn serve_connection<U: Packets, P: Pipes, D: Deadline>(
     loop {
         match select(usb.read_packet(&mut rx), pipes.replies(&mut tx)).await {
             Either::First(Ok(n)) => {
+                pipes.arrived(&rx[..n]);
                 let mut rest = &rx[..n];
                 while !rest.is_empty() {
                     match select(pipes.to_engine(rest), pipes.replies(&mut tx)).await {

@@ -427,17 +427,22 @@ impl usb::Packets for Cdc<'_> {
 }
 
 /// The pipes between the cores as `usb::Pipes`, and the abort watch on
-/// the way in: an ABORT is seen as it arrives, while core 1 is busy.
+/// the way in: an ABORT is seen as its packet arrives, while core 1 is
+/// busy, and before core 1 can read it. (While the pipe is full, core 0
+/// reads no more packets: an ABORT behind a request longer than the pipe
+/// is seen once core 1 has taken some. A host has one request out at a
+/// time, so that is a retransmission of a long one.)
 struct CorePipes {
     watch: core::cell::RefCell<AbortWatch>,
 }
 
 impl usb::Pipes for CorePipes {
     async fn to_engine(&self, data: &[u8]) -> usize {
-        let n = FROM_HOST.write(data).await;
-        // What went into the pipe, as the engine will read it.
-        self.watch.borrow_mut().on_bytes(&data[..n]);
-        n
+        FROM_HOST.write(data).await
+    }
+
+    fn arrived(&self, packet: &[u8]) {
+        self.watch.borrow_mut().on_bytes(packet);
     }
 
     async fn replies(&self, buf: &mut [u8]) -> usize {
@@ -450,6 +455,8 @@ impl usb::Pipes for CorePipes {
 
     fn forget_to_engine(&self) {
         FROM_HOST.clear();
+        // A frame cut short here is not the start of the next host's.
+        self.watch.borrow_mut().forget();
     }
 }
 

@@ -43,7 +43,7 @@ mod spec;
 mod target;
 
 pub use self::bridged::{
-    restart_cause, BridgeError, BridgeOptions, BridgeTarget, LinkStats, MAX_GIVE_UPS,
+    restart_cause, AbortOutcome, BridgeError, BridgeOptions, BridgeTarget, LinkStats, MAX_GIVE_UPS,
 };
 pub use self::emu::EmuTarget;
 pub use self::link::labgrid::{parse_labgrid, LabgridLink, Place};

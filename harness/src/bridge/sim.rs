@@ -200,6 +200,7 @@ pub fn serve<R: Read + Send + 'static, W: Write>(
             move || receive(reader, faults, watch, tx, &stop, &done)
         })),
     };
+    server.bus_mut().stop_with(Arc::clone(stop));
     // When the chip's clock last caught up with the wall clock.
     let mut synced = WallInstant::now();
     while !stop.load(Ordering::Relaxed) {

@@ -8,6 +8,8 @@ use crate::bus::{Bus, EmuBus, Op, Reply};
 use crate::protocol::{OutputRecord, Straps};
 use crate::time::{Duration, Instant};
 use ppmc_core::bridge::abort::AbortLine;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration as WallDuration, Instant as WallInstant};
 
 /// The longest stretch of a paced wait between two looks at the wall
@@ -49,6 +51,8 @@ pub struct SimBus {
     /// up (`None` in virtual time).
     anchor: Option<(WallInstant, Instant)>,
     abort: Option<AbortLine>,
+    /// The simulator is asked to stop (SIGINT): paced waits end at once.
+    stop: Option<Arc<AtomicBool>>,
 }
 
 impl SimBus {
@@ -57,7 +61,14 @@ impl SimBus {
             anchor: realtime.then(|| (WallInstant::now(), chip.bus().now())),
             chip,
             abort: None,
+            stop: None,
         }
+    }
+
+    /// Paced waits end at once when `stop` is set (the simulator is
+    /// shutting down): a ten-minute move must not hold up its exit.
+    pub fn stop_with(&mut self, stop: Arc<AtomicBool>) {
+        self.stop = Some(stop);
     }
 
     /// Paced: lines the chip's clock up with the wall clock now (a request
@@ -80,6 +91,10 @@ impl SimBus {
 
     fn aborted(&self) -> bool {
         self.abort.as_ref().is_some_and(AbortLine::pending)
+            || self
+                .stop
+                .as_ref()
+                .is_some_and(|s| s.load(Ordering::Relaxed))
     }
 
     /// Waits until the wall clock has caught up with the chip, or an
@@ -235,7 +250,7 @@ mod tests {
         let mut bus = paced();
         let line = AbortLine::new();
         bus.watch_abort(line.clone());
-        line.begin(1);
+        line.begin(1, true);
         line.raise(1);
         bus.run(Op::Delay(Duration::from_secs(5)));
         assert!(bus.now() <= Instant::ZERO + SLICE, "{:?}", bus.now());

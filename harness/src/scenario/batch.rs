@@ -98,6 +98,13 @@ impl<'t> Batch<'t> {
     }
 
     /// The bus events logged so far.
+    /// Lifts the target's wall-clock deadline (`--timeout`): what comes
+    /// after the scenario's body (fetching the capture it left) is not
+    /// cut short by it.
+    pub(super) fn lift_deadline(&mut self) {
+        self.target.set_deadline(None);
+    }
+
     pub(super) fn into_bus(self) -> Vec<Event> {
         self.bus
     }

@@ -76,6 +76,11 @@ impl<'t> Driver<'t> {
     }
 
     /// The bus events and measurements recorded so far.
+    /// The scenario's body is over: its `--timeout` no longer applies.
+    pub(crate) fn lift_deadline(&mut self) {
+        self.batch.lift_deadline();
+    }
+
     pub(crate) fn into_parts(self) -> (Vec<Event>, Vec<Measurement>) {
         (self.batch.into_bus(), self.measurements)
     }

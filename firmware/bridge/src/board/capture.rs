@@ -22,6 +22,11 @@ pub(super) const SETTLE_TICKS: u64 = 8;
 /// capacity): a chip that pulses without end cannot exhaust the heap.
 const MOST_RECORDS: usize = limits::CAPTURE_RECORDS as usize + limits::OP_RECORDS;
 
+/// The longest the board code idles between looks at the abort line:
+/// an ABORT stops a quiet wait within about this (`docs/bridge-protocol.md`
+/// section 5).
+const ABORT_LOOK_NS: u64 = 1_000_000;
+
 impl<H: Hal> Board<H> {
     /// Takes what the capture holds: the outputs the CPU samples, then the
     /// edge words from the PIO counters (an edge from before the sample is
@@ -153,6 +158,12 @@ impl<H: Hal> Board<H> {
     /// polled (then the time it saw no change is a sight of them), and a
     /// look after whether they changed.
     pub(super) fn idle(&mut self, until: u64) {
+        // With an abort line, never long without a look at it: the
+        // hardware's own idle may last seconds when nothing moves.
+        let until = match self.abort {
+            Some(_) => until.min(self.now_ticks() + self.timer.to_ticks(ABORT_LOOK_NS)),
+            None => until,
+        };
         let entry = self.hal.read_high_pins() & pins::SAMPLED_HIGH;
         let began = self.now_ticks();
         self.sighted(entry, began);

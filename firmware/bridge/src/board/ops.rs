@@ -132,6 +132,13 @@ impl<H: Hal> Board<H> {
             self.idle(until);
         }
         let end = self.now_ticks();
+        if self.aborted() {
+            // Cut short by the host's ABORT: what follows (the engine's
+            // stop of the chip) acts now, not at the delay's end.
+            self.aim = None;
+            self.moment = end;
+            return Reply::Delayed { at: self.at(end) };
+        }
         // Late (the CPU took longer than `d`): the next op acts now.
         self.aim = kind.map(|_| target.max(end));
         self.moment = target.max(end);

@@ -1012,3 +1012,53 @@ fn a_re_armed_channel_moves_the_words_its_fifo_still_holds() {
     );
     assert_eq!(TwinDma(&mut t.world).ring_word(ch.channel, 0), 0x1234_5678);
 }
+
+/// An ABORT (`docs/bridge-protocol.md` section 5) that comes while the
+/// board code waits out a long, quiet DELAY ends the wait within about a
+/// millisecond of the twin's time, and what the engine does next (its
+/// look at BUSY before an Immediate Stop) acts then, not at the delay's
+/// end: the board code idles in short stretches while an abort line is
+/// installed, and a delay cut short aims nothing at its old end.
+#[test]
+fn an_abort_in_a_quiet_delay_ends_it_and_the_next_op_acts_at_once() {
+    use ppmc_core::bridge::abort_line::AbortLine;
+    use ppmc_core::bridge::engine::BridgeEngine;
+    use ppmc_core::bridge::frame::{self, FrameDecoder};
+    use ppmc_core::bridge::wire::{BridgeErrorCode, Request, Response};
+    use std::sync::atomic::Ordering;
+    let b = twin();
+    let timer = b.timer();
+    let progress = b.hal().progress.clone();
+    let line = AbortLine::new();
+    let mut engine = BridgeEngine::new(b, 1, true, "twin").with_abort(line.clone());
+    // One second of the twin's time into the delay (150 MHz), the host's
+    // ABORT arrives, naming the batch (sequence 1).
+    let raiser = std::thread::spawn(move || {
+        while progress.load(Ordering::Relaxed) < 150_000_000 {
+            std::thread::sleep(std::time::Duration::from_micros(200));
+        }
+        line.raise(1);
+    });
+    let batch = Request::Batch(std::vec![
+        Op::Reset,
+        Op::Delay(Duration::from_secs(30)),
+        Op::ReadStatus,
+    ]);
+    let out = engine.on_bytes(&frame::encode(&batch.encode(1, timer)));
+    raiser.join().expect("the raiser");
+    let mut d = FrameDecoder::new();
+    d.extend(&out);
+    let payload = d.decode().expect("a frame").expect("a whole one");
+    match Response::decode(&payload, timer).expect("decodes").1 {
+        Response::Error {
+            code: BridgeErrorCode::Aborted,
+            detail,
+        } => assert_eq!(detail, "stopped by ABORT after 2 ops"),
+        other => panic!("not ABORTED: {other:?}"),
+    }
+    let now = engine.bus().now().as_nanos();
+    assert!(
+        (1_000_000_000..1_100_000_000).contains(&now),
+        "the wait and the look after it end where the abort came: {now} ns"
+    );
+}

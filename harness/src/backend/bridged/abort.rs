@@ -5,7 +5,7 @@
 //! bridge does not go on with a ten-minute move for nobody, and the next
 //! run on it opens at once.
 
-use super::error::BridgeError;
+use super::error::{AbortOutcome, BridgeError};
 use super::target::BridgeTarget;
 use crate::backend::link::Link;
 use crate::stop::StopRequest;
@@ -31,18 +31,21 @@ impl<L: Link> BridgeTarget<L> {
             req,
             Request::Batch(_) | Request::BatchCapture { .. } | Request::SelfTest(_)
         );
-        if !runs_ops || self.opts.stop.urgent() {
-            return error;
-        }
+        // Only a request that went out can be running.
+        let may_run = runs_ops && self.sent && !self.opts.stop.urgent();
+        let mut abort = || match may_run {
+            false => AbortOutcome::NotSent,
+            true => self.send_abort(seq),
+        };
         match error {
             BridgeError::PastDeadline { link, what, .. } => BridgeError::PastDeadline {
                 link,
                 what,
-                aborted: self.send_abort(seq),
+                abort: abort(),
             },
             BridgeError::Interrupted { link, .. } => BridgeError::Interrupted {
                 link,
-                aborted: self.send_abort(seq),
+                abort: abort(),
             },
             BridgeError::NoAnswer {
                 link,
@@ -51,11 +54,7 @@ impl<L: Link> BridgeTarget<L> {
                 secs,
                 mut heard,
             } => {
-                heard.push_str(match self.send_abort(seq) {
-                    Some(true) => "; the bridge stopped the request on ABORT",
-                    Some(false) => "; the bridge answered ABORT with nothing running",
-                    None => "; ABORT sent, unanswered",
-                });
+                heard.push_str(abort().note());
                 BridgeError::NoAnswer {
                     link,
                     what,
@@ -68,10 +67,18 @@ impl<L: Link> BridgeTarget<L> {
         }
     }
 
-    /// Sends ABORT and waits a little for ABORT_REPLY: whether the bridge
-    /// stopped a request (`None`: no answer, or a bridge that does not
-    /// know ABORT). Never fails: the host is giving up already.
-    fn send_abort(&mut self, request: u8) -> Option<bool> {
+    /// Sends ABORT for request `request` and waits a little for
+    /// ABORT_REPLY. Never fails: the host is giving up already.
+    fn send_abort(&mut self, request: u8) -> AbortOutcome {
+        match self.abort_exchange(request) {
+            Some(true) => AbortOutcome::Stopped,
+            Some(false) => AbortOutcome::NothingRunning,
+            None => AbortOutcome::Unanswered,
+        }
+    }
+
+    /// Whether the bridge stopped `request` (`None`: no answer).
+    fn abort_exchange(&mut self, request: u8) -> Option<bool> {
         let seq = self.next_seq();
         let bytes = frame::encode(&Request::Abort { request }.encode(seq, self.timer));
         self.link.send(&bytes).ok()?;

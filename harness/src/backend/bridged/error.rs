@@ -80,30 +80,18 @@ pub enum BridgeError {
         last: String,
     },
     /// A stop was asked for (SIGINT, SIGTERM) while waiting on the link.
-    #[error("{link}: interrupted by a stop request{}", match aborted {
-        Some(true) => "; the bridge stopped the request in flight (ABORT)",
-        Some(false) => "; the bridge had no request running (ABORT)",
-        None => "",
-    })]
+    #[error("{link}: interrupted by a stop request{}", abort.note())]
     Interrupted {
         link: String,
-        /// What the bridge answered the ABORT sent for the request in
-        /// flight: whether it stopped it (`None`: none sent, or no answer).
-        aborted: Option<bool>,
+        /// What became of the ABORT sent for the request in flight.
+        abort: AbortOutcome,
     },
-    /// A reply came back timed before an earlier one, with no chip reset
-    /// in between: the bridge restarted behind the open port (a watchdog,
-    /// a brown-out) and the chip's state was lost with it.
-    #[error("{link}: the scenario's --timeout passed while the bridge ran {what}{}", match aborted {
-        Some(true) => "; the bridge stopped it (ABORT)",
-        Some(false) => "; the bridge had no request running (ABORT)",
-        None => "; ABORT went unanswered",
-    })]
+    #[error("{link}: the scenario's --timeout passed during {what}{}", abort.note())]
     PastDeadline {
         link: String,
         what: String,
-        /// What the bridge answered the ABORT (`None`: no answer).
-        aborted: Option<bool>,
+        /// What became of the ABORT sent for it.
+        abort: AbortOutcome,
     },
     #[error("{link}: the bridge's clock went back from {was} to {now} without a chip reset: the bridge restarted behind the open port and the chip's state is unknown")]
     ClockWentBack {
@@ -117,6 +105,34 @@ pub enum BridgeError {
     /// run it. Batches are then sent in smaller requests.
     #[error("{link}: a {len}-byte request keeps arriving garbled")]
     Garbled { link: String, len: usize },
+}
+
+/// What became of the ABORT a host sends for a request it stopped waiting
+/// for (`docs/bridge-protocol.md` section 5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AbortOutcome {
+    /// None was sent: the request had not gone out, or could not be
+    /// running (the link was lost), or a second stop request hurried.
+    NotSent,
+    /// Sent; no ABORT_REPLY within its wait (or a bridge that does not
+    /// know ABORT).
+    Unanswered,
+    /// The bridge stopped the request (its reply: ERROR `ABORTED`).
+    Stopped,
+    /// The bridge had no such request running: it had ended.
+    NothingRunning,
+}
+
+impl AbortOutcome {
+    /// What an error message says of it.
+    pub fn note(self) -> &'static str {
+        match self {
+            AbortOutcome::NotSent => "",
+            AbortOutcome::Unanswered => "; ABORT sent, unanswered",
+            AbortOutcome::Stopped => "; the bridge stopped the request in flight (ABORT)",
+            AbortOutcome::NothingRunning => "; the bridge had no request running (ABORT)",
+        }
+    }
 }
 
 impl BridgeError {

@@ -207,6 +207,7 @@ impl<L: Link> BridgeTarget<L> {
         let seq = self.next_seq();
         if !self.recovering {
             self.in_flight = Some(seq);
+            self.sent = false;
         }
         let payload = req.encode(seq, self.timer);
         let splittable = payload.len() > MIN_REQUEST;
@@ -262,7 +263,7 @@ impl<L: Link> BridgeTarget<L> {
                 return Err(BridgeError::PastDeadline {
                     link: self.link.name(),
                     what: what.to_string(),
-                    aborted: None,
+                    abort: AbortOutcome::NotSent,
                 });
             }
             let now = WallInstant::now();
@@ -321,6 +322,9 @@ impl<L: Link> BridgeTarget<L> {
                 continue;
             }
             let sent = WallInstant::now();
+            if !self.recovering {
+                self.sent = true;
+            }
             self.stats.round_trips += 1;
             let had = frags.received();
             let mut budget = (wait + extra).min(give_up_at.saturating_duration_since(sent));
@@ -557,7 +561,7 @@ impl<L: Link> BridgeTarget<L> {
     pub(super) fn interrupted(&self) -> BridgeError {
         BridgeError::Interrupted {
             link: self.link.name(),
-            aborted: None,
+            abort: AbortOutcome::NotSent,
         }
     }
 

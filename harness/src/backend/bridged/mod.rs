@@ -29,6 +29,6 @@ mod target;
 #[cfg(test)]
 mod tests;
 
-pub use self::error::{restart_cause, BridgeError};
+pub use self::error::{restart_cause, AbortOutcome, BridgeError};
 pub use self::options::{BridgeOptions, MAX_GIVE_UPS};
 pub use self::target::{BridgeTarget, LinkStats};

@@ -87,6 +87,9 @@ pub struct BridgeTarget<L: Link> {
     /// Past this moment no request is waited for (a scenario's
     /// `--timeout`, [`Target::set_deadline`]).
     pub(super) deadline: Option<WallInstant>,
+    /// Whether the request in flight went out at least once (only then
+    /// can the bridge be running it, and an ABORT be worth sending).
+    pub(super) sent: bool,
     /// Frames that arrived garbled, either way (corrupt frames here,
     /// bad-frame errors from the bridge): what makes the host shrink its
     /// requests and the bridge's reply fragments.
@@ -150,6 +153,7 @@ impl<L: Link> BridgeTarget<L> {
             recovering: false,
             in_flight: None,
             deadline: None,
+            sent: false,
             garbled: 0,
             give_ups: 0,
             last_give_up: String::new(),
