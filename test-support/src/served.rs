@@ -141,11 +141,7 @@ pub fn stopped_in_the_long_move_then_reopened(served: &Served, short: &str) -> D
         stop: stop.clone(),
         ..BridgeOptions::default()
     });
-    let long: Vec<_> = ppmc_scenarios::all()
-        .into_iter()
-        .filter(|s| s.name == "s3_3_4_accel_ffffff_is_16777216_steps")
-        .collect();
-    assert_eq!(long.len(), 1);
+    let long = vec![scenario("s3_3_4_accel_ffffff_is_16777216_steps")];
     let running = std::thread::spawn(move || {
         let r = run_suite(&mut first, &long, 1, DriverOptions::default(), |_| {});
         (r, first.link_stats())
@@ -177,12 +173,16 @@ pub fn stopped_in_the_long_move_then_reopened(served: &Served, short: &str) -> D
         "{}: the next host opened in {opened:?}",
         served.link.display()
     );
-    let short: Vec<_> = ppmc_scenarios::all()
-        .into_iter()
-        .filter(|s| s.name == short)
-        .collect();
-    assert_eq!(short.len(), 1);
+    let short = vec![scenario(short)];
     let results = run_suite(&mut next, &short, 1, DriverOptions::default(), |_| {});
     assert_eq!(results[0].verdict, Verdict::Passed, "{results:#?}");
     opened
+}
+
+/// The suite's scenario of this name.
+fn scenario(name: &str) -> ppmc::scenario::Scenario {
+    ppmc_scenarios::all()
+        .into_iter()
+        .find(|s| s.name == name)
+        .unwrap_or_else(|| panic!("no scenario `{name}`"))
 }

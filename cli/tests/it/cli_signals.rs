@@ -47,17 +47,31 @@ fn check_interrupted(dir: &Path, scenarios: usize) {
         scenarios,
         "{xml}"
     );
-    let record: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.join("run.json")).expect("the JSON record"),
-    )
-    .expect("JSON");
-    check_record(&run_record_schema(), &record);
+    let record = record(dir);
     assert_eq!(
         record["summary"]["not_run"].as_u64(),
         Some(scenarios as u64),
         "{}",
         record["summary"]
     );
+}
+
+/// The run's JSON record in `dir`, checked against its schema.
+fn record(dir: &Path) -> serde_json::Value {
+    let record: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("run.json")).expect("the JSON record"),
+    )
+    .expect("JSON");
+    check_record(&run_record_schema(), &record);
+    record
+}
+
+/// `ppmc run --tag long` on `sim`, reports in `dir`, 1.5 s in: it has
+/// opened the bridge and started the 16,777,216-step move.
+fn into_the_long_move(sim: &BridgeSim, dir: &Path) -> Child {
+    let child = run(&[], &sim.target(), &["--tag", "long"], dir);
+    std::thread::sleep(Duration::from_millis(1500));
+    child
 }
 
 fn signal(child: &Child, sig: &str) {
@@ -98,9 +112,7 @@ fn two_signals_in_a_row_still_write_the_reports() {
     let sim = BridgeSim::start(&["--realtime"]);
     for sig in ["-INT", "-TERM"] {
         let dir = scratch("twice");
-        let mut child = run(&[], &sim.target(), &["--tag", "long"], dir.path());
-        // Into the long move: the run has opened the bridge and started.
-        std::thread::sleep(Duration::from_millis(1500));
+        let mut child = into_the_long_move(&sim, dir.path());
         signal(&child, sig);
         // The second as a CI runner sends it, after a moment (two within
         // 200 ms are one request, as GNU timeout delivers its one twice).
@@ -145,18 +157,13 @@ fn after_ctrl_c_in_the_long_move_the_next_run_on_the_bridge_opens_at_once() {
     let sim = BridgeSim::start(&["--realtime"]);
     for sig in ["-INT", "-KILL"] {
         let dir = scratch("abort");
-        let mut child = run(&[], &sim.target(), &["--tag", "long"], dir.path());
-        // Into the long move: the run has opened the bridge and started.
-        std::thread::sleep(Duration::from_millis(1500));
+        let mut child = into_the_long_move(&sim, dir.path());
         signal(&child, sig);
         let status = wait_bounded(&mut child, WIND_DOWN);
         if sig == "-INT" {
             assert_eq!(status.code(), Some(130), "{status}");
             // The record says the host stopped the bridge.
-            let record: serde_json::Value = serde_json::from_str(
-                &std::fs::read_to_string(dir.path().join("run.json")).expect("record"),
-            )
-            .expect("JSON");
+            let record = record(dir.path());
             let stats = &record["run"]["boards"][0]["link"];
             assert_eq!(stats["aborts"].as_u64(), Some(1), "{record}");
         }
@@ -190,11 +197,7 @@ fn a_scenario_past_its_timeout_is_stopped_on_the_bridge_and_the_run_goes_on() {
     );
     let status = wait_bounded(&mut child, Duration::from_secs(120));
     assert_eq!(status.code(), Some(1), "{status}");
-    let record: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.path().join("run.json")).expect("the JSON record"),
-    )
-    .expect("JSON");
-    check_record(&run_record_schema(), &record);
+    let record = record(dir.path());
     let scenarios = record["scenarios"].as_array().expect("scenarios");
     assert!(scenarios.len() > 3, "{}", scenarios.len());
     for s in scenarios {

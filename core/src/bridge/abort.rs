@@ -16,6 +16,7 @@
 //! Bytes a bridge drops (a connection that ends mid-frame) cannot make the
 //! watch and the engine disagree: nothing is counted.
 
+use super::abort_line::takes_over;
 pub use super::abort_line::AbortLine;
 use super::frame::FrameDecoder;
 use super::wire::{kind, Request, Timer, PROTOCOL_VERSION};
@@ -73,8 +74,7 @@ impl AbortWatch {
                 true
             }
             Ok((_, Request::Hello { version, host })) if version == PROTOCOL_VERSION => {
-                // As the engine greets: 0 is nobody's, and always new.
-                let new = host == 0 || host != self.host;
+                let new = takes_over(self.host, host);
                 self.host = host;
                 if new {
                     self.line.raise_any();

@@ -6,6 +6,14 @@
 use alloc::sync::Arc;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
+/// Whether a HELLO of host session `host` takes the bridge over from the
+/// host of the last HELLO, `last` (`docs/bridge-protocol.md` section 3):
+/// another session, or 0, which is nobody's and always new. The engine
+/// then clears its cache; the receive path stops what runs.
+pub fn takes_over(last: u32, host: u32) -> bool {
+    host == 0 || host != last
+}
+
 /// A request's sequence number, tagged so that 0 means none.
 const fn tag(seq: u8) -> u32 {
     0x100 | seq as u32

@@ -13,6 +13,7 @@
 //! (at most once, `docs/bridge-protocol.md` section 3).
 
 use super::abort::AbortLine;
+use super::abort_line::takes_over;
 use super::frame::{self, FrameDecoder, FrameError};
 use super::wire::{
     self, capture_bytes, fragment, kind, BridgeErrorCode, CaptureChunk, Hello, Incoming,
@@ -465,7 +466,7 @@ impl<B: Bus> BridgeEngine<B> {
     /// that happens to match the last host's is run, not answered from the
     /// cache. Host session 0 is nobody's: it always starts afresh.
     fn greet(&mut self, host: u32) -> bool {
-        let resumed = host != 0 && host == self.host;
+        let resumed = !takes_over(self.host, host);
         if !resumed {
             self.last = None;
             self.host = host;
