@@ -9,8 +9,7 @@
 //! Both read a 32-bit little-endian ELF (what the Cortex-M targets link)
 //! and refuse anything else with a message that says where it stopped.
 
-mod elf;
-mod uf2;
+use ppmc_fwtool::{elf, uf2};
 
 use std::process::ExitCode;
 

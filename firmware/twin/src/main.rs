@@ -8,19 +8,17 @@
 //! anything happens, so runs are repeatable.
 
 use ppmc_bridge_fw::twin;
+use ppmc_twin::{lock, open_pty, readable, working, Running};
 use ppmc_core::bridge::abort::{AbortLine, AbortWatch};
 use ppmc_core::bridge::engine::BridgeEngine;
-use ppmc_core::bridge::frame::{self, FrameDecoder};
-use ppmc_core::bridge::wire::{Response, Timer};
+use ppmc_core::bridge::frame::FrameDecoder;
 use ppmc_core::emu::{faults, ModelConfig};
 use ppmc_core::protocol::Straps;
-use ppmc_core::time::Duration;
-use std::ffi::CStr;
 use std::io::{self, Write};
-use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
+use std::os::fd::AsRawFd;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 
 const HELP: &str = "\
@@ -103,116 +101,6 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
     }))
 }
 
-/// A pseudo-terminal in raw mode: the master, and the slave's path.
-fn open_pty() -> io::Result<(OwnedFd, String)> {
-    let mut master: libc::c_int = -1;
-    let mut slave: libc::c_int = -1;
-    // SAFETY: openpty writes two descriptors; the name, termios and
-    // window size are optional and null here.
-    let rc = unsafe {
-        libc::openpty(
-            &mut master,
-            &mut slave,
-            std::ptr::null_mut(),
-            std::ptr::null(),
-            std::ptr::null(),
-        )
-    };
-    if rc != 0 {
-        return Err(io::Error::last_os_error());
-    }
-    // SAFETY: both are open descriptors openpty just gave us.
-    let (master, slave) = unsafe { (OwnedFd::from_raw_fd(master), OwnedFd::from_raw_fd(slave)) };
-    // SAFETY: a zeroed termios is filled by tcgetattr before use.
-    let mut t: libc::termios = unsafe { std::mem::zeroed() };
-    // SAFETY: valid descriptor and pointer.
-    unsafe {
-        if libc::tcgetattr(slave.as_raw_fd(), &mut t) == 0 {
-            libc::cfmakeraw(&mut t);
-            libc::tcsetattr(slave.as_raw_fd(), libc::TCSANOW, &t);
-        }
-    }
-    // SAFETY: ptsname_r writes a NUL-terminated name into the buffer.
-    let mut name = [0 as libc::c_char; 128];
-    let rc = unsafe { libc::ptsname_r(master.as_raw_fd(), name.as_mut_ptr(), name.len()) };
-    if rc != 0 {
-        return Err(io::Error::from_raw_os_error(rc));
-    }
-    // SAFETY: NUL-terminated by ptsname_r.
-    let path = unsafe { CStr::from_ptr(name.as_ptr()) }
-        .to_string_lossy()
-        .into_owned();
-    // The slave stays open here too, so that a host closing it does not
-    // leave the master reading EIO; dropping it would.
-    std::mem::forget(slave);
-    Ok((master, path))
-}
-
-/// Waits up to 50 ms for the master to be readable.
-fn readable(fd: std::os::fd::RawFd) -> bool {
-    let mut p = libc::pollfd {
-        fd,
-        events: libc::POLLIN,
-        revents: 0,
-    };
-    // SAFETY: one valid pollfd.
-    let n = unsafe { libc::poll(&mut p, 1, 50) };
-    n > 0 && p.revents & libc::POLLIN != 0
-}
-
-/// The request the engine is running: its sequence number, the twin's
-/// cycle and the wall time when it began.
-struct Running {
-    seq: u8,
-    cycle: u64,
-    since: std::time::Instant,
-    /// When the last WORKING about it went out.
-    said: Option<std::time::Instant>,
-}
-
-impl Running {
-    /// A WORKING is due: none yet, or the last 50 ms ago.
-    fn due(&self) -> bool {
-        self.said
-            .is_none_or(|t| t.elapsed() >= std::time::Duration::from_millis(50))
-    }
-}
-
-/// A lock that a panicked holder does not poison for the rest.
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-/// While the engine runs one request, a WORKING message
-/// (`docs/bridge-protocol.md` section 5) 10 ms after it began and every
-/// 50 ms after that, with how far the twin's clock has run since it
-/// began: the twin runs slower than real time, more so on a busy machine,
-/// and the host waits by its clock instead of its own.
-fn working(
-    out: Arc<Mutex<std::fs::File>>,
-    running: Arc<Mutex<Option<Running>>>,
-    progress: Arc<AtomicU64>,
-    timer: Timer,
-) {
-    use std::time::Duration as Wall;
-    std::thread::spawn(move || loop {
-        std::thread::sleep(Wall::from_millis(10));
-        // The reply's writer holds `out` while it clears `running`: no
-        // WORKING follows the reply it is about.
-        let mut out = lock(&out);
-        let frame = match &mut *lock(&running) {
-            Some(r) if r.since.elapsed() >= Wall::from_millis(10) && r.due() => {
-                r.said = Some(std::time::Instant::now());
-                let cycles = progress.load(Ordering::Relaxed).saturating_sub(r.cycle);
-                let elapsed = Duration::from_nanos(timer.to_nanos(cycles / 2));
-                frame::encode(&Response::Working { elapsed }.encode(r.seq, timer))
-            }
-            _ => continue,
-        };
-        let _ = out.write_all(&frame).and_then(|_| out.flush());
-    });
-}
-
 /// The receive path, on a thread of its own as a board's USB is on its
 /// own core: what arrives is shown to the abort watch at once (an ABORT
 /// stops the request the engine runs, `docs/bridge-protocol.md`
@@ -286,7 +174,13 @@ fn serve(o: Options) -> Result<(), String> {
             .map_err(|e| format!("no second handle on {path}: {e}"))?,
     ));
     let running: Arc<Mutex<Option<Running>>> = Arc::default();
-    working(out.clone(), running.clone(), progress.clone(), timer);
+    working(
+        out.clone(),
+        running.clone(),
+        progress.clone(),
+        twin::SYSCLK_HZ,
+        timer,
+    );
     let reader = file
         .try_clone()
         .map_err(|e| format!("no third handle on {path}: {e}"))?;
