@@ -170,6 +170,33 @@ impl Machine {
         self.emu.cycles()
     }
 
+    /// Where each core is and what the USB controller holds, for a
+    /// message about an image that did not get where it should have.
+    pub fn where_it_is(&mut self) -> String {
+        let mut r = |a: u32| self.emu.mmio_read32(a);
+        let usb: Vec<u32> = [0x40, 0x4C, 0x50, 0x90, 0x78]
+            .iter()
+            .map(|o| r(0x5011_0000 + o))
+            .collect();
+        let timer = r(0x400B_0028);
+        format!(
+            "after {} cycles core 0 is at {:#010x}, core 1 at {:#010x} ({}); USB MAIN_CTRL {:#x}, \
+             SIE_CTRL {:#x}, SIE_STATUS {:#x}, INTE {:#x}, USB_PWR {:#x}; TIMER0 {} us; clk_sys {} Hz, clk_ref {} Hz",
+            self.emu.cycles(),
+            self.emu.core(0).regs.pc(),
+            self.emu.core(1).regs.pc(),
+            if self.launch.done { "launched" } else { "not launched" },
+            usb[0],
+            usb[1],
+            usb[2],
+            usb[3],
+            usb[4],
+            timer,
+            self.emu.bus.sys_clk_hz(),
+            self.emu.bus.ref_clk_hz(),
+        )
+    }
+
     /// The chip side, for what it counted.
     pub fn chip(&self) -> &ChipSide {
         &self.chip

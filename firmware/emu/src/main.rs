@@ -1,35 +1,348 @@
+//! `ppmc-emu`, run by `firmware/run-emu`: the RP2350 bridge's image, the
+//! very ELF `firmware/build` turns into the UF2 a lab flashes, on
+//! rp2350-emu (an emulator of the RP2350 that this project did not
+//! write, vendored with the changes `firmware/vendor/rp2350-emu/
+//! PPMC-CHANGES.md` lists), its GPIOs wired to the reference chip model
+//! and its USB device, enumerated by a host of ours, served on a
+//! pseudo-terminal as `ppmc bridge-sim`, `firmware/run-qemu` and
+//! `firmware/run-twin` serve theirs.
+//!
+//! Time is the emulator's: it passes as the image runs, far slower than
+//! real time, so the host side says WORKING for the image while a
+//! request runs (`docs/bridge-protocol.md` section 5), as the twin does.
+
+mod cdc;
 mod machine;
+mod usb;
 
+use cdc::Transactions;
+use machine::{Machine, SYS_CLK_HZ};
 use ppmc_bridge_fw::twin::chip::ChipSide;
-use ppmc_core::emu::{Board as Model, ModelConfig};
+use ppmc_core::bridge::frame::FrameDecoder;
+use ppmc_core::bridge::wire::Timer;
+use ppmc_core::emu::{faults, Board as Model, ModelConfig};
 use ppmc_core::protocol::Straps;
+use ppmc_twin::{lock, open_pty, readable, working, Running};
+use std::collections::VecDeque;
+use std::io::{self, Write};
+use std::os::fd::AsRawFd;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
 
-fn main() {
-    let path = std::env::args().nth(1).expect("ELF");
-    let cycles: u64 = std::env::args().nth(2).and_then(|s| s.parse().ok()).unwrap_or(30_000_000);
-    let elf = std::fs::read(&path).expect("read");
-    let flash = machine::flash_image(&elf).expect("flash");
-    let model = Model::new(Straps::default(), ModelConfig::default()).expect("model");
-    let chip = ChipSide::new(model, machine::SYS_CLK_HZ);
-    let mut m = machine::Machine::boot(&flash, chip).expect("boot");
-    let t0 = std::time::Instant::now();
-    let step = 1_000_000;
-    let mut done = 0;
-    while done < cycles {
-        m.run(step).expect("run");
-        done += step;
-        if done % 5_000_000 == 0 {
-            println!(
-                "{done}: core0 {:#x} core1 {:#x} launched {} writes {} reads {} floating {}",
-                m.emu.core(0).regs.pc(),
-                m.emu.core(1).regs.pc(),
-                m.core1_launched(),
-                m.chip().writes,
-                m.chip().reads,
-                m.floating
-            );
+const HELP: &str = "\
+ppmc-emu: the RP2350 bridge image, unmodified, on rp2350-emu, served on a pseudo-terminal
+
+usage: firmware/run-emu [options]          (builds the image first)
+       ppmc-emu --image ELF [options]
+
+  --image ELF          the board's ELF, as firmware/build prints it
+  --clock-mhz MHZ      the chip's SysClk strap, 1 to 40; default 16, as
+                       the image is built (PPMC_SYSCLK_HZ)
+  --csel high|low      default high
+  --vsel high|low      default high
+  --chip-fault NAME    a fault of the catalogue (ppmc fault-matrix --list);
+                       repeat to combine
+  --link PATH          also make PATH a symbolic link to the pty (removed on exit)
+  -h, --help           this text
+
+It boots the image, enumerates its USB device, prints
+`run-emu: serving on /dev/pts/N`, and stops on SIGINT or SIGTERM.";
+
+static STOP: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(_: libc::c_int) {
+    STOP.store(true, Ordering::Relaxed);
+}
+
+struct Options {
+    image: PathBuf,
+    straps: Straps,
+    model: ModelConfig,
+    link: Option<PathBuf>,
+}
+
+fn parse(args: &[String]) -> Result<Option<Options>, String> {
+    let mut image = None;
+    let mut straps = Straps::default();
+    let mut model = ModelConfig::default();
+    let mut link = None;
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        let mut value = || {
+            it.next()
+                .cloned()
+                .ok_or_else(|| format!("{a} needs a value"))
+        };
+        match a.as_str() {
+            "-h" | "--help" => return Ok(None),
+            "--image" => image = Some(PathBuf::from(value()?)),
+            "--clock-mhz" => {
+                let v = value()?;
+                let mhz: f64 = v
+                    .parse()
+                    .map_err(|_| format!("--clock-mhz `{v}` is not a number"))?;
+                let hz = (mhz * 1e6).round();
+                if !(1e6..=40e6).contains(&hz) {
+                    return Err(format!("--clock-mhz `{v}`: 1 to 40"));
+                }
+                straps.sysclk_hz = hz as u32;
+            }
+            "--csel" | "--vsel" => {
+                let v = value()?;
+                let high = match v.as_str() {
+                    "high" => true,
+                    "low" => false,
+                    _ => return Err(format!("{a} `{v}`: high or low")),
+                };
+                if a == "--csel" {
+                    straps.csel_high = high;
+                } else {
+                    straps.vsel_high = high;
+                }
+            }
+            "--chip-fault" => {
+                let v = value()?;
+                faults::apply_named(&v, &mut model).map_err(|e| format!("--chip-fault: {e}"))?;
+            }
+            "--link" => link = Some(PathBuf::from(value()?)),
+            other => return Err(format!("unknown option `{other}` (--help lists them)")),
         }
     }
-    let s = t0.elapsed().as_secs_f64();
-    println!("{:.1} M cycles/s", cycles as f64 / s / 1e6);
+    let image = image.ok_or("--image ELF is needed (firmware/run-emu builds and gives it)")?;
+    Ok(Some(Options {
+        image,
+        straps,
+        model,
+        link,
+    }))
+}
+
+/// The pty's reader, on a thread of its own: what the host writes,
+/// queued for the USB host to send.
+fn receive(mut pty: std::fs::File) -> mpsc::Receiver<Vec<u8>> {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let mut buf = [0u8; 4096];
+        while !STOP.load(Ordering::Relaxed) {
+            if !readable(pty.as_raw_fd()) {
+                continue;
+            }
+            let n = match io::Read::read(&mut pty, &mut buf) {
+                Ok(n) => n,
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                // No host on the other end: wait for one.
+                Err(_) => {
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                    continue;
+                }
+            };
+            if tx.send(buf[..n].to_vec()).is_err() {
+                return;
+            }
+        }
+    });
+    rx
+}
+
+/// The requests the image has yet to answer, by sequence number and the
+/// cycle each arrived at: the oldest is the one WORKING speaks of.
+#[derive(Default)]
+struct Outstanding {
+    requests: FrameDecoder,
+    replies: FrameDecoder,
+    waiting: VecDeque<(u8, u64)>,
+}
+
+impl Outstanding {
+    fn sent(&mut self, bytes: &[u8], cycle: u64) {
+        for chunk in bytes.split_inclusive(|b| *b == 0) {
+            self.requests.extend(chunk);
+            if let Ok(Some(p)) = self.requests.decode() {
+                if let Some(&seq) = p.first() {
+                    self.waiting.push_back((seq, cycle));
+                }
+            }
+        }
+    }
+
+    /// Takes the bytes the image sent; true when an answer came.
+    fn answered(&mut self, bytes: &[u8]) -> bool {
+        let mut any = false;
+        for chunk in bytes.split_inclusive(|b| *b == 0) {
+            self.replies.extend(chunk);
+            if let Ok(Some(p)) = self.replies.decode() {
+                if let Some(&seq) = p.first() {
+                    let before = self.waiting.len();
+                    self.waiting.retain(|(s, _)| *s != seq);
+                    any |= self.waiting.len() != before;
+                }
+            }
+        }
+        any
+    }
+}
+
+/// Cycles the image runs between two looks at the USB: 100 us.
+const SLICE: u64 = 15_000;
+/// With nothing to send and nothing outstanding, the image runs this long
+/// after the last byte, then waits for the host with its clock stopped.
+const IDLE_AFTER: u64 = 7_500_000;
+
+fn serve(o: Options) -> Result<(), String> {
+    let elf = std::fs::read(&o.image).map_err(|e| format!("{}: {e}", o.image.display()))?;
+    let flash = machine::flash_image(&elf).map_err(|e| format!("{}: {e}", o.image.display()))?;
+    let model = Model::new(o.straps, o.model).map_err(|e| format!("the chip model: {e}"))?;
+    let mut m = Machine::boot(&flash, ChipSide::new(model, SYS_CLK_HZ))?;
+    let mut host = usb::Host::new(&mut m);
+    let enumerated = cdc::enumerate(&mut host);
+    let mut port = enumerated.map_err(|e| format!("USB enumeration: {e}; {}", m.where_it_is()))?;
+    eprintln!(
+        "run-emu: the image enumerated as \"{}\" (serial {}) after {} ms of its time",
+        port.product,
+        port.serial,
+        m.cycles() / u64::from(SYS_CLK_HZ / 1000)
+    );
+    let (master, path) = open_pty().map_err(|e| format!("no pseudo-terminal: {e}"))?;
+    if let Some(link) = &o.link {
+        let _ = std::fs::remove_file(link);
+        std::os::unix::fs::symlink(&path, link)
+            .map_err(|e| format!("--link {}: {e}", link.display()))?;
+    }
+    println!("run-emu: serving on {path}");
+    let _ = io::stdout().flush();
+    let file = std::fs::File::from(master);
+    let out = Arc::new(Mutex::new(
+        file.try_clone()
+            .map_err(|e| format!("no second handle on {path}: {e}"))?,
+    ));
+    let running: Arc<Mutex<Option<Running>>> = Arc::default();
+    let progress = Arc::new(AtomicU64::new(m.cycles()));
+    let timer = Timer {
+        hz: ppmc_bridge_fw::timebase::timer_hz(SYS_CLK_HZ),
+    };
+    working(
+        out.clone(),
+        running.clone(),
+        progress.clone(),
+        SYS_CLK_HZ,
+        timer,
+    );
+    let reader = file
+        .try_clone()
+        .map_err(|e| format!("no third handle on {path}: {e}"))?;
+    let arrived = receive(reader);
+    let mut pending: VecDeque<u8> = VecDeque::new();
+    let mut outstanding = Outstanding::default();
+    let mut last_traffic = m.cycles();
+    let result = loop {
+        if STOP.load(Ordering::Relaxed) {
+            break Ok(());
+        }
+        let idle = pending.is_empty()
+            && outstanding.waiting.is_empty()
+            && m.cycles() - last_traffic > IDLE_AFTER;
+        let wait = if idle { 50 } else { 0 };
+        match arrived.recv_timeout(std::time::Duration::from_millis(wait)) {
+            Ok(bytes) => {
+                outstanding.sent(&bytes, m.cycles());
+                pending.extend(bytes);
+                last_traffic = m.cycles();
+            }
+            Err(mpsc::RecvTimeoutError::Timeout) if idle => continue,
+            Err(mpsc::RecvTimeoutError::Timeout) => {}
+            Err(mpsc::RecvTimeoutError::Disconnected) => break Ok(()),
+        }
+        let mut host = usb::Host::new(&mut m);
+        if let Err(e) = host.run(SLICE) {
+            break Err(e);
+        }
+        if !pending.is_empty() {
+            let n = pending.len().min(port.packet);
+            let chunk: Vec<u8> = pending.iter().take(n).copied().collect();
+            match port.send(&mut host, &chunk) {
+                Ok(true) => {
+                    pending.drain(..n);
+                }
+                Ok(false) => {}
+                Err(e) => break Err(e),
+            }
+        }
+        let mut failed = None;
+        loop {
+            let data = match port.receive(&mut host) {
+                Ok(d) => d,
+                Err(e) => {
+                    failed = Some(e);
+                    break;
+                }
+            };
+            if data.is_empty() {
+                break;
+            }
+            last_traffic = host.cycles();
+            let mut out = lock(&out);
+            if outstanding.answered(&data) {
+                *lock(&running) = None;
+            }
+            if let Err(e) = out.write_all(&data).and_then(|_| out.flush()) {
+                failed = Some(format!("writing to {path}: {e}"));
+                break;
+            }
+        }
+        if let Some(e) = failed {
+            break Err(e);
+        }
+        let now = m.cycles();
+        progress.store(now, Ordering::Relaxed);
+        let mut r = lock(&running);
+        if r.is_none() {
+            if let Some(&(seq, cycle)) = outstanding.waiting.front() {
+                *r = Some(Running {
+                    seq,
+                    cycle,
+                    since: std::time::Instant::now(),
+                    said: None,
+                });
+            }
+        }
+    };
+    if let Some(link) = &o.link {
+        let _ = std::fs::remove_file(link);
+    }
+    result
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let o = match parse(&args) {
+        Ok(Some(o)) => o,
+        Ok(None) => {
+            println!("{HELP}");
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("run-emu: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    // SAFETY: the handler only stores to an atomic.
+    unsafe {
+        libc::signal(
+            libc::SIGINT,
+            on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
+        );
+        libc::signal(
+            libc::SIGTERM,
+            on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
+        );
+    }
+    match serve(o) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("run-emu: {e}");
+            ExitCode::from(1)
+        }
+    }
 }

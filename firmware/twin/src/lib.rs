@@ -126,4 +126,3 @@ pub fn working(
         let _ = out.write_all(&frame).and_then(|_| out.flush());
     });
 }
-

@@ -8,12 +8,12 @@
 //! anything happens, so runs are repeatable.
 
 use ppmc_bridge_fw::twin;
-use ppmc_twin::{lock, open_pty, readable, working, Running};
 use ppmc_core::bridge::abort::{AbortLine, AbortWatch};
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::bridge::frame::FrameDecoder;
 use ppmc_core::emu::{faults, ModelConfig};
 use ppmc_core::protocol::Straps;
+use ppmc_twin::{lock, open_pty, readable, working, Running};
 use std::io::{self, Write};
 use std::os::fd::AsRawFd;
 use std::path::PathBuf;

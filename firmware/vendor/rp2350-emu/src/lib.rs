@@ -147,6 +147,7 @@ mod pio_tests;
 mod tests_narrow;
 
 pub use self::bus::Bus;
+pub use self::peripherals::usb::{DataPid, Handshake, InResponse, UsbHost};
 pub use self::core::CoreCounters;
 pub use self::core::CortexM33;
 pub use self::core_riscv::Hazard3;
@@ -1150,6 +1151,19 @@ impl Emulator {
                     {
                         self.bus.atomics.clear_wfe_waiting(i);
                     }
+                    // ppmc: an enabled interrupt that becomes pending is
+                    // a WFE wake-up event too (Armv8-M ARM, DDI0553,
+                    // B11.3 "Wait For Event": an exception that would be
+                    // taken), as it wakes WFI below; before, a core in
+                    // WFE slept through it (embassy's executor waits in
+                    // WFE for its timer's interrupt). The event
+                    // register is left as it is. PPMC-CHANGES.md.
+                    if self.bus.atomics.is_wfe_waiting(i) {
+                        let pending = self.bus.atomics.irq_pending_load(i);
+                        if pending != 0 && arm[i].ppb.any_pending_enabled(pending) {
+                            self.bus.atomics.clear_wfe_waiting(i);
+                        }
+                    }
                     // WFI wake: enabled pending IRQ clears WFI sleep.
                     // The peek is non-consuming; the next step() will
                     // merge via `take_irq_pending`.
@@ -1381,6 +1395,16 @@ impl Emulator {
         } else {
             self.bus.write32(addr, value, 0);
         }
+    }
+
+    /// The virtual USB host attached to the USB port (ppmc; see
+    /// [`peripherals::usb::UsbHost`]). Perform one transaction per call
+    /// and `run` the emulator between calls so firmware can react.
+    /// Serial execution model only: debug-asserts the emulator has not
+    /// been promoted into Threaded mode.
+    pub fn usb_host(&mut self) -> UsbHost<'_> {
+        self.assert_not_placeholder();
+        UsbHost::new(&mut self.bus)
     }
 
     /// Read a 32-bit word from an MMIO address via the bus. Charges zero

@@ -58,3 +58,35 @@ fn a_one_millisecond_watchdog_fires_after_one_millisecond() {
     emu.run(1_000).expect("runs");
     assert!(emu.bus.watchdog_reset_requested(), "never fired");
 }
+
+/// DDI0553 B11.3 (Wait For Event): an interrupt that would be taken wakes
+/// a core from WFE. Before the change only SEV's event did, and embassy's
+/// executor, asleep in WFE for its timer's alarm, never woke.
+#[test]
+fn a_timer_interrupt_wakes_a_core_asleep_in_wfe() {
+    let mut emu = quiet();
+    // Core 0: WFE. TIMER0's alarm 0 (IRQ 0) enabled in
+    // the NVIC and the timer; the alarm 100 us ahead.
+    let code: Vec<u8> = [
+        0xBF20u16, // wfe
+        0xE7FE,    // b .
+    ]
+    .iter()
+    .flat_map(|h| h.to_le_bytes())
+    .collect();
+    emu.load_image(0x2000_0000, &code);
+    emu.core_mut(0).wake();
+    emu.core_mut(0).regs.set_pc(0x2000_0000);
+    emu.mmio_write32(0xE000_E100, 1); // NVIC_ISER0: IRQ 0
+    start_ticks(&mut emu, 0x18);
+    emu.mmio_write32(0x400B_0040, 1); // TIMER0 INTE: alarm 0
+    let now = emu.mmio_read32(TIMER0_TIMERAWL);
+    emu.mmio_write32(0x400B_0010, now + 100); // ALARM0
+    emu.run(7_500).expect("runs"); // 50 us: still asleep
+    assert!(emu.core(0).is_wfe_waiting(), "not asleep before the alarm");
+    emu.run(15_000).expect("runs"); // 150 us
+    assert!(
+        !emu.core(0).is_wfe_waiting(),
+        "still asleep in WFE after the alarm"
+    );
+}

@@ -361,7 +361,8 @@ pub struct Bus {
     /// CORESIGHT_TRACE — storage-only CoreSight block at `0xE004_1000`
     /// (HLD V5 §8.E.2). No trace data produced.
     pub(crate) coresight_trace: CoresightTraceRegs,
-    /// USBCTRL — register-surface stub (HLD V5 §Component 1). Covers
+    /// USBCTRL — device controller model with a virtual host (ppmc;
+    /// `peripherals::usb`, PPMC-CHANGES.md). Covers
     /// regs at `USBCTRL_REGS_BASE` and DPRAM at `USBCTRL_DPRAM_BASE`.
     /// Held in reset post-bootrom; firmware must release `RESET_USBCTRL`
     /// before any access lands.
@@ -1216,6 +1217,13 @@ impl Bus {
             ext_irqs |= self.powman.advance(sys_clks, &self.clock_tree);
         }
         self.raise_irqs_u64(ext_irqs);
+
+        // USBCTRL (ppmc): USBCTRL_IRQ is level-like — re-assert it at
+        // every quantum end while INTS != 0 (RP2350 datasheet §12.7
+        // INTS; see `peripherals::usb` module docs).
+        if !self.is_held_in_reset_bit(RESET_USBCTRL) && self.usbctrl.irq_level() {
+            self.assert_irq_shared(crate::irq::IRQ_USBCTRL_IRQ);
+        }
 
         // DMA ticks after peripherals produce DREQ (HLD V5 §5.6).
         // Loop once per advanced sysclk so DMA throughput tracks the

@@ -226,6 +226,7 @@ impl ThreadedEmulator {
             last_fetch_addr: _,
             warned_addrs: _,
             watchdog_reset_requested: _,
+            ref_clk_carry: _,
             syscfg: _,
             tbman: _,
             glitch: _,
