@@ -253,8 +253,8 @@ impl Machine {
     fn read_pads(&mut self) {
         let mut p = Pads::default();
         for g in 0..GPIOS {
-            let ctrl = self.emu.peek(IO_BANK0 + 8 * g as u32 + 4);
-            let pad = self.emu.peek(PADS_BANK0 + 4 + 4 * g as u32);
+            let ctrl = self.emu.mmio_read32(IO_BANK0 + 8 * g as u32 + 4);
+            let pad = self.emu.mmio_read32(PADS_BANK0 + 4 + 4 * g as u32);
             let bit = 1u64 << g;
             match ctrl & 0x1F {
                 F_SIO => p.sio |= bit,
