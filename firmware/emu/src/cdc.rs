@@ -340,3 +340,40 @@ impl Port {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A CDC ACM configuration as embassy-usb writes it (USB CDC 1.2,
+    /// PSTN 5.3): the communication interface with its notification
+    /// endpoint, then the data interface with bulk OUT 0x01 and IN 0x82.
+    fn cdc_configuration() -> Vec<u8> {
+        let mut c = vec![9, 2, 0, 0, 2, 1, 0, 0x80, 50];
+        c.extend([8, 0x0B, 0, 2, 2, 2, 0, 0]); // interface association
+        c.extend([9, 4, 0, 0, 1, 2, 2, 0, 0]); // communication interface
+        c.extend([5, 0x24, 0, 0x10, 0x01]); // CDC header
+        c.extend([7, 5, 0x83, 3, 8, 0, 255]); // notification: interrupt IN
+        c.extend([9, 4, 1, 0, 2, 0x0A, 0, 0, 0]); // data interface
+        c.extend([7, 5, 0x01, 2, 64, 0, 0]); // bulk OUT 1
+        c.extend([7, 5, 0x82, 2, 64, 0, 0]); // bulk IN 2
+        let total = c.len() as u16;
+        c[2..4].copy_from_slice(&total.to_le_bytes());
+        c
+    }
+
+    #[test]
+    fn the_data_interfaces_bulk_endpoints_are_found_not_the_notification() {
+        assert_eq!(data_endpoints(&cdc_configuration()), Ok((2, 1, 64)));
+    }
+
+    #[test]
+    fn a_configuration_without_a_data_interface_or_cut_short_is_refused() {
+        let c = cdc_configuration();
+        let without: Vec<u8> = c[..c.len() - 23].to_vec();
+        assert!(data_endpoints(&without).is_err());
+        let cut = &c[..c.len() - 3];
+        let e = data_endpoints(cut).expect_err("cut short");
+        assert!(e.contains("runs past it"), "{e}");
+    }
+}

@@ -197,16 +197,6 @@ impl Machine {
         )
     }
 
-    /// The chip side, for what it counted.
-    pub fn chip(&self) -> &ChipSide {
-        &self.chip
-    }
-
-    /// Whether the image has started core 1.
-    pub fn core1_launched(&self) -> bool {
-        self.launch.done
-    }
-
     /// Runs at least `cycles` more cycles, quantum by quantum, the pins
     /// exchanged between each two.
     pub fn run(&mut self, cycles: u64) -> Result<(), String> {
@@ -219,7 +209,7 @@ impl Machine {
                 .run_quantum()
                 .map_err(|e| format!("rp2350-emu stopped at cycle {}: {e:?}", self.emu.cycles()))?;
             self.quanta += 1;
-            if self.quanta % PADS_EVERY == 0 {
+            if self.quanta.is_multiple_of(PADS_EVERY) {
                 self.read_pads();
             }
             self.exchange_pins();
@@ -304,5 +294,40 @@ impl Machine {
         bus.gpio_external_mask = u32::MAX;
         bus.gpio_external_in.store(pin as u32, Ordering::Relaxed);
         bus.set_gpio_external_in_hi((pin >> 32) as u32 & 0xFFFF, 0xFFFF);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 32-bit little-endian ELF with one loadable segment of `data` at
+    /// `addr`.
+    fn elf(addr: u32, data: &[u8]) -> Vec<u8> {
+        let mut b = vec![0u8; 0x34 + 32];
+        b[..6].copy_from_slice(b"\x7fELF\x01\x01");
+        b[0x1C..0x20].copy_from_slice(&0x34u32.to_le_bytes()); // phoff
+        b[0x2A..0x2C].copy_from_slice(&32u16.to_le_bytes()); // phentsize
+        b[0x2C..0x2E].copy_from_slice(&1u16.to_le_bytes()); // phnum
+        let off = b.len() as u32;
+        let ph = 0x34;
+        b[ph..ph + 4].copy_from_slice(&1u32.to_le_bytes()); // PT_LOAD
+        b[ph + 4..ph + 8].copy_from_slice(&off.to_le_bytes());
+        b[ph + 12..ph + 16].copy_from_slice(&addr.to_le_bytes()); // paddr
+        b[ph + 16..ph + 20].copy_from_slice(&(data.len() as u32).to_le_bytes());
+        b.extend_from_slice(data);
+        b
+    }
+
+    #[test]
+    fn the_flash_image_holds_each_segment_at_its_load_address() {
+        let f = flash_image(&elf(FLASH + 4, &[1, 2, 3, 4, 5, 6, 7, 8])).expect("an image");
+        assert_eq!(f, [0xFF, 0xFF, 0xFF, 0xFF, 1, 2, 3, 4, 5, 6, 7, 8]);
+    }
+
+    #[test]
+    fn a_segment_outside_the_flash_is_refused_with_its_address() {
+        let e = flash_image(&elf(0x2000_0000, &[0; 8])).expect_err("RAM");
+        assert!(e.contains("0x20000000"), "{e}");
     }
 }

@@ -147,11 +147,11 @@ mod pio_tests;
 mod tests_narrow;
 
 pub use self::bus::Bus;
-pub use self::peripherals::usb::{DataPid, Handshake, InResponse, UsbHost};
 pub use self::core::CoreCounters;
 pub use self::core::CortexM33;
 pub use self::core_riscv::Hazard3;
 pub use self::memory::Memory;
+pub use self::peripherals::usb::{DataPid, Handshake, InResponse, UsbHost};
 pub use self::sio::Sio;
 
 pub use picoem_common::Pacer;

@@ -32,7 +32,10 @@ fn run_to_the_end(emu: &mut Emulator, end: u32) {
         }
         emu.step().expect("a step");
     }
-    panic!("core 0 never reached {end:#x}: pc {:#x}", emu.core(0).regs.pc());
+    panic!(
+        "core 0 never reached {end:#x}: pc {:#x}",
+        emu.core(0).regs.pc()
+    );
 }
 
 /// DDI0553 C2.4 (LDA, LDAB, LDAH, LDAEX, STL, STLB, STLH, STLEX): each is

@@ -886,7 +886,11 @@ impl CortexM33 {
         // On one core with no cache the ordering is the program order, so
         // each is its plain or exclusive access. Before, these fell through
         // to LDRD/STRD below and did something else (PPMC-CHANGES.md).
-        if hw0 & 0xFFE0 == 0xE8C0 && (hw1 >> 7) & 0x1F == 0x1F && (hw1 >> 4) & 0x7 != 0x3 && (hw1 >> 4) & 0x7 != 0x7 {
+        if hw0 & 0xFFE0 == 0xE8C0
+            && (hw1 >> 7) & 0x1F == 0x1F
+            && (hw1 >> 4) & 0x7 != 0x3
+            && (hw1 >> 4) & 0x7 != 0x7
+        {
             let load = hw0 & 0x10 != 0;
             let rn = (hw0 & 0xF) as usize;
             let rt = ((hw1 >> 12) & 0xF) as usize;
