@@ -20,130 +20,63 @@ use machine::{Machine, SYS_CLK_HZ};
 use ppmc_bridge_fw::twin::chip::ChipSide;
 use ppmc_core::bridge::frame::FrameDecoder;
 use ppmc_core::bridge::wire::Timer;
-use ppmc_core::emu::{faults, Board as Model, ModelConfig};
-use ppmc_core::protocol::Straps;
-use ppmc_twin::{lock, open_pty, readable, working, Running};
+use ppmc_core::emu::Board as Model;
+use ppmc_twin::{
+    lock, open_pty, read_pty, stop_on_signals, stopping, working, BoardOptions, Running,
+    BOARD_OPTIONS_HELP,
+};
 use std::collections::VecDeque;
 use std::io::{self, Write};
-use std::os::fd::AsRawFd;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 
-const HELP: &str = "\
+/// `--help`, around [`BOARD_OPTIONS_HELP`].
+const HELP: [&str; 2] = [
+    "\
 ppmc-emu: the RP2350 bridge image, unmodified, on rp2350-emu, served on a pseudo-terminal
 
 usage: firmware/run-emu [options]          (builds the image first)
        ppmc-emu --image ELF [options]
 
   --image ELF          the board's ELF, as firmware/build prints it
-  --clock-mhz MHZ      the chip's SysClk strap, 1 to 40; default 16, as
-                       the image is built (PPMC_SYSCLK_HZ)
-  --csel high|low      default high
-  --vsel high|low      default high
-  --chip-fault NAME    a fault of the catalogue (ppmc fault-matrix --list);
-                       repeat to combine
-  --link PATH          also make PATH a symbolic link to the pty (removed on exit)
-  -h, --help           this text
+",
+    "  -h, --help           this text
 
-It boots the image, enumerates its USB device, prints
-`run-emu: serving on /dev/pts/N`, and stops on SIGINT or SIGTERM.";
-
-static STOP: AtomicBool = AtomicBool::new(false);
-
-extern "C" fn on_signal(_: libc::c_int) {
-    STOP.store(true, Ordering::Relaxed);
-}
+The chip's SysClk strap must be the one the image was built with
+(PPMC_SYSCLK_HZ, 16 MHz by default). It boots the image, enumerates its
+USB device, prints `run-emu: serving on /dev/pts/N`, and stops on SIGINT
+or SIGTERM.",
+];
 
 struct Options {
     image: PathBuf,
-    straps: Straps,
-    model: ModelConfig,
-    link: Option<PathBuf>,
+    board: BoardOptions,
 }
 
+/// The options; `None` for `--help`.
 fn parse(args: &[String]) -> Result<Option<Options>, String> {
     let mut image = None;
-    let mut straps = Straps::default();
-    let mut model = ModelConfig::default();
-    let mut link = None;
+    let mut board = BoardOptions::default();
     let mut it = args.iter();
     while let Some(a) = it.next() {
+        if a == "-h" || a == "--help" {
+            return Ok(None);
+        }
         let mut value = || {
             it.next()
                 .cloned()
                 .ok_or_else(|| format!("{a} needs a value"))
         };
-        match a.as_str() {
-            "-h" | "--help" => return Ok(None),
-            "--image" => image = Some(PathBuf::from(value()?)),
-            "--clock-mhz" => {
-                let v = value()?;
-                let mhz: f64 = v
-                    .parse()
-                    .map_err(|_| format!("--clock-mhz `{v}` is not a number"))?;
-                let hz = (mhz * 1e6).round();
-                if !(1e6..=40e6).contains(&hz) {
-                    return Err(format!("--clock-mhz `{v}`: 1 to 40"));
-                }
-                straps.sysclk_hz = hz as u32;
-            }
-            "--csel" | "--vsel" => {
-                let v = value()?;
-                let high = match v.as_str() {
-                    "high" => true,
-                    "low" => false,
-                    _ => return Err(format!("{a} `{v}`: high or low")),
-                };
-                if a == "--csel" {
-                    straps.csel_high = high;
-                } else {
-                    straps.vsel_high = high;
-                }
-            }
-            "--chip-fault" => {
-                let v = value()?;
-                faults::apply_named(&v, &mut model).map_err(|e| format!("--chip-fault: {e}"))?;
-            }
-            "--link" => link = Some(PathBuf::from(value()?)),
-            other => return Err(format!("unknown option `{other}` (--help lists them)")),
+        if a == "--image" {
+            image = Some(PathBuf::from(value()?));
+        } else if !board.take(a, &mut value)? {
+            return Err(format!("unknown option `{a}` (--help lists them)"));
         }
     }
     let image = image.ok_or("--image ELF is needed (firmware/run-emu builds and gives it)")?;
-    Ok(Some(Options {
-        image,
-        straps,
-        model,
-        link,
-    }))
-}
-
-/// The pty's reader, on a thread of its own: what the host writes,
-/// queued for the USB host to send.
-fn receive(mut pty: std::fs::File) -> mpsc::Receiver<Vec<u8>> {
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        let mut buf = [0u8; 4096];
-        while !STOP.load(Ordering::Relaxed) {
-            if !readable(pty.as_raw_fd()) {
-                continue;
-            }
-            let n = match io::Read::read(&mut pty, &mut buf) {
-                Ok(n) => n,
-                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
-                // No host on the other end: wait for one.
-                Err(_) => {
-                    std::thread::sleep(std::time::Duration::from_millis(20));
-                    continue;
-                }
-            };
-            if tx.send(buf[..n].to_vec()).is_err() {
-                return;
-            }
-        }
-    });
-    rx
+    Ok(Some(Options { image, board }))
 }
 
 /// The requests the image has yet to answer, by sequence number and the
@@ -193,7 +126,8 @@ const IDLE_AFTER: u64 = 7_500_000;
 fn serve(o: Options) -> Result<(), String> {
     let elf = std::fs::read(&o.image).map_err(|e| format!("{}: {e}", o.image.display()))?;
     let flash = machine::flash_image(&elf).map_err(|e| format!("{}: {e}", o.image.display()))?;
-    let model = Model::new(o.straps, o.model).map_err(|e| format!("the chip model: {e}"))?;
+    let model = Model::new(o.board.straps, o.board.model.clone())
+        .map_err(|e| format!("the chip model: {e}"))?;
     let mut m = Machine::boot(&flash, ChipSide::new(model, SYS_CLK_HZ))?;
     let mut host = usb::Host::new(&mut m);
     let enumerated = cdc::enumerate(&mut host);
@@ -205,11 +139,7 @@ fn serve(o: Options) -> Result<(), String> {
         m.cycles() / u64::from(SYS_CLK_HZ / 1000)
     );
     let (master, path) = open_pty().map_err(|e| format!("no pseudo-terminal: {e}"))?;
-    if let Some(link) = &o.link {
-        let _ = std::fs::remove_file(link);
-        std::os::unix::fs::symlink(&path, link)
-            .map_err(|e| format!("--link {}: {e}", link.display()))?;
-    }
+    o.board.make_link(&path)?;
     println!("run-emu: serving on {path}");
     let _ = io::stdout().flush();
     let file = std::fs::File::from(master);
@@ -232,12 +162,13 @@ fn serve(o: Options) -> Result<(), String> {
     let reader = file
         .try_clone()
         .map_err(|e| format!("no third handle on {path}: {e}"))?;
-    let arrived = receive(reader);
+    // What the host writes, queued for the USB host to send.
+    let arrived = read_pty(reader, |_| {});
     let mut pending: VecDeque<u8> = VecDeque::new();
     let mut outstanding = Outstanding::default();
     let mut last_traffic = m.cycles();
     let result = loop {
-        if STOP.load(Ordering::Relaxed) {
+        if stopping() {
             break Ok(());
         }
         let idle = pending.is_empty()
@@ -308,9 +239,7 @@ fn serve(o: Options) -> Result<(), String> {
             }
         }
     };
-    if let Some(link) = &o.link {
-        let _ = std::fs::remove_file(link);
-    }
+    o.board.remove_link();
     result
 }
 
@@ -319,7 +248,7 @@ fn main() -> ExitCode {
     let o = match parse(&args) {
         Ok(Some(o)) => o,
         Ok(None) => {
-            println!("{HELP}");
+            println!("{}{BOARD_OPTIONS_HELP}\n{}", HELP[0], HELP[1]);
             return ExitCode::SUCCESS;
         }
         Err(e) => {
@@ -327,17 +256,7 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    // SAFETY: the handler only stores to an atomic.
-    unsafe {
-        libc::signal(
-            libc::SIGINT,
-            on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
-        );
-        libc::signal(
-            libc::SIGTERM,
-            on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
-        );
-    }
+    stop_on_signals();
     match serve(o) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -1,17 +1,165 @@
 //! Serving a simulated bridge on a pseudo-terminal, as `ppmc-twin` and
-//! `ppmc-emu` (the image on rp2350-emu) both do: the pty itself, and the
-//! WORKING messages of a bridge that runs slower than real time
-//! (`docs/bridge-protocol.md` section 5), sent by the host side of the
-//! simulation with the simulated clock's progress.
+//! `ppmc-emu` (the image on rp2350-emu) both do: the options both take
+//! (the chip's straps and faults, a link to the pty), a stop on SIGINT or
+//! SIGTERM, the pty and its reader, and the WORKING messages of a bridge
+//! that runs slower than real time (`docs/bridge-protocol.md` section 5),
+//! sent by the host side of the simulation with the simulated clock's
+//! progress.
 
 use ppmc_core::bridge::frame;
 use ppmc_core::bridge::wire::{Response, Timer};
+use ppmc_core::emu::{faults, ModelConfig};
+use ppmc_core::protocol::Straps;
 use ppmc_core::time::Duration;
 use std::ffi::CStr;
 use std::io::{self, Write};
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+
+/// The `--help` lines of [`BoardOptions`].
+pub const BOARD_OPTIONS_HELP: &str =
+    "  --clock-mhz MHZ      the chip's SysClk strap, 1 to 40 (fractions allowed); default 16
+  --csel high|low      default high
+  --vsel high|low      default high
+  --chip-fault NAME    a fault of the catalogue (ppmc fault-matrix --list),
+                       swap-error-A-B or status-stuck-0xNN; repeat to combine
+  --link PATH          also make PATH a symbolic link to the pty (removed on exit)";
+
+/// The options of the board a simulated bridge serves: the chip's straps
+/// and faults, and where to link its pty.
+#[derive(Debug, Default)]
+pub struct BoardOptions {
+    pub straps: Straps,
+    pub model: ModelConfig,
+    pub link: Option<PathBuf>,
+}
+
+impl BoardOptions {
+    /// Takes `flag`, and its value from `value`, when it is one of
+    /// [`BOARD_OPTIONS_HELP`]'s: `Ok(false)` when it is not.
+    pub fn take(
+        &mut self,
+        flag: &str,
+        value: &mut dyn FnMut() -> Result<String, String>,
+    ) -> Result<bool, String> {
+        match flag {
+            "--clock-mhz" => {
+                let v = value()?;
+                let mhz: f64 = v
+                    .parse()
+                    .map_err(|_| format!("--clock-mhz `{v}` is not a number"))?;
+                let hz = (mhz * 1e6).round();
+                if !(1e6..=40e6).contains(&hz) {
+                    return Err(format!("--clock-mhz `{v}`: 1 to 40"));
+                }
+                self.straps.sysclk_hz = hz as u32;
+            }
+            "--csel" | "--vsel" => {
+                let v = value()?;
+                let high = match v.as_str() {
+                    "high" => true,
+                    "low" => false,
+                    _ => return Err(format!("{flag} `{v}`: high or low")),
+                };
+                if flag == "--csel" {
+                    self.straps.csel_high = high;
+                } else {
+                    self.straps.vsel_high = high;
+                }
+            }
+            "--chip-fault" => {
+                let v = value()?;
+                faults::apply_named(&v, &mut self.model)
+                    .map_err(|e| format!("--chip-fault: {e}"))?;
+            }
+            "--link" => self.link = Some(PathBuf::from(value()?)),
+            _ => return Ok(false),
+        }
+        Ok(true)
+    }
+
+    /// Makes `--link` a symbolic link to the pty at `path`, if given.
+    pub fn make_link(&self, path: &str) -> Result<(), String> {
+        if let Some(link) = &self.link {
+            let _ = std::fs::remove_file(link);
+            std::os::unix::fs::symlink(path, link)
+                .map_err(|e| format!("--link {}: {e}", link.display()))?;
+        }
+        Ok(())
+    }
+
+    /// Removes the `--link`, if given.
+    pub fn remove_link(&self) {
+        remove_link(self.link.as_deref());
+    }
+}
+
+/// Removes `link`, if any.
+pub fn remove_link(link: Option<&Path>) {
+    if let Some(link) = link {
+        let _ = std::fs::remove_file(link);
+    }
+}
+
+/// Raised by SIGINT or SIGTERM once [`stop_on_signals`] has run.
+pub static STOP: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(_: libc::c_int) {
+    STOP.store(true, Ordering::Relaxed);
+}
+
+/// Whether a signal asked the simulation to stop.
+pub fn stopping() -> bool {
+    STOP.load(Ordering::Relaxed)
+}
+
+/// SIGINT and SIGTERM raise [`STOP`] from here on.
+pub fn stop_on_signals() {
+    // SAFETY: the handler only stores to an atomic.
+    unsafe {
+        libc::signal(
+            libc::SIGINT,
+            on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
+        );
+        libc::signal(
+            libc::SIGTERM,
+            on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
+        );
+    }
+}
+
+/// The pty's reader, on a thread of its own until [`STOP`]: each read is
+/// shown to `look` as it arrives, then queued.
+pub fn read_pty(
+    mut pty: std::fs::File,
+    mut look: impl FnMut(&[u8]) + Send + 'static,
+) -> mpsc::Receiver<Vec<u8>> {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let mut buf = [0u8; 4096];
+        while !stopping() {
+            if !readable(pty.as_raw_fd()) {
+                continue;
+            }
+            let n = match io::Read::read(&mut pty, &mut buf) {
+                Ok(n) => n,
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                // No host on the other end: wait for one.
+                Err(_) => {
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                    continue;
+                }
+            };
+            look(&buf[..n]);
+            if tx.send(buf[..n].to_vec()).is_err() {
+                return;
+            }
+        }
+    });
+    rx
+}
 
 /// A pseudo-terminal in raw mode: the master, and the slave's path.
 pub fn open_pty() -> io::Result<(OwnedFd, String)> {

@@ -11,128 +11,52 @@ use ppmc_bridge_fw::twin;
 use ppmc_core::bridge::abort::{AbortLine, AbortWatch};
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::bridge::frame::FrameDecoder;
-use ppmc_core::emu::{faults, ModelConfig};
-use ppmc_core::protocol::Straps;
-use ppmc_twin::{lock, open_pty, readable, working, Running};
+use ppmc_twin::{
+    lock, open_pty, read_pty, remove_link, stop_on_signals, stopping, working, BoardOptions,
+    Running, BOARD_OPTIONS_HELP,
+};
 use std::io::{self, Write};
-use std::os::fd::AsRawFd;
-use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::{mpsc, Arc, Mutex};
 
-const HELP: &str = "\
+/// `--help`, around [`BOARD_OPTIONS_HELP`].
+const HELP: [&str; 2] = [
+    "\
 ppmc-twin: the RP2350 bridge's board code on a twin of the RP2350, served on a pseudo-terminal
 
 usage: firmware/run-twin [options]
 
-  --clock-mhz MHZ      the chip's SysClk strap, 1 to 40 (fractions allowed); default 16
-  --csel high|low      default high
-  --vsel high|low      default high
-  --chip-fault NAME    a fault of the catalogue (ppmc fault-matrix --list),
-                       swap-error-A-B or status-stuck-0xNN; repeat to combine
-  --link PATH          also make PATH a symbolic link to the pty (removed on exit)
-  -h, --help           this text
+",
+    "  -h, --help           this text
 
 It prints `run-twin: serving on /dev/pts/N` once it serves, and stops on
-SIGINT or SIGTERM.";
+SIGINT or SIGTERM.",
+];
 
-static STOP: AtomicBool = AtomicBool::new(false);
-
-extern "C" fn on_signal(_: libc::c_int) {
-    STOP.store(true, Ordering::Relaxed);
-}
-
-struct Options {
-    straps: Straps,
-    model: ModelConfig,
-    link: Option<PathBuf>,
-}
-
-fn parse(args: &[String]) -> Result<Option<Options>, String> {
-    let mut straps = Straps::default();
-    let mut model = ModelConfig::default();
-    let mut link = None;
+/// The options; `None` for `--help`.
+fn parse(args: &[String]) -> Result<Option<BoardOptions>, String> {
+    let mut o = BoardOptions::default();
     let mut it = args.iter();
     while let Some(a) = it.next() {
+        if a == "-h" || a == "--help" {
+            return Ok(None);
+        }
         let mut value = || {
             it.next()
                 .cloned()
                 .ok_or_else(|| format!("{a} needs a value"))
         };
-        match a.as_str() {
-            "-h" | "--help" => return Ok(None),
-            "--clock-mhz" => {
-                let v = value()?;
-                let mhz: f64 = v
-                    .parse()
-                    .map_err(|_| format!("--clock-mhz `{v}` is not a number"))?;
-                let hz = (mhz * 1e6).round();
-                if !(1e6..=40e6).contains(&hz) {
-                    return Err(format!("--clock-mhz `{v}`: 1 to 40"));
-                }
-                straps.sysclk_hz = hz as u32;
-            }
-            "--csel" | "--vsel" => {
-                let v = value()?;
-                let high = match v.as_str() {
-                    "high" => true,
-                    "low" => false,
-                    _ => return Err(format!("{a} `{v}`: high or low")),
-                };
-                if a == "--csel" {
-                    straps.csel_high = high;
-                } else {
-                    straps.vsel_high = high;
-                }
-            }
-            "--chip-fault" => {
-                let v = value()?;
-                faults::apply_named(&v, &mut model).map_err(|e| format!("--chip-fault: {e}"))?;
-            }
-            "--link" => link = Some(PathBuf::from(value()?)),
-            other => return Err(format!("unknown option `{other}` (--help lists them)")),
+        if !o.take(a, &mut value)? {
+            return Err(format!("unknown option `{a}` (--help lists them)"));
         }
     }
-    Ok(Some(Options {
-        straps,
-        model,
-        link,
-    }))
+    Ok(Some(o))
 }
 
-/// The receive path, on a thread of its own as a board's USB is on its
-/// own core: what arrives is shown to the abort watch at once (an ABORT
-/// stops the request the engine runs, `docs/bridge-protocol.md`
-/// section 5), then queued for the engine.
-fn receive(mut pty: std::fs::File, mut watch: AbortWatch) -> mpsc::Receiver<Vec<u8>> {
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        let mut buf = [0u8; 4096];
-        while !STOP.load(Ordering::Relaxed) {
-            if !readable(pty.as_raw_fd()) {
-                continue;
-            }
-            let n = match io::Read::read(&mut pty, &mut buf) {
-                Ok(n) => n,
-                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
-                // No host on the other end: wait for one.
-                Err(_) => {
-                    std::thread::sleep(std::time::Duration::from_millis(20));
-                    continue;
-                }
-            };
-            watch.on_bytes(&buf[..n]);
-            if tx.send(buf[..n].to_vec()).is_err() {
-                return;
-            }
-        }
-    });
-    rx
-}
-
-fn serve(o: Options) -> Result<(), String> {
-    let board = twin::board(o.straps, o.model).map_err(|e| format!("the twin cannot boot: {e}"))?;
+fn serve(o: BoardOptions) -> Result<(), String> {
+    let board =
+        twin::board(o.straps, o.model.clone()).map_err(|e| format!("the twin cannot boot: {e}"))?;
     let timer = board.timer();
     let progress = board.hal().progress.clone();
     let session = std::process::id() ^ 0x7717_0000;
@@ -147,21 +71,15 @@ fn serve(o: Options) -> Result<(), String> {
         .with_capture_capacity(ppmc_bridge_fw::limits::CAPTURE_RECORDS)
         .with_abort(abort.clone());
     let (master, path) = open_pty().map_err(|e| format!("no pseudo-terminal: {e}"))?;
-    if let Some(link) = &o.link {
-        let _ = std::fs::remove_file(link);
-        std::os::unix::fs::symlink(&path, link)
-            .map_err(|e| format!("--link {}: {e}", link.display()))?;
-    }
+    o.make_link(&path)?;
     // A signal during a long op (the twin runs every cycle of it) must not
     // wait for the op to end: a second later, this thread stops the twin.
     let link = o.link.clone();
     std::thread::spawn(move || loop {
         std::thread::sleep(std::time::Duration::from_millis(50));
-        if STOP.load(Ordering::Relaxed) {
+        if stopping() {
             std::thread::sleep(std::time::Duration::from_secs(1));
-            if let Some(link) = &link {
-                let _ = std::fs::remove_file(link);
-            }
+            remove_link(link.as_deref());
             eprintln!("run-twin: stopped in the middle of an op");
             std::process::exit(0);
         }
@@ -184,10 +102,17 @@ fn serve(o: Options) -> Result<(), String> {
     let reader = file
         .try_clone()
         .map_err(|e| format!("no third handle on {path}: {e}"))?;
-    let arrived = receive(reader, AbortWatch::new(abort.clone()));
+    // The receive path, on a thread of its own as a board's USB is on its
+    // own core: what arrives is shown to the abort watch at once (an ABORT
+    // stops the request the engine runs, `docs/bridge-protocol.md`
+    // section 5), then queued for the engine.
+    let mut watch = AbortWatch::new(abort.clone());
+    let arrived = read_pty(reader, move |bytes| {
+        watch.on_bytes(bytes);
+    });
     let mut requests = FrameDecoder::new();
     let result = loop {
-        if STOP.load(Ordering::Relaxed) {
+        if stopping() {
             break Ok(());
         }
         let bytes = match arrived.recv_timeout(std::time::Duration::from_millis(50)) {
@@ -222,9 +147,7 @@ fn serve(o: Options) -> Result<(), String> {
             break Err(e);
         }
     };
-    if let Some(link) = &o.link {
-        let _ = std::fs::remove_file(link);
-    }
+    o.remove_link();
     result
 }
 
@@ -233,7 +156,7 @@ fn main() -> ExitCode {
     let o = match parse(&args) {
         Ok(Some(o)) => o,
         Ok(None) => {
-            println!("{HELP}");
+            println!("{}{BOARD_OPTIONS_HELP}\n{}", HELP[0], HELP[1]);
             return ExitCode::SUCCESS;
         }
         Err(e) => {
@@ -241,17 +164,7 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    // SAFETY: the handler only stores to an atomic.
-    unsafe {
-        libc::signal(
-            libc::SIGINT,
-            on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
-        );
-        libc::signal(
-            libc::SIGTERM,
-            on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
-        );
-    }
+    stop_on_signals();
     match serve(o) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
