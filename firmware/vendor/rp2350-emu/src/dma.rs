@@ -75,6 +75,12 @@ const CH_AL3_READ_ADDR_TRIG: u32 = 0x3C;
 
 // Per-channel debug registers — read-only (datasheet §12.6.6).
 const CH_DBG_CTDREQ_OFFSET: u32 = 0x800;
+/// ppmc: TRANS_COUNT's fields on the RP2350 (datasheet 12.6.2.2): COUNT
+/// in bits 27:0, MODE in 31:28 (0 NORMAL, 1 TRIGGER_SELF, 0xF ENDLESS).
+const TRANS_COUNT_COUNT_MASK: u32 = 0x0FFF_FFFF;
+const TRANS_COUNT_MODE_SHIFT: u32 = 28;
+const TRANS_COUNT_MODE_TRIGGER_SELF: u32 = 0x1;
+const TRANS_COUNT_MODE_ENDLESS: u32 = 0xF;
 
 // Global registers (RP2350 datasheet §12.6.6).
 //
@@ -204,6 +210,9 @@ pub struct DmaChannel {
     pub trans_count_reload: u32,
     /// CTRL register. `BUSY` is derived on read from [`Self::busy`].
     pub ctrl: u32,
+    /// ppmc: TRANS_COUNT.MODE (bits 31:28) of the sequence running,
+    /// latched from the reload value when the channel was triggered.
+    pub mode: u32,
     /// Transfer-in-progress flag. Decoupled from `ctrl` so a
     /// read-through-CTRL still surfaces the live state correctly.
     pub busy: bool,
@@ -509,7 +518,8 @@ impl Dma {
                     let inner = (offset - CH_DBG_CTDREQ_OFFSET) % 0x40;
                     match inner {
                         0 => 0, // CTDREQ — not modelled
-                        4 => self.channels[ch].trans_count,
+                        // ppmc: DBG_TCR shows the RELOAD value (12.6.2.2).
+                        4 => self.channels[ch].trans_count_reload,
                         _ => 0,
                     }
                 } else {
@@ -617,7 +627,7 @@ impl Dma {
                 ch.write_addr
             }
             CH_TRANS_COUNT | CH_AL1_TRANS_COUNT | CH_AL2_TRANS_COUNT_TRIG | CH_AL3_TRANS_COUNT => {
-                ch.trans_count
+                ch.trans_count | ch.mode << TRANS_COUNT_MODE_SHIFT
             }
             CH_CTRL_TRIG | CH_AL1_CTRL | CH_AL2_CTRL | CH_AL3_CTRL => ctrl_image,
             _ => 0,
@@ -644,14 +654,16 @@ impl Dma {
                 self.channels[ch_idx].write_addr = new;
                 self.trigger_channel(ch_idx);
             }
+            // ppmc: a write sets the RELOAD value only; the live counter
+            // takes it when the channel is next triggered (RP2350
+            // datasheet 12.6.2.2, "Transfer Count"). The crate wrote both,
+            // so a write to a running channel changed its live count.
             CH_TRANS_COUNT | CH_AL1_TRANS_COUNT | CH_AL3_TRANS_COUNT => {
-                let new = apply_alias(self.channels[ch_idx].trans_count, value, alias);
-                self.channels[ch_idx].trans_count = new;
+                let new = apply_alias(self.channels[ch_idx].trans_count_reload, value, alias);
                 self.channels[ch_idx].trans_count_reload = new;
             }
             CH_AL2_TRANS_COUNT_TRIG => {
-                let new = apply_alias(self.channels[ch_idx].trans_count, value, alias);
-                self.channels[ch_idx].trans_count = new;
+                let new = apply_alias(self.channels[ch_idx].trans_count_reload, value, alias);
                 self.channels[ch_idx].trans_count_reload = new;
                 self.trigger_channel(ch_idx);
             }
@@ -693,17 +705,26 @@ impl Dma {
         }
     }
 
-    /// Arm a channel: if `CTRL.EN` is set and `TRANS_COUNT > 0`, mark
-    /// `BUSY`. Otherwise no-op.
+    /// Arm a channel: if `CTRL.EN` is set, the channel is idle and the
+    /// RELOAD count is not 0, copy RELOAD into the live counter and its
+    /// MODE, and mark `BUSY`. Otherwise no-op.
+    ///
+    /// ppmc: the trigger copies RELOAD into the live counter (RP2350
+    /// datasheet 12.6.2.2, "Transfer Count"), and a trigger of a channel
+    /// that is already busy is ignored (12.6.3, "Triggers"); the crate
+    /// copied the live count into RELOAD, and counted MODE's bits
+    /// (31:28) as part of the count.
     fn trigger_channel(&mut self, ch_idx: usize) {
         let ch = &mut self.channels[ch_idx];
-        if (ch.ctrl & CTRL_EN) == 0 {
+        if (ch.ctrl & CTRL_EN) == 0 || ch.busy {
             return;
         }
-        if ch.trans_count == 0 {
+        let count = ch.trans_count_reload & TRANS_COUNT_COUNT_MASK;
+        if count == 0 {
             return;
         }
-        ch.trans_count_reload = ch.trans_count;
+        ch.trans_count = count;
+        ch.mode = ch.trans_count_reload >> TRANS_COUNT_MODE_SHIFT;
         ch.busy = true;
     }
 
@@ -848,20 +869,25 @@ impl Dma {
             };
         }
 
-        // Consume one unit of trans_count.
+        // Consume one unit of trans_count: not in ENDLESS mode, and in
+        // TRIGGER_SELF mode the channel triggers itself when the count
+        // runs out (ppmc: RP2350 datasheet 12.6.2.2, TRANS_COUNT.MODE).
+        if ch.mode == TRANS_COUNT_MODE_ENDLESS {
+            return;
+        }
         ch.trans_count = ch.trans_count.saturating_sub(1);
         if ch.trans_count == 0 {
             ch.busy = false;
+            let again = ch.mode == TRANS_COUNT_MODE_TRIGGER_SELF;
             if (ch.ctrl & CTRL_IRQ_QUIET) == 0 {
                 self.intr |= 1u32 << ch_idx;
             }
             let chain_to = ch.chain_to() as usize;
             if chain_to != ch_idx && chain_to < NUM_CHANNELS {
-                let reload = self.channels[chain_to].trans_count_reload;
-                if reload > 0 {
-                    self.channels[chain_to].trans_count = reload;
-                }
                 self.trigger_channel(chain_to);
+            }
+            if again {
+                self.trigger_channel(ch_idx);
             }
         }
     }
@@ -1155,7 +1181,11 @@ mod tests {
 
         assert_eq!(bus.read32(DMA_BASE, 0), 0x2000_1000);
         assert_eq!(bus.read32(DMA_BASE + 0x04, 0), 0x2000_2000);
-        assert_eq!(bus.read32(DMA_BASE + 0x08, 0), 42);
+        // ppmc: a write sets RELOAD (seen at DBG_TCR, 0x804); the live
+        // count, which TRANS_COUNT reads, takes it at the next trigger
+        // (RP2350 datasheet 12.6.2.2).
+        assert_eq!(bus.read32(DMA_BASE + 0x08, 0), 0);
+        assert_eq!(bus.read32(DMA_BASE + 0x804, 0), 42);
     }
 
     // ----------------------------------------------------------------

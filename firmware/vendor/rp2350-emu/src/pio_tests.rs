@@ -929,23 +929,29 @@ fn pio_narrow_writes_to_ctrl_dont_trigger_sm_restart() {
     // bits [7:4] all set). The TXF-only-widen drop means this byte
     // never reaches the PIO peripheral — SM_RESTART must NOT fire and
     // PC must stay at 5.
+    // ppmc: SM_RESTART keeps the PC (RP2350 datasheet 11.7) and clears
+    // the input shift counter: `in null, 5` gives the restart something
+    // to clear.
+    bus.write32(0x5020_00D8, 0x4065, 0);
+    assert_eq!(bus.pio[0].sm[0].isr_shift_count(), 5, "precondition");
     bus.write8(0x5020_0001, 0xF0, 0);
     assert_eq!(
-        bus.pio[0].sm[0].pc(),
+        bus.pio[0].sm[0].isr_shift_count(),
         5,
-        "narrow byte-1 write must NOT trigger SM_RESTART (PC stays at 5)"
+        "narrow byte-1 write must NOT trigger SM_RESTART"
     );
 
     // Comparison case: a full-width 32-bit write of `0x0000_00F0`
-    // DOES trigger SM_RESTART (PC←0). This proves byte-1 narrow drop
-    // is genuinely a drop rather than a coincidence (e.g. that the
-    // SM_RESTART path itself isn't broken).
+    // DOES trigger SM_RESTART (the shift counter cleared, the PC kept).
+    // This proves byte-1 narrow drop is genuinely a drop rather than a
+    // coincidence (e.g. that the SM_RESTART path itself isn't broken).
     bus.write32(0x5020_0000, 0x0000_00F0, 0);
     assert_eq!(
-        bus.pio[0].sm[0].pc(),
+        bus.pio[0].sm[0].isr_shift_count(),
         0,
-        "full-width SM_RESTART write must reset PC to 0 (control case)"
+        "full-width SM_RESTART write must clear the shift counter (control case)"
     );
+    assert_eq!(bus.pio[0].sm[0].pc(), 5, "SM_RESTART keeps the PC");
 }
 
 /// Narrow byte-0 write to SMn_INSTR (`0x0D8`) MUST NOT force-execute.

@@ -20526,7 +20526,12 @@ mod stage7_dma_coverage {
         assert_eq!(bus.read32(DMA_BASE + 0x18, 0), 0x2222);
         assert_eq!(bus.read32(DMA_BASE + 0x2C, 0), 0x2222);
         assert_eq!(bus.read32(DMA_BASE + 0x34, 0), 0x2222);
-        // AL1_TRANS_COUNT (0x1C).
+        // AL1_TRANS_COUNT (0x1C). ppmc: they read the live count, which
+        // takes the written RELOAD value at a trigger (RP2350 datasheet
+        // 12.6.2.2): trigger with EN clear does nothing, so with EN set
+        // and a DREQ that never comes, the count stays whole.
+        bus.write32(DMA_BASE + 0x10, 1 | 0x00 << 17, 0); // AL1_CTRL: EN, TREQ 0
+        bus.write32(DMA_BASE + 0x3C, 0x1111, 0); // AL3_READ_ADDR_TRIG
         assert_eq!(bus.read32(DMA_BASE + 0x1C, 0), 5);
         assert_eq!(bus.read32(DMA_BASE + 0x24, 0), 5);
         assert_eq!(bus.read32(DMA_BASE + 0x38, 0), 5);
@@ -29050,7 +29055,8 @@ mod stage3_dma_residue {
         let mut dma = Dma::new();
         dma.write32(CH_TRANS_COUNT, 0xFF, 0);
         dma.write32(CH_TRANS_COUNT, 0x0F, 3); // CLR
-        assert_eq!(dma.channel(0).trans_count, 0xF0);
+        // ppmc: a write sets RELOAD (RP2350 datasheet 12.6.2.2).
+        assert_eq!(dma.channel(0).trans_count_reload, 0xF0);
     }
 
     /// CTRL_TRIG with `BSWAP` set fires the warn-once latch via the

@@ -2304,6 +2304,31 @@ impl Bus {
         }
     }
 
+    /// ppmc: a word write to PIO block `idx`. A write to CTRL (offset 0)
+    /// with NEXT_PIO_MASK (23:20) or PREV_PIO_MASK (19:16) also applies
+    /// its NEXTPREV_SM_DISABLE/ENABLE/CLKDIV_RESTART (bits 25, 24, 26) to
+    /// those state machines of the next block (block 0 after the last)
+    /// and the previous one (the last before block 0), in the same write
+    /// (RP2350 datasheet 11.7, CTRL). The crate applied a CTRL write to
+    /// its own block only, so state machines started this way never ran.
+    /// Through the XOR and SET aliases the trigger bits (which read as
+    /// 0) act as written; through the CLR alias they do nothing.
+    fn pio_write32(&mut self, idx: usize, offset: u32, val: u32, alias: u32) {
+        self.pio[idx].write32(offset, val, alias);
+        if offset & 0xFFF != 0 || alias == 3 || val & (0b111 << 24) == 0 {
+            return;
+        }
+        let n = self.pio.len();
+        let next = (val >> 20) & 0xF;
+        let prev = (val >> 16) & 0xF;
+        if next != 0 {
+            self.pio[(idx + 1) % n].ctrl_from_neighbour(next, val);
+        }
+        if prev != 0 {
+            self.pio[(idx + n - 1) % n].ctrl_from_neighbour(prev, val);
+        }
+    }
+
     /// Fold an `irqs: u64` mask from a peripheral's write-path into
     /// the per-core pending banks via [`Self::assert_irq_shared`]. Used
     /// by the narrow-access dispatch and the word-RMW dispatch paths;
@@ -3300,9 +3325,9 @@ impl Bus {
                             let mask = self.powman.write32(offset, val, alias);
                             self.raise_irqs_u64(mask);
                         }
-                        0x5020_0000 => self.pio[0].write32(offset, val, alias),
-                        0x5030_0000 => self.pio[1].write32(offset, val, alias),
-                        0x5040_0000 => self.pio[2].write32(offset, val, alias),
+                        0x5020_0000 => self.pio_write32(0, offset, val, alias),
+                        0x5030_0000 => self.pio_write32(1, offset, val, alias),
+                        0x5040_0000 => self.pio_write32(2, offset, val, alias),
                         USBCTRL_REGS_BASE => {
                             let mut ext_irqs = 0u64;
                             self.usbctrl.write32(offset, val, alias, &mut ext_irqs);
