@@ -174,7 +174,9 @@ pub enum Reply {
         at: Instant,
         summary: PulseSummary,
     },
-    /// The pulse count was reached; `at` is the time of that pulse.
+    /// The pulse count was reached; `at` is the time of that pulse, or
+    /// when the wait began if the pulse came before it (the wait then
+    /// ends at once: no reply is stamped before the op ahead of it).
     PulsesReached {
         at: Instant,
     },

@@ -146,6 +146,45 @@ impl Cycle {
     }
 }
 
+/// The counts of a bus cycle's steps ([`BusTiming::counts`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StepCounts {
+    setup: u32,
+    strobe: u32,
+    strobe_sampled: u32,
+    hold: u32,
+    recovery: u32,
+}
+
+impl StepCounts {
+    /// The steps of `cycle`.
+    pub fn steps(&self, cycle: Cycle) -> Steps {
+        let mut s = Steps {
+            words: [0; Steps::MAX],
+            len: 0,
+        };
+        let a0 = |a: bool| u32::from(a) << pin::A0;
+        match cycle {
+            Cycle::Write { a0: a, byte } => {
+                let on = a0(a) | 1 << pin::DIR | 1 << pin::RD | 1 << pin::WR | u32::from(byte);
+                s.push(step(0xFF, on, false, self.setup));
+                s.push(step(0xFF, on & !(1 << pin::WR), false, self.strobe));
+                s.push(step(0xFF, on, false, self.hold));
+                s.push(step(0xFF, IDLE, false, self.recovery));
+            }
+            Cycle::Read { a0: a } => {
+                let on = a0(a) | 1 << pin::RD | 1 << pin::WR; // DIR low: towards the bridge
+                s.push(step(0x00, on, false, self.setup));
+                s.push(step(0x00, on & !(1 << pin::RD), true, self.strobe_sampled));
+                s.push(step(0x00, on | 1 << pin::CS, false, self.hold));
+                s.push(step(0x00, IDLE, false, 0));
+                s.push(step(0xFF, IDLE, false, self.recovery));
+            }
+        }
+        s
+    }
+}
+
 /// One step's word: D0-D7 directions (1 = driven), the 13 pin levels,
 /// sample, count.
 pub const fn step(dirs: u8, pins: u32, sample: bool, count: u32) -> u32 {
@@ -172,31 +211,21 @@ impl BusTiming {
 
     /// The steps of `cycle` at a system clock of `sysclk_hz`.
     pub fn steps(&self, cycle: Cycle, sysclk_hz: u32) -> Result<Steps, TooLong> {
+        Ok(self.counts(sysclk_hz)?.steps(cycle))
+    }
+
+    /// Each step's count at a system clock of `sysclk_hz`, worked out once:
+    /// the board code plays a cycle in every op, and each count is a
+    /// 64-bit division (some 240 cycles of a Cortex-M33).
+    pub fn counts(&self, sysclk_hz: u32) -> Result<StepCounts, TooLong> {
         let n = |ns| self.count(ns, sysclk_hz, STEP_CYCLES);
-        let mut s = Steps {
-            words: [0; Steps::MAX],
-            len: 0,
-        };
-        let a0 = |a: bool| u32::from(a) << pin::A0;
-        match cycle {
-            Cycle::Write { a0: a, byte } => {
-                let on = a0(a) | 1 << pin::DIR | 1 << pin::RD | 1 << pin::WR | u32::from(byte);
-                s.push(step(0xFF, on, false, n(self.setup_ns)?));
-                s.push(step(0xFF, on & !(1 << pin::WR), false, n(self.strobe_ns)?));
-                s.push(step(0xFF, on, false, n(self.hold_ns)?));
-                s.push(step(0xFF, IDLE, false, self.recovery(sysclk_hz)?));
-            }
-            Cycle::Read { a0: a } => {
-                let on = a0(a) | 1 << pin::RD | 1 << pin::WR; // DIR low: towards the bridge
-                s.push(step(0x00, on, false, n(self.setup_ns)?));
-                let strobe = self.count(self.strobe_ns, sysclk_hz, STEP_CYCLES_SAMPLED)?;
-                s.push(step(0x00, on & !(1 << pin::RD), true, strobe));
-                s.push(step(0x00, on | 1 << pin::CS, false, n(self.hold_ns)?));
-                s.push(step(0x00, IDLE, false, 0));
-                s.push(step(0xFF, IDLE, false, self.recovery(sysclk_hz)?));
-            }
-        }
-        Ok(s)
+        Ok(StepCounts {
+            setup: n(self.setup_ns)?,
+            strobe: n(self.strobe_ns)?,
+            strobe_sampled: self.count(self.strobe_ns, sysclk_hz, STEP_CYCLES_SAMPLED)?,
+            hold: n(self.hold_ns)?,
+            recovery: self.recovery(sysclk_hz)?,
+        })
     }
 
     /// The idle step's count: the next cycle changes the data lines'

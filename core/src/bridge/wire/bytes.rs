@@ -24,8 +24,22 @@ impl Timer {
         if self.hz == Self::NANOS.hz {
             return ns;
         }
-        let t = (u128::from(ns) * u128::from(self.hz) + 500_000_000) / 1_000_000_000;
-        u64::try_from(t).unwrap_or(u64::MAX)
+        if let Some(n) = ns
+            .checked_mul(self.hz)
+            .and_then(|n| n.checked_add(NANOS_PER_S / 2))
+        {
+            return BY_SECOND.div_rem(n).0;
+        }
+        // ns = a s + b ns: a whole seconds are `a * hz` ticks exactly, and
+        // only the part of a second is divided, in 64 bits.
+        let (a, b) = (ns / NANOS_PER_S, ns % NANOS_PER_S);
+        match b.checked_mul(self.hz) {
+            Some(part) => whole_then(a, self.hz, (part + NANOS_PER_S / 2) / NANOS_PER_S),
+            None => {
+                let t = (u128::from(ns) * u128::from(self.hz) + 500_000_000) / 1_000_000_000;
+                u64::try_from(t).unwrap_or(u64::MAX)
+            }
+        }
     }
 
     /// Nanoseconds to ticks, rounded up: for a bound, which must not
@@ -34,8 +48,14 @@ impl Timer {
         if self.hz == Self::NANOS.hz {
             return ns;
         }
-        let t = (u128::from(ns) * u128::from(self.hz)).div_ceil(1_000_000_000);
-        u64::try_from(t).unwrap_or(u64::MAX)
+        let (a, b) = (ns / NANOS_PER_S, ns % NANOS_PER_S);
+        match b.checked_mul(self.hz) {
+            Some(part) => whole_then(a, self.hz, part.div_ceil(NANOS_PER_S)),
+            None => {
+                let t = (u128::from(ns) * u128::from(self.hz)).div_ceil(1_000_000_000);
+                u64::try_from(t).unwrap_or(u64::MAX)
+            }
+        }
     }
 
     /// Ticks to nanoseconds, rounded up (for a bound).
@@ -46,8 +66,16 @@ impl Timer {
         if self.hz == 0 {
             return u64::MAX;
         }
-        let n = (u128::from(ticks) * 1_000_000_000).div_ceil(u128::from(self.hz));
-        u64::try_from(n).unwrap_or(u64::MAX)
+        // ticks = q hz + r: q whole seconds, and the rest (r < hz, so
+        // r * 10^9 fits 64 bits for any timer below 18 GHz) divided.
+        let (q, r) = (ticks / self.hz, ticks % self.hz);
+        match r.checked_mul(NANOS_PER_S) {
+            Some(part) => whole_then(q, NANOS_PER_S, part.div_ceil(self.hz)),
+            None => {
+                let n = (u128::from(ticks) * 1_000_000_000).div_ceil(u128::from(self.hz));
+                u64::try_from(n).unwrap_or(u64::MAX)
+            }
+        }
     }
 
     /// Whether a tick is a whole number of nanoseconds, so that times
@@ -72,9 +100,125 @@ impl Timer {
         if self.hz == 0 {
             return u64::MAX;
         }
-        let n = u128::from(ticks) * 1_000_000_000 / u128::from(self.hz);
-        u64::try_from(n).unwrap_or(u64::MAX)
+        // One 64-bit division while the product fits (some four minutes
+        // at 75 MHz), two past it.
+        if let Some(n) = ticks.checked_mul(NANOS_PER_S) {
+            return n / self.hz;
+        }
+        let (q, r) = (ticks / self.hz, ticks % self.hz);
+        match r.checked_mul(NANOS_PER_S) {
+            Some(part) => whole_then(q, NANOS_PER_S, part / self.hz),
+            None => {
+                let n = u128::from(ticks) * 1_000_000_000 / u128::from(self.hz);
+                u64::try_from(n).unwrap_or(u64::MAX)
+            }
+        }
     }
+}
+
+/// A fixed 64-bit divisor with its reciprocal: `n / d` by a multiply and
+/// at most two corrections, exact for every `n` (the estimate
+/// `n * floor(2^64 / d) / 2^64` is at most one below the quotient).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Divisor {
+    d: u64,
+    m: u64,
+}
+
+impl Divisor {
+    const fn new(d: u64) -> Divisor {
+        let m = if d > 1 {
+            (u64::MAX as u128 + 1) / d as u128
+        } else {
+            0
+        };
+        Divisor { d, m: m as u64 }
+    }
+
+    /// `(n / d, n % d)`; `d` must not be 0.
+    fn div_rem(self, n: u64) -> (u64, u64) {
+        if self.d == 1 {
+            return (n, 0);
+        }
+        let mut q = ((u128::from(n) * u128::from(self.m)) >> 64) as u64;
+        let mut r = n - q * self.d;
+        if r >= self.d {
+            q += 1;
+            r -= self.d;
+        }
+        (q, r)
+    }
+}
+
+/// A [`Timer`] with its divisions prepared: the same conversions, to the
+/// nanosecond and the tick, with no division at run time while the
+/// product fits 64 bits (some four minutes of ticks at 75 MHz). A bridge
+/// converts several times per op, and a 64-bit division costs a Cortex-M33
+/// some 240 cycles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FastTimer {
+    timer: Timer,
+    by_hz: Divisor,
+}
+
+impl FastTimer {
+    pub fn new(timer: Timer) -> FastTimer {
+        FastTimer {
+            timer,
+            by_hz: Divisor::new(timer.hz.max(1)),
+        }
+    }
+
+    pub fn timer(&self) -> Timer {
+        self.timer
+    }
+
+    /// [`Timer::to_ticks`] (which divides by a constant, prepared).
+    pub fn to_ticks(&self, ns: u64) -> u64 {
+        self.timer.to_ticks(ns)
+    }
+
+    /// [`Timer::to_nanos`].
+    pub fn to_nanos(&self, ticks: u64) -> u64 {
+        match ticks.checked_mul(NANOS_PER_S) {
+            Some(n) if self.timer.hz != 0 && self.timer.hz != Timer::NANOS.hz => {
+                self.by_hz.div_rem(n).0
+            }
+            _ => self.timer.to_nanos(ticks),
+        }
+    }
+
+    /// [`Timer::to_nanos_up`].
+    pub fn to_nanos_up(&self, ticks: u64) -> u64 {
+        match ticks.checked_mul(NANOS_PER_S) {
+            Some(n) if self.timer.hz != 0 && self.timer.hz != Timer::NANOS.hz => {
+                let (q, r) = self.by_hz.div_rem(n);
+                q + u64::from(r != 0)
+            }
+            _ => self.timer.to_nanos_up(ticks),
+        }
+    }
+
+    /// [`Timer::edge_tolerance`].
+    pub fn edge_tolerance(&self) -> Duration {
+        self.timer.edge_tolerance()
+    }
+}
+
+const NANOS_PER_S: u64 = 1_000_000_000;
+
+/// Division by a second's nanoseconds, prepared.
+const BY_SECOND: Divisor = Divisor::new(NANOS_PER_S);
+
+/// `whole * per + part`, or `u64::MAX` where it does not fit: the
+/// conversions above split a value into whole seconds and the rest, so
+/// that none needs a 128-bit division (a loop of some thousand cycles on
+/// a Cortex-M33, where the bridge converts several times per op).
+fn whole_then(whole: u64, per: u64, part: u64) -> u64 {
+    whole
+        .checked_mul(per)
+        .and_then(|w| w.checked_add(part))
+        .unwrap_or(u64::MAX)
 }
 
 #[derive(Debug)]
@@ -266,5 +410,39 @@ impl<'a> R<'a> {
                 field: "input",
                 value: u64::from(i),
             })
+    }
+}
+
+#[cfg(test)]
+mod divisor_tests {
+    use super::Divisor;
+
+    #[test]
+    fn a_prepared_divisor_divides_exactly_at_the_edges() {
+        for d in [
+            2,
+            3,
+            7,
+            40,
+            75_000_000,
+            1_000_000_000,
+            u64::MAX - 1,
+            u64::MAX,
+        ] {
+            let v = Divisor::new(d);
+            for n in [
+                0,
+                1,
+                d - 1,
+                d,
+                d.saturating_add(1),
+                d.saturating_mul(2) - 1,
+                u64::MAX - 1,
+                u64::MAX,
+            ] {
+                assert_eq!(v.div_rem(n), (n / d, n % d), "{n} / {d}");
+            }
+        }
+        assert_eq!(Divisor::new(1).div_rem(u64::MAX), (u64::MAX, 0));
     }
 }

@@ -16,7 +16,7 @@ mod ops;
 mod tests;
 
 pub use self::bridge_side::{capture_bytes, Incoming, ReplyWriter, WireOp};
-pub use self::bytes::Timer;
+pub use self::bytes::{FastTimer, Timer};
 pub use self::message::{
     fragment, kind, parse_fragment, BridgeErrorCode, CaptureChunk, Hello, Request, Response,
     WireError, FRAGMENT_DATA, MAX_PAD, MAX_REPLY, MAX_SAMPLES, MIN_FRAGMENT_DATA, PROTOCOL_VERSION,

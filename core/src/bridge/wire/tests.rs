@@ -632,3 +632,77 @@ proptest! {
         let _ = Response::decode(&b, T);
     }
 }
+
+/// The conversions as one 128-bit expression each: what `Timer`'s split
+/// arithmetic must equal, to the nanosecond and the tick, so that traces
+/// stay byte-identical.
+fn wide(x: u128) -> u64 {
+    u64::try_from(x).unwrap_or(u64::MAX)
+}
+
+proptest! {
+    #[test]
+    fn the_split_conversions_equal_the_128_bit_ones(
+        hz in prop_oneof![
+            Just(75_000_000u64),
+            Just(16_000_000u64),
+            Just(133_333_333u64),
+            Just(1_000_000_000u64),
+            Just(u64::from(u32::MAX)),
+            1u64..=20_000_000_000,
+        ],
+        v in prop_oneof![0u64..4_000_000_000, any::<u64>()],
+    ) {
+        let t = Timer { hz };
+        let (v1, h) = (u128::from(v), u128::from(hz));
+        let g = 1_000_000_000u128;
+        prop_assert_eq!(t.to_ticks(v), wide((v1 * h + g / 2) / g));
+        prop_assert_eq!(t.to_ticks_up(v), wide((v1 * h).div_ceil(g)));
+        prop_assert_eq!(t.to_nanos(v), wide(v1 * g / h));
+        prop_assert_eq!(t.to_nanos_up(v), wide((v1 * g).div_ceil(h)));
+        // The prepared divisions give the same, to the tick and the
+        // nanosecond.
+        let f = FastTimer::new(t);
+        prop_assert_eq!(f.to_ticks(v), t.to_ticks(v));
+        prop_assert_eq!(f.to_nanos(v), t.to_nanos(v));
+        prop_assert_eq!(f.to_nanos_up(v), t.to_nanos_up(v));
+    }
+}
+
+/// A run of `(ReadPins, Delay)` pairs whose samples the bridge read late,
+/// each stamped off the grid, takes a PINS and a DELAYED entry per pair:
+/// more than the SAMPLES entry they take on the grid. The host sizes its
+/// requests by `worst_reply_len`, so it must count that; it counted the
+/// SAMPLES form, and a bridge whose CPU could not keep a 250 ns grid (the
+/// unmodified image on rp2350-emu) answered OVERFLOW to the stop-switching
+/// scenarios' batches (Section 3-5-1).
+#[test]
+fn samples_read_off_their_grid_fit_the_worst_reply_length() {
+    let step = Duration::from_nanos(250);
+    let mut ops = Vec::new();
+    for _ in 0..200 {
+        ops.extend([Op::ReadPins, Op::Delay(step)]);
+    }
+    let groups = wire_ops(&ops);
+    assert_eq!(groups, [400], "one SAMPLE op");
+    for late_ns in [0u64, 7] {
+        let mut w = ReplyWriter::new(1, false, T, usize::MAX);
+        for k in 0..200u64 {
+            // Each sample read `late_ns` after its place on the grid.
+            let at = 1_000 + k * 250 + late_ns * (k % 2);
+            w.push(Reply::Pins {
+                at: Instant::from_nanos(at),
+                pins: pins(0),
+            });
+            w.push(Reply::Delayed {
+                at: Instant::from_nanos(at + 250),
+            });
+        }
+        let entries = w.finish().expect("no limit").len() - 4;
+        assert!(
+            entries <= worst_reply_len(&ops),
+            "late by {late_ns} ns: {entries} bytes, worst counted {}",
+            worst_reply_len(&ops)
+        );
+    }
+}

@@ -49,10 +49,10 @@ impl<H: Hal> Board<H> {
         if self.fault.is_some() {
             return (self.now_ticks(), None);
         }
-        let steps = match self.timing.steps(c, self.sysclk_hz) {
-            Ok(s) => s,
+        let steps = match self.counts {
+            Some(counts) => counts.steps(c),
             // The default timing fits; a board's own is checked at start.
-            Err(_) => return (self.now_ticks(), None),
+            None => return (self.now_ticks(), None),
         };
         let deadline =
             self.hal.cycles() + CYCLE_DEADLINE_US * u64::from(self.sysclk_hz / 1_000_000);

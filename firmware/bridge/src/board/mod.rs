@@ -33,7 +33,7 @@ mod ops;
 mod outputs;
 mod selftest;
 
-use crate::bus_cycle::BusTiming;
+use crate::bus_cycle::{BusTiming, StepCounts};
 use crate::hal::Hal;
 use crate::limits;
 use crate::pins;
@@ -42,7 +42,7 @@ use alloc::string::String;
 use alloc::vec::Vec;
 use ppmc_core::bridge::abort::AbortLine;
 use ppmc_core::bridge::move_tracker::MoveTracker;
-use ppmc_core::bridge::wire::Timer;
+use ppmc_core::bridge::wire::{FastTimer, Timer};
 use ppmc_core::bus::{Op, Uncertainty};
 use ppmc_core::protocol::{EdgeRuns, OutputRecord, PinEvent, Straps};
 use ppmc_core::time::{Duration, Instant};
@@ -50,8 +50,12 @@ use ppmc_core::time::{Duration, Instant};
 pub struct Board<H: Hal> {
     hal: H,
     sysclk_hz: u32,
-    timer: Timer,
-    timing: BusTiming,
+    /// The timer HELLO_REPLY announces, its divisions prepared: the
+    /// board code converts between its ticks and nanoseconds in every op.
+    timer: FastTimer,
+    /// The bus cycles' step counts at this clock (`BusTiming::counts`),
+    /// `None` for a timing that does not fit the player (checked at start).
+    counts: Option<StepCounts>,
     straps: Straps,
     /// The cycle the edge counters started on.
     started: u64,
@@ -149,16 +153,16 @@ impl<H: Hal> Board<H> {
     /// outputs.
     pub fn new(mut hal: H, timing: BusTiming, straps: Straps) -> Board<H> {
         let sysclk_hz = hal.sysclk_hz();
-        let timer = Timer {
+        let timer = FastTimer::new(Timer {
             hz: timebase::timer_hz(sysclk_hz),
-        };
+        });
         let started = hal.start_counters();
         let epoch = hal.cycles() / 2;
         let mut bus = Board {
             hal,
             sysclk_hz,
             timer,
-            timing,
+            counts: timing.counts(sysclk_hz).ok(),
             straps,
             started,
             epoch,
@@ -202,7 +206,7 @@ impl<H: Hal> Board<H> {
 
     /// The timer HELLO_REPLY announces.
     pub fn timer(&self) -> Timer {
-        self.timer
+        self.timer.timer()
     }
 
     /// How sure this board's times are, by path (HELLO_REPLY's
@@ -262,6 +266,6 @@ impl<H: Hal> Board<H> {
 }
 
 /// Bridge ticks as the record's time: since `epoch`, the last chip reset.
-fn record_time(timer: Timer, epoch: u64, ticks: u64) -> Instant {
+fn record_time(timer: FastTimer, epoch: u64, ticks: u64) -> Instant {
     Instant::from_nanos(timer.to_nanos(ticks.saturating_sub(epoch)))
 }

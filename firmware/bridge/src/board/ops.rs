@@ -78,7 +78,7 @@ impl<H: Hal> Board<H> {
     /// waits on a flag), and [`CPU_LEAD_US`] for the code between.
     fn lead(&self, k: Lag) -> u64 {
         let cycles = |c: Cycle, to_moment: bool| -> u64 {
-            let Ok(steps) = self.timing.steps(c, self.sysclk_hz) else {
+            let Some(steps) = self.counts.map(|n| n.steps(c)) else {
                 return 0;
             };
             let words = steps.words();
@@ -338,14 +338,18 @@ impl<H: Hal> Bus for Board<H> {
             },
             Op::AwaitPulses { count, timeout } => {
                 let deadline = self.deadline(timeout);
+                let began = self.at(self.now_ticks());
                 loop {
                     self.refresh();
                     let n = self.record.last_move_pulses().count;
                     let t = self.now_ticks();
                     if n >= count {
                         // The moment is the pulse's own, not when the
-                        // capture brought it: a delay counts from it.
-                        let at = self.pulse_time(count).unwrap_or(self.at(t));
+                        // capture brought it: a delay counts from it. A
+                        // pulse that came before the wait began ends it
+                        // as it begins, as on the reference model: a
+                        // reply is never stamped before the op ahead.
+                        let at = self.pulse_time(count).unwrap_or(self.at(t)).max(began);
                         self.moment = self.epoch + self.timer.to_ticks(at.as_nanos());
                         break Reply::PulsesReached { at };
                     }
@@ -363,8 +367,10 @@ impl<H: Hal> Bus for Board<H> {
         if matches!(op, Op::Delay(_)) && self.aim.is_some() {
             return reply;
         }
+        // The next op drains the capture before it runs (above): only the
+        // batch's last drains it here, so that an op costs one drain.
         let ends_batch = self.next.is_none();
-        if !(aimed && op == Op::ReadPins) || ends_batch {
+        if ends_batch {
             self.refresh();
         }
         self.batch_done |= ends_batch;

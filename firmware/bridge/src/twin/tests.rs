@@ -476,6 +476,55 @@ fn a_delay_counts_from_the_last_ops_moment_and_the_next_op_acts_on_time() {
 }
 
 #[test]
+fn a_wait_for_a_pulse_already_past_ends_when_it_starts() {
+    // A reply is stamped when its op ended (`Reply`); a wait for a pulse
+    // that came before the wait began ends at once, as the reference
+    // model's does (`EmuBus`), not back at the pulse: the bridge's clock
+    // never goes back between replies (the host takes a clock that went
+    // back for a bridge restarted behind its port). Found by the
+    // unmodified image on rp2350-emu, whose CPU took longer over a decel
+    // stop than pulses 300 to 330 took (e7_second_decel_stop), where the
+    // twin is quick.
+    let mut b = twin();
+    let mut ops = accel_move(5_000);
+    ops.truncate(ops.len() - 2);
+    ops.extend([
+        Op::Delay(Duration::from_millis(20)),
+        Op::ReadPulses,
+        Op::AwaitPulses {
+            count: 10,
+            timeout: Duration::from_secs(1),
+        },
+    ]);
+    let replies: Vec<Reply> = (0..ops.len())
+        .map(|i| {
+            b.next_op(ops.get(i + 1).copied());
+            b.run(ops[i])
+        })
+        .collect();
+    let n = replies.len();
+    let before = match replies[n - 2] {
+        Reply::Pulses { at, summary } => {
+            assert!(summary.count > 10, "pulse 10 already past: {summary:?}");
+            at
+        }
+        ref r => panic!("{r:?}"),
+    };
+    let reached = match replies[n - 1] {
+        Reply::PulsesReached { at } => at,
+        ref r => panic!("{r:?}"),
+    };
+    assert!(
+        reached >= before,
+        "the wait ended at {reached}, before the op ahead of it ({before})"
+    );
+    assert!(
+        reached.as_nanos() - before.as_nanos() < 20_000,
+        "the wait ended at {reached}, long after it began ({before})"
+    );
+}
+
+#[test]
 fn regular_pin_samples_stay_on_their_grid() {
     // `ReadPins, Delay(step)` pairs: each sample is read where its delay
     // aimed and stamped there, so that the bridge sends them as one
