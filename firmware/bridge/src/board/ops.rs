@@ -158,16 +158,20 @@ impl<H: Hal> Board<H> {
         }
     }
 
-    /// The time of pulse `n` (from 1) of the last move, if it came.
-    fn pulse_time(&self, n: u64) -> Option<Instant> {
+    /// The time of pulse `n` (from 1) of the last move, if it came:
+    /// looked for from the move's last run back, as a wait for a pulse
+    /// asks for the one that just came (a ramp is a run per pulse).
+    fn pulse_time(&mut self, n: u64) -> Option<Instant> {
         let first = self.record.moves.last()?.first_run;
-        let mut left = n.checked_sub(1)?;
-        for r in &self.record.runs[first..] {
-            let c = u64::from(r.count);
-            if left < c {
-                return Some(r.at(left as u32));
+        let index = n.checked_sub(1)?;
+        // Pulses before each run, counted down from the move's total.
+        let mut before = self.move_pulses();
+        for r in self.record.runs[first..].iter().rev() {
+            before -= u64::from(r.count);
+            if index >= before {
+                let k = index - before;
+                return (k < u64::from(r.count)).then(|| r.at(k as u32));
             }
-            left -= c;
         }
         None
     }
@@ -191,6 +195,7 @@ impl<H: Hal> Board<H> {
         self.epoch = self.now_ticks();
         self.moment = self.epoch;
         self.record = OutputRecord::default();
+        self.counted = Default::default();
         self.pending.clear();
         self.last_pulse = 0;
         self.edges.reset();
@@ -227,7 +232,10 @@ impl<H: Hal> Bus for Board<H> {
         // and the next drain reports the capture lost (CAPTURE_OVERRUN).
         let aimed = self.aim.is_some();
         let aiming = matches!(op, Op::Delay(_)) && self.next.and_then(Lag::of).is_some();
-        if !aimed && !aiming {
+        // After a wait for a pulse, which ended in a drain, the op that
+        // acts on the pulse (a stop, an input) goes at once.
+        let drained = core::mem::take(&mut self.drained);
+        if !aimed && !aiming && !drained {
             self.refresh();
         }
         let reply = match op {
@@ -341,7 +349,7 @@ impl<H: Hal> Bus for Board<H> {
                 let began = self.at(self.now_ticks());
                 loop {
                     self.refresh();
-                    let n = self.record.last_move_pulses().count;
+                    let n = self.move_pulses();
                     let t = self.now_ticks();
                     if n >= count {
                         // The moment is the pulse's own, not when the
@@ -351,6 +359,7 @@ impl<H: Hal> Bus for Board<H> {
                         // reply is never stamped before the op ahead.
                         let at = self.pulse_time(count).unwrap_or(self.at(t)).max(began);
                         self.moment = self.epoch + self.timer.to_ticks(at.as_nanos());
+                        self.drained = true;
                         break Reply::PulsesReached { at };
                     }
                     if t >= deadline || self.aborted() {
@@ -371,6 +380,7 @@ impl<H: Hal> Bus for Board<H> {
         // batch's last drains it here, so that an op costs one drain.
         let ends_batch = self.next.is_none();
         if ends_batch {
+            self.drained = false;
             self.refresh();
         }
         self.batch_done |= ends_batch;

@@ -525,6 +525,49 @@ fn a_wait_for_a_pulse_already_past_ends_when_it_starts() {
 }
 
 #[test]
+fn the_pulses_counted_as_they_come_are_the_records_count() {
+    // `Board::move_pulses` counts the last move's runs as they close, so
+    // that a wait for a pulse does not count a ramp's runs (one a pulse)
+    // again after every drain; it must agree with the record's own count
+    // through a move, at its end, and after a chip reset and a new move.
+    let mut b = twin();
+    let mut ops = accel_move(2_000);
+    ops.truncate(ops.len() - 2);
+    for n in [1, 100, 700, 1_500] {
+        ops.push(Op::AwaitPulses {
+            count: n,
+            timeout: Duration::from_secs(1),
+        });
+    }
+    ops.push(Op::AwaitStatus {
+        mask: Status::BUSY,
+        value: 0,
+        timeout: Duration::from_secs(2),
+    });
+    let mut checked = 0;
+    for round in 0..2 {
+        for i in 0..ops.len() {
+            b.next_op(ops.get(i + 1).copied());
+            b.run(ops[i]);
+            let counted = b.move_pulses();
+            assert_eq!(
+                counted,
+                b.record().last_move_pulses().count,
+                "round {round}, after op {i} ({:?})",
+                ops[i]
+            );
+            checked += u64::from(counted > 0);
+        }
+        assert_eq!(b.move_pulses(), 2_000, "round {round}");
+        // A chip reset starts the record again: the count with it.
+        b.next_op(None);
+        b.run(Op::Reset);
+        assert_eq!(b.move_pulses(), 0);
+    }
+    assert!(checked >= 10, "counted through the moves: {checked}");
+}
+
+#[test]
 fn regular_pin_samples_stay_on_their_grid() {
     // `ReadPins, Delay(step)` pairs: each sample is read where its delay
     // aimed and stamped there, so that the bridge sends them as one
