@@ -275,6 +275,14 @@ impl Rings {
         self.readers[i].level(self.channels[i].write_index(d))
     }
 
+    /// The `k`-th word (from 0) of ring `i` the CPU has not read, if the
+    /// DMA wrote it, left unread. A ring lapped meanwhile is told by the
+    /// next [`Rings::pull`] or [`Rings::take_lost`], which read it afresh.
+    pub fn peek(&self, d: &mut impl DmaRegs, i: usize, k: usize) -> Option<u32> {
+        let ch = self.channels[i];
+        (k < self.level(d, i)).then(|| d.ring_word(ch.channel, self.readers[i].at_offset(k)))
+    }
+
     /// Whether any ring holds words the CPU has not read (at the first
     /// that does: an idle loop asks on every pass).
     pub fn hold_words(&self, d: &mut impl DmaRegs) -> bool {

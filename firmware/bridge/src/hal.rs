@@ -60,6 +60,11 @@ pub trait Hal {
     /// A word counter `c` pushed, if one is waiting.
     fn capture_pull(&mut self, c: Counter) -> Option<u32>;
 
+    /// The `k`-th word (from 0) counter `c` pushed that is not pulled yet,
+    /// if there is one, left where it is: a wait for a pulse finds its
+    /// pulse among words not drained yet.
+    fn capture_peek(&mut self, c: Counter, k: usize) -> Option<u32>;
+
     /// The most words any counter's RX FIFO holds now (FLEVEL).
     fn capture_level(&mut self) -> usize;
 

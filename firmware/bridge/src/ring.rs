@@ -72,6 +72,11 @@ impl Reader {
         (write % RING_WORDS + RING_WORDS - 1) % RING_WORDS
     }
 
+    /// The ring index `k` words past the next to read.
+    pub fn at_offset(&self, k: usize) -> usize {
+        (self.read + k) % RING_WORDS
+    }
+
     /// Words written and not yet read (a full ring reads as empty: the
     /// next [`Reader::next`] tells them apart).
     pub fn level(&self, write: usize) -> usize {

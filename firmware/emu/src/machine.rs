@@ -32,12 +32,16 @@ use std::sync::atomic::Ordering;
 /// The RP2350's system clock as the image sets it (150 MHz).
 pub const SYS_CLK_HZ: u32 = 150_000_000;
 
-/// Cycles the emulator runs between two looks at the pins: 4 cycles,
-/// 27 ns at 150 MHz. The bus player's shortest step is 7 cycles
-/// (`ppmc_bridge_fw::programs::bus_player`) and the chip's read access
-/// takes tens of nanoseconds, so an answer a quantum late is still within
-/// the step that samples it.
-pub const QUANTUM: u32 = 4;
+/// Cycles the emulator runs between two looks at the pins: 2 cycles,
+/// 13 ns at 150 MHz, one tick of the bridge's timer. The chip's edges
+/// reach the RP2350 on a quantum's boundary, so a quantum is the jitter
+/// the emulation adds to every captured edge; at 4 cycles (2 ticks) it
+/// was more than a pulse run's tolerance (a tick and a nanosecond), where
+/// a real RP2350's counters see an edge within their 2-cycle pass. It
+/// costs some 5 % of the emulator's speed. The bus
+/// player's shortest step is 7 cycles (`ppmc_bridge_fw::programs::bus_player`),
+/// so an answer a quantum late is still within the step that samples it.
+pub const QUANTUM: u32 = 2;
 
 /// Where the image lies: the XIP flash window.
 pub const FLASH: u32 = 0x1000_0000;

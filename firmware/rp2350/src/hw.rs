@@ -286,6 +286,10 @@ impl Hal for Rp2350 {
         self.rings.pull(&mut RpDma, c.index())
     }
 
+    fn capture_peek(&mut self, c: Counter, k: usize) -> Option<u32> {
+        self.rings.peek(&mut RpDma, c.index(), k)
+    }
+
     fn capture_level(&mut self) -> usize {
         self.rings.fullest(&mut RpDma)
     }

@@ -77,6 +77,12 @@ impl<H: Hal> Board<H> {
         self.record.pins.extend(self.pending.drain(..n));
     }
 
+    /// Where a counter's word `w`, taken now, puts its edge (ticks).
+    pub(super) fn edge_ticks(&self, w: u32) -> u64 {
+        let e = timebase::place(w, (self.hal.cycles() - self.started) / 2);
+        self.started / 2 + e.at
+    }
+
     /// The edge counters' words, each placed in time by the clock read
     /// after it was taken from its FIFO (so at or after its edge).
     fn drain(&mut self) {

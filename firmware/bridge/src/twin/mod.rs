@@ -299,6 +299,11 @@ impl Hal for Twin {
         self.rings.pull(d, i)
     }
 
+    fn capture_peek(&mut self, c: Counter, k: usize) -> Option<u32> {
+        self.spend(self.cpu_cycles);
+        self.rings.peek(&mut TwinDma(&mut self.world), c.index(), k)
+    }
+
     fn capture_level(&mut self) -> usize {
         self.spend(self.cpu_cycles);
         self.rings.fullest(&mut TwinDma(&mut self.world))

@@ -568,6 +568,46 @@ fn the_pulses_counted_as_they_come_are_the_records_count() {
 }
 
 #[test]
+fn a_pulse_found_among_words_not_drained_has_the_records_time() {
+    // A wait for a pulse looks for it among the POUT words not drained
+    // yet: the time it answers is the one the record gives that pulse
+    // once drained, for pulses at any point of a move.
+    let mut b = twin();
+    let mut ops = accel_move(2_000);
+    ops.truncate(ops.len() - 2);
+    let targets = [1u64, 2, 150, 700, 1_999];
+    for n in targets {
+        ops.push(Op::AwaitPulses {
+            count: n,
+            timeout: Duration::from_secs(1),
+        });
+    }
+    ops.push(Op::AwaitStatus {
+        mask: Status::BUSY,
+        value: 0,
+        timeout: Duration::from_secs(2),
+    });
+    let replies: Vec<Reply> = (0..ops.len())
+        .map(|i| {
+            b.next_op(ops.get(i + 1).copied());
+            b.run(ops[i])
+        })
+        .collect();
+    use ppmc_core::time::Instant;
+    let pulses: Vec<Instant> = b.record().pulses().map(|(t, _)| t).collect();
+    assert_eq!(pulses.len(), 2_000);
+    let reached: Vec<Instant> = replies
+        .iter()
+        .filter_map(|r| match r {
+            Reply::PulsesReached { at } => Some(*at),
+            _ => None,
+        })
+        .collect();
+    let want: Vec<Instant> = targets.iter().map(|n| pulses[*n as usize - 1]).collect();
+    assert_eq!(reached, want);
+}
+
+#[test]
 fn regular_pin_samples_stay_on_their_grid() {
     // `ReadPins, Delay(step)` pairs: each sample is read where its delay
     // aimed and stamped there, so that the bridge sends them as one
