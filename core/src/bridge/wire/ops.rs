@@ -95,19 +95,12 @@ pub fn wire_op_len(group: &[Op], timer: Timer) -> usize {
     w.0.len()
 }
 
-/// The most bytes the replies to one wire op can take. A SAMPLE op's
-/// pairs take one SAMPLES entry while the bridge keeps to their grid, but
-/// a bridge that reads a sample late stamps it when read (its CPU slower
-/// than the step, `docs/bridge-protocol.md`), and each pair off the grid
-/// is then a PINS and a DELAYED entry of its own: the most.
+/// The most bytes the reply entry to one wire op can take.
 pub fn worst_reply_len(group: &[Op]) -> usize {
     match group {
         [] => 0,
         [o] => worst_reply_entry(o),
-        _ => {
-            let plain: usize = group.iter().map(worst_reply_entry).sum();
-            plain.max(SAMPLES_HEAD + SAMPLES_RUN * (group.len() / 2))
-        }
+        _ => SAMPLES_HEAD + SAMPLES_RUN * (group.len() / 2),
     }
 }
 

@@ -212,7 +212,7 @@ fn sample_a_move(
 }
 
 #[test]
-fn pin_sampling_costs_a_round_trip_per_465_samples_and_matches_the_emulator() {
+fn pin_sampling_costs_a_round_trip_per_1500_samples_and_matches_the_emulator() {
     // On the pulse grid, and off it (every sample then differs from the
     // one before: no run-length saving at all).
     let steps: [fn(Duration) -> Duration; 2] = [|p| p, |p| p.scale(13, 10)];
@@ -231,14 +231,9 @@ fn pin_sampling_costs_a_round_trip_per_465_samples_and_matches_the_emulator() {
         let before = t.stats.round_trips;
         let got = sample_a_move(&mut t, step, 3_000);
         assert_eq!(got, want);
-        // A request holds as many samples as the reply budget holds
-        // should each be read off its grid (a PINS and a DELAYED entry,
-        // 22 bytes: a bridge whose CPU is slower than the step stamps
-        // each where it read it): 465 of them, so 3,000 take 7 (it was
-        // 47 at 128 ops each, and 2 when the host counted on the grid,
-        // which drew OVERFLOW from the RP2350's image on rp2350-emu).
-        assert_eq!(REPLY_ENTRIES_BUDGET / 22, 465);
-        assert_eq!(t.stats.round_trips - before, 7);
+        // One batch for everything before the samples and the first
+        // ~1,500 of them, one for the rest (it was 47 at 128 ops each).
+        assert_eq!(t.stats.round_trips - before, 2);
     }
 }
 
