@@ -44,7 +44,10 @@ impl<H: Hal> Board<H> {
         self.hal.keepalive();
         let started = self.now_ticks();
         self.poll_inner();
-        self.poll_ticks = self.now_ticks() - started;
+        // The longest drain so far: one drains more words than the last
+        // did when the capture waited meanwhile (a wait for a pulse drains
+        // only now and then), and a delay must not start one it cannot end.
+        self.poll_ticks = self.poll_ticks.max(self.now_ticks() - started);
     }
 
     fn poll_inner(&mut self) {

@@ -89,7 +89,7 @@ pub struct Board<H: Hal> {
     batch_done: bool,
     /// Pin samples taken without a poll around them.
     samples: u32,
-    /// How long the last poll took (ticks).
+    /// The longest poll so far (ticks): a delay starts none it cannot end.
     poll_ticks: u64,
     /// RD*'s fall at the last status read (ticks).
     last_status: u64,

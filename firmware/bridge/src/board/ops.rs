@@ -32,8 +32,12 @@ const DRAIN_EVERY_NS: u64 = 50_000;
 
 /// What the code between a delay's end and the next op's moment may take,
 /// beyond the op's bus cycles, so that the op can aim its moment at the
-/// delay's end ([`Board::lead`]).
-const CPU_LEAD_US: u64 = 2;
+/// delay's end ([`Board::lead`]). On the image on rp2350-emu the delay's
+/// reply and the next op's dispatch take some 4 us of the RP2350's time
+/// (600 cycles); at 2 us (what the twin, which charges the board code's
+/// arithmetic nothing, had needed) an input aimed 24.6 us after a pulse
+/// came 9 us late (`s3_6_hs_limit_cruise_17us_not_after`). Twice that.
+const CPU_LEAD_US: u64 = 8;
 
 /// Time enough for a look at the capture FIFOs' levels (ticks: 32 cycles).
 const LOOK_TICKS: u64 = 16;
@@ -360,10 +364,9 @@ impl<H: Hal> Bus for Board<H> {
                 let every = self.timer.to_ticks(DRAIN_EVERY_NS);
                 let mut drained_at: Option<u64> = None;
                 loop {
-                    let now = self.now_ticks();
-                    if drained_at.is_none_or(|d| now >= d + every)
-                        || self.hal.capture_level() >= RING_WORDS / 4
-                    {
+                    // The look for the pulse first; a drain, when due, only
+                    // where it is not there yet, and then a look again.
+                    if drained_at.is_none() {
                         self.refresh();
                         drained_at = Some(self.now_ticks());
                     }
@@ -397,6 +400,13 @@ impl<H: Hal> Bus for Board<H> {
                             at: self.at(t),
                             count: n,
                         };
+                    }
+                    if drained_at.is_some_and(|d| t >= d + every)
+                        || self.hal.capture_level() >= RING_WORDS / 4
+                    {
+                        self.refresh();
+                        drained_at = Some(self.now_ticks());
+                        continue;
                     }
                     self.idle(deadline);
                 }
