@@ -610,6 +610,43 @@ fn a_pulse_found_among_words_not_drained_has_the_records_time() {
 }
 
 #[test]
+fn steps_are_not_pin_changes_however_often_the_outputs_are_sampled() {
+    // Status reads back to back through a move, by a CPU as quick as the
+    // RP2350's (a cycle a hardware access: the image on rp2350-emu) drain
+    // the capture between a pulse and the phase change it makes, or see
+    // the change before the pulse's word is in its ring. Each change is
+    // still that pulse's step, not a pin change of its own (each would be
+    // a capture record: the 22,000-step triangle overran the capture).
+    for cpu in [12, 4, 1] {
+        let mut b = twin();
+        b.hal_mut().cpu_cycles = cpu;
+        let mut ops = accel_move(400);
+        ops.truncate(ops.len() - 2);
+        ops.extend(std::iter::repeat_n(Op::ReadStatus, 6_000));
+        ops.push(Op::AwaitStatus {
+            mask: Status::BUSY,
+            value: 0,
+            timeout: Duration::from_secs(2),
+        });
+        for i in 0..ops.len() {
+            b.next_op(ops.get(i + 1).copied());
+            b.run(ops[i]);
+        }
+        assert_eq!(b.record().last_move_pulses().count, 400);
+        let phases = b
+            .record()
+            .pins
+            .iter()
+            .filter(|p| p.pin == ppmc_core::protocol::capture::Pin::Phases)
+            .count();
+        assert!(
+            phases <= 2,
+            "{cpu} cycles an access: {phases} steps recorded as pin changes"
+        );
+    }
+}
+
+#[test]
 fn regular_pin_samples_stay_on_their_grid() {
     // `ReadPins, Delay(step)` pairs: each sample is read where its delay
     // aimed and stamped there, so that the bridge sends them as one
