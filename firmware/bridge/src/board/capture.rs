@@ -68,11 +68,8 @@ impl<H: Hal> Board<H> {
         self.drain();
         // A change of S1..S5 is a step when a POUT edge came since the
         // last sample (or just before it, its word then still on its way:
-        // a CPU as quick as the RP2350's reads the outputs before the
-        // pulse's word is in its ring, so a word that came since the drain
-        // counts too).
-        let stepped = self.last_pulse + SETTLE_TICKS >= before
-            || self.hal.capture_peek(Counter::Pout, 0).is_some();
+        // `sample` looks for one that came since the drain).
+        let stepped = self.last_pulse + SETTLE_TICKS >= before;
         let recorded = self.pending.len();
         self.sample(word, changed, sampled, stepped);
         // How sure the stamps of the changes recorded are (steps are not).

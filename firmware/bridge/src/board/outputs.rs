@@ -3,7 +3,7 @@
 //! read reports them.
 
 use super::Board;
-use crate::hal::Hal;
+use crate::hal::{Counter, Hal};
 use crate::pins;
 use ppmc_core::protocol::{Direction, OutputLogic, Pin, Pins};
 use ppmc_core::time::Instant;
@@ -68,7 +68,10 @@ impl<H: Hal> Board<H> {
                     self.switching = true;
                     self.pin(at, Pin::Switching, 1);
                 }
-            } else if !stepped {
+            } else if !stepped && self.hal.capture_peek(Counter::Pout, 0).is_none() {
+                // Not a step unless a POUT word came since the drain: a CPU
+                // as quick as the RP2350's reads the outputs before the
+                // pulse's word is in its ring.
                 self.pin(at, Pin::Phases, is);
             }
         } else if self.switching
