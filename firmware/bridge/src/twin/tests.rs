@@ -39,6 +39,17 @@ fn run(bus: &mut impl Bus, ops: &[Op]) -> Vec<Reply> {
     ops.iter().map(|op| bus.run(*op)).collect()
 }
 
+/// `ops` run as the engine runs a batch: each op told the one after it
+/// (`Bus::next_op`), so that delays aim the next op's moment.
+fn run_as_engine(b: &mut TwinBoard, ops: &[Op]) -> Vec<Reply> {
+    (0..ops.len())
+        .map(|i| {
+            b.next_op(ops.get(i + 1).copied());
+            b.run(ops[i])
+        })
+        .collect()
+}
+
 /// The pulse times of the last move, in ns.
 fn pulse_times(bus: &impl Bus) -> Vec<u64> {
     bus.record()
@@ -423,15 +434,7 @@ fn a_delay_counts_from_the_last_ops_moment_and_the_next_op_acts_on_time() {
         let mut b = twin();
         let mut ops = accel_move(5_000);
         ops.truncate(ops.len() - 3);
-        let engine_like = |b: &mut TwinBoard, ops: &[Op]| -> Vec<Reply> {
-            (0..ops.len())
-                .map(|i| {
-                    b.next_op(ops.get(i + 1).copied());
-                    b.run(ops[i])
-                })
-                .collect()
-        };
-        engine_like(&mut b, &ops);
+        run_as_engine(&mut b, &ops);
         let trigger = if write {
             Op::WriteCommand {
                 byte: 0x08,
@@ -445,7 +448,7 @@ fn a_delay_counts_from_the_last_ops_moment_and_the_next_op_acts_on_time() {
         };
         // Twice: the second delay knows how long the op took the first time.
         for n in [100, 200] {
-            let replies = engine_like(
+            let replies = run_as_engine(
                 &mut b,
                 &[
                     Op::AwaitPulses {
@@ -496,12 +499,7 @@ fn a_wait_for_a_pulse_already_past_ends_when_it_starts() {
             timeout: Duration::from_secs(1),
         },
     ]);
-    let replies: Vec<Reply> = (0..ops.len())
-        .map(|i| {
-            b.next_op(ops.get(i + 1).copied());
-            b.run(ops[i])
-        })
-        .collect();
+    let replies = run_as_engine(&mut b, &ops);
     let n = replies.len();
     let before = match replies[n - 2] {
         Reply::Pulses { at, summary } => {
@@ -589,12 +587,7 @@ fn a_pulse_found_among_words_not_drained_has_the_records_time() {
         value: 0,
         timeout: Duration::from_secs(2),
     });
-    let replies: Vec<Reply> = (0..ops.len())
-        .map(|i| {
-            b.next_op(ops.get(i + 1).copied());
-            b.run(ops[i])
-        })
-        .collect();
+    let replies = run_as_engine(&mut b, &ops);
     use ppmc_core::time::Instant;
     let pulses: Vec<Instant> = b.record().pulses().map(|(t, _)| t).collect();
     assert_eq!(pulses.len(), 2_000);
@@ -628,10 +621,7 @@ fn steps_are_not_pin_changes_however_often_the_outputs_are_sampled() {
             value: 0,
             timeout: Duration::from_secs(2),
         });
-        for i in 0..ops.len() {
-            b.next_op(ops.get(i + 1).copied());
-            b.run(ops[i]);
-        }
+        run_as_engine(&mut b, &ops);
         assert_eq!(b.record().last_move_pulses().count, 400);
         let phases = b
             .record()
@@ -659,12 +649,7 @@ fn regular_pin_samples_stay_on_their_grid() {
     for _ in 0..40 {
         ops.extend([Op::ReadPins, Op::Delay(step)]);
     }
-    let replies: Vec<Reply> = (0..ops.len())
-        .map(|i| {
-            b.next_op(ops.get(i + 1).copied());
-            b.run(ops[i])
-        })
-        .collect();
+    let replies = run_as_engine(&mut b, &ops);
     let times: Vec<u64> = replies
         .iter()
         .filter_map(|r| match r {
@@ -711,10 +696,7 @@ fn pins_sampled_every_250_ns_through_a_fast_move_lose_no_pulse() {
         timeout: Duration::from_secs(2),
     });
     let mut b = board(straps, ModelConfig::default()).expect("boots");
-    for i in 0..ops.len() {
-        b.next_op(ops.get(i + 1).copied());
-        b.run(ops[i]);
-    }
+    run_as_engine(&mut b, &ops);
     assert!(!b.capture_lost());
     assert_eq!(b.record().last_move_pulses().count, 5_000);
 }
@@ -924,10 +906,7 @@ fn sampled_changes_and_polled_waits_are_within_what_hello_declares() {
     init(&mut ops);
     ops.push(Op::Delay(Duration::from_millis(1)));
     let mut b = twin();
-    for i in 0..ops.len() {
-        b.next_op(ops.get(i + 1).copied());
-        b.run(ops[i]);
-    }
+    run_as_engine(&mut b, &ops);
     assert_eq!(b.fault(), None);
     let u = crate::board::Board::uncertainty(&b);
     let got = phase_changes(b.record());
