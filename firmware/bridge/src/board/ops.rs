@@ -372,25 +372,23 @@ impl<H: Hal> Bus for Board<H> {
                     }
                     let n = self.move_pulses();
                     let t = self.now_ticks();
-                    let waiting = count.saturating_sub(n + 1);
-                    let word = match usize::try_from(waiting) {
-                        Ok(k) if n < count => self.hal.capture_peek(Counter::Pout, k),
-                        _ => None,
+                    // The pulse drained into the record, or its word
+                    // waiting in the ring.
+                    let pulse = if n >= count {
+                        Some(self.pulse_time(count).unwrap_or(self.at(t)))
+                    } else {
+                        usize::try_from(count - n - 1)
+                            .ok()
+                            .and_then(|k| self.hal.capture_peek(Counter::Pout, k))
+                            .map(|w| self.at(self.edge_ticks(w)))
                     };
-                    if let Some(w) = word {
-                        // The pulse came; its word waits in the ring.
-                        let at = self.at(self.edge_ticks(w)).max(began);
-                        self.moment = self.epoch + self.timer.to_ticks(at.as_nanos());
-                        self.drained = true;
-                        break Reply::PulsesReached { at };
-                    }
-                    if n >= count {
+                    if let Some(at) = pulse {
                         // The moment is the pulse's own, not when the
                         // capture brought it: a delay counts from it. A
                         // pulse that came before the wait began ends it
                         // as it begins, as on the reference model: a
                         // reply is never stamped before the op ahead.
-                        let at = self.pulse_time(count).unwrap_or(self.at(t)).max(began);
+                        let at = at.max(began);
                         self.moment = self.epoch + self.timer.to_ticks(at.as_nanos());
                         self.drained = true;
                         break Reply::PulsesReached { at };
