@@ -21,10 +21,7 @@ use ppmc_bridge_fw::twin::chip::ChipSide;
 use ppmc_core::bridge::frame::FrameDecoder;
 use ppmc_core::bridge::wire::Timer;
 use ppmc_core::emu::Board as Model;
-use ppmc_twin::{
-    lock, open_pty, read_pty, stop_on_signals, stopping, working, BoardOptions, Running,
-    BOARD_OPTIONS_HELP,
-};
+use ppmc_twin::{lock, open_pty, read_pty, stopping, working, BoardOptions, Running};
 use std::collections::VecDeque;
 use std::io::{self, Write};
 use std::path::PathBuf;
@@ -32,7 +29,7 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 
-/// `--help`, around [`BOARD_OPTIONS_HELP`].
+/// `--help`, around [`ppmc_twin::BOARD_OPTIONS_HELP`].
 const HELP: [&str; 2] = [
     "\
 ppmc-emu: the RP2350 bridge image, unmodified, on rp2350-emu, served on a pseudo-terminal
@@ -244,24 +241,5 @@ fn serve(o: Options) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let o = match parse(&args) {
-        Ok(Some(o)) => o,
-        Ok(None) => {
-            println!("{}{BOARD_OPTIONS_HELP}\n{}", HELP[0], HELP[1]);
-            return ExitCode::SUCCESS;
-        }
-        Err(e) => {
-            eprintln!("run-emu: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    stop_on_signals();
-    match serve(o) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("run-emu: {e}");
-            ExitCode::from(1)
-        }
-    }
+    ppmc_twin::run_main("run-emu", HELP, parse, serve)
 }

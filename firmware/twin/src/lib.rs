@@ -130,6 +130,40 @@ pub fn stop_on_signals() {
     }
 }
 
+/// A simulated bridge's `main`: its arguments parsed (`None` asks for
+/// the help: `help[0]`, the board options' lines, `help[1]`), the stop on
+/// signals, then `serve`. Exit status 0 when it served and stopped, 1
+/// when it could not serve, 2 on bad usage; each error on stderr after
+/// `name`.
+pub fn run_main<O>(
+    name: &str,
+    help: [&str; 2],
+    parse: impl FnOnce(&[String]) -> Result<Option<O>, String>,
+    serve: impl FnOnce(O) -> Result<(), String>,
+) -> std::process::ExitCode {
+    use std::process::ExitCode;
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let o = match parse(&args) {
+        Ok(Some(o)) => o,
+        Ok(None) => {
+            println!("{}{BOARD_OPTIONS_HELP}\n{}", help[0], help[1]);
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("{name}: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    stop_on_signals();
+    match serve(o) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{name}: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
 /// The pty's reader, on a thread of its own until [`STOP`]: each read is
 /// shown to `look` as it arrives, then queued.
 pub fn read_pty(

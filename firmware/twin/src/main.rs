@@ -11,16 +11,13 @@ use ppmc_bridge_fw::twin;
 use ppmc_core::bridge::abort::{AbortLine, AbortWatch};
 use ppmc_core::bridge::engine::BridgeEngine;
 use ppmc_core::bridge::frame::FrameDecoder;
-use ppmc_twin::{
-    lock, open_pty, read_pty, remove_link, stop_on_signals, stopping, working, BoardOptions,
-    Running, BOARD_OPTIONS_HELP,
-};
+use ppmc_twin::{lock, open_pty, read_pty, remove_link, stopping, working, BoardOptions, Running};
 use std::io::{self, Write};
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
 use std::sync::{mpsc, Arc, Mutex};
 
-/// `--help`, around [`BOARD_OPTIONS_HELP`].
+/// `--help`, around [`ppmc_twin::BOARD_OPTIONS_HELP`].
 const HELP: [&str; 2] = [
     "\
 ppmc-twin: the RP2350 bridge's board code on a twin of the RP2350, served on a pseudo-terminal
@@ -152,24 +149,5 @@ fn serve(o: BoardOptions) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let o = match parse(&args) {
-        Ok(Some(o)) => o,
-        Ok(None) => {
-            println!("{}{BOARD_OPTIONS_HELP}\n{}", HELP[0], HELP[1]);
-            return ExitCode::SUCCESS;
-        }
-        Err(e) => {
-            eprintln!("run-twin: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    stop_on_signals();
-    match serve(o) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("run-twin: {e}");
-            ExitCode::from(1)
-        }
-    }
+    ppmc_twin::run_main("run-twin", HELP, parse, serve)
 }
