@@ -338,14 +338,23 @@ impl PlainChip {
         );
     }
 
-    /// Whether the ramp is already running down to the end (3-3-2).
+    /// Whether the ramp is already running down to the end (3-3-2): the
+    /// pulse being timed is the move's last, or the period after it is
+    /// slower than the one being timed, so the pulse being timed is the
+    /// first of the deceleration's PA pulses at falling speed (notes N24,
+    /// N49).
     fn in_final_deceleration(&self) -> bool {
         let Some(m) = self.mv.as_ref() else {
             return false;
         };
         let Some(s) = self.setup else { return false };
-        let room = i64::from(m.end - m.emitted) - 1;
-        m.emitted > 0 && (m.index + 1).min(i64::from(s.pa) - 1) > room
+        if m.emitted == 0 {
+            return false;
+        }
+        // The room the next pulse will leave, as `pulse` works it out.
+        let room_next = i64::from(m.end - m.emitted) - 2;
+        let next = (m.index + 1).min(i64::from(s.pa) - 1).min(room_next);
+        m.emitted + 1 >= m.end || next < m.index
     }
 
     pub(super) fn decelerate(&mut self, limit: bool) {
