@@ -38,6 +38,20 @@ pub trait Hal {
     /// since the last [`Hal::resync`].
     fn cycles(&self) -> u64;
 
+    /// The low 32 bits of a clock that counts system clock cycles, to
+    /// time spans shorter than 2^31 cycles the cheapest way (on the RP2350
+    /// the core's cycle counter itself). Its differences agree with
+    /// [`Hal::cycles`]'s; [`Hal::clock_pair`] gives both at one reading.
+    fn fine(&self) -> u32 {
+        self.cycles() as u32
+    }
+
+    /// [`Hal::cycles`] and [`Hal::fine`] at one reading.
+    fn clock_pair(&self) -> (u64, u32) {
+        let c = self.cycles();
+        (c, c as u32)
+    }
+
     /// Sets the clock right again from a source that keeps counting while
     /// the core sleeps (the 1 MHz timer): the board code calls it at every
     /// op and whenever it polls between requests.
@@ -50,6 +64,11 @@ pub trait Hal {
     /// in, as closely as the implementation can tell. The board code calls
     /// it only when the FIFO has room: a write to a full FIFO is lost.
     fn bus_push(&mut self, word: u32) -> u64;
+
+    /// [`Hal::bus_push`], stamped on [`Hal::fine`]'s clock.
+    fn bus_push_fine(&mut self, word: u32) -> u32 {
+        self.bus_push(word) as u32
+    }
 
     /// FSTAT.TXEMPTY of the bus player.
     fn bus_tx_empty(&mut self) -> bool;
@@ -65,7 +84,7 @@ pub trait Hal {
     /// pulse among words not drained yet.
     fn capture_peek(&mut self, c: Counter, k: usize) -> Option<u32>;
 
-    /// The most words any counter's RX FIFO holds now (FLEVEL).
+    /// The most words any counter has waiting, in its ring, not yet read.
     fn capture_level(&mut self) -> usize;
 
     /// Whether any counter stalled on a full RX FIFO since the last call

@@ -196,10 +196,20 @@ const _: () = assert!(WATCHDOG_MS * 1_000 <= 0xFF_FFFF);
 
 impl Rp2350 {
     /// Reads the cycle counter and the timer together and sets the clock
-    /// by them (`ppmc_bridge_fw::clock`).
+    /// by them (`ppmc_bridge_fw::clock`). Out of line: [`Hal::cycles`]
+    /// needs it once in seven seconds.
+    #[cold]
+    #[inline(never)]
     fn update(&self) -> u64 {
+        self.update_pair().0
+    }
+
+    /// [`Rp2350::update`], and the cycle counter's reading it was set at.
+    #[cold]
+    #[inline(never)]
+    fn update_pair(&self) -> (u64, u32) {
         let (fine, us) = cortex_m::interrupt::free(|_| (DWT::cycle_count(), now_us()));
-        self.clock.borrow_mut().update(fine, us)
+        (self.clock.borrow_mut().update(fine, us), fine)
     }
 
     /// The hardware layer, with the cycle counter running (`start`) and
@@ -219,6 +229,7 @@ impl Rp2350 {
     /// now, less the cycles since. The counters' start and the
     /// generator's are stamped alike, so that what the self-test measures
     /// between them is the capture's, not a difference in stamping.
+    #[inline(always)]
     fn stamp(&self) -> u64 {
         let after = DWT::cycle_count();
         let now = self.cycles();
@@ -254,6 +265,11 @@ impl Hal for Rp2350 {
         self.sysclk_hz
     }
 
+    // Inlined, as the bus ops' hot loops read the clock at every pass:
+    // out of line it cost 49 cycles a call (its registers saved and
+    // restored) on the image on rp2350-emu, where ten calls made half of
+    // a status wait's pass.
+    #[inline(always)]
     fn cycles(&self) -> u64 {
         if let Some(c) = self.clock.borrow().extend(DWT::cycle_count()) {
             return c;
@@ -261,23 +277,47 @@ impl Hal for Rp2350 {
         self.update()
     }
 
+    #[inline(always)]
+    fn fine(&self) -> u32 {
+        DWT::cycle_count()
+    }
+
+    #[inline(always)]
+    fn clock_pair(&self) -> (u64, u32) {
+        let fine = DWT::cycle_count();
+        match self.clock.borrow().extend(fine) {
+            Some(c) => (c, fine),
+            None => self.update_pair(),
+        }
+    }
+
     fn resync(&mut self) {
         self.update();
     }
 
+    #[inline]
     fn bus_tx_full(&mut self) -> bool {
         pio(0).fstat().read().txfull() & 1 != 0
     }
 
+    #[inline]
     fn bus_push(&mut self, word: u32) -> u64 {
         pio(0).txf(0).write_value(word);
         self.stamp()
     }
 
+    #[inline(always)]
+    fn bus_push_fine(&mut self, word: u32) -> u32 {
+        pio(0).txf(0).write_value(word);
+        DWT::cycle_count()
+    }
+
+    #[inline]
     fn bus_tx_empty(&mut self) -> bool {
         pio(0).fstat().read().txempty() & 1 != 0
     }
 
+    #[inline]
     fn bus_pull(&mut self) -> Option<u32> {
         (pio(0).fstat().read().rxempty() & 1 == 0).then(|| pio(0).rxf(0).read())
     }

@@ -5,6 +5,7 @@
 
 use super::{record_time, Board};
 use crate::hal::{Counter, Hal};
+use crate::ring::RING_WORDS;
 use crate::{limits, pins, timebase};
 use ppmc_core::protocol::{Direction, Pin, PinEvent};
 use ppmc_core::time::Instant;
@@ -21,6 +22,15 @@ pub(super) const SETTLE_TICKS: u64 = 8;
 /// and the engine answers CAPTURE_OVERRUN (the record holds more than the
 /// capacity): a chip that pulses without end cannot exhaust the heap.
 const MOST_RECORDS: usize = limits::CAPTURE_RECORDS as usize + limits::OP_RECORDS;
+
+/// How long [`Board::keep_up`] lets the capture wait in its rings while
+/// the outputs do not change.
+const KEEP_UP_NS: u64 = 20_000;
+
+/// How long a status wait lets the capture wait in its rings
+/// ([`Board::sight_in_wait`]): a drain is a gap in the wait's polling, and
+/// the longer between them, the fewer flags stamped across one.
+const WAIT_DRAIN_NS: u64 = 200_000;
 
 /// The longest the board code idles between looks at the abort line:
 /// an ABORT stops a quiet wait within about this (`docs/bridge-protocol.md`
@@ -48,6 +58,40 @@ impl<H: Hal> Board<H> {
         // did when the capture waited meanwhile (a wait for a pulse drains
         // only now and then), and a delay must not start one it cannot end.
         self.poll_ticks = self.poll_ticks.max(self.now_ticks() - started);
+    }
+
+    /// [`Board::refresh`] where the capture needs it, a sight of the
+    /// sampled outputs where it does not: between ops and in a status
+    /// wait's loop. A refresh costs the RP2350 some 900 cycles (6 us; on
+    /// the image on rp2350-emu, `firmware/README.md`), a sight some 30.
+    /// It refreshes when the outputs changed (or a pin read saw them
+    /// change), and when the last refresh is [`KEEP_UP_NS`] old: the
+    /// counters' words wait in their rings meanwhile, 256 words each.
+    pub(super) fn keep_up(&mut self) {
+        let word = self.hal.read_high_pins() & pins::SAMPLED_HIGH;
+        let now = self.now_ticks();
+        let fresh = now < self.last_sample + self.timer.to_ticks(KEEP_UP_NS);
+        if fresh && word == self.last_word && self.changed_by.is_none() {
+            self.sighted(word, now);
+        } else {
+            self.refresh();
+        }
+    }
+
+    /// In a status wait's loop: a sight of the sampled outputs (a change
+    /// is first seen here, and stamped by the next drain within the
+    /// bracket of the sights), and a drain only when the last is
+    /// [`WAIT_DRAIN_NS`] old or (looked at when `levels`) a ring is a
+    /// quarter full.
+    pub(super) fn sight_in_wait(&mut self, levels: bool) {
+        let word = self.hal.read_high_pins() & pins::SAMPLED_HIGH;
+        let now = self.now_ticks();
+        self.sighted(word, now);
+        if now >= self.last_sample + self.timer.to_ticks(WAIT_DRAIN_NS)
+            || (levels && self.hal.capture_level() >= RING_WORDS / 4)
+        {
+            self.refresh();
+        }
     }
 
     fn poll_inner(&mut self) {

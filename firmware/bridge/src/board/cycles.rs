@@ -4,7 +4,7 @@
 //! and data reads, writes, and waits on a status flag.
 
 use super::Board;
-use crate::bus_cycle::{self, Cycle};
+use crate::bus_cycle::{self, Cycle, Steps};
 use crate::hal::Hal;
 use alloc::format;
 use alloc::string::String;
@@ -16,6 +16,12 @@ use ppmc_core::time::Duration;
 /// that changed between them is stamped halfway, within half of it (the
 /// `polled` uncertainty HELLO_REPLY declares, [`Board::uncertainty`]).
 pub(super) const CLOSE_NS: u64 = 2_000;
+
+/// How many passes of a status wait's loop go between two sights of the
+/// sampled outputs ([`Board::sight_in_wait`]): some 2 us each on the image
+/// on rp2350-emu, within [`crate::limits::SAMPLE_BRACKET_NS`]; every
+/// eighth sight looks at the rings' levels too.
+const SIGHT_EVERY: u32 = 4;
 
 /// The longest a bus cycle may take before the bridge calls its player
 /// stuck: 1 ms (a cycle of the longest steps takes 35 us at 150 MHz).
@@ -54,9 +60,20 @@ impl<H: Hal> Board<H> {
             // The default timing fits; a board's own is checked at start.
             None => return (self.now_ticks(), None),
         };
-        let deadline =
-            self.hal.cycles() + CYCLE_DEADLINE_US * u64::from(self.sysclk_hz / 1_000_000);
-        let mut moment = self.hal.cycles();
+        self.play(c, &steps, aim)
+    }
+
+    /// [`Board::cycle`] of `steps`, cycle `c`'s, worked out already.
+    #[inline(always)]
+    fn play(&mut self, c: Cycle, steps: &Steps, aim: Option<u64>) -> (u64, Option<u8>) {
+        // Cycles from here on are counted on the cheap 32-bit clock, from
+        // `base` (a bus cycle takes microseconds; its deadline is 1 ms).
+        let (base, f0) = self.hal.clock_pair();
+        let mut p = Player {
+            f0,
+            limit: CYCLE_DEADLINE_US as u32 * (self.sysclk_hz / 1_000_000),
+            free: self.player_free.saturating_sub(base).min(1 << 30) as u32,
+        };
         if let Some(t) = aim {
             // The cycle's moment at tick `t`: an anchor step, whose start
             // its push tells, then a wait step timed from it.
@@ -69,39 +86,37 @@ impl<H: Hal> Board<H> {
             let anchor = u64::from(bus_cycle::step_cycles(ANCHOR));
             let fits = anchor + u64::from(bus_cycle::MAX_COUNT + bus_cycle::STEP_CYCLES) + before;
             while self.hal.cycles() + fits < goal {}
-            let Some(pull) = self.push_step(ANCHOR, deadline, c) else {
-                return (self.now_ticks(), None);
+            let Some(pull) = p.push(&mut self.hal, ANCHOR) else {
+                return self.player_stuck(c);
             };
-            let waited = pull + anchor + u64::from(bus_cycle::STEP_CYCLES) + before;
+            let waited =
+                base + u64::from(pull) + anchor + u64::from(bus_cycle::STEP_CYCLES) + before;
             if goal >= waited {
                 let count = (goal - waited).min(u64::from(bus_cycle::MAX_COUNT)) as u32;
-                if self
-                    .push_step(
-                        bus_cycle::step(0xFF, bus_cycle::IDLE, false, count),
-                        deadline,
-                        c,
-                    )
-                    .is_none()
-                {
-                    return (self.now_ticks(), None);
+                let wait = bus_cycle::step(0xFF, bus_cycle::IDLE, false, count);
+                if p.push(&mut self.hal, wait).is_none() {
+                    return self.player_stuck(c);
                 }
             }
         }
+        let mut moment = 0;
         for (i, w) in steps.words().iter().enumerate() {
-            let Some(pull) = self.push_step(*w, deadline, c) else {
-                return (self.now_ticks(), None);
+            let Some(pull) = p.push(&mut self.hal, *w) else {
+                return self.player_stuck(c);
             };
             if i == c.moment_step() {
-                moment = pull + u64::from(bus_cycle::PINS_AT);
+                moment = pull + bus_cycle::PINS_AT;
             }
         }
+        self.player_free = base + u64::from(p.free);
+        let moment = base + u64::from(moment);
         self.moment = moment / 2;
         let byte = match c {
             Cycle::Read { .. } => loop {
                 if let Some(w) = self.hal.bus_pull() {
                     break Some(w as u8);
                 }
-                if self.hal.cycles() > deadline {
+                if p.late(&self.hal) {
                     self.fail(format!(
                         "the bus player (PIO0 SM0) returned no byte for 1 ms after a {c:?}"
                     ));
@@ -110,7 +125,7 @@ impl<H: Hal> Board<H> {
             },
             Cycle::Write { .. } => {
                 while !self.hal.bus_tx_empty() {
-                    if self.hal.cycles() > deadline {
+                    if p.late(&self.hal) {
                         self.fail(format!(
                             "the bus player (PIO0 SM0) did not finish a {c:?} in 1 ms"
                         ));
@@ -123,27 +138,27 @@ impl<H: Hal> Board<H> {
         (moment / 2, byte)
     }
 
-    /// Writes step `w` when the player's TX FIFO has room; the cycle the
-    /// player will take it on (its `pull`), predicted. `None` when the
-    /// player took no step for the cycle's deadline: a hardware fault.
-    fn push_step(&mut self, w: u32, deadline: u64, c: Cycle) -> Option<u64> {
-        while self.hal.bus_tx_full() {
-            if self.hal.cycles() > deadline {
-                self.fail(format!(
-                    "the bus player (PIO0 SM0) took no step for 1 ms: a step of a {c:?} not written"
-                ));
-                return None;
-            }
-        }
-        let pushed = self.hal.bus_push(w);
-        let pull = self.player_free.max(pushed + 1);
-        self.player_free = pull + u64::from(bus_cycle::step_cycles(w));
-        Some(pull)
+    /// The player took no step for a cycle's deadline: a hardware fault.
+    /// Out of line, off the bus cycle's path.
+    #[cold]
+    #[inline(never)]
+    fn player_stuck(&mut self, c: Cycle) -> (u64, Option<u8>) {
+        self.fail(format!(
+            "the bus player (PIO0 SM0) took no step for 1 ms: a step of a {c:?} not written"
+        ));
+        (self.now_ticks(), None)
     }
 
     pub(super) fn read_status(&mut self, aim: Option<u64>) -> (u64, Status) {
         let (t, b) = self.cycle(Cycle::Read { a0: true }, aim);
         let status = Status(b.unwrap_or(0));
+        self.note_status(t, status);
+        (t, status)
+    }
+
+    /// What a status read at tick `t` tells: the move tracker's settling,
+    /// and a change of BUSY.
+    fn note_status(&mut self, t: u64, status: Status) {
         self.tracker.on_status(&mut self.record, status);
         let prev = core::mem::replace(&mut self.last_status, t);
         if status.busy() != self.busy {
@@ -155,7 +170,6 @@ impl<H: Hal> Board<H> {
             let at = self.at(if close { prev + gap / 2 } else { t });
             self.pin(at, Pin::Busy, u8::from(self.busy));
         }
-        (t, status)
     }
 
     /// Polls the status register until `status & mask == value`, at most
@@ -170,24 +184,46 @@ impl<H: Hal> Board<H> {
         deadline: u64,
     ) -> Result<(u64, Status), (u64, Status)> {
         let start = self.now_ticks();
-        let mut prev = None;
+        let close = self.timer.to_ticks(CLOSE_NS);
+        let read = Cycle::Read { a0: true };
+        // Worked out once for the whole wait.
+        let steps = self.counts.map(|n| n.steps(read));
+        let mut prev: Option<(u64, Status)> = None;
+        let mut passes: u32 = 0;
         loop {
-            let (t, s) = self.read_status(None);
+            let (t, b) = match &steps {
+                Some(steps) if self.fault.is_none() => self.play(read, steps, None),
+                // As [`Board::cycle`] answers.
+                _ => (self.now_ticks(), None),
+            };
+            let s = Status(b.unwrap_or(0));
+            // A read like the one before tells nothing new but its time.
+            match prev {
+                Some((_, p)) if p == s => self.last_status = t,
+                _ => self.note_status(t, s),
+            }
             if s.0 & mask == value {
                 let end = match prev {
-                    Some(p) if t - p <= self.timer.to_ticks(CLOSE_NS) => p + (t - p) / 2,
+                    Some((p, _)) if t - p <= close => p + (t - p) / 2,
                     _ => t,
                 };
-                if let Some(p) = prev {
+                if let Some((p, _)) = prev {
                     self.longest_pass = self.longest_pass.max(t - p);
                 }
                 return Ok((end.saturating_sub(start), s));
             }
-            prev = Some(t);
+            prev = Some((t, s));
             if t >= deadline || self.aborted() {
                 return Err((t, s));
             }
-            self.refresh();
+            // The outputs sighted every few passes (their bracket), the
+            // capture drained only when it must: a drain is a pass of
+            // some 6 us on the RP2350, and a flag that changes meanwhile
+            // is stamped no closer than that.
+            passes = passes.wrapping_add(1);
+            if passes.is_multiple_of(SIGHT_EVERY) {
+                self.sight_in_wait(passes.is_multiple_of(SIGHT_EVERY * 8));
+            }
         }
     }
 
@@ -213,5 +249,44 @@ impl<H: Hal> Board<H> {
         self.tracker
             .on_write(&mut self.record, command, byte, at, phases);
         Reply::Written { at, waited }
+    }
+}
+
+/// The bus player's steps as one cycle pushes them, timed on the cheap
+/// 32-bit clock ([`Hal::clock_pair`]) from the cycle's start. Five steps
+/// make a status read; on the image on rp2350-emu the 64-bit clock and its
+/// arithmetic had cost some 100 cycles of the RP2350 a step, and a status
+/// wait's pass 13 us.
+struct Player {
+    /// The clock's reading at the cycle's start.
+    f0: u32,
+    /// The cycle's deadline, in cycles from its start.
+    limit: u32,
+    /// When the player is free for the next step, from the start.
+    free: u32,
+}
+
+impl Player {
+    /// Writes step `w` when the player's TX FIFO has room (a write to a
+    /// full FIFO is lost); the cycle the player takes it on (its `pull`),
+    /// predicted: the player takes a step when both the step is in the
+    /// FIFO and the step before has played ([`Board::cycle`]). `None`
+    /// past the deadline.
+    #[inline(always)]
+    fn push(&mut self, hal: &mut impl Hal, w: u32) -> Option<u32> {
+        while hal.bus_tx_full() {
+            if self.late(hal) {
+                return None;
+            }
+        }
+        let pushed = hal.bus_push_fine(w).wrapping_sub(self.f0);
+        let pull = self.free.max(pushed + 1);
+        self.free = pull + bus_cycle::step_cycles(w);
+        Some(pull)
+    }
+
+    #[inline(always)]
+    fn late(&self, hal: &impl Hal) -> bool {
+        hal.fine().wrapping_sub(self.f0) > self.limit
     }
 }

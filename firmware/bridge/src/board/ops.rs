@@ -233,19 +233,20 @@ impl<H: Hal> Bus for Board<H> {
             self.hal.resync();
             self.batch_done = false;
         }
-        // The capture is drained between ops, but for those aimed at a
-        // moment: an op right after a delay that ended early for it, and a
-        // delay that will end early for the next (its loop drains the
-        // capture while there is time). A tight run of pin samples so
-        // drains nothing; a FIFO that fills meanwhile stalls its counter,
-        // and the next drain reports the capture lost (CAPTURE_OVERRUN).
+        // The capture is kept up between ops ([`Board::keep_up`]: a sight
+        // of the outputs, a drain when they changed or the last is old),
+        // but for those aimed at a moment: an op right after a delay that
+        // ended early for it, and a delay that will end early for the next
+        // (its loop drains the capture while there is time). A tight run
+        // of pin samples so drains nothing; a ring the DMA laps meanwhile
+        // is the capture lost (CAPTURE_OVERRUN).
         let aimed = self.aim.is_some();
         let aiming = matches!(op, Op::Delay(_)) && self.next.and_then(Lag::of).is_some();
         // After a wait for a pulse, which ended in a drain, the op that
         // acts on the pulse (a stop, an input) goes at once.
         let drained = core::mem::take(&mut self.drained);
         if !aimed && !aiming && !drained {
-            self.refresh();
+            self.keep_up();
         }
         let reply = match op {
             Op::WriteCommand { byte, wait_ibf } => self.write(true, byte, wait_ibf),
