@@ -8,7 +8,7 @@ use crate::bus_cycle::{self, Cycle, Steps};
 use crate::hal::Hal;
 use alloc::format;
 use alloc::string::String;
-use ppmc_core::bus::Reply;
+use ppmc_core::bus::{Op, Reply};
 use ppmc_core::protocol::{Pin, Status};
 use ppmc_core::time::Duration;
 
@@ -158,7 +158,7 @@ impl<H: Hal> Board<H> {
 
     /// What a status read at tick `t` tells: the move tracker's settling,
     /// and a change of BUSY.
-    fn note_status(&mut self, t: u64, status: Status) {
+    pub(super) fn note_status(&mut self, t: u64, status: Status) {
         self.tracker.on_status(&mut self.record, status);
         let prev = core::mem::replace(&mut self.last_status, t);
         if status.busy() != self.busy {
@@ -245,6 +245,15 @@ impl<H: Hal> Board<H> {
         let aim = self.aim;
         let (t, _) = self.cycle(Cycle::Write { a0: command, byte }, aim);
         let at = self.at(t);
+        // A status read next in the batch is played right behind the
+        // write, the bus's recovery after it, as a host's `out` and `in`
+        // follow each other: the ops between would put some 10 us of the
+        // RP2350's time between them, and the chip takes a byte within
+        // microseconds (Section 3-1-1: IBF is 1 only until then).
+        if self.next == Some(Op::ReadStatus) && self.fault.is_none() {
+            let (t, b) = self.cycle(Cycle::Read { a0: true }, None);
+            self.early_status = Some((t, Status(b.unwrap_or(0))));
+        }
         self.refresh();
         self.tracker
             .on_write(&mut self.record, command, byte, at, phases);

@@ -113,6 +113,10 @@ pub struct Board<H: Hal> {
     /// The op before drained the capture as it ended (a wait for a pulse
     /// that came): the next runs without a drain of its own first.
     drained: bool,
+    /// A status read the write before played right behind its own cycle,
+    /// for the status read that follows it in the batch: its moment
+    /// (ticks) and the status ([`Board::write`]).
+    early_status: Option<(u64, ppmc_core::protocol::Status)>,
     edges: EdgeRuns,
     tracker: MoveTracker,
     /// Last sampled S1..S5 levels, AUXO levels and DIR, for changes.
@@ -191,6 +195,7 @@ impl<H: Hal> Board<H> {
             longest_pass: 0,
             counted: Counted::default(),
             drained: false,
+            early_status: None,
             edges: EdgeRuns::new(timer.edge_tolerance()),
             tracker: MoveTracker::new(),
             last_s: 0,

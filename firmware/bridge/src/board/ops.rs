@@ -245,14 +245,22 @@ impl<H: Hal> Bus for Board<H> {
         // After a wait for a pulse, which ended in a drain, the op that
         // acts on the pulse (a stop, an input) goes at once.
         let drained = core::mem::take(&mut self.drained);
-        if !aimed && !aiming && !drained {
+        // Played behind the write before, for this op alone.
+        let early = self.early_status.take();
+        if !aimed && !aiming && !drained && early.is_none() {
             self.keep_up();
         }
         let reply = match op {
             Op::WriteCommand { byte, wait_ibf } => self.write(true, byte, wait_ibf),
             Op::WriteData { byte, wait_ibf } => self.write(false, byte, wait_ibf),
             Op::ReadStatus => {
-                let (t, status) = self.read_status(self.aim);
+                let (t, status) = match early {
+                    Some((t, status)) => {
+                        self.note_status(t, status);
+                        (t, status)
+                    }
+                    None => self.read_status(self.aim),
+                };
                 Reply::Status {
                     at: self.at(t),
                     status,
