@@ -99,6 +99,17 @@ pub trait Hal {
     /// Drives the chip's input `i` (`pins::INPUTS` order) to `high`.
     fn set_input(&mut self, i: usize, high: bool);
 
+    /// [`Hal::set_input`] at cycle `at` (or at once, if past): the
+    /// register and the bit worked out first, then a spin on the clock,
+    /// then the write alone; the cycle just after the write. On the image
+    /// on rp2350-emu a spin on [`Hal::cycles`] and the write after it came
+    /// 0.5 us late, and the latency probes of Table 3-3 allow 0.3.
+    fn set_input_at(&mut self, i: usize, high: bool, at: u64) -> u64 {
+        while self.cycles() < at {}
+        self.set_input(i, high);
+        self.cycles()
+    }
+
     /// Drives RESET* to `high`.
     fn set_reset(&mut self, high: bool);
 

@@ -434,6 +434,22 @@ impl Hal for Rp2350 {
         Self::sio_set(pins::INPUTS[i], high);
     }
 
+    fn set_input_at(&mut self, i: usize, high: bool, at: u64) -> u64 {
+        let g = pins::INPUTS[i];
+        let out = pac::SIO.gpio_out((g / 32) as usize);
+        let reg = if high {
+            out.value_set()
+        } else {
+            out.value_clr()
+        };
+        let bit = 1 << (g % 32);
+        let (now, f0) = self.clock_pair();
+        let wait = at.saturating_sub(now).min(1 << 30) as u32;
+        while DWT::cycle_count().wrapping_sub(f0) < wait {}
+        reg.write_value(bit);
+        now + u64::from(DWT::cycle_count().wrapping_sub(f0))
+    }
+
     fn set_reset(&mut self, high: bool) {
         Self::sio_set(pins::RESET, high);
     }

@@ -32,12 +32,17 @@ const DRAIN_EVERY_NS: u64 = 50_000;
 
 /// What the code between a delay's end and the next op's moment may take,
 /// beyond the op's bus cycles, so that the op can aim its moment at the
-/// delay's end ([`Board::lead`]). On the image on rp2350-emu the delay's
-/// reply and the next op's dispatch take some 4 us of the RP2350's time
-/// (600 cycles); at 2 us (what the twin, which charges the board code's
-/// arithmetic nothing, had needed) an input aimed 24.6 us after a pulse
-/// came 9 us late (`s3_6_hs_limit_cruise_17us_not_after`). Twice that.
-const CPU_LEAD_US: u64 = 8;
+/// delay's end ([`Board::lead`]). An op that starts early spins until its
+/// moment, so a lead longer than needed costs nothing but the spin; one
+/// too short makes the op late. On the image on rp2350-emu the delay's
+/// reply, the next op's dispatch and, for a write that waits for IBF = 0,
+/// its status read and what it notes, took some 13 us of the RP2350's
+/// time: at 8 us a Decelerating Stop aimed 17.4 us before a pulse came
+/// 5.3 us late (`s3_6_decel_stop_17us_not_after`); at 2 us (what the
+/// twin, which charges the board code's arithmetic nothing, had needed)
+/// an input aimed 24.6 us after a pulse came 9 us late. Half as much
+/// again as the longest seen.
+const CPU_LEAD_US: u64 = 20;
 
 /// Time enough for a look at the capture FIFOs' levels (ticks: 32 cycles).
 const LOOK_TICKS: u64 = 16;
@@ -310,11 +315,9 @@ impl<H: Hal> Bus for Board<H> {
             }
             Op::SetInput { input, asserted } => {
                 let i = ChipInput::ALL.iter().position(|x| *x == input).unwrap_or(0);
-                if let Some(t) = self.aim {
-                    self.spin_until(t);
-                }
-                self.hal.set_input(i, level(asserted));
-                self.moment = self.now_ticks();
+                // At the moment the delay before it aimed at, or now.
+                let at = self.aim.map_or(0, |t| t * 2);
+                self.moment = self.hal.set_input_at(i, level(asserted), at) / 2;
                 Reply::InputSet {
                     at: self.at(self.moment),
                 }
@@ -408,8 +411,18 @@ impl<H: Hal> Bus for Board<H> {
                             count: n,
                         };
                     }
-                    if drained_at.is_some_and(|d| t >= d + every)
-                        || self.hal.capture_level() >= RING_WORDS / 4
+                    // No drain when the pulse is the next to come: a drain
+                    // takes some 6 us of the RP2350's time (the image on
+                    // rp2350-emu), and the pulse, seen only after it, had
+                    // made the op that acts on it late
+                    // (`s3_6_decel_stop_17us_not_after`, 1 us of 0.4).
+                    let next = count - n == 1
+                        || usize::try_from(count - n - 2)
+                            .ok()
+                            .is_some_and(|k| self.hal.capture_peek(Counter::Pout, k).is_some());
+                    if !next
+                        && (drained_at.is_some_and(|d| t >= d + every)
+                            || self.hal.capture_level() >= RING_WORDS / 4)
                     {
                         self.refresh();
                         drained_at = Some(self.now_ticks());
