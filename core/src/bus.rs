@@ -309,6 +309,22 @@ pub trait Bus {
     /// time the next op takes to reach its moment.
     fn next_op(&mut self, _next: Option<Op>) {}
 
+    /// Runs `pairs` `(ReadPins, Delay(step))` pairs as one (the SAMPLE ops
+    /// of the bridge protocol in a row), `after` the op that follows them, and hands
+    /// each op's reply to `emit` in order, as [`Bus::run`] would have given
+    /// them; `false` (the default) when the bus runs such pairs op by op.
+    /// A bridge whose CPU spends microseconds on each op keeps a sampling
+    /// grid finer than that only so (firmware/README.md).
+    fn sample_run(
+        &mut self,
+        _step: Duration,
+        _pairs: usize,
+        _after: Option<Op>,
+        _emit: &mut dyn FnMut(Reply),
+    ) -> bool {
+        false
+    }
+
     /// Everything captured on the output side since the last reset.
     fn record(&self) -> &OutputRecord;
 

@@ -488,19 +488,56 @@ impl<B: Bus> BridgeEngine<B> {
         }
         let mut full = None;
         let mut ran = 0;
-        let mut ops = WireOp::ops(ops).peekable();
-        while let Some(op) = ops.next() {
-            if self.abort_pending() {
-                return Err(self.abort_request(ran));
+        let mut i = 0;
+        'ops: while let Some(w) = ops.get(i) {
+            if let WireOp::Sample { step, .. } = *w {
+                // SAMPLE ops in a row at one step: one run of samples, for
+                // a bus that runs them as one (`Bus::sample_run`).
+                let run = ops[i..]
+                    .iter()
+                    .take_while(|n| matches!(n, WireOp::Sample { step: s, .. } if *s == step))
+                    .count();
+                let pairs = ops[i..i + run].iter().map(|n| n.len() / 2).sum::<usize>();
+                if self.abort_pending() {
+                    return Err(self.abort_request(ran));
+                }
+                let held = self.held();
+                if held > self.capture_capacity as usize {
+                    full = Some(held);
+                    break;
+                }
+                let after = ops.get(i + run).map(|n| n.op(0));
+                if self
+                    .bus
+                    .sample_run(step, pairs, after, &mut |r| replies.push(r))
+                {
+                    ran += 2 * pairs;
+                    i += run;
+                    continue;
+                }
             }
-            let held = self.held();
-            if op != Op::Reset && held > self.capture_capacity as usize {
-                full = Some(held);
-                break;
+            // The op after this wire op's last.
+            let after = ops.get(i + 1).map(|n| n.op(0));
+            for j in 0..w.len() {
+                let op = w.op(j);
+                if self.abort_pending() {
+                    return Err(self.abort_request(ran));
+                }
+                let held = self.held();
+                if op != Op::Reset && held > self.capture_capacity as usize {
+                    full = Some(held);
+                    break 'ops;
+                }
+                let next = if j + 1 < w.len() {
+                    Some(w.op(j + 1))
+                } else {
+                    after
+                };
+                self.bus.next_op(next);
+                replies.push(self.bus.run(op));
+                ran += 1;
             }
-            self.bus.next_op(ops.peek().copied());
-            replies.push(self.bus.run(op));
-            ran += 1;
+            i += 1;
         }
         // Stopped inside the last op's wait, perhaps.
         if self.abort_pending() {

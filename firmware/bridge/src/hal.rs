@@ -116,6 +116,20 @@ pub trait Hal {
     /// The levels of GPIO 32-47, bit 0 being GPIO 32.
     fn read_high_pins(&mut self) -> u16;
 
+    /// `n` reads of [`Hal::read_high_pins`] on a grid (at most
+    /// [`crate::limits::GRID_SAMPLES`]), kept for [`Hal::grid_read`]: the
+    /// first at cycle `t0`, each next `step` cycles after the one before,
+    /// or after the cycle the clock said when it was read, if that was
+    /// more than `slack` past its time (the CPU came to it late). The
+    /// RP2350 spins on its raw cycle counter between reads: a sample costs
+    /// it some 15 instructions, where an op of the engine costs it
+    /// thousands.
+    fn read_pins_grid(&mut self, t0: u64, step: u64, slack: u64, n: usize);
+
+    /// The `k`th read of the last [`Hal::read_pins_grid`]: its cycle and
+    /// the levels.
+    fn grid_read(&self, k: usize) -> (u64, u16);
+
     /// Gives the capture inputs of POUT and INT* to the self-test
     /// generator (`on`: CAPTURE_OE* high, the chip's outputs cut off,
     /// then TEST_GEN driven low), or back to the chip (TEST_GEN released,

@@ -50,6 +50,13 @@
 /// code to it under the suite's busiest loads.
 pub const SAMPLE_BRACKET_NS: u64 = 10_000;
 
+/// The most pin samples the board code reads in one loop
+/// (`Board::sample_run`): five SAMPLE ops of 512, more than the three
+/// periods of stop switching the scenarios of Section 3-5-1 sample 250 ns
+/// apart (2,086 reads). Kept outside the heap: on the RP2350 in a static
+/// of 8 bytes a read (20 KiB).
+pub const GRID_SAMPLES: usize = 5 * 512;
+
 /// The heap: the RP2350 board's, and the QEMU board's with it, so that the
 /// virtual board runs out where the board does. The board has 512 KiB of
 /// RAM for data; the rest is its stack and statics.

@@ -20,6 +20,7 @@ use embassy_rp::pac::pio::regs::{
 use ppmc_bridge_fw::clock::Clock;
 use ppmc_bridge_fw::dma::{self, DmaRegs, Rings};
 use ppmc_bridge_fw::hal::{Counter, Hal};
+use ppmc_bridge_fw::limits::GRID_SAMPLES;
 use ppmc_bridge_fw::pins;
 use ppmc_bridge_fw::pioregs::{self, fdebug, shiftctrl, SmRegs, START_COUNTERS, STOP_COUNTERS};
 use ppmc_bridge_fw::programs::Loaded;
@@ -105,6 +106,17 @@ const _: () = assert!(core::mem::align_of::<Ring>() == RING_WORDS * 4);
 
 static RINGS: [Ring; 4] = [const { Ring(UnsafeCell::new([0; RING_WORDS])) }; 4];
 
+/// The reads of a run of pin samples (`Hal::read_pins_grid`): each its
+/// cycle from the run's start and the levels of GPIO 32-47. A static, not
+/// the heap, whose every byte `ppmc_bridge_fw::limits` has counted.
+struct Grid(UnsafeCell<[(u32, u16); GRID_SAMPLES]>);
+
+// SAFETY: only core 1's board code reads and writes it, one call at a
+// time.
+unsafe impl Sync for Grid {}
+
+static GRID: Grid = Grid(UnsafeCell::new([(0, 0); GRID_SAMPLES]));
+
 /// The DMA block's registers and the rings, as the board code reaches them
 /// (`ppmc_bridge_fw::dma`, which the board twin runs too): channels 0-3,
 /// one a counter in `Counter::ALL` order; main.rs claims them from
@@ -170,6 +182,8 @@ pub struct Rp2350 {
     beat: (u32, u64),
     /// The counters' rings: their channels, and the CPU's side of each.
     rings: Rings,
+    /// The cycle the last run of pin samples counted from (`GRID`).
+    grid_base: u64,
 }
 
 /// Core 0's heartbeat: it counts up every 100 ms while core 0's executor
@@ -222,6 +236,7 @@ impl Rp2350 {
             gen,
             beat: (HEARTBEAT.load(Ordering::Relaxed), 0),
             rings: rings(),
+            grid_base: 0,
         }
     }
 
@@ -448,6 +463,38 @@ impl Hal for Rp2350 {
         while DWT::cycle_count().wrapping_sub(f0) < wait {}
         reg.write_value(bit);
         now + u64::from(DWT::cycle_count().wrapping_sub(f0))
+    }
+
+    fn read_pins_grid(&mut self, t0: u64, step: u64, slack: u64, n: usize) {
+        // On the cycle counter from one reading of the clock: the grid
+        // spans at most a few milliseconds (`Board::sample_run`).
+        let (now, f0) = self.clock_pair();
+        self.grid_base = now;
+        let (step, slack) = (step.min(1 << 30) as u32, slack.min(1 << 30) as u32);
+        let mut t = t0.saturating_sub(now).min(1 << 30) as u32;
+        let gpio = pac::SIO.gpio_in(1);
+        // SAFETY: only core 1's board code uses the grid, one call at a
+        // time (`GRID`).
+        let grid = unsafe { &mut *GRID.0.get() };
+        for o in grid.iter_mut().take(n) {
+            let seen = loop {
+                let c = DWT::cycle_count().wrapping_sub(f0);
+                if c >= t {
+                    break c;
+                }
+            };
+            let word = gpio.read() as u16;
+            let at = if seen > t + slack { seen } else { t };
+            *o = (at, word);
+            t = at + step;
+        }
+    }
+
+    fn grid_read(&self, k: usize) -> (u64, u16) {
+        // SAFETY: as in `read_pins_grid`.
+        let grid = unsafe { &*GRID.0.get() };
+        grid.get(k)
+            .map_or((0, 0), |&(at, word)| (self.grid_base + u64::from(at), word))
     }
 
     fn set_reset(&mut self, high: bool) {

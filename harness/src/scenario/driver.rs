@@ -365,29 +365,8 @@ impl<'t> Driver<'t> {
         let cycles = (on + off).saturating_mul(3);
         let n = (cycles.as_nanos() / step.as_nanos().max(1)) as usize + 1;
         let samples = self.sample_pins(step, n)?;
-        // Edges of "any phase energized", each with the gap from the
-        // sample before it: the change lies somewhere in that gap.
-        let mut edges: Vec<(Instant, bool, Duration)> = Vec::new();
-        for w in samples.windows(2) {
-            let (a, b) = (w[0].1.phases != 0, w[1].1.phases != 0);
-            if a != b {
-                edges.push((w[1].0, b, w[1].0.saturating_since(w[0].0)));
-            }
-        }
-        // A full ON stretch (rise .. fall) and a full OFF stretch (fall ..
-        // rise). Its uncertainty: the two samples' stamps, and the larger
-        // of the two gaps its ends lie in (the sampling's own resolution,
-        // on every target).
         let stamps = self.u.access.saturating_mul(2);
-        let stretch = |level: bool| {
-            edges
-                .windows(2)
-                .find(|w| w[0].1 == level && w[1].1 != level)
-                .map(|w| {
-                    let u = stamps.saturating_add(w[0].2.max(w[1].2));
-                    (w[1].0.saturating_since(w[0].0), w[1].0, u)
-                })
-        };
+        let stretch = |level: bool| chop_stretch(&samples, level, on.min(off), stamps);
         let now = self.batch.clock();
         for (name, level, want) in [("switching_on", true, on), ("switching_off", false, off)] {
             let Some((got, at, u)) = stretch(level) else {
@@ -739,5 +718,87 @@ impl<'t> Driver<'t> {
                 auxo,
             }),
         )
+    }
+}
+
+/// The first full stretch of stop switching's chopping at `level` (ON:
+/// any phase energized) in `samples`: from the edge that starts it to the
+/// edge that ends it, the time of its end, and its uncertainty (the two
+/// samples' `stamps`, and the larger of the gaps its two edges lie in: the
+/// sampling's own resolution). Only a stretch sampled throughout counts:
+/// no gap between samples, at its ends or within, as long as `shortest`
+/// (the shorter of ON and OFF), which could hide a whole stretch.
+fn chop_stretch(
+    samples: &[(Instant, Pins)],
+    level: bool,
+    shortest: Duration,
+    stamps: Duration,
+) -> Option<(Duration, Instant, Duration)> {
+    // Each edge: its time, its new level, the gap it lies in, and the
+    // widest gap since the edge before.
+    let mut edges: Vec<(Instant, bool, Duration, Duration)> = Vec::new();
+    let mut widest = Duration::ZERO;
+    for w in samples.windows(2) {
+        let gap = w[1].0.saturating_since(w[0].0);
+        let (a, b) = (w[0].1.phases != 0, w[1].1.phases != 0);
+        if a != b {
+            edges.push((w[1].0, b, gap, widest));
+            widest = Duration::ZERO;
+        } else {
+            widest = widest.max(gap);
+        }
+    }
+    edges
+        .windows(2)
+        .find(|w| w[0].1 == level && w[1].1 != level && w[0].2.max(w[1].2).max(w[1].3) < shortest)
+        .map(|w| {
+            let u = stamps.saturating_add(w[0].2.max(w[1].2));
+            (w[1].0.saturating_since(w[0].0), w[1].0, u)
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Samples of the phases (`true`: energized) at the given times (us).
+    fn sampled(points: &[(u64, bool)]) -> Vec<(Instant, Pins)> {
+        points
+            .iter()
+            .map(|&(t, on)| {
+                let pins = Pins {
+                    int: false,
+                    hold: true,
+                    aux: false,
+                    auxo: 0,
+                    phases: if on { 0b00011 } else { 0 },
+                    phase_levels: if on { 0b00011 } else { 0 },
+                    dir: ppmc_core::protocol::Direction::Cw,
+                    busy: false,
+                };
+                (Instant::from_nanos(t * 1_000), pins)
+            })
+            .collect()
+    }
+
+    /// Section 3-5-1's chopping, 65 us ON and 108.75 us OFF, sampled every
+    /// microsecond but for a gap of 6.7 ms (a bridge's samples in two
+    /// runs, with its bookkeeping between): the OFF stretch across the gap
+    /// may hide ON stretches, and is not measured; the next one, sampled
+    /// throughout, is.
+    #[test]
+    fn a_stretch_across_a_gap_that_could_hide_a_stretch_is_not_measured() {
+        let level = |t: u64| (t % 174) < 65;
+        let mut points: Vec<(u64, bool)> = (0..130).map(|t| (t, level(t))).collect();
+        points.extend((6_830..7_400).map(|t| (t, level(t))));
+        let s = sampled(&points);
+        let (off, end, u) = chop_stretch(&s, false, Duration::from_micros(65), Duration::ZERO)
+            .expect("an OFF stretch sampled throughout");
+        assert!(
+            end.as_nanos() > 6_830_000,
+            "measured across the gap: ends at {end}"
+        );
+        assert_eq!(off, Duration::from_micros(109), "{off}");
+        assert_eq!(u, Duration::from_micros(1));
     }
 }

@@ -120,7 +120,7 @@ fn a_host_waits_by_the_twins_clock_not_its_own() {
         "a spin's pass and a read: 10 ticks"
     );
     assert_eq!(hello.uncertainty.sampled.as_nanos(), 5_000);
-    assert_eq!(hello.uncertainty.polled.as_nanos(), 1_000);
+    assert_eq!(hello.uncertainty.polled.as_nanos(), 1_500);
 }
 
 #[test]

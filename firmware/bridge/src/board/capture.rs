@@ -5,7 +5,6 @@
 
 use super::{record_time, Board};
 use crate::hal::{Counter, Hal};
-use crate::ring::RING_WORDS;
 use crate::{limits, pins, timebase};
 use ppmc_core::protocol::{Direction, Pin, PinEvent};
 use ppmc_core::time::Instant;
@@ -30,7 +29,7 @@ const KEEP_UP_NS: u64 = 20_000;
 /// How long a status wait lets the capture wait in its rings
 /// ([`Board::sight_in_wait`]): a drain is a gap in the wait's polling, and
 /// the longer between them, the fewer flags stamped across one.
-const WAIT_DRAIN_NS: u64 = 200_000;
+pub(super) const WAIT_DRAIN_NS: u64 = 200_000;
 
 /// The longest the board code idles between looks at the abort line:
 /// an ABORT stops a quiet wait within about this (`docs/bridge-protocol.md`
@@ -78,18 +77,17 @@ impl<H: Hal> Board<H> {
         }
     }
 
-    /// In a status wait's loop: a sight of the sampled outputs (a change
-    /// is first seen here, and stamped by the next drain within the
-    /// bracket of the sights), and a drain only when the last is
-    /// [`WAIT_DRAIN_NS`] old or (looked at when `levels`) a ring is a
-    /// quarter full.
-    pub(super) fn sight_in_wait(&mut self, levels: bool) {
+    /// In a status wait's loop, at every pass: a sight of the sampled
+    /// outputs (a change is first seen here, and stamped by the next drain
+    /// within the bracket of the sights), and a drain only when the last
+    /// is [`WAIT_DRAIN_NS`] old (`drain` ticks: the capture waits in its
+    /// rings meanwhile, 256 words each: at 400 kpps, 640 us).
+    #[inline(always)]
+    pub(super) fn sight_in_wait(&mut self, drain: u64) {
         let word = self.hal.read_high_pins() & pins::SAMPLED_HIGH;
         let now = self.now_ticks();
         self.sighted(word, now);
-        if now >= self.last_sample + self.timer.to_ticks(WAIT_DRAIN_NS)
-            || (levels && self.hal.capture_level() >= RING_WORDS / 4)
-        {
+        if now >= self.last_sample + drain {
             self.refresh();
         }
     }

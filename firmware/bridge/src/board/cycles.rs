@@ -15,13 +15,12 @@ use ppmc_core::time::Duration;
 /// Two status reads at most this far apart (ns) are a wait's loop: a flag
 /// that changed between them is stamped halfway, within half of it (the
 /// `polled` uncertainty HELLO_REPLY declares, [`Board::uncertainty`]).
-pub(super) const CLOSE_NS: u64 = 2_000;
-
-/// How many passes of a status wait's loop go between two sights of the
-/// sampled outputs ([`Board::sight_in_wait`]): some 2 us each on the image
-/// on rp2350-emu, within [`crate::limits::SAMPLE_BRACKET_NS`]; every
-/// eighth sight looks at the rings' levels too.
-const SIGHT_EVERY: u32 = 4;
+/// A pass of the loop takes the image on rp2350-emu 2.5 us of the
+/// RP2350's time (the twin, which charges the board code's arithmetic
+/// nothing, 1): at 2 us, its BUSY stamps were the later read's, as much
+/// as a pass late, where HELLO said 1 us (`s3_3_3_single_step_cw_then_ccw`
+/// failed by 0.4 us beyond it).
+pub(super) const CLOSE_NS: u64 = 3_000;
 
 /// The longest a bus cycle may take before the bridge calls its player
 /// stuck: 1 ms (a cycle of the longest steps takes 35 us at 150 MHz).
@@ -186,10 +185,10 @@ impl<H: Hal> Board<H> {
         let start = self.now_ticks();
         let close = self.timer.to_ticks(CLOSE_NS);
         let read = Cycle::Read { a0: true };
+        let drain = self.timer.to_ticks(super::capture::WAIT_DRAIN_NS);
         // Worked out once for the whole wait.
         let steps = self.counts.map(|n| n.steps(read));
         let mut prev: Option<(u64, Status)> = None;
-        let mut passes: u32 = 0;
         loop {
             let (t, b) = match &steps {
                 Some(steps) if self.fault.is_none() => self.play(read, steps, None),
@@ -216,14 +215,13 @@ impl<H: Hal> Board<H> {
             if t >= deadline || self.aborted() {
                 return Err((t, s));
             }
-            // The outputs sighted every few passes (their bracket), the
-            // capture drained only when it must: a drain is a pass of
+            // The outputs sighted at every pass, so that every pass is as
+            // long (a pass that did more was longer than CLOSE_NS on the
+            // image, and the flag it saw change was stamped at its end);
+            // the capture drained only when it must: a drain is a pass of
             // some 6 us on the RP2350, and a flag that changes meanwhile
             // is stamped no closer than that.
-            passes = passes.wrapping_add(1);
-            if passes.is_multiple_of(SIGHT_EVERY) {
-                self.sight_in_wait(passes.is_multiple_of(SIGHT_EVERY * 8));
-            }
+            self.sight_in_wait(drain);
         }
     }
 

@@ -117,6 +117,7 @@ pub struct Board<H: Hal> {
     /// for the status read that follows it in the batch: its moment
     /// (ticks) and the status ([`Board::write`]).
     early_status: Option<(u64, ppmc_core::protocol::Status)>,
+
     edges: EdgeRuns,
     tracker: MoveTracker,
     /// Last sampled S1..S5 levels, AUXO levels and DIR, for changes.
@@ -196,6 +197,7 @@ impl<H: Hal> Board<H> {
             counted: Counted::default(),
             drained: false,
             early_status: None,
+
             edges: EdgeRuns::new(timer.edge_tolerance()),
             tracker: MoveTracker::new(),
             last_s: 0,

@@ -7,6 +7,7 @@ use super::cycles::ANCHOR;
 use super::Board;
 use crate::bus_cycle::{self, Cycle};
 use crate::hal::{Counter, Hal};
+use crate::limits;
 use crate::pins;
 use crate::ring::RING_WORDS;
 use alloc::string::String;
@@ -43,6 +44,18 @@ const DRAIN_EVERY_NS: u64 = 50_000;
 /// an input aimed 24.6 us after a pulse came 9 us late. Half as much
 /// again as the longest seen.
 const CPU_LEAD_US: u64 = 20;
+
+/// The longest run of pin samples [`Board::sample_run`] reads in one loop
+/// while a move may run: the capture waits in its rings meanwhile (256
+/// words each: 640 us at 400 kpps). The three periods of stop switching
+/// Section 3-5-1's scenarios sample take 521 us.
+const SAMPLE_RUN_NS: u64 = 600_000;
+
+/// The longest run of pin samples while the chip is not BUSY (its last
+/// status read so; only a write starts a move): no pulse fills a ring,
+/// and the run is bounded by the host's ABORT, which it hears only after.
+/// Section 3-5-1's look for chopping after a move samples 3 ms.
+const IDLE_SAMPLE_RUN_NS: u64 = 4_000_000;
 
 /// Time enough for a look at the capture FIFOs' levels (ticks: 32 cycles).
 const LOOK_TICKS: u64 = 16;
@@ -450,6 +463,75 @@ impl<H: Hal> Bus for Board<H> {
 
     fn next_op(&mut self, next: Option<Op>) {
         self.next = next;
+    }
+
+    /// A SAMPLE op's `(ReadPins, Delay(step))` pairs on the grid the delay
+    /// before aimed the first at: read in one tight loop
+    /// ([`Hal::read_pins_grid`]), then noted and answered as the ops one
+    /// by one would have been, the last delay as [`Board::delay`] runs it.
+    /// Op by op, the engine and the board code cost the image on
+    /// rp2350-emu some 10 us a pair, and the stop-switching scenarios'
+    /// samples 250 ns apart each came off their grid: a reply of 34 KB for
+    /// a buffer of 12 (OVERFLOW). Not for a run longer than [`SAMPLE_RUN_NS`] while the chip may
+    /// pulse ([`IDLE_SAMPLE_RUN_NS`] while it does not): the capture waits
+    /// in its rings meanwhile.
+    fn sample_run(
+        &mut self,
+        step: Duration,
+        pairs: usize,
+        after: Option<Op>,
+        emit: &mut dyn FnMut(Reply),
+    ) -> bool {
+        let n = pairs;
+        let st = self.timer.to_ticks(step.as_nanos());
+        if self.fault.is_some()
+            || n == 0
+            || n > limits::GRID_SAMPLES
+            || st.saturating_mul(n as u64)
+                > self.timer.to_ticks(if self.busy {
+                    SAMPLE_RUN_NS
+                } else {
+                    IDLE_SAMPLE_RUN_NS
+                })
+        {
+            return false;
+        }
+        if core::mem::take(&mut self.batch_done) {
+            self.hal.resync();
+        }
+        self.early_status = None;
+        // Where the delay before aimed the first read; else now, the
+        // capture drained first, as a pin read of its own is.
+        let t0 = match self.aim {
+            Some(t) => t,
+            None => {
+                self.refresh();
+                self.now_ticks()
+            }
+        };
+        self.hal.read_pins_grid(t0 * 2, st * 2, SPIN_TICKS * 2, n);
+        for k in 0..n {
+            let (c, word) = self.hal.grid_read(k);
+            let m = c / 2;
+            self.sighted(word & pins::SAMPLED_HIGH, m);
+            self.moment = m;
+            emit(Reply::Pins {
+                at: self.at(m),
+                pins: self.pins_from(word),
+            });
+            if k + 1 < n {
+                // Each delay between ends where the next read was.
+                let (next, _) = self.hal.grid_read(k + 1);
+                emit(Reply::Delayed {
+                    at: self.at(next / 2),
+                });
+            } else {
+                self.next = after;
+                self.aim = None;
+                emit(self.run(Op::Delay(step)));
+            }
+        }
+        true
     }
 
     fn record(&self) -> &OutputRecord {

@@ -95,6 +95,8 @@ pub struct Twin {
     /// Cycles a pass of [`Hal::idle`]'s loop takes (read the pins and the
     /// capture FIFOs' levels, compare): how late after a change it returns.
     pub idle_step: u64,
+    /// The reads of the last [`Hal::read_pins_grid`].
+    grid: std::vec::Vec<(u64, u16)>,
 }
 
 impl Twin {
@@ -113,6 +115,7 @@ impl Twin {
             idle_step: 2 * CPU_CYCLES,
             progress: Default::default(),
             owed: core::cell::Cell::new(0),
+            grid: std::vec::Vec::new(),
             drains: Drains::default(),
             rings: Rings::new(Counter::ALL.map(|c| dma::counter_channel(c, ring_addr(c.index())))),
         };
@@ -432,6 +435,27 @@ impl Hal for Twin {
     fn read_high_pins(&mut self) -> u16 {
         self.spend(self.cpu_cycles);
         (self.world.pads() >> 32) as u16
+    }
+
+    fn read_pins_grid(&mut self, t0: u64, step: u64, slack: u64, n: usize) {
+        // A spin on the clock, then the read, as the image's loop.
+        let mut grid = core::mem::take(&mut self.grid);
+        grid.clear();
+        let mut t = t0;
+        for _ in 0..n {
+            let mut seen = self.cycles();
+            while seen < t {
+                seen = self.cycles();
+            }
+            let at = if seen > t + slack { seen } else { t };
+            grid.push((at, self.read_high_pins()));
+            t = at + step;
+        }
+        self.grid = grid;
+    }
+
+    fn grid_read(&self, k: usize) -> (u64, u16) {
+        self.grid.get(k).copied().unwrap_or_default()
     }
 
     fn idle(&mut self, until: u64) -> u64 {

@@ -1254,3 +1254,68 @@ fn a_status_read_right_after_a_write_sees_the_byte_waiting() {
         assert!(replies[3].at() > read, "{replies:?}");
     }
 }
+
+#[test]
+fn a_run_of_pin_samples_keeps_its_grid_however_slow_the_ops() {
+    // The stop-switching scenarios (Section 3-5-1) sample the outputs 250
+    // ns apart: SAMPLE ops of the bridge protocol, each up to 512
+    // `(ReadPins, Delay)` pairs. Op by op, at 24 cycles a hardware access,
+    // the engine and the board code put each read microseconds off its
+    // grid (the image on rp2350-emu: 10 us a pair, and a reply of 34 KB
+    // for a buffer of 12). As one run (`Board::sample_run`), every read is
+    // on the grid, and the run's replies are the ops' replies.
+    use ppmc_core::bridge::engine::BridgeEngine;
+    use ppmc_core::bridge::frame::{self, FrameDecoder};
+    use ppmc_core::bridge::wire::{parse_fragment, Request, Response};
+    let step = Duration::from_nanos(250);
+    for cpu in [12, 24] {
+        let mut b = twin();
+        b.hal_mut().cpu_cycles = cpu;
+        let timer = b.timer();
+        let mut engine = BridgeEngine::new(b, 1, true, "twin").with_timer(timer);
+        let mut ops = std::vec![Op::Reset, Op::Delay(Duration::from_micros(50))];
+        // Five SAMPLE ops on the wire, one run on the board.
+        ops.extend((0..2_086).flat_map(|_| [Op::ReadPins, Op::Delay(step)]));
+        ops.push(Op::ReadStatus);
+        let out = engine.on_bytes(&frame::encode(&Request::Batch(ops).encode(1, timer)));
+        let mut d = FrameDecoder::new();
+        d.extend(&out);
+        let mut payload = Vec::new();
+        while let Some(f) = d.decode().expect("a valid frame") {
+            match parse_fragment(&f) {
+                Some((_, _, _, data)) => payload.extend_from_slice(data),
+                None => payload = f,
+            }
+        }
+        let Response::Batch(replies) = Response::decode(&payload, timer).expect("decodes").1 else {
+            panic!("{cpu} cycles an access: not a batch reply");
+        };
+        assert_eq!(replies.len(), 2 + 2 * 2_086 + 1, "{cpu} cycles an access");
+        let reads: Vec<u64> = replies
+            .iter()
+            .filter_map(|r| match r {
+                Reply::Pins { at, .. } => Some(at.as_nanos()),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(reads.len(), 2_086);
+        let off: Vec<u64> = reads
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .filter(|d| !(250..=255).contains(d))
+            .collect();
+        assert!(
+            off.is_empty(),
+            "{cpu} cycles an access: {} of 2,085 gaps off the 250 ns grid, e.g. {:?} ns",
+            off.len(),
+            &off[..off.len().min(5)]
+        );
+        // The status read after the run comes after its last delay.
+        let last = replies.len() - 1;
+        assert!(
+            replies[last].at() > replies[last - 1].at(),
+            "{:?}",
+            &replies[last - 2..]
+        );
+    }
+}
