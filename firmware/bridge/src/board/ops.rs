@@ -468,12 +468,12 @@ impl<H: Hal> Bus for Board<H> {
     /// A SAMPLE op's `(ReadPins, Delay(step))` pairs on the grid the delay
     /// before aimed the first at: read in one tight loop
     /// ([`Hal::read_pins_grid`]), then noted and answered as the ops one
-    /// by one would have been, the last delay as [`Board::delay`] runs it.
+    /// by one would have been, the last delay as `Board::delay` runs it.
     /// Op by op, the engine and the board code cost the image on
     /// rp2350-emu some 10 us a pair, and the stop-switching scenarios'
     /// samples 250 ns apart each came off their grid: a reply of 34 KB for
-    /// a buffer of 12 (OVERFLOW). Not for a run longer than [`SAMPLE_RUN_NS`] while the chip may
-    /// pulse ([`IDLE_SAMPLE_RUN_NS`] while it does not): the capture waits
+    /// a buffer of 12 (OVERFLOW). Not for a run longer than `SAMPLE_RUN_NS` while the chip may
+    /// pulse (`IDLE_SAMPLE_RUN_NS` while it does not): the capture waits
     /// in its rings meanwhile.
     fn sample_run(
         &mut self,
