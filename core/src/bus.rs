@@ -309,6 +309,11 @@ pub trait Bus {
     /// time the next op takes to reach its moment.
     fn next_op(&mut self, _next: Option<Op>) {}
 
+    /// The batch in flight ends here, before the op [`Bus::next_op`] last
+    /// named (an ABORT, a full capture): nothing prepared for that op may
+    /// serve another.
+    fn abandon(&mut self) {}
+
     /// Runs `pairs` `(ReadPins, Delay(step))` pairs as one (the SAMPLE ops
     /// of the bridge protocol in a row), `after` the op that follows them, and hands
     /// each op's reply to `emit` in order, as [`Bus::run`] would have given

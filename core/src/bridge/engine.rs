@@ -478,7 +478,8 @@ impl<B: Bus> BridgeEngine<B> {
     /// `replies`; the error response otherwise. A batch stops before an op
     /// (a chip reset excepted, which empties the capture) once the capture
     /// holds more than its buffer: the capture then outgrows its buffer by
-    /// at most what one op adds, whatever the batch asks for.
+    /// at most what one op (or one run of samples, `Bus::sample_run`)
+    /// adds, whatever the batch asks for.
     fn run_ops(&mut self, ops: &[WireOp], replies: &mut ReplyWriter) -> Result<(), Response> {
         if ops.len() > usize::from(MAX_BATCH_OPS) {
             return Err(Response::Error {
@@ -543,6 +544,9 @@ impl<B: Bus> BridgeEngine<B> {
         if self.abort_pending() {
             return Err(self.abort_request(ran.saturating_sub(1)));
         }
+        if full.is_some() {
+            self.bus.abandon();
+        }
         match (self.bus.fault(), full) {
             (Some(what), _) => Err(Response::Error {
                 code: BridgeErrorCode::Hardware,
@@ -566,7 +570,9 @@ impl<B: Bus> BridgeEngine<B> {
             line.acknowledge();
         }
         self.stopped = Some(self.current);
-        // No op of the batch follows: nothing to aim the stop's at.
+        // No op of the batch follows: nothing to aim the stop's at, and
+        // nothing read ahead for one (a status read behind a write).
+        self.bus.abandon();
         self.bus.next_op(None);
         let busy =
             matches!(self.bus.run(Op::ReadStatus), Reply::Status { status, .. } if status.busy());

@@ -26,6 +26,14 @@ const MOST_RECORDS: usize = limits::CAPTURE_RECORDS as usize + limits::OP_RECORD
 /// the outputs do not change.
 const KEEP_UP_NS: u64 = 20_000;
 
+/// How close to its moment an aimed op spins rather than idles
+/// ([`Board::approach`]): 5 us (375 ticks). An idle returns at once while
+/// a move's words wait in the rings (it does not drain them), and each
+/// return and sight costs the image on rp2350-emu a microsecond or more:
+/// at 2 us, an input aimed 31.7 us after a pulse came 0.34 us late
+/// (`s3_6_hs_limit_accel_12us_not_after` allows 0.3).
+const APPROACH_TICKS: u64 = 375;
+
 /// How long a status wait lets the capture wait in its rings
 /// ([`Board::sight_in_wait`]): a drain is a gap in the wait's polling, and
 /// the longer between them, the fewer flags stamped across one.
@@ -43,8 +51,10 @@ impl<H: Hal> Board<H> {
     /// source can precede any more. Called between ops, in every wait, and
     /// while the bridge waits for the host.
     pub fn poll(&mut self) {
-        // Called between requests, when the core may have slept.
+        // Called between requests, when the core may have slept; nothing
+        // read ahead for a batch's op serves the next batch.
         self.hal.resync();
+        self.early_status = None;
         self.refresh();
     }
 
@@ -201,6 +211,21 @@ impl<H: Hal> Board<H> {
         while self.now_ticks() < t {
             self.refresh();
             self.idle(t);
+        }
+    }
+
+    /// Waits, idling, until [`APPROACH_TICKS`] before tick `t`, for an op
+    /// aimed at `t` that spins the rest of the way: the outputs are sighted
+    /// meanwhile, so that a change in the wait is stamped within its
+    /// bracket ([`crate::limits::SAMPLE_BRACKET_NS`]). A spin alone, up to
+    /// the 20 us an aimed op starts early, had left the outputs unseen: on
+    /// the image on rp2350-emu the software reset's excitation off was
+    /// stamped 6.9 us from its change, where HELLO says 5.1
+    /// (`s3_5_4_software_reset_frees_the_motor`).
+    pub(super) fn approach(&mut self, t: u64) {
+        let until = t.saturating_sub(APPROACH_TICKS);
+        while self.now_ticks() < until {
+            self.idle(until);
         }
     }
 

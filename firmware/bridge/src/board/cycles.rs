@@ -84,6 +84,7 @@ impl<H: Hal> Board<H> {
                 + u64::from(bus_cycle::PINS_AT);
             let anchor = u64::from(bus_cycle::step_cycles(ANCHOR));
             let fits = anchor + u64::from(bus_cycle::MAX_COUNT + bus_cycle::STEP_CYCLES) + before;
+            self.approach(goal.saturating_sub(fits) / 2);
             while self.hal.cycles() + fits < goal {}
             let Some(pull) = p.push(&mut self.hal, ANCHOR) else {
                 return self.player_stuck(c);
@@ -158,6 +159,7 @@ impl<H: Hal> Board<H> {
     /// What a status read at tick `t` tells: the move tracker's settling,
     /// and a change of BUSY.
     pub(super) fn note_status(&mut self, t: u64, status: Status) {
+        self.wrote = false;
         self.tracker.on_status(&mut self.record, status);
         let prev = core::mem::replace(&mut self.last_status, t);
         if status.busy() != self.busy {
@@ -242,6 +244,7 @@ impl<H: Hal> Board<H> {
         let phases = self.energized(self.last_s);
         let aim = self.aim;
         let (t, _) = self.cycle(Cycle::Write { a0: command, byte }, aim);
+        self.wrote = true;
         let at = self.at(t);
         // A status read next in the batch is played right behind the
         // write, the bus's recovery after it, as a host's `out` and `in`

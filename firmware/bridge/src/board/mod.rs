@@ -117,6 +117,9 @@ pub struct Board<H: Hal> {
     /// for the status read that follows it in the batch: its moment
     /// (ticks) and the status ([`Board::write`]).
     early_status: Option<(u64, ppmc_core::protocol::Status)>,
+    /// A byte written since the last status read: a move may have begun
+    /// that `busy` does not know of yet.
+    wrote: bool,
 
     edges: EdgeRuns,
     tracker: MoveTracker,
@@ -197,6 +200,7 @@ impl<H: Hal> Board<H> {
             counted: Counted::default(),
             drained: false,
             early_status: None,
+            wrote: false,
 
             edges: EdgeRuns::new(timer.edge_tolerance()),
             tracker: MoveTracker::new(),

@@ -52,7 +52,8 @@ const CPU_LEAD_US: u64 = 20;
 const SAMPLE_RUN_NS: u64 = 600_000;
 
 /// The longest run of pin samples while the chip is not BUSY (its last
-/// status read so; only a write starts a move): no pulse fills a ring,
+/// status read so, and nothing written since: only a write starts a
+/// move): no pulse fills a ring,
 /// and the run is bounded by the host's ABORT, which it hears only after.
 /// Section 3-5-1's look for chopping after a move samples 3 ms.
 const IDLE_SAMPLE_RUN_NS: u64 = 4_000_000;
@@ -265,7 +266,10 @@ impl<H: Hal> Bus for Board<H> {
         let drained = core::mem::take(&mut self.drained);
         // Played behind the write before, for this op alone.
         let early = self.early_status.take();
-        if !aimed && !aiming && !drained && early.is_none() {
+        if matches!(op, Op::ReadPulses) {
+            // It answers from the record: every pulse so far drained.
+            self.refresh();
+        } else if !aimed && !aiming && !drained && early.is_none() {
             self.keep_up();
         }
         let reply = match op {
@@ -329,7 +333,10 @@ impl<H: Hal> Bus for Board<H> {
             Op::SetInput { input, asserted } => {
                 let i = ChipInput::ALL.iter().position(|x| *x == input).unwrap_or(0);
                 // At the moment the delay before it aimed at, or now.
-                let at = self.aim.map_or(0, |t| t * 2);
+                let at = self.aim.map_or(0, |t| {
+                    self.approach(t);
+                    t * 2
+                });
                 self.moment = self.hal.set_input_at(i, level(asserted), at) / 2;
                 Reply::InputSet {
                     at: self.at(self.moment),
@@ -356,6 +363,7 @@ impl<H: Hal> Bus for Board<H> {
                     // the CPU more than the step): stamped when read, not
                     // where it was aimed, so that a stamp never lies.
                     // Within a pass of the spin loop it is on time.
+                    self.approach(t);
                     let seen = self.spin_until(t);
                     let word = self.hal.read_high_pins();
                     self.moment = if seen > t + SPIN_TICKS { seen } else { t };
@@ -419,9 +427,11 @@ impl<H: Hal> Bus for Board<H> {
                         break Reply::PulsesReached { at };
                     }
                     if t >= deadline || self.aborted() {
+                        // Counted with every pulse drained.
+                        self.refresh();
                         break Reply::PulsesTimedOut {
                             at: self.at(t),
-                            count: n,
+                            count: self.move_pulses(),
                         };
                     }
                     // No drain when the pulse is the next to come: a drain
@@ -433,7 +443,12 @@ impl<H: Hal> Bus for Board<H> {
                         || usize::try_from(count - n - 2)
                             .ok()
                             .is_some_and(|k| self.hal.capture_peek(Counter::Pout, k).is_some());
-                    if !next
+                    // But never a millisecond without one: the watchdog is
+                    // fed there, and a pulse that does not come (the move
+                    // ended short) leaves words in the rings, which end
+                    // every idle at once.
+                    let overdue = drained_at.is_some_and(|d| t >= d + 20 * every);
+                    if (!next || overdue)
                         && (drained_at.is_some_and(|d| t >= d + every)
                             || self.hal.capture_level() >= RING_WORDS / 4)
                     {
@@ -465,6 +480,10 @@ impl<H: Hal> Bus for Board<H> {
         self.next = next;
     }
 
+    fn abandon(&mut self) {
+        self.early_status = None;
+    }
+
     /// A SAMPLE op's `(ReadPins, Delay(step))` pairs on the grid the delay
     /// before aimed the first at: read in one tight loop
     /// ([`Hal::read_pins_grid`]), then noted and answered as the ops one
@@ -488,7 +507,7 @@ impl<H: Hal> Bus for Board<H> {
             || n == 0
             || n > limits::GRID_SAMPLES
             || st.saturating_mul(n as u64)
-                > self.timer.to_ticks(if self.busy {
+                > self.timer.to_ticks(if self.busy || self.wrote {
                     SAMPLE_RUN_NS
                 } else {
                     IDLE_SAMPLE_RUN_NS
@@ -500,20 +519,30 @@ impl<H: Hal> Bus for Board<H> {
             self.hal.resync();
         }
         self.early_status = None;
+        self.drained = false;
         // Where the delay before aimed the first read; else now, the
         // capture drained first, as a pin read of its own is.
         let t0 = match self.aim {
-            Some(t) => t,
+            Some(t) => {
+                self.approach(t);
+                t
+            }
             None => {
                 self.refresh();
                 self.now_ticks()
             }
         };
         self.hal.read_pins_grid(t0 * 2, st * 2, SPIN_TICKS * 2, n);
+        // The reads as sights of the outputs, then the capture drained
+        // (it waited in its rings through the run), then the answers.
+        for k in 0..n {
+            let (c, word) = self.hal.grid_read(k);
+            self.sighted(word & pins::SAMPLED_HIGH, c / 2);
+        }
+        self.refresh();
         for k in 0..n {
             let (c, word) = self.hal.grid_read(k);
             let m = c / 2;
-            self.sighted(word & pins::SAMPLED_HIGH, m);
             self.moment = m;
             emit(Reply::Pins {
                 at: self.at(m),

@@ -1324,3 +1324,35 @@ fn a_run_of_pin_samples_keeps_its_grid_however_slow_the_ops() {
         );
     }
 }
+
+#[test]
+fn a_status_read_ahead_for_an_abandoned_op_is_not_the_next_reads() {
+    // The status read played behind a write is for the batch's next op
+    // alone. An ABORT (or a full capture) abandons the batch there, and
+    // the engine's own look at BUSY must read the chip as it is then,
+    // not the status from before the chip took the byte (Section 3-1-1:
+    // IBF 1; the engine would have taken an early BUSY 0 for a stopped
+    // motor, and left a move running).
+    for abandon in [false, true] {
+        let mut b = twin();
+        run_as_engine(&mut b, &[Op::Reset]);
+        b.next_op(Some(Op::ReadStatus));
+        b.run(Op::WriteCommand {
+            byte: 0x02,
+            wait_ibf: None,
+        });
+        // 20 us pass: the chip takes the byte after 6 (notes N11).
+        let until = b.hal().cycles() + 20 * 150;
+        while b.hal().cycles() < until {
+            b.hal_mut().idle(until);
+        }
+        if abandon {
+            b.abandon();
+        }
+        b.next_op(None);
+        let Reply::Status { status, .. } = b.run(Op::ReadStatus) else {
+            panic!("not a status reply");
+        };
+        assert_eq!(status.ibf(), !abandon, "abandoned: {abandon}");
+    }
+}
