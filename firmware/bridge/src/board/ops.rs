@@ -520,17 +520,16 @@ impl<H: Hal> Bus for Board<H> {
         }
         self.early_status = None;
         self.drained = false;
-        // Where the delay before aimed the first read; else now, the
-        // capture drained first, as a pin read of its own is.
+        // Where the delay before aimed the first read; else now (the
+        // capture is drained after the reads, below: a drain first had put
+        // the run's first reads 1 to 2 us off the grid of the run before,
+        // a request before, on the twin).
         let t0 = match self.aim {
             Some(t) => {
                 self.approach(t);
                 t
             }
-            None => {
-                self.refresh();
-                self.now_ticks()
-            }
+            None => self.now_ticks(),
         };
         self.hal.read_pins_grid(t0 * 2, st * 2, SPIN_TICKS * 2, n);
         // The reads as sights of the outputs, then the capture drained
