@@ -50,6 +50,17 @@ fn run_as_engine(b: &mut TwinBoard, ops: &[Op]) -> Vec<Reply> {
         .collect()
 }
 
+/// The times of the pin reads among `replies`, in ns.
+fn pin_read_times(replies: &[Reply]) -> Vec<u64> {
+    replies
+        .iter()
+        .filter_map(|r| match r {
+            Reply::Pins { at, .. } => Some(at.as_nanos()),
+            _ => None,
+        })
+        .collect()
+}
+
 /// The pulse times of the last move, in ns.
 fn pulse_times(bus: &impl Bus) -> Vec<u64> {
     bus.record()
@@ -650,13 +661,7 @@ fn regular_pin_samples_stay_on_their_grid() {
         ops.extend([Op::ReadPins, Op::Delay(step)]);
     }
     let replies = run_as_engine(&mut b, &ops);
-    let times: Vec<u64> = replies
-        .iter()
-        .filter_map(|r| match r {
-            Reply::Pins { at, .. } => Some(at.as_nanos()),
-            _ => None,
-        })
-        .collect();
+    let times = pin_read_times(&replies);
     assert_eq!(times.len(), 40);
     // Every step is `step` in the bridge's ticks (19 of 13.3 ns).
     let timer = b.timer();
@@ -1296,13 +1301,7 @@ fn a_run_of_pin_samples_keeps_its_grid_however_slow_the_ops() {
             panic!("{cpu} cycles an access: not a batch reply");
         };
         assert_eq!(replies.len(), 2 + 2 * 2_086 + 1, "{cpu} cycles an access");
-        let reads: Vec<u64> = replies
-            .iter()
-            .filter_map(|r| match r {
-                Reply::Pins { at, .. } => Some(at.as_nanos()),
-                _ => None,
-            })
-            .collect();
+        let reads = pin_read_times(&replies);
         assert_eq!(reads.len(), 2_086);
         let off: Vec<u64> = reads
             .windows(2)
