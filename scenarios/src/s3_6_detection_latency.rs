@@ -18,8 +18,16 @@ pub fn scenarios() -> Vec<Scenario> {
 }
 
 /// At high speed (RH = 20), stands on pulse 500 of a long CW move, waits
-/// until `ahead` before pulse 501 and triggers.
-fn at_speed_probe(d: &mut Driver, ahead: Duration, trigger: fn(&mut Driver) -> Outcome, id: TimingId) -> Outcome {
+/// until `ahead` before pulse 501 and triggers; the move then outputs
+/// `pulses` (where the trigger landed where it was aimed:
+/// [`Driver::expect_probe`]).
+fn at_speed_probe(
+    d: &mut Driver,
+    ahead: Duration,
+    trigger: fn(&mut Driver) -> Outcome,
+    id: TimingId,
+    pulses: u64,
+) -> Outcome {
     d.init_and_wait(Init::four_phase())?;
     d.start(Move::accel(Cw, 5_000))?;
     d.after_pulses(500)?;
@@ -28,21 +36,23 @@ fn at_speed_probe(d: &mut Driver, ahead: Duration, trigger: fn(&mut Driver) -> O
     trigger(d)?;
     d.expect_latency(id)?;
     d.wait_idle()?;
-    Ok(())
+    d.expect_probe(id, 500, ahead, |d| d.expect_pulses(pulses, Cw))
 }
 
 /// Early on the ramp of RL = 21 -> RH = 20 (periods of 44 us, whatever the
 /// curve), stands on pulse 11, waits until `ahead` before pulse 12, asserts
-/// L3.
-fn accel_probe(d: &mut Driver, ahead: Duration) -> Outcome {
+/// L3; the move then outputs `pulses` (as [`at_speed_probe`]).
+fn accel_probe(d: &mut Driver, ahead: Duration, pulses: u64) -> Outcome {
+    let id = TimingId::HighSpeedLimitAccel;
     d.init_and_wait(Init::four_phase().rates(21, 20))?;
     d.start(Move::high_speed(Cw))?;
     d.after_pulses(11)?;
     let (period, ahead) = (d.period(21), d.fw(ahead));
     d.wait(period.saturating_sub(ahead))?;
     d.set(Input::L3, true)?;
-    d.expect_latency(TimingId::HighSpeedLimitAccel)?;
-    d.expect_finish(0x8E)
+    d.expect_latency(id)?;
+    d.expect_finish(0x8E)?;
+    d.expect_probe(id, 11, ahead, |d| d.expect_pulses(pulses, Cw))
 }
 
 fn decel_stop(d: &mut Driver) -> Outcome {
@@ -56,45 +66,39 @@ fn l3(d: &mut Driver) -> Outcome {
 /// a Decelerating Stop 16.6 us before a pulse: that pulse is still output at speed
 #[scenario(tags("timing", "decel-stop", "latency-probe"))]
 fn s3_6_decel_stop_17us_not_before(d: &mut Driver) -> Outcome {
-    at_speed_probe(d, Duration::from_nanos(16_600), decel_stop, TimingId::DecelStopProcessing)?;
     // Pulse index 500 still at speed; 501 and 99 more decelerate.
-    d.expect_pulses(501 + 100, Cw)
+    at_speed_probe(d, Duration::from_nanos(16_600), decel_stop, TimingId::DecelStopProcessing, 501 + 100)
 }
 
 /// a Decelerating Stop 17.4 us before a pulse: the deceleration starts from it
 #[scenario(tags("timing", "decel-stop", "latency-probe"))]
 fn s3_6_decel_stop_17us_not_after(d: &mut Driver) -> Outcome {
-    at_speed_probe(d, Duration::from_nanos(17_400), decel_stop, TimingId::DecelStopProcessing)?;
-    d.expect_pulses(500 + 100, Cw)
+    at_speed_probe(d, Duration::from_nanos(17_400), decel_stop, TimingId::DecelStopProcessing, 500 + 100)
 }
 
 /// L3 at high speed 16.6 us before a pulse: that pulse is still output at speed
 #[scenario(tags("timing", "hs-limit", "latency-probe"))]
 fn s3_6_hs_limit_cruise_17us_not_before(d: &mut Driver) -> Outcome {
-    at_speed_probe(d, Duration::from_nanos(16_600), l3, TimingId::HighSpeedLimitCruise)?;
-    d.expect_pulses(501 + 100, Cw)
+    at_speed_probe(d, Duration::from_nanos(16_600), l3, TimingId::HighSpeedLimitCruise, 501 + 100)
 }
 
 /// L3 at high speed 17.4 us before a pulse: the deceleration starts from it
 #[scenario(tags("timing", "hs-limit", "latency-probe"))]
 fn s3_6_hs_limit_cruise_17us_not_after(d: &mut Driver) -> Outcome {
-    at_speed_probe(d, Duration::from_nanos(17_400), l3, TimingId::HighSpeedLimitCruise)?;
-    d.expect_pulses(500 + 100, Cw)
+    at_speed_probe(d, Duration::from_nanos(17_400), l3, TimingId::HighSpeedLimitCruise, 500 + 100)
 }
 
 /// L3 while accelerating 11.7 us before a pulse: that pulse is still on the ramp up
 #[scenario(tags("timing", "hs-limit", "latency-probe"))]
 fn s3_6_hs_limit_accel_12us_not_before(d: &mut Driver) -> Outcome {
-    accel_probe(d, Duration::from_nanos(11_700))?;
     // Pulse index 11 still goes out on the way up; the ramp turns at 12.
-    d.expect_pulses(24, Cw)
+    accel_probe(d, Duration::from_nanos(11_700), 24)
 }
 
 /// L3 while accelerating 12.3 us before a pulse: the ramp turns down from it
 #[scenario(tags("timing", "hs-limit", "latency-probe"))]
 fn s3_6_hs_limit_accel_12us_not_after(d: &mut Driver) -> Outcome {
-    accel_probe(d, Duration::from_nanos(12_300))?;
-    d.expect_pulses(22, Cw)
+    accel_probe(d, Duration::from_nanos(12_300), 22)
 }
 
 /// 22,000 steps with PA = 11,220: the longest triangles take nearly 1.1 ms to the first POUT

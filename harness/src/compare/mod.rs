@@ -5,7 +5,11 @@
 //! n-th, the n-th change of each pin with the n-th, the n-th measurement of
 //! a name with the n-th. Times are taken relative to the anchor, the write
 //! that started the move in progress (the `move` event), so a board whose
-//! clock runs a little differently still lines up.
+//! clock runs a little differently still lines up. A pin change before the
+//! first move since the chip's reset is timed from the write before it
+//! (the initialization's final byte, an AUX command), not from the reset:
+//! a bridge whose ops take longer than the golden's would otherwise
+//! diverge there for its own pace, not the chip's.
 //!
 //! Each quantity has its own rule:
 //! - exactly: bus values (status bytes, read data, written bytes), error
@@ -126,16 +130,44 @@ impl Run {
     }
 }
 
+/// What a trace's times are taken from, at a point in it.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct Anchor {
+    /// The start of the move in progress or last made, or the chip's
+    /// reset when there was no move since.
+    at: Instant,
+    /// Whether `at` is a move's start.
+    moved: bool,
+    /// The last write to the chip since `at`.
+    write: Option<Instant>,
+}
+
+impl Anchor {
+    /// What a pin change is timed from, and its name: the move's start; or
+    /// before any move since the reset, the write before the change.
+    fn of_pin(&self) -> From {
+        match (self.moved, self.write) {
+            (true, _) => (self.at, "the move's start"),
+            (false, Some(w)) => (w, "the write before it"),
+            (false, None) => (self.at, "the chip's reset"),
+        }
+    }
+}
+
+/// What a pin change is timed from, and that moment's name.
+type From = (Instant, &'static str);
+
 /// The streams of a trace, each in order.
 #[derive(Debug, Default)]
 struct Streams {
     bus: Vec<(Instant, BusEvent)>,
     moves: Vec<(Instant, EventKind)>,
     pulses: Vec<Run>,
-    pins: BTreeMap<Pin, Vec<(Instant, u8, Instant)>>,
+    /// Each change: its time, its value, what it is timed from.
+    pins: BTreeMap<Pin, Vec<(Instant, u8, From)>>,
     measures: BTreeMap<String, Vec<(Instant, Duration, Duration)>>,
     /// The anchor in force at the end.
-    anchor: Instant,
+    anchor: Anchor,
 }
 
 /// What of the traces a compare looks at: all of them, or, when one of
@@ -186,22 +218,36 @@ impl View {
     }
 }
 
-fn streams(t: &Trace, anchor: Instant, view: &View) -> Streams {
+fn streams(t: &Trace, anchor: Anchor, view: &View) -> Streams {
     let mut s = Streams::default();
     let mut anchor = anchor;
     let mut pending_first = false;
     for e in &t.events {
         match &e.kind {
             EventKind::Bus(b) => {
-                if *b == BusEvent::Reset {
-                    anchor = e.at;
+                match b {
+                    BusEvent::Reset => {
+                        anchor = Anchor {
+                            at: e.at,
+                            moved: false,
+                            write: None,
+                        }
+                    }
+                    BusEvent::WriteCommand { .. } | BusEvent::WriteData { .. } => {
+                        anchor.write = Some(e.at);
+                    }
+                    _ => {}
                 }
                 if let Some(b) = view.bus(*b) {
                     s.bus.push((e.at, b));
                 }
             }
             k @ EventKind::Move { .. } => {
-                anchor = e.at;
+                anchor = Anchor {
+                    at: e.at,
+                    moved: true,
+                    write: None,
+                };
                 pending_first = true;
                 s.moves.push((e.at, k.clone()));
             }
@@ -209,14 +255,17 @@ fn streams(t: &Trace, anchor: Instant, view: &View) -> Streams {
                 if let Some(run) = e.pulse_run() {
                     s.pulses.push(Run {
                         run,
-                        anchor,
+                        anchor: anchor.at,
                         first_of_move: pending_first,
                     });
                 }
                 pending_first = false;
             }
             EventKind::Pin { pin, value } if view.pin(*pin) => {
-                s.pins.entry(*pin).or_default().push((e.at, *value, anchor));
+                s.pins
+                    .entry(*pin)
+                    .or_default()
+                    .push((e.at, *value, anchor.of_pin()));
             }
             EventKind::Pin { .. } => {}
             EventKind::Measure { .. } if view.capture.is_some() => {}
@@ -316,7 +365,7 @@ pub struct Resume {
     pins: BTreeMap<Pin, usize>,
     measures: BTreeMap<String, usize>,
     /// The anchor in force (golden, got).
-    anchors: (Instant, Instant),
+    anchors: (Anchor, Anchor),
 }
 
 impl Resume {
@@ -702,10 +751,10 @@ fn compare_pins(
                 diverged = true;
                 break;
             }
-            let gd = gs[i].0.saturating_since(ga);
-            let od = ot.saturating_since(oa);
+            let gd = gs[i].0.saturating_since(ga.0);
+            let od = ot.saturating_since(oa.0);
             let band = tol.band(gd, tol.latency_bp);
-            let what = || format!("{quantity}: time from the move's start");
+            let what = || format!("{quantity}: time from {}", oa.1);
             if first.check(ot, what, gd, od, band, u.pin(*pin)) {
                 diverged = true;
                 break;
@@ -821,6 +870,53 @@ end
 
     fn golden() -> Trace {
         Trace::parse(GOLDEN).expect("golden parses")
+    }
+
+    /// An initialization (section 3-2) and its outputs, with the final
+    /// data byte written `final_at` us after the reset and the phases set
+    /// `phases_after` us after that byte.
+    fn init_trace(final_at: u64, phases_after: u64) -> Trace {
+        let text = format!(
+            "ppmc-trace 1
+scenario init
+section 3-2
+target emu
+detail sysclk_hz 16000000
+detail csel high
+detail vsel high
+detail ext_clock_hz none
+events
+0.000us reset
+{}.000us wc 0x02 waited=0.000us
+{final_at}.000us wd 0x00 waited=6.000us
+{}.000us pin s 0b11000
+end
+",
+            final_at - 6,
+            final_at + phases_after,
+        );
+        Trace::parse(&text).expect("parses")
+    }
+
+    /// Section 3-2: the chip sets its outputs a fixed time after the
+    /// initialization's final byte. A bridge whose ops take longer than
+    /// the golden's writes that byte later after the reset (here 124 us
+    /// for 24): timed from the reset, its outputs diverged for the
+    /// bridge's pace; timed from the write, they agree. The chip setting
+    /// them later after the write is still the divergence, named so.
+    #[test]
+    fn a_pin_change_before_any_move_is_timed_from_the_write_before_it() {
+        let tol = Tolerances::default();
+        compare(&init_trace(24, 44), &init_trace(124, 44), &tol)
+            .expect("the same 44 us after the final byte");
+        let late = compare(&init_trace(24, 44), &init_trace(124, 60), &tol)
+            .expect_err("16 us later after the final byte");
+        assert_eq!(
+            late.quantity,
+            "pin s change 1: time from the write before it"
+        );
+        assert_eq!(late.golden, "44.000us");
+        assert_eq!(late.got, "60.000us");
     }
 
     /// The decision rule (docs/conformance.md) in a compare: a board's

@@ -260,13 +260,7 @@ impl Driver<'_> {
         let t = self.flushed("a decelerating stop or high-speed limit", |d| {
             d.batch.trigger()
         })?;
-        let rec = self.capture()?;
-        let from = rec.moves.last().map_or(0, |m| m.first_run);
-        let before: u64 = rec.runs[..from].iter().map(|r| u64::from(r.count)).sum();
-        let times: Vec<Instant> = rec.runs[from..]
-            .iter()
-            .flat_map(|r| (0..r.count).map(move |i| r.at(i)))
-            .collect();
+        let (before, times) = self.last_move_times()?;
         let n = times.len() as u64;
         // Pulse index the deceleration started from: at high speed it and
         // PA - 1 more make the PA pulses of deceleration; during acceleration
@@ -312,5 +306,178 @@ impl Driver<'_> {
         // observable is how long after the trigger the first pulse of the
         // deceleration came.
         Ok(start_time.saturating_since(t))
+    }
+
+    /// The pulses before the most recent move (all the scenario's), and
+    /// that move's pulse times.
+    fn last_move_times(&mut self) -> Outcome<(u64, Vec<Instant>)> {
+        let rec = self.capture()?;
+        let from = rec.moves.last().map_or(0, |m| m.first_run);
+        let before: u64 = rec.runs[..from].iter().map(|r| u64::from(r.count)).sum();
+        let times = rec.runs[from..]
+            .iter()
+            .flat_map(|r| (0..r.count).map(move |i| r.at(i)))
+            .collect();
+        Ok((before, times))
+    }
+
+    /// A latency probe's outcome (Table 3-3, section 3-6): the trigger was
+    /// aimed `ahead` before pulse `index` (from 0) of the most recent move,
+    /// just outside `id`'s band, so that the pulse count `check` expects
+    /// says on which side of the band the latency lies. That holds only
+    /// where the trigger landed on the aimed side of the band's edge. A
+    /// count that differs is the device's failure where the trigger's
+    /// stamp and the pulse's, with their uncertainty, put it surely on
+    /// that side; otherwise the instrument missed its aim
+    /// ([`HarnessError::Aim`]), and the count says nothing of the device.
+    /// (What the device did is still held to the trigger's stamp, where
+    /// it landed: [`Driver::expect_latency`].)
+    pub fn expect_probe(
+        &mut self,
+        id: TimingId,
+        index: u64,
+        ahead: Duration,
+        check: impl FnOnce(&mut Self) -> Outcome,
+    ) -> Outcome {
+        let (lo, hi) = id.row().band_for(&self.straps);
+        let outside = ahead > hi || ahead < lo;
+        if !outside {
+            return Err(Stop::Error(HarnessError::Scenario(format!(
+                "scenario bug: a probe of {} aimed {ahead} ahead, inside its band of {lo} to {}",
+                id.name(),
+                Limit(hi)
+            ))));
+        }
+        let counted = check(self).and_then(|()| self.flush());
+        let Err(Stop::Failed(failure)) = counted else {
+            return counted;
+        };
+        let t = self.flushed("a probe's trigger", |d| d.batch.trigger())?;
+        let (before, times) = self.last_move_times()?;
+        let Some(&p) = times.get(index as usize) else {
+            return Err(Stop::Failed(failure));
+        };
+        let got = p.saturating_since(t);
+        let u = self.u.access.saturating_add(self.u.edge);
+        let sure = if ahead > hi {
+            got.saturating_sub(u) > hi
+        } else {
+            got.saturating_add(u) < lo
+        };
+        if sure {
+            return Err(Stop::Failed(failure));
+        }
+        let edge = if ahead > hi { hi } else { lo };
+        Err(Stop::Error(HarnessError::Aim(format!(
+            "{} probe: the trigger was aimed {ahead} before pulse {}, and landed {got} \
+             (±{u}) before it, not surely on the aimed side of the band's edge at {edge}; \
+             the pulse count that then differed ({}) says nothing of the device",
+            id.name(),
+            before + index + 1,
+            failure.got,
+        ))))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::backend::{EmuTarget, Op, Reply, Target, TargetError, TargetInfo};
+    use crate::emu::ModelConfig;
+    use crate::protocol::{Direction, OutputRecord, Straps};
+    use crate::scenario::{DriverOptions, Init, Move};
+
+    /// The emulator behind an instrument that lands the op after a wait
+    /// for pulses `late` after its aim, as a bridge whose CPU is slower
+    /// than its delays assume does.
+    #[derive(Debug)]
+    struct Late {
+        emu: EmuTarget,
+        late: Duration,
+        after_await: bool,
+    }
+
+    impl Target for Late {
+        fn info(&self) -> TargetInfo {
+            self.emu.info()
+        }
+        fn capture(&mut self) -> Result<OutputRecord, TargetError> {
+            self.emu.capture()
+        }
+        fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {
+            let ops: Vec<Op> = ops
+                .iter()
+                .map(|op| match *op {
+                    Op::AwaitPulses { .. } => {
+                        self.after_await = true;
+                        *op
+                    }
+                    Op::Delay(d) if self.after_await => {
+                        self.after_await = false;
+                        Op::Delay(d + self.late)
+                    }
+                    _ => *op,
+                })
+                .collect();
+            self.emu.execute(&ops)
+        }
+    }
+
+    /// Section 3-6's Decelerating Stop probe (Table 3-3, 17 us): at high
+    /// speed, the stop aimed 17.4 us before pulse 501, so that the
+    /// deceleration starts from it and the move outputs 500 + PA pulses.
+    fn decel_stop_probe(late: Duration, pulses: u64) -> Outcome {
+        let mut t = Late {
+            emu: EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator"),
+            late,
+            after_await: false,
+        };
+        let mut d = Driver::new(&mut t, DriverOptions::default());
+        d.reset()?;
+        d.init_and_wait(Init::four_phase())?;
+        d.start(Move::accel(Direction::Cw, 5_000))?;
+        d.after_pulses(500)?;
+        let ahead = d.fw(Duration::from_nanos(17_400));
+        d.wait(d.period(20).saturating_sub(ahead))?;
+        d.decel_stop()?;
+        d.expect_latency(TimingId::DecelStopProcessing)?;
+        d.wait_idle()?;
+        d.expect_probe(TimingId::DecelStopProcessing, 500, ahead, |d| {
+            d.expect_pulses(pulses, Direction::Cw)
+        })
+    }
+
+    #[test]
+    fn a_probe_whose_trigger_landed_where_aimed_passes() {
+        assert_eq!(decel_stop_probe(Duration::ZERO, 600), Ok(()));
+    }
+
+    /// The instrument landed the stop 2.6 us late (as the RP2350 image
+    /// built by clippy's driver did on the emulated CPU): 14.8 us before
+    /// pulse 501, inside the band, where either count is the chip's right.
+    /// The count then differs from the probe's, and the device is not to
+    /// blame: an infrastructure error that says where the trigger landed.
+    #[test]
+    fn a_count_that_differs_after_a_missed_aim_blames_the_instrument() {
+        match decel_stop_probe(Duration::from_nanos(2_600), 600) {
+            Err(Stop::Error(e @ HarnessError::Aim(_))) => {
+                assert_eq!(e.kind(), ppmc_record::ErrorKind::Infrastructure);
+                let m = e.to_string();
+                assert!(m.contains("aimed 17.400us before pulse 501"), "{m}");
+                assert!(m.contains("landed 14.800us"), "{m}");
+            }
+            other => panic!("expected the instrument's miss, got {other:?}"),
+        }
+    }
+
+    /// The trigger landed where aimed, and the count is not the one the
+    /// datasheet gives (here the probe expects a pulse too many): the
+    /// device's failure, as before.
+    #[test]
+    fn a_count_that_differs_after_a_good_aim_is_the_devices_failure() {
+        match decel_stop_probe(Duration::ZERO, 601) {
+            Err(Stop::Failed(f)) => assert!(f.got.starts_with("600"), "{f:?}"),
+            other => panic!("expected a device failure, got {other:?}"),
+        }
     }
 }

@@ -47,6 +47,12 @@ pub enum HarnessError {
     /// A golden trace is missing, unreadable or could not be used.
     #[error("{0}")]
     Golden(String),
+    /// The target did an op too far from the moment the scenario aimed it
+    /// at for the check to mean what it says (a latency probe's trigger
+    /// placed on the other side of its band's edge): the instrument's
+    /// miss, which says nothing about the device.
+    #[error("{0}")]
+    Aim(String),
 }
 
 impl HarnessError {

@@ -10,14 +10,16 @@ use ppmc_record::{AttemptRecord, ErrorKind, ErrorRecord, FailureRecord, Scenario
 
 impl HarnessError {
     /// Whose problem it is, as a report types it: the infrastructure's
-    /// when the link to the target failed under it (the board is not to
-    /// blame, and neither is the harness), else the harness's.
+    /// when the link to the target failed under it or the instrument
+    /// missed an op's aim (the board is not to blame, and neither is the
+    /// harness), else the harness's.
     pub fn kind(&self) -> ErrorKind {
         match self {
             HarnessError::Target {
                 kind: TargetErrorKind::Link,
                 ..
-            } => ErrorKind::Infrastructure,
+            }
+            | HarnessError::Aim(_) => ErrorKind::Infrastructure,
             _ => ErrorKind::Harness,
         }
     }

@@ -126,14 +126,17 @@ pub struct Retry {
 
 impl Retry {
     /// Whether a scenario that ended in `v` is tried again: a link error
-    /// (the link, a garbled reply, a capture that did not come back), and
-    /// with `failures` a device failure. Never the scenario's own bug, a
+    /// (the link, a garbled reply, a capture that did not come back), an
+    /// op the target did too far from its aim, and with `failures` a
+    /// device failure. Never the scenario's own bug, a
     /// budget, a golden file, or a stop.
     pub fn takes(&self, v: &Verdict) -> bool {
         use crate::backend::TargetErrorKind;
         match v {
             Verdict::Error(HarnessError::Target { kind, .. }) => *kind == TargetErrorKind::Link,
-            Verdict::Error(HarnessError::Reply(_) | HarnessError::Capture(_)) => true,
+            Verdict::Error(
+                HarnessError::Reply(_) | HarnessError::Capture(_) | HarnessError::Aim(_),
+            ) => true,
             Verdict::Failed(_) => self.failures,
             _ => false,
         }
