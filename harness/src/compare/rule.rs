@@ -60,6 +60,12 @@ impl Unsure {
         f(&self.golden) + f(&self.got)
     }
 
+    /// How sure each side's sight of a status flag is (golden, got): a
+    /// wait no longer than this found the flag already changed.
+    pub(super) fn polled(&self) -> (Duration, Duration) {
+        (self.golden.polled, self.got.polled)
+    }
+
     /// A wait for a flag: from an access to the poll that saw it.
     pub(super) fn wait(&self) -> Duration {
         self.both(|u| u.access + u.polled)

@@ -174,16 +174,19 @@ impl<H: Hal> Board<H> {
     }
 
     /// Polls the status register until `status & mask == value`, at most
-    /// until `deadline`; the ticks waited, or the last status. The flag
-    /// changed between the last two reads: when they are close (the loop's
-    /// pass), the wait is taken to end halfway, the best estimate of the
-    /// chip's own moment.
+    /// until `deadline`: the tick the wait ended and the ticks it waited,
+    /// or the last read's tick and status. The flag changed between the
+    /// last two reads: when they are close (the loop's pass), the wait is
+    /// taken to end halfway, the best estimate of the chip's own moment,
+    /// the moment the capture gives the change of BUSY too. (A caller
+    /// that added the ticks waited to a clock read of its own stamped the
+    /// end early by the code between the two reads: 1.3 us on the image.)
     pub(super) fn wait_status(
         &mut self,
         mask: u8,
         value: u8,
         deadline: u64,
-    ) -> Result<(u64, Status), (u64, Status)> {
+    ) -> Result<(u64, u64, Status), (u64, Status)> {
         let start = self.now_ticks();
         let close = self.timer.to_ticks(CLOSE_NS);
         let read = Cycle::Read { a0: true };
@@ -211,7 +214,7 @@ impl<H: Hal> Board<H> {
                 if let Some((p, _)) = prev {
                     self.longest_pass = self.longest_pass.max(t - p);
                 }
-                return Ok((end.saturating_sub(start), s));
+                return Ok((end, end.saturating_sub(start), s));
             }
             prev = Some((t, s));
             if t >= deadline || self.aborted() {
@@ -232,7 +235,7 @@ impl<H: Hal> Board<H> {
         if let Some(d) = wait {
             let deadline = self.deadline(d);
             match self.wait_status(Status::IBF, 0, deadline) {
-                Ok((w, _)) => waited = Duration::from_nanos(self.timer.to_nanos(w)),
+                Ok((_, w, _)) => waited = Duration::from_nanos(self.timer.to_nanos(w)),
                 Err((t, status)) => {
                     return Reply::WriteTimedOut {
                         at: self.at(t),

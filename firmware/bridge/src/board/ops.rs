@@ -293,7 +293,7 @@ impl<H: Hal> Bus for Board<H> {
                 if let Some(d) = wait_obf {
                     let deadline = self.deadline(d);
                     match self.wait_status(Status::OBF, Status::OBF, deadline) {
-                        Ok((w, _)) => waited = Duration::from_nanos(self.timer.to_nanos(w)),
+                        Ok((_, w, _)) => waited = Duration::from_nanos(self.timer.to_nanos(w)),
                         Err((t, status)) => {
                             return Reply::ReadTimedOut {
                                 at: self.at(t),
@@ -316,11 +316,10 @@ impl<H: Hal> Bus for Board<H> {
                 value,
                 timeout,
             } => {
-                let start = self.now_ticks();
                 let deadline = self.deadline(timeout);
                 match self.wait_status(mask, value & mask, deadline) {
-                    Ok((w, status)) => Reply::Awaited {
-                        at: self.at(start + w),
+                    Ok((end, w, status)) => Reply::Awaited {
+                        at: self.at(end),
                         waited: Duration::from_nanos(self.timer.to_nanos(w)),
                         status,
                     },

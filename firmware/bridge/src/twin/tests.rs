@@ -1355,3 +1355,48 @@ fn a_status_read_ahead_for_an_abandoned_op_is_not_the_next_reads() {
         assert_eq!(status.ibf(), !abandon, "abandoned: {abandon}");
     }
 }
+
+#[test]
+fn an_await_ends_where_the_capture_stamps_the_flags_change() {
+    // Section 3-3: BUSY rises when a move starts and falls when it ends.
+    // A wait for it and the capture's BUSY change come from the same pair
+    // of status reads, stamped halfway between them: they are one moment.
+    // The wait's end was its length added to the op's start, a clock read
+    // taken before the wait's own (the deadline worked out between): on
+    // the image on rp2350-emu 1.3 us early, 2 us before the chip's change
+    // (HELLO says 1.5 us for `polled`), found by comparing the image's
+    // trace with the twin's (`ppmc compare`). At 40 cycles an access, as
+    // on the image.
+    for cpu in [12, 40] {
+        let mut b = twin();
+        b.hal_mut().cpu_cycles = cpu;
+        let ops = accel_move(100);
+        let replies = run_as_engine(&mut b, &ops);
+        let busy: Vec<(u64, u8)> = b
+            .record()
+            .pins
+            .iter()
+            .filter(|p| p.pin == ppmc_core::protocol::Pin::Busy)
+            .map(|p| (p.at.as_nanos(), p.value))
+            .collect();
+        let awaited: Vec<u64> = replies
+            .iter()
+            .filter_map(|r| match r {
+                Reply::Awaited { at, waited, .. } if *waited > Duration::ZERO => {
+                    Some(at.as_nanos())
+                }
+                _ => None,
+            })
+            .collect();
+        let rise = busy.iter().find(|(_, v)| *v == 1).expect("BUSY rose").0;
+        let fall = busy.iter().find(|(_, v)| *v == 0).expect("BUSY fell").0;
+        assert!(
+            awaited.contains(&rise),
+            "{cpu} cycles: BUSY rose at {rise}, waits ended at {awaited:?}"
+        );
+        assert!(
+            awaited.contains(&fall),
+            "{cpu} cycles: BUSY fell at {fall}, waits ended at {awaited:?}"
+        );
+    }
+}
