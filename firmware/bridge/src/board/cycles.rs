@@ -26,9 +26,20 @@ pub(super) const CLOSE_NS: u64 = 3_000;
 /// stuck: 1 ms (a cycle of the longest steps takes 35 us at 150 MHz).
 const CYCLE_DEADLINE_US: u64 = 1_000;
 
-/// The step an aimed cycle starts with: the bus left idle for 47 cycles,
-/// time enough for the CPU to write the wait step after it.
-pub(super) const ANCHOR: u32 = bus_cycle::step(0xFF, bus_cycle::IDLE, false, 40);
+/// The step an aimed cycle starts with: the bus left idle for 407 cycles,
+/// time enough for the CPU to write the wait step after it, which it
+/// works out from when the player took this one. At 47 cycles, on the
+/// image on rp2350-emu, the player had finished it before the wait step
+/// came, and an aimed write landed up to 1.1 us late (a latency probe
+/// of Table 3-3, whose window is 0.4 us); on the twin, late from 40
+/// cycles a hardware access on.
+pub(super) const ANCHOR: u32 = bus_cycle::step(0xFF, bus_cycle::IDLE, false, 400);
+
+/// The cycles from a read of the clock to the player's taking of a step
+/// pushed right after it: the step worked out, a look at the FIFO's level
+/// and the push. On the image on rp2350-emu, 20 left an aimed write 0.36
+/// us (54 cycles) late.
+const PUSH_CYCLES: u64 = 70;
 
 impl<H: Hal> Board<H> {
     /// The bridge's own hardware failed: later ops do nothing, and the
@@ -86,16 +97,35 @@ impl<H: Hal> Board<H> {
             let fits = anchor + u64::from(bus_cycle::MAX_COUNT + bus_cycle::STEP_CYCLES) + before;
             self.approach(goal.saturating_sub(fits) / 2);
             while self.hal.cycles() + fits < goal {}
-            let Some(pull) = p.push(&mut self.hal, ANCHOR) else {
-                return self.player_stuck(c);
-            };
-            let waited =
-                base + u64::from(pull) + anchor + u64::from(bus_cycle::STEP_CYCLES) + before;
-            if goal >= waited {
-                let count = (goal - waited).min(u64::from(bus_cycle::MAX_COUNT)) as u32;
-                let wait = bus_cycle::step(0xFF, bus_cycle::IDLE, false, count);
-                if p.push(&mut self.hal, wait).is_none() {
+            let step = u64::from(bus_cycle::STEP_CYCLES);
+            // When the player takes what is pushed now: after the steps
+            // it still has (a status read's recovery), at the earliest.
+            let start = (self.hal.cycles() + PUSH_CYCLES).max(base + u64::from(p.free));
+            if start + anchor + step + before > goal {
+                // Behind (the CPU came to the cycle with less than the
+                // anchor's time to spare, after ops that cost it more
+                // than their lead): no anchor, whose idle would make it
+                // late, but one wait step timed from the clock, right
+                // to within the few cycles a push takes.
+                let spare = goal.saturating_sub(start + step + before);
+                if spare > 0 {
+                    let count = spare.min(u64::from(bus_cycle::MAX_COUNT)) as u32;
+                    let wait = bus_cycle::step(0xFF, bus_cycle::IDLE, false, count);
+                    if p.push(&mut self.hal, wait).is_none() {
+                        return self.player_stuck(c);
+                    }
+                }
+            } else {
+                let Some(pull) = p.push(&mut self.hal, ANCHOR) else {
                     return self.player_stuck(c);
+                };
+                let waited = base + u64::from(pull) + anchor + step + before;
+                if goal >= waited {
+                    let count = (goal - waited).min(u64::from(bus_cycle::MAX_COUNT)) as u32;
+                    let wait = bus_cycle::step(0xFF, bus_cycle::IDLE, false, count);
+                    if p.push(&mut self.hal, wait).is_none() {
+                        return self.player_stuck(c);
+                    }
                 }
             }
         }

@@ -56,6 +56,9 @@ pub struct Board<H: Hal> {
     /// The bus cycles' step counts at this clock (`BusTiming::counts`),
     /// `None` for a timing that does not fit the player (checked at start).
     counts: Option<StepCounts>,
+    /// How long before its moment each kind of aimed op must start
+    /// ([`Board::lead`]), by [`ops::Lag::ALL`]'s order.
+    leads: [u64; 6],
     straps: Straps,
     /// The cycle the edge counters started on.
     started: u64,
@@ -176,6 +179,7 @@ impl<H: Hal> Board<H> {
             sysclk_hz,
             timer,
             counts: timing.counts(sysclk_hz).ok(),
+            leads: [0; 6],
             straps,
             started,
             epoch,
@@ -215,6 +219,7 @@ impl<H: Hal> Board<H> {
             overruns: 0,
             abort: None,
         };
+        bus.leads = ops::Lag::ALL.map(|k| bus.work_out_lead(k));
         let word = bus.hal.read_high_pins() & pins::SAMPLED_HIGH;
         let now = bus.now_ticks();
         bus.sample(word, bus.at(now), now, false);

@@ -64,7 +64,7 @@ const LOOK_TICKS: u64 = 16;
 /// The kinds of op a delay ends early for ([`Bus::next_op`]), to aim
 /// their moment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Lag {
+pub(super) enum Lag {
     /// A write that waits for IBF = 0 (a status read first).
     WriteAfterIbf,
     Write,
@@ -77,6 +77,16 @@ enum Lag {
 }
 
 impl Lag {
+    /// Every kind, in the order of [`Board::leads`].
+    pub(super) const ALL: [Lag; 6] = [
+        Lag::WriteAfterIbf,
+        Lag::Write,
+        Lag::ReadAfterObf,
+        Lag::Read,
+        Lag::Input,
+        Lag::Pins,
+    ];
+
     fn of(op: Op) -> Option<Lag> {
         Some(match op {
             Op::WriteCommand { wait_ibf, .. } | Op::WriteData { wait_ibf, .. } => {
@@ -101,10 +111,19 @@ fn level(asserted: bool) -> bool {
 }
 
 impl<H: Hal> Board<H> {
-    /// How long before its moment an op of kind `k` must start (ticks):
-    /// its bus cycles before the moment (a status read first, for one that
-    /// waits on a flag), and [`CPU_LEAD_US`] for the code between.
+    /// How long before its moment an op of kind `k` must start (ticks),
+    /// worked out once ([`Board::leads`]): a delay that ends for an aimed
+    /// op is often right behind a wait for a pulse, and on the image the
+    /// working out took some 500 cycles of the 3,700 between a pulse and a
+    /// stop aimed 24.6 us after it (Section 3-6's probes).
     fn lead(&self, k: Lag) -> u64 {
+        self.leads[k as usize]
+    }
+
+    /// [`Board::lead`] of `k`, worked out: its bus cycles before the
+    /// moment (a status read first, for one that waits on a flag), and
+    /// [`CPU_LEAD_US`] for the code between.
+    pub(super) fn work_out_lead(&self, k: Lag) -> u64 {
         let cycles = |c: Cycle, to_moment: bool| -> u64 {
             let Some(steps) = self.counts.map(|n| n.steps(c)) else {
                 return 0;
