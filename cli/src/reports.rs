@@ -3,6 +3,7 @@
 //! one record after it.
 
 use crate::{usage, CliError};
+use files::kind::Kind;
 use ppmc_files as files;
 use ppmc_record::RunRecord;
 use ppmc_report as report;
@@ -102,6 +103,23 @@ pub(super) fn prepare_reports(
                     pb.display()
                 )));
             }
+        }
+    }
+    // A report replaces only a report of its kind (or an empty file).
+    let kinds = [(Kind::Junit, junit), (Kind::Json, json), (Kind::Html, html)];
+    for ((flag, _), (kind, path)) in named.iter().zip(kinds) {
+        let Some(path) = path.filter(|p| p.as_os_str() != "-") else {
+            continue;
+        };
+        let found =
+            files::kind::of(path).map_err(|e| CliError::BadInput(format!("ppmc: {flag} {e}")))?;
+        if let Some(k) = found.filter(|k| *k != kind) {
+            return Err(usage(format!(
+                "{flag} {}: the file is {}, not {}: refusing to replace it (give another path, or remove the file first)",
+                path.display(),
+                k.name(),
+                kind.name()
+            )));
         }
     }
     let on_stdout: Vec<&str> = reports

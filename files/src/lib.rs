@@ -18,6 +18,8 @@
 //!   `/dev/zero` until memory runs out) and refuses one beyond a size limit;
 //! - every error names the path and what was being done to it.
 
+pub mod kind;
+
 use std::fmt;
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Read, Write};

@@ -209,6 +209,75 @@ fn the_same_file_for_two_reports_is_refused_before_the_run() {
     assert!(d.join("r.xml").is_file() && d.join("r.json").is_file());
 }
 
+/// Issue 44: a report path that names a file holding something else (a
+/// results store, a golden trace, another kind of report, a file of the
+/// user's) is refused before the run, the file kept byte for byte; a
+/// report of the same kind is replaced, as asked.
+#[test]
+fn a_report_over_a_file_of_another_kind_is_refused_before_the_run() {
+    let dir = scratch("report-kinds");
+    let d = dir.path();
+    let run = |args: &[&str]| {
+        let mut all = vec!["run", "--filter", "e0_undefined"];
+        all.extend_from_slice(args);
+        ppmc_in(d, &all)
+    };
+    // One run writes a store and one report of each kind.
+    let out = run(&[
+        "--store", "k.db", "--json", "r.json", "--html", "r.html", "--junit", "r.xml",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    fs::copy(
+        golden_dir().join("e0_undefined_command_code.snap"),
+        d.join("g.snap"),
+    )
+    .expect("a golden trace");
+    fs::write(d.join("notes.txt"), "a file of the user's\n").expect("notes");
+    let refused = [
+        ("--json", "k.db", "a results store (SQLite)"),
+        ("--html", "g.snap", "a golden trace"),
+        ("--html", "r.json", "a JSON run record"),
+        ("--junit", "r.html", "an HTML report of ppmc's"),
+        ("--json", "r.xml", "a JUnit report"),
+        ("--junit", "notes.txt", "not a report of ppmc's"),
+    ];
+    for (flag, file, what) in refused {
+        let before = fs::read(d.join(file)).expect("there");
+        let out = run(&[flag, file]);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flag} {file}: {err}");
+        assert!(
+            err.contains(&format!("{flag} {file}: the file is {what}")),
+            "{flag} {file}: {err}"
+        );
+        assert!(out.stdout.is_empty(), "nothing ran: {}", text(&out.stdout));
+        assert_eq!(
+            fs::read(d.join(file)).expect("kept"),
+            before,
+            "{file} changed"
+        );
+    }
+    // The same kind, and an empty file, are replaced.
+    fs::write(d.join("empty.json"), "").expect("empty");
+    for (flag, file) in [
+        ("--json", "r.json"),
+        ("--html", "r.html"),
+        ("--junit", "r.xml"),
+        ("--json", "empty.json"),
+    ] {
+        let out = run(&[flag, file]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{flag} {file}: {}",
+            text(&out.stderr)
+        );
+    }
+    assert!(fs::read_to_string(d.join("empty.json"))
+        .expect("written")
+        .contains("ppmc-run-record/"));
+}
+
 /// Every output is tried before any scenario runs: a folder that is a
 /// regular file, a report that is a directory.
 #[test]

@@ -66,10 +66,16 @@ impl Causes {
         o: Instant,
         oc: Causes,
     ) -> Vec<(Duration, Duration, &'static str)> {
+        // A trace that starts without a reset (a capture's) starts with
+        // no input named.
+        let name = match gc.input.1 {
+            "" => "the trace's start",
+            name => name,
+        };
         let mut t = vec![(
             g.saturating_since(gc.input.0),
             o.saturating_since(oc.input.0),
-            gc.input.1,
+            name,
         )];
         if let (Some(gp), Some(op)) = (gc.pulse, oc.pulse) {
             t.push((
