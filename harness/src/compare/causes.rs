@@ -3,14 +3,14 @@
 //! and how a change timed so is judged, for an output pin and for a flag a
 //! wait saw.
 
-use super::rule::{fit, shown, Fit};
-use super::{Divergence, First, Tolerances};
+use super::rule::{fit, First, Fit};
+use super::Tolerances;
 use crate::protocol::PulseRun;
-use crate::time::{Duration, Instant, Limit};
+use crate::time::{Duration, Instant};
 use crate::trace::BusEvent;
 
 /// What a trace's times are taken from, at a point in it.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) struct Anchor {
     /// The start of the move in progress or last made, or the chip's
     /// reset when there was no move since: a move's pulses are timed from
@@ -21,6 +21,18 @@ pub(super) struct Anchor {
     pub(super) input: (Instant, &'static str),
     /// The last run of pulses so far.
     pub(super) run: Option<PulseRun>,
+}
+
+impl Default for Anchor {
+    /// A trace's start: a trace that starts without a reset (a capture's)
+    /// has no input before its first changes.
+    fn default() -> Anchor {
+        Anchor {
+            at: Instant::ZERO,
+            input: (Instant::ZERO, "the trace's start"),
+            run: None,
+        }
+    }
 }
 
 impl Anchor {
@@ -66,16 +78,10 @@ impl Causes {
         o: Instant,
         oc: Causes,
     ) -> Vec<(Duration, Duration, &'static str)> {
-        // A trace that starts without a reset (a capture's) starts with
-        // no input named.
-        let name = match gc.input.1 {
-            "" => "the trace's start",
-            name => name,
-        };
         let mut t = vec![(
             g.saturating_since(gc.input.0),
             o.saturating_since(oc.input.0),
-            name,
+            gc.input.1,
         )];
         if let (Some(gp), Some(op)) = (gc.pulse, oc.pulse) {
             t.push((
@@ -90,8 +96,9 @@ impl Causes {
 
 /// Judges a change the chip made, timed from each cause the two sides
 /// share (`timings`, [`Causes::timings`]), each within the tolerance of
-/// the nearest cause: no divergence where one of them agrees (by `out`, given the band; graded MARGINAL by `u` where
-/// `graded`), else the divergence timed from the cause it misses least.
+/// the nearest cause: no divergence where one of them agrees (by `out`,
+/// given the band; graded MARGINAL by `u` where `graded`), else the
+/// divergence timed from the cause it misses least.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn judge_change(
     first: &mut First,
@@ -128,14 +135,7 @@ pub(super) fn judge_change(
             let Some(&(gd, od, from)) = timings.iter().min_by_key(miss) else {
                 return false;
             };
-            let (lo, hi) = band(gd);
-            first.offer(Divergence {
-                at,
-                quantity: named(from),
-                golden: shown(gd, Duration::ZERO),
-                got: shown(od, u),
-                allowed: format!("{lo}..={}", Limit(hi)),
-            });
+            first.diverge(at, named(from), gd, od, band(gd), u);
             true
         }
     }

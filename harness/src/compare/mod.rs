@@ -3,13 +3,13 @@
 //! Events are aligned by their place in their own stream, never by absolute
 //! time: the n-th bus transaction with the n-th, the n-th pulse with the
 //! n-th, the n-th change of each pin with the n-th, the n-th measurement of
-//! a name with the n-th. Times are taken relative to the anchor, the write
-//! that started the move in progress (the `move` event), so a board whose
-//! clock runs a little differently still lines up. A pin change before the
-//! first move since the chip's reset is timed from the write before it
-//! (the initialization's final byte, an AUX command), not from the reset:
-//! a bridge whose ops take longer than the golden's would otherwise
-//! diverge there for its own pace, not the chip's.
+//! a name with the n-th. A move's pulses are timed from the anchor, the
+//! write that started it (the `move` event), so a board whose clock runs a
+//! little differently still lines up. A change the chip makes (an output
+//! pin, a flag a wait saw) is timed from what made the chip make it, its
+//! last input or its last pulse (`causes.rs`), never from a wait's start
+//! or the reset: a bridge whose ops take longer than the golden's would
+//! otherwise diverge for its own pace, not the chip's.
 //!
 //! Each quantity has its own rule:
 //! - exactly: bus values (status bytes, read data, written bytes), error
@@ -33,10 +33,10 @@ mod rule;
 pub use rule::{Graded, MarginalComparison};
 
 use crate::protocol::{Pin, PulseRun, Straps, TimingId};
-use crate::time::{Duration, Instant, Limit};
+use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, EventKind, Trace};
 use causes::{first_look, judge_change, wait_diverges, Anchor, Causes, Wait};
-use rule::{fit, shown, Fit, Unsure};
+use rule::{fit, First, Fit, Unsure};
 use std::collections::BTreeMap;
 use std::fmt;
 
@@ -264,65 +264,6 @@ fn streams(t: &Trace, anchor: Anchor, view: &View) -> Streams {
     s.anchor = anchor;
     s.first_look = first_look(s.bus.iter().map(|(_, b, _)| b));
     s
-}
-
-/// Keeps the earliest divergence, and the comparisons that were MARGINAL.
-#[derive(Debug, Default)]
-struct First(Option<Divergence>, Graded);
-
-impl First {
-    fn offer(&mut self, d: Divergence) {
-        if self.0.as_ref().is_none_or(|cur| d.at < cur.at) {
-            self.0 = Some(d);
-        }
-    }
-
-    /// Judges the timing `got` (± `u`) against `band` by the decision
-    /// rule: `true` where it is the divergence (offered).
-    fn check(
-        &mut self,
-        at: Instant,
-        quantity: impl FnOnce() -> String,
-        golden: Duration,
-        got: Duration,
-        band: (Duration, Duration),
-        u: Duration,
-    ) -> bool {
-        match fit(got, band, u) {
-            Fit::In => false,
-            Fit::Marginal => {
-                self.1.note(MarginalComparison {
-                    at,
-                    quantity: quantity(),
-                    golden,
-                    got,
-                    lo: band.0,
-                    hi: band.1,
-                    u,
-                });
-                false
-            }
-            Fit::Out => {
-                self.offer(Divergence {
-                    at,
-                    quantity: quantity(),
-                    golden: golden.to_string(),
-                    got: shown(got, u),
-                    allowed: band_text(band),
-                });
-                true
-            }
-        }
-    }
-
-    /// Whether anything at or after `at` can still be the first.
-    fn beaten_by(&self, at: Instant) -> bool {
-        self.0.as_ref().is_some_and(|cur| cur.at <= at)
-    }
-}
-
-fn band_text((lo, hi): (Duration, Duration)) -> String {
-    format!("{lo}..={}", Limit(hi))
 }
 
 /// Compares `got` with `golden`; `Ok(())` when every quantity is within

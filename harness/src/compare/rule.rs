@@ -7,9 +7,10 @@
 //! limit, it is MARGINAL: within the instruments' uncertainty of it.
 //! With `U` = 0 (two emulator traces) this is the band alone, as it was.
 
+use super::Divergence;
 use crate::bus::Uncertainty;
 use crate::protocol::Pin;
-use crate::time::{Duration, Instant};
+use crate::time::{Duration, Instant, Limit};
 use crate::trace::Trace;
 
 /// Where a value lies against its band, `± u`.
@@ -128,6 +129,74 @@ impl Graded {
         if self.first.as_ref().is_none_or(|f| m.at < f.at) {
             self.first = Some(m);
         }
+    }
+}
+
+/// Keeps the earliest divergence, and the comparisons that were MARGINAL.
+#[derive(Debug, Default)]
+pub(super) struct First(pub(super) Option<Divergence>, pub(super) Graded);
+
+impl First {
+    pub(super) fn offer(&mut self, d: Divergence) {
+        if self.0.as_ref().is_none_or(|cur| d.at < cur.at) {
+            self.0 = Some(d);
+        }
+    }
+
+    /// Judges the timing `got` (± `u`) against `band` by the decision
+    /// rule: `true` where it is the divergence (offered).
+    pub(super) fn check(
+        &mut self,
+        at: Instant,
+        quantity: impl FnOnce() -> String,
+        golden: Duration,
+        got: Duration,
+        band: (Duration, Duration),
+        u: Duration,
+    ) -> bool {
+        match fit(got, band, u) {
+            Fit::In => false,
+            Fit::Marginal => {
+                self.1.note(MarginalComparison {
+                    at,
+                    quantity: quantity(),
+                    golden,
+                    got,
+                    lo: band.0,
+                    hi: band.1,
+                    u,
+                });
+                false
+            }
+            Fit::Out => {
+                self.diverge(at, quantity(), golden, got, band, u);
+                true
+            }
+        }
+    }
+
+    /// Offers the divergence of `got` (± `u`) from `golden`, outside `band`.
+    pub(super) fn diverge(
+        &mut self,
+        at: Instant,
+        quantity: String,
+        golden: Duration,
+        got: Duration,
+        band: (Duration, Duration),
+        u: Duration,
+    ) {
+        self.offer(Divergence {
+            at,
+            quantity,
+            golden: golden.to_string(),
+            got: shown(got, u),
+            allowed: format!("{}..={}", band.0, Limit(band.1)),
+        });
+    }
+
+    /// Whether anything at or after `at` can still be the first.
+    pub(super) fn beaten_by(&self, at: Instant) -> bool {
+        self.0.as_ref().is_some_and(|cur| cur.at <= at)
     }
 }
 

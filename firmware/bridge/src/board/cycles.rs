@@ -101,31 +101,25 @@ impl<H: Hal> Board<H> {
             // When the player takes what is pushed now: after the steps
             // it still has (a status read's recovery), at the earliest.
             let start = (self.hal.cycles() + PUSH_CYCLES).max(base + u64::from(p.free));
-            if start + anchor + step + before > goal {
+            // The wait step's count, from when the player takes it.
+            let count = if start + anchor + step + before > goal {
                 // Behind (the CPU came to the cycle with less than the
                 // anchor's time to spare, after ops that cost it more
                 // than their lead): no anchor, whose idle would make it
-                // late, but one wait step timed from the clock, right
-                // to within the few cycles a push takes.
-                let spare = goal.saturating_sub(start + step + before);
-                if spare > 0 {
-                    let count = spare.min(u64::from(bus_cycle::MAX_COUNT)) as u32;
-                    let wait = bus_cycle::step(0xFF, bus_cycle::IDLE, false, count);
-                    if p.push(&mut self.hal, wait).is_none() {
-                        return self.player_stuck(c);
-                    }
-                }
+                // late, but a wait step timed from the clock, right to
+                // within the few cycles a push takes.
+                goal.checked_sub(start + step + before)
             } else {
                 let Some(pull) = p.push(&mut self.hal, ANCHOR) else {
                     return self.player_stuck(c);
                 };
-                let waited = base + u64::from(pull) + anchor + step + before;
-                if goal >= waited {
-                    let count = (goal - waited).min(u64::from(bus_cycle::MAX_COUNT)) as u32;
-                    let wait = bus_cycle::step(0xFF, bus_cycle::IDLE, false, count);
-                    if p.push(&mut self.hal, wait).is_none() {
-                        return self.player_stuck(c);
-                    }
+                goal.checked_sub(base + u64::from(pull) + anchor + step + before)
+            };
+            if let Some(count) = count {
+                let count = count.min(u64::from(bus_cycle::MAX_COUNT)) as u32;
+                let wait = bus_cycle::step(0xFF, bus_cycle::IDLE, false, count);
+                if p.push(&mut self.hal, wait).is_none() {
+                    return self.player_stuck(c);
                 }
             }
         }
