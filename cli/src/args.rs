@@ -373,10 +373,13 @@ pub struct ReportArgs {
     /// first divergence marked, the pins around each failure.
     #[arg(long, value_name = "FILE")]
     pub html: Option<PathBuf>,
-    /// Keep the run record in a results store (SQLite; made when not
-    /// there), for `ppmc history` and `ppmc report --store`
-    /// (docs/results-store.md).
-    #[arg(long, value_name = "FILE")]
+    /// Keep the run record in a results store, for `ppmc history` and
+    /// `ppmc report --store` (docs/results-store.md): an SQLite file (made
+    /// when not there), or a lab's PostgreSQL database
+    /// (`postgres://user@host/db`; TLS as `sslmode=` asks, the password
+    /// from the URL or PGPASSWORD). A run the store does not take is kept
+    /// on disk for `ppmc store push`.
+    #[arg(long, value_name = "FILE|URL", env = "PPMC_STORE")]
     pub store: Option<PathBuf>,
 }
 

@@ -8,8 +8,9 @@ use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct HistoryArgs {
-    /// The results store (`ppmc run --store FILE` makes and fills it).
-    #[arg(long, value_name = "FILE")]
+    /// The results store (`ppmc run --store FILE` makes and fills it): a
+    /// file, or a PostgreSQL database (`postgres://user@host/db`).
+    #[arg(long, value_name = "FILE|URL", env = "PPMC_STORE")]
     store: PathBuf,
     /// Scenarios listed at most, lowest pass rate first (0: all).
     #[arg(long, value_name = "N", default_value_t = 10)]
@@ -30,16 +31,13 @@ fn plural<'a>(n: u64, one: &'a str, many: &'a str) -> &'a str {
 }
 
 pub fn run(args: HistoryArgs) -> Result<(), CliError> {
-    let store =
-        Store::open_existing(&args.store).map_err(|e| CliError::BadInput(format!("ppmc: {e}")))?;
-    let h = store
-        .history()
-        .map_err(|e| CliError::Failed(e.to_string()))?;
+    let mut store = Store::open_existing(&args.store).map_err(crate::reports::store_error)?;
+    let h = store.history().map_err(crate::reports::store_error)?;
     // Every text of the store printed through `p`: a label a lab script
     // planted may hold a terminal's escape sequences.
     outln!(
         "{}: {} runs, {} boards{}",
-        args.store.display(),
+        p(&store.shown()),
         h.runs,
         h.boards,
         h.span

@@ -27,6 +27,7 @@ mod reports;
 mod run;
 mod selftest;
 mod signals;
+mod store;
 mod suggest;
 
 use clap::{Parser, Subcommand};
@@ -123,6 +124,10 @@ enum Command {
     /// yield per revision, the scenarios with the lowest pass rate, each
     /// measurement's spread and Cpk per revision (docs/results-store.md).
     History(history::HistoryArgs),
+    /// A results store by hand: `ppmc store push RECORD...` sends run
+    /// records it did not take (its server was out of reach), each run
+    /// kept once however often it is sent (docs/results-store.md).
+    Store(store::StoreArgs),
 }
 
 /// The whole `ppmc` command line over `suite`: parses the process's
@@ -157,6 +162,7 @@ pub fn main(suite: Vec<Scenario>) -> ExitCode {
         Command::Selftest(args) => selftest::run(args),
         Command::Report(args) => report::run(args),
         Command::History(args) => history::run(args),
+        Command::Store(args) => store::run(args),
     };
     match done {
         Ok(()) => ExitCode::SUCCESS,

@@ -21,8 +21,9 @@ pub struct ReportArgs {
     /// Draw a results store's history instead (`--store` of `ppmc run`):
     /// yield per revision, each measurement's distribution per revision
     /// against its band with its Cpk, each scenario's pass rate across
-    /// boards, the trend over time.
-    #[arg(long, value_name = "FILE")]
+    /// boards, the trend over time. A file, or a PostgreSQL database
+    /// (`postgres://user@host/db`).
+    #[arg(long, value_name = "FILE|URL")]
     store: Option<PathBuf>,
     /// Where to write the page (replaced if it is there); `-` for
     /// standard output.
@@ -42,12 +43,9 @@ pub fn run(args: ReportArgs) -> Result<(), CliError> {
                 args.output.display()
             )));
         }
-        let store =
-            Store::open_existing(path).map_err(|e| CliError::BadInput(format!("ppmc: {e}")))?;
-        let history = store
-            .history()
-            .map_err(|e| CliError::Failed(e.to_string()))?;
-        let page = report::history_html(&history, &args.title, &path.display().to_string());
+        let mut store = Store::open_existing(path).map_err(crate::reports::store_error)?;
+        let history = store.history().map_err(crate::reports::store_error)?;
+        let page = report::history_html(&history, &args.title, &store.shown());
         files::write_report(&args.output, page.as_bytes())?;
         if args.output.as_os_str() != "-" {
             outln!(

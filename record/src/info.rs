@@ -122,6 +122,11 @@ impl BoardInfo {
 /// Facts about a run that every report carries.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunInfo {
+    /// The run's own name, made when it starts (a random UUID): a results
+    /// store keeps a run once under it, however often its record is sent
+    /// (`ppmc store push`). Absent from records of an older ppmc.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<String>,
     pub harness_version: String,
     pub git_revision: String,
     /// The boards, in the order of `--target`; results name them by name.
@@ -177,6 +182,7 @@ impl RunInfo {
     /// `git_revision`, on `boards` spread as `spread` says.
     pub fn new(version: &str, git_revision: &str, boards: Vec<BoardInfo>, spread: &str) -> RunInfo {
         RunInfo {
+            id: Some(uuid::Uuid::new_v4().to_string()),
             harness_version: version.to_string(),
             git_revision: git_revision.to_string(),
             boards,

@@ -10,6 +10,7 @@
 // Test helpers, never printed.
 #![allow(missing_debug_implementations)]
 
+pub mod postgres;
 pub mod served;
 
 use ppmc::backend::{EmuTarget, Op, Reply, Target};

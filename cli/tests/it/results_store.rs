@@ -242,6 +242,8 @@ fn the_store_page_lists_every_board_of_a_thousand_runs_with_its_last_verdict() {
         r["run"]["boards"][0]["board_serial"] = format!("SN-{board:04}").into();
         r["run"]["boards"][0]["board_rev"] = rev.into();
         r["run"]["host"] = format!("station-{}", board % 4).into();
+        // Each a run of its own (a store keeps a run's id once).
+        r["run"]["id"] = format!("00000000-0000-4000-8000-{run:012}").into();
         // A run a minute, in order.
         r["run"]["started"] = format!("2026-11-01T{:02}:{:02}:00Z", run / 60, run % 60).into();
         if failed {

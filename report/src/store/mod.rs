@@ -1,163 +1,149 @@
-//! The results store: every run record kept in one SQLite file
-//! (`--store results.db`), keyed by board serial, revision, bridge, ppmc
-//! version, commit and time, for `ppmc history` and `ppmc report --store`
-//! (`docs/results-store.md`).
+//! The results store: every run record kept in one database, keyed by
+//! board serial, revision, bridge, ppmc version, commit and time, for
+//! `ppmc history` and `ppmc report --store` (`docs/results-store.md`).
+//! One station's store is an SQLite file (`--store results.db`); a lab's
+//! is a PostgreSQL database that every station writes to
+//! (`--store postgres://user@host/db`).
 //!
 //! `mod.rs` opens a store (made new, or an older one brought up to this
-//! schema) and adds run records to it; `stats.rs` asks it what a lab
-//! wants to know: yield per revision, each scenario's pass rate, each
-//! measurement's spread and Cpk, revision against revision, the trend.
+//! schema) and adds run records to it, each once; `schema.rs` is the
+//! schema and what the two databases spell differently; `db.rs` one
+//! connection to either; `location.rs` where a store is; `stats.rs` asks
+//! it what a lab wants to know: yield per revision, each scenario's pass
+//! rate, each measurement's spread and Cpk, revision against revision,
+//! the trend.
 //!
-//! The schema is versioned by SQLite's `user_version`: [`SCHEMA`] is this
-//! ppmc's; an older store is migrated in place, in one transaction, by
-//! [`MIGRATIONS`]; a newer one is refused, never written.
+//! [`SCHEMA`] is this ppmc's; an older store is migrated in place, in one
+//! transaction, by [`MIGRATIONS`]; a newer one is refused, never written.
 
+mod db;
+mod location;
+mod schema;
 mod stats;
 
+pub use db::Dialect;
+pub use location::{redact, Location, Server, TlsMode};
+pub use schema::{MIGRATIONS, SCHEMA};
 pub use stats::{
     mean_sd, BoardRecord, Distribution, History, RevisionYield, ScenarioRate, TrendPoint,
 };
 
+use db::{Conn, DbError, Pg, Value};
 use ppmc_record::RunRecord;
-use rusqlite::{params, Connection, OpenFlags, Transaction, TransactionBehavior};
-use std::path::{Path, PathBuf};
+use rusqlite::{Connection, OpenFlags};
+use std::path::Path;
 use std::time::Duration;
 
-/// This ppmc's store schema.
-pub const SCHEMA: u32 = 1;
-
-/// Each schema from the first, as the statements that make it from the one
-/// before (`MIGRATIONS[0]` makes schema 1 from an empty file). A store at
-/// schema N runs `MIGRATIONS[N..]`. Never edit one that has shipped: add
-/// the next.
-pub const MIGRATIONS: [&str; 1] = [r#"
-CREATE TABLE runs (
-    id              INTEGER PRIMARY KEY,
-    started         TEXT    NOT NULL,  -- RFC 3339, UTC
-    harness_version TEXT    NOT NULL,
-    git_revision    TEXT    NOT NULL,
-    host            TEXT    NOT NULL,
-    source          TEXT    NOT NULL,  -- 'boards' or 'capture'
-    wall_s          REAL    NOT NULL,
-    passed          INTEGER NOT NULL,
-    marginal        INTEGER NOT NULL,
-    flaky           INTEGER NOT NULL,
-    failed          INTEGER NOT NULL,
-    errors          INTEGER NOT NULL,
-    not_run         INTEGER NOT NULL,
-    record          TEXT    NOT NULL   -- the JSON run record, without its figures
-);
-CREATE TABLE boards (
-    id              INTEGER PRIMARY KEY,
-    run_id          INTEGER NOT NULL REFERENCES runs(id),
-    name            TEXT    NOT NULL,
-    target          TEXT    NOT NULL,
-    board_serial    TEXT,
-    board_rev       TEXT,
-    bridge_firmware TEXT,
-    bridge_serial   TEXT,
-    reached         INTEGER NOT NULL   -- 0: the board took no part
-);
-CREATE TABLE results (
-    id         INTEGER PRIMARY KEY,
-    run_id     INTEGER NOT NULL REFERENCES runs(id),
-    board_id   INTEGER REFERENCES boards(id),
-    scenario   TEXT    NOT NULL,
-    section    TEXT    NOT NULL,
-    pass       INTEGER,
-    verdict    TEXT    NOT NULL,  -- passed, marginal, flaky, failed, error, not_run
-    blame      TEXT,              -- judged from a capture: board, host or capture
-    attempts   INTEGER NOT NULL,  -- how many times it ran
-    elapsed_ns INTEGER NOT NULL,
-    detail     TEXT
-);
-CREATE TABLE measurements (
-    result_id      INTEGER NOT NULL REFERENCES results(id),
-    name           TEXT    NOT NULL,
-    value_ns       INTEGER NOT NULL,
-    lo_ns          INTEGER NOT NULL,
-    hi_ns          INTEGER,          -- NULL: no upper limit
-    marginal_lo_ns INTEGER NOT NULL,
-    marginal_hi_ns INTEGER,
-    grade          TEXT    NOT NULL
-);
-CREATE INDEX boards_run ON boards(run_id);
-CREATE INDEX boards_rev ON boards(board_rev, board_serial);
-CREATE INDEX results_run ON results(run_id);
-CREATE INDEX results_board ON results(board_id);
-CREATE INDEX results_scenario ON results(scenario);
-CREATE INDEX measurements_result ON measurements(result_id);
-CREATE INDEX measurements_name ON measurements(name);
-"#];
-
-/// A store that could not be opened, read or written: the file, and why.
+/// A store that could not be opened, read or written: where it is (the
+/// file, or the server's URL without its password), and why.
 #[derive(Debug, thiserror::Error)]
-#[error("{path}: {why}")]
+#[error("{at}: {why}")]
 pub struct StoreError {
-    pub path: PathBuf,
+    pub at: String,
     pub why: String,
+    pub fault: Fault,
+}
+
+/// Whose the trouble is, for the exit status.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    /// The store is damaged or none of ppmc's, or the path or URL given
+    /// cannot be a store: the user's input (exit 2, wherever it is found).
+    Store,
+    /// The server could not be reached, or was lost: the lab's network or
+    /// server, not the store.
+    Link,
+    /// Anything else the database said.
+    Other,
 }
 
 /// An open results store.
 #[derive(Debug)]
 pub struct Store {
-    conn: Connection,
-    path: PathBuf,
-    /// The migrated copy an older store is read through, removed on drop.
+    conn: Conn,
+    location: Location,
+    /// The migrated copy an older SQLite store is read through, removed on
+    /// drop.
     _copy: Option<tempfile::NamedTempFile>,
+    /// An older PostgreSQL store being read: its migration runs in a
+    /// transaction that is rolled back when the store is dropped.
+    rollback: bool,
+}
+
+/// What [`Store::add`] did with a record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Added {
+    /// Kept, as the run of this id in the store.
+    New(i64),
+    /// Already there (sent before): kept once.
+    Already,
 }
 
 impl Store {
-    /// Opens the store at `path`, made new when nothing is there, an older
-    /// one migrated to [`SCHEMA`]. A symlink, a folder, a file that is not
-    /// SQLite, or a store of a newer ppmc is refused by name.
-    pub fn open(path: &Path) -> Result<Store, StoreError> {
-        Store::open_with(path, true)
+    /// Opens the store `given` names (a file, or a `postgres://` URL),
+    /// made new when nothing is there, an older one migrated to
+    /// [`SCHEMA`]. A symlink, a folder, a file that is not SQLite, a
+    /// database of another program or a store of a newer ppmc is refused
+    /// by name.
+    pub fn open(given: &Path) -> Result<Store, StoreError> {
+        Store::open_with(given, &MIGRATIONS)
     }
 
     /// Opens an existing store to read it, changing nothing in it: a store
-    /// of an older schema is migrated in a temporary copy, so that an
+    /// of an older schema is read as migrated (SQLite: in a temporary
+    /// copy; PostgreSQL: in a transaction rolled back after), so that an
     /// archived store, read-only or shared, reads as it is.
-    pub fn open_existing(path: &Path) -> Result<Store, StoreError> {
-        Store::open_existing_with(path, &MIGRATIONS)
+    pub fn open_existing(given: &Path) -> Result<Store, StoreError> {
+        Store::open_existing_with(given, &MIGRATIONS)
+    }
+
+    fn locate(given: &Path) -> Result<Location, StoreError> {
+        Location::of(given).map_err(|why| StoreError {
+            at: redact(&given.to_string_lossy()),
+            why,
+            fault: Fault::Store,
+        })
     }
 
     /// [`Store::open_existing`] with `migrations` as this ppmc's (its
     /// schema their count): a test brings a store to a schema to come.
-    fn open_existing_with(path: &Path, migrations: &[&str]) -> Result<Store, StoreError> {
+    fn open_existing_with(given: &Path, migrations: &[&str]) -> Result<Store, StoreError> {
+        let location = Store::locate(given)?;
+        let path = match &location {
+            Location::File(path) => path.clone(),
+            Location::Server(server) => {
+                let conn = Conn::Postgres(Box::new(Pg::new(connect(server)?)));
+                let mut store = Store::with(conn, location.clone());
+                let at = store.schema()?;
+                store.check_version(at, migrations.len() as u32, false)?;
+                if at < migrations.len() as u32 {
+                    store.conn.batch("BEGIN").map_err(|e| store.fail(e))?;
+                    store.rollback = true;
+                    store.apply(migrations)?;
+                }
+                return Ok(store);
+            }
+        };
         let err = |why: String| StoreError {
-            path: path.to_path_buf(),
+            at: path.display().to_string(),
             why,
+            fault: Fault::Store,
         };
         // Not there at all; a dangling link is named as a link below.
-        if std::fs::symlink_metadata(path).is_err() {
+        if std::fs::symlink_metadata(&path).is_err() {
             return Err(err(
                 "no results store here (ppmc run --store FILE makes one)".into(),
             ));
         }
-        ppmc_files::check_replaceable(path).map_err(|e| err(e.to_string()))?;
+        ppmc_files::check_replaceable(&path).map_err(|e| err(e.to_string()))?;
         let flags = OpenFlags::SQLITE_OPEN_READ_ONLY
             | OpenFlags::SQLITE_OPEN_NOFOLLOW
             | OpenFlags::SQLITE_OPEN_NO_MUTEX;
-        let conn = Connection::open_with_flags(path, flags).map_err(|e| err(e.to_string()))?;
-        conn.busy_timeout(Duration::from_secs(30))
-            .map_err(|e| err(e.to_string()))?;
-        let store = Store {
-            conn,
-            path: path.to_path_buf(),
-            _copy: None,
-        };
+        let mut store = Store::with(sqlite(&path, flags)?, location.clone());
         let (at, schema) = (store.schema()?, migrations.len() as u32);
+        store.check_version(at, schema, false)?;
         if at == schema {
             return Ok(store);
-        }
-        if at == 0 {
-            return Err(err(
-                "not a ppmc results store: it has no schema version (an empty file, or another program's SQLite file)".into(),
-            ));
-        }
-        if at > schema {
-            return Err(err(newer(at, schema)));
         }
         let copying = |e: &dyn std::fmt::Display| {
             err(format!(
@@ -175,137 +161,234 @@ impl Store {
         std::fs::remove_file(&target).map_err(|e| copying(&e))?;
         store
             .conn
-            .execute("VACUUM INTO ?1", [target.to_string_lossy()])
-            .map_err(|e| copying(&e))?;
+            .execute(
+                "VACUUM INTO $1",
+                &[Value::Text(target.to_string_lossy().into_owned())],
+            )
+            .map_err(|e| copying(&e.why))?;
         let flags = OpenFlags::SQLITE_OPEN_READ_WRITE | OpenFlags::SQLITE_OPEN_NO_MUTEX;
-        let conn = Connection::open_with_flags(&target, flags).map_err(|e| err(e.to_string()))?;
-        let mut s = Store {
-            conn,
-            path: path.to_path_buf(),
-            _copy: Some(copy),
-        };
+        let mut s = Store::with(sqlite(&target, flags)?, location);
+        s._copy = Some(copy);
         s.migrate_with(migrations)?;
         Ok(s)
     }
 
-    fn open_with(path: &Path, create: bool) -> Result<Store, StoreError> {
-        let err = |why: String| StoreError {
-            path: path.to_path_buf(),
-            why,
+    fn open_with(given: &Path, migrations: &[&str]) -> Result<Store, StoreError> {
+        let location = Store::locate(given)?;
+        let conn = match &location {
+            Location::File(path) => {
+                let err = |why: String| StoreError {
+                    at: path.display().to_string(),
+                    why,
+                    fault: Fault::Store,
+                };
+                ppmc_files::check_replaceable(path).map_err(|e| err(e.to_string()))?;
+                // A store in a folder not there yet: the folder is made,
+                // as a report's would be.
+                if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+                    std::fs::create_dir_all(parent)
+                        .map_err(|e| err(format!("making its folder {}: {e}", parent.display())))?;
+                }
+                let flags = OpenFlags::SQLITE_OPEN_READ_WRITE
+                    | OpenFlags::SQLITE_OPEN_NOFOLLOW
+                    | OpenFlags::SQLITE_OPEN_NO_MUTEX
+                    | OpenFlags::SQLITE_OPEN_CREATE;
+                sqlite(path, flags)?
+            }
+            Location::Server(server) => Conn::Postgres(Box::new(Pg::new(connect(server)?))),
         };
-        ppmc_files::check_replaceable(path).map_err(|e| err(e.to_string()))?;
-        // A store in a folder not there yet: the folder is made, as a
-        // report's would be.
-        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-            std::fs::create_dir_all(parent)
-                .map_err(|e| err(format!("making its folder {}: {e}", parent.display())))?;
-        }
-        let mut flags = OpenFlags::SQLITE_OPEN_READ_WRITE
-            | OpenFlags::SQLITE_OPEN_NOFOLLOW
-            | OpenFlags::SQLITE_OPEN_NO_MUTEX;
-        if create {
-            flags |= OpenFlags::SQLITE_OPEN_CREATE;
-        }
-        let conn = Connection::open_with_flags(path, flags).map_err(|e| err(e.to_string()))?;
-        // Two CI jobs writing one store wait for each other, briefly.
-        conn.busy_timeout(Duration::from_secs(30))
-            .map_err(|e| err(e.to_string()))?;
-        let mut store = Store {
-            conn,
-            path: path.to_path_buf(),
-            _copy: None,
-        };
-        store.migrate()?;
+        let mut store = Store::with(conn, location);
+        store.migrate_with(migrations)?;
         Ok(store)
     }
 
-    fn fail(&self, e: impl std::fmt::Display) -> StoreError {
-        StoreError {
-            path: self.path.clone(),
-            why: e.to_string(),
+    fn with(conn: Conn, location: Location) -> Store {
+        Store {
+            conn,
+            location,
+            _copy: None,
+            rollback: false,
         }
+    }
+
+    fn fail(&self, e: impl Into<Failure>) -> StoreError {
+        let e = e.into();
+        StoreError {
+            at: self.location.shown(),
+            why: e.why,
+            fault: e.fault,
+        }
+    }
+
+    /// Which database the store is in.
+    pub fn dialect(&self) -> Dialect {
+        self.conn.dialect()
     }
 
     /// The store's schema version.
-    pub fn schema(&self) -> Result<u32, StoreError> {
-        self.conn
-            .query_row("PRAGMA user_version", [], |r| r.get(0))
-            .map_err(|e| self.fail(not_a_store(e)))
+    pub fn schema(&mut self) -> Result<u32, StoreError> {
+        schema::version(&mut self.conn).map_err(|e| self.fail(e))
     }
 
-    /// Brings the store to [`SCHEMA`], in one transaction.
-    fn migrate(&mut self) -> Result<(), StoreError> {
-        self.migrate_with(&MIGRATIONS)
+    /// Refuses a store ppmc cannot read at `schema`: a newer one, or (when
+    /// not `empty_ok`) a database with no version.
+    fn check_version(&mut self, at: u32, schema: u32, empty_ok: bool) -> Result<(), StoreError> {
+        if at > schema {
+            return Err(self.fail(DbError::corrupt(newer(at, schema))));
+        }
+        if at == 0 && !empty_ok {
+            return Err(self.fail(DbError::corrupt(match self.dialect() {
+                Dialect::Sqlite => "not a ppmc results store: it has no schema version (an empty file, or another program's SQLite file)",
+                Dialect::Postgres => "not a ppmc results store: the database has no ppmc schema (ppmc run --store URL makes one in an empty database)",
+            })));
+        }
+        Ok(())
     }
 
     /// Brings the store to the schema of `migrations`, in one transaction
-    /// that holds the write lock from its start: of two ppmc making one
-    /// new store at once, the second finds it made.
+    /// that holds off every other ppmc's migration from its start: of two
+    /// ppmc making one new store at once, the second finds it made.
     fn migrate_with(&mut self, migrations: &[&str]) -> Result<(), StoreError> {
-        let schema = migrations.len() as u32;
-        if self.schema()? == schema {
+        if self.schema()? == migrations.len() as u32 {
             return Ok(());
         }
-        let path = self.path.clone();
-        let tx = self
-            .conn
-            .transaction_with_behavior(TransactionBehavior::Immediate)
-            .map_err(|e| fail_at(&path, not_a_store(e)))?;
-        let at: u32 = tx
-            .query_row("PRAGMA user_version", [], |r| r.get(0))
-            .map_err(|e| fail_at(&path, not_a_store(e)))?;
-        if at > schema {
-            return Err(fail_at(&path, newer(at, schema)));
+        schema::begin_migration(&mut self.conn).map_err(|e| self.fail(e))?;
+        let done = self
+            .apply(migrations)
+            .and_then(|()| self.conn.batch("COMMIT").map_err(|e| self.fail(e)));
+        if done.is_err() {
+            let _ = self.conn.batch("ROLLBACK");
         }
+        done
+    }
+
+    /// The steps from the store's schema to that of `migrations`, in the
+    /// transaction begun.
+    fn apply(&mut self, migrations: &[&str]) -> Result<(), StoreError> {
+        let schema = migrations.len() as u32;
+        let at = self.schema()?;
+        self.check_version(at, schema, true)?;
         if at == schema {
             return Ok(());
         }
-        if at == 0 {
-            // Version 0 is a new, empty file, or some other SQLite file.
-            let tables: i64 = tx
-                .query_row("SELECT count(*) FROM sqlite_master", [], |r| r.get(0))
-                .map_err(|e| fail_at(&path, not_a_store(e)))?;
-            if tables > 0 {
-                return Err(fail_at(
-                    &path,
-                    "an SQLite file that is not a ppmc results store (it has tables, and no schema version)",
-                ));
-            }
+        if at == 0 && schema::tables(&mut self.conn).map_err(|e| self.fail(e))? > 0 {
+            return Err(self.fail(DbError::corrupt(match self.dialect() {
+                Dialect::Sqlite => "an SQLite file that is not a ppmc results store (it has tables, and no schema version)",
+                Dialect::Postgres => "a database that is not a ppmc results store (it has tables, and no ppmc schema): give ppmc a database of its own",
+            })));
         }
+        let dialect = self.dialect();
         for (n, step) in migrations.iter().enumerate().skip(at as usize) {
-            tx.execute_batch(step)
-                .map_err(|e| fail_at(&path, format!("migrating to schema {}: {e}", n + 1)))?;
+            self.conn
+                .batch(&schema::render(step, dialect))
+                .map_err(|e| self.fail(format!("migrating to schema {}: {}", n + 1, e.why)))?;
         }
-        tx.pragma_update(None, "user_version", schema)
-            .map_err(|e| fail_at(&path, e))?;
-        tx.commit().map_err(|e| fail_at(&path, e))
+        schema::set_version(&mut self.conn, schema).map_err(|e| self.fail(e))
     }
 
     /// Adds a run record, in one transaction: the run, its boards, every
-    /// result and measurement. Returns the run's id in the store.
-    pub fn add(&mut self, record: &RunRecord) -> Result<i64, StoreError> {
-        let path = self.path.clone();
-        let text = stored_text(record).map_err(|e| fail_at(&path, e))?;
-        let tx = self.conn.transaction().map_err(|e| fail_at(&path, e))?;
-        let id = insert(&tx, record, &text).map_err(|e| fail_at(&path, e))?;
-        tx.commit().map_err(|e| fail_at(&path, e))?;
-        Ok(id)
+    /// result and measurement. A record already there (the same run's id;
+    /// for a record with none, the same text) is kept once.
+    pub fn add(&mut self, record: &RunRecord) -> Result<Added, StoreError> {
+        let text = stored_text(record).map_err(|e| self.fail(e.to_string()))?;
+        let key = record.run.id.clone().unwrap_or_else(|| {
+            format!(
+                "text:{}",
+                uuid::Uuid::new_v5(&uuid::Uuid::NAMESPACE_OID, text.as_bytes())
+            )
+        });
+        // A server that closed an idle connection during a long run is
+        // asked again, once.
+        if let (Conn::Postgres(pg), Location::Server(server)) = (&mut self.conn, &self.location) {
+            if pg.client.is_closed() {
+                **pg = Pg::new(connect(server)?);
+            }
+        }
+        self.conn.batch("BEGIN").map_err(|e| self.fail(e))?;
+        let done = insert(&mut self.conn, record, &text, &key).and_then(|added| {
+            self.conn.batch("COMMIT")?;
+            Ok(added)
+        });
+        if done.is_err() {
+            let _ = self.conn.batch("ROLLBACK");
+        }
+        done.map_err(|e| self.fail(e))
     }
 
     /// How many runs the store holds.
-    pub fn runs(&self) -> Result<u64, StoreError> {
-        self.conn
-            .query_row("SELECT count(*) FROM runs", [], |r| r.get(0))
-            .map_err(|e| self.fail(e))
+    pub fn runs(&mut self) -> Result<u64, StoreError> {
+        let n = self.conn.row("SELECT count(*) FROM runs", &[]);
+        n.and_then(|r| r.uint(0)).map_err(|e| self.fail(e))
     }
 
-    pub fn path(&self) -> &Path {
-        &self.path
+    /// Where the store is, as messages name it (never a password).
+    pub fn shown(&self) -> String {
+        self.location.shown()
     }
 
-    pub(crate) fn conn(&self) -> &Connection {
-        &self.conn
+    pub(crate) fn conn(&mut self) -> &mut Conn {
+        &mut self.conn
     }
+}
+
+impl Drop for Store {
+    fn drop(&mut self) {
+        if self.rollback {
+            let _ = self.conn.batch("ROLLBACK");
+        }
+    }
+}
+
+/// Why, and whose.
+#[derive(Debug)]
+struct Failure {
+    why: String,
+    fault: Fault,
+}
+
+impl From<DbError> for Failure {
+    fn from(e: DbError) -> Failure {
+        Failure {
+            why: e.why,
+            fault: e.fault,
+        }
+    }
+}
+
+impl From<String> for Failure {
+    fn from(why: String) -> Failure {
+        Failure {
+            why,
+            fault: Fault::Other,
+        }
+    }
+}
+
+fn sqlite(path: &Path, flags: OpenFlags) -> Result<Conn, StoreError> {
+    let fail = |e: rusqlite::Error| {
+        let e = DbError::from(e);
+        StoreError {
+            at: path.display().to_string(),
+            why: e.why,
+            // A file SQLite cannot open is the user's path.
+            fault: Fault::Store,
+        }
+    };
+    let conn = Connection::open_with_flags(path, flags).map_err(fail)?;
+    // Two CI jobs writing one store wait for each other, briefly.
+    conn.busy_timeout(Duration::from_secs(30)).map_err(fail)?;
+    Ok(Conn::Sqlite(conn))
+}
+
+fn connect(server: &Server) -> Result<postgres::Client, StoreError> {
+    server.connect().map_err(|e| StoreError {
+        at: server.shown.clone(),
+        why: format!("cannot reach the store's server: {}", e.why),
+        fault: match e.fault {
+            Fault::Store => Fault::Store,
+            _ => Fault::Link,
+        },
+    })
 }
 
 /// The refusal of a store a newer ppmc made.
@@ -313,23 +396,6 @@ fn newer(at: u32, schema: u32) -> String {
     format!(
         "a results store of schema {at}, made by a newer ppmc; this one reads schemas up to {schema}: update ppmc"
     )
-}
-
-fn fail_at(path: &Path, e: impl std::fmt::Display) -> StoreError {
-    StoreError {
-        path: path.to_path_buf(),
-        why: e.to_string(),
-    }
-}
-
-/// SQLite's word for a file that is not a database, in ours.
-fn not_a_store(e: rusqlite::Error) -> String {
-    match e.sqlite_error_code() {
-        Some(rusqlite::ErrorCode::NotADatabase) => {
-            "not a results store (not an SQLite file)".to_string()
-        }
-        _ => e.to_string(),
-    }
 }
 
 /// The record as the store keeps it: without its figures, which only the
@@ -343,63 +409,65 @@ fn stored_text(record: &RunRecord) -> Result<String, serde_json::Error> {
     serde_json::to_string(&kept)
 }
 
-fn insert(tx: &Transaction, r: &RunRecord, text: &str) -> rusqlite::Result<i64> {
+fn int(v: impl TryInto<i64>) -> Value {
+    // Counts and nanoseconds: far below i64's end in any run.
+    Value::Int(v.try_into().unwrap_or(i64::MAX))
+}
+
+fn insert(c: &mut Conn, r: &RunRecord, text: &str, key: &str) -> Result<Added, DbError> {
     let s = &r.summary;
     let source = if r.run.source.is_some() {
         "capture"
     } else {
         "boards"
     };
-    tx.execute(
+    let run = c.query(
         "INSERT INTO runs (started, harness_version, git_revision, host, source, wall_s,
-             passed, marginal, flaky, failed, errors, not_run, record)
-         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13)",
-        params![
-            r.run.started,
-            r.run.harness_version,
-            r.run.git_revision,
-            r.run.host,
-            source,
-            r.run.wall_s,
-            s.passed,
-            s.marginal,
-            s.flaky,
-            s.failed,
-            s.errors,
-            s.not_run,
-            text,
+             passed, marginal, flaky, failed, errors, not_run, record, run_key)
+         VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14)
+         ON CONFLICT (run_key) DO NOTHING RETURNING id",
+        &[
+            r.run.started.as_str().into(),
+            r.run.harness_version.as_str().into(),
+            r.run.git_revision.as_str().into(),
+            r.run.host.as_str().into(),
+            source.into(),
+            r.run.wall_s.into(),
+            int(s.passed),
+            int(s.marginal),
+            int(s.flaky),
+            int(s.failed),
+            int(s.errors),
+            int(s.not_run),
+            text.into(),
+            key.into(),
         ],
     )?;
-    let run = tx.last_insert_rowid();
+    let Some(run) = run.first() else {
+        return Ok(Added::Already);
+    };
+    let run = run.int(0)?;
     let mut board_ids = Vec::with_capacity(r.run.boards.len());
     for b in &r.run.boards {
-        tx.execute(
-            "INSERT INTO boards (run_id, name, target, board_serial, board_rev,
-                 bridge_firmware, bridge_serial, reached)
-             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
-            params![
-                run,
-                b.name,
-                b.target,
-                b.board_serial,
-                b.board_rev,
-                b.bridge_firmware,
-                b.bridge_serial,
-                b.error.is_none(),
-            ],
-        )?;
-        board_ids.push((b.name.as_str(), tx.last_insert_rowid()));
+        let id = c
+            .row(
+                "INSERT INTO boards (run_id, name, target, board_serial, board_rev,
+                     bridge_firmware, bridge_serial, reached)
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8) RETURNING id",
+                &[
+                    run.into(),
+                    b.name.as_str().into(),
+                    b.target.as_str().into(),
+                    b.board_serial.clone().into(),
+                    b.board_rev.clone().into(),
+                    b.bridge_firmware.clone().into(),
+                    b.bridge_serial.clone().into(),
+                    int(b.error.is_none()),
+                ],
+            )?
+            .int(0)?;
+        board_ids.push((b.name.as_str(), id));
     }
-    let mut result = tx.prepare(
-        "INSERT INTO results (run_id, board_id, scenario, section, pass, verdict, blame,
-             attempts, elapsed_ns, detail)
-         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)",
-    )?;
-    let mut measure = tx.prepare(
-        "INSERT INTO measurements (result_id, name, value_ns, lo_ns, hi_ns, marginal_lo_ns,
-             marginal_hi_ns, grade)
-         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
-    )?;
     for sc in &r.scenarios {
         let board = sc
             .board
@@ -412,33 +480,44 @@ fn insert(tx: &Transaction, r: &RunRecord, text: &str) -> rusqlite::Result<i64> 
             .map(|f| format!("{}: expected {}, got {}", f.expectation, f.expected, f.got))
             .or_else(|| sc.error.as_ref().map(|e| e.message.clone()))
             .or_else(|| sc.detail.clone());
-        result.execute(params![
-            run,
-            board,
-            sc.name,
-            sc.section,
-            sc.pass,
-            sc.verdict.name(),
-            sc.blame.flatten().map(|b| b.name()),
-            sc.attempts.len() as i64 + 1,
-            sc.elapsed_ns as i64,
-            detail,
-        ])?;
-        let rid = tx.last_insert_rowid();
+        let rid = c
+            .row(
+                "INSERT INTO results (run_id, board_id, scenario, section, pass, verdict, blame,
+                     attempts, elapsed_ns, detail)
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10) RETURNING id",
+                &[
+                    run.into(),
+                    board.into(),
+                    sc.name.as_str().into(),
+                    sc.section.as_str().into(),
+                    sc.pass.map(int).unwrap_or(Value::Null),
+                    sc.verdict.name().into(),
+                    sc.blame.flatten().map(|b| b.name()).into(),
+                    int(sc.attempts.len() + 1),
+                    int(sc.elapsed_ns),
+                    detail.into(),
+                ],
+            )?
+            .int(0)?;
         for m in &sc.measurements {
-            measure.execute(params![
-                rid,
-                m.name,
-                m.value.as_nanos() as i64,
-                m.lo.as_nanos() as i64,
-                m.hi_ns().map(|v| v as i64),
-                m.marginal_lo.as_nanos() as i64,
-                m.marginal_hi_ns().map(|v| v as i64),
-                m.grade.name(),
-            ])?;
+            c.execute(
+                "INSERT INTO measurements (result_id, name, value_ns, lo_ns, hi_ns, marginal_lo_ns,
+                     marginal_hi_ns, grade)
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8)",
+                &[
+                    rid.into(),
+                    m.name.as_str().into(),
+                    int(m.value.as_nanos()),
+                    int(m.lo.as_nanos()),
+                    m.hi_ns().map(int).unwrap_or(Value::Null),
+                    int(m.marginal_lo.as_nanos()),
+                    m.marginal_hi_ns().map(int).unwrap_or(Value::Null),
+                    m.grade.name().into(),
+                ],
+            )?;
         }
     }
-    Ok(run)
+    Ok(Added::New(run))
 }
 
 #[cfg(test)]
@@ -447,32 +526,45 @@ mod tests {
 
     /// An older store is read through a migrated copy: the copy is at the
     /// newer schema (a column a later ppmc added is there), the file
-    /// itself is not touched. Schema 2 here is a stand-in for the next.
+    /// itself is not touched. The step after the last is a stand-in for
+    /// the next.
     #[test]
     fn an_older_store_is_read_through_a_migrated_copy() {
         let dir = tempfile::tempdir().expect("scratch");
         let path = dir.path().join("old.db");
-        drop(Store::open(&path).expect("made at schema 1"));
+        drop(Store::open(&path).expect("made at this schema"));
         let before = std::fs::read(&path).expect("read");
-        let next = [MIGRATIONS[0], "ALTER TABLE runs ADD COLUMN note TEXT;"];
-        let s = Store::open_existing_with(&path, &next).expect("read at schema 2");
-        assert_eq!(s.schema().expect("schema"), 2);
-        let n: i64 = s
+        let next = [
+            MIGRATIONS[0],
+            MIGRATIONS[1],
+            "ALTER TABLE runs ADD COLUMN note TEXT;",
+        ];
+        let mut s = Store::open_existing_with(&path, &next).expect("read at the next schema");
+        assert_eq!(s.schema().expect("schema"), SCHEMA + 1);
+        let n = s
             .conn()
-            .query_row("SELECT count(note) FROM runs", [], |r| r.get(0))
+            .row("SELECT count(note) FROM runs", &[])
+            .and_then(|r| r.int(0))
             .expect("the new column");
         assert_eq!(n, 0);
         drop(s);
         assert_eq!(std::fs::read(&path).expect("read"), before, "untouched");
-        // The other way round, a store of schema 2 is refused by schema 1.
+        // The other way round, a store of the next schema is refused by
+        // this one.
         let newer_path = dir.path().join("new.db");
         let mut s = Store::open(&newer_path).expect("made");
-        s.migrate_with(&next).expect("to 2");
+        s.migrate_with(&next).expect("to the next");
         drop(s);
         let e = Store::open_existing(&newer_path).expect_err("refused");
         assert!(
-            e.to_string().contains("schema 2, made by a newer ppmc"),
+            e.to_string()
+                .contains(&format!("schema {}, made by a newer ppmc", SCHEMA + 1)),
             "{e}"
+        );
+        assert_eq!(
+            e.fault,
+            Fault::Store,
+            "a store this ppmc cannot read is bad input"
         );
     }
 }

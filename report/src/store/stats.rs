@@ -9,6 +9,7 @@
 //! flaky result passed, and is counted as flaky too; so did a result
 //! judged from a capture that blames the host firmware, not the board).
 
+use super::db::{Conn, DbError};
 use super::{Store, StoreError};
 use std::collections::BTreeMap;
 
@@ -231,26 +232,31 @@ const REV: &str = "coalesce(b.board_rev, '(none)')";
 
 impl Store {
     /// What the store says across all its runs.
-    pub fn history(&self) -> Result<History, StoreError> {
-        let q = |e: rusqlite::Error| self.fail(format!("reading the store: {e}"));
-        let c = self.conn();
+    pub fn history(&mut self) -> Result<History, StoreError> {
         let mut h = History {
             runs: self.runs()?,
             ..History::default()
         };
-        h.boards = c
-            .query_row(
-                &format!("SELECT count(DISTINCT {BOARD}) FROM boards b WHERE b.reached"),
-                [],
-                |r| r.get(0),
-            )
-            .map_err(q)?;
-        h.span = c
-            .query_row("SELECT min(started), max(started) FROM runs", [], |r| {
-                Ok(r.get::<_, Option<String>>(0)?
-                    .zip(r.get::<_, Option<String>>(1)?))
+        let read = self.read(&mut h);
+        read.map_err(|e| {
+            self.fail(DbError {
+                why: format!("reading the store: {}", e.why),
+                fault: e.fault,
             })
-            .map_err(q)?;
+        })?;
+        Ok(h)
+    }
+
+    fn read(&mut self, h: &mut History) -> Result<(), DbError> {
+        let c = self.conn();
+        h.boards = c
+            .row(
+                &format!("SELECT count(DISTINCT {BOARD}) FROM boards b WHERE b.reached <> 0"),
+                &[],
+            )?
+            .uint(0)?;
+        let span = c.row("SELECT min(started), max(started) FROM runs", &[])?;
+        h.span = span.opt_text(0)?.zip(span.opt_text(1)?);
         // Each board test: its revision, board, and whether it passed.
         let tests = format!(
             "SELECT b.id AS id, b.run_id AS run_id, {REV} AS rev, {BOARD} AS board,
@@ -260,119 +266,108 @@ impl Store {
                           OR r.blame = 'host')) AS passed,
                 (SELECT count(*) FROM results r WHERE r.board_id = b.id
                      AND r.verdict = 'flaky') AS flaky
-             FROM boards b WHERE b.reached"
+             FROM boards b WHERE b.reached <> 0"
         );
-        let mut st = c
-            .prepare(&format!(
-                "SELECT rev, count(*), sum(results > 0 AND passed = results),
-                     count(DISTINCT board), sum(flaky)
-                 FROM ({tests}) GROUP BY rev ORDER BY rev"
-            ))
-            .map_err(q)?;
-        h.revisions = st
-            .query_map([], |r| {
+        h.revisions = c
+            .query(
+                &format!(
+                    "SELECT rev, count(*), count(CASE WHEN results > 0 AND passed = results THEN 1 END),
+                         count(DISTINCT board), CAST(sum(flaky) AS BIGINT)
+                     FROM ({tests}) t GROUP BY rev ORDER BY rev"
+                ),
+                &[],
+            )?
+            .iter()
+            .map(|r| {
                 Ok(RevisionYield {
-                    rev: r.get(0)?,
-                    tests: r.get(1)?,
-                    passed: r.get(2)?,
-                    boards: r.get(3)?,
-                    flaky: r.get(4)?,
+                    rev: r.text(0)?,
+                    tests: r.uint(1)?,
+                    passed: r.uint(2)?,
+                    boards: r.uint(3)?,
+                    flaky: r.uint(4)?,
                 })
             })
-            .map_err(q)?
-            .collect::<Result<_, _>>()
-            .map_err(q)?;
-        let mut st = c
-            .prepare(&format!(
-                "SELECT run_id, coalesce((SELECT started FROM runs WHERE id = run_id), ''), rev, board,
-                     results, passed, coalesce((SELECT host FROM runs WHERE id = run_id), '')
-                 FROM ({tests}) ORDER BY 2, run_id, id"
-            ))
-            .map_err(q)?;
-        h.trend = st
-            .query_map([], |r| {
+            .collect::<Result<_, DbError>>()?;
+        h.trend = c
+            .query(
+                &format!(
+                    "SELECT run_id, coalesce((SELECT started FROM runs WHERE id = run_id), ''), rev, board,
+                         results, passed, coalesce((SELECT host FROM runs WHERE id = run_id), '')
+                     FROM ({tests}) t ORDER BY 2, run_id, id"
+                ),
+                &[],
+            )?
+            .iter()
+            .map(|r| {
                 Ok(TrendPoint {
-                    run: r.get(0)?,
-                    started: r.get(1)?,
-                    rev: r.get(2)?,
-                    board: r.get(3)?,
-                    results: r.get(4)?,
-                    passed: r.get(5)?,
-                    station: r.get(6)?,
+                    run: r.int(0)?,
+                    started: r.text(1)?,
+                    rev: r.text(2)?,
+                    board: r.text(3)?,
+                    results: r.uint(4)?,
+                    passed: r.uint(5)?,
+                    station: r.text(6)?,
                 })
             })
-            .map_err(q)?
-            .collect::<Result<_, _>>()
-            .map_err(q)?;
-        let mut st = c
-            .prepare(&format!(
-                "SELECT r.scenario, min(r.section), count(*),
-                     sum(r.verdict IN ('passed', 'marginal')), sum(r.verdict = 'flaky'),
-                     sum(r.verdict = 'failed'), sum(r.verdict = 'error'),
-                     sum(r.verdict = 'not_run'),
-                     count(DISTINCT CASE WHEN b.reached THEN {BOARD} END)
-                 FROM results r LEFT JOIN boards b ON b.id = r.board_id
-                 GROUP BY r.scenario"
-            ))
-            .map_err(q)?;
-        h.scenarios = st
-            .query_map([], |r| {
+            .collect::<Result<_, DbError>>()?;
+        let mut scenarios: Vec<ScenarioRate> = c
+            .query(
+                &format!(
+                    "SELECT r.scenario, min(r.section), count(*),
+                         count(CASE WHEN r.verdict IN ('passed', 'marginal') THEN 1 END),
+                         count(CASE WHEN r.verdict = 'flaky' THEN 1 END),
+                         count(CASE WHEN r.verdict = 'failed' THEN 1 END),
+                         count(CASE WHEN r.verdict = 'error' THEN 1 END),
+                         count(CASE WHEN r.verdict = 'not_run' THEN 1 END),
+                         count(DISTINCT CASE WHEN b.reached <> 0 THEN {BOARD} END)
+                     FROM results r LEFT JOIN boards b ON b.id = r.board_id
+                     GROUP BY r.scenario"
+                ),
+                &[],
+            )?
+            .iter()
+            .map(|r| {
                 Ok(ScenarioRate {
-                    scenario: r.get(0)?,
-                    section: r.get(1)?,
-                    results: r.get(2)?,
-                    passed: r.get(3)?,
-                    flaky: r.get(4)?,
-                    failed: r.get(5)?,
-                    errors: r.get(6)?,
-                    not_run: r.get(7)?,
-                    boards: r.get(8)?,
+                    scenario: r.text(0)?,
+                    section: r.text(1)?,
+                    results: r.uint(2)?,
+                    passed: r.uint(3)?,
+                    flaky: r.uint(4)?,
+                    failed: r.uint(5)?,
+                    errors: r.uint(6)?,
+                    not_run: r.uint(7)?,
+                    boards: r.uint(8)?,
                 })
             })
-            .map_err(q)?
-            .collect::<Result<_, _>>()
-            .map_err(q)?;
-        h.scenarios.sort_by(|a, b| {
+            .collect::<Result<_, DbError>>()?;
+        scenarios.sort_by(|a, b| {
             a.rate()
                 .total_cmp(&b.rate())
                 .then_with(|| a.scenario.cmp(&b.scenario))
         });
-        h.measurements = self.distributions()?;
-        Ok(h)
+        h.scenarios = scenarios;
+        h.measurements = distributions(c)?;
+        Ok(())
     }
+}
 
-    /// Each measurement's values per scenario and revision.
-    fn distributions(&self) -> Result<Vec<Distribution>, StoreError> {
-        let q = |e: rusqlite::Error| self.fail(format!("reading the store: {e}"));
-        let mut st = self
-            .conn()
-            .prepare(&format!(
-                "SELECT r.scenario, m.name, {REV}, m.value_ns, m.lo_ns, m.hi_ns,
-                     m.marginal_lo_ns, m.marginal_hi_ns
-                 FROM measurements m JOIN results r ON r.id = m.result_id
-                     LEFT JOIN boards b ON b.id = r.board_id
-                 ORDER BY m.rowid"
-            ))
-            .map_err(q)?;
-        let mut groups: BTreeMap<(String, String, String), Distribution> = BTreeMap::new();
-        let rows = st
-            .query_map([], |r| {
-                Ok((
-                    (
-                        r.get::<_, String>(0)?,
-                        r.get::<_, String>(1)?,
-                        r.get::<_, String>(2)?,
-                    ),
-                    r.get::<_, u64>(3)?,
-                    r.get::<_, u64>(4)?,
-                    r.get::<_, Option<u64>>(5)?,
-                    r.get::<_, u64>(6)?,
-                    r.get::<_, Option<u64>>(7)?,
-                ))
-            })
-            .map_err(q)?;
-        for row in rows {
-            let ((scenario, name, rev), v, lo, hi, mlo, mhi) = row.map_err(q)?;
+/// Each measurement's values per scenario and revision, in the order they
+/// were kept.
+fn distributions(c: &mut Conn) -> Result<Vec<Distribution>, DbError> {
+    let mut groups: BTreeMap<(String, String, String), Distribution> = BTreeMap::new();
+    c.for_each(
+        &format!(
+            "SELECT r.scenario, m.name, {REV}, m.value_ns, m.lo_ns, m.hi_ns,
+                 m.marginal_lo_ns, m.marginal_hi_ns
+             FROM measurements m JOIN results r ON r.id = m.result_id
+                 LEFT JOIN boards b ON b.id = r.board_id
+             ORDER BY m.result_id, m.name, m.value_ns"
+        ),
+        &[],
+        |r| {
+            let (scenario, name, rev) = (r.text(0)?, r.text(1)?, r.text(2)?);
+            let (v, lo, hi) = (r.uint(3)?, r.uint(4)?, r.opt_uint(5)?);
+            let (mlo, mhi) = (r.uint(6)?, r.opt_uint(7)?);
             let place = match hi {
                 Some(hi) if hi > lo => (v as f64 - lo as f64) / (hi - lo) as f64,
                 Some(_) => 0.5,
@@ -401,16 +396,17 @@ impl Store {
             d.max_ns = d.max_ns.max(v);
             d.values.push(v);
             d.positions.push(place);
-        }
-        Ok(groups
-            .into_values()
-            .map(|mut d| {
-                let xs: Vec<f64> = d.values.iter().map(|&v| v as f64).collect();
-                d.mean_ns = mean_sd(&xs).0;
-                d
-            })
-            .collect())
-    }
+            Ok(())
+        },
+    )?;
+    Ok(groups
+        .into_values()
+        .map(|mut d| {
+            let xs: Vec<f64> = d.values.iter().map(|&v| v as f64).collect();
+            d.mean_ns = mean_sd(&xs).0;
+            d
+        })
+        .collect())
 }
 
 #[cfg(test)]
