@@ -21,9 +21,10 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 /// The files whose commands run.
-const FILES: [&str; 14] = [
+const FILES: [&str; 15] = [
     "README.md",
     "docs/reports.md",
+    "docs/results-store.md",
     "docs/capture.md",
     "docs/board-farm.md",
     "firmware/README.md",
@@ -420,8 +421,22 @@ fn workspace(tag: &str) -> tempfile::TempDir {
     dir
 }
 
+/// The lab's PostgreSQL store of docs/board-farm.md, which a throwaway
+/// server's database stands for (`ppmc_test_support::postgres`).
+const LAB_STORE: &str = "postgres://ppmc@db.lab:5432/results";
+
+/// What a file's commands share: the bridges its board ports stand for,
+/// and the lab's store (`None` until a command names it; `Some(None)`
+/// where this machine has no PostgreSQL, outside CI).
+#[derive(Default)]
+struct Lab {
+    boards: [Option<Bridge>; 2],
+    store: Option<Option<ppmc_test_support::postgres::Db>>,
+}
+
 /// Runs one documented `ppmc` command in `dir`; `Err` says what is wrong.
-fn run(doc: &Doc, args: &str, dir: &Path, boards: &mut [Option<Bridge>; 2]) -> Result<(), String> {
+fn run(doc: &Doc, args: &str, dir: &Path, lab: &mut Lab) -> Result<(), String> {
+    let boards = &mut lab.boards;
     let mut args = args.to_string();
     for (from, to) in SHRINK {
         args = args.replace(from, to);
@@ -433,6 +448,18 @@ fn run(doc: &Doc, args: &str, dir: &Path, boards: &mut [Option<Bridge>; 2]) -> R
         argv.truncate(i);
         file
     });
+    if argv.iter().any(|a| a.contains(LAB_STORE)) {
+        let db = lab
+            .store
+            .get_or_insert_with(ppmc_test_support::postgres::Db::new);
+        let Some(db) = db else {
+            eprintln!("{doc}: skipped: no PostgreSQL here");
+            return Ok(());
+        };
+        for a in &mut argv {
+            *a = a.replace(LAB_STORE, &db.url);
+        }
+    }
     if argv.first().map(String::as_str) == Some("bridge-sim") {
         // Started, must say where it serves, stopped.
         Bridge::start(dir, "doc-bridge", &argv[1..])?;
@@ -530,7 +557,7 @@ fn check_file(file: &'static str, ci: &str, labgrid: &str) -> (usize, Vec<String
     let mut bad = Vec::new();
     let mut ran = 0;
     let dir = workspace("docs");
-    let mut boards = [None, None];
+    let mut lab = Lab::default();
     for doc in commands(file) {
         if doc.command.contains('<') && !doc.command.contains(" < ") {
             // A template (`crash-<hash>`): the loop it shows runs in
@@ -546,7 +573,7 @@ fn check_file(file: &'static str, ci: &str, labgrid: &str) -> (usize, Vec<String
                 continue;
             }
             ran += 1;
-            if let Err(e) = run(&doc, &args, dir.path(), &mut boards) {
+            if let Err(e) = run(&doc, &args, dir.path(), &mut lab) {
                 bad.push(format!("{doc}: {e}"));
             }
             continue;
@@ -655,7 +682,7 @@ fn the_extraction_reads_commands_as_a_shell_would() {
         &doc,
         "export out/nothing.trace -o wave.vcd",
         dir.path(),
-        &mut [None, None],
+        &mut Lab::default(),
     )
     .expect_err("a file a clean checkout lacks");
     assert!(e.contains("exit status Some(2)"), "{e}");

@@ -26,5 +26,6 @@ mod layers;
 mod report_html;
 mod reports;
 mod results_store;
+mod shared_store;
 mod suite_captures;
 mod vcd_sigrok;

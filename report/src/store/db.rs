@@ -94,7 +94,9 @@ impl From<rusqlite::Error> for DbError {
                 | C::CannotOpen
                 | C::ReadOnly
                 | C::PermissionDenied
-                | C::OperationInterrupted,
+                | C::OperationInterrupted
+                // A trigger or a key of the lab's refused the row.
+                | C::ConstraintViolation,
             ) => DbError::new(e.to_string()),
             // Damage, a table or column gone, a value of the wrong type:
             // the store is not as ppmc made it.
