@@ -142,7 +142,18 @@ enum Command {
 /// }
 /// ```
 pub fn main(suite: Vec<Scenario>) -> ExitCode {
+    // Held until the command's handlers are in (signals.rs); a binary
+    // holds them itself first thing (hold_signals), before building its
+    // suite.
+    signals::hold();
     let cli: Cli = suggest::parse();
+    // Only these install handlers (and let the signals go as they do).
+    if !matches!(
+        cli.command,
+        Command::Run(_) | Command::Selftest(_) | Command::BridgeSim(_) | Command::ChaosProxy(_)
+    ) {
+        signals::release();
+    }
     out::set_color(cli.color);
     let suite = &suite;
     let done = match cli.command {
@@ -168,6 +179,14 @@ pub fn main(suite: Vec<Scenario>) -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => e.exit(),
     }
+}
+
+/// Holds SIGINT and SIGTERM from a binary's first instruction until the
+/// command's handlers are in place, so that a run stopped at once still
+/// writes its reports: call it first in `main`, before the suite is built
+/// and [`main`] runs.
+pub fn hold_signals() {
+    signals::hold();
 }
 
 /// Why a command did not end in success. Every command returns it, and

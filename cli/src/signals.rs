@@ -11,6 +11,14 @@
 //!
 //! [`stop_requested`] serves commands with nothing to save: a second
 //! signal ends them at once.
+//!
+//! From the process's first instruction until a command's handlers are in
+//! place, SIGINT and SIGTERM are held ([`hold`]): one that comes while the
+//! arguments are read waits, and reaches the handler the moment it is
+//! installed, so a run stopped in its first milliseconds still leaves its
+//! reports (it left none in 11 of 40 tries, issue 44). A command that
+//! installs no handler lets them go ([`release`]) and ends as any process
+//! does.
 
 use ppmc::stop::StopRequest;
 use std::sync::atomic::AtomicBool;
@@ -19,6 +27,31 @@ use std::sync::Arc;
 /// Signals this close together are one request (a sender that signals
 /// both the process and its group).
 const SAME_REQUEST: std::time::Duration = std::time::Duration::from_millis(200);
+
+/// The two signals a command stops on.
+#[cfg(unix)]
+fn stop_signals() -> nix::sys::signal::SigSet {
+    use nix::sys::signal::{SigSet, Signal};
+    let mut set = SigSet::empty();
+    set.add(Signal::SIGINT);
+    set.add(Signal::SIGTERM);
+    set
+}
+
+/// Holds SIGINT and SIGTERM until [`release`]: call it first, before any
+/// thread is started (each thread takes the mask of the one that started
+/// it).
+pub fn hold() {
+    #[cfg(unix)]
+    let _ = stop_signals().thread_block();
+}
+
+/// Lets held signals go: one that came meanwhile is delivered now, to the
+/// handler installed, or with its default action where there is none.
+pub fn release() {
+    #[cfg(unix)]
+    let _ = stop_signals().thread_unblock();
+}
 
 /// Installs the handlers of a command that writes reports; the [`StopRequest`]
 /// they raise. A thread of its own takes the signals (the handler itself
@@ -51,6 +84,8 @@ pub fn install() -> StopRequest {
                 });
         }
     }
+    // The handler is in: a signal held since the start arrives now.
+    release();
     stop
 }
 
@@ -65,5 +100,6 @@ pub fn stop_requested() -> Arc<AtomicBool> {
         let _ = signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&flag));
         let _ = signal_hook::flag::register(sig, Arc::clone(&flag));
     }
+    release();
     flag
 }

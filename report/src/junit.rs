@@ -15,7 +15,8 @@ use std::fmt::Write as _;
 /// virtual time as a suite property per case; a failure or error carries
 /// its explanation in `message` and as its text; infrastructure problems
 /// (target unreachable or lost) are errors, an interrupted run's leftovers
-/// are skipped; the files saved for each result (its `attachments`) are
+/// are skipped, and the suite counts one error more for the interruption,
+/// which its `system-err` explains; the files saved for each result (its `attachments`) are
 /// `[[ATTACHMENT|path]]` lines in `system-out`.
 ///
 /// A run on one board is one test suite with the board's facts as
@@ -69,9 +70,25 @@ pub fn junit(record: &RunRecord) -> String {
             .filter(|c| element(c).is_some_and(|(t, _, _)| t == tag))
             .count()
     };
+    // The runs an interrupted run never reached: each case skipped, and
+    // its suite an error of its own, so that a CI page that reads only the
+    // counts sees the run did not finish.
+    let interrupted = |cases: &[Case]| -> usize {
+        cases
+            .iter()
+            .map(|c| match c {
+                Case::One(i) => usize::from(
+                    results[*i].error.as_ref().map(|e| e.kind) == Some(ErrorKind::Interrupted),
+                ),
+                Case::Many(r) => r.interrupted,
+            })
+            .sum()
+    };
+    let suite_errors =
+        |cases: &[Case]| kind_count(cases, "error") + usize::from(interrupted(cases) > 0);
     let all: usize = groups.iter().map(|(_, c)| c.len()).sum();
     let (failures, errors): (usize, usize) = groups.iter().fold((0, 0), |(f, e), (_, c)| {
-        (f + kind_count(c, "failure"), e + kind_count(c, "error"))
+        (f + kind_count(c, "failure"), e + suite_errors(c))
     });
     let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = writeln!(
@@ -135,7 +152,7 @@ pub fn junit(record: &RunRecord) -> String {
             esc(&suite_name),
             cases.len(),
             kind_count(&cases, "failure"),
-            kind_count(&cases, "error"),
+            suite_errors(&cases),
             kind_count(&cases, "skipped"),
             esc(&info.started),
             esc(&info.host)
@@ -203,6 +220,16 @@ pub fn junit(record: &RunRecord) -> String {
                     repeated_case(&mut x, r, name, shared);
                 }
             }
+        }
+        let never = interrupted(&cases);
+        if never > 0 {
+            let _ = writeln!(
+                x,
+                "    <system-err>{}</system-err>",
+                esc(&format!(
+                    "the run was interrupted before its end (SIGINT or SIGTERM, or its standard output closed): {never} of its scenario runs here were never run, each a skipped test case; this suite counts one error for it, and ppmc exited 130"
+                ))
+            );
         }
         x.push_str("  </testsuite>\n");
     }

@@ -47,6 +47,17 @@ fn check_interrupted(dir: &Path, scenarios: usize) {
         scenarios,
         "{xml}"
     );
+    // Issue 44: the interruption is an error of the suite, said in its
+    // system-err, so that a CI page reading the counts sees the run did
+    // not finish (it read failures="0" errors="0").
+    let report = quick_junit::Report::deserialize_from_str(&xml).expect("parses");
+    assert!(report.errors >= 1, "{xml}");
+    let suite = &report.test_suites[0];
+    assert_eq!(suite.errors, 1, "{xml}");
+    assert!(
+        xml.contains("<system-err>the run was interrupted before its end"),
+        "{xml}"
+    );
     let record = record(dir);
     assert_eq!(
         record["summary"]["not_run"].as_u64(),
@@ -215,4 +226,97 @@ fn a_scenario_past_its_timeout_is_stopped_on_the_bridge_and_the_run_goes_on() {
         }
     }
     assert_eq!(record["summary"]["error"], 1, "{}", record["summary"]);
+}
+
+/// Whether `pid` holds (blocks) or catches SIGTERM, from its
+/// `/proc/PID/status`: `(held, caught)`.
+fn sigterm_state(pid: u32) -> Option<(bool, bool)> {
+    // Not before ppmc is the program: between fork and exec the C library
+    // holds every signal in the child.
+    let exe = std::fs::read_link(format!("/proc/{pid}/exe")).ok()?;
+    if exe != Path::new(env!("CARGO_BIN_EXE_ppmc")) {
+        return None;
+    }
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    let mask = |field: &str| {
+        status
+            .lines()
+            .find_map(|l| l.strip_prefix(field))
+            .and_then(|v| u64::from_str_radix(v.trim(), 16).ok())
+            .unwrap_or(0)
+    };
+    let (term, hup) = (1 << (15 - 1), 1);
+    // Held by ppmc: SIGTERM alone, not every signal as the C library
+    // holds them for a moment while it starts a thread.
+    let blocked = mask("SigBlk:");
+    Some((
+        blocked & term != 0 && blocked & hup == 0,
+        mask("SigCgt:") & term != 0,
+    ))
+}
+
+/// SIGTERM in a run's first milliseconds (issue 44: 11 of 40 such runs on
+/// the emulator left no report, the signal arriving before the handlers
+/// were installed). Forty tries: each waits until the process is in its
+/// own code (it holds SIGTERM, or already catches it; before that it is
+/// still being loaded, which no program can help), then signals it 0 to
+/// 7.8 ms later. Every run leaves both reports: a run the signal reached
+/// is interrupted (exit 130), its record valid and, where scenarios were
+/// left, its JUnit suite an error; one that ended first passed. The signal must be seen held in
+/// some tries: a ppmc that installs its handlers late, with nothing held
+/// meanwhile, shows only "caught".
+#[test]
+fn sigterm_in_the_first_milliseconds_still_leaves_the_reports() {
+    let (mut interrupted, mut held) = (0, 0);
+    for i in 0..40u64 {
+        let dir = scratch("early");
+        let mut child = run(&[], "emu", &["--skip-tag", "long"], dir.path());
+        let deadline = Instant::now() + WIND_DOWN;
+        loop {
+            match sigterm_state(child.id()) {
+                Some((true, _)) => {
+                    held += 1;
+                    break;
+                }
+                Some((false, true)) => break,
+                _ => {}
+            }
+            assert!(
+                Instant::now() < deadline,
+                "try {i}: ppmc never reached its code"
+            );
+            std::thread::yield_now();
+        }
+        std::thread::sleep(Duration::from_micros(200 * i));
+        signal(&child, "-TERM");
+        let status = wait_bounded(&mut child, WIND_DOWN);
+        let xml = std::fs::read_to_string(dir.path().join("report.xml"))
+            .unwrap_or_else(|e| panic!("try {i} ({status}): no JUnit report: {e}"));
+        let record = record(dir.path());
+        match status.code() {
+            // Interrupted: the scenarios it did not reach are in the
+            // reports (none when the signal came after the last one).
+            Some(130) => {
+                let never = record["summary"]["not_run"].as_u64().unwrap_or(0);
+                interrupted += usize::from(never > 0);
+                assert_eq!(
+                    xml.contains("<system-err>the run was interrupted"),
+                    never > 0,
+                    "try {i}: {never} not run"
+                );
+            }
+            Some(0) => assert_eq!(record["summary"]["not_run"].as_u64(), Some(0)),
+            other => panic!("try {i}: exit {other:?}"),
+        }
+    }
+    eprintln!("{held} of 40 tries saw SIGTERM held, {interrupted} were interrupted");
+    assert!(
+        held > 0,
+        "SIGTERM was never seen held before the handlers were in"
+    );
+    // The signal came first in most tries: the test is about them.
+    assert!(
+        interrupted >= 10,
+        "only {interrupted} of 40 runs were interrupted"
+    );
 }

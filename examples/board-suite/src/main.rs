@@ -13,6 +13,9 @@ mod x_axis;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    // First: SIGINT and SIGTERM wait for the run's handlers, so a run
+    // stopped at once still writes its reports.
+    ppmc_cli::hold_signals();
     let mut suite = ppmc_scenarios::all();
     suite.extend(x_axis::scenarios());
     ppmc_cli::main(suite)
