@@ -39,11 +39,11 @@ pub struct TargetArgs {
     link_retries: u32,
     /// The board's serial number, for the reports and the results store
     /// (a target's own `,board-serial=` overrides it).
-    #[arg(long, value_name = "SERIAL")]
+    #[arg(long, value_name = "SERIAL", value_parser = label)]
     pub(super) board_serial: Option<String>,
     /// The board's revision label, for the reports and the results store
     /// (a target's own `,rev=` overrides it).
-    #[arg(long, value_name = "REV")]
+    #[arg(long, value_name = "REV", value_parser = label)]
     pub(super) board_rev: Option<String>,
     /// Asked for (a signal), opening a target and every wait on its link
     /// end early.
@@ -352,6 +352,12 @@ impl ToleranceArgs {
 
 /// The reports a command writes of its run record (`ppmc run`, `ppmc
 /// compare`, `ppmc judge`): one group, so each flag means one thing.
+/// A board's label, as the reports and the store keep it
+/// ([`ppmc_record::check_label`]).
+pub(crate) fn label(s: &str) -> Result<String, String> {
+    ppmc_record::check_label(s).map(|()| s.to_string())
+}
+
 #[derive(Debug, Default, Clone, Args)]
 pub struct ReportArgs {
     /// Write a JUnit XML report (docs/reports.md: a test case per scenario,

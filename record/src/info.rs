@@ -119,6 +119,34 @@ impl BoardInfo {
     }
 }
 
+/// The longest board label (name, revision, serial) ppmc keeps.
+pub const MAX_LABEL: usize = 200;
+
+/// Checks a board's label (`name=`, `rev=`, `board-serial=` and their
+/// flags) as the reports and the results store keep it: printable text
+/// (no control character: a line break or a terminal's escape would garble
+/// every listing), at most [`MAX_LABEL`] characters, not empty and not
+/// `(none)`, which the reports write for a board given no label.
+pub fn check_label(label: &str) -> Result<(), String> {
+    if label.is_empty() {
+        return Err("an empty label: give one, or leave the option out".into());
+    }
+    if label == "(none)" {
+        return Err("`(none)` is what the reports write for no label: give another".into());
+    }
+    if let Some(c) = label.chars().find(|c| c.is_control()) {
+        return Err(format!(
+            "the label holds the control character {}: a label is printable text",
+            c.escape_default()
+        ));
+    }
+    let n = label.chars().count();
+    if n > MAX_LABEL {
+        return Err(format!("a label of {n} characters: at most {MAX_LABEL}"));
+    }
+    Ok(())
+}
+
 /// Facts about a run that every report carries.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunInfo {

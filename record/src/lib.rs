@@ -28,7 +28,7 @@ mod tally;
 
 pub use deviation::{human_ns, signed_ns, Bound, Deviation, DeviationUnit, Reference};
 pub use figures::{Figures, MoveFigure, PinWave, Waveform, MAX_WAVE_PULSES};
-pub use info::{rfc3339, BoardInfo, CaptureSource, RunInfo, RunOptions};
+pub use info::{check_label, rfc3339, BoardInfo, CaptureSource, RunInfo, RunOptions, MAX_LABEL};
 pub use measurement::{Grade, Grading, Measurement, MARGINAL_PCT};
 pub use result::{
     AttemptRecord, Blame, ErrorKind, ErrorRecord, FailureRecord, HostFindingRecord, RangeRecord,

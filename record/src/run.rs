@@ -123,7 +123,29 @@ impl RunRecord {
                 ))
             }
         }
-        serde_json::from_str(text).map_err(|e| err(format!("run record does not read: {e}")))
+        let record: RunRecord = serde_json::from_str(text)
+            .map_err(|e| err(format!("run record does not read: {e}")))?;
+        // Its labels as ppmc would have taken them: a store and every
+        // listing keep them (an unknown verdict is refused above, by
+        // serde, naming the verdicts there are).
+        for (i, b) in record.run.boards.iter().enumerate() {
+            let labels = [
+                ("name", Some(&b.name)),
+                ("board_rev", b.board_rev.as_ref()),
+                ("board_serial", b.board_serial.as_ref()),
+            ];
+            for (field, label) in labels {
+                if let Some(label) = label {
+                    crate::check_label(label).map_err(|why| {
+                        err(format!(
+                            "run.boards[{i}].{field} `{}`: {why}",
+                            printable(label)
+                        ))
+                    })?;
+                }
+            }
+        }
+        Ok(record)
     }
 
     /// The run record in the file at `path`.

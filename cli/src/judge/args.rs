@@ -24,10 +24,10 @@ pub struct JudgeArgs {
     #[command(flatten)]
     pub(crate) reports: ReportArgs,
     /// The board's serial number, for the reports and the store.
-    #[arg(long, value_name = "SERIAL")]
+    #[arg(long, value_name = "SERIAL", value_parser = crate::args::label)]
     pub(crate) board_serial: Option<String>,
     /// The board's revision label, for the reports and the store.
-    #[arg(long, value_name = "REV")]
+    #[arg(long, value_name = "REV", value_parser = crate::args::label)]
     pub(crate) board_rev: Option<String>,
     /// Also write the capture as a trace in our format, `DIR/<scenario>.snap`
     /// (never replacing a file there), for `ppmc compare GOLDEN --traces

@@ -197,3 +197,100 @@ fn a_store_damaged_where_reading_finds_it_is_exit_2() {
         assert!(err.contains(db_s), "{err}");
     }
 }
+
+/// Issue 44: a verdict a store's row holds that is none of ppmc's was
+/// counted in no rate without a word, and a run could keep a label that
+/// garbles every listing. Now: a label with a control character, an
+/// empty one or `(none)` is refused where it is given (flag, target
+/// option, record), and a store with a verdict of another program's is
+/// refused by `history` by name (exit 2), on both backends.
+#[test]
+fn an_unknown_verdict_or_label_is_refused_by_name() {
+    let dir = scratch("labels");
+    for args in [
+        vec!["run", "--filter", "e0_undefined", "--board-rev", "B\n2"],
+        vec!["run", "--filter", "e0_undefined", "--board-serial", ""],
+        vec![
+            "run",
+            "--filter",
+            "e0_undefined",
+            "--target",
+            "emu,rev=(none)",
+        ],
+        vec![
+            "run",
+            "--filter",
+            "e0_undefined",
+            "--target",
+            "emu,board-serial=\u{1b}[31mSN",
+        ],
+    ] {
+        let out = ppmc_in(dir.path(), &[], &args);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("label"), "{args:?}: {err}");
+    }
+    // A record of a board whose revision holds a terminal's escape.
+    let json = dir.path().join("run.json");
+    let out = ppmc_in(
+        dir.path(),
+        &[],
+        &[
+            "run",
+            "--filter",
+            "e0_undefined",
+            "--json",
+            json.to_str().expect("utf-8"),
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let mut record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("written")).expect("JSON");
+    record["run"]["boards"][0]["board_rev"] = "B\u{1b}[2J".into();
+    let planted = dir.path().join("planted.json");
+    std::fs::write(&planted, record.to_string()).expect("written");
+    let db = ppmc_test_support::postgres::Db::new();
+    let file = dir.path().join("results.db");
+    let mut stores = vec![file.to_str().expect("utf-8").to_string()];
+    stores.extend(db.as_ref().map(|d| d.url.clone()));
+    for store in &stores {
+        let out = ppmc_in(
+            dir.path(),
+            &[],
+            &[
+                "store",
+                "push",
+                "--store",
+                store,
+                planted.to_str().expect("utf-8"),
+            ],
+        );
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains("run.boards[0].board_rev `B\\u{1b}[2J`"),
+            "{err}"
+        );
+        // A verdict another program wrote into the store.
+        let out = ppmc_in(
+            dir.path(),
+            &[],
+            &[
+                "store",
+                "push",
+                "--store",
+                store,
+                json.to_str().expect("utf-8"),
+            ],
+        );
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        sql(store, "UPDATE results SET verdict = 'exploded';");
+        let out = ppmc_in(dir.path(), &[], &["history", "--store", store]);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains("verdict `exploded`, not one of ppmc's (passed, marginal, flaky, failed, error, not_run)"),
+            "{err}"
+        );
+    }
+}

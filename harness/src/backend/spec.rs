@@ -274,10 +274,11 @@ impl TargetSpec {
         };
         let text = |k: &str, v: &str| {
             if v.is_empty() {
-                Err(bad(&format!("{k}= needs a value")))
-            } else {
-                Ok(v.to_string())
+                return Err(bad(&format!("{k}= needs a value")));
             }
+            ppmc_record::check_label(v)
+                .map(|()| v.to_string())
+                .map_err(|why| bad(&format!("{k}=: {why}")))
         };
         for part in parts {
             let (k, v) = part.split_once('=').unwrap_or((part, ""));

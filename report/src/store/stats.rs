@@ -249,6 +249,7 @@ impl Store {
 
     fn read(&mut self, h: &mut History) -> Result<(), DbError> {
         let c = self.conn();
+        refuse_unknown(c)?;
         h.boards = c
             .row(
                 &format!("SELECT count(DISTINCT {BOARD}) FROM boards b WHERE b.reached <> 0"),
@@ -349,6 +350,45 @@ impl Store {
         h.measurements = distributions(c)?;
         Ok(())
     }
+}
+
+/// A store whose verdicts, blames or grades are none of ppmc's (written
+/// by another program, or edited) is refused by name: counted, they
+/// would fall out of every rate without a word.
+fn refuse_unknown(c: &mut Conn) -> Result<(), DbError> {
+    let checks = [
+        (
+            "SELECT id, verdict FROM results WHERE verdict NOT IN
+                 ('passed', 'marginal', 'flaky', 'failed', 'error', 'not_run') ORDER BY id LIMIT 1",
+            "results",
+            "verdict",
+            "passed, marginal, flaky, failed, error, not_run",
+        ),
+        (
+            "SELECT id, blame FROM results WHERE blame IS NOT NULL
+                 AND blame NOT IN ('board', 'host', 'capture') ORDER BY id LIMIT 1",
+            "results",
+            "blame",
+            "board, host, capture",
+        ),
+        (
+            "SELECT result_id, grade FROM measurements WHERE grade NOT IN
+                 ('PASS', 'MARGINAL', 'FAIL') ORDER BY result_id LIMIT 1",
+            "measurements of result",
+            "grade",
+            "PASS, MARGINAL, FAIL",
+        ),
+    ];
+    for (sql, table, column, known) in checks {
+        if let Some(row) = c.query(sql, &[])?.first() {
+            return Err(DbError::corrupt(format!(
+                "{table} {}: {column} `{}`, not one of ppmc's ({known})",
+                row.int(0)?,
+                ppmc_record::printable(&row.text(1)?)
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Each measurement's values per scenario and revision, in the order they
