@@ -414,8 +414,8 @@ impl ReportArgs {
         }
     }
 
-    /// Opens the store, if asked for ([`crate::reports::open_store`]).
+    /// Opens the store, if asked for ([`crate::store::open_store`]).
     pub fn open_store(&self) -> Result<Option<ppmc_report::store::Store>, CliError> {
-        crate::reports::open_store(self.store.as_deref())
+        crate::store::open_store(self.store.as_deref())
     }
 }

@@ -31,8 +31,8 @@ fn plural<'a>(n: u64, one: &'a str, many: &'a str) -> &'a str {
 }
 
 pub fn run(args: HistoryArgs) -> Result<(), CliError> {
-    let mut store = Store::open_existing(&args.store).map_err(crate::reports::store_error)?;
-    let h = store.history().map_err(crate::reports::store_error)?;
+    let mut store = Store::open_existing(&args.store).map_err(crate::store::store_error)?;
+    let h = store.history().map_err(crate::store::store_error)?;
     // Every text of the store printed through `p`: a label a lab script
     // planted may hold a terminal's escape sequences.
     outln!(

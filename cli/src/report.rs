@@ -43,8 +43,8 @@ pub fn run(args: ReportArgs) -> Result<(), CliError> {
                 args.output.display()
             )));
         }
-        let mut store = Store::open_existing(path).map_err(crate::reports::store_error)?;
-        let history = store.history().map_err(crate::reports::store_error)?;
+        let mut store = Store::open_existing(path).map_err(crate::store::store_error)?;
+        let history = store.history().map_err(crate::store::store_error)?;
         let page = report::history_html(&history, &args.title, &store.shown());
         files::write_report(&args.output, page.as_bytes())?;
         if args.output.as_os_str() != "-" {

@@ -7,7 +7,7 @@ use files::kind::Kind;
 use ppmc_files as files;
 use ppmc_record::RunRecord;
 use ppmc_report as report;
-use ppmc_report::store::{Added, Fault, Location, Store, StoreError};
+use ppmc_report::store::{Added, Location, Store};
 use std::path::Path;
 
 /// Where a command writes its record: each report, if asked for.
@@ -62,52 +62,10 @@ pub(super) fn write(record: &RunRecord, to: Outputs, store: Option<&mut Store>) 
                 store.shown(),
                 record.run.id.as_deref().unwrap_or("(none)")
             )),
-            Err(e) => problems.push(unsent(record, to.json, &e)),
+            Err(e) => problems.push(crate::store::unsent(record, to.json, &e)),
         }
     }
     problems
-}
-
-/// A record the store did not take is kept on disk, for `ppmc store push`
-/// to send when the store is back: the `--json` record where there is one
-/// in a file, else a record of its own in the working folder, never over
-/// another file.
-fn unsent(record: &RunRecord, json: Option<&Path>, e: &StoreError) -> String {
-    let kept = match json.filter(|p| p.as_os_str() != "-") {
-        Some(p) => Ok(p.to_path_buf()),
-        None => {
-            let id = record.run.id.as_deref().unwrap_or("run");
-            let path = std::path::PathBuf::from(format!("ppmc-unsent-{id}.json"));
-            record
-                .to_json()
-                .map_err(|e| e.to_string())
-                .and_then(|text| {
-                    files::create_new(&path, text.as_bytes()).map_err(|e| e.to_string())
-                })
-                .map(|()| path)
-        }
-    };
-    match kept {
-        Ok(path) => format!(
-            "--store {e}: the run's record was not kept in the store; it is in {}: `ppmc store push {}` sends it when the store is back",
-            path.display(),
-            path.display()
-        ),
-        Err(why) => format!(
-            "--store {e}: the run's record was not kept in the store, nor on disk ({why}): give --json FILE to keep the next one"
-        ),
-    }
-}
-
-/// A store's trouble as the command's: the store's own damage or a path
-/// or URL that cannot be one is the user's input (exit 2), wherever it
-/// was found; a server out of reach is the lab's (exit 1).
-pub(super) fn store_error(e: StoreError) -> CliError {
-    match e.fault {
-        Fault::Store => CliError::BadInput(format!("ppmc: {e}")),
-        Fault::Link => CliError::Infrastructure(e.to_string()),
-        Fault::Other => CliError::Failed(e.to_string()),
-    }
 }
 
 /// Tries the `--junit` and `--json` outputs before the work, rather than
@@ -160,18 +118,8 @@ pub(super) fn prepare_reports(
     // A report replaces only a report of its kind (or an empty file).
     let kinds = [(Kind::Junit, junit), (Kind::Json, json), (Kind::Html, html)];
     for ((flag, _), (kind, path)) in named.iter().zip(kinds) {
-        let Some(path) = path.filter(|p| p.as_os_str() != "-") else {
-            continue;
-        };
-        let found =
-            files::kind::of(path).map_err(|e| CliError::BadInput(format!("ppmc: {flag} {e}")))?;
-        if let Some(k) = found.filter(|k| *k != kind) {
-            return Err(usage(format!(
-                "{flag} {}: the file is {}, not {}: refusing to replace it (give another path, or remove the file first)",
-                path.display(),
-                k.name(),
-                kind.name()
-            )));
+        if let Some(path) = path.filter(|p| p.as_os_str() != "-") {
+            files::kind::may_replace(path, kind).map_err(|e| usage(format!("{flag} {e}")))?;
         }
     }
     let on_stdout: Vec<&str> = reports
@@ -191,17 +139,4 @@ pub(super) fn prepare_reports(
             on_stdout.join(" - and ")
         ))),
     }
-}
-
-/// Opens the results store a run will keep its record in, before the run:
-/// a store that cannot be used is found before the boards' time is spent.
-pub(super) fn open_store(path: Option<&Path>) -> Result<Option<Store>, CliError> {
-    path.map(|p| {
-        Store::open(p).map_err(|e| match e.fault {
-            // Found before the run: whatever it is, no board's time spent.
-            Fault::Link => CliError::Infrastructure(format!("ppmc: --store {e}")),
-            _ => CliError::BadInput(format!("ppmc: --store {e}")),
-        })
-    })
-    .transpose()
 }

@@ -6,8 +6,8 @@
 use crate::CliError;
 use clap::{Args, Subcommand};
 use ppmc_record::RunRecord;
-use ppmc_report::store::{Added, Store};
-use std::path::PathBuf;
+use ppmc_report::store::{Added, Fault, Store, StoreError};
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, Args)]
 pub struct StoreArgs {
@@ -35,7 +35,7 @@ enum StoreCommand {
 
 pub fn run(args: StoreArgs) -> Result<(), CliError> {
     let StoreCommand::Push { store, records } = args.command;
-    let mut store = Store::open(&store).map_err(crate::reports::store_error)?;
+    let mut store = Store::open(&store).map_err(store_error)?;
     let (mut kept, mut already, mut unreadable) = (0, 0, 0);
     for path in &records {
         let record = match RunRecord::read(path) {
@@ -46,7 +46,7 @@ pub fn run(args: StoreArgs) -> Result<(), CliError> {
                 continue;
             }
         };
-        match store.add(&record).map_err(crate::reports::store_error)? {
+        match store.add(&record).map_err(store_error)? {
             Added::New(id) => {
                 kept += 1;
                 outln!("{}: kept, run {id} of {}", path.display(), store.shown());
@@ -67,5 +67,42 @@ pub fn run(args: StoreArgs) -> Result<(), CliError> {
             "ppmc: store push: {n} record{} could not be read (named above)",
             if n == 1 { "" } else { "s" }
         ))),
+    }
+}
+
+/// A store's trouble as the command's: the store's own damage or a path
+/// or URL that cannot be one is the user's input (exit 2), wherever it
+/// was found; a server out of reach is the lab's (exit 1).
+pub(super) fn store_error(e: StoreError) -> CliError {
+    match e.fault {
+        Fault::Store => CliError::BadInput(format!("ppmc: {e}")),
+        Fault::Link => CliError::Infrastructure(e.to_string()),
+        Fault::Other => CliError::Failed(e.to_string()),
+    }
+}
+
+/// Opens the results store a run will keep its record in, before the run:
+/// a store that cannot be used is found before the boards' time is spent.
+pub(super) fn open_store(path: Option<&Path>) -> Result<Option<Store>, CliError> {
+    path.map(|p| {
+        Store::open(p).map_err(|e| match e.fault {
+            Fault::Link => CliError::Infrastructure(format!("ppmc: --store {e}")),
+            _ => CliError::BadInput(format!("ppmc: --store {e}")),
+        })
+    })
+    .transpose()
+}
+
+/// The run's record is not in the store: where it is kept instead.
+pub(super) fn unsent(record: &RunRecord, json: Option<&Path>, e: &StoreError) -> String {
+    match ppmc_report::store::keep_unsent(record, json) {
+        Ok(path) => format!(
+            "--store {e}: the run's record was not kept in the store; it is in {}: `ppmc store push {}` sends it when the store is back",
+            path.display(),
+            path.display()
+        ),
+        Err(why) => format!(
+            "--store {e}: the run's record was not kept in the store, nor on disk ({why}): give --json FILE to keep the next one"
+        ),
     }
 }

@@ -330,8 +330,19 @@ pub trait Bus {
         false
     }
 
-    /// Everything captured on the output side since the last reset.
+    /// Everything captured on the output side since the last reset (or
+    /// since what [`Bus::forget_record_before`] dropped).
     fn record(&self) -> &OutputRecord;
+
+    /// Lets the bus drop its record before `mark` (a mark of
+    /// [`Bus::record`]), which the host has fetched: what it dropped. The
+    /// bridge engine counts the host's positions across it, so that a
+    /// long session (a fuzz run of hours) holds a window of its capture,
+    /// not its history. The default keeps everything, as a bridge whose
+    /// capture is a ring buffer of its own may.
+    fn forget_record_before(&mut self, _mark: OutputMark) -> OutputMark {
+        OutputMark::default()
+    }
 
     /// The chip's straps (system clock, CSEL, VSEL, external clock).
     fn straps(&self) -> Straps;
@@ -684,6 +695,10 @@ impl EmuBus {
 }
 
 impl Bus for EmuBus {
+    fn forget_record_before(&mut self, mark: OutputMark) -> OutputMark {
+        EmuBus::forget_record_before(self, mark)
+    }
+
     fn run(&mut self, op: Op) -> Reply {
         self.run_op(op)
     }

@@ -75,6 +75,23 @@ pub fn of(path: &Path) -> Result<Option<Kind>, FileError> {
     Ok(Some(Kind::of_head(&head)))
 }
 
+/// Whether a report of `kind` may be written over `path`: nothing there,
+/// an empty file, or a report of that kind. `Err` names what is there
+/// instead (a results store, a golden trace, another kind of report, a
+/// file of the user's), or why it could not be read.
+pub fn may_replace(path: &Path, kind: Kind) -> Result<(), String> {
+    match of(path) {
+        Err(e) => Err(e.to_string()),
+        Ok(Some(k)) if k != kind => Err(format!(
+            "{}: the file is {}, not {}: refusing to replace it (give another path, or remove the file first)",
+            path.display(),
+            k.name(),
+            kind.name()
+        )),
+        Ok(_) => Ok(()),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

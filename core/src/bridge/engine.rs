@@ -21,7 +21,7 @@ use super::wire::{
     PROTOCOL_VERSION,
 };
 use crate::bus::{Bus, Op, Reply};
-use crate::protocol::{Command, OpFlags, Status};
+use crate::protocol::{Command, MoveStart, OpFlags, OutputMark, Status};
 use crate::time::{Duration, Instant};
 use alloc::boxed::Box;
 use alloc::format;
@@ -70,6 +70,10 @@ pub struct BridgeEngine<B> {
     /// buffer holds (as announced in HELLO_REPLY); beyond it the capture
     /// is overrun until the next chip reset.
     capture_capacity: u32,
+    /// What the bus let go of its record since the last reset (what the
+    /// host had fetched): the host's positions count from the reset, the
+    /// bus's record from here.
+    forgotten: OutputMark,
     /// The host session of the last HELLO (0: none yet).
     host: u32,
     /// The last request that was not a HELLO, LINK or RESEND, and the
@@ -108,6 +112,7 @@ impl<B: Bus> BridgeEngine<B> {
             timer: Timer::NANOS,
             virtual_time,
             capture_capacity: u32::MAX,
+            forgotten: OutputMark::default(),
             host: 0,
             last: None,
             control: None,
@@ -359,6 +364,9 @@ impl<B: Bus> BridgeEngine<B> {
                     Ok(()) if let Some(held) = self.overrun() => {
                         self.overrun_error(held).encode(seq, self.timer)
                     }
+                    Ok(()) if let Some(gone) = self.let_go(runs, pins, moves) => {
+                        gone.encode(seq, self.timer)
+                    }
                     Ok(()) => match replies.finish() {
                         Ok(mut bytes) => {
                             // The capture takes what room the replies leave.
@@ -422,9 +430,10 @@ impl<B: Bus> BridgeEngine<B> {
                 pins,
                 moves,
                 max,
-            } => match self.overrun() {
-                Some(held) => self.overrun_error(held),
-                None => Response::Capture(self.chunk(runs, pins, moves, max)),
+            } => match (self.overrun(), self.let_go(runs, pins, moves)) {
+                (Some(held), _) => self.overrun_error(held),
+                (None, Some(gone)) => gone,
+                (None, None) => Response::Capture(self.chunk(runs, pins, moves, max)),
             },
             Request::BatchCapture { .. } => Response::Error {
                 code: BridgeErrorCode::Malformed,
@@ -437,6 +446,8 @@ impl<B: Bus> BridgeEngine<B> {
                         detail: what.into(),
                     };
                 }
+                // The self-test resets the chip, and its capture with it.
+                self.forgotten = OutputMark::default();
                 match self.bus.self_test(&plan) {
                     Ok(reply) => Response::SelfTest(reply),
                     Err(detail) => Response::Error {
@@ -536,6 +547,10 @@ impl<B: Bus> BridgeEngine<B> {
                 };
                 self.bus.next_op(next);
                 replies.push(self.bus.run(op));
+                if op == Op::Reset {
+                    // A new capture, counted from 0.
+                    self.forgotten = OutputMark::default();
+                }
                 ran += 1;
             }
             i += 1;
@@ -642,9 +657,43 @@ impl<B: Bus> BridgeEngine<B> {
         &mut self.bus
     }
 
-    /// Up to `max` capture records of each kind from these positions on.
+    /// The host asks for the capture from these positions on (counted
+    /// from the last reset): what came before, it has. The bus may let
+    /// that go ([`Bus::forget_record_before`]). `Some` refusal when the
+    /// host asks for records let go already (a host that has not fetched
+    /// them: another host's session, with no chip reset since).
+    fn let_go(&mut self, runs: u32, pins: u32, moves: u32) -> Option<Response> {
+        let want = OutputMark {
+            runs: runs as usize,
+            pins: pins as usize,
+            moves: moves as usize,
+        };
+        if want.before(self.forgotten) {
+            return Some(Response::Error {
+                code: BridgeErrorCode::CaptureOverrun,
+                detail: format!(
+                    "the capture before run {}, pin change {} and move {} was fetched and let go: reset the chip to capture afresh",
+                    self.forgotten.runs,
+                    self.forgotten.pins,
+                    self.forgotten.moves
+                ),
+            });
+        }
+        let dropped = self.bus.forget_record_before(want.minus(self.forgotten));
+        self.forgotten = self.forgotten.plus(dropped);
+        None
+    }
+
+    /// Up to `max` capture records of each kind from these positions on
+    /// (counted from the last reset; [`Self::let_go`] has run).
     fn chunk(&self, runs: u32, pins: u32, moves: u32, max: u16) -> CaptureChunk {
         let rec = self.bus.record();
+        let gone = self.forgotten;
+        let (runs, pins, moves) = (
+            runs.saturating_sub(gone.runs as u32),
+            pins.saturating_sub(gone.pins as u32),
+            moves.saturating_sub(gone.moves as u32),
+        );
         let max = usize::from(max.max(1));
         let take = |from: u32, len: usize, max: usize| {
             let from = (from as usize).min(len);
@@ -656,7 +705,15 @@ impl<B: Bus> BridgeEngine<B> {
         CaptureChunk {
             runs: rec.runs[r0..r1].to_vec(),
             pins: rec.pins[p0..p1].to_vec(),
-            moves: rec.moves[m0..m1].to_vec(),
+            // Each move's first run, counted from the reset as the host
+            // counts.
+            moves: rec.moves[m0..m1]
+                .iter()
+                .map(|m| MoveStart {
+                    first_run: m.first_run + gone.runs,
+                    ..*m
+                })
+                .collect(),
             overwritten_bytes: rec.overwritten_bytes,
             more: r1 < rec.runs.len() || p1 < rec.pins.len() || m1 < rec.moves.len(),
         }

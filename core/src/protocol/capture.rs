@@ -285,6 +285,31 @@ pub struct OutputMark {
     pub moves: usize,
 }
 
+impl OutputMark {
+    /// Both counted together: a mark past what was dropped.
+    pub fn plus(self, o: OutputMark) -> OutputMark {
+        OutputMark {
+            runs: self.runs + o.runs,
+            pins: self.pins + o.pins,
+            moves: self.moves + o.moves,
+        }
+    }
+
+    /// `self` counted from `o` on (0 where it lies before `o`).
+    pub fn minus(self, o: OutputMark) -> OutputMark {
+        OutputMark {
+            runs: self.runs.saturating_sub(o.runs),
+            pins: self.pins.saturating_sub(o.pins),
+            moves: self.moves.saturating_sub(o.moves),
+        }
+    }
+
+    /// Whether `self` lies before `o` in any kind of record.
+    pub fn before(self, o: OutputMark) -> bool {
+        self.runs < o.runs || self.pins < o.pins || self.moves < o.moves
+    }
+}
+
 /// Everything observable on the output side since reset.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct OutputRecord {

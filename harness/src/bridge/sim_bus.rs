@@ -5,7 +5,7 @@
 
 use super::timed::Timed;
 use crate::bus::{Bus, EmuBus, Op, Reply};
-use crate::protocol::{OutputRecord, Straps};
+use crate::protocol::{OutputMark, OutputRecord, Straps};
 use crate::time::{Duration, Instant};
 use ppmc_core::bridge::abort::AbortLine;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -192,6 +192,12 @@ impl Bus for SimBus {
 
     fn record(&self) -> &OutputRecord {
         self.chip.bus().record()
+    }
+
+    /// The exact chip lets the fetched capture go; the timed one keeps its
+    /// (its edges are resampled from the chip's, position by position).
+    fn forget_record_before(&mut self, mark: OutputMark) -> OutputMark {
+        self.chip.bus_mut().forget_record_before(mark)
     }
 
     fn straps(&self) -> Straps {

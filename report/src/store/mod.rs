@@ -20,6 +20,7 @@ mod db;
 mod location;
 mod schema;
 mod stats;
+mod unsent;
 
 pub use db::Dialect;
 pub use location::{redact, Location, Server, TlsMode};
@@ -27,6 +28,7 @@ pub use schema::{MIGRATIONS, SCHEMA};
 pub use stats::{
     mean_sd, BoardRecord, Distribution, History, RevisionYield, ScenarioRate, TrendPoint,
 };
+pub use unsent::keep_unsent;
 
 use db::{Conn, DbError, Pg, Value};
 use ppmc_record::RunRecord;

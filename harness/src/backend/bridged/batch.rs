@@ -6,7 +6,7 @@ use super::options::*;
 use super::target::*;
 use crate::backend::link::Link;
 use crate::backend::target::{Op, Reply, SelfTestPlan, SelfTestRun};
-use crate::protocol::OutputRecord;
+use crate::protocol::{MoveStart, OutputMark, OutputRecord};
 use crate::time::Instant;
 use ppmc_core::bridge::wire::MAX_BATCH_OPS;
 use ppmc_core::bridge::wire::{self, CaptureChunk, Request, Response};
@@ -40,10 +40,12 @@ impl<L: Link> BridgeTarget<L> {
     /// Where the next capture fetch starts: the last pulse run known (it
     /// may have grown), and the pin changes and moves after those known.
     pub(super) fn capture_from(&self) -> (u32, u32, u32) {
+        // Counted from the chip's reset, across what was let go.
+        let at = self.let_go.plus(self.captured.mark());
         (
-            self.captured.runs.len().saturating_sub(1) as u32,
-            self.captured.pins.len() as u32,
-            self.captured.moves.len() as u32,
+            at.runs.saturating_sub(1) as u32,
+            at.pins as u32,
+            at.moves as u32,
         )
     }
 
@@ -56,7 +58,15 @@ impl<L: Link> BridgeTarget<L> {
         }
         self.captured.runs.extend(c.runs);
         self.captured.pins.extend(c.pins);
-        self.captured.moves.extend(c.moves);
+        // A move's first run, counted from the reset on the wire, from
+        // what is held here.
+        let gone = self.let_go.runs;
+        self.captured
+            .moves
+            .extend(c.moves.into_iter().map(|m| MoveStart {
+                first_run: m.first_run.saturating_sub(gone),
+                ..m
+            }));
         self.captured.overwritten_bytes = c.overwritten_bytes;
         c.more
     }
@@ -109,6 +119,7 @@ impl<L: Link> BridgeTarget<L> {
         if ops.contains(&Op::Reset) {
             // A chip reset clears the bridge's capture.
             self.captured = OutputRecord::default();
+            self.let_go = OutputMark::default();
         }
         let mut out = Vec::with_capacity(ops.len());
         let max_ops = usize::from(self.hello.max_batch_ops.clamp(1, MAX_BATCH_OPS.max(1)));
@@ -190,6 +201,7 @@ impl<L: Link> BridgeTarget<L> {
         plan: &SelfTestPlan,
     ) -> Result<SelfTestRun, BridgeError> {
         self.captured = OutputRecord::default();
+        self.let_go = OutputMark::default();
         self.captured_current = false;
         self.clock = Instant::ZERO;
         // The chip reset (100 us) and the bursts, each with its gap.
@@ -199,14 +211,15 @@ impl<L: Link> BridgeTarget<L> {
             other => return Err(self.unexpected("self-test", &other)),
         };
         let capture = match self.fetch_capture() {
-            Ok(r) => Ok(r),
+            Ok(()) => Ok(self.captured.clone()),
             Err(BridgeError::CaptureOverrun { detail, .. }) => Err(detail),
             Err(e) => return Err(e),
         };
         Ok(SelfTestRun { reply, capture })
     }
 
-    pub(super) fn fetch_capture(&mut self) -> Result<OutputRecord, BridgeError> {
+    /// Brings `captured` up to date with the bridge's capture.
+    pub(super) fn fetch_capture(&mut self) -> Result<(), BridgeError> {
         while !self.captured_current {
             let (runs, pins, moves) = self.capture_from();
             let req = Request::Capture {
@@ -245,7 +258,7 @@ impl<L: Link> BridgeTarget<L> {
             }
         }
         self.captured_current = self.hello.virtual_time;
-        Ok(self.captured.clone())
+        Ok(())
     }
 }
 

@@ -8,8 +8,8 @@ use crate::backend::target::{
     Op, Reply, SelfTestPlan, SelfTestRun, Target, TargetError, TargetErrorKind, TargetInfo,
     Uncertainty,
 };
-use crate::protocol::OutputRecord;
 use crate::protocol::Straps;
+use crate::protocol::{OutputMark, OutputRecord};
 use crate::time::Instant;
 use ppmc_core::bridge::frame::FrameDecoder;
 use ppmc_core::bridge::wire::{
@@ -42,8 +42,12 @@ pub struct BridgeTarget<L: Link> {
     pub(super) hello: Hello,
     pub(super) timer: Timer,
     pub(super) opts: BridgeOptions,
-    /// The capture fetched so far (since the last chip reset).
+    /// The capture fetched so far (since the last chip reset, less what
+    /// the caller let go: [`Target::forget_capture_before`]).
     pub(super) captured: OutputRecord,
+    /// What of the capture since the last chip reset `captured` no longer
+    /// holds: the bridge's positions count from the reset.
+    pub(super) let_go: OutputMark,
     /// `captured` is the whole capture as of now: the last request brought
     /// the rest of it back, and the bridge's chip has not moved on since
     /// (it runs in virtual time, so nothing happens between requests).
@@ -137,6 +141,7 @@ impl<L: Link> BridgeTarget<L> {
             timer: Timer::NANOS,
             opts,
             captured: OutputRecord::default(),
+            let_go: OutputMark::default(),
             captured_current: false,
             clock: Instant::ZERO,
             rtt: RoundTrip::default(),
@@ -352,7 +357,30 @@ impl<L: Link> Target for BridgeTarget<L> {
     /// (the last run may have grown). Costs nothing when the last batch
     /// brought the rest of the capture back with it.
     fn capture(&mut self) -> Result<OutputRecord, TargetError> {
-        Ok(self.counted(Self::fetch_capture)?)
+        self.counted(Self::fetch_capture)?;
+        Ok(self.captured.clone())
+    }
+
+    /// The batch, then the capture from `from` on: the part the caller has
+    /// not seen, not a copy of everything.
+    fn execute_then_capture_since(
+        &mut self,
+        ops: &[Op],
+        from: OutputMark,
+    ) -> Result<(Vec<Reply>, OutputRecord), TargetError> {
+        let replies = self.execute(ops)?;
+        self.counted(Self::fetch_capture)?;
+        Ok((replies, self.captured.since(from)))
+    }
+
+    /// Lets go of the capture before `mark`, as the emulator does (the
+    /// last move and its runs stay): the bridge is told where the next
+    /// fetch starts, and may let go of it too. A long differential run
+    /// so holds a window on both sides.
+    fn forget_capture_before(&mut self, mark: OutputMark) -> OutputMark {
+        let dropped = self.captured.forget_before(mark);
+        self.let_go = self.let_go.plus(dropped);
+        dropped
     }
 
     fn execute(&mut self, ops: &[Op]) -> Result<Vec<Reply>, TargetError> {

@@ -682,3 +682,31 @@ fn a_bridge_that_says_working_for_ever_is_given_up() {
         assert!(t.stats.working > 0, "{:?}", t.stats);
     }
 }
+
+/// Issue 44: a long differential fuzz against a bridge grew without end
+/// (9 MB at 1 minute to 21 MB at 5, the bridge 8 to 14 MB): the host kept
+/// the whole capture since the chip's reset and copied it on every fetch,
+/// and the bridge kept it all too. Now what the run has compared is let
+/// go on both sides: after 20,000 actions (whose whole record would be
+/// several times the bound) each holds a window.
+#[test]
+fn a_long_differential_run_holds_a_window_of_the_capture_on_both_sides() {
+    use crate::fuzzing::differential::{program, run, DiffSettings};
+    use ppmc_core::bus::Bus;
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
+    let s = DiffSettings {
+        straps: t.straps(),
+        ..DiffSettings::default()
+    };
+    let mut seen = 0;
+    let d = run(&mut t, program(5).take(20_000), &s, |n| {
+        seen = n;
+        true
+    });
+    assert_eq!(d.expect("runs"), None);
+    assert_eq!(seen, 20_000);
+    let held = |r: &crate::protocol::OutputRecord| r.runs.len() + r.pins.len() + r.moves.len();
+    let (host, bridge) = (held(&t.captured), held(t.link.server.bus().record()));
+    assert!(host <= 2_000, "the host holds {host} records");
+    assert!(bridge <= 2_000, "the bridge holds {bridge} records");
+}
