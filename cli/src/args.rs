@@ -37,6 +37,13 @@ pub struct TargetArgs {
     /// a noisy line is alive).
     #[arg(long, value_name = "N", default_value_t = 10)]
     link_retries: u32,
+    /// A place this run acquires (`labgrid:<place>,acquire`) that a dead
+    /// ppmc of this machine left locked (killed outright, so it could not
+    /// let go) is taken, where it would be refused with its owner and age.
+    /// A lock of a live run, of another machine or of a person is never
+    /// taken (docs/board-farm.md).
+    #[arg(long)]
+    steal_stale: bool,
     /// The board's serial number, for the reports and the results store
     /// (a target's own `,board-serial=` overrides it).
     #[arg(long, value_name = "SERIAL", value_parser = label)]
@@ -215,6 +222,7 @@ impl TargetArgs {
             link_timeout: std::time::Duration::from_nanos(self.link_timeout.as_nanos()),
             link_retries: self.link_retries,
             stop: self.stop.clone(),
+            steal_stale: self.steal_stale,
         }
     }
 

@@ -77,6 +77,9 @@ pub fn install() -> StopRequest {
                         }
                         last = Some(now);
                         if raised.urgent() {
+                            // No lease will be dropped: let go of the
+                            // places this run acquired first.
+                            ppmc::backend::link::lease::release_all();
                             std::process::exit(130);
                         }
                         raised.request();

@@ -168,4 +168,42 @@ fn the_suite_passes_on_a_labgrid_place_and_an_unacquired_place_is_refused() {
     );
     assert_eq!(junit.matches("name=\"board_of.").count(), 95);
     assert_eq!(mark(&out, "exports-left-two"), "0");
+    // Leases (issue 44): a place ppmc acquired is released when the run
+    // passes and when it is stopped; a run killed outright leaves a lock
+    // that the next run names by owner and age, and --steal-stale takes.
+    assert_eq!(
+        mark(&out, "lease-ok-exit"),
+        "0",
+        "{}",
+        read(dir.path(), "lease/ok.err")
+    );
+    assert_eq!(mark(&out, "lease-after-ok"), "None");
+    assert_eq!(
+        mark(&out, "lease-int-exit"),
+        "130",
+        "{}",
+        read(dir.path(), "lease/int.err")
+    );
+    assert_eq!(mark(&out, "lease-after-int"), "None");
+    assert_ne!(
+        mark(&out, "lease-after-kill"),
+        "None",
+        "a killed run cannot let go"
+    );
+    let pid = mark(&out, "lease-killed-pid");
+    assert_eq!(mark(&out, "lease-stale-exit"), "1");
+    let says = mark(&out, "lease-stale-says");
+    assert!(
+        says.contains(&format!("by ppmc pid {pid} on "))
+            && says.contains(" s: that process is gone, and left its lock; --steal-stale takes it"),
+        "{says}"
+    );
+    assert_eq!(
+        mark(&out, "lease-steal-exit"),
+        "0",
+        "{}",
+        mark(&out, "lease-steal-says")
+    );
+    assert!(mark(&out, "lease-steal-says").contains("took a stale lock"));
+    assert_eq!(mark(&out, "lease-after-steal"), "None");
 }

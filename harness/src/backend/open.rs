@@ -32,6 +32,9 @@ pub struct OpenOptions {
     pub link_retries: u32,
     /// Asked for, opening and every wait on the link end early.
     pub stop: StopRequest,
+    /// A place ppmc acquires may be taken from a dead ppmc's lock
+    /// (`--steal-stale`, `backend::link::lease`).
+    pub steal_stale: bool,
 }
 
 impl Default for OpenOptions {
@@ -43,6 +46,7 @@ impl Default for OpenOptions {
             link_timeout: serial.reply_timeout,
             link_retries: serial.retries,
             stop: StopRequest::default(),
+            steal_stale: false,
         }
     }
 }
@@ -118,8 +122,12 @@ pub fn open(spec: &TargetSpec, opts: &OpenOptions) -> Result<Box<dyn Target>, Op
             Ok(Box::new(t))
         }
         Address::Bridge { driver, address } => {
+            let how = crate::backend::link::LinkOpen {
+                stop: opts.stop.clone(),
+                steal_stale: opts.steal_stale,
+            };
             let link = driver
-                .open(&address, opts.stop.clone())
+                .open(&address, &how)
                 .map_err(|e| OpenError::Infrastructure(e.to_string()))?;
             open_bridge(link, driver, spec, opts)
         }

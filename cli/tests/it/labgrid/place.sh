@@ -89,3 +89,34 @@ cd ..
 echo "MARK exports-left-two $(pgrep -fc 'labgrid-client -c .* export' || true)"
 labgrid-client -p rig2 release
 labgrid-client -p rig1 release
+
+# Leases (issue 44, docs/board-farm.md "Leases"): ppmc acquires rig1
+# itself (`,acquire`) and lets go of it however the run ends.
+acquired() { labgrid-client -p rig1 show 2>/dev/null | sed -n 's/^ *acquired: //p'; }
+mkdir lease && cd lease
+"$ppmc" run --target labgrid:rig1,acquire --filter s3_4_1 > ok.out 2> ok.err
+echo "MARK lease-ok-exit $?"
+echo "MARK lease-after-ok $(acquired)"
+# Stopped by SIGINT in the middle of a soak: released too.
+"$ppmc" run --target labgrid:rig1,acquire --filter s3_4_1 --repeat 100000 > int.out 2> int.err &
+run=$!
+for _ in $(seq 300); do labgrid-client -p rig1 show 2>/dev/null | grep -q 'ppmc_pid=' && break; sleep 0.1; done
+sleep 1
+kill -INT "$run"; wait "$run"
+echo "MARK lease-int-exit $?"
+echo "MARK lease-after-int $(acquired)"
+# Killed outright: its lock stays, and the next run names whose it is.
+"$ppmc" run --target labgrid:rig1,acquire --filter s3_4_1 --repeat 100000 > killed.out 2> killed.err &
+run=$!
+for _ in $(seq 300); do labgrid-client -p rig1 show 2>/dev/null | grep -q 'ppmc_pid=' && break; sleep 0.1; done
+kill -KILL "$run"; wait "$run" 2>/dev/null
+echo "MARK lease-killed-pid $run"
+echo "MARK lease-after-kill $(acquired)"
+"$ppmc" run --target labgrid:rig1,acquire --filter s3_4_1 > stale.out 2> stale.err
+echo "MARK lease-stale-exit $?"
+echo "MARK lease-stale-says $(tr '\n' ' ' < stale.err)"
+"$ppmc" run --target labgrid:rig1,acquire --steal-stale --filter s3_4_1 > steal.out 2> steal.err
+echo "MARK lease-steal-exit $?"
+echo "MARK lease-steal-says $(tr '\n' ' ' < steal.err)"
+echo "MARK lease-after-steal $(acquired)"
+cd ..

@@ -9,14 +9,19 @@
 //! (`LG_PROXY`) the address it wrote is a forwarding that lives as long as
 //! the client. The link keeps the client until it is dropped, then stops it.
 //!
+//! With `,acquire` ppmc acquires the place itself first, and lets go of it
+//! on every way out (`lease.rs`: a dead job's lock is told from a live
+//! one's, and `--steal-stale` takes it).
+//!
 //! The coordinator is the client's business: `LG_COORDINATOR` (and
 //! `LG_PROXY`) in the environment reach it unchanged. The client program is
 //! `labgrid-client` on the `PATH`, or `PPMC_LABGRID_CLIENT`.
 
+use super::lease::Lease;
 use super::rfc2217::Rfc2217Link;
 use super::serial::SerialLink;
 use super::tcp::TcpLink;
-use super::{bad_address, Link, LinkDriver};
+use super::{bad_address, Link, LinkDriver, LinkOpen};
 use crate::stop::StopRequest;
 use std::fmt;
 use std::io::{self, BufRead, BufReader};
@@ -34,6 +39,8 @@ const EXPORT_TIMEOUT: WallDuration = WallDuration::from_secs(60);
 pub struct Place {
     pub name: String,
     pub port: Option<String>,
+    /// `,acquire`: ppmc acquires the place, and releases it at the end.
+    pub acquire: bool,
 }
 
 /// The driver of `labgrid:<place>[,port=NAME]`.
@@ -48,11 +55,11 @@ impl LinkDriver for LabgridDriver {
     }
 
     fn form(&self) -> &'static str {
-        "labgrid:<place>[,port=NAME]"
+        "labgrid:<place>[,port=NAME][,acquire]"
     }
 
     fn about(&self) -> &'static str {
-        "the serial port of a labgrid place you have acquired"
+        "the serial port of a labgrid place you have acquired (`,acquire`: ppmc acquires it, and releases it however the run ends)"
     }
 
     fn default_pad(&self) -> u16 {
@@ -63,14 +70,20 @@ impl LinkDriver for LabgridDriver {
         parse_labgrid(address).map(drop).ok_or("")
     }
 
-    fn open(&self, address: &str, stop: StopRequest) -> io::Result<Box<dyn Link>> {
+    fn open(&self, address: &str, how: &LinkOpen) -> io::Result<Box<dyn Link>> {
         let place = parse_labgrid(address).ok_or_else(|| bad_address(self, address))?;
-        Ok(Box::new(LabgridLink::open_until(place, stop)?))
+        let lease = match place.acquire {
+            true => Some(Lease::acquire(&place.name, how.steal_stale)?),
+            false => None,
+        };
+        let mut link = LabgridLink::open_until(place, how.stop.clone())?;
+        link._lease = lease;
+        Ok(Box::new(link))
     }
 }
 
-/// Reads `labgrid:<place>[,port=NAME]`. A place name is what labgrid
-/// accepts: letters, digits, `-`, `_`, `.`.
+/// Reads `labgrid:<place>[,port=NAME][,acquire]`. A place name is what
+/// labgrid accepts: letters, digits, `-`, `_`, `.`.
 pub fn parse_labgrid(spec: &str) -> Option<Place> {
     let rest = spec.strip_prefix("labgrid:")?;
     let mut parts = rest.split(',');
@@ -81,13 +94,19 @@ pub fn parse_labgrid(spec: &str) -> Option<Place> {
     };
     let name = parts.next().filter(|n| ok(n))?.to_string();
     let mut port = None;
+    let mut acquire = false;
     for p in parts {
         match p.split_once('=') {
             Some(("port", v)) if ok(v) => port = Some(v.to_string()),
+            None if p == "acquire" => acquire = true,
             _ => return None,
         }
     }
-    Some(Place { name, port })
+    Some(Place {
+        name,
+        port,
+        acquire,
+    })
 }
 
 /// The running `labgrid-client export`, stopped when dropped.
@@ -186,6 +205,8 @@ pub struct LabgridLink {
     /// Declared after `inner`: the connection closes before the client
     /// (and any forwarding it keeps) stops.
     _export: Export,
+    /// The place, when ppmc acquired it: released last.
+    _lease: Option<Lease>,
 }
 
 impl fmt::Debug for LabgridLink {
@@ -197,7 +218,7 @@ impl fmt::Debug for LabgridLink {
     }
 }
 
-fn client_program() -> String {
+pub(super) fn client_program() -> String {
     std::env::var("PPMC_LABGRID_CLIENT").unwrap_or_else(|_| "labgrid-client".into())
 }
 
@@ -242,6 +263,7 @@ impl LabgridLink {
             place,
             inner,
             _export: export,
+            _lease: None,
         })
     }
 }
@@ -371,21 +393,25 @@ mod tests {
             parse_labgrid("labgrid:board-1"),
             Some(Place {
                 name: "board-1".into(),
-                port: None
+                port: None,
+                acquire: false,
             })
         );
         assert_eq!(
             parse_labgrid("labgrid:rig.2,port=bridge"),
             Some(Place {
                 name: "rig.2".into(),
-                port: Some("bridge".into())
+                port: Some("bridge".into()),
+                acquire: false,
             })
         );
+        assert!(parse_labgrid("labgrid:rig1,acquire,port=b").is_some_and(|p| p.acquire));
         for bad in [
             "labgrid:",
             "labgrid:a b",
             "labgrid:a,port=",
             "labgrid:a,speed=9",
+            "labgrid:a,acquire=yes",
             "serial:x",
         ] {
             assert_eq!(parse_labgrid(bad), None, "{bad}");
@@ -419,6 +445,7 @@ mod tests {
         let env = environment(&Place {
             name: "b1".into(),
             port: Some("bridge".into()),
+            acquire: true,
         });
         let v: serde_json::Value = serde_json::from_str(&env).expect("JSON");
         assert_eq!(v["targets"]["b1"]["resources"]["RemotePlace"]["name"], "b1");

@@ -12,6 +12,7 @@
 //! one line in [`DRIVERS`].
 
 pub mod labgrid;
+pub mod lease;
 pub mod rfc2217;
 pub mod serial;
 pub mod tcp;
@@ -58,8 +59,18 @@ pub trait LinkDriver: Sync + fmt::Debug {
     /// `Err` with a hint to add to the form when it does not.
     fn check(&self, address: &str) -> Result<(), &'static str>;
     /// Opens the link at `address` (one [`Self::check`] passed), given up
-    /// once `stop` is asked for. The error names the link and says why.
-    fn open(&self, address: &str, stop: StopRequest) -> io::Result<Box<dyn Link>>;
+    /// once `how.stop` is asked for. The error names the link and says why.
+    fn open(&self, address: &str, how: &LinkOpen) -> io::Result<Box<dyn Link>>;
+}
+
+/// How a link is opened.
+#[derive(Debug, Clone, Default)]
+pub struct LinkOpen {
+    /// Asked for: the open is given up.
+    pub stop: StopRequest,
+    /// A link that acquires a place (`labgrid:<place>,acquire`) may take
+    /// a lock a dead ppmc left (`--steal-stale`; `lease.rs`).
+    pub steal_stale: bool,
 }
 
 /// An error for an address that does not read, from a driver's `open`

@@ -232,9 +232,13 @@ impl LinkDriver for Rfc2217Driver {
             .ok_or(HOST_PORT_HINT)
     }
 
-    fn open(&self, address: &str, stop: StopRequest) -> io::Result<Box<dyn Link>> {
+    fn open(&self, address: &str, how: &super::LinkOpen) -> io::Result<Box<dyn Link>> {
         let (addr, baud) = parse_rfc2217(address).ok_or_else(|| bad_address(self, address))?;
-        Ok(Box::new(Rfc2217Link::open_until(&addr, baud, stop)?))
+        Ok(Box::new(Rfc2217Link::open_until(
+            &addr,
+            baud,
+            how.stop.clone(),
+        )?))
     }
 }
 

@@ -2,7 +2,6 @@
 //! its driver: `serial:<path>[,baud=N]` addresses.
 
 use super::{bad_address, timed_out, Link, LinkDriver};
-use crate::stop::StopRequest;
 use std::fmt;
 use std::io::{self, Read, Write};
 use std::time::Duration as WallDuration;
@@ -50,7 +49,7 @@ impl LinkDriver for SerialDriver {
         parse_serial_address(address).map(drop).ok_or("")
     }
 
-    fn open(&self, address: &str, _stop: StopRequest) -> io::Result<Box<dyn Link>> {
+    fn open(&self, address: &str, _how: &super::LinkOpen) -> io::Result<Box<dyn Link>> {
         let (path, baud) =
             parse_serial_address(address).ok_or_else(|| bad_address(self, address))?;
         Ok(Box::new(SerialLink::open(&path, baud)?))

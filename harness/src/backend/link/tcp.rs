@@ -73,9 +73,9 @@ impl LinkDriver for TcpDriver {
             .ok_or(HOST_PORT_HINT)
     }
 
-    fn open(&self, address: &str, stop: StopRequest) -> io::Result<Box<dyn Link>> {
+    fn open(&self, address: &str, how: &super::LinkOpen) -> io::Result<Box<dyn Link>> {
         let addr = parse_tcp(address).ok_or_else(|| bad_address(self, address))?;
-        Ok(Box::new(TcpLink::open_until(&addr, stop)?))
+        Ok(Box::new(TcpLink::open_until(&addr, how.stop.clone())?))
     }
 }
 
