@@ -623,10 +623,13 @@ impl<B: Bus> BridgeEngine<B> {
     }
 
     /// The records captured since the last reset: pulse runs, pin changes
-    /// and move records.
+    /// and move records, those let go of after the host fetched them
+    /// included (`capture_capacity` counts from the reset, as HELLO_REPLY
+    /// announces it).
     fn held(&self) -> usize {
         let rec = self.bus.record();
-        rec.runs.len() + rec.pins.len() + rec.moves.len()
+        let gone = self.forgotten;
+        rec.runs.len() + rec.pins.len() + rec.moves.len() + gone.runs + gone.pins + gone.moves
     }
 
     /// The records captured since the last reset, if more than the
@@ -1064,12 +1067,35 @@ mod tests {
                 break;
             }
         }
+        // Every record came, counted from the reset; what the host had
+        // fetched the bridge let go of (the last move and its runs kept).
         let rec = s.bus().record();
+        let gone = s.forgotten;
         assert_eq!(
             (runs as usize, pins as usize, moves as usize),
-            (rec.runs.len(), rec.pins.len(), rec.moves.len())
+            (
+                rec.runs.len() + gone.runs,
+                rec.pins.len() + gone.pins,
+                rec.moves.len() + gone.moves
+            )
         );
         assert_eq!(moves, 30);
+        assert!(gone.moves > 0 && rec.moves.len() < 30, "{gone:?}");
+        // Asking again for what was let go: refused, saying so.
+        let Response::Error { code, detail } = ask(
+            &mut s,
+            101,
+            &Request::Capture {
+                runs: 0,
+                pins: 0,
+                moves: 0,
+                max: 50,
+            },
+        ) else {
+            panic!("an error");
+        };
+        assert_eq!(code, BridgeErrorCode::CaptureOverrun);
+        assert!(detail.contains("let go"), "{detail}");
     }
 
     #[test]
