@@ -393,7 +393,12 @@ pub struct ReportArgs {
     /// (`postgres://user@host/db`; TLS as `sslmode=` asks, the password
     /// from the URL or PGPASSWORD). A run the store does not take is kept
     /// on disk for `ppmc store push`.
-    #[arg(long, value_name = "FILE|URL", env = "PPMC_STORE")]
+    #[arg(
+        long,
+        value_name = "FILE|URL",
+        env = "PPMC_STORE",
+        hide_env_values = true
+    )]
     pub store: Option<PathBuf>,
 }
 

@@ -10,7 +10,12 @@ use std::path::PathBuf;
 pub struct HistoryArgs {
     /// The results store (`ppmc run --store FILE` makes and fills it): a
     /// file, or a PostgreSQL database (`postgres://user@host/db`).
-    #[arg(long, value_name = "FILE|URL", env = "PPMC_STORE")]
+    #[arg(
+        long,
+        value_name = "FILE|URL",
+        env = "PPMC_STORE",
+        hide_env_values = true
+    )]
     store: PathBuf,
     /// Scenarios listed at most, lowest pass rate first (0: all).
     #[arg(long, value_name = "N", default_value_t = 10)]

@@ -27,23 +27,24 @@ pub(super) fn write(record: &RunRecord, to: Outputs, store: Option<&mut Store>) 
         let done = text
             .map_err(|e| format!("{}: {e}", path.display()))
             .and_then(|t| files::write_report(path, t.as_bytes()).map_err(|e| e.to_string()));
-        if let Err(e) = done {
-            problems.push(e);
-        }
+        let ok = done.is_ok();
+        problems.extend(done.err());
+        ok
     };
     if let Some(p) = to.junit {
-        put(p, Ok(report::junit(record)));
+        let _ = put(p, Ok(report::junit(record)));
     }
-    if let Some(p) = to.json {
+    // The JSON record, where it was written: a store's fallback.
+    let json = to.json.filter(|p| {
         put(
             p,
             record
                 .to_json()
                 .map_err(|e| format!("cannot render the JSON run record: {e}")),
-        );
-    }
+        )
+    });
     if let Some(p) = to.html {
-        put(
+        let _ = put(
             p,
             Ok(report::html(
                 std::slice::from_ref(record),
@@ -62,7 +63,7 @@ pub(super) fn write(record: &RunRecord, to: Outputs, store: Option<&mut Store>) 
                 store.shown(),
                 record.run.id.as_deref().unwrap_or("(none)")
             )),
-            Err(e) => problems.push(crate::store::unsent(record, to.json, &e)),
+            Err(e) => problems.push(crate::store::unsent(record, json, &e)),
         }
     }
     problems

@@ -25,7 +25,12 @@ enum StoreCommand {
     /// are still sent).
     Push {
         /// The results store: a file, or `postgres://user@host/db`.
-        #[arg(long, value_name = "FILE|URL", env = "PPMC_STORE")]
+        #[arg(
+            long,
+            value_name = "FILE|URL",
+            env = "PPMC_STORE",
+            hide_env_values = true
+        )]
         store: PathBuf,
         /// The run records to send.
         #[arg(value_name = "RECORD", required = true)]

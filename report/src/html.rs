@@ -420,7 +420,7 @@ mod tests {
         let m = r#"{"at_ns":1000,"kind":"constant","dir":"cw","steps":3,"runs":[[10,3,200]]}"#;
         let text = format!(
             r#"{{"format":"ppmc-run-record/4","run":{{"harness_version":"0","git_revision":"x",
-            "boards":[{{"name":"b\u0000<i>","target":"emu","board_rev":null,"bridge_firmware":null,"error":null}}],
+            "boards":[{{"name":"b","target":"emu","board_rev":null,"bridge_firmware":null,"error":null}}],
             "started":"s","wall_s":0,"host":"h","options":{{"golden":null,"marginal_pct":0.25,
             "interval_tol_pct":1,"time_floor_ns":100}}}},"summary":{{"passed":0,"marginal":0,
             "failed":1,"error":0,"not_run":0}},"scenarios":[{{"name":"s","board":"b","section":"3-1",
@@ -432,7 +432,11 @@ mod tests {
             window.0,
             window.1
         );
-        RunRecord::parse(&text, "t").expect("a record")
+        let mut r = RunRecord::parse(&text, "t").expect("a record");
+        // A label no record may hold (parse refuses it), drawn all the
+        // same by a page made of a record built otherwise.
+        r.run.boards[0].name = "b\u{0}<i>".into();
+        r
     }
 
     #[test]

@@ -41,7 +41,19 @@ const FILES: [&str; 15] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 36] = [
+const ELSEWHERE: [(&str, &str); 39] = [
+    (
+        "scripts/store-load",
+        "by hand (10,000 runs of the suite; its figures in docs/performance.md); .ci/run runs it with 100 runs a station on both databases",
+    ),
+    (
+        "scripts/fuzz-memory",
+        "by hand (30 minutes of a fuzz against bridge-sim; its figures in docs/performance.md)",
+    ),
+    (
+        "scripts/pg-throwaway",
+        "started by .ci/run for the store's tests; by hand, a server to try the store on",
+    ),
     (
         "scripts/rebuild-figures",
         "in .ci/run (after the tests, on the built workspace)",

@@ -7,7 +7,7 @@
 //!
 //! ```text
 //! emu | serial:<path>[,baud=N] | tcp://<host>:<port>
-//!     | rfc2217://<host>:<port>[,baud=N] | labgrid:<place>[,port=NAME]
+//!     | rfc2217://<host>:<port>[,baud=N] | labgrid:<place>[,port=NAME][,acquire]
 //! then any of: ,name=LABEL ,rev=LABEL ,pad=BYTES
 //!              ,clock-mhz=MHZ ,csel=high|low ,vsel=high|low ,ext-clock-khz=KHZ
 //! ```
@@ -61,7 +61,7 @@ impl Address {
 }
 
 /// Every address form, as the usage messages list them: `` `emu`,
-/// `serial:<path>[,baud=N]`, ... or `labgrid:<place>[,port=NAME]` ``.
+/// `serial:<path>[,baud=N]`, ... or `labgrid:<place>[,port=NAME][,acquire]` ``.
 pub fn forms() -> String {
     let mut forms = String::from("`emu`");
     for (i, d) in DRIVERS.iter().enumerate() {
@@ -469,7 +469,7 @@ mod tests {
             .0;
         assert_eq!(
             e,
-            "unknown target `usb:0`: use `emu`, `serial:<path>[,baud=N]`, `tcp://<host>:<port>`, `rfc2217://<host>:<port>[,baud=N]` or `labgrid:<place>[,port=NAME]`"
+            "unknown target `usb:0`: use `emu`, `serial:<path>[,baud=N]`, `tcp://<host>:<port>`, `rfc2217://<host>:<port>[,baud=N]` or `labgrid:<place>[,port=NAME][,acquire]`"
         );
         for (text, prefix) in [
             ("serial:/dev/ttyACM0", "serial:"),

@@ -119,7 +119,9 @@ impl From<postgres::Error> for DbError {
         let fault = match e.code() {
             _ if e.is_closed() => Fault::Link,
             Some(c) if c.code().starts_with("42") || c.code().starts_with("XX") => Fault::Store,
-            Some(c) if c.code().starts_with("08") => Fault::Link,
+            // The connection's loss, and the server going down or
+            // dropping it (57P01-57P03).
+            Some(c) if c.code().starts_with("08") || c.code().starts_with("57P") => Fault::Link,
             _ => Fault::Other,
         };
         DbError { why, fault }

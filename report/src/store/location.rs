@@ -82,7 +82,13 @@ impl Server {
         let (scheme, rest) = url
             .split_once("://")
             .ok_or_else(|| bad("not a postgres:// URL"))?;
-        let (head, query) = rest.split_once('?').unwrap_or((rest, ""));
+        // The query starts after the user part, which ends at the last
+        // `@` (a password may hold `?`).
+        let from = rest.rfind('@').map_or(0, |at| at + 1);
+        let (head, query) = match rest[from..].find('?') {
+            Some(q) => (&rest[..from + q], &rest[from + q + 1..]),
+            None => (rest, ""),
+        };
         let mut tls = TlsMode::Prefer;
         let mut root_cert = None;
         let mut kept = Vec::new();
@@ -164,7 +170,8 @@ impl Server {
         let provider = Arc::new(rustls::crypto::ring::default_provider());
         let verifier: Arc<dyn rustls::client::danger::ServerCertVerifier> =
             match (&self.root_cert, self.tls) {
-                (Some(file), _) => {
+                // As libpq: `prefer` (and `allow`) never check.
+                (Some(file), TlsMode::Require | TlsMode::VerifyCa | TlsMode::VerifyFull) => {
                     let roots = Arc::new(read_roots(file)?);
                     let webpki = rustls::client::WebPkiServerVerifier::builder_with_provider(
                         roots,
@@ -177,7 +184,7 @@ impl Server {
                         names: self.tls == TlsMode::VerifyFull,
                     })
                 }
-                (None, _) => Arc::new(tls::Unchecked(provider.clone())),
+                _ => Arc::new(tls::Unchecked(provider.clone())),
             };
         Ok(rustls::ClientConfig::builder_with_provider(provider)
             .with_safe_default_protocol_versions()
@@ -230,36 +237,24 @@ fn percent_decode(s: &str) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-/// A URL as messages show it: no password, neither in its user part nor
-/// as a `password=` parameter.
+/// A URL as messages show it: the scheme, the user and the host, port and
+/// database, and nothing else. The user part ends at the URL's last `@`
+/// (a password may hold `/`, `?` or `@` unescaped, which the client library
+/// takes), and the whole query goes (a password may be given there too,
+/// under a percent-encoded key): nothing of a password can be shown.
 pub fn redact(url: &str) -> String {
     let Some((scheme, rest)) = url.split_once("://") else {
-        return url.to_string();
+        return "(a store URL that does not read)".to_string();
     };
-    let end = rest.find(['/', '?']).unwrap_or(rest.len());
-    let (authority, tail) = rest.split_at(end);
-    let authority = match authority.rsplit_once('@') {
-        Some((user, host)) => {
-            let user = user.split_once(':').map_or(user, |(u, _)| u);
-            format!("{user}@{host}")
-        }
-        None => authority.to_string(),
+    let (user, after) = match rest.rsplit_once('@') {
+        Some((userinfo, after)) => (
+            format!("{}@", userinfo.split_once(':').map_or(userinfo, |(u, _)| u)),
+            after,
+        ),
+        None => (String::new(), rest),
     };
-    let tail = match tail.split_once('?') {
-        Some((path, query)) => {
-            let kept: Vec<&str> = query
-                .split('&')
-                .filter(|p| !p.starts_with("password="))
-                .collect();
-            if kept.iter().all(|p| p.is_empty()) {
-                path.to_string()
-            } else {
-                format!("{path}?{}", kept.join("&"))
-            }
-        }
-        None => tail.to_string(),
-    };
-    format!("{scheme}://{authority}{tail}")
+    let place = after.split_once('?').map_or(after, |(p, _)| p);
+    format!("{scheme}://{user}{place}")
 }
 
 /// The two ways a server's certificate is taken.
@@ -388,7 +383,16 @@ mod tests {
             ),
             (
                 "postgresql://lab@db/results?password=s3cret&application_name=x",
-                "postgresql://lab@db/results?application_name=x",
+                "postgresql://lab@db/results",
+            ),
+            (
+                "postgres://127.0.0.1:1/db?pass%77ord=s3cret",
+                "postgres://127.0.0.1:1/db",
+            ),
+            // A password with `/`, `?` and `@` in it, as the client takes it.
+            (
+                "postgres://lab:pa/s?s@s3cret@127.0.0.1:1/db",
+                "postgres://lab@127.0.0.1:1/db",
             ),
             ("postgres://db/results", "postgres://db/results"),
         ] {
@@ -407,6 +411,9 @@ mod tests {
 
     #[test]
     fn the_url_asks_for_tls_as_libpq_reads_it() {
+        // A `?` in the password is not the query's start.
+        let s = Server::parse("postgres://u:p?w@h/db?sslmode=disable").expect("parses");
+        assert_eq!(s.tls, TlsMode::Disable);
         let s = Server::parse("postgres://u@h/db?sslmode=verify-full&sslrootcert=%2Ftmp%2Fca.pem")
             .expect("parses");
         assert_eq!(s.tls, TlsMode::VerifyFull);

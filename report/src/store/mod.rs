@@ -67,10 +67,12 @@ pub struct Store {
     /// The migrated copy an older SQLite store is read through, removed on
     /// drop.
     _copy: Option<tempfile::NamedTempFile>,
-    /// An older PostgreSQL store being read: its migration runs in a
-    /// transaction that is rolled back when the store is dropped.
-    rollback: bool,
 }
+
+/// The oldest schema every read (`history`, `report --store`) works on as
+/// it is: an older PostgreSQL store is read so, never migrated by a read.
+/// Raise it when a read comes to need a later schema's column.
+pub const READS_FROM: u32 = 1;
 
 /// What [`Store::add`] did with a record.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -91,9 +93,9 @@ impl Store {
         Store::open_with(given, &MIGRATIONS)
     }
 
-    /// Opens an existing store to read it, changing nothing in it: a store
-    /// of an older schema is read as migrated (SQLite: in a temporary
-    /// copy; PostgreSQL: in a transaction rolled back after), so that an
+    /// Opens an existing store to read it, changing nothing in it: an
+    /// older SQLite store is read through a migrated temporary copy, an
+    /// older PostgreSQL store as it is (from [`READS_FROM`] on), so that an
     /// archived store, read-only or shared, reads as it is.
     pub fn open_existing(given: &Path) -> Result<Store, StoreError> {
         Store::open_existing_with(given, &MIGRATIONS)
@@ -114,14 +116,17 @@ impl Store {
         let path = match &location {
             Location::File(path) => path.clone(),
             Location::Server(server) => {
+                // Read as it is: every query a read asks works on every
+                // schema from READS_FROM on, so a read needs no migration,
+                // no right to change the tables, and no lock on them.
                 let conn = Conn::Postgres(Box::new(Pg::new(connect(server)?)));
                 let mut store = Store::with(conn, location.clone());
                 let at = store.schema()?;
                 store.check_version(at, migrations.len() as u32, false)?;
-                if at < migrations.len() as u32 {
-                    store.conn.batch("BEGIN").map_err(|e| store.fail(e))?;
-                    store.rollback = true;
-                    store.apply(migrations)?;
+                if at < READS_FROM {
+                    return Err(store.fail(DbError::corrupt(format!(
+                        "a results store of schema {at}, which this ppmc reads from schema {READS_FROM} on"
+                    ))));
                 }
                 return Ok(store);
             }
@@ -209,7 +214,6 @@ impl Store {
             conn,
             location,
             _copy: None,
-            rollback: false,
         }
     }
 
@@ -299,15 +303,26 @@ impl Store {
                 uuid::Uuid::new_v5(&uuid::Uuid::NAMESPACE_OID, text.as_bytes())
             )
         });
-        // A server that closed an idle connection during a long run is
-        // asked again, once.
-        if let (Conn::Postgres(pg), Location::Server(server)) = (&mut self.conn, &self.location) {
-            if pg.client.is_closed() {
-                **pg = Pg::new(connect(server)?);
+        match self.add_once(record, &text, &key) {
+            // A server that dropped the connection during a long run (an
+            // idle timeout, a restart) is connected to again, once; the
+            // transaction that failed left nothing.
+            Err(e) if e.fault == Fault::Link => {
+                if let (Conn::Postgres(pg), Location::Server(server)) =
+                    (&mut self.conn, &self.location)
+                {
+                    **pg = Pg::new(connect(server)?);
+                    return self.add_once(record, &text, &key);
+                }
+                Err(e)
             }
+            done => done,
         }
+    }
+
+    fn add_once(&mut self, record: &RunRecord, text: &str, key: &str) -> Result<Added, StoreError> {
         self.conn.batch("BEGIN").map_err(|e| self.fail(e))?;
-        let done = insert(&mut self.conn, record, &text, &key).and_then(|added| {
+        let done = insert(&mut self.conn, record, text, key).and_then(|added| {
             self.conn.batch("COMMIT")?;
             Ok(added)
         });
@@ -330,14 +345,6 @@ impl Store {
 
     pub(crate) fn conn(&mut self) -> &mut Conn {
         &mut self.conn
-    }
-}
-
-impl Drop for Store {
-    fn drop(&mut self) {
-        if self.rollback {
-            let _ = self.conn.batch("ROLLBACK");
-        }
     }
 }
 

@@ -274,7 +274,7 @@ impl Store {
                 &format!(
                     "SELECT rev, count(*), count(CASE WHEN results > 0 AND passed = results THEN 1 END),
                          count(DISTINCT board), CAST(sum(flaky) AS BIGINT)
-                     FROM ({tests}) t GROUP BY rev ORDER BY rev"
+                     FROM ({tests}) t GROUP BY rev"
                 ),
                 &[],
             )?
@@ -289,6 +289,9 @@ impl Store {
                 })
             })
             .collect::<Result<_, DbError>>()?;
+        // In byte order on both databases (PostgreSQL's collation would
+        // order them its own way).
+        h.revisions.sort_by(|a, b| a.rev.cmp(&b.rev));
         h.trend = c
             .query(
                 &format!(

@@ -34,7 +34,7 @@ use std::time::{Duration as WallDuration, Instant as WallInstant};
 const EXPORT_TIMEOUT: WallDuration = WallDuration::from_secs(60);
 
 /// The place (and, with `,port=NAME`, which of its serial ports) of a
-/// `labgrid:<place>[,port=NAME]` target.
+/// `labgrid:<place>[,port=NAME][,acquire]` target.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Place {
     pub name: String,
@@ -43,7 +43,7 @@ pub struct Place {
     pub acquire: bool,
 }
 
-/// The driver of `labgrid:<place>[,port=NAME]`.
+/// The driver of `labgrid:<place>[,port=NAME][,acquire]`.
 #[derive(Debug)]
 pub struct LabgridDriver;
 

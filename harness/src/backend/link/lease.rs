@@ -13,11 +13,18 @@
 //! | `ppmc_boot` | the machine's boot id, first 12 hex digits: a lock from before a reboot is dead |
 //! | `ppmc_start` | the process's start, in clock ticks since boot (`/proc/PID/stat`): a pid used again is another process |
 //! | `ppmc_since` | when it acquired the place, seconds since 1970 |
+//! | `ppmc_pidns` | its PID namespace (`/proc/self/ns/pid`): a process of another container cannot be seen |
+//! | `ppmc_owner` | the place's holder as labgrid names it (`host/user`) when ppmc acquired it |
 //!
-//! A lock held by a process of this machine that is gone is stale: the run
-//! says whose it was and how old it is, and `--steal-stale` takes it
-//! (`labgrid-client release --kick`, then acquires). A lock of another
-//! machine's, or of a process still running, is never taken.
+//! A lock is stale only when all of it says so: the place is still held by
+//! the holder the tags name (not by someone who took it over since), and
+//! its ppmc ran on this machine, in this PID namespace, and is gone (no
+//! such process, another process under its pid, or a boot since). The run
+//! then says whose it was and how old it is, and `--steal-stale` takes it
+//! (`labgrid-client release-from HOLDER`, which lets go only if that holder
+//! still has it, then acquires). A lock whose holder cannot be told gone
+//! (another machine's, another container's, a run still going, a person's,
+//! or a machine without `/proc`) is never taken.
 
 use std::io;
 use std::process::{Command, Stdio};
@@ -28,13 +35,21 @@ use std::time::{SystemTime, UNIX_EPOCH};
 static HELD: Mutex<Vec<String>> = Mutex::new(Vec::new());
 
 /// The tags a lease sets, and clears when it ends.
-const TAGS: [&str; 5] = [
+const TAGS: [&str; 7] = [
     "ppmc_pid",
     "ppmc_host",
     "ppmc_boot",
     "ppmc_start",
     "ppmc_since",
+    "ppmc_pidns",
+    "ppmc_owner",
 ];
+
+/// How long a labgrid client may take for one step of a lease.
+const CLIENT_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(30);
+/// How long letting go may take when the process is about to end at once
+/// (a third signal): it must end.
+const LAST_GASP: std::time::Duration = std::time::Duration::from_secs(5);
 
 /// A place acquired by this process, released when dropped.
 #[derive(Debug)]
@@ -110,24 +125,40 @@ pub fn holder(shown: &Shown, me: &Machine, now: u64, alive: impl Fn(u32, &str) -
             format!("for {}", human_age(now.saturating_sub(t)))
         });
     let owner = format!("acquired by {by}, by ppmc pid {pid} on {host}, {age}");
-    let pid_n = pid.parse::<u32>().ok();
-    if host != me.host {
-        return Holder {
-            words: format!("{owner}: another machine's run, which this one cannot see"),
-            stale: false,
-        };
-    }
-    let dead = match (pid_n, shown.tag("ppmc_boot"), shown.tag("ppmc_start")) {
-        (_, Some(boot), _) if boot != me.boot => true,
-        (Some(p), _, Some(start)) => !alive(p, start),
-        _ => false,
+    let verdict = |words: &str, stale: bool| Holder {
+        words: format!("{owner}: {words}"),
+        stale,
     };
-    Holder {
-        words: match dead {
-            true => format!("{owner}: that process is gone, and left its lock"),
-            false => format!("{owner}: that run is still going"),
-        },
-        stale: dead,
+    if shown.tag("ppmc_owner") != shown.acquired.as_deref() {
+        return verdict(
+            "but held by someone else since (the tags are an older run's)",
+            false,
+        );
+    }
+    if host != me.host {
+        return verdict("another machine's run, which this one cannot see", false);
+    }
+    if me.boot.is_empty() || me.pidns.is_empty() {
+        return verdict("this machine cannot tell whether that run is going", false);
+    }
+    if shown.tag("ppmc_boot").is_some_and(|b| b != me.boot) {
+        return verdict(
+            "a run from before this machine's last boot, and left its lock",
+            true,
+        );
+    }
+    if shown.tag("ppmc_pidns") != Some(me.pidns.as_str()) {
+        return verdict(
+            "a run in another container of this machine, which this one cannot see",
+            false,
+        );
+    }
+    match (pid.parse::<u32>().ok(), shown.tag("ppmc_start")) {
+        (Some(p), Some(start)) if !alive(p, start) => {
+            verdict("that process is gone, and left its lock", true)
+        }
+        (Some(_), Some(_)) => verdict("that run is still going", false),
+        _ => verdict("its tags do not say which process it was", false),
     }
 }
 
@@ -145,6 +176,8 @@ fn human_age(secs: u64) -> String {
 pub struct Machine {
     pub host: String,
     pub boot: String,
+    /// This process's PID namespace (digits of `/proc/self/ns/pid`).
+    pub pidns: String,
 }
 
 impl Machine {
@@ -164,6 +197,14 @@ impl Machine {
             .filter(char::is_ascii_hexdigit)
             .take(12)
             .collect();
+        let pidns: String = std::fs::read_link("/proc/self/ns/pid")
+            .map(|p| {
+                p.to_string_lossy()
+                    .chars()
+                    .filter(char::is_ascii_digit)
+                    .collect()
+            })
+            .unwrap_or_default();
         Machine {
             host: if host.is_empty() {
                 "unknown".into()
@@ -171,6 +212,7 @@ impl Machine {
                 host
             },
             boot,
+            pidns,
         }
     }
 }
@@ -184,17 +226,50 @@ pub fn start_ticks(pid: u32) -> Option<String> {
     rest.split(' ').nth(19).map(str::to_string)
 }
 
-fn client(place: &str, args: &[&str]) -> io::Result<String> {
+/// Runs the labgrid client on `place`, at most `limit`: its output.
+fn client_within(place: &str, args: &[&str], limit: std::time::Duration) -> io::Result<String> {
     let program = super::labgrid::client_program();
-    let out = Command::new(&program)
+    let mut child = Command::new(&program)
         .args(["-p", place])
         .args(args)
         .stdin(Stdio::null())
-        .output()
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
         .map_err(|e| io::Error::other(format!("cannot run `{program}`: {e}")))?;
-    let text = String::from_utf8_lossy(&out.stdout).into_owned();
-    if !out.status.success() {
-        let err = String::from_utf8_lossy(&out.stderr);
+    let (mut out, mut err) = (child.stdout.take(), child.stderr.take());
+    let read = std::thread::spawn(move || {
+        let mut o = String::new();
+        let mut e = String::new();
+        if let Some(s) = out.as_mut() {
+            let _ = io::Read::read_to_string(s, &mut o);
+        }
+        if let Some(s) = err.as_mut() {
+            let _ = io::Read::read_to_string(s, &mut e);
+        }
+        (o, e)
+    });
+    let end = std::time::Instant::now() + limit;
+    let status = loop {
+        if let Some(s) = child.try_wait()? {
+            break s;
+        }
+        if std::time::Instant::now() >= end {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(io::Error::new(
+                io::ErrorKind::TimedOut,
+                format!(
+                    "`{program} -p {place} {}` did not answer within {} s",
+                    args.join(" "),
+                    limit.as_secs()
+                ),
+            ));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let (text, err) = read.join().unwrap_or_default();
+    if !status.success() {
         let why = err
             .lines()
             .rev()
@@ -207,6 +282,10 @@ fn client(place: &str, args: &[&str]) -> io::Result<String> {
         )));
     }
     Ok(text)
+}
+
+fn client(place: &str, args: &[&str]) -> io::Result<String> {
+    client_within(place, args, CLIENT_TIMEOUT)
 }
 
 impl Lease {
@@ -235,10 +314,16 @@ impl Lease {
                     format!("{who}: the place is {}{hint}", h.words),
                 ));
             }
-            client(place, &["release", "--kick"]).map_err(fail)?;
+            // Only if that holder still has it: a lock taken over since
+            // the look above is not kicked.
+            let holder = shown.acquired.as_deref().unwrap_or_default();
+            client(place, &["release-from", holder]).map_err(fail)?;
             eprintln!("ppmc: {who}: took a stale lock: the place was {}", h.words);
         }
         client(place, &["acquire"]).map_err(fail)?;
+        let owner = Shown::parse(&client(place, &["show"]).map_err(fail)?)
+            .acquired
+            .unwrap_or_default();
         let lease = Lease {
             place: place.to_string(),
             released: false,
@@ -256,6 +341,8 @@ impl Lease {
             format!("ppmc_boot={}", me.boot),
             format!("ppmc_start={}", start_ticks(pid).unwrap_or_default()),
             format!("ppmc_since={since}"),
+            format!("ppmc_pidns={}", me.pidns),
+            format!("ppmc_owner={owner}"),
         ];
         let mut args = vec!["set-tags"];
         args.extend(tags.iter().map(String::as_str));
@@ -270,7 +357,7 @@ impl Lease {
         if std::mem::replace(&mut self.released, true) {
             return;
         }
-        release_place(&self.place);
+        release_place(&self.place, CLIENT_TIMEOUT);
         if let Ok(mut held) = HELD.lock() {
             held.retain(|p| *p != self.place);
         }
@@ -283,12 +370,12 @@ impl Drop for Lease {
     }
 }
 
-fn release_place(place: &str) {
+fn release_place(place: &str, limit: std::time::Duration) {
     let clear: Vec<String> = TAGS.iter().map(|t| format!("{t}=")).collect();
     let mut args = vec!["set-tags"];
     args.extend(clear.iter().map(String::as_str));
-    let cleared = client(place, &args);
-    if let Err(e) = cleared.and_then(|_| client(place, &["release"])) {
+    let cleared = client_within(place, &args, limit);
+    if let Err(e) = cleared.and_then(|_| client_within(place, &["release"], limit)) {
         eprintln!("ppmc: labgrid:{place}: could not let go of the place: {e}");
     }
 }
@@ -301,7 +388,7 @@ pub fn release_all() {
         .map(|mut h| std::mem::take(&mut *h))
         .unwrap_or_default();
     for p in places {
-        release_place(&p);
+        release_place(&p, LAST_GASP);
     }
 }
 
@@ -311,7 +398,7 @@ mod tests {
 
     const SHOW: &str = "\
 Place 'rig1':
-  tags: ppmc_boot=0123456789ab, ppmc_host=bench-7, ppmc_pid=4242, ppmc_since=1000, ppmc_start=777
+  tags: ppmc_boot=0123456789ab, ppmc_host=bench-7, ppmc_owner=bench-7/ci, ppmc_pid=4242, ppmc_pidns=4026531836, ppmc_since=1000, ppmc_start=777
   matches:
     bench1/bridge/*
   acquired: bench-7/ci
@@ -324,6 +411,7 @@ Place 'rig1':
         Machine {
             host: "bench-7".into(),
             boot: "0123456789ab".into(),
+            pidns: "4026531836".into(),
         }
     }
 
@@ -349,6 +437,25 @@ Place 'rig1':
             ..me()
         };
         assert!(holder(&shown, &rebooted, 1_300, |_, _| true).stale);
+        // Taken over since by someone (the tags stay): never stale.
+        let mut taken = shown.clone();
+        taken.acquired = Some("bench-7/alice".into());
+        let h = holder(&taken, &me(), 1_300, |_, _| false);
+        assert!(
+            !h.stale && h.words.contains("held by someone else"),
+            "{h:?}"
+        );
+        // Another container, or a machine that cannot tell: never stale.
+        let contained = Machine {
+            pidns: "4026532000".into(),
+            ..me()
+        };
+        assert!(!holder(&shown, &contained, 1_300, |_, _| false).stale);
+        let blind = Machine {
+            boot: String::new(),
+            ..me()
+        };
+        assert!(!holder(&shown, &blind, 1_300, |_, _| false).stale);
         let elsewhere = Machine {
             host: "bench-8".into(),
             ..me()
