@@ -17,7 +17,7 @@
 //! `LG_PROXY`) in the environment reach it unchanged. The client program is
 //! `labgrid-client` on the `PATH`, or `PPMC_LABGRID_CLIENT`.
 
-use super::lease::Lease;
+use super::lease::{client_program, Lease};
 use super::rfc2217::Rfc2217Link;
 use super::serial::SerialLink;
 use super::tcp::TcpLink;
@@ -216,10 +216,6 @@ impl fmt::Debug for LabgridLink {
             .field("inner", &self.inner)
             .finish()
     }
-}
-
-pub(super) fn client_program() -> String {
-    std::env::var("PPMC_LABGRID_CLIENT").unwrap_or_else(|_| "labgrid-client".into())
 }
 
 impl LabgridLink {

@@ -226,9 +226,15 @@ pub fn start_ticks(pid: u32) -> Option<String> {
     rest.split(' ').nth(19).map(str::to_string)
 }
 
+/// The labgrid client: `labgrid-client` on the `PATH`, or
+/// `PPMC_LABGRID_CLIENT`.
+pub(super) fn client_program() -> String {
+    std::env::var("PPMC_LABGRID_CLIENT").unwrap_or_else(|_| "labgrid-client".into())
+}
+
 /// Runs the labgrid client on `place`, at most `limit`: its output.
 fn client_within(place: &str, args: &[&str], limit: std::time::Duration) -> io::Result<String> {
-    let program = super::labgrid::client_program();
+    let program = client_program();
     let mut child = Command::new(&program)
         .args(["-p", place])
         .args(args)
