@@ -116,8 +116,13 @@ impl From<postgres::Error> for DbError {
         };
         // A closed connection is the link's; the server's own errors
         // about the store's tables are the store's.
+        // An I/O error on the way (a connection reset by the server) is
+        // the link's too.
+        let io = e
+            .source()
+            .is_some_and(|c| c.downcast_ref::<std::io::Error>().is_some());
         let fault = match e.code() {
-            _ if e.is_closed() => Fault::Link,
+            _ if e.is_closed() || io => Fault::Link,
             Some(c) if c.code().starts_with("42") || c.code().starts_with("XX") => Fault::Store,
             // The connection's loss, and the server going down or
             // dropping it (57P01-57P03).
