@@ -79,6 +79,14 @@ impl DbError {
     }
 }
 
+/// A failure of ppmc's own making (a record that does not render), not the
+/// database's.
+impl From<String> for DbError {
+    fn from(why: String) -> DbError {
+        DbError::new(why)
+    }
+}
+
 impl From<rusqlite::Error> for DbError {
     fn from(e: rusqlite::Error) -> DbError {
         use rusqlite::ErrorCode as C;

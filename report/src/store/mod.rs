@@ -217,7 +217,7 @@ impl Store {
         }
     }
 
-    fn fail(&self, e: impl Into<Failure>) -> StoreError {
+    fn fail(&self, e: impl Into<DbError>) -> StoreError {
         let e = e.into();
         StoreError {
             at: self.location.shown(),
@@ -345,31 +345,6 @@ impl Store {
 
     pub(crate) fn conn(&mut self) -> &mut Conn {
         &mut self.conn
-    }
-}
-
-/// Why, and whose.
-#[derive(Debug)]
-struct Failure {
-    why: String,
-    fault: Fault,
-}
-
-impl From<DbError> for Failure {
-    fn from(e: DbError) -> Failure {
-        Failure {
-            why: e.why,
-            fault: e.fault,
-        }
-    }
-}
-
-impl From<String> for Failure {
-    fn from(why: String) -> Failure {
-        Failure {
-            why,
-            fault: Fault::Other,
-        }
     }
 }
 
