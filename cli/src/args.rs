@@ -223,6 +223,7 @@ impl TargetArgs {
             link_retries: self.link_retries,
             stop: self.stop.clone(),
             steal_stale: self.steal_stale,
+            power: Default::default(),
         }
     }
 

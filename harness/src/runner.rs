@@ -3,9 +3,11 @@
 //! at once ([`run_on_boards`], [`stream_on_boards`]), opened together as a
 //! [`Farm`], which keeps the boards it could not reach out of the verdict.
 
-use crate::backend::{self, Op, OpenError, OpenOptions, Target, TargetInfo, TargetSpec};
+use crate::backend::{
+    self, Op, OpenError, OpenOptions, Power, Reply, Target, TargetInfo, TargetSpec,
+};
 use crate::scenario::{
-    run_scenario, Attempt, DriverOptions, NotRun, Scenario, ScenarioResult, Verdict,
+    run_scenario, Attempt, DriverOptions, HarnessError, NotRun, Scenario, ScenarioResult, Verdict,
 };
 use crate::stop::StopRequest;
 use crate::time::Duration;
@@ -145,7 +147,7 @@ pub fn run_suite_until(
                 _ if interrupted => not_run(NotRun::Interrupted),
                 Some(why) => not_run(NotRun::TargetLost(why.clone())),
                 None => {
-                    let (r, lost) = run_checked(target, s, opts);
+                    let (r, lost) = run_checked(target, s, opts, None);
                     dead = lost;
                     r
                 }
@@ -157,26 +159,56 @@ pub fn run_suite_until(
     results
 }
 
-/// Runs `s`, and after a harness error gives the target a health check (a
-/// chip reset): `Some(why)` when that fails too and the target is taken
-/// as lost.
+/// Runs `s`, and after a harness error or a device failure gives the
+/// target a health check ([`health`]): `Some(why)` when the target is
+/// taken as lost. A board that hung is brought back by `power` when it
+/// has a switch ([`recover`]): the scenario is then an infrastructure
+/// error naming the hang, and the run goes on from the next.
 fn run_checked(
     target: &mut dyn Target,
     s: &Scenario,
     opts: DriverOptions,
+    mut power: Option<&mut Power>,
 ) -> (ScenarioResult, Option<String>) {
     let mut earlier = Vec::new();
     loop {
         let mut r = run_scenario(target, s, opts);
         let mut lost = None;
-        if matches!(r.verdict, Verdict::Error(_)) {
-            if let Err(e) = target.execute(&[Op::Reset]) {
-                lost = Some(e.to_string());
+        let mut recovered = false;
+        if matches!(r.verdict, Verdict::Error(_) | Verdict::Failed(_)) {
+            match (health(target), power.as_deref_mut()) {
+                (Ok(()), _) => {}
+                (Err(h), _) if h.interrupted => lost = Some(h.why),
+                (Err(h), Some(p)) => match recover(target, p, &h.why) {
+                    Ok(recovery) => {
+                        // The first sign, then what the health check found
+                        // (a silent bridge says the same twice: once).
+                        let hang = match &r.verdict {
+                            _ if !h.busy => format!("its bridge stopped answering ({})", h.why),
+                            Verdict::Failed(f) => {
+                                format!("{}, after the scenario failed {f}", h.why)
+                            }
+                            Verdict::Error(e) => {
+                                format!("{}, after the scenario's error: {e}", h.why)
+                            }
+                            _ => h.why,
+                        };
+                        r.verdict = Verdict::Error(HarnessError::Hung { hang, recovery });
+                        recovered = true;
+                    }
+                    Err(why) => lost = Some(why),
+                },
+                // Without a switch a chip BUSY after its reset is left to
+                // the next scenario's reset, and its verdict.
+                (Err(h), None) if h.busy => {}
+                (Err(h), None) => lost = Some(h.why),
             }
         }
         // Again on the same board, while it is there and the policy takes
-        // this end; every attempt stays on record.
+        // this end; every attempt stays on record. A scenario the board
+        // hung under is not: the run goes on from the next.
         let again = lost.is_none()
+            && !recovered
             && earlier.len() < opts.retry.times as usize
             && opts.retry.takes(&r.verdict);
         if again {
@@ -186,6 +218,64 @@ fn run_checked(
         r.attempts = earlier;
         return (r, lost);
     }
+}
+
+/// Why a board failed its health check.
+#[derive(Debug)]
+struct Hang {
+    why: String,
+    /// The chip answered, BUSY after its reset.
+    busy: bool,
+    /// A stop was asked for: nothing hung.
+    interrupted: bool,
+}
+
+/// The health check after a scenario that did not pass: a chip reset, and
+/// the status after it. A board hangs when its bridge does not answer, or
+/// its chip is still BUSY after the reset (3-1-1: the reset ends any move;
+/// a chip BUSY past that is past its longest legal move).
+fn health(target: &mut dyn Target) -> Result<(), Hang> {
+    match target.execute(&[Op::Reset, Op::ReadStatus]) {
+        Err(e) => Err(Hang {
+            why: e.to_string(),
+            busy: false,
+            interrupted: e.kind == crate::backend::TargetErrorKind::Interrupted,
+        }),
+        Ok(replies) => match replies.get(1) {
+            Some(Reply::Status { status, .. }) if status.busy() => Err(Hang {
+                why: format!(
+                    "the chip stayed BUSY after a chip reset (status 0x{:02X})",
+                    status.0
+                ),
+                busy: true,
+                interrupted: false,
+            }),
+            _ => Ok(()),
+        },
+    }
+}
+
+/// Brings back a board that hung (`hang` says how): its power cycled by
+/// its switch, the board reached again ([`Target::restart`]) and health
+/// checked. `Ok` says what was done; `Err` why the board is lost.
+fn recover(target: &mut dyn Target, p: &mut Power, hang: &str) -> Result<String, String> {
+    if p.left == 0 {
+        return Err(format!(
+            "{hang}; the board has had the {} power cycles it may have in a run (--power-cycles)",
+            p.of
+        ));
+    }
+    p.left -= 1;
+    let n = p.of - p.left;
+    p.switch
+        .cycle(&p.spec)
+        .map_err(|e| format!("{hang}; its power cycle failed: {e}"))?;
+    let cycled = format!("power-cycled by `{}` ({n} of {})", p.switch, p.of);
+    target
+        .restart(p.boot)
+        .map_err(|e| format!("{hang}; {cycled}, but: {e}"))?;
+    health(target).map_err(|h| format!("{hang}; {cycled}, and it is still hung: {}", h.why))?;
+    Ok(cycled)
 }
 
 /// The result of a scenario that did not run, and why.
@@ -272,6 +362,7 @@ pub fn run_on_boards(
     let mut all = Vec::new();
     stream_on_boards(
         boards,
+        &mut [],
         scenarios,
         repeat,
         opts,
@@ -292,6 +383,7 @@ pub fn run_on_boards(
 #[allow(clippy::too_many_arguments)]
 pub fn stream_on_boards(
     boards: &mut [Box<dyn Target>],
+    powers: &mut [Option<Power>],
     scenarios: &[Scenario],
     repeat: usize,
     opts: DriverOptions,
@@ -318,8 +410,10 @@ pub fn stream_on_boards(
     let queues = &queues;
     std::thread::scope(|scope| {
         let (tx, rx) = mpsc::channel();
+        let mut powers = powers.iter_mut();
         for (board, target) in boards.iter_mut().enumerate() {
             let tx = tx.clone();
+            let mut power = powers.next().and_then(|p| p.as_mut());
             let q = board.min(queues.len() - 1);
             scope.spawn(move || loop {
                 if stop() {
@@ -331,7 +425,12 @@ pub fn stream_on_boards(
                     return;
                 }
                 let slot = q * per_queue + taken;
-                let (result, lost) = run_checked(target.as_mut(), scenario_of(slot), opts);
+                let (result, lost) = run_checked(
+                    target.as_mut(),
+                    scenario_of(slot),
+                    opts,
+                    power.as_deref_mut(),
+                );
                 let gone = lost.is_some();
                 let _ = tx.send(Report {
                     slot,
@@ -404,6 +503,8 @@ pub struct Farm {
     specs: Vec<TargetSpec>,
     /// The targets reached, and for each, its spec's index.
     targets: Vec<Box<dyn Target>>,
+    /// Each target's power switch, where it has one.
+    powers: Vec<Option<Power>>,
     reached: Vec<usize>,
     /// The specs not reached (their index) and why.
     unreached: Vec<(usize, OpenError)>,
@@ -438,6 +539,7 @@ impl Farm {
         let mut farm = Farm {
             specs: Vec::new(),
             targets: Vec::new(),
+            powers: Vec::new(),
             reached: Vec::new(),
             unreached: Vec::new(),
             stop: opts.stop.clone(),
@@ -446,6 +548,7 @@ impl Farm {
             match opened {
                 Ok(t) => {
                     farm.targets.push(t);
+                    farm.powers.push(Power::of(&specs[b], &opts.power));
                     farm.reached.push(b);
                 }
                 Err(e @ OpenError::Invalid(_)) => return Err(e),
@@ -556,6 +659,7 @@ impl Farm {
         let reached = &self.reached;
         stream_on_boards(
             &mut self.targets,
+            &mut self.powers,
             scenarios,
             repeat,
             opts,

@@ -338,6 +338,7 @@ mod tests {
         let mut most = 0;
         stream_on_boards(
             &mut boards,
+            &mut [],
             &suite,
             passes,
             DriverOptions::default(),

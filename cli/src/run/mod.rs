@@ -30,7 +30,11 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
         true => Spread::Each,
         false => Spread::Share,
     };
-    let mut farm = Farm::open(specs, &args.target.open_options())?;
+    let open = ppmc::backend::OpenOptions {
+        power: args.power.options(),
+        ..args.target.open_options()
+    };
+    let mut farm = Farm::open(specs, &open)?;
     let (rev, serial) = (&args.target.board_rev, &args.target.board_serial);
     let boards = session::boards(&farm, rev.as_deref(), serial.as_deref());
     let mut info = ppmc::runner::run_info(boards, spread.name(several_specs));

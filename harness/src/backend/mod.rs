@@ -36,9 +36,11 @@
 //! retries, reconnects and verdicts come with [`BridgeTarget`].
 
 mod bridged;
+mod command;
 mod emu;
 pub mod link;
 mod open;
+pub mod power;
 mod spec;
 mod target;
 
@@ -52,6 +54,7 @@ pub use self::link::serial::{parse_serial_address, SerialLink};
 pub use self::link::tcp::{parse_tcp, TcpLink};
 pub use self::link::{Link, LinkDriver, DRIVERS};
 pub use self::open::{check, open, OpenError, OpenOptions};
+pub use self::power::{Hub, Power, PowerOptions, PowerSwitch};
 pub use self::spec::{forms, Address, SpecError, StrapOptions, TargetSpec};
 pub use self::target::{
     Op, Reply, SelfTestPlan, SelfTestReply, SelfTestRun, Target, TargetError, TargetErrorKind,

@@ -35,6 +35,9 @@ pub struct OpenOptions {
     /// A place ppmc acquires may be taken from a dead ppmc's lock
     /// (`--steal-stale`, `backend::link::lease`).
     pub steal_stale: bool,
+    /// How a board that hangs is brought back: its power switch, and the
+    /// cycles it may have ([`super::power`]).
+    pub power: super::power::PowerOptions,
 }
 
 impl Default for OpenOptions {
@@ -47,6 +50,7 @@ impl Default for OpenOptions {
             link_retries: serial.retries,
             stop: StopRequest::default(),
             steal_stale: false,
+            power: super::power::PowerOptions::default(),
         }
     }
 }

@@ -196,6 +196,18 @@ pub trait Target: Send {
     /// an instant, has nothing to cut short.
     fn set_deadline(&mut self, _at: Option<std::time::Instant>) {}
 
+    /// The board's power was cycled ([`crate::backend::power`]): reach it
+    /// again as at open, trying until `boot` has passed (the link opened
+    /// anew, a new session with its bridge, the health check). The
+    /// default, for a target with nothing to reach again, refuses.
+    fn restart(&mut self, boot: std::time::Duration) -> Result<(), TargetError> {
+        let _ = boot;
+        Err(TargetError::new(
+            TargetErrorKind::Unsupported,
+            "this target cannot be reached again after a power cycle",
+        ))
+    }
+
     /// Runs one op.
     fn execute_one(&mut self, op: Op) -> Result<Reply, TargetError> {
         let mut replies = self.execute(std::slice::from_ref(&op))?;

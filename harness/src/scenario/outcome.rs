@@ -53,6 +53,11 @@ pub enum HarnessError {
     /// miss, which says nothing about the device.
     #[error("{0}")]
     Aim(String),
+    /// The board hung under the scenario (its bridge silent past the
+    /// link's bounds, or its chip BUSY after a chip reset) and was brought
+    /// back by power, so the scenario cannot be judged; the run went on.
+    #[error("the board hung: {hang}; {recovery}, and the run went on")]
+    Hung { hang: String, recovery: String },
 }
 
 impl HarnessError {

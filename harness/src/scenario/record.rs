@@ -19,7 +19,8 @@ impl HarnessError {
                 kind: TargetErrorKind::Link,
                 ..
             }
-            | HarnessError::Aim(_) => ErrorKind::Infrastructure,
+            | HarnessError::Aim(_)
+            | HarnessError::Hung { .. } => ErrorKind::Infrastructure,
             _ => ErrorKind::Harness,
         }
     }

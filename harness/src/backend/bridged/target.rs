@@ -119,7 +119,13 @@ impl<L: Link> BridgeTarget<L> {
     /// Says hello, then checks the board's health: a chip reset, and the
     /// status register reading 0x00 after it.
     pub fn open(link: L, opts: BridgeOptions) -> Result<Self, BridgeError> {
-        let mut t = BridgeTarget {
+        let mut t = Self::unopened(link, opts);
+        t.handshake()?;
+        Ok(t)
+    }
+
+    fn unopened(link: L, opts: BridgeOptions) -> Self {
+        BridgeTarget {
             link,
             decoder: FrameDecoder::new(),
             seq: 0,
@@ -163,7 +169,13 @@ impl<L: Link> BridgeTarget<L> {
             give_ups: 0,
             last_give_up: String::new(),
             stats: LinkStats::default(),
-        };
+        }
+    }
+
+    /// A session with the bridge, as at open: HELLO, the link's settings,
+    /// and the health check.
+    fn handshake(&mut self) -> Result<(), BridgeError> {
+        let t = self;
         t.hello = t.say_hello()?;
         t.timer = Timer {
             hz: t.hello.timer_hz,
@@ -185,7 +197,7 @@ impl<L: Link> BridgeTarget<L> {
                 },
             })?;
         match replies.get(1) {
-            Some(Reply::Status { status, .. }) if status.0 == 0 => Ok(t),
+            Some(Reply::Status { status, .. }) if status.0 == 0 => Ok(()),
             Some(Reply::Status { status, .. }) => Err(BridgeError::Unhealthy {
                 link: t.link.name(),
                 detail: format!(
@@ -201,6 +213,81 @@ impl<L: Link> BridgeTarget<L> {
                 },
             }),
         }
+    }
+
+    /// After the board's power was cycled: the link opened anew and a new
+    /// session as at open (HELLO, the link's settings, the health check),
+    /// tried until `boot` has passed (a USB port enumerates again, a
+    /// bridge boots). The bridge must report the straps it reported
+    /// before: another board behind the link would be judged as this one.
+    pub fn restart(&mut self, boot: WallDuration) -> Result<(), BridgeError> {
+        let straps = self.hello.straps;
+        let end = WallInstant::now() + boot;
+        let mut wait = self.opts.backoff.max(WallDuration::from_millis(50));
+        let why = loop {
+            let tried = self
+                .link
+                .restart()
+                .map_err(|e| e.to_string())
+                .and_then(|()| {
+                    self.stats.reopens += 1;
+                    self.new_session().map_err(|e| e.to_string())
+                });
+            let why = match tried {
+                Ok(()) => break None,
+                Err(why) => why,
+            };
+            if WallInstant::now() >= end || self.opts.stop.sleep(wait) {
+                break Some(why);
+            }
+            wait = (wait * 2).min(WallDuration::from_secs(2));
+        };
+        if let Some(why) = why {
+            return Err(BridgeError::Unhealthy {
+                link: self.link.name(),
+                detail: format!(
+                    "not back within {} s of its power cycle ({why})",
+                    boot.as_secs_f64()
+                ),
+            });
+        }
+        if self.hello.straps != straps {
+            return Err(BridgeError::Unhealthy {
+                link: self.link.name(),
+                detail: format!(
+                    "after its power cycle the bridge reports its chip strapped {}, not {straps} as before: another board answers",
+                    self.hello.straps
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Forgets the session of a bridge that lost its power, and starts
+    /// another: what the bridge knew of this host (its cached request,
+    /// the link's settings, the capture) is gone with it.
+    fn new_session(&mut self) -> Result<(), BridgeError> {
+        self.decoder = FrameDecoder::new();
+        self.opened = false;
+        self.recovering = false;
+        self.in_flight = None;
+        self.sent = false;
+        self.deadline = None;
+        self.captured = OutputRecord::default();
+        self.let_go = OutputMark::default();
+        self.captured_current = false;
+        self.clock = Instant::ZERO;
+        self.garbled = 0;
+        self.clean = 0;
+        self.give_ups = 0;
+        self.last_give_up.clear();
+        // A delimiter first: whatever part of a frame the bridge kept ends
+        // there, not in our HELLO.
+        self.link.send(&[0]).map_err(|e| BridgeError::Io {
+            path: self.link.name(),
+            source: e,
+        })?;
+        self.handshake()
     }
 
     pub fn hello(&self) -> &Hello {
@@ -389,6 +476,10 @@ impl<L: Link> Target for BridgeTarget<L> {
 
     fn self_test(&mut self, plan: &SelfTestPlan) -> Result<SelfTestRun, TargetError> {
         Ok(self.counted(|t| t.run_self_test(plan))?)
+    }
+
+    fn restart(&mut self, boot: WallDuration) -> Result<(), TargetError> {
+        Ok(BridgeTarget::restart(self, boot)?)
     }
 }
 

@@ -207,6 +207,7 @@ pub struct LabgridLink {
     _export: Export,
     /// The place, when ppmc acquired it: released last.
     _lease: Option<Lease>,
+    stop: StopRequest,
 }
 
 impl fmt::Debug for LabgridLink {
@@ -241,8 +242,8 @@ impl LabgridLink {
                 };
                 let addr = format!("{host}:{}", found.port);
                 match proto {
-                    Some("rfc2217") => Box::new(Rfc2217Link::open_until(&addr, found.speed, stop)?),
-                    Some("raw") => Box::new(TcpLink::open_until(&addr, stop)?),
+                    Some("rfc2217") => Box::new(Rfc2217Link::open_until(&addr, found.speed, stop.clone())?),
+                    Some("raw") => Box::new(TcpLink::open_until(&addr, stop.clone())?),
                     other => {
                         return Err(io::Error::new(
                             io::ErrorKind::Unsupported,
@@ -260,6 +261,7 @@ impl LabgridLink {
             inner,
             _export: export,
             _lease: None,
+            stop,
         })
     }
 }
@@ -374,8 +376,42 @@ impl Link for LabgridLink {
         self.inner.reopen()
     }
 
+    /// Asks labgrid again where the port is: after a power cycle the
+    /// exporter may serve it anew, on another port. The lease is kept.
+    fn restart(&mut self) -> io::Result<()> {
+        // The old connection closes first: a serial server serves one
+        // client at a time.
+        self.inner = Box::new(Closed(self.inner.name()));
+        let fresh = LabgridLink::open_until(self.place.clone(), self.stop.clone())?;
+        self.inner = fresh.inner;
+        self._export = fresh._export;
+        Ok(())
+    }
+
     fn name(&self) -> String {
         format!("labgrid:{} ({})", self.place.name, self.inner.name())
+    }
+}
+
+/// A connection closed while another is opened in its place.
+#[derive(Debug)]
+struct Closed(String);
+
+impl Link for Closed {
+    fn send(&mut self, _: &[u8]) -> io::Result<()> {
+        Err(io::ErrorKind::NotConnected.into())
+    }
+
+    fn recv(&mut self, _: &mut [u8], _: WallDuration) -> io::Result<usize> {
+        Err(io::ErrorKind::NotConnected.into())
+    }
+
+    fn reopen(&mut self) -> io::Result<()> {
+        Err(io::ErrorKind::NotConnected.into())
+    }
+
+    fn name(&self) -> String {
+        self.0.clone()
     }
 }
 

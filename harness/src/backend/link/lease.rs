@@ -27,7 +27,7 @@
 //! or a machine without `/proc`) is never taken.
 
 use std::io;
-use std::process::{Command, Stdio};
+use std::process::Command;
 use std::sync::Mutex;
 use std::time::{SystemTime, UNIX_EPOCH};
 
@@ -228,66 +228,17 @@ pub fn start_ticks(pid: u32) -> Option<String> {
 
 /// The labgrid client: `labgrid-client` on the `PATH`, or
 /// `PPMC_LABGRID_CLIENT`.
-pub(super) fn client_program() -> String {
+pub(crate) fn client_program() -> String {
     std::env::var("PPMC_LABGRID_CLIENT").unwrap_or_else(|_| "labgrid-client".into())
 }
 
 /// Runs the labgrid client on `place`, at most `limit`: its output.
 fn client_within(place: &str, args: &[&str], limit: std::time::Duration) -> io::Result<String> {
     let program = client_program();
-    let mut child = Command::new(&program)
-        .args(["-p", place])
-        .args(args)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .map_err(|e| io::Error::other(format!("cannot run `{program}`: {e}")))?;
-    let (mut out, mut err) = (child.stdout.take(), child.stderr.take());
-    let read = std::thread::spawn(move || {
-        let mut o = String::new();
-        let mut e = String::new();
-        if let Some(s) = out.as_mut() {
-            let _ = io::Read::read_to_string(s, &mut o);
-        }
-        if let Some(s) = err.as_mut() {
-            let _ = io::Read::read_to_string(s, &mut e);
-        }
-        (o, e)
-    });
-    let end = std::time::Instant::now() + limit;
-    let status = loop {
-        if let Some(s) = child.try_wait()? {
-            break s;
-        }
-        if std::time::Instant::now() >= end {
-            let _ = child.kill();
-            let _ = child.wait();
-            return Err(io::Error::new(
-                io::ErrorKind::TimedOut,
-                format!(
-                    "`{program} -p {place} {}` did not answer within {} s",
-                    args.join(" "),
-                    limit.as_secs()
-                ),
-            ));
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    };
-    let (text, err) = read.join().unwrap_or_default();
-    if !status.success() {
-        let why = err
-            .lines()
-            .rev()
-            .find(|l| !l.trim().is_empty())
-            .unwrap_or("");
-        return Err(io::Error::other(format!(
-            "`{program} -p {place} {}` failed: {}",
-            args.join(" "),
-            why.trim()
-        )));
-    }
-    Ok(text)
+    let shown = format!("{program} -p {place} {}", args.join(" "));
+    let mut cmd = Command::new(&program);
+    cmd.args(["-p", place]).args(args);
+    crate::backend::command::run_within(&mut cmd, &shown, limit)
 }
 
 fn client(place: &str, args: &[&str]) -> io::Result<String> {

@@ -89,6 +89,12 @@ pub trait Link: Send + fmt::Debug {
     fn recv(&mut self, buf: &mut [u8], timeout: WallDuration) -> io::Result<usize>;
     /// Opens the link again after it failed.
     fn reopen(&mut self) -> io::Result<()>;
+    /// Opens the link anew after the far end lost its power: where a link
+    /// is found again (a serial server that moved, a port enumerated
+    /// again) it is looked up again. The default reopens.
+    fn restart(&mut self) -> io::Result<()> {
+        self.reopen()
+    }
     /// What to call the link in messages: `serial:/dev/ttyACM0`.
     fn name(&self) -> String;
     /// The serial number of the device at the link's far end, where the
@@ -110,6 +116,10 @@ impl Link for Box<dyn Link> {
 
     fn reopen(&mut self) -> io::Result<()> {
         (**self).reopen()
+    }
+
+    fn restart(&mut self) -> io::Result<()> {
+        (**self).restart()
     }
 
     fn name(&self) -> String {

@@ -1,0 +1,153 @@
+//! Running another program for a board (labgrid's client, a power switch)
+//! with a bound: its output, or an error that names the command and says
+//! why (it could not start, it failed and what it said last, it did not
+//! answer in time and was killed).
+
+use std::io;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Runs `cmd` (shown in messages as `shown`), at most `limit`, its input
+/// closed: its standard output when it succeeds. A program that does not
+/// end in time is killed; one that fails gives its last line of complaint.
+pub(crate) fn run_within(cmd: &mut Command, shown: &str, limit: Duration) -> io::Result<String> {
+    let mut child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| io::Error::new(e.kind(), format!("cannot run `{shown}`: {e}")))?;
+    // Both pipes drained on the side, so a chatty program never blocks.
+    // A program that leaves something running behind it (a power script
+    // that restarts a service) may leave the pipes open: its output is
+    // then what arrived by a moment after it ended.
+    let out = drain(child.stdout.take());
+    let err = drain(child.stderr.take());
+    let end = Instant::now() + limit;
+    let status = loop {
+        if let Some(s) = child.try_wait()? {
+            break s;
+        }
+        if Instant::now() >= end {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(io::Error::new(
+                io::ErrorKind::TimedOut,
+                format!("`{shown}` did not answer within {} s", limit.as_secs()),
+            ));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let (text, err) = (out.collect(), err.collect());
+    if !status.success() {
+        let why = err
+            .lines()
+            .chain(text.lines())
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("");
+        let why = match why.trim() {
+            "" => format!("{status}"),
+            line => format!("{status}: {line}"),
+        };
+        return Err(io::Error::other(format!("`{shown}` failed ({why})")));
+    }
+    Ok(text)
+}
+
+/// A pipe read to its end on a thread of its own.
+struct Drained {
+    text: std::sync::Arc<std::sync::Mutex<Vec<u8>>>,
+    done: std::sync::mpsc::Receiver<()>,
+}
+
+fn drain(pipe: Option<impl io::Read + Send + 'static>) -> Drained {
+    let text = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let (tx, done) = std::sync::mpsc::channel();
+    if let Some(mut pipe) = pipe {
+        let text = text.clone();
+        std::thread::spawn(move || {
+            let mut buf = [0u8; 4096];
+            while let Ok(n @ 1..) = pipe.read(&mut buf) {
+                if let Ok(mut t) = text.lock() {
+                    t.extend_from_slice(&buf[..n]);
+                }
+            }
+            let _ = tx.send(());
+        });
+    }
+    Drained { text, done }
+}
+
+impl Drained {
+    /// What the pipe gave: all of it once it closes, or what arrived
+    /// within a moment.
+    fn collect(self) -> String {
+        let _ = self.done.recv_timeout(Duration::from_millis(500));
+        let bytes = self.text.lock().map(|t| t.clone()).unwrap_or_default();
+        String::from_utf8_lossy(&bytes).into_owned()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn output_failure_and_a_program_that_hangs_each_say_so() {
+        let ok = run_within(
+            Command::new("sh").args(["-c", "echo hi"]),
+            "sh hi",
+            Duration::from_secs(10),
+        );
+        assert_eq!(ok.expect("works"), "hi\n");
+        let failed = run_within(
+            Command::new("sh").args(["-c", "echo no such relay >&2; exit 3"]),
+            "relay",
+            Duration::from_secs(10),
+        )
+        .expect_err("fails")
+        .to_string();
+        assert!(
+            failed.contains("`relay` failed (exit status: 3: no such relay)"),
+            "{failed}"
+        );
+        let hung = run_within(
+            Command::new("sleep").arg("30"),
+            "sleep 30",
+            Duration::from_millis(200),
+        )
+        .expect_err("fails");
+        assert_eq!(hung.kind(), io::ErrorKind::TimedOut);
+        assert!(
+            hung.to_string().contains("`sleep 30` did not answer"),
+            "{hung}"
+        );
+        let missing = run_within(
+            &mut Command::new("/nonexistent/ppmc-power"),
+            "ppmc-power",
+            Duration::from_secs(1),
+        )
+        .expect_err("fails");
+        assert!(
+            missing.to_string().starts_with("cannot run `ppmc-power`"),
+            "{missing}"
+        );
+    }
+
+    /// A power script that restarts a service leaves it running with the
+    /// script's pipes: the script's end is what counts, not the service's.
+    #[test]
+    fn a_program_that_leaves_a_child_holding_its_pipes_still_ends() {
+        let said = run_within(
+            Command::new("sh").args(["-c", "sleep 600 & echo $!"]),
+            "restart",
+            Duration::from_secs(60),
+        )
+        .expect("works");
+        let pid = said.trim();
+        let alive = std::path::Path::new("/proc").join(pid).exists();
+        let _ = Command::new("kill").arg(pid).status();
+        assert!(alive, "run_within waited for what the program left running");
+    }
+}
