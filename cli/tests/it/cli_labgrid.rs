@@ -206,4 +206,27 @@ fn the_suite_passes_on_a_labgrid_place_and_an_unacquired_place_is_refused() {
     );
     assert!(mark(&out, "lease-steal-says").contains("took a stale lock"));
     assert_eq!(mark(&out, "lease-after-steal"), "None");
+    // Recovery by power (issue 44): rig3's bridge hangs mid-run; labgrid's
+    // ExternalPowerDriver restarts it, and every other scenario is graded.
+    let run = read(dir.path(), "power/run.out");
+    let why = || format!("{run}\n{}\n{}", read(dir.path(), "power/run.err"), logs());
+    assert_eq!(mark(&out, "power-exit"), "1", "{}", why());
+    assert!(
+        run.ends_with("suite: 94 passed, 0 failed, 1 errors, 0 not run\n"),
+        "{}",
+        why()
+    );
+    let hang = run
+        .lines()
+        .find(|l| l.contains("infrastructure error: the board hung: "))
+        .unwrap_or_else(|| panic!("no hang named: {}", why()));
+    assert!(
+        hang.contains("its bridge stopped answering (labgrid:rig3 (rfc2217://127.0.0.1:")
+            && hang.ends_with(
+                "power-cycled by `labgrid-client -p rig3 power cycle` (1 of 3), and the run went on"
+            ),
+        "{hang}"
+    );
+    assert_eq!(mark(&out, "power-starts"), "2", "one power cycle");
+    assert_eq!(mark(&out, "power-after"), "None", "the place let go");
 }

@@ -16,6 +16,7 @@ mod cli_fuzz;
 mod cli_labgrid;
 mod cli_network;
 mod cli_outputs;
+mod cli_power;
 mod cli_selftest;
 mod cli_signals;
 mod code_shape;

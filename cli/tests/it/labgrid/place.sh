@@ -13,6 +13,12 @@ ppmc=$1 lg=$2 dir=$3
 export PATH="$lg:$PATH" LG_COORDINATOR=127.0.0.1:20408
 
 pids=()
+# rig3's bridge (recovery by power) is served from a folder under /dev,
+# as labgrid's exporter wants a port's path to be: a link that the power
+# switch points at each new bridge-sim.
+power=$(mktemp -d /dev/shm/ppmc-power-XXXXXX)
+script=$(cd "$(dirname "$0")/../../../.." && pwd)/scripts/bridge-sim-power
+export PPMC=$ppmc
 # The labgrid clients that export a port in this network namespace (a
 # run on another, a test beside this one, is none of ours).
 exports_here() {
@@ -24,8 +30,10 @@ exports_here() {
     echo "$n"
 }
 cleanup() {
+    "$script" "$power" off 2>/dev/null
     for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null; done
     wait 2>/dev/null
+    rm -rf "$power"
 }
 trap cleanup EXIT
 trap 'exit 143' TERM INT
@@ -55,6 +63,10 @@ bridge2:
   RawSerialPort:
     port: $(readlink "$dir/pty2")
     speed: 115200
+bridge3:
+  RawSerialPort:
+    port: $power/pty
+    speed: 115200
 YAML
 # The exporter gives up on a coordinator that is not listening yet.
 for _ in $(seq 150); do
@@ -64,7 +76,7 @@ done
 labgrid-exporter -c 127.0.0.1:20408 --hostname 127.0.0.1 -n bench1 exporter.yaml > exporter.log 2>&1 &
 pids+=($!)
 for _ in $(seq 150); do
-    [ "$(labgrid-client resources 2>/dev/null | grep -c '^bench1/bridge2\?/')" = 2 ] && break
+    [ "$(labgrid-client resources 2>/dev/null | grep -c '^bench1/bridge[23]\?/')" = 3 ] && break
     sleep 0.2
 done
 resources=$(labgrid-client resources 2>&1 | tr '\n' ' ')
@@ -133,4 +145,33 @@ echo "MARK lease-stale-says $(tr '\n' ' ' < stale.err)"
 echo "MARK lease-steal-exit $?"
 echo "MARK lease-steal-says $(tr '\n' ' ' < steal.err)"
 echo "MARK lease-after-steal $(acquired)"
+cd ..
+
+# Recovery by power (issue 44, docs/board-farm.md "A board that hangs"):
+# rig3's bridge stops answering after 60 frames. Its power is labgrid's
+# ExternalPowerDriver, in the environment LG_ENV names, whose command
+# restarts the bridge-sim; ppmc cycles it through `labgrid-client power
+# cycle`, asks labgrid again where the port is, and goes on.
+"$script" "$power" on --stall-after 60
+labgrid-client -p rig3 create
+labgrid-client -p rig3 add-match 'bench1/bridge3/*'
+cat > "$dir/power-env.yaml" <<YAML
+targets:
+  rig3:
+    resources:
+      RemotePlace:
+        name: rig3
+    drivers:
+      ExternalPowerDriver:
+        cmd_on: "$script $power on"
+        cmd_off: "$script $power off"
+        cmd_cycle: "$script $power cycle"
+YAML
+mkdir power && cd power
+LG_ENV="$dir/power-env.yaml" "$ppmc" run --target labgrid:rig3,acquire --skip-tag long \
+    --link-timeout 200ms --link-retries 3 --junit report.xml > run.out 2> run.err
+echo "MARK power-exit $?"
+# Each bridge-sim started says where it serves, once.
+echo "MARK power-starts $(grep -c 'serving on' "$power/bridge-sim.log")"
+echo "MARK power-after $(labgrid-client -p rig3 show 2>/dev/null | sed -n 's/^ *acquired: //p')"
 cd ..
