@@ -3,6 +3,7 @@
 //! arguments, opens the boards, prints and picks the exit status.
 
 mod args;
+mod power;
 
 pub use args::RunArgs;
 

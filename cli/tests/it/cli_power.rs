@@ -29,10 +29,7 @@ fn hanging_bridge(dir: &Path) {
 }
 
 fn stop_bridge(dir: &Path) {
-    let _ = Command::new(power_script())
-        .arg(dir)
-        .arg("off")
-        .status();
+    let _ = Command::new(power_script()).arg(dir).arg("off").status();
 }
 
 /// Runs the suite, less its long moves, on the bridge in `dir` with
@@ -135,10 +132,20 @@ fn power_options_the_user_got_wrong_are_refused_before_any_board_is_touched() {
     let out = ppmc(&["run", "--power-hub", "1-1.4"]);
     assert_eq!(out.status.code(), Some(2));
     let err = text(&out.stderr);
-    assert!(err.contains("--power-hub `1-1.4`: write LOCATION:PORT"), "{err}");
+    assert!(
+        err.contains("--power-hub `1-1.4`: write LOCATION:PORT"),
+        "{err}"
+    );
     let out = ppmc(&["run", "--power-hub", "1-1:2", "--power-cmd", "relay"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(text(&out.stderr).contains("cannot be used with"), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("cannot be used with"),
+        "{}",
+        text(&out.stderr)
+    );
     let help = text(&ppmc(&["run", "--help"]).stdout);
-    assert!(help.contains("Recovery by power:") && help.contains("--power-cycles <N>"), "{help}");
+    assert!(
+        help.contains("Recovery by power:") && help.contains("--power-cycles <N>"),
+        "{help}"
+    );
 }

@@ -41,7 +41,12 @@ const FILES: [&str; 15] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 39] = [
+const ELSEWHERE: [(&str, &str); 41] = [
+    (
+        "scripts/bridge-sim-power",
+        "in cli/tests/it/cli_power.rs (a bridge-sim made to hang, power-cycled through --power-cmd and --power-hub)",
+    ),
+    ("export LG_ENV=", "in cli/tests/it/labgrid/place.sh"),
     (
         "scripts/store-load",
         "by hand (10,000 runs of the suite; its figures in docs/performance.md); .ci/run runs it with 100 runs a station on both databases",
@@ -186,7 +191,11 @@ const ELSEWHERE: [(&str, &str); 39] = [
 /// local stand-in: `(text in the command, where)`. Those "in
 /// cli/tests/it/labgrid/place.sh" must appear in that script as written
 /// (with `"$ppmc"` for `ppmc`).
-const PPMC_ELSEWHERE: [(&str, &str); 5] = [
+const PPMC_ELSEWHERE: [(&str, &str); 6] = [
+    (
+        "serial:/tmp/rig/pty",
+        "in cli/tests/it/cli_power.rs (the same bridge, made to hang and power-cycled)",
+    ),
     (
         "judge out/capture.sr",
         "in cli/tests/it/cli_capture.rs (sigrok-cli converts a capture to .sr at 100, 24 and 4 MHz, each judged)",

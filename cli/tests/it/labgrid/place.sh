@@ -155,7 +155,8 @@ cd ..
 "$script" "$power" on --stall-after 60
 labgrid-client -p rig3 create
 labgrid-client -p rig3 add-match 'bench1/bridge3/*'
-cat > "$dir/power-env.yaml" <<YAML
+mkdir power && cd power
+cat > power-env.yaml <<YAML
 targets:
   rig3:
     resources:
@@ -167,9 +168,8 @@ targets:
         cmd_off: "$script $power off"
         cmd_cycle: "$script $power cycle"
 YAML
-mkdir power && cd power
-LG_ENV="$dir/power-env.yaml" "$ppmc" run --target labgrid:rig3,acquire --skip-tag long \
-    --link-timeout 200ms --link-retries 3 --junit report.xml > run.out 2> run.err
+export LG_ENV=power-env.yaml
+"$ppmc" run --target labgrid:rig3,acquire --skip-tag long --link-timeout 200ms --link-retries 3 --junit report.xml > run.out 2> run.err
 echo "MARK power-exit $?"
 # Each bridge-sim started says where it serves, once.
 echo "MARK power-starts $(grep -c 'serving on' "$power/bridge-sim.log")"
