@@ -4,7 +4,8 @@
 //! [`Farm`], which keeps the boards it could not reach out of the verdict.
 
 use crate::backend::{
-    self, Op, OpenError, OpenOptions, Power, Reply, Target, TargetInfo, TargetSpec,
+    self, BridgeError, Op, OpenError, OpenOptions, Power, Reply, Target, TargetErrorKind,
+    TargetInfo, TargetSpec,
 };
 use crate::scenario::{
     run_scenario, Attempt, DriverOptions, HarnessError, NotRun, Scenario, ScenarioResult, Verdict,
@@ -162,8 +163,10 @@ pub fn run_suite_until(
 /// Runs `s`, and after a harness error or a device failure gives the
 /// target a health check ([`health`]): `Some(why)` when the target is
 /// taken as lost. A board that hung is brought back by `power` when it
-/// has a switch ([`recover`]): the scenario is then an infrastructure
-/// error naming the hang, and the run goes on from the next.
+/// has a switch ([`recover`]) and the run goes on from the next scenario:
+/// a scenario that ended in an error is then an infrastructure error
+/// naming the hang; one that failed stays the board's failure, which says
+/// what came after.
 fn run_checked(
     target: &mut dyn Target,
     s: &Scenario,
@@ -176,32 +179,32 @@ fn run_checked(
         let mut lost = None;
         let mut recovered = false;
         if matches!(r.verdict, Verdict::Error(_) | Verdict::Failed(_)) {
-            match (health(target), power.as_deref_mut()) {
-                (Ok(()), _) => {}
-                (Err(h), _) if h.interrupted => lost = Some(h.why),
-                (Err(h), Some(p)) => match recover(target, p, &h.why) {
-                    Ok(recovery) => {
-                        // The first sign, then what the health check found
-                        // (a silent bridge says the same twice: once).
-                        let hang = match &r.verdict {
-                            _ if !h.busy => format!("its bridge stopped answering ({})", h.why),
-                            Verdict::Failed(f) => {
-                                format!("{}, after the scenario failed {f}", h.why)
-                            }
-                            Verdict::Error(e) => {
-                                format!("{}, after the scenario's error: {e}", h.why)
-                            }
-                            _ => h.why,
-                        };
-                        r.verdict = Verdict::Error(HarnessError::Hung { hang, recovery });
+            let hang = match health(target) {
+                Ok(()) => None,
+                Err(Hang::Gone(why)) => {
+                    lost = Some(why);
+                    None
+                }
+                Err(h) => Some(h),
+            };
+            if let Some(hang) = hang {
+                let outcome = match power.as_deref_mut() {
+                    Some(p) => recover(target, p, &hang),
+                    None => Recovery::NoSwitch(String::new()),
+                };
+                match (outcome, &hang) {
+                    (Recovery::Back(recovery), _) => {
+                        note_hang(&mut r.verdict, hang.why(), recovery);
                         recovered = true;
                     }
-                    Err(why) => lost = Some(why),
-                },
-                // Without a switch a chip BUSY after its reset is left to
-                // the next scenario's reset, and its verdict.
-                (Err(h), None) if h.busy => {}
-                (Err(h), None) => lost = Some(h.why),
+                    (Recovery::Lost(why), _) => lost = Some(why),
+                    // Without a switch (or one that failed) a chip BUSY
+                    // after its reset is left to the next scenario's reset,
+                    // and its verdict; a silent bridge is lost.
+                    (Recovery::NoSwitch(_), Hang::Busy(_)) => {}
+                    (Recovery::NoSwitch(why), h) if why.is_empty() => lost = Some(h.why().into()),
+                    (Recovery::NoSwitch(why), h) => lost = Some(format!("{}; {why}", h.why())),
+                }
             }
         }
         // Again on the same board, while it is there and the policy takes
@@ -220,62 +223,123 @@ fn run_checked(
     }
 }
 
+/// Says on `verdict` that the board hung (`hang`) and was brought back
+/// (`recovery`): an error becomes the infrastructure's error naming the
+/// hang; a failure stays the board's, and says what followed it.
+fn note_hang(verdict: &mut Verdict, hang: &str, recovery: String) {
+    match verdict {
+        Verdict::Failed(f) => {
+            f.got = format!("{}; then {hang}, and the board was {recovery}", f.got);
+        }
+        v => {
+            *v = Verdict::Error(HarnessError::Hung {
+                hang: hang.to_string(),
+                recovery,
+            })
+        }
+    }
+}
+
 /// Why a board failed its health check.
 #[derive(Debug)]
-struct Hang {
-    why: String,
-    /// The chip answered, BUSY after its reset.
-    busy: bool,
-    /// A stop was asked for: nothing hung.
-    interrupted: bool,
+enum Hang {
+    /// Its bridge fell silent: the words.
+    Silent(String),
+    /// Its chip answered, BUSY after its reset: the words.
+    Busy(String),
+    /// Anything else (a stop, another host on the bridge, a link given up
+    /// too often, a bridge that answers wrongly): the board is lost, as it
+    /// always was, and no power cycle is tried.
+    Gone(String),
+}
+
+impl Hang {
+    fn why(&self) -> &str {
+        match self {
+            Hang::Silent(w) | Hang::Busy(w) | Hang::Gone(w) => w,
+        }
+    }
 }
 
 /// The health check after a scenario that did not pass: a chip reset, and
-/// the status after it. A board hangs when its bridge does not answer, or
-/// its chip is still BUSY after the reset (3-1-1: the reset ends any move;
-/// a chip BUSY past that is past its longest legal move).
+/// the status after it. A board hangs when its bridge falls silent, or its
+/// chip is still BUSY after the reset (3-1-1: the reset ends any move; a
+/// chip BUSY past it is past its longest legal move).
 fn health(target: &mut dyn Target) -> Result<(), Hang> {
     match target.execute(&[Op::Reset, Op::ReadStatus]) {
-        Err(e) => Err(Hang {
-            why: e.to_string(),
-            busy: false,
-            interrupted: e.kind == crate::backend::TargetErrorKind::Interrupted,
-        }),
+        Err(e) if silence(&e) => Err(Hang::Silent(format!("its bridge stopped answering ({e})"))),
+        Err(e) => Err(Hang::Gone(e.to_string())),
         Ok(replies) => match replies.get(1) {
-            Some(Reply::Status { status, .. }) if status.busy() => Err(Hang {
-                why: format!(
-                    "the chip stayed BUSY after a chip reset (status 0x{:02X})",
-                    status.0
-                ),
-                busy: true,
-                interrupted: false,
-            }),
+            Some(Reply::Status { status, .. }) if status.busy() => Err(Hang::Busy(format!(
+                "the chip stayed BUSY after a chip reset (status 0x{:02X})",
+                status.0
+            ))),
             _ => Ok(()),
         },
     }
 }
 
-/// Brings back a board that hung (`hang` says how): its power cycled by
-/// its switch, the board reached again ([`Target::restart`]) and health
-/// checked. `Ok` says what was done; `Err` why the board is lost.
-fn recover(target: &mut dyn Target, p: &mut Power, hang: &str) -> Result<String, String> {
+/// Whether `e` says the bridge fell silent: a bridge's own error says so
+/// ([`BridgeError::is_silence`]); another target's link error is taken so.
+fn silence(e: &crate::backend::TargetError) -> bool {
+    match e.get_ref().downcast_ref::<BridgeError>() {
+        Some(b) => b.is_silence(),
+        None => e.kind == TargetErrorKind::Link,
+    }
+}
+
+/// What became of a hung board's recovery.
+#[derive(Debug)]
+enum Recovery {
+    /// Power-cycled and reached again: what was done.
+    Back(String),
+    /// Power-cycled (or tried), and not back: why, for the scenarios left.
+    Lost(String),
+    /// No cycle happened (no switch, none left, the switch failed, a stop):
+    /// why, empty for no switch. The board is as it was.
+    NoSwitch(String),
+}
+
+/// Brings back a board that hung: its power cycled by its switch, the
+/// board reached again ([`Target::power_cycle`]) and health checked.
+fn recover(target: &mut dyn Target, p: &mut Power, hang: &Hang) -> Recovery {
     if p.left == 0 {
-        return Err(format!(
-            "{hang}; the board has had the {} power cycles it may have in a run (--power-cycles)",
+        return Recovery::NoSwitch(format!(
+            "the board has had the {} power cycles it may have in a run (--power-cycles)",
             p.of
         ));
     }
+    if p.stop.requested() {
+        return Recovery::NoSwitch("no power cycle: the run was interrupted".into());
+    }
     p.left -= 1;
-    let n = p.of - p.left;
-    p.switch
-        .cycle(&p.spec)
-        .map_err(|e| format!("{hang}; its power cycle failed: {e}"))?;
-    let cycled = format!("power-cycled by `{}` ({n} of {})", p.switch, p.of);
-    target
-        .restart(p.boot)
-        .map_err(|e| format!("{hang}; {cycled}, but: {e}"))?;
-    health(target).map_err(|h| format!("{hang}; {cycled}, and it is still hung: {}", h.why))?;
-    Ok(cycled)
+    let cycled = format!(
+        "power-cycled by `{}` ({} of {})",
+        p.switch,
+        p.of - p.left,
+        p.of
+    );
+    let mut switched = Ok(());
+    let (switch, spec) = (&p.switch, &p.spec);
+    let back = target.power_cycle(
+        &mut || {
+            switched = switch.cycle(spec).map_err(|e| e.to_string());
+            switched.clone()
+        },
+        p.boot,
+    );
+    if let Err(why) = switched {
+        return Recovery::NoSwitch(format!("its power cycle failed: {why}"));
+    }
+    let hung = hang.why();
+    if let Err(e) = back {
+        return Recovery::Lost(format!("{hung}; {cycled}, but: {e}"));
+    }
+    match health(target) {
+        Ok(()) => Recovery::Back(cycled),
+        Err(Hang::Busy(still)) => Recovery::Back(format!("{cycled}, and {still}")),
+        Err(h) => Recovery::Lost(format!("{hung}; {cycled}, and then: {}", h.why())),
+    }
 }
 
 /// The result of a scenario that did not run, and why.
@@ -548,7 +612,8 @@ impl Farm {
             match opened {
                 Ok(t) => {
                     farm.targets.push(t);
-                    farm.powers.push(Power::of(&specs[b], &opts.power));
+                    farm.powers
+                        .push(Power::of(&specs[b], &opts.power, &opts.stop));
                     farm.reached.push(b);
                 }
                 Err(e @ OpenError::Invalid(_)) => return Err(e),

@@ -1,17 +1,18 @@
 //! Recovery by power (`backend::power`, the runner's health check): a
 //! board that hangs under a scenario is power-cycled once, reached again,
-//! and the run goes on from the next scenario; the scenario in flight is
-//! an infrastructure error naming the hang. A board that cannot be brought
-//! back is lost, and says why.
+//! and the run goes on from the next scenario; a scenario in flight that
+//! ended in an error is an infrastructure error naming the hang. A board
+//! that cannot be brought back is lost, and says why.
 //!
 //! The boards here are the emulator behind a wrapper that hangs on cue,
 //! in both ways a board hangs: its bridge silent, or its chip still BUSY
 //! after a chip reset (3-1-1: a reset ends any move, so a chip BUSY past
-//! it is past its longest legal move). The switch is a real command.
+//! it is past its longest legal move; the scenario that met it stays the
+//! board's failure). The switch is a real command.
 
 use ppmc::backend::{
-    EmuTarget, Op, Power, PowerOptions, Reply, Target, TargetError, TargetErrorKind, TargetInfo,
-    TargetSpec,
+    BridgeError, EmuTarget, Op, Power, PowerOptions, Reply, Target, TargetError, TargetErrorKind,
+    TargetInfo, TargetSpec,
 };
 use ppmc::protocol::{OutputRecord, Status};
 use ppmc::runner::{stream_on_boards, BoardResult, Spread};
@@ -26,10 +27,12 @@ enum Hang {
     Silent,
     /// Every status read has BUSY set, a chip reset too.
     Busy,
+    /// Another host took the bridge over: no hang, nothing to cycle.
+    Displaced,
 }
 
 /// The emulator, hung from its `at`-th batch on until its power is cycled
-/// (`restart`, which counts batches from 0 again), as often as `times`
+/// (`power_cycle`, which counts batches from 0 again), as often as `times`
 /// says. Each scenario of [`suite`] is one batch.
 struct Hanging {
     emu: EmuTarget,
@@ -63,7 +66,7 @@ impl Target for Hanging {
 
     fn capture(&mut self) -> Result<OutputRecord, TargetError> {
         match (self.hung, self.how) {
-            (true, Hang::Silent) => Err(silent()),
+            (true, Hang::Silent | Hang::Displaced) => Err(silent()),
             _ => self.emu.capture(),
         }
     }
@@ -77,6 +80,10 @@ impl Target for Hanging {
         match (self.hung, self.how) {
             (false, _) => self.emu.execute(ops),
             (true, Hang::Silent) => Err(silent()),
+            (true, Hang::Displaced) => Err(BridgeError::Displaced {
+                link: "serial:/dev/bench".into(),
+            }
+            .into()),
             (true, Hang::Busy) => Ok(self
                 .emu
                 .execute(ops)?
@@ -92,7 +99,12 @@ impl Target for Hanging {
         }
     }
 
-    fn restart(&mut self, _: std::time::Duration) -> Result<(), TargetError> {
+    fn power_cycle(
+        &mut self,
+        cycle: &mut dyn FnMut() -> Result<(), String>,
+        _: std::time::Duration,
+    ) -> Result<(), TargetError> {
+        cycle().map_err(|e| TargetError::new(TargetErrorKind::Other, e))?;
         self.restarts.fetch_add(1, Ordering::SeqCst);
         self.hung = false;
         self.batches = 0;
@@ -148,6 +160,7 @@ fn switch(dir: &Path, cycles: u32, fail: bool) -> Power {
             cycles,
             ..PowerOptions::default()
         },
+        &Default::default(),
     )
     .expect("a switch")
 }
@@ -223,35 +236,74 @@ fn a_silent_bridge_is_power_cycled_once_and_the_run_goes_on() {
     assert_eq!(restarts.load(Ordering::SeqCst), 1);
 }
 
+/// A chip BUSY after a chip reset breaks 3-1-1: the scenario that met it
+/// stays the board's failure, and says that the board was power-cycled;
+/// the run goes on.
 #[test]
-fn a_chip_busy_after_its_reset_is_power_cycled_and_the_failure_kept_in_the_words() {
+fn a_chip_busy_after_its_reset_is_power_cycled_and_stays_the_boards_failure() {
     let (_keep, dir) = scratch();
     let restarts = Arc::new(AtomicU32::new(0));
     let r = run(
         Hanging::boxed(Hang::Busy, 4, 1, &restarts),
         Some(switch(&dir, 3, false)),
     );
-    let errors: Vec<&BoardResult> = r.iter().filter(|r| hung(r).is_some()).collect();
-    assert_eq!(errors.len(), 1, "{r:#?}");
-    let (hang, _) = hung(errors[0]).expect("works");
-    assert!(
-        hang.starts_with(
-            "the chip stayed BUSY after a chip reset (status 0x04), after the scenario failed at "
-        ),
-        "{hang}"
-    );
-    assert!(
-        hang.contains("BUSY after a chip reset: expected false, got true"),
-        "{hang}"
-    );
+    let verdicts: Vec<&str> = r.iter().map(|r| r.result.verdict.label()).collect();
     assert_eq!(
-        r.iter()
-            .filter(|r| r.result.verdict == Verdict::Passed)
-            .count(),
-        5,
-        "every other scenario graded"
+        verdicts,
+        ["passed", "passed", "passed", "failed", "passed", "passed"]
+    );
+    let Verdict::Failed(f) = &r[3].result.verdict else {
+        unreachable!()
+    };
+    assert_eq!(f.expectation, "BUSY after a chip reset");
+    assert!(
+        f.got.starts_with(
+            "true; then the chip stayed BUSY after a chip reset (status 0x04), and the board was power-cycled by `sh '"
+        ) && f.got.ends_with("power.sh' cycle` (1 of 3)"),
+        "{}",
+        f.got
     );
     assert_eq!(log(&dir), "bench-1 cycle\n");
+    assert_eq!(restarts.load(Ordering::SeqCst), 1);
+}
+
+/// A labgrid place without a power resource, or a relay that does not
+/// answer: a chip BUSY after its reset is then left to the next
+/// scenario's reset, as without a switch, and the board is not lost.
+#[test]
+fn a_busy_chip_whose_switch_fails_is_left_as_without_one() {
+    let (_keep, dir) = scratch();
+    let restarts = Arc::new(AtomicU32::new(0));
+    let r = run(
+        Hanging::boxed(Hang::Busy, 2, 1, &restarts),
+        Some(switch(&dir, 3, true)),
+    );
+    assert!(
+        r.iter()
+            .skip(1)
+            .all(|r| matches!(r.result.verdict, Verdict::Failed(_))),
+        "{r:#?}"
+    );
+    assert_eq!(restarts.load(Ordering::SeqCst), 0);
+}
+
+/// What is no hang is never power-cycled: another host on the bridge
+/// loses the board as it always did.
+#[test]
+fn a_bridge_another_host_took_is_not_power_cycled() {
+    let (_keep, dir) = scratch();
+    let restarts = Arc::new(AtomicU32::new(0));
+    let r = run(
+        Hanging::boxed(Hang::Displaced, 2, 1, &restarts),
+        Some(switch(&dir, 3, false)),
+    );
+    let verdicts: Vec<&str> = r.iter().map(|r| r.result.verdict.label()).collect();
+    assert_eq!(
+        verdicts,
+        ["passed", "error", "not run", "not run", "not run", "not run"]
+    );
+    assert_eq!(log(&dir), "", "no cycle");
+    assert_eq!(restarts.load(Ordering::SeqCst), 0);
 }
 
 #[test]

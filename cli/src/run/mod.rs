@@ -27,6 +27,7 @@ pub fn run(mut args: RunArgs, suite: &[Scenario]) -> Result<(), CliError> {
     let outputs = args.reports.outputs();
     let specs = args.target.specs().map_err(usage)?;
     let several_specs = specs.len();
+    args.power.check(several_specs).map_err(usage)?;
     let spread = match args.each && several_specs > 1 {
         true => Spread::Each,
         false => Spread::Share,

@@ -38,6 +38,18 @@ fn hub(s: &str) -> Result<ppmc::backend::Hub, String> {
 }
 
 impl PowerArgs {
+    /// What cannot hold for `boards` boards: one hub port for several
+    /// would cycle every board when one hangs.
+    pub(crate) fn check(&self, boards: usize) -> Result<(), String> {
+        match &self.power_hub {
+            Some(h) if boards > 1 => Err(format!(
+                "--power-hub {}:{} with {boards} --target: one port would cycle every board when one hangs; give --power-cmd a script that picks the board's port by PPMC_BOARD",
+                h.location, h.port
+            )),
+            _ => Ok(()),
+        }
+    }
+
     /// What the flags say.
     pub(crate) fn options(&self) -> ppmc::backend::PowerOptions {
         ppmc::backend::PowerOptions {

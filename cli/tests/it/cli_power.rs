@@ -38,7 +38,7 @@ fn stop_bridge(dir: &Path) {
 fn run_with(dir: &Path, power: &[&str], env: &[(&str, &Path)]) -> (Option<i32>, String, String) {
     let junit = dir.join("report.xml");
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_ppmc"));
-    cmd.args(["run", "--skip-tag", "long", "--link-timeout", "200ms"])
+    cmd.args(["run", "--skip-tag", "long", "--link-timeout", "500ms"])
         .args(["--link-retries", "3", "--target"])
         .arg(format!("serial:{}", dir.join("pty").display()))
         .arg("--junit")
@@ -134,6 +134,21 @@ fn power_options_the_user_got_wrong_are_refused_before_any_board_is_touched() {
     let err = text(&out.stderr);
     assert!(
         err.contains("--power-hub `1-1.4`: write LOCATION:PORT"),
+        "{err}"
+    );
+    let out = ppmc(&[
+        "run",
+        "--power-hub",
+        "1-1:2",
+        "--target",
+        "emu",
+        "--target",
+        "emu",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("--power-hub 1-1:2 with 2 --target: one port would cycle every board"),
         "{err}"
     );
     let out = ppmc(&["run", "--power-hub", "1-1:2", "--power-cmd", "relay"]);

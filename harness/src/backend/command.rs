@@ -11,6 +11,11 @@ use std::time::{Duration, Instant};
 /// closed: its standard output when it succeeds. A program that does not
 /// end in time is killed; one that fails gives its last line of complaint.
 pub(crate) fn run_within(cmd: &mut Command, shown: &str, limit: Duration) -> io::Result<String> {
+    // A process group of its own: a terminal's Ctrl-C meant for ppmc does
+    // not cut a power switch off half way, and a program that does not end
+    // in time is stopped with everything it started.
+    #[cfg(unix)]
+    std::os::unix::process::CommandExt::process_group(cmd, 0);
     let mut child = cmd
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -25,16 +30,19 @@ pub(crate) fn run_within(cmd: &mut Command, shown: &str, limit: Duration) -> io:
     let err = drain(child.stderr.take());
     let end = Instant::now() + limit;
     let status = loop {
-        if let Some(s) = child.try_wait()? {
+        let ended = child.try_wait();
+        if let Ok(Some(s)) = ended {
             break s;
         }
-        if Instant::now() >= end {
-            let _ = child.kill();
-            let _ = child.wait();
-            return Err(io::Error::new(
-                io::ErrorKind::TimedOut,
-                format!("`{shown}` did not answer within {} s", limit.as_secs()),
-            ));
+        if ended.is_err() || Instant::now() >= end {
+            stop_group(&mut child);
+            return Err(match ended {
+                Err(e) => io::Error::new(e.kind(), format!("`{shown}`: {e}")),
+                Ok(_) => io::Error::new(
+                    io::ErrorKind::TimedOut,
+                    format!("`{shown}` did not answer within {limit:?}"),
+                ),
+            });
         }
         std::thread::sleep(Duration::from_millis(20));
     };
@@ -53,6 +61,19 @@ pub(crate) fn run_within(cmd: &mut Command, shown: &str, limit: Duration) -> io:
         return Err(io::Error::other(format!("`{shown}` failed ({why})")));
     }
     Ok(text)
+}
+
+/// Kills `child` and every process of its group (what a shell started),
+/// and reaps it.
+fn stop_group(child: &mut std::process::Child) {
+    #[cfg(unix)]
+    let _ = Command::new("kill")
+        .args(["-KILL", "--", &format!("-{}", child.id())])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status();
+    let _ = child.kill();
+    let _ = child.wait();
 }
 
 /// A pipe read to its end on a thread of its own.
@@ -112,17 +133,31 @@ mod tests {
             failed.contains("`relay` failed (exit status: 3: no such relay)"),
             "{failed}"
         );
+        // A program that hangs is stopped with what it started.
+        let dir = tempfile::tempdir().expect("works");
+        let pid = dir.path().join("pid");
         let hung = run_within(
-            Command::new("sleep").arg("30"),
-            "sleep 30",
-            Duration::from_millis(200),
+            Command::new("sh")
+                .arg("-c")
+                .arg(format!("sleep 600 & echo $! > '{}'; wait", pid.display())),
+            "relay 3",
+            Duration::from_millis(500),
         )
         .expect_err("fails");
         assert_eq!(hung.kind(), io::ErrorKind::TimedOut);
         assert!(
-            hung.to_string().contains("`sleep 30` did not answer"),
+            hung.to_string()
+                .contains("`relay 3` did not answer within 500ms"),
             "{hung}"
         );
+        let pid = std::fs::read_to_string(&pid).expect("works");
+        let proc = std::path::Path::new("/proc").join(pid.trim());
+        let gone = (0..100).any(|_| {
+            std::thread::sleep(Duration::from_millis(20));
+            !proc.exists()
+                || std::fs::read_to_string(proc.join("stat")).is_ok_and(|s| s.contains(") Z "))
+        });
+        assert!(gone, "the program's child outlived it");
         let missing = run_within(
             &mut Command::new("/nonexistent/ppmc-power"),
             "ppmc-power",

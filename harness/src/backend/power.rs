@@ -23,6 +23,7 @@
 use super::link::labgrid::parse_labgrid;
 use super::link::lease::client_program;
 use super::spec::{SpecError, TargetSpec};
+use crate::stop::StopRequest;
 use std::fmt;
 use std::process::Command;
 use std::time::Duration;
@@ -179,18 +180,22 @@ pub struct Power {
     /// How many it had.
     pub of: u32,
     pub boot: Duration,
+    /// Asked for, no cycle starts (one under way ends: a board left
+    /// without power is worse than a wait).
+    pub stop: StopRequest,
 }
 
 impl Power {
     /// The board `spec` names, with its switch under `opts`; `None` when it
     /// has none.
-    pub fn of(spec: &TargetSpec, opts: &PowerOptions) -> Option<Power> {
+    pub fn of(spec: &TargetSpec, opts: &PowerOptions, stop: &StopRequest) -> Option<Power> {
         PowerSwitch::of(spec, opts).map(|switch| Power {
             switch,
             spec: spec.clone(),
             left: opts.cycles,
             of: opts.cycles,
             boot: opts.boot,
+            stop: stop.clone(),
         })
     }
 }

@@ -196,15 +196,22 @@ pub trait Target: Send {
     /// an instant, has nothing to cut short.
     fn set_deadline(&mut self, _at: Option<std::time::Instant>) {}
 
-    /// The board's power was cycled ([`crate::backend::power`]): reach it
-    /// again as at open, trying until `boot` has passed (the link opened
-    /// anew, a new session with its bridge, the health check). The
-    /// default, for a target with nothing to reach again, refuses.
-    fn restart(&mut self, boot: std::time::Duration) -> Result<(), TargetError> {
-        let _ = boot;
+    /// Brings back a board that hung ([`crate::backend::power`]): lets go
+    /// of its link, has `cycle` switch its power off and on, then reaches
+    /// its bridge again as at open (the link opened anew, a new session,
+    /// the same straps), trying until `boot` has passed. The chip's health
+    /// is the caller's to check. An error from `cycle` ends it at once.
+    /// The default, for a target with no power to cycle (the emulator),
+    /// refuses without calling `cycle`.
+    fn power_cycle(
+        &mut self,
+        cycle: &mut dyn FnMut() -> Result<(), String>,
+        boot: std::time::Duration,
+    ) -> Result<(), TargetError> {
+        let _ = (cycle, boot);
         Err(TargetError::new(
             TargetErrorKind::Unsupported,
-            "this target cannot be reached again after a power cycle",
+            "this target has no power to cycle",
         ))
     }
 

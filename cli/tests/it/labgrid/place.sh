@@ -169,7 +169,7 @@ targets:
         cmd_cycle: "$script $power cycle"
 YAML
 export LG_ENV=power-env.yaml
-"$ppmc" run --target labgrid:rig3,acquire --skip-tag long --link-timeout 200ms --link-retries 3 --junit report.xml > run.out 2> run.err
+"$ppmc" run --target labgrid:rig3,acquire --skip-tag long --link-timeout 500ms --link-retries 3 --junit report.xml > run.out 2> run.err
 echo "MARK power-exit $?"
 # Each bridge-sim started says where it serves, once.
 echo "MARK power-starts $(grep -c 'serving on' "$power/bridge-sim.log")"

@@ -107,6 +107,23 @@ pub enum BridgeError {
     Garbled { link: String, len: usize },
 }
 
+impl BridgeError {
+    /// Whether the bridge fell silent: no answer, a link that would not
+    /// come back, a port that failed. That is how a hung board looks from
+    /// the host, and what a power cycle may cure. A bridge that answers
+    /// wrongly, a link given up too often, another host's use of the
+    /// bridge, or a stop is not.
+    pub fn is_silence(&self) -> bool {
+        matches!(
+            self,
+            BridgeError::NoAnswer { .. }
+                | BridgeError::LinkLost { .. }
+                | BridgeError::Io { .. }
+                | BridgeError::Open(_)
+        )
+    }
+}
+
 /// What became of the ABORT a host sends for a request it stopped waiting
 /// for (`docs/bridge-protocol.md` section 5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -175,6 +175,12 @@ impl<L: Link> BridgeTarget<L> {
     /// A session with the bridge, as at open: HELLO, the link's settings,
     /// and the health check.
     fn handshake(&mut self) -> Result<(), BridgeError> {
+        self.session()?;
+        self.health_check()
+    }
+
+    /// HELLO and the link's settings.
+    fn session(&mut self) -> Result<(), BridgeError> {
         let t = self;
         t.hello = t.say_hello()?;
         t.timer = Timer {
@@ -185,6 +191,12 @@ impl<L: Link> BridgeTarget<L> {
         if t.link_ok {
             t.set_link(t.fragment, t.opts.pad)?;
         }
+        Ok(())
+    }
+
+    /// A chip reset, and the status register reading 0x00 after it.
+    fn health_check(&mut self) -> Result<(), BridgeError> {
+        let t = self;
         // From here on a reconnect must find this session again.
         t.opened = true;
         let replies = t
@@ -215,16 +227,26 @@ impl<L: Link> BridgeTarget<L> {
         }
     }
 
-    /// After the board's power was cycled: the link opened anew and a new
-    /// session as at open (HELLO, the link's settings, the health check),
-    /// tried until `boot` has passed (a USB port enumerates again, a
-    /// bridge boots). The bridge must report the straps it reported
-    /// before: another board behind the link would be judged as this one.
-    pub fn restart(&mut self, boot: WallDuration) -> Result<(), BridgeError> {
+    /// Brings back a board that hung: the link let go of, its power cycled
+    /// by `cycle`, the link opened anew and a new session started (HELLO,
+    /// the link's settings), tried until `boot` has passed (a USB port
+    /// enumerates again, a bridge boots). The bridge must report the
+    /// straps it reported before: another board behind the link would be
+    /// judged as this one. The chip's health is the caller's to check.
+    pub fn power_cycle(
+        &mut self,
+        cycle: &mut dyn FnMut() -> Result<(), String>,
+        boot: WallDuration,
+    ) -> Result<(), BridgeError> {
         let straps = self.hello.straps;
+        self.link.close();
+        cycle().map_err(|why| BridgeError::Unhealthy {
+            link: self.link.name(),
+            detail: format!("its power cycle failed: {why}"),
+        })?;
         let end = WallInstant::now() + boot;
         let mut wait = self.opts.backoff.max(WallDuration::from_millis(50));
-        let why = loop {
+        loop {
             let tried = self
                 .link
                 .restart()
@@ -234,22 +256,19 @@ impl<L: Link> BridgeTarget<L> {
                     self.new_session().map_err(|e| e.to_string())
                 });
             let why = match tried {
-                Ok(()) => break None,
+                Ok(()) => break,
                 Err(why) => why,
             };
+            if self.opts.stop.requested() {
+                return Err(self.interrupted());
+            }
             if WallInstant::now() >= end || self.opts.stop.sleep(wait) {
-                break Some(why);
+                return Err(BridgeError::Unhealthy {
+                    link: self.link.name(),
+                    detail: format!("not back within {:?} of its power cycle ({why})", boot),
+                });
             }
             wait = (wait * 2).min(WallDuration::from_secs(2));
-        };
-        if let Some(why) = why {
-            return Err(BridgeError::Unhealthy {
-                link: self.link.name(),
-                detail: format!(
-                    "not back within {} s of its power cycle ({why})",
-                    boot.as_secs_f64()
-                ),
-            });
         }
         if self.hello.straps != straps {
             return Err(BridgeError::Unhealthy {
@@ -287,7 +306,10 @@ impl<L: Link> BridgeTarget<L> {
             path: self.link.name(),
             source: e,
         })?;
-        self.handshake()
+        self.session()?;
+        // From here on a reconnect must find this session again.
+        self.opened = true;
+        Ok(())
     }
 
     pub fn hello(&self) -> &Hello {
@@ -478,8 +500,12 @@ impl<L: Link> Target for BridgeTarget<L> {
         Ok(self.counted(|t| t.run_self_test(plan))?)
     }
 
-    fn restart(&mut self, boot: WallDuration) -> Result<(), TargetError> {
-        Ok(BridgeTarget::restart(self, boot)?)
+    fn power_cycle(
+        &mut self,
+        cycle: &mut dyn FnMut() -> Result<(), String>,
+        boot: WallDuration,
+    ) -> Result<(), TargetError> {
+        Ok(BridgeTarget::power_cycle(self, cycle, boot)?)
     }
 }
 

@@ -47,6 +47,11 @@ struct MemLink {
     /// the reply to the next send outside them (a slow path).
     hold: Vec<usize>,
     held: Vec<u8>,
+    /// The link was let go of for a power cycle: the bridge at the next
+    /// reopen is a fresh one, strapped so.
+    powered_off: Option<Straps>,
+    /// The straps of the bridge that answers after a power cycle.
+    straps_after_cycle: Straps,
 }
 
 impl MemLink {
@@ -67,6 +72,8 @@ impl MemLink {
             garble: Vec::new(),
             hold: Vec::new(),
             held: Vec::new(),
+            powered_off: None,
+            straps_after_cycle: Straps::default(),
         }
     }
 
@@ -136,6 +143,10 @@ impl Link for MemLink {
         Ok(n)
     }
 
+    fn close(&mut self) {
+        self.powered_off = Some(self.straps_after_cycle);
+    }
+
     fn reopen(&mut self) -> io::Result<()> {
         if self.fail_reopens > 0 {
             self.fail_reopens -= 1;
@@ -143,6 +154,11 @@ impl Link for MemLink {
         }
         self.pending.clear();
         self.broken = false;
+        if let Some(straps) = self.powered_off.take() {
+            let bus = EmuBus::new(straps, ModelConfig::default()).expect("emu");
+            self.server = BridgeEngine::new(bus, 9, true, "test-bridge");
+            self.mute = false;
+        }
         if self.restart_on_reopen {
             self.server = Self::bridge(2);
         }
@@ -709,4 +725,62 @@ fn a_long_differential_run_holds_a_window_of_the_capture_on_both_sides() {
     let (host, bridge) = (held(&t.captured), held(t.link.server.bus().record()));
     assert!(host <= 2_000, "the host holds {host} records");
     assert!(bridge <= 2_000, "the bridge holds {bridge} records");
+}
+
+/// Recovery by power: a bridge that fell silent is let go of, its power
+/// cycled, and reached again as a new session; the same board or none.
+#[test]
+fn a_silent_bridge_is_reached_again_after_its_power_cycle_as_the_same_board() {
+    let boot = WallDuration::from_millis(300);
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
+    t.link.mute = true;
+    let e = t.execute(&[Op::ReadStatus]).expect_err("silent");
+    assert!(e
+        .get_ref()
+        .downcast_ref::<BridgeError>()
+        .is_some_and(BridgeError::is_silence));
+    let mut cycles = 0;
+    t.power_cycle(
+        &mut || {
+            cycles += 1;
+            Ok(())
+        },
+        boot,
+    )
+    .expect("back");
+    assert_eq!(cycles, 1);
+    assert_eq!(t.hello().session, 9, "a new session");
+    let replies = t
+        .execute(&[Op::Reset, Op::ReadStatus])
+        .expect("answers again");
+    assert!(matches!(replies[1], Reply::Status { status, .. } if status.0 == 0));
+
+    // Another board behind the link after the cycle.
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
+    t.link.straps_after_cycle = Straps {
+        sysclk_hz: 12_000_000,
+        ..Straps::default()
+    };
+    let e = t
+        .power_cycle(&mut || Ok(()), boot)
+        .expect_err("another board");
+    assert!(e.to_string().contains("another board answers"), "{e}");
+
+    // A port that does not come back, and a switch that fails.
+    let mut t = BridgeTarget::open(MemLink::new(), quick()).expect("healthy");
+    t.link.fail_reopens = u32::MAX;
+    let e = t.power_cycle(&mut || Ok(()), boot).expect_err("not back");
+    assert!(
+        e.to_string()
+            .contains("not back within 300ms of its power cycle (no such port)"),
+        "{e}"
+    );
+    let e = t
+        .power_cycle(&mut || Err("relay 3 is off line".into()), boot)
+        .expect_err("switch");
+    assert!(
+        e.to_string()
+            .contains("its power cycle failed: relay 3 is off line"),
+        "{e}"
+    );
 }

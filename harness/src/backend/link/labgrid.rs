@@ -376,12 +376,16 @@ impl Link for LabgridLink {
         self.inner.reopen()
     }
 
+    /// The connection closes (a serial server serves one client at a
+    /// time); the export and the lease stay.
+    fn close(&mut self) {
+        self.inner = Box::new(Closed(self.inner.name()));
+    }
+
     /// Asks labgrid again where the port is: after a power cycle the
     /// exporter may serve it anew, on another port. The lease is kept.
     fn restart(&mut self) -> io::Result<()> {
-        // The old connection closes first: a serial server serves one
-        // client at a time.
-        self.inner = Box::new(Closed(self.inner.name()));
+        self.close();
         let fresh = LabgridLink::open_until(self.place.clone(), self.stop.clone())?;
         self.inner = fresh.inner;
         self._export = fresh._export;

@@ -89,6 +89,10 @@ pub trait Link: Send + fmt::Debug {
     fn recv(&mut self, buf: &mut [u8], timeout: WallDuration) -> io::Result<usize>;
     /// Opens the link again after it failed.
     fn reopen(&mut self) -> io::Result<()>;
+    /// Lets go of the connection while the far end's power is cycled (a
+    /// USB port held open across it may come back under another name);
+    /// [`Self::restart`] opens it again. The default keeps it.
+    fn close(&mut self) {}
     /// Opens the link anew after the far end lost its power: where a link
     /// is found again (a serial server that moved, a port enumerated
     /// again) it is looked up again. The default reopens.
@@ -116,6 +120,10 @@ impl Link for Box<dyn Link> {
 
     fn reopen(&mut self) -> io::Result<()> {
         (**self).reopen()
+    }
+
+    fn close(&mut self) {
+        (**self).close()
     }
 
     fn restart(&mut self) -> io::Result<()> {

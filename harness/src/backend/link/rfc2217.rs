@@ -302,6 +302,11 @@ impl Link for Rfc2217Link {
         Ok(n)
     }
 
+    fn close(&mut self) {
+        self.tcp.close();
+        self.pending.clear();
+    }
+
     fn reopen(&mut self) -> io::Result<()> {
         self.tcp.reopen()?;
         self.greet()

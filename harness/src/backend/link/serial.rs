@@ -134,6 +134,10 @@ impl Link for SerialLink {
         }
     }
 
+    fn close(&mut self) {
+        self.port = None;
+    }
+
     fn reopen(&mut self) -> io::Result<()> {
         self.port = None;
         let port = serialport::new(&self.path, self.baud)

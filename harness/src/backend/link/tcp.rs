@@ -181,6 +181,10 @@ impl Link for TcpLink {
         }
     }
 
+    fn close(&mut self) {
+        self.stream = None;
+    }
+
     fn reopen(&mut self) -> io::Result<()> {
         self.stream = None;
         let s = connect(self.addr.clone(), &self.stop)?;
