@@ -101,3 +101,18 @@ pub(crate) fn with_suffix(p: &Path, suffix: &str) -> PathBuf {
     s.push(suffix);
     PathBuf::from(s)
 }
+
+/// The files of `dir`, sorted by name, as bytes.
+pub(crate) fn read_folder(dir: &Path) -> Result<Vec<Vec<u8>>, CliError> {
+    let rd =
+        std::fs::read_dir(dir).map_err(|e| usage(format!("cannot read {}: {e}", dir.display())))?;
+    let mut files: Vec<PathBuf> = rd
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file())
+        .collect();
+    files.sort();
+    files
+        .iter()
+        .map(|f| Ok(ppmc_files::read(f, 1 << 20)?))
+        .collect()
+}

@@ -1,6 +1,7 @@
 //! `ppmc fuzz`: turning fuzz findings into something people can read and
 //! keep, and differential runs against a target.
 
+mod campaign;
 mod coverage;
 mod inputs;
 mod minimize;
@@ -111,6 +112,13 @@ enum FuzzCommand {
     /// against a target and the emulator side by side (the default when no
     /// subcommand is given).
     Run(run::DiffArgs),
+    /// A guided campaign against any target: `bus_bytes` inputs (protocol
+    /// violations included) run from a chip reset, each judged by the
+    /// datasheet's invariants on what the board answered, with the
+    /// reference model's coverage of the same input as the feedback, on a
+    /// budget of board time. Exit status 1 when an invariant broke and
+    /// broke again when run once more.
+    Campaign(campaign::CampaignArgs),
 }
 
 pub fn run(args: FuzzArgs, suite: &[ppmc::scenario::Scenario]) -> Result<(), CliError> {
@@ -118,6 +126,7 @@ pub fn run(args: FuzzArgs, suite: &[ppmc::scenario::Scenario]) -> Result<(), Cli
         Some(FuzzCommand::Seeds { out }) => seeds::run(&out, suite),
         None => run::run(args.run),
         Some(FuzzCommand::Run(a)) => run::run(a),
+        Some(FuzzCommand::Campaign(a)) => campaign::run(a, suite),
         Some(FuzzCommand::Triage { paths, model }) => triage::run(&paths, &model),
         Some(FuzzCommand::Coverage { paths, kind }) => coverage::run(&paths, kind.into()),
         Some(FuzzCommand::Reproduce { input }) => reproduce::run(&input),

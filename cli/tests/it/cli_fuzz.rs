@@ -230,3 +230,84 @@ fn triage_buckets_and_coverage_reports() {
     let missing = ppmc(&["fuzz", "coverage", "no/such/dir"]);
     assert_eq!(missing.status.code(), Some(2));
 }
+
+/// Issue 45: a guided campaign against a board (a bridge-sim whose chip
+/// outputs its pulses the wrong way, 3-3) finds the fault within a minute
+/// of board time and writes it where it says; the same campaign against
+/// the clean chip finds nothing (no false alarm); its corpus resumes.
+#[test]
+fn a_guided_campaign_finds_a_faulty_board_and_not_a_clean_one() {
+    let dir = scratch("campaign");
+    let d = dir.path();
+    let faulty = common::BridgeSim::start(&["--chip-fault", "dir-inverted"]);
+    let findings = d.join("findings");
+    let out = ppmc(&[
+        "fuzz",
+        "campaign",
+        "--target",
+        &faulty.target(),
+        "--budget",
+        "60s",
+        "--findings",
+        findings.to_str().expect("utf-8"),
+    ]);
+    let said = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{said}{}", text(&out.stderr));
+    assert!(said.contains("finding: phase-pattern after op "), "{said}");
+    let summary = said.lines().last().unwrap_or_default();
+    assert!(
+        summary.starts_with(&format!("campaign on {}: ", faulty.target()))
+            && summary.contains(" s of board time (")
+            && !summary.ends_with(" 0 findings, 0 flaky"),
+        "{summary}"
+    );
+    let written: Vec<_> = std::fs::read_dir(&findings)
+        .expect("findings written")
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        written
+            .iter()
+            .any(|n| n.starts_with("phase-pattern-") && n.ends_with(".bin")),
+        "{written:?}"
+    );
+    drop(faulty);
+
+    let clean = common::BridgeSim::start(&[]);
+    let corpus = d.join("corpus");
+    let run = |budget: &str| {
+        ppmc(&[
+            "fuzz",
+            "campaign",
+            "--target",
+            &clean.target(),
+            "--budget",
+            budget,
+            "--corpus",
+            corpus.to_str().expect("utf-8"),
+            "--findings",
+            d.join("none").to_str().expect("utf-8"),
+        ])
+    };
+    let out = run("30s");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}{}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+    assert!(
+        text(&out.stdout).ends_with(", 0 findings, 0 flaky\n"),
+        "{}",
+        text(&out.stdout)
+    );
+    let kept = std::fs::read_dir(&corpus).expect("corpus").count();
+    assert!(kept > 10, "{kept} inputs kept");
+    // A second campaign starts from the corpus: it runs every kept input
+    // before mutating, so its first budget goes on them.
+    let out = run("1s");
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(std::fs::read_dir(&corpus).expect("corpus").count() >= kept);
+}

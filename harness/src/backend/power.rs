@@ -3,7 +3,7 @@
 //!
 //! A board that hangs (its bridge silent past the link's bounds, or its
 //! chip still BUSY after a chip reset) is brought back by cycling its
-//! power once, then reaching its bridge again ([`Target::restart`]). The
+//! power once, then reaching its bridge again ([`Target::power_cycle`]). The
 //! switch is, for each board:
 //!
 //! - `--power-cmd CMD`: the shell runs `CMD cycle`, with `PPMC_BOARD` (the
@@ -18,7 +18,7 @@
 //! Every command is bounded ([`SWITCH_TIMEOUT`]); one that fails or hangs
 //! leaves the board lost, as a board without a switch is, and says why.
 //!
-//! [`Target::restart`]: super::Target::restart
+//! [`Target::power_cycle`]: super::Target::power_cycle
 
 use super::link::labgrid::parse_labgrid;
 use super::link::lease::client_program;

@@ -17,10 +17,14 @@
 //!   suite (`ppmc fuzz seeds`).
 //! - [`differential`]: seeded runs of typed actions on a target beside the
 //!   reference emulator (`ppmc fuzz run`).
+//! - [`guided`]: a campaign of `bus_bytes` inputs on any target, judged by
+//!   the invariants on the board's own answers, guided by the model's
+//!   coverage, on a budget of board time (`ppmc fuzz campaign`).
 
 pub mod actions;
 pub mod campaign;
 pub mod differential;
 pub mod finding;
+pub mod guided;
 pub mod seeds;
 pub mod targets;

@@ -137,6 +137,19 @@ pub fn bus_bytes(suite: &[(&str, Trace)]) -> Vec<(String, Vec<u8>)> {
         .collect()
 }
 
+/// The bus traffic of every scenario of `suite` as it runs on the
+/// emulator: the seeds of a campaign against a board.
+pub fn suite_traffic(suite: &[crate::scenario::Scenario]) -> Result<Vec<Vec<u8>>, String> {
+    let mut emu =
+        EmuTarget::new(Straps::default(), Default::default()).map_err(|e| e.to_string())?;
+    let results = crate::runner::run_suite(&mut emu, suite, 1, Default::default(), |_| {});
+    let traces: Vec<_> = results
+        .into_iter()
+        .filter_map(|r| Some((r.name, r.trace?)))
+        .collect();
+    Ok(bus_bytes(&traces).into_iter().map(|(_, b)| b).collect())
+}
+
 /// Seeded random bytes, each decoding to a few dozen typed actions.
 pub fn typed_actions() -> Vec<(String, Vec<u8>)> {
     use rand::{Rng, SeedableRng};

@@ -1,0 +1,445 @@
+//! Guided fuzzing of any target (`ppmc fuzz campaign`): `bus_bytes`
+//! inputs (the byte grammar of [`crate::bus_program`], protocol violations
+//! included) run on a board from a chip reset, each judged on what the
+//! board itself answered by the datasheet's invariants
+//! ([`crate::invariants::replay`]), with the reference model's domain
+//! coverage of the same input ([`Coverage`]) as the feedback: an input
+//! that reaches something new (a command in a chip state, an error code, a
+//! way a move ends, an input during a move) is kept in the corpus and
+//! mutated further. A chip like this one has no breakpoints to read; the
+//! model tells, for every byte the board was given, which state and which
+//! rule it exercised.
+//!
+//! The budget is the board's own time (its clock, from each chip reset to
+//! the input's last op), not the host's: a slow link costs wall time, not
+//! budget. A break is run again at once: one that repeats is a finding,
+//! one that does not is kept apart as flaky.
+
+use super::campaign::Coverage;
+use crate::backend::{Op, Target, TargetError};
+use crate::bus_program::{self, BusOp};
+use crate::invariants::replay::{judge, probed_ops, Found};
+use crate::time::Duration;
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+use std::collections::BTreeSet;
+
+/// What a campaign may spend, and how its inputs are bounded.
+#[derive(Debug, Clone)]
+pub struct Settings {
+    /// Board time the campaign may use, summed over its executions.
+    pub budget: Duration,
+    /// An input is cut where its waits would take the board past this
+    /// (an input may ask for minutes of waiting).
+    pub max_input_time: Duration,
+    /// An input is cut after this many ops.
+    pub max_ops: usize,
+    /// A mutated input is at most this long, in bytes.
+    pub max_len: usize,
+    /// Seed of the mutations: with the same seeds and target, the same
+    /// campaign.
+    pub seed: u64,
+    /// Byte strings the mutator inserts whole (a libFuzzer dictionary's
+    /// entries: the separator, command writes).
+    pub dictionary: Vec<Vec<u8>>,
+    /// Without feedback: every input a mutation of a seed, nothing kept
+    /// (the blind baseline a guided campaign is measured against).
+    pub blind: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            budget: Duration::from_secs(60),
+            max_input_time: Duration::from_secs(1),
+            max_ops: 64,
+            max_len: 512,
+            seed: 1,
+            dictionary: default_dictionary(),
+            blind: false,
+        }
+    }
+}
+
+/// The separator, the reads, and a command write of every command byte
+/// of chapter 3: what `fuzz/bus_bytes.dict` holds, for a campaign run
+/// where that file is not.
+pub fn default_dictionary() -> Vec<Vec<u8>> {
+    let mut d: Vec<Vec<u8>> = vec![
+        bus_program::SEPARATOR.to_vec(),
+        vec![2],
+        vec![3],
+        vec![6, 1, 0],
+        vec![6, 100, 0],
+    ];
+    for byte in [
+        0x00, 0x01, 0x02, 0x03, 0x05, 0x06, 0x07, 0x0B, 0x0D, 0x12, 0x22,
+    ] {
+        d.push(vec![0, byte]);
+    }
+    d
+}
+
+/// An input that broke an invariant on the target.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Finding {
+    /// The input as run (cut to the campaign's bounds).
+    pub input: Vec<u8>,
+    pub found: Found,
+    /// It broke the same invariant when run again at once.
+    pub repeated: bool,
+}
+
+/// What a campaign did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Stats {
+    pub executions: u64,
+    /// Board time spent, summed over the executions.
+    pub board_time: Duration,
+    /// Coverage features reached so far.
+    pub features: usize,
+    /// Inputs in the corpus (seeds that reached something, and finds).
+    pub corpus: usize,
+    pub findings: usize,
+    pub flaky: usize,
+}
+
+impl Stats {
+    /// Executions per second of board time.
+    pub fn per_board_second(&self) -> f64 {
+        match self.board_time.as_nanos() {
+            0 => 0.0,
+            ns => self.executions as f64 / (ns as f64 / 1e9),
+        }
+    }
+}
+
+/// What a campaign tells its caller as it runs.
+#[derive(Debug)]
+pub enum Event<'a> {
+    /// An input reached features nothing before it had: kept.
+    NewCoverage { input: &'a [u8], new: usize },
+    /// An input broke an invariant (repeated or flaky).
+    Finding(&'a Finding),
+    /// After every execution.
+    Progress(&'a Stats),
+}
+
+/// A name for an input that is the same on every build: 16 hex digits of
+/// its FNV-1a hash, to name its file in a corpus or among findings.
+pub fn name(input: &[u8]) -> String {
+    let h = input.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+        (h ^ u64::from(*b)).wrapping_mul(0x100_0000_01b3)
+    });
+    format!("{h:016x}")
+}
+
+/// The coverage features an input reaches on the reference model: its
+/// domain coverage ([`Coverage`]), one name per cell reached.
+pub fn features(ops: &[BusOp]) -> BTreeSet<String> {
+    let c = Coverage::of(&[ops.to_vec()]);
+    let mut f = BTreeSet::new();
+    f.extend(
+        c.commands
+            .keys()
+            .map(|(class, state)| format!("command {class} while {}", state.name())),
+    );
+    f.extend(c.errors.keys().map(|e| format!("error {e}")));
+    f.extend(
+        c.finishes
+            .keys()
+            .map(|(kind, cause)| format!("{kind} ended by {cause}")),
+    );
+    f.extend(
+        c.inputs_while_moving
+            .keys()
+            .map(|i| format!("{i} during a move")),
+    );
+    f
+}
+
+/// The ops of `input` that a campaign runs: at most `max_ops`, and none
+/// past `max_input_time` of waiting.
+pub fn bounded_ops(input: &[u8], s: &Settings) -> Vec<BusOp> {
+    let mut waited = Duration::ZERO;
+    let mut out = Vec::new();
+    for op in bus_program::ops(input).take(s.max_ops) {
+        if let BusOp::Advance(d) = op {
+            waited += d;
+            if waited > s.max_input_time {
+                break;
+            }
+        }
+        out.push(op);
+    }
+    out
+}
+
+/// Runs `ops` on `target` from a chip reset, in one batch with its
+/// capture (one round trip on a board that takes the batch whole), and
+/// judges them: the break, if any, and the board time it took.
+pub fn execute(
+    target: &mut dyn Target,
+    ops: &[BusOp],
+) -> Result<(Option<Found>, Duration), TargetError> {
+    let mut batch = Vec::with_capacity(1 + ops.len() * 3);
+    batch.push(Op::Reset);
+    batch.extend(probed_ops(ops));
+    let (replies, capture) = target.execute_then_capture(&batch)?;
+    let took = replies
+        .last()
+        .map_or(Duration::ZERO, |r| Duration::from_nanos(r.at().as_nanos()));
+    let found = judge(
+        ops,
+        replies.get(1..).unwrap_or_default(),
+        &capture,
+        target.straps(),
+    )
+    .map_err(|m| TargetError::new(crate::backend::TargetErrorKind::Other, m))?;
+    Ok((found, took))
+}
+
+/// Runs a campaign on `target` from `seeds` until its budget of board
+/// time is spent or `on` says stop (it returns false). Every seed runs
+/// first; then mutations of the corpus. Errors of the target end it.
+pub fn run(
+    target: &mut dyn Target,
+    seeds: &[Vec<u8>],
+    s: &Settings,
+    mut on: impl FnMut(Event<'_>) -> bool,
+) -> Result<Stats, TargetError> {
+    let mut rng = StdRng::seed_from_u64(s.seed);
+    let mut stats = Stats::default();
+    let mut seen: BTreeSet<String> = BTreeSet::new();
+    let mut corpus: Vec<Vec<u8>> = Vec::new();
+    let seeds: Vec<&Vec<u8>> = seeds.iter().filter(|x| !x.is_empty()).collect();
+    let mut next_seed = 0;
+    while stats.board_time < s.budget {
+        let input = if next_seed < seeds.len() {
+            next_seed += 1;
+            seeds[next_seed - 1].clone()
+        } else {
+            let pool: Vec<&Vec<u8>> = match s.blind || corpus.is_empty() {
+                true => seeds.clone(),
+                false => corpus.iter().collect(),
+            };
+            mutate(&mut rng, &pool, s)
+        };
+        let ops = bounded_ops(&input, s);
+        let (found, took) = execute(target, &ops)?;
+        stats.executions += 1;
+        stats.board_time += took;
+        let input = bus_program::encode(&ops);
+        if !s.blind || next_seed <= seeds.len() {
+            let new: Vec<String> = features(&ops)
+                .into_iter()
+                .filter(|f| !seen.contains(f))
+                .collect();
+            if !new.is_empty() {
+                stats.features += new.len();
+                seen.extend(new.iter().cloned());
+                if !s.blind {
+                    corpus.push(input.clone());
+                    stats.corpus = corpus.len();
+                }
+                if !on(Event::NewCoverage {
+                    input: &input,
+                    new: new.len(),
+                }) {
+                    break;
+                }
+            }
+        }
+        if let Some(found) = found {
+            // Run again at once: a break the board repeats is a finding.
+            let (again, took) = execute(target, &ops)?;
+            stats.executions += 1;
+            stats.board_time += took;
+            let repeated =
+                again.is_some_and(|a| a.violation.invariant == found.violation.invariant);
+            match repeated {
+                true => stats.findings += 1,
+                false => stats.flaky += 1,
+            }
+            let finding = Finding {
+                input: input.clone(),
+                found,
+                repeated,
+            };
+            if !on(Event::Finding(&finding)) {
+                break;
+            }
+        }
+        if !on(Event::Progress(&stats)) {
+            break;
+        }
+    }
+    Ok(stats)
+}
+
+/// A mutation of an input of `pool`: a few of libFuzzer's kinds (a bit
+/// flipped, a byte set, bytes inserted or erased, a dictionary entry put
+/// in, a piece of another input spliced in, whole ops reordered).
+pub fn mutate(rng: &mut StdRng, pool: &[&Vec<u8>], s: &Settings) -> Vec<u8> {
+    let mut x: Vec<u8> = match pool.is_empty() {
+        true => Vec::new(),
+        false => pool[rng.random_range(0..pool.len())].clone(),
+    };
+    for _ in 0..rng.random_range(1..=4) {
+        let at = |rng: &mut StdRng, x: &Vec<u8>| rng.random_range(0..=x.len());
+        match rng.random_range(0..7) {
+            0 if !x.is_empty() => {
+                let i = rng.random_range(0..x.len());
+                x[i] ^= 1 << rng.random_range(0..8);
+            }
+            1 if !x.is_empty() => {
+                let i = rng.random_range(0..x.len());
+                x[i] = rng.random();
+            }
+            2 => {
+                let i = at(rng, &x);
+                let n = rng.random_range(1..=4);
+                let bytes: Vec<u8> = (0..n).map(|_| rng.random()).collect();
+                x.splice(i..i, bytes);
+            }
+            3 if !x.is_empty() => {
+                let i = rng.random_range(0..x.len());
+                let n = rng.random_range(1..=8).min(x.len() - i);
+                x.drain(i..i + n);
+            }
+            4 if !s.dictionary.is_empty() => {
+                let i = at(rng, &x);
+                let d = &s.dictionary[rng.random_range(0..s.dictionary.len())];
+                x.splice(i..i, d.iter().copied());
+            }
+            5 if !pool.is_empty() => {
+                let other = pool[rng.random_range(0..pool.len())];
+                if !other.is_empty() {
+                    let a = rng.random_range(0..other.len());
+                    let b = rng.random_range(a..=other.len());
+                    let i = at(rng, &x);
+                    x.splice(i..i, other[a..b].iter().copied());
+                }
+            }
+            _ => {
+                // Whole ops: one moved elsewhere (the order of writes is
+                // what the chip's state depends on).
+                let mut ops = bus_program::decode(&x);
+                if ops.len() > 1 {
+                    let op = ops.remove(rng.random_range(0..ops.len()));
+                    ops.insert(rng.random_range(0..=ops.len()), op);
+                    x = bus_program::encode(&ops);
+                }
+            }
+        }
+    }
+    x.truncate(s.max_len);
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::backend::EmuTarget;
+
+    fn emu(faults: &[&str]) -> EmuTarget {
+        let mut model = crate::emu::ModelConfig::default();
+        let faults: Vec<String> = faults.iter().map(|f| f.to_string()).collect();
+        crate::faults::apply_all(&faults, &mut model).expect("catalogued");
+        EmuTarget::new(Default::default(), model).expect("emulator")
+    }
+
+    /// The same seed, the same campaign: inputs, coverage and stats.
+    #[test]
+    fn a_campaign_is_replayed_by_its_seed() {
+        let seeds = vec![bus_program::encode(&[
+            BusOp::Command(0x00),
+            BusOp::ReadStatus,
+        ])];
+        let s = Settings {
+            budget: Duration::from_millis(200),
+            ..Settings::default()
+        };
+        let go = |t: &mut EmuTarget| {
+            let mut kept = Vec::new();
+            let stats = run(t, &seeds, &s, |e| {
+                if let Event::NewCoverage { input, .. } = e {
+                    kept.push(input.to_vec());
+                }
+                true
+            })
+            .expect("runs");
+            (stats, kept)
+        };
+        let (a, kept_a) = go(&mut emu(&[]));
+        let (b, kept_b) = go(&mut emu(&[]));
+        assert_eq!(a, b);
+        assert_eq!(kept_a, kept_b);
+        assert!(a.board_time >= s.budget, "{a:?}");
+        assert!(a.features > 0 && a.executions > 1, "{a:?}");
+    }
+
+    /// An input is cut where its waits pass the bound, and its board time
+    /// is the board's clock, not the host's.
+    #[test]
+    fn an_input_is_bounded_and_costs_its_board_time() {
+        let s = Settings {
+            max_input_time: Duration::from_millis(15),
+            ..Settings::default()
+        };
+        let input = bus_program::encode(&[
+            BusOp::Advance(Duration::from_millis(10)),
+            BusOp::ReadStatus,
+            BusOp::Advance(Duration::from_millis(10)),
+            BusOp::ReadStatus,
+        ]);
+        let ops = bounded_ops(&input, &s);
+        assert_eq!(ops.len(), 2);
+        let (found, took) = execute(&mut emu(&[]), &ops).expect("runs");
+        assert_eq!(found, None);
+        assert!(
+            took >= Duration::from_millis(10) && took < Duration::from_millis(11),
+            "{took}"
+        );
+    }
+
+    /// The committed `bus_bytes` seed corpus (the suite's traffic).
+    fn corpus() -> Vec<Vec<u8>> {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/corpus/bus_bytes");
+        let mut files: Vec<_> = std::fs::read_dir(dir)
+            .expect("the seed corpus")
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .collect();
+        files.sort();
+        files
+            .iter()
+            .map(|f| std::fs::read(f).expect("a seed"))
+            .collect()
+    }
+
+    /// A faulty board of the catalogue (a remaining count one too many,
+    /// 3-4-4) is found from the suite's traffic, and the break repeats;
+    /// the clean model breaks nothing on the same input.
+    #[test]
+    fn a_catalogued_fault_is_found_and_repeats() {
+        let s = Settings {
+            budget: Duration::from_secs(600),
+            ..Settings::default()
+        };
+        let mut findings = Vec::new();
+        let stats = run(&mut emu(&["remaining-off-by-one"]), &corpus(), &s, |e| {
+            if let Event::Finding(f) = e {
+                findings.push(f.clone());
+            }
+            findings.is_empty()
+        })
+        .expect("runs");
+        let f = findings
+            .first()
+            .unwrap_or_else(|| panic!("nothing found: {stats:?}"));
+        assert!(f.repeated);
+        assert_eq!(f.found.violation.invariant.as_str(), "remaining-pulses");
+        let ops = bus_program::decode(&f.input);
+        assert_eq!(execute(&mut emu(&[]), &ops).expect("runs").0, None);
+    }
+}
