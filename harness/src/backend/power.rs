@@ -15,8 +15,11 @@
 //!   `labgrid-client -p PLACE power cycle` (its power resource, or the
 //!   power driver of the environment `LG_ENV` names).
 //!
-//! Every command is bounded ([`SWITCH_TIMEOUT`]); one that fails or hangs
-//! leaves the board lost, as a board without a switch is, and says why.
+//! Every command is bounded ([`SWITCH_TIMEOUT`]) and runs in a process
+//! group of its own. One that fails or hangs leaves the board as a board
+//! without a switch is (a silent bridge lost, a BUSY chip left to the next
+//! scenario's reset), and says why. The runner's side (what a hang is,
+//! whose verdict it is) is `runner.rs`'s `run_checked`.
 //!
 //! [`Target::power_cycle`]: super::Target::power_cycle
 
