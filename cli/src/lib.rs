@@ -20,6 +20,7 @@ mod history;
 mod judge;
 mod lines;
 mod list;
+mod power;
 mod progress;
 mod record;
 mod report;

@@ -4,8 +4,7 @@
 //! [`Farm`], which keeps the boards it could not reach out of the verdict.
 
 use crate::backend::{
-    self, BridgeError, Op, OpenError, OpenOptions, Power, Reply, Target, TargetErrorKind,
-    TargetInfo, TargetSpec,
+    self, Op, OpenError, OpenOptions, Power, Reply, Target, TargetInfo, TargetSpec,
 };
 use crate::scenario::{
     run_scenario, Attempt, DriverOptions, HarnessError, NotRun, Scenario, ScenarioResult, Verdict,
@@ -202,8 +201,8 @@ fn run_checked(
                     // after its reset is left to the next scenario's reset,
                     // and its verdict; a silent bridge is lost.
                     (Recovery::NoSwitch(_), Hang::Busy(_)) => {}
-                    (Recovery::NoSwitch(why), h) if why.is_empty() => lost = Some(h.why().into()),
-                    (Recovery::NoSwitch(why), h) => lost = Some(format!("{}; {why}", h.why())),
+                    (Recovery::NoSwitch(why), h) if why.is_empty() => lost = Some(h.error().into()),
+                    (Recovery::NoSwitch(why), h) => lost = Some(format!("{}; {why}", h.error())),
                 }
             }
         }
@@ -243,8 +242,8 @@ fn note_hang(verdict: &mut Verdict, hang: &str, recovery: String) {
 /// Why a board failed its health check.
 #[derive(Debug)]
 enum Hang {
-    /// Its bridge fell silent: the words.
-    Silent(String),
+    /// Its bridge fell silent: the words, and the link's error.
+    Silent(String, String),
     /// Its chip answered, BUSY after its reset: the words.
     Busy(String),
     /// Anything else (a stop, another host on the bridge, a link given up
@@ -256,7 +255,15 @@ enum Hang {
 impl Hang {
     fn why(&self) -> &str {
         match self {
-            Hang::Silent(w) | Hang::Busy(w) | Hang::Gone(w) => w,
+            Hang::Silent(w, _) | Hang::Busy(w) | Hang::Gone(w) => w,
+        }
+    }
+
+    /// The error itself, as a board lost without a power cycle names it.
+    fn error(&self) -> &str {
+        match self {
+            Hang::Silent(_, e) => e,
+            h => h.why(),
         }
     }
 }
@@ -267,7 +274,10 @@ impl Hang {
 /// chip BUSY past it is past its longest legal move).
 fn health(target: &mut dyn Target) -> Result<(), Hang> {
     match target.execute(&[Op::Reset, Op::ReadStatus]) {
-        Err(e) if silence(&e) => Err(Hang::Silent(format!("its bridge stopped answering ({e})"))),
+        Err(e) if crate::backend::power::silent(&e) => Err(Hang::Silent(
+            format!("its bridge stopped answering ({e})"),
+            e.to_string(),
+        )),
         Err(e) => Err(Hang::Gone(e.to_string())),
         Ok(replies) => match replies.get(1) {
             Some(Reply::Status { status, .. }) if status.busy() => Err(Hang::Busy(format!(
@@ -276,15 +286,6 @@ fn health(target: &mut dyn Target) -> Result<(), Hang> {
             ))),
             _ => Ok(()),
         },
-    }
-}
-
-/// Whether `e` says the bridge fell silent: a bridge's own error says so
-/// ([`BridgeError::is_silence`]); another target's link error is taken so.
-fn silence(e: &crate::backend::TargetError) -> bool {
-    match e.get_ref().downcast_ref::<BridgeError>() {
-        Some(b) => b.is_silence(),
-        None => e.kind == TargetErrorKind::Link,
     }
 }
 

@@ -368,3 +368,49 @@ fn a_board_past_its_cycles_or_whose_switch_fails_is_lost_and_says_why() {
         "{why}"
     );
 }
+
+/// Issue 45: a board that hangs mid-campaign (silent, or its chip BUSY
+/// after a chip reset) is brought back by its switch, the input it hung
+/// under is kept as a finding, and the campaign goes on to its budget.
+#[test]
+fn a_board_that_hangs_mid_campaign_is_brought_back_and_the_campaign_goes_on() {
+    use ppmc::bus_program::{self, BusOp};
+    use ppmc::fuzzing::guided::{self, Event, Settings, What};
+    let seeds = vec![bus_program::encode(&[
+        BusOp::Command(0x00),
+        BusOp::ReadStatus,
+    ])];
+    let settings = Settings {
+        budget: ppmc::time::Duration::from_millis(300),
+        ..Settings::default()
+    };
+    for how in [Hang::Silent, Hang::Busy] {
+        let (_keep, dir) = scratch();
+        let restarts = Arc::new(AtomicU32::new(0));
+        let mut board = Hanging::boxed(how, 5, 1, &restarts);
+        let mut power = switch(&dir, 3, false);
+        let mut hangs = Vec::new();
+        let stats = guided::run(board.as_mut(), Some(&mut power), &seeds, &settings, |e| {
+            if let Event::Finding(f) = e {
+                if let What::Hang { hang, recovery } = &f.what {
+                    hangs.push((hang.clone(), recovery.clone()));
+                }
+            }
+            true
+        })
+        .unwrap_or_else(|e| panic!("{how:?}: the campaign ended: {e}"));
+        assert_eq!(hangs.len(), 1, "{how:?}: {stats:?}");
+        let (hang, recovery) = &hangs[0];
+        match how {
+            Hang::Silent => assert!(hang.starts_with("its bridge stopped answering ("), "{hang}"),
+            _ => assert_eq!(
+                hang,
+                "its chip stayed BUSY after a chip reset (status 0x04)"
+            ),
+        }
+        assert!(recovery.starts_with("power-cycled by `sh '"), "{recovery}");
+        assert_eq!(restarts.load(Ordering::SeqCst), 1);
+        assert!(stats.board_time >= settings.budget, "went on: {stats:?}");
+        assert_eq!(log(&dir), "bench-1 cycle\n");
+    }
+}

@@ -39,6 +39,11 @@ pub struct CampaignArgs {
     /// blind baseline to measure guidance against).
     #[arg(long)]
     blind: bool,
+    /// A board that hangs under an input (its bridge silent, or its chip
+    /// BUSY after a chip reset) is brought back by a chip reset, else by
+    /// its power switch, and the input is kept as a finding.
+    #[command(flatten)]
+    power: crate::power::PowerArgs,
 }
 
 pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
@@ -57,6 +62,8 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
     for dir in args.seeds.iter().chain(&args.corpus) {
         seeds.extend(super::inputs::read_folder(dir)?);
     }
+    let spec = args.target.single().map_err(crate::usage)?;
+    let mut power = ppmc::backend::Power::of(&spec, &args.power.options(), &stop);
     let mut target = args.target.open()?;
     let settings = Settings {
         budget: args.budget,
@@ -71,27 +78,23 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
     );
     let t0 = std::time::Instant::now();
     let mut written: Result<(), CliError> = Ok(());
-    let stats = guided::run(target.as_mut(), &seeds, &settings, |e| {
+    let stats = guided::run(target.as_mut(), power.as_mut(), &seeds, &settings, |e| {
         let w = match e {
             Event::NewCoverage { input, .. } => match &args.corpus {
                 Some(dir) => keep(dir, &format!("{}.bin", guided::name(input)), input),
                 None => Ok(()),
             },
             Event::Finding(f) => {
-                let v = &f.found.violation;
-                let name = format!(
-                    "{}{}-{}.bin",
-                    if f.repeated { "" } else { "flaky-" },
-                    v.invariant,
-                    guided::name(&f.input)
-                );
+                let hang = matches!(f.what, guided::What::Hang { .. });
+                let label = match (hang, f.repeated) {
+                    (true, _) | (false, true) => "finding",
+                    (false, false) => "flaky",
+                };
+                let flaky = if label == "flaky" { "flaky-" } else { "" };
+                let name = format!("{flaky}{}-{}.bin", f.what.name(), guided::name(&f.input));
                 bar.suspend(|| {
-                    outln!(
-                        "{}: {v} (at {}) -> {}",
-                        if f.repeated { "finding" } else { "flaky" },
-                        f.found.at,
-                        args.findings.join(&name).display()
-                    )
+                    let at = args.findings.join(&name);
+                    outln!("{label}: {} -> {}", f.what, at.display())
                 });
                 keep(&args.findings, &name, &f.input)
             }
@@ -110,7 +113,7 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
     written?;
     let s = stats.map_err(|e| CliError::Failed(format!("infrastructure error: {e}")))?;
     outln!(
-        "campaign on {}: {} executions in {:.1} s of board time ({:.1} per board-second; {:.1} s wall), {} features, corpus {}, {} findings, {} flaky",
+        "campaign on {}: {} executions in {:.1} s of board time ({:.1} per board-second; {:.1} s wall), {} features, corpus {}, {} findings ({} hangs), {} flaky",
         args.target.name(),
         s.executions,
         s.board_time.as_secs_f64(),
@@ -119,6 +122,7 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
         s.features,
         s.corpus,
         s.findings,
+        s.hangs,
         s.flaky
     );
     match s.findings {

@@ -69,7 +69,7 @@ pub struct RunArgs {
     #[arg(long, default_value_t = ppmc_record::MARGINAL_PCT)]
     pub(crate) marginal: f64,
     #[command(flatten)]
-    pub(crate) power: super::power::PowerArgs,
+    pub(crate) power: crate::power::PowerArgs,
 }
 
 fn parse_window(s: &str) -> Result<Window, String> {

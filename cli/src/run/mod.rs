@@ -3,7 +3,6 @@
 //! arguments, opens the boards, prints and picks the exit status.
 
 mod args;
-mod power;
 
 pub use args::RunArgs;
 

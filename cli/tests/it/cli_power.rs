@@ -164,3 +164,60 @@ fn power_options_the_user_got_wrong_are_refused_before_any_board_is_touched() {
         "{help}"
     );
 }
+
+/// Issue 45: a board made to hang mid-campaign is brought back by its
+/// power switch; the input it hung under is a finding, and the campaign
+/// goes on to the end of its budget.
+#[test]
+fn a_board_made_to_hang_mid_campaign_is_power_cycled_and_the_campaign_goes_on() {
+    let dir = scratch("power-campaign");
+    hanging_bridge(dir.path());
+    let cmd = format!("{} {}", power_script().display(), dir.path().display());
+    let findings = dir.path().join("findings");
+    let out = Command::new(env!("CARGO_BIN_EXE_ppmc"))
+        .args([
+            "fuzz",
+            "campaign",
+            "--budget",
+            "20s",
+            "--link-timeout",
+            "500ms",
+        ])
+        .args(["--link-retries", "3", "--target"])
+        .arg(format!("serial:{}", dir.path().join("pty").display()))
+        .arg("--findings")
+        .arg(&findings)
+        .args(["--power-cmd", &cmd])
+        .env("PPMC", env!("CARGO_BIN_EXE_ppmc"))
+        .output()
+        .expect("ppmc runs");
+    stop_bridge(dir.path());
+    let said = format!("{}{}", text(&out.stdout), text(&out.stderr));
+    assert_eq!(out.status.code(), Some(1), "a hang is a finding:\n{said}");
+    assert!(
+        said.contains("finding: the board hung: its bridge stopped answering (serial:")
+            && said.contains(&format!("power-cycled by `{cmd} cycle` (1 of 3) -> ")),
+        "{said}"
+    );
+    let summary = said
+        .lines()
+        .find(|l| l.starts_with("campaign on "))
+        .unwrap_or_else(|| panic!("no summary:\n{said}"));
+    assert!(summary.contains(" findings (1 hangs), "), "{summary}");
+    let board_time: f64 = summary
+        .split(" executions in ")
+        .nth(1)
+        .and_then(|r| r.split(" s of board time").next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{summary}"));
+    assert!(
+        board_time >= 20.0,
+        "the campaign went on to its budget: {summary}"
+    );
+    let kept: Vec<String> = std::fs::read_dir(&findings)
+        .expect("findings")
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(kept.iter().any(|n| n.starts_with("hang-")), "{kept:?}");
+}

@@ -21,11 +21,13 @@
 //! scenario's reset), and says why. The runner's side (what a hang is,
 //! whose verdict it is) is `runner.rs`'s `run_checked`.
 //!
-//! [`Target::power_cycle`]: super::Target::power_cycle
+//! [`Target::power_cycle`]: super::target::Target::power_cycle
 
+use super::bridged::BridgeError;
 use super::link::labgrid::parse_labgrid;
 use super::link::lease::client_program;
 use super::spec::{SpecError, TargetSpec};
+use super::target::{TargetError, TargetErrorKind};
 use crate::stop::StopRequest;
 use std::fmt;
 use std::process::Command;
@@ -170,6 +172,17 @@ impl fmt::Display for PowerSwitch {
             }
             PowerSwitch::Labgrid(p) => write!(f, "{} -p {p} power cycle", client_program()),
         }
+    }
+}
+
+/// Whether `e` says a board's bridge fell silent, the hang a power cycle
+/// may cure: a bridge's own error says so
+/// ([`BridgeError::is_silence`]); another target's link error is taken
+/// so.
+pub fn silent(e: &TargetError) -> bool {
+    match e.get_ref().downcast_ref::<BridgeError>() {
+        Some(b) => b.is_silence(),
+        None => e.kind == TargetErrorKind::Link,
     }
 }
 

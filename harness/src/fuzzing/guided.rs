@@ -16,7 +16,8 @@
 //! one that does not is kept apart as flaky.
 
 use super::campaign::Coverage;
-use crate::backend::{Op, Target, TargetError};
+use crate::backend::power::{silent, Power};
+use crate::backend::{Op, Reply, Target, TargetError, TargetErrorKind};
 use crate::bus_program::{self, BusOp};
 use crate::invariants::replay::{judge, probed_ops, Found};
 use crate::time::Duration;
@@ -80,14 +81,45 @@ pub fn default_dictionary() -> Vec<Vec<u8>> {
     d
 }
 
-/// An input that broke an invariant on the target.
+/// An input that broke an invariant on the target, or that the board
+/// hung under.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Finding {
     /// The input as run (cut to the campaign's bounds).
     pub input: Vec<u8>,
-    pub found: Found,
-    /// It broke the same invariant when run again at once.
+    pub what: What,
+    /// It broke the same invariant when run again at once (a hang is not
+    /// run again: it is kept as it came).
     pub repeated: bool,
+}
+
+/// What a finding found.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum What {
+    /// An invariant broke, judged on the board's own answers.
+    Break(Found),
+    /// The board hung under the input (its bridge silent, or its chip
+    /// BUSY after a chip reset), and was brought back as `recovery` says.
+    Hang { hang: String, recovery: String },
+}
+
+impl What {
+    /// Its name in a file name: the invariant's id, or `hang`.
+    pub fn name(&self) -> String {
+        match self {
+            What::Break(f) => f.violation.invariant.to_string(),
+            What::Hang { .. } => "hang".into(),
+        }
+    }
+}
+
+impl std::fmt::Display for What {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            What::Break(found) => write!(f, "{} (at {})", found.violation, found.at),
+            What::Hang { hang, recovery } => write!(f, "the board hung: {hang}; {recovery}"),
+        }
+    }
 }
 
 /// What a campaign did.
@@ -102,6 +134,8 @@ pub struct Stats {
     pub corpus: usize,
     pub findings: usize,
     pub flaky: usize,
+    /// Hangs the board was brought back from.
+    pub hangs: usize,
 }
 
 impl Stats {
@@ -186,6 +220,16 @@ pub fn execute(
     batch.push(Op::Reset);
     batch.extend(probed_ops(ops));
     let (replies, capture) = target.execute_then_capture(&batch)?;
+    // A chip BUSY right after its reset is hung: 3-1-1's reset ends any
+    // move. Nothing the input did is to be judged on it.
+    if let Some(Reply::Status { status, .. }) = replies.get(1).filter(|_| !ops.is_empty()) {
+        if status.busy() {
+            return Err(TargetError::new(
+                TargetErrorKind::Other,
+                StuckBusy(status.0),
+            ));
+        }
+    }
     let took = replies
         .last()
         .map_or(Duration::ZERO, |r| Duration::from_nanos(r.at().as_nanos()));
@@ -204,6 +248,7 @@ pub fn execute(
 /// first; then mutations of the corpus. Errors of the target end it.
 pub fn run(
     target: &mut dyn Target,
+    mut power: Option<&mut Power>,
     seeds: &[Vec<u8>],
     s: &Settings,
     mut on: impl FnMut(Event<'_>) -> bool,
@@ -226,7 +271,26 @@ pub fn run(
             mutate(&mut rng, &pool, s)
         };
         let ops = bounded_ops(&input, s);
-        let (found, took) = execute(target, &ops)?;
+        let (found, took) = match execute(target, &ops) {
+            Ok(x) => x,
+            Err(e) => {
+                // The board hung under the input: brought back, the input
+                // kept as a finding, and the campaign goes on.
+                let (hang, recovery) = bring_back(target, power.as_deref_mut(), e)?;
+                stats.executions += 1;
+                stats.hangs += 1;
+                stats.findings += 1;
+                let finding = Finding {
+                    input: bus_program::encode(&ops),
+                    what: What::Hang { hang, recovery },
+                    repeated: false,
+                };
+                if !on(Event::Finding(&finding)) || !on(Event::Progress(&stats)) {
+                    break;
+                }
+                continue;
+            }
+        };
         stats.executions += 1;
         stats.board_time += took;
         let input = bus_program::encode(&ops);
@@ -252,7 +316,13 @@ pub fn run(
         }
         if let Some(found) = found {
             // Run again at once: a break the board repeats is a finding.
-            let (again, took) = execute(target, &ops)?;
+            let (again, took) = match execute(target, &ops) {
+                Ok(x) => x,
+                Err(e) => {
+                    bring_back(target, power.as_deref_mut(), e)?;
+                    (None, Duration::ZERO)
+                }
+            };
             stats.executions += 1;
             stats.board_time += took;
             let repeated =
@@ -263,7 +333,7 @@ pub fn run(
             }
             let finding = Finding {
                 input: input.clone(),
-                found,
+                what: What::Break(found),
                 repeated,
             };
             if !on(Event::Finding(&finding)) {
@@ -275,6 +345,68 @@ pub fn run(
         }
     }
     Ok(stats)
+}
+
+/// A chip BUSY after a chip reset: the status it read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("its chip stayed BUSY after a chip reset (status 0x{0:02X})")]
+pub struct StuckBusy(pub u8);
+
+/// Brings back a board that failed under an input with `e`: a chip reset
+/// when its bridge still answers and its chip is not BUSY after it; else,
+/// when it fell silent or its chip stays BUSY and it has a switch with a
+/// cycle left, a power cycle ([`Target::power_cycle`]). The hang and what
+/// brought it back; `Err` (the error, or why it could not be brought back)
+/// ends the campaign.
+fn bring_back(
+    target: &mut dyn Target,
+    power: Option<&mut Power>,
+    e: TargetError,
+) -> Result<(String, String), TargetError> {
+    let stuck = e.get_ref().downcast_ref::<StuckBusy>().is_some();
+    if e.kind == TargetErrorKind::Interrupted || !(stuck || silent(&e)) {
+        return Err(e);
+    }
+    let hang = match stuck {
+        true => e.to_string(),
+        false => format!("its bridge stopped answering ({e})"),
+    };
+    let busy = |t: &mut dyn Target| match t.execute(&[Op::Reset, Op::ReadStatus]) {
+        Ok(r) => Ok(matches!(r.get(1), Some(Reply::Status { status, .. }) if status.busy())),
+        Err(e) => Err(e),
+    };
+    // A bridge that answers again after its ABORT needs no more than a
+    // chip reset; a chip BUSY after one needs power.
+    if !stuck {
+        match busy(target) {
+            Ok(false) => return Ok((hang, "a chip reset brought it back".into())),
+            Ok(true) => {}
+            Err(again) if silent(&again) => {}
+            Err(again) => return Err(again),
+        }
+    }
+    let Some(p) = power.filter(|p| p.left > 0 && !p.stop.requested()) else {
+        return Err(e);
+    };
+    p.left -= 1;
+    let cycled = format!(
+        "power-cycled by `{}` ({} of {})",
+        p.switch,
+        p.of - p.left,
+        p.of
+    );
+    let (switch, spec) = (&p.switch, &p.spec);
+    target.power_cycle(
+        &mut || switch.cycle(spec).map_err(|e| e.to_string()),
+        p.boot,
+    )?;
+    match busy(target)? {
+        false => Ok((hang, cycled)),
+        true => Err(TargetError::new(
+            TargetErrorKind::Other,
+            format!("{hang}; {cycled}, and its chip is still BUSY after a chip reset"),
+        )),
+    }
 }
 
 /// A mutation of an input of `pool`: a few of libFuzzer's kinds (a bit
@@ -362,7 +494,7 @@ mod tests {
         };
         let go = |t: &mut EmuTarget| {
             let mut kept = Vec::new();
-            let stats = run(t, &seeds, &s, |e| {
+            let stats = run(t, None, &seeds, &s, |e| {
                 if let Event::NewCoverage { input, .. } = e {
                     kept.push(input.to_vec());
                 }
@@ -427,18 +559,24 @@ mod tests {
             ..Settings::default()
         };
         let mut findings = Vec::new();
-        let stats = run(&mut emu(&["remaining-off-by-one"]), &corpus(), &s, |e| {
-            if let Event::Finding(f) = e {
-                findings.push(f.clone());
-            }
-            findings.is_empty()
-        })
+        let stats = run(
+            &mut emu(&["remaining-off-by-one"]),
+            None,
+            &corpus(),
+            &s,
+            |e| {
+                if let Event::Finding(f) = e {
+                    findings.push(f.clone());
+                }
+                findings.is_empty()
+            },
+        )
         .expect("runs");
         let f = findings
             .first()
             .unwrap_or_else(|| panic!("nothing found: {stats:?}"));
         assert!(f.repeated);
-        assert_eq!(f.found.violation.invariant.as_str(), "remaining-pulses");
+        assert_eq!(f.what.name(), "remaining-pulses");
         let ops = bus_program::decode(&f.input);
         assert_eq!(execute(&mut emu(&[]), &ops).expect("runs").0, None);
     }

@@ -1,5 +1,6 @@
-//! `ppmc run`'s recovery by power: its flags, and the options they give
-//! the boards ([`ppmc::backend::power`]).
+//! Recovery by power on the command line: the flags of `ppmc run` and
+//! `ppmc fuzz campaign`, and the options they give the boards
+//! ([`ppmc::backend::power`]).
 
 use clap::Args;
 
