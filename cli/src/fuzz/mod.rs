@@ -5,6 +5,7 @@ mod campaign;
 mod coverage;
 mod inputs;
 mod minimize;
+mod replay;
 mod reproduce;
 mod run;
 mod seeds;
@@ -119,6 +120,12 @@ enum FuzzCommand {
     /// budget of board time. Exit status 1 when an invariant broke and
     /// broke again when run once more.
     Campaign(campaign::CampaignArgs),
+    /// Replay a finding of a campaign (any `bus_bytes` input) on any
+    /// target, bit for bit as the campaign ran it (a chip reset, then its
+    /// ops with a status read around each), judged by the invariants on
+    /// what the target answered; with --shrink, shrink it. Exit status 1
+    /// when it breaks an invariant there, 0 when it breaks none.
+    Replay(replay::ReplayArgs),
 }
 
 pub fn run(args: FuzzArgs, suite: &[ppmc::scenario::Scenario]) -> Result<(), CliError> {
@@ -127,6 +134,7 @@ pub fn run(args: FuzzArgs, suite: &[ppmc::scenario::Scenario]) -> Result<(), Cli
         None => run::run(args.run),
         Some(FuzzCommand::Run(a)) => run::run(a),
         Some(FuzzCommand::Campaign(a)) => campaign::run(a, suite),
+        Some(FuzzCommand::Replay(a)) => replay::run(a),
         Some(FuzzCommand::Triage { paths, model }) => triage::run(&paths, &model),
         Some(FuzzCommand::Coverage { paths, kind }) => coverage::run(&paths, kind.into()),
         Some(FuzzCommand::Reproduce { input }) => reproduce::run(&input),

@@ -266,12 +266,80 @@ fn a_guided_campaign_finds_a_faulty_board_and_not_a_clean_one() {
         .filter_map(|e| e.ok())
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect();
-    assert!(
+    let finding = findings.join(
         written
             .iter()
-            .any(|n| n.starts_with("phase-pattern-") && n.ends_with(".bin")),
-        "{written:?}"
+            .find(|n| n.starts_with("phase-pattern-") && n.ends_with(".bin"))
+            .unwrap_or_else(|| panic!("{written:?}")),
     );
+    let finding_s = finding.to_str().expect("utf-8");
+
+    // The finding travels: it replays on the board it was found on, on
+    // the emulator with the same fault, the same ops at the same times
+    // (the same board time to the nanosecond), and breaks nothing on the
+    // clean emulator.
+    let replay = |target: &str| {
+        let out = ppmc(&["fuzz", "replay", finding_s, "--target", target]);
+        let said = text(&out.stdout);
+        let board_time = said
+            .split(" s of board time")
+            .next()
+            .and_then(|h| h.rsplit(", ").next())
+            .unwrap_or_default()
+            .to_string();
+        (out.status.code(), said, board_time)
+    };
+    let (code, on_board, t_board) = replay(&faulty.target());
+    assert_eq!(code, Some(1), "{on_board}");
+    assert!(
+        on_board.contains(": breaks phase-pattern after op "),
+        "{on_board}"
+    );
+    let (code, on_emu, t_emu) = replay("emu,chip-fault=dir-inverted");
+    assert_eq!(code, Some(1), "{on_emu}");
+    assert_eq!(t_emu, t_board, "{on_emu}{on_board}");
+    assert_eq!(replay("emu").0, Some(0));
+
+    // It shrinks on the board (the clean emulator does not break), and
+    // becomes a regression scenario that fails on the faulty chip.
+    let small = d.join("small.bin");
+    let out = ppmc(&[
+        "fuzz",
+        "replay",
+        finding_s,
+        "--target",
+        &faulty.target(),
+        "--shrink",
+        "-o",
+        small.to_str().expect("utf-8"),
+    ]);
+    let said = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{said}{}", text(&out.stderr));
+    assert!(
+        said.contains(&format!("shrunk on {}: ", faulty.target()))
+            && said.contains("phase-pattern still breaks"),
+        "{said}"
+    );
+    let (before, after) = (
+        bus_ops(&std::fs::read(&finding).expect("finding")),
+        bus_ops(&std::fs::read(&small).expect("shrunk")),
+    );
+    assert!(after < before, "{after} ops of {before}");
+    let scen = d.join("scenarios");
+    std::fs::create_dir_all(&scen).expect("dir");
+    let out = ppmc(&[
+        "fuzz",
+        "to-scenario",
+        small.to_str().expect("utf-8"),
+        "--dir",
+        scen.to_str().expect("utf-8"),
+        "--chip-fault",
+        "dir-inverted",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let scenario = std::fs::read_to_string(scen.join("fuzz_phase_pattern_1.rs"))
+        .expect("a regression scenario");
+    assert!(scenario.contains("regression(d, OPS)"), "{scenario}");
     drop(faulty);
 
     let clean = common::BridgeSim::start(&[]);
@@ -310,4 +378,9 @@ fn a_guided_campaign_finds_a_faulty_board_and_not_a_clean_one() {
     let out = run("1s");
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     assert!(std::fs::read_dir(&corpus).expect("corpus").count() >= kept);
+}
+
+/// How many ops a `bus_bytes` input holds.
+fn bus_ops(bytes: &[u8]) -> usize {
+    ppmc::bus_program::decode(bytes).len()
 }

@@ -191,7 +191,11 @@ const ELSEWHERE: [(&str, &str); 41] = [
 /// local stand-in: `(text in the command, where)`. Those "in
 /// cli/tests/it/labgrid/place.sh" must appear in that script as written
 /// (with `"$ppmc"` for `ppmc`).
-const PPMC_ELSEWHERE: [(&str, &str); 6] = [
+const PPMC_ELSEWHERE: [(&str, &str); 7] = [
+    (
+        "fuzz replay fuzz-findings/",
+        "in cli/tests/it/cli_fuzz.rs (a finding of a campaign against a faulty bridge-sim, replayed there and on the emulator, shrunk, made a scenario)",
+    ),
     (
         "serial:/tmp/rig/pty",
         "in cli/tests/it/cli_power.rs (the same bridge, made to hang and power-cycled)",

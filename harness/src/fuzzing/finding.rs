@@ -52,10 +52,21 @@ pub struct Minimized {
 /// zero data bytes, until a whole pass changes nothing. `None` when `ops`
 /// does not break `invariant` to begin with.
 pub fn minimize(ops: &[BusOp], cfg: &ModelConfig, invariant: Invariant) -> Option<Minimized> {
+    minimize_by(ops, invariant, |ops| first_break(ops, cfg))
+}
+
+/// [`minimize`] by any judge: `judge` runs ops (on the emulator, or on a
+/// board) and says the first invariant they break, if any. Each call is
+/// one try.
+pub fn minimize_by(
+    ops: &[BusOp],
+    invariant: Invariant,
+    mut judge: impl FnMut(&[BusOp]) -> Option<Violation>,
+) -> Option<Minimized> {
     let mut tries = 0;
     let mut breaks = |ops: &[BusOp]| -> Option<Violation> {
         tries += 1;
-        first_break(ops, cfg).filter(|v| v.invariant == invariant)
+        judge(ops).filter(|v| v.invariant == invariant)
     };
     let mut best = ops.to_vec();
     let mut v = breaks(&best)?;

@@ -347,6 +347,35 @@ pub fn run(
     Ok(stats)
 }
 
+/// Shrinks `ops` on `target` while they break `invariant` there, as
+/// [`finding::minimize`](super::finding::minimize) does on the emulator:
+/// each try is an execution on the target, from a chip reset. `None` when
+/// they do not break it to begin with; the first error of the target ends
+/// it.
+pub fn shrink_on(
+    target: &mut dyn Target,
+    ops: &[BusOp],
+    invariant: crate::invariants::ids::Invariant,
+) -> Result<Option<super::finding::Minimized>, TargetError> {
+    let mut failed = None;
+    let small = super::finding::minimize_by(ops, invariant, |ops| {
+        if failed.is_some() {
+            return None;
+        }
+        match execute(target, ops) {
+            Ok((found, _)) => found.map(|f| f.violation),
+            Err(e) => {
+                failed = Some(e);
+                None
+            }
+        }
+    });
+    match failed {
+        Some(e) => Err(e),
+        None => Ok(small),
+    }
+}
+
 /// A chip BUSY after a chip reset: the status it read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[error("its chip stayed BUSY after a chip reset (status 0x{0:02X})")]
