@@ -35,6 +35,11 @@ pub struct CampaignArgs {
     /// same campaign.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// An input is cut where its waits would take the board past this
+    /// (board time per execution, from the chip reset): shorter inputs,
+    /// more executions per board-second.
+    #[arg(long, value_name = "DURATION", default_value = "1s", value_parser = crate::args::parse_duration)]
+    max_input_time: ppmc::time::Duration,
     /// No feedback: every input a mutation of a seed, nothing kept (the
     /// blind baseline to measure guidance against).
     #[arg(long)]
@@ -69,6 +74,7 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
         budget: args.budget,
         seed: args.seed,
         blind: args.blind,
+        max_input_time: args.max_input_time,
         ..Settings::default()
     };
     let bar = ProgressBar::new_spinner();

@@ -41,7 +41,11 @@ const FILES: [&str; 15] = [
 
 /// Commands run elsewhere, by prefix, and where. Those "in .ci/run" must
 /// appear in `.ci/run` as written (the part after the prefix's match).
-const ELSEWHERE: [(&str, &str); 41] = [
+const ELSEWHERE: [(&str, &str); 42] = [
+    (
+        "PPMC=target/release/ppmc scripts/campaign-figures",
+        "by hand (42 campaigns of a minute of board time each against bridge-sim; its figures in docs/performance.md)",
+    ),
     (
         "scripts/bridge-sim-power",
         "in cli/tests/it/cli_power.rs (a bridge-sim made to hang, power-cycled through --power-cmd and --power-hub)",

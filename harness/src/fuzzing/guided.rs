@@ -130,7 +130,8 @@ pub struct Stats {
     pub board_time: Duration,
     /// Coverage features reached so far.
     pub features: usize,
-    /// Inputs in the corpus (seeds that reached something, and finds).
+    /// Inputs mutation found that reached something new (the seeds are
+    /// mutated besides them).
     pub corpus: usize,
     pub findings: usize,
     pub flaky: usize,
@@ -260,13 +261,17 @@ pub fn run(
     let seeds: Vec<&Vec<u8>> = seeds.iter().filter(|x| !x.is_empty()).collect();
     let mut next_seed = 0;
     while stats.board_time < s.budget {
-        let input = if next_seed < seeds.len() {
+        let is_seed = next_seed < seeds.len();
+        let input = if is_seed {
             next_seed += 1;
             seeds[next_seed - 1].clone()
         } else {
-            let pool: Vec<&Vec<u8>> = match s.blind || corpus.is_empty() {
-                true => seeds.clone(),
-                false => corpus.iter().collect(),
+            // Half the time an input that reached something new (what
+            // guides), else a seed (what keeps the variety).
+            let finds = !s.blind && !corpus.is_empty() && rng.random_bool(0.5);
+            let pool: Vec<&Vec<u8>> = match finds {
+                true => corpus.iter().collect(),
+                false => seeds.clone(),
             };
             mutate(&mut rng, &pool, s)
         };
@@ -294,7 +299,9 @@ pub fn run(
         stats.executions += 1;
         stats.board_time += took;
         let input = bus_program::encode(&ops);
-        if !s.blind || next_seed <= seeds.len() {
+        // Coverage is measured in both modes; only a guided campaign keeps
+        // what reached something new.
+        {
             let new: Vec<String> = features(&ops)
                 .into_iter()
                 .filter(|f| !seen.contains(f))
@@ -302,10 +309,12 @@ pub fn run(
             if !new.is_empty() {
                 stats.features += new.len();
                 seen.extend(new.iter().cloned());
-                if !s.blind {
+                // The seeds stay in the pool anyway: the corpus keeps what
+                // mutation found.
+                if !s.blind && !is_seed {
                     corpus.push(input.clone());
-                    stats.corpus = corpus.len();
                 }
+                stats.corpus = corpus.len();
                 if !on(Event::NewCoverage {
                     input: &input,
                     new: new.len(),
