@@ -67,6 +67,11 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
     for dir in args.seeds.iter().chain(&args.corpus) {
         seeds.extend(super::inputs::read_folder(dir)?);
     }
+    if seeds.iter().all(|x| x.is_empty()) {
+        return Err(crate::usage(
+            "no seed input to start from: --seeds and --corpus hold no file that is not empty",
+        ));
+    }
     let spec = args.target.single().map_err(crate::usage)?;
     let mut power = ppmc::backend::Power::of(&spec, &args.power.options(), &stop);
     let mut target = args.target.open()?;
@@ -131,10 +136,7 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
         s.hangs,
         s.flaky
     );
-    match s.findings {
-        0 => Ok(()),
-        _ => Err(CliError::Verdict),
-    }
+    (s.findings == 0).then_some(()).ok_or(CliError::Verdict)
 }
 
 /// Writes `bytes` as `dir/name` unless a file of that name is there (the

@@ -384,3 +384,24 @@ fn a_guided_campaign_finds_a_faulty_board_and_not_a_clean_one() {
 fn bus_ops(bytes: &[u8]) -> usize {
     ppmc::bus_program::decode(bytes).len()
 }
+
+/// A campaign with nothing to start from says so, before any board is
+/// touched, instead of mutating nothing for ever.
+#[test]
+fn a_campaign_without_seeds_is_a_usage_error() {
+    let dir = scratch("no-seeds");
+    let out = ppmc(&[
+        "fuzz",
+        "campaign",
+        "--seeds",
+        dir.path().to_str().expect("utf-8"),
+        "--findings",
+        dir.path().join("f").to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("no seed input to start from"),
+        "{}",
+        text(&out.stderr)
+    );
+}

@@ -25,6 +25,10 @@ use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use std::collections::BTreeSet;
 
+/// The least board time an execution counts: a board whose clock does not
+/// move (an input of nothing) still uses up a budget.
+pub const MIN_EXECUTION: Duration = Duration::from_micros(1);
+
 /// What a campaign may spend, and how its inputs are bounded.
 #[derive(Debug, Clone)]
 pub struct Settings {
@@ -259,6 +263,12 @@ pub fn run(
     let mut seen: BTreeSet<String> = BTreeSet::new();
     let mut corpus: Vec<Vec<u8>> = Vec::new();
     let seeds: Vec<&Vec<u8>> = seeds.iter().filter(|x| !x.is_empty()).collect();
+    if seeds.is_empty() {
+        return Err(TargetError::new(
+            TargetErrorKind::Unsupported,
+            "a campaign needs at least one seed input that is not empty",
+        ));
+    }
     let mut next_seed = 0;
     while stats.board_time < s.budget {
         let is_seed = next_seed < seeds.len();
@@ -297,7 +307,7 @@ pub fn run(
             }
         };
         stats.executions += 1;
-        stats.board_time += took;
+        stats.board_time += took.max(MIN_EXECUTION);
         let input = bus_program::encode(&ops);
         // Coverage is measured in both modes; only a guided campaign keeps
         // what reached something new.
@@ -333,7 +343,7 @@ pub fn run(
                 }
             };
             stats.executions += 1;
-            stats.board_time += took;
+            stats.board_time += took.max(MIN_EXECUTION);
             let repeated =
                 again.is_some_and(|a| a.violation.invariant == found.violation.invariant);
             match repeated {
@@ -547,6 +557,25 @@ mod tests {
         assert_eq!(kept_a, kept_b);
         assert!(a.board_time >= s.budget, "{a:?}");
         assert!(a.features > 0 && a.executions > 1, "{a:?}");
+    }
+
+    /// A campaign with nothing to mutate is refused, and one of inputs that
+    /// take no board time still ends.
+    #[test]
+    fn a_campaign_without_seeds_is_refused_and_one_of_empty_inputs_ends() {
+        let s = Settings {
+            budget: Duration::from_millis(1),
+            ..Settings::default()
+        };
+        let e = run(&mut emu(&[]), None, &[Vec::new()], &s, |_| true).expect_err("no seed");
+        assert!(e.to_string().contains("at least one seed"), "{e}");
+        // A seed that decodes to no op takes no board time; the campaign
+        // still comes to its end.
+        let stats = run(&mut emu(&[]), None, &[b"FUZZ".to_vec()], &s, |_| true).expect("ends");
+        assert!(
+            stats.executions >= 1 && stats.board_time >= s.budget,
+            "{stats:?}"
+        );
     }
 
     /// An input is cut where its waits pass the bound, and its board time
