@@ -3,9 +3,8 @@
 //! at once ([`run_on_boards`], [`stream_on_boards`]), opened together as a
 //! [`Farm`], which keeps the boards it could not reach out of the verdict.
 
-use crate::backend::{
-    self, Op, OpenError, OpenOptions, Power, Reply, Target, TargetInfo, TargetSpec,
-};
+use crate::backend::power::{busy_after_reset, silent, CycleError};
+use crate::backend::{self, OpenError, OpenOptions, Power, Target, TargetInfo, TargetSpec};
 use crate::scenario::{
     run_scenario, Attempt, DriverOptions, HarnessError, NotRun, Scenario, ScenarioResult, Verdict,
 };
@@ -273,19 +272,16 @@ impl Hang {
 /// chip is still BUSY after the reset (3-1-1: the reset ends any move; a
 /// chip BUSY past it is past its longest legal move).
 fn health(target: &mut dyn Target) -> Result<(), Hang> {
-    match target.execute(&[Op::Reset, Op::ReadStatus]) {
-        Err(e) if crate::backend::power::silent(&e) => Err(Hang::Silent(
+    match busy_after_reset(target) {
+        Err(e) if silent(&e) => Err(Hang::Silent(
             format!("its bridge stopped answering ({e})"),
             e.to_string(),
         )),
         Err(e) => Err(Hang::Gone(e.to_string())),
-        Ok(replies) => match replies.get(1) {
-            Some(Reply::Status { status, .. }) if status.busy() => Err(Hang::Busy(format!(
-                "the chip stayed BUSY after a chip reset (status 0x{:02X})",
-                status.0
-            ))),
-            _ => Ok(()),
-        },
+        Ok(Some(status)) => Err(Hang::Busy(format!(
+            "the chip stayed BUSY after a chip reset (status 0x{status:02X})"
+        ))),
+        Ok(None) => Ok(()),
     }
 }
 
@@ -304,38 +300,17 @@ enum Recovery {
 /// Brings back a board that hung: its power cycled by its switch, the
 /// board reached again ([`Target::power_cycle`]) and health checked.
 fn recover(target: &mut dyn Target, p: &mut Power, hang: &Hang) -> Recovery {
-    if p.left == 0 {
-        return Recovery::NoSwitch(format!(
-            "the board has had the {} power cycles it may have in a run (--power-cycles)",
-            p.of
-        ));
-    }
-    if p.stop.requested() {
-        return Recovery::NoSwitch("no power cycle: the run was interrupted".into());
-    }
-    p.left -= 1;
-    let cycled = format!(
-        "power-cycled by `{}` ({} of {})",
-        p.switch,
-        p.of - p.left,
-        p.of
-    );
-    let mut switched = Ok(());
-    let (switch, spec) = (&p.switch, &p.spec);
-    let back = target.power_cycle(
-        &mut || {
-            switched = switch.cycle(spec).map_err(|e| e.to_string());
-            switched.clone()
-        },
-        p.boot,
-    );
-    if let Err(why) = switched {
-        return Recovery::NoSwitch(format!("its power cycle failed: {why}"));
-    }
     let hung = hang.why();
-    if let Err(e) = back {
-        return Recovery::Lost(format!("{hung}; {cycled}, but: {e}"));
-    }
+    let cycled = match p.cycle(target) {
+        Ok(cycled) => cycled,
+        Err(CycleError::NotTried(why)) => return Recovery::NoSwitch(why),
+        Err(CycleError::Switch { why, .. }) => {
+            return Recovery::NoSwitch(format!("its power cycle failed: {why}"))
+        }
+        Err(CycleError::NotBack { cycled, error }) => {
+            return Recovery::Lost(format!("{hung}; {cycled}, but: {error}"))
+        }
+    };
     match health(target) {
         Ok(()) => Recovery::Back(cycled),
         Err(Hang::Busy(still)) => Recovery::Back(format!("{cycled}, and {still}")),
@@ -777,7 +752,7 @@ static NOT_OPENED: OpenError = OpenError::Infrastructure(String::new());
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::backend::{TargetError, TargetErrorKind};
+    use crate::backend::{Op, TargetError, TargetErrorKind};
     use crate::scenario::{Driver, HarnessError, Outcome};
 
     fn ok(_: &mut Driver) -> Outcome {

@@ -188,6 +188,11 @@ fn scratch() -> (tempfile::TempDir, PathBuf) {
     (dir, p)
 }
 
+/// Each result's verdict, as the reports spell it.
+fn labels(r: &[BoardResult]) -> Vec<&'static str> {
+    r.iter().map(|r| r.result.verdict.label()).collect()
+}
+
 fn hung(r: &BoardResult) -> Option<(&str, &str)> {
     match &r.result.verdict {
         Verdict::Error(HarnessError::Hung { hang, recovery }) => Some((hang, recovery)),
@@ -207,7 +212,7 @@ fn a_silent_bridge_is_power_cycled_once_and_the_run_goes_on() {
         Hanging::boxed(Hang::Silent, 2, 1, &restarts),
         Some(switch(&dir, 3, false)),
     );
-    let verdicts: Vec<&str> = r.iter().map(|r| r.result.verdict.label()).collect();
+    let verdicts = labels(&r);
     assert_eq!(
         verdicts,
         ["passed", "error", "passed", "passed", "passed", "passed"]
@@ -247,7 +252,7 @@ fn a_chip_busy_after_its_reset_is_power_cycled_and_stays_the_boards_failure() {
         Hanging::boxed(Hang::Busy, 4, 1, &restarts),
         Some(switch(&dir, 3, false)),
     );
-    let verdicts: Vec<&str> = r.iter().map(|r| r.result.verdict.label()).collect();
+    let verdicts = labels(&r);
     assert_eq!(
         verdicts,
         ["passed", "passed", "passed", "failed", "passed", "passed"]
@@ -297,7 +302,7 @@ fn a_bridge_another_host_took_is_not_power_cycled() {
         Hanging::boxed(Hang::Displaced, 2, 1, &restarts),
         Some(switch(&dir, 3, false)),
     );
-    let verdicts: Vec<&str> = r.iter().map(|r| r.result.verdict.label()).collect();
+    let verdicts = labels(&r);
     assert_eq!(
         verdicts,
         ["passed", "error", "not run", "not run", "not run", "not run"]
@@ -310,7 +315,7 @@ fn a_bridge_another_host_took_is_not_power_cycled() {
 fn without_a_switch_a_silent_bridge_is_lost_and_a_busy_chip_is_the_boards_failure() {
     let restarts = Arc::new(AtomicU32::new(0));
     let r = run(Hanging::boxed(Hang::Silent, 2, 1, &restarts), None);
-    let verdicts: Vec<&str> = r.iter().map(|r| r.result.verdict.label()).collect();
+    let verdicts = labels(&r);
     assert_eq!(
         verdicts,
         ["passed", "error", "not run", "not run", "not run", "not run"]
@@ -339,7 +344,7 @@ fn a_board_past_its_cycles_or_whose_switch_fails_is_lost_and_says_why() {
         Hanging::boxed(Hang::Silent, 2, 2, &restarts),
         Some(switch(&dir, 1, false)),
     );
-    let verdicts: Vec<&str> = r.iter().map(|r| r.result.verdict.label()).collect();
+    let verdicts = labels(&r);
     assert_eq!(
         verdicts,
         ["passed", "error", "error", "not run", "not run", "not run"],

@@ -27,7 +27,7 @@ use super::bridged::BridgeError;
 use super::link::labgrid::parse_labgrid;
 use super::link::lease::client_program;
 use super::spec::{SpecError, TargetSpec};
-use super::target::{TargetError, TargetErrorKind};
+use super::target::{Op, Reply, Target, TargetError, TargetErrorKind};
 use crate::stop::StopRequest;
 use std::fmt;
 use std::process::Command;
@@ -186,6 +186,29 @@ pub fn silent(e: &TargetError) -> bool {
     }
 }
 
+/// The health check of a board that may have hung: a chip reset, and the
+/// status after it. `Some(status)` when the chip is still BUSY (3-1-1: the
+/// reset ends any move, so a chip BUSY past it is hung).
+pub fn busy_after_reset(target: &mut dyn Target) -> Result<Option<u8>, TargetError> {
+    let replies = target.execute(&[Op::Reset, Op::ReadStatus])?;
+    Ok(match replies.get(1) {
+        Some(Reply::Status { status, .. }) if status.busy() => Some(status.0),
+        _ => None,
+    })
+}
+
+/// Why [`Power::cycle`] did not bring a board back.
+#[derive(Debug)]
+pub enum CycleError {
+    /// No cycle was tried (none left, or a stop was asked for): why. The
+    /// board is as it was.
+    NotTried(String),
+    /// The switch failed: its words, and the target's error.
+    Switch { why: String, error: TargetError },
+    /// Power-cycled (`cycled` says how), and not reached again.
+    NotBack { cycled: String, error: TargetError },
+}
+
 /// One board's switch, and the cycles it has left in this run.
 #[derive(Debug, Clone)]
 pub struct Power {
@@ -202,6 +225,45 @@ pub struct Power {
 }
 
 impl Power {
+    /// Spends one of the board's cycles on `target`: its switch cycles its
+    /// power, and the target is reached again ([`Target::power_cycle`]).
+    /// What was done (`power-cycled by `CMD` (1 of 3)`), or why not. The
+    /// chip's health is the caller's to check.
+    pub fn cycle(&mut self, target: &mut dyn Target) -> Result<String, CycleError> {
+        if self.left == 0 {
+            return Err(CycleError::NotTried(format!(
+                "the board has had the {} power cycles it may have in a run (--power-cycles)",
+                self.of
+            )));
+        }
+        if self.stop.requested() {
+            return Err(CycleError::NotTried(
+                "no power cycle: the run was interrupted".into(),
+            ));
+        }
+        self.left -= 1;
+        let cycled = format!(
+            "power-cycled by `{}` ({} of {})",
+            self.switch,
+            self.of - self.left,
+            self.of
+        );
+        let mut switched = Ok(());
+        let (switch, spec) = (&self.switch, &self.spec);
+        let back = target.power_cycle(
+            &mut || {
+                switched = switch.cycle(spec).map_err(|e| e.to_string());
+                switched.clone()
+            },
+            self.boot,
+        );
+        match (back, switched) {
+            (Ok(()), _) => Ok(cycled),
+            (Err(error), Err(why)) => Err(CycleError::Switch { why, error }),
+            (Err(error), Ok(())) => Err(CycleError::NotBack { cycled, error }),
+        }
+    }
+
     /// The board `spec` names, with its switch under `opts`; `None` when it
     /// has none.
     pub fn of(spec: &TargetSpec, opts: &PowerOptions, stop: &StopRequest) -> Option<Power> {

@@ -16,7 +16,7 @@
 //! one that does not is kept apart as flaky.
 
 use super::campaign::Coverage;
-use crate::backend::power::{silent, Power};
+use crate::backend::power::{busy_after_reset, silent, CycleError, Power};
 use crate::backend::{Op, Reply, Target, TargetError, TargetErrorKind};
 use crate::bus_program::{self, BusOp};
 use crate::invariants::replay::{judge, probed_ops, Found};
@@ -419,10 +419,7 @@ fn bring_back(
         true => e.to_string(),
         false => format!("its bridge stopped answering ({e})"),
     };
-    let busy = |t: &mut dyn Target| match t.execute(&[Op::Reset, Op::ReadStatus]) {
-        Ok(r) => Ok(matches!(r.get(1), Some(Reply::Status { status, .. }) if status.busy())),
-        Err(e) => Err(e),
-    };
+    let busy = |t: &mut dyn Target| busy_after_reset(t).map(|b| b.is_some());
     // A bridge that answers again after its ABORT needs no more than a
     // chip reset; a chip BUSY after one needs power.
     if !stuck {
@@ -433,21 +430,16 @@ fn bring_back(
             Err(again) => return Err(again),
         }
     }
-    let Some(p) = power.filter(|p| p.left > 0 && !p.stop.requested()) else {
+    let Some(p) = power else {
         return Err(e);
     };
-    p.left -= 1;
-    let cycled = format!(
-        "power-cycled by `{}` ({} of {})",
-        p.switch,
-        p.of - p.left,
-        p.of
-    );
-    let (switch, spec) = (&p.switch, &p.spec);
-    target.power_cycle(
-        &mut || switch.cycle(spec).map_err(|e| e.to_string()),
-        p.boot,
-    )?;
+    let cycled = match p.cycle(target) {
+        Ok(cycled) => cycled,
+        Err(CycleError::NotTried(_)) => return Err(e),
+        Err(CycleError::Switch { error, .. } | CycleError::NotBack { error, .. }) => {
+            return Err(error)
+        }
+    };
     match busy(target)? {
         false => Ok((hang, cycled)),
         true => Err(TargetError::new(
