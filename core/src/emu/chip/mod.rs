@@ -517,8 +517,9 @@ impl Chip {
                 }
             }
             Timer::InitOutputs { epoch } if epoch == self.config_epoch => {
+                let was = self.energized_pattern();
                 self.phases_on = true;
-                self.record_phases();
+                self.record_phases_from(was);
             }
             Timer::InitDone { epoch } if epoch == self.config_epoch && self.motion.is_none() => {
                 self.initializing = false;
@@ -559,13 +560,14 @@ impl Chip {
                 self.record.pin(now, Pin::Auxo, bits);
             }
             Timer::ExcitationOff { epoch } if epoch == self.config_epoch => {
+                let was = self.energized_pattern();
                 self.phases_on = false;
                 self.out_winding = None;
                 self.phase_index = 0;
                 self.set_switching(None);
                 self.hold_epoch += 1;
                 self.set_hold(false);
-                self.record_phases();
+                self.record_phases_from(was);
             }
             // A timer whose move or configuration has since been replaced.
             _ => {}

@@ -463,9 +463,15 @@ impl Chip {
         self.switching_since = since;
     }
 
-    pub(super) fn record_phases(&mut self) {
+    /// Records the phases set outside stepping (an initialization's, an
+    /// excitation OFF's) where they differ from `was`, the pattern before:
+    /// a re-initialization keeps the winding and its step (3-2-1 (3), note
+    /// N15), and a pin that does not move makes no change to record.
+    pub(super) fn record_phases_from(&mut self, was: u8) {
         let p = self.energized_pattern();
-        self.record.pin(self.now, Pin::Phases, p);
+        if p != was {
+            self.record.pin(self.now, Pin::Phases, p);
+        }
     }
 
     /// Energized phases ignoring stop switching.

@@ -459,9 +459,14 @@ impl PlainChip {
         }
     }
 
-    fn show_phases(&mut self) {
+    /// Shows the phases set outside stepping where they differ from
+    /// `was`, the pattern before: a pin that does not move makes no change
+    /// (a re-initialization keeps them, 3-2-1 (3)).
+    fn show_phases_from(&mut self, was: u8) {
         let p = self.phases_now();
-        self.set_pin(Pin::Phases, p);
+        if p != was {
+            self.set_pin(Pin::Phases, p);
+        }
     }
 
     fn fire(&mut self, e: Event) {
@@ -493,8 +498,9 @@ impl PlainChip {
                 }
             }
             Event::PhasesSet { epoch } if epoch == self.epoch => {
+                let was = self.phases_now();
                 self.energized = true;
-                self.show_phases();
+                self.show_phases_from(was);
             }
             // A completed initialization holds the motor (N38), and starts
             // the stop switching it asks for (N39).
@@ -515,13 +521,14 @@ impl PlainChip {
                 self.set_pin(Pin::Auxo, v);
             }
             Event::ExcitationOff { epoch } if epoch == self.epoch => {
+                let was = self.phases_now();
                 self.energized = false;
                 self.shown = None;
                 self.step = 0;
                 self.set_switching(false);
                 self.hold_epoch += 1;
                 self.set_hold(false);
-                self.show_phases();
+                self.show_phases_from(was);
             }
             _ => {}
         }
