@@ -298,3 +298,70 @@ fn after_a_stop_in_the_long_move_the_next_host_opens_the_twin_at_once() {
     let twin = Served::start("run-twin", &[]);
     common::served::stopped_in_the_long_move_then_reopened(&twin, "e3_data_without_a_command");
 }
+
+/// A change of a sampled output is stamped within the `sampled` the board
+/// declares, even where the board code sees it as it begins to idle: AUXO
+/// set 14 us after its data byte (3-5-5, Table 3-3) just as a software
+/// reset comes in (3-5-4), whose phases go off 18 us later. The
+/// differential run against the model found AUXO stamped with the
+/// phases, 12 us late: the delay's loop saw it on entering the hardware's
+/// idle and slept to the next change. The model's moment is the reference
+/// emulator's, run on the twin's timeline (each op begun when the twin
+/// began it).
+#[test]
+fn a_sampled_change_seen_as_the_board_code_idles_is_stamped_within_its_uncertainty() {
+    use ppmc::backend::{Op, Reply, Target};
+    use ppmc::fuzzing::reference::{run_at, starts};
+    use ppmc::protocol::Pin;
+    use ppmc::time::{Duration, Instant};
+    let twin = Served::start("run-twin", &[]);
+    let mut t = twin.target();
+    let mut emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+    let wait = Some(Duration::from_millis(10));
+    let wc = |byte| Op::WriteCommand {
+        byte,
+        wait_ibf: wait,
+    };
+    let wd = |byte| Op::WriteData {
+        byte,
+        wait_ibf: wait,
+    };
+    let batches = [
+        vec![Op::Reset],
+        vec![wc(0x02), wd(100), wd(20), wd(100), wd(0), Op::ReadStatus],
+        vec![Op::Delay(Duration::from_millis(20)), Op::ReadStatus],
+        vec![wc(0x86), wd(0x04), Op::ReadStatus],
+        vec![wc(0xC0), Op::ReadStatus],
+        vec![Op::Delay(Duration::from_millis(1)), Op::ReadStatus],
+    ];
+    let (mut twin_at, mut emu_at) = (Instant::ZERO, Instant::ZERO);
+    for ops in &batches {
+        let replies = t.execute(ops).expect("the twin runs it");
+        let begun = starts(ops, &replies, twin_at, false);
+        let on_emu = run_at(&mut emu, ops, &begun, emu_at).expect("the model runs it");
+        twin_at = replies.last().map_or(twin_at, Reply::at);
+        emu_at = on_emu.last().map_or(emu_at, Reply::at);
+    }
+    let auxo = |r: &ppmc::protocol::OutputRecord| -> Vec<Instant> {
+        r.pins
+            .iter()
+            .filter(|e| e.pin == Pin::Auxo)
+            .map(|e| e.at)
+            .collect()
+    };
+    let got = auxo(&t.capture().expect("the twin's capture"));
+    let want = auxo(&emu.capture().expect("the model's capture"));
+    assert_eq!((got.len(), want.len()), (1, 1), "{got:?} {want:?}");
+    let u = t.uncertainty();
+    let off = got[0]
+        .saturating_since(want[0])
+        .max(want[0].saturating_since(got[0]));
+    assert!(
+        off <= u.sampled + u.access,
+        "AUXO at {} on the twin, {} in the model: {off} off, declared within {} (and {} for the write)",
+        got[0],
+        want[0],
+        u.sampled,
+        u.access
+    );
+}

@@ -244,6 +244,12 @@ impl<H: Hal> Board<H> {
         let entry = self.hal.read_high_pins() & pins::SAMPLED_HIGH;
         let began = self.now_ticks();
         self.sighted(entry, began);
+        // A change seen and not yet stamped: no idle, which would sleep
+        // until the outputs change again and so lose this change's
+        // bracket to the next. The caller's loop stamps it first.
+        if self.changed_by.is_some() {
+            return;
+        }
         let seen = self.hal.idle(until * 2) / 2;
         self.sighted(entry, seen.max(began));
         let word = self.hal.read_high_pins() & pins::SAMPLED_HIGH;
