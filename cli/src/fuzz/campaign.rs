@@ -7,7 +7,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use ppmc::fuzzing::guided::{self, Event, Settings};
 use ppmc::scenario::Scenario;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct CampaignArgs {
@@ -44,6 +44,11 @@ pub struct CampaignArgs {
     /// blind baseline to measure guidance against).
     #[arg(long)]
     blind: bool,
+    /// Judge by the datasheet's invariants alone: not also against the
+    /// reference model run on the board's timeline (for a board built to
+    /// differ from the model).
+    #[arg(long)]
+    no_model: bool,
     /// A board that hangs under an input (its bridge silent, or its chip
     /// BUSY after a chip reset) is brought back by a chip reset, else by
     /// its power switch, and the input is kept as a finding.
@@ -60,18 +65,7 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
     if let Some(dir) = &args.corpus {
         ppmc_files::prepare_folder(dir)?;
     }
-    let mut seeds = match args.seeds.is_empty() {
-        true => ppmc::fuzzing::seeds::suite_traffic(suite).map_err(CliError::Failed)?,
-        false => Vec::new(),
-    };
-    for dir in args.seeds.iter().chain(&args.corpus) {
-        seeds.extend(super::inputs::read_folder(dir)?);
-    }
-    if seeds.iter().all(|x| x.is_empty()) {
-        return Err(crate::usage(
-            "no seed input to start from: --seeds and --corpus hold no file that is not empty",
-        ));
-    }
+    let seeds = super::corpus::seeds(&args.seeds, args.corpus.as_deref(), suite)?;
     let spec = args.target.single().map_err(crate::usage)?;
     let mut power = ppmc::backend::Power::of(&spec, &args.power.options(), &stop);
     let mut target = args.target.open()?;
@@ -80,6 +74,7 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
         seed: args.seed,
         blind: args.blind,
         max_input_time: args.max_input_time,
+        model: (!args.no_model).then(|| args.target.model()),
         ..Settings::default()
     };
     let bar = ProgressBar::new_spinner();
@@ -89,10 +84,14 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
     );
     let t0 = std::time::Instant::now();
     let mut written: Result<(), CliError> = Ok(());
+    // Board time when the last execution ended: where a finding came.
+    let mut board = 0.0;
     let stats = guided::run(target.as_mut(), power.as_mut(), &seeds, &settings, |e| {
         let w = match e {
             Event::NewCoverage { input, .. } => match &args.corpus {
-                Some(dir) => keep(dir, &format!("{}.bin", guided::name(input)), input),
+                Some(dir) => {
+                    super::corpus::keep(dir, &format!("{}.bin", guided::name(input)), input)
+                }
                 None => Ok(()),
             },
             Event::Finding(f) => {
@@ -105,11 +104,16 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
                 let name = format!("{flaky}{}-{}.bin", f.what.name(), guided::name(&f.input));
                 bar.suspend(|| {
                     let at = args.findings.join(&name);
-                    outln!("{label}: {} -> {}", f.what, at.display())
+                    outln!(
+                        "{label} at {board:.3} s of board time: {} -> {}",
+                        f.what,
+                        at.display()
+                    )
                 });
-                keep(&args.findings, &name, &f.input)
+                super::corpus::keep(&args.findings, &name, &f.input)
             }
             Event::Progress(s) => {
+                board = s.board_time.as_secs_f64();
                 bar.set_message(format!(
                     "{} executions, {:.1} per board-second, {} features, {} findings ({} flaky), board time {:.1} s",
                     s.executions, s.per_board_second(), s.features, s.findings, s.flaky, s.board_time.as_secs_f64()
@@ -137,14 +141,4 @@ pub fn run(mut args: CampaignArgs, suite: &[Scenario]) -> Result<(), CliError> {
         s.flaky
     );
     (s.findings == 0).then_some(()).ok_or(CliError::Verdict)
-}
-
-/// Writes `bytes` as `dir/name` unless a file of that name is there (the
-/// same input, by its hash).
-fn keep(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), CliError> {
-    let path = dir.join(name);
-    match path.exists() {
-        true => Ok(()),
-        false => Ok(ppmc_files::create_new(&path, bytes)?),
-    }
 }

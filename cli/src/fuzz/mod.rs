@@ -2,7 +2,9 @@
 //! keep, and differential runs against a target.
 
 mod campaign;
+mod corpus;
 mod coverage;
+mod departure;
 mod inputs;
 mod minimize;
 mod replay;

@@ -4,7 +4,6 @@ use crate::args::TargetArgs;
 use crate::{usage, CliError};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use ppmc::backend::{EmuTarget, Target};
 use ppmc::fuzzing::differential::{self, DiffSettings};
 use std::path::PathBuf;
 use std::time::Instant as WallClock;
@@ -21,9 +20,15 @@ pub struct DiffArgs {
     /// input change or a register read, with the flowchart's waits).
     /// Memory does not grow with them: the run keeps what came since both
     /// sides were last at rest and agreed (and the last move's records);
-    /// a departure is replayed from the seed, not from memory.
-    #[arg(long, default_value_t = 1_000)]
-    ops: usize,
+    /// a departure is replayed from the seed, not from memory. Default:
+    /// 1000, or no limit with --budget.
+    #[arg(long)]
+    ops: Option<usize>,
+    /// Stop when the target's own clock (from its chip reset) has run
+    /// this long, e.g. 60s: the same budget of board time as a `fuzz
+    /// campaign`, to measure one against the other.
+    #[arg(long, value_name = "DURATION", value_parser = crate::args::parse_duration)]
+    budget: Option<ppmc::time::Duration>,
     /// Stop after this much wall time (e.g. 30s, 5m, 1h) even if --ops
     /// are not done.
     #[arg(long, value_parser = crate::args::parse_wall_duration)]
@@ -42,10 +47,7 @@ pub struct DiffArgs {
 }
 
 pub fn run(args: DiffArgs) -> Result<(), CliError> {
-    let straps = match args.target.straps() {
-        Ok(s) => s,
-        Err(e) => return Err(usage(e)),
-    };
+    let straps = args.target.straps().map_err(usage)?;
     let seed = args.seed.unwrap_or_else(|| {
         std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
@@ -57,22 +59,7 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(format!("fuzz-diff-{seed}.ppmc")));
     ppmc_files::check_writable(&out)?;
-    let mut target: Box<dyn Target> = if args.target.name() == "emu" {
-        let mut model = args.target.model();
-        if let Err(e) = ppmc::faults::apply_all(&args.chip_faults, &mut model) {
-            return Err(usage(format!("--chip-fault: {e}")));
-        }
-        match EmuTarget::new(straps, model) {
-            Ok(t) => Box::new(t),
-            Err(e) => return Err(usage(e)),
-        }
-    } else if !args.chip_faults.is_empty() {
-        return Err(usage(
-            "--chip-fault applies to --target emu; a bridge simulator takes it as `ppmc bridge-sim --chip-fault`",
-        ));
-    } else {
-        args.target.open()?
-    };
+    let mut target = super::departure::open(&args.target, straps, &args.chip_faults)?;
     // On a board, its bridge's straps (the emulator's are those given).
     let straps = target.straps();
     let settings = DiffSettings {
@@ -81,68 +68,81 @@ pub fn run(args: DiffArgs) -> Result<(), CliError> {
         ..DiffSettings::default()
     };
     let name = args.target.name().to_string();
+    let n = match (args.ops, args.budget) {
+        (Some(n), _) => n.max(1),
+        (None, Some(_)) => usize::MAX,
+        (None, None) => 1_000,
+    };
+    let budget = args.budget.map(|b| b.to_string());
     errln!(
-        "ppmc fuzz: seed {seed}, {} actions against {name} (replay with --seed {seed})",
-        args.ops
+        "ppmc fuzz: seed {seed}, {} against {name} (replay with --seed {seed})",
+        match (&budget, args.ops) {
+            (Some(b), None) => format!("{b} of board time"),
+            (Some(b), Some(_)) => format!("{n} actions or {b} of board time"),
+            (None, _) => format!("{n} actions"),
+        }
     );
     // Generated as they run: a billion actions cost no more memory than ten.
-    let n = args.ops.max(1);
-    let bar = ProgressBar::new(n as u64);
+    let bar = match args.budget {
+        Some(b) => ProgressBar::new(b.as_nanos() / 1_000_000),
+        None => ProgressBar::new(n as u64),
+    };
     bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} actions {elapsed} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template(match args.budget {
+            Some(_) => "{bar:40} {pos}/{len} ms of board time {elapsed} {msg}",
+            None => "{bar:40} {pos}/{len} actions {elapsed} {msg}",
+        })
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let t0 = WallClock::now();
     let limit = args
         .duration
         .map(|d| std::time::Duration::from_nanos(d.as_nanos()));
-    let mut done = 0;
+    let (mut done, mut board) = (0, ppmc::time::Duration::ZERO);
+    // The stream's domain coverage, counted as `fuzz campaign` counts its
+    // features, to measure the two on one scale.
+    let mut coverage = ppmc::fuzzing::campaign::Coverage::default();
+    let mut walk = ppmc::fuzzing::campaign::Walk::new();
     let acts = differential::program(seed).take(n);
-    let result = differential::run(target.as_mut(), acts, &settings, |n| {
-        done = n;
-        bar.set_position(n as u64);
-        limit.is_none_or(|l| t0.elapsed() < l)
+    let result = differential::run(target.as_mut(), acts, &settings, |step| {
+        (done, board) = (step.actions, step.board_time);
+        if let Some(w) = walk.as_mut() {
+            step.ops.iter().for_each(|op| w.step(&mut coverage, *op));
+        }
+        match args.budget {
+            Some(_) => bar.set_position(board.as_nanos() / 1_000_000),
+            None => bar.set_position(done as u64),
+        }
+        limit.is_none_or(|l| t0.elapsed() < l) && args.budget.is_none_or(|b| board < b)
     });
     bar.finish_and_clear();
-    let departure = match result {
-        Ok(d) => d,
+    let spent = format!(
+        "{done} actions in {:.1} s of board time ({:.1} s wall), {} features",
+        board.as_secs_f64(),
+        t0.elapsed().as_secs_f64(),
+        coverage.cells().len()
+    );
+    match result {
+        Ok(None) => {
+            outln!("seed {seed}: {spent}, no departure from the emulator");
+            Ok(())
+        }
+        Ok(Some(d)) => {
+            outln!("seed {seed}: {d}");
+            outln!("seed {seed}: departed after {spent}");
+            super::departure::keep(
+                target.as_mut(),
+                &settings,
+                seed,
+                &name,
+                &d,
+                args.minimize_budget,
+                &out,
+            )
+        }
         Err(e) => {
             errln!("ppmc fuzz: infrastructure error after {done} actions: {e}");
-            return Err(CliError::Verdict);
+            Err(CliError::Verdict)
         }
-    };
-    let Some(d) = departure else {
-        outln!(
-            "seed {seed}: {done} actions in {:.1} s, no departure from the emulator",
-            t0.elapsed().as_secs_f64()
-        );
-        return Ok(());
-    };
-    outln!("seed {seed}: {d}");
-    // The seed replays the run up to the departure.
-    let acts: Vec<_> = differential::program(seed).take(d.action + 1).collect();
-    let (small, small_d) =
-        match differential::minimize(target.as_mut(), &acts, &settings, args.minimize_budget) {
-            Ok(x) => x,
-            Err(e) => {
-                errln!("ppmc fuzz: infrastructure error while minimizing: {e}");
-                return Err(CliError::Verdict);
-            }
-        };
-    let (acts_out, d_out) = match small_d {
-        Some(sd) => (small, sd),
-        // Not reproducible from a reset (a flaky board): keep the whole run.
-        None => {
-            errln!("ppmc fuzz: the departure did not repeat from a reset; keeping the whole run");
-            (acts, d.clone())
-        }
-    };
-    let text = differential::script(&acts_out, &d_out, seed, &name);
-    ppmc_files::write(&out, text.as_bytes())?;
-    outln!(
-        "minimized to {} actions; reproducer written to {}",
-        acts_out.len(),
-        out.display()
-    );
-    Err(CliError::Verdict)
+    }
 }

@@ -253,7 +253,10 @@ fn a_guided_campaign_finds_a_faulty_board_and_not_a_clean_one() {
     ]);
     let said = text(&out.stdout);
     assert_eq!(out.status.code(), Some(1), "{said}{}", text(&out.stderr));
-    assert!(said.contains("finding: phase-pattern after op "), "{said}");
+    assert!(
+        said.contains(" s of board time: phase-pattern after op "),
+        "{said}"
+    );
     let summary = said.lines().last().unwrap_or_default();
     assert!(
         summary.starts_with(&format!("campaign on {}: ", faulty.target()))

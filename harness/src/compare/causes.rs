@@ -5,9 +5,24 @@
 
 use super::rule::{fit, First, Fit};
 use super::Tolerances;
-use crate::protocol::PulseRun;
+use crate::protocol::{Pin, PulseRun};
 use crate::time::{Duration, Instant};
 use crate::trace::BusEvent;
+
+/// One of the chip's inputs (a write, a data read, an input's change, or
+/// its reset), as a cause a change is timed from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Input {
+    pub(super) at: Instant,
+    pub(super) name: &'static str,
+    /// Its number among the trace's inputs the compare pairs: the same
+    /// input on both sides has the same number.
+    pub(super) n: u64,
+    /// A write that waited for IBF = 0: on a bridge, stamped at a strobe
+    /// it makes after its wait by its own pace, so what the chip did when
+    /// it became ready for the byte may lie before the stamp.
+    pub(super) strobe: bool,
+}
 
 /// What a trace's times are taken from, at a point in it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -16,9 +31,16 @@ pub(super) struct Anchor {
     /// reset when there was no move since: a move's pulses are timed from
     /// it.
     pub(super) at: Instant,
-    /// The chip's last input (a write, a data read, an input's change, or
-    /// its reset) and its name.
-    pub(super) input: (Instant, &'static str),
+    /// The chip's last input, and the one before it.
+    pub(super) input: Input,
+    pub(super) before: Option<Input>,
+    /// Inputs counted so far ([`Anchor::input`]).
+    pub(super) inputs: u64,
+    /// The last bus access that read the status register (a status read,
+    /// a wait for a flag, a flowchart write's or read's wait): a bridge
+    /// sees BUSY change there, and a change it stamps long after it lies
+    /// anywhere between ([`Causes::looked`]).
+    pub(super) looked: Instant,
     /// The last run of pulses so far.
     pub(super) run: Option<PulseRun>,
 }
@@ -29,13 +51,42 @@ impl Default for Anchor {
     fn default() -> Anchor {
         Anchor {
             at: Instant::ZERO,
-            input: (Instant::ZERO, "the trace's start"),
+            input: Input {
+                at: Instant::ZERO,
+                name: "the trace's start",
+                n: 0,
+                strobe: false,
+            },
+            before: None,
+            inputs: 0,
+            looked: Instant::ZERO,
             run: None,
         }
     }
 }
 
 impl Anchor {
+    /// The chip took an input at `at`; `counted` where the compare pairs
+    /// it with the other side's (its view keeps it), so that the n-th
+    /// counted input on one side is the n-th on the other.
+    pub(super) fn input(&mut self, at: Instant, name: &'static str, strobe: bool, counted: bool) {
+        let n = match counted {
+            true => {
+                self.inputs += 1;
+                self.inputs
+            }
+            // Matched with no other input by its number.
+            false => u64::MAX,
+        };
+        self.before = Some(self.input);
+        self.input = Input {
+            at,
+            name,
+            n,
+            strobe,
+        };
+    }
+
     /// What a change the chip made at `at` (a flag a wait saw, an output
     /// pin) may be timed from: what made the chip make it, never a
     /// bridge's pace. The chip acts on its inputs (the write before it,
@@ -56,7 +107,9 @@ impl Anchor {
         });
         Causes {
             input: self.input,
+            before: self.before,
             pulse,
+            looked: self.looked,
         }
     }
 }
@@ -64,33 +117,130 @@ impl Anchor {
 /// What a change the chip made may be timed from ([`Anchor::causes`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub(super) struct Causes {
-    input: (Instant, &'static str),
+    input: Input,
+    before: Option<Input>,
     pulse: Option<Instant>,
+    /// The last access that read the status register before the change.
+    pub(super) looked: Instant,
+}
+
+impl Default for Input {
+    fn default() -> Input {
+        Anchor::default().input
+    }
+}
+
+/// A change timed on both sides from one cause.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Timing {
+    pub(super) golden: Duration,
+    pub(super) got: Duration,
+    pub(super) from: &'static str,
+    /// Whether each side's cause was a waited write (golden, got)
+    /// ([`Input::strobe`]).
+    pub(super) strobes: (bool, bool),
 }
 
 impl Causes {
     /// A change at `g` (golden, from `gc`) and at `o` (got, from `oc`),
-    /// timed from each cause the two share: (golden, got, the cause's
-    /// name), the chip's last input first.
-    pub(super) fn timings(
-        g: Instant,
-        gc: Causes,
-        o: Instant,
-        oc: Causes,
-    ) -> Vec<(Duration, Duration, &'static str)> {
-        let mut t = vec![(
-            g.saturating_since(gc.input.0),
-            o.saturating_since(oc.input.0),
-            gc.input.1,
-        )];
+    /// timed from each cause the two share, the chip's last input first.
+    /// The same input on both sides: where a change came between two
+    /// inputs on one side and after the second on the other (a bridge
+    /// whose writes follow IBF's fall later than the emulator's do), both
+    /// are timed from the first.
+    pub(super) fn timings(g: Instant, gc: Causes, o: Instant, oc: Causes) -> Vec<Timing> {
+        let same = |a: Option<Input>, b: Input| a.filter(|a| a.n == b.n);
+        let (gi, oi) = if gc.input.n == oc.input.n {
+            (gc.input, oc.input)
+        } else if let Some(gb) = same(gc.before, oc.input) {
+            (gb, oc.input)
+        } else if let Some(ob) = same(oc.before, gc.input) {
+            (gc.input, ob)
+        } else {
+            (gc.input, oc.input)
+        };
+        let mut t = vec![Timing {
+            golden: g.saturating_since(gi.at),
+            got: o.saturating_since(oi.at),
+            from: gi.name,
+            strobes: (gi.strobe, oi.strobe),
+        }];
         if let (Some(gp), Some(op)) = (gc.pulse, oc.pulse) {
-            t.push((
-                g.saturating_since(gp),
-                o.saturating_since(op),
-                "the last pulse before it",
-            ));
+            t.push(Timing {
+                golden: g.saturating_since(gp),
+                got: o.saturating_since(op),
+                from: "the last pulse before it",
+                strobes: (false, false),
+            });
         }
         t
+    }
+}
+
+/// How far a pin's change may lie from where a side's trace puts it,
+/// where that side's times are not exact: a time judged as a range.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct PinSlack {
+    /// A change timed from a waited write may be up to a poll's pass and
+    /// an access longer than timed: the chip may have acted when it
+    /// became ready for the byte, which a bridge's write follows by its
+    /// own pace (golden, got; [`Timing::strobes`] says where it applies).
+    lag: (Duration, Duration),
+    /// BUSY's change, on a side that finds it by reading the status
+    /// register, is stamped at the first read that saw it: where that read
+    /// came longer than a poll's pass after the one before (a bridge reads
+    /// no status while it waits out a delay), the change lies anywhere
+    /// between the two (`docs/bridge-protocol.md` section 4), up to this
+    /// much earlier.
+    gaps: (Duration, Duration),
+}
+
+impl PinSlack {
+    /// The slack of `pin`'s change at `g` and `o` (with their causes),
+    /// on sides whose lag after a waited write is `lag`
+    /// ([`super::rule::Unsure::strobe_lag`]; also a poll's pass).
+    pub(super) fn of(
+        pin: Pin,
+        (g, gc): (Instant, &Causes),
+        (o, oc): (Instant, &Causes),
+        lag: (Duration, Duration),
+    ) -> PinSlack {
+        let gap = |stamp: Instant, c: &Causes, pass: Duration| {
+            let gap = stamp.saturating_since(c.looked);
+            match pin == Pin::Busy && pass > Duration::ZERO && gap > pass {
+                true => gap,
+                false => Duration::ZERO,
+            }
+        };
+        PinSlack {
+            lag,
+            gaps: (gap(g, gc, lag.0), gap(o, oc, lag.1)),
+        }
+    }
+
+    fn lags(&self, t: &Timing) -> (Duration, Duration) {
+        let on = |strobe: bool, lag: Duration| match strobe {
+            true => lag,
+            false => Duration::ZERO,
+        };
+        (on(t.strobes.0, self.lag.0), on(t.strobes.1, self.lag.1))
+    }
+
+    /// Whether `t` is a point on both sides (then graded as ever).
+    pub(super) fn exact(&self, t: &Timing) -> bool {
+        let zero = (Duration::ZERO, Duration::ZERO);
+        self.lags(t) == zero && self.gaps == zero
+    }
+
+    /// Whether `t` lies outside `band` (the golden's point's), with the
+    /// got side's uncertainty `u`: a range passes where it meets the band.
+    pub(super) fn out(&self, t: &Timing, (lo, hi): (Duration, Duration), u: Duration) -> bool {
+        if self.exact(t) {
+            return fit(t.got, (lo, hi), u) == Fit::Out;
+        }
+        let (lag_g, lag_o) = self.lags(t);
+        let (lo, hi) = (lo.saturating_sub(self.gaps.0), hi + lag_g);
+        t.got + lag_o + u < lo || t.got.saturating_sub(self.gaps.1 + u) > hi
     }
 }
 
@@ -104,22 +254,27 @@ pub(super) fn judge_change(
     first: &mut First,
     at: Instant,
     quantity: &str,
-    timings: &[(Duration, Duration, &'static str)],
+    timings: &[Timing],
     tol: &Tolerances,
     u: Duration,
-    graded: bool,
-    out: impl Fn(Duration, (Duration, Duration)) -> bool,
+    graded: impl Fn(&Timing) -> bool,
+    out: impl Fn(&Timing, (Duration, Duration)) -> bool,
 ) -> bool {
     // Each cause held to the tolerance of the nearest one: timed from a
     // cause milliseconds back, 1 % would let through what the nearest
     // cause catches.
-    let nearest = timings.iter().map(|t| t.0).min().unwrap_or(Duration::ZERO);
+    let nearest = timings
+        .iter()
+        .map(|t| t.golden)
+        .min()
+        .unwrap_or(Duration::ZERO);
     let slack = tol.band(nearest, tol.latency_bp).1.saturating_sub(nearest);
     let band = |gd: Duration| (gd.saturating_sub(slack), gd.saturating_add(slack));
     let named = |from: &str| format!("{quantity}, from {from}");
-    match timings.iter().find(|&&(gd, od, _)| !out(od, band(gd))) {
-        Some(&(gd, od, from)) => {
-            if graded {
+    match timings.iter().find(|t| !out(t, band(t.golden))) {
+        Some(t) => {
+            let (gd, od, from) = (t.golden, t.got, t.from);
+            if graded(t) {
                 // MARGINAL where it straddles a limit.
                 first.check(at, || named(from), gd, od, band(gd), u);
             }
@@ -128,11 +283,20 @@ pub(super) fn judge_change(
         None => {
             // The nearest miss, and of misses as near, the nearest cause:
             // the one the change is timed from best.
-            let miss = |&&(gd, od, _): &&(Duration, Duration, &str)| {
-                let (lo, hi) = band(gd);
-                (lo.saturating_sub(od).max(od.saturating_sub(hi)), gd)
+            let miss = |t: &&Timing| {
+                let (lo, hi) = band(t.golden);
+                (
+                    lo.saturating_sub(t.got).max(t.got.saturating_sub(hi)),
+                    t.golden,
+                )
             };
-            let Some(&(gd, od, from)) = timings.iter().min_by_key(miss) else {
+            let Some(&Timing {
+                golden: gd,
+                got: od,
+                from,
+                ..
+            }) = timings.iter().min_by_key(miss)
+            else {
                 return false;
             };
             first.diverge(at, named(from), gd, od, band(gd), u);
@@ -213,8 +377,9 @@ pub(super) fn wait_diverges(
         &timings,
         tol,
         u,
-        graded,
-        |od, band| {
+        |_| graded,
+        |t, band| {
+            let od = t.got;
             match (g.saw, o.saw) {
                 (true, true) => fit(od, band, u) == Fit::Out,
                 (false, false) => false,

@@ -35,8 +35,8 @@ pub use rule::{Graded, MarginalComparison};
 use crate::protocol::{Pin, PulseRun, Straps, TimingId};
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, EventKind, Trace};
-use causes::{first_look, judge_change, wait_diverges, Anchor, Causes, Wait};
-use rule::{fit, First, Fit, Unsure};
+use causes::{first_look, judge_change, wait_diverges, Anchor, Causes, PinSlack, Timing, Wait};
+use rule::{First, Unsure};
 use std::collections::BTreeMap;
 use std::fmt;
 
@@ -207,23 +207,42 @@ fn streams(t: &Trace, anchor: Anchor, view: &View) -> Streams {
         match &e.kind {
             EventKind::Bus(b) => {
                 let causes = anchor.causes(e.at);
+                let waited = |w: &Option<Duration>| w.is_some_and(|w| w > Duration::ZERO);
                 let input = match b {
                     BusEvent::Reset => {
+                        // Inputs are counted on: a capture's view keeps
+                        // no reset.
                         anchor = Anchor {
                             at: e.at,
+                            inputs: anchor.inputs,
                             ..Anchor::default()
                         };
-                        Some("the chip's reset")
+                        Some(("the chip's reset", false))
                     }
-                    BusEvent::WriteCommand { .. } | BusEvent::WriteData { .. } => {
-                        Some("the write before it")
+                    BusEvent::WriteCommand { waited: w, .. }
+                    | BusEvent::WriteData { waited: w, .. } => {
+                        Some(("the write before it", waited(w)))
                     }
-                    BusEvent::ReadData { .. } => Some("the data read before it"),
-                    BusEvent::SetInput { .. } => Some("the input's change before it"),
+                    BusEvent::ReadData { .. } => Some(("the data read before it", false)),
+                    BusEvent::SetInput { .. } => Some(("the input's change before it", false)),
                     _ => None,
                 };
-                if let Some(name) = input {
-                    anchor.input = (e.at, name);
+                if let Some((name, strobe)) = input {
+                    anchor.input(e.at, name, strobe, view.bus(*b).is_some());
+                }
+                let looked = match b {
+                    BusEvent::WriteCommand { waited, .. }
+                    | BusEvent::WriteData { waited, .. }
+                    | BusEvent::ReadData { waited, .. } => waited.is_some(),
+                    BusEvent::ReadStatus(_)
+                    | BusEvent::Await { .. }
+                    | BusEvent::WriteTimedOut { .. }
+                    | BusEvent::ReadTimedOut
+                    | BusEvent::Reset => true,
+                    _ => false,
+                };
+                if looked {
+                    anchor.looked = e.at;
                 }
                 if let Some(b) = view.bus(*b) {
                     s.bus.push((e.at, b, causes));
@@ -685,10 +704,12 @@ fn compare_pins(
                 break;
             }
             let timings = Causes::timings(gs[i].0, ga, ot, oa);
+            let slack = PinSlack::of(*pin, (gs[i].0, &ga), (ot, &oa), u.strobe_lag());
             let u = u.pin(*pin);
-            let out = |od, band| fit(od, band, u) == Fit::Out;
+            let graded = |t: &Timing| slack.exact(t);
+            let out = |t: &Timing, band: (Duration, Duration)| slack.out(t, band, u);
             let what = format!("{quantity}: time");
-            if judge_change(first, ot, &what, &timings, tol, u, true, out) {
+            if judge_change(first, ot, &what, &timings, tol, u, graded, out) {
                 diverged = true;
                 break;
             }
@@ -850,6 +871,110 @@ end
         );
         assert_eq!(late.golden, "44.000us");
         assert_eq!(late.got, "60.000us");
+    }
+
+    /// A change the chip makes on its own between two writes (AUX* on,
+    /// Table 3-3, for an AUX ON command taken from the input buffer when
+    /// an initialization ends, 3-1-1) comes after the second write on the
+    /// emulator, which writes as IBF falls, and before it on a bridge,
+    /// which writes about 2 us later (a poll's pass and its strobe). Both
+    /// are timed from the first write, the bridge's time as a range of
+    /// its lag: no departure (a differential run on the board twin found
+    /// it). An AUX* late past the band and the lag still departs.
+    #[test]
+    fn a_change_between_writes_is_timed_from_the_same_write_on_both_sides() {
+        let trace = |text: &str| {
+            let t = format!(
+                "ppmc-trace 1\nscenario aux\nsection 3-5-2\ntarget t\ndetail sysclk_hz 16000000\ndetail csel high\ndetail vsel high\ndetail ext_clock_hz none\n{text}end\n"
+            );
+            Trace::parse(&t).expect("parses")
+        };
+        let golden = trace(
+            "events
+0.000us reset
+1000.000us wc 0x25 waited=6.000us
+1006.000us wd 0xCB waited=6.000us
+1008.000us pin aux 1
+",
+        );
+        // AUX* on at `aux` us, before the second write or after it.
+        let board = |aux: &str| {
+            let (before, after) = match aux < "1010.200" {
+                true => (format!("{aux}us pin aux 1\n"), String::new()),
+                false => (String::new(), format!("{aux}us pin aux 1\n")),
+            };
+            trace(&format!(
+                "detail uncertainty edge=14ns sampled=5000ns access=134ns polled=1500ns
+events
+0.000us reset
+1002.186us wc 0x25 waited=7.800us
+{before}1010.200us wd 0xCB waited=6.000us
+{after}"
+            ))
+        };
+        let tol = Tolerances::default();
+        compare(&golden, &board("1008.000"), &tol)
+            .expect("8 us after the chip took AUX ON, on both sides");
+        // After the second write on both sides: 2 us on the emulator, and
+        // on the bridge 6.5 us, past even its lag of 3.134 us.
+        let late = compare(&golden, &board("1016.700"), &tol).expect_err("6.5 us after wd 0xCB");
+        assert_eq!(
+            late.quantity,
+            "pin aux change 1: time, from the write before it"
+        );
+        assert_eq!(
+            (late.golden.as_str(), late.got.as_str()),
+            ("2.000us", "6.500us ±0.148us")
+        );
+        let early = compare(&golden, &board("1003.000"), &tol).expect_err("0.8 us after wc 0x25");
+        assert_eq!(early.got, "0.814us ±0.148us");
+    }
+
+    /// A bridge finds BUSY's change by reading the status register, and
+    /// reads none while it waits out a delay: a change it stamps at the
+    /// first read 9 ms after the read before lies anywhere between the
+    /// two (docs/bridge-protocol.md section 4), and the 60 us Table 3-3
+    /// gives lies in there. No departure; a change stamped early, with a
+    /// read just before it, still departs.
+    #[test]
+    fn a_busy_change_stamped_after_a_long_gap_in_status_reads_is_a_range() {
+        let trace = |text: &str| {
+            let t = format!(
+                "ppmc-trace 1\nscenario busy\nsection 3-3-5\ntarget t\ndetail sysclk_hz 16000000\ndetail csel high\ndetail vsel high\ndetail ext_clock_hz none\n{text}end\n"
+            );
+            Trace::parse(&t).expect("parses")
+        };
+        let golden = |read: &str| {
+            trace(&format!(
+                "events
+0.000us reset
+1000.000us wd 0x00 waited=6.000us
+1000.500us rs 0x00
+{read}1060.000us pin busy 1
+"
+            ))
+        };
+        let board = |busy: &str, read: &str| {
+            trace(&format!(
+                "detail uncertainty edge=14ns sampled=5000ns access=134ns polled=1500ns
+events
+0.000us reset
+1000.000us wd 0x00 waited=6.000us
+1000.500us rs 0x00
+{read}{busy}us pin busy 1
+"
+            ))
+        };
+        let tol = Tolerances::default();
+        compare(&golden(""), &board("10120.000", ""), &tol)
+            .expect("the change lies between 1000.5 us and 10120 us");
+        let read = "1010.000us rs 0x00\n";
+        let early = compare(&golden(read), &board("1011.000", read), &tol)
+            .expect_err("BUSY 11 us after the write, not 60");
+        assert_eq!(
+            early.quantity,
+            "pin busy change 1: time, from the write before it"
+        );
     }
 
     /// The decision rule (docs/conformance.md) in a compare: a board's

@@ -67,6 +67,19 @@ impl Unsure {
         (self.golden.polled, self.got.polled)
     }
 
+    /// How much earlier than a waited write's stamp the chip may have
+    /// become ready for its byte (golden, got): a bridge finds IBF's fall
+    /// by polling (a pass is up to twice `polled`) and then makes its
+    /// strobe (an access). Zero on an exact trace, whose writes come as
+    /// IBF falls.
+    pub(super) fn strobe_lag(&self) -> (Duration, Duration) {
+        let lag = |u: &Uncertainty| match u.polled > Duration::ZERO {
+            true => u.polled.saturating_mul(2) + u.access,
+            false => Duration::ZERO,
+        };
+        (lag(&self.golden), lag(&self.got))
+    }
+
     /// A wait for a flag: from an access to the poll that saw it.
     pub(super) fn wait(&self) -> Duration {
         self.both(|u| u.access + u.polled)

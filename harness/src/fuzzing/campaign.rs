@@ -8,7 +8,8 @@ use crate::emu::ModelConfig;
 use crate::invariants::ids::Invariant;
 use crate::invariants::oracle::Checker;
 use crate::invariants::rules::Violation;
-use crate::protocol::{Command, ErrorCode, Input, MoveKind, StatusField};
+use crate::protocol::{Command, ErrorCode, Input, MoveKind, OutputRecord, StatusField};
+use crate::time::Duration;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -109,6 +110,157 @@ pub struct Coverage {
     pub finishes: BTreeMap<(String, String), u64>,
     /// Inputs asserted while a move was under way.
     pub inputs_while_moving: BTreeMap<&'static str, u64>,
+    /// (command class before, command class) -> count: each command
+    /// written after another (the order the chip's state depends on).
+    pub pairs: BTreeMap<(String, String), u64>,
+    /// (command class, error number) -> count: an error the status
+    /// register first showed after that command.
+    pub errors_by_command: BTreeMap<(String, u8), u64>,
+    /// (command class or input, ramp phase) -> count: what was written
+    /// or asserted during a move, by where its ramp was (3-4-2).
+    pub during_ramp: BTreeMap<(String, &'static str), u64>,
+}
+
+/// A walk of one input on the clean model, op by op, counting what each
+/// reached into a [`Coverage`]: what [`Coverage::of`] does for a whole
+/// input, for a stream that comes an op at a time.
+#[derive(Debug)]
+pub struct Walk {
+    k: Checker,
+    /// Pin events already looked at: only new ones can be a move's end.
+    pins_seen: usize,
+    /// The class of the last command written.
+    last_command: Option<String>,
+    /// The error number the status register showed after the last op.
+    last_error: Option<u8>,
+}
+
+impl Walk {
+    /// A walk from a chip straight out of reset; `None` if the clean model
+    /// cannot be made (it always can).
+    pub fn new() -> Option<Walk> {
+        Some(Walk {
+            k: Checker::new(ModelConfig::default()).ok()?,
+            pins_seen: 0,
+            last_command: None,
+            last_error: None,
+        })
+    }
+
+    /// Applies `op` and counts what it reached into `c`.
+    pub fn step(&mut self, c: &mut Coverage, op: BusOp) {
+        let board = self.k.board();
+        // The state as the host sees it (through the board), and the
+        // model's own view of whether it was initialized.
+        let state = if board.read_status().busy() {
+            ChipState::Moving
+        } else if board.chip().initialized() {
+            ChipState::Idle
+        } else {
+            ChipState::Uninitialized
+        };
+        let phase = match state {
+            ChipState::Moving => Some(ramp_phase(board.record())),
+            _ => None,
+        };
+        match op {
+            BusOp::Command(b) => {
+                let class = command_class(b);
+                *c.commands.entry((class.clone(), state)).or_default() += 1;
+                if let Some(p) = phase {
+                    *c.during_ramp.entry((class.clone(), p)).or_default() += 1;
+                }
+                let before = self.last_command.replace(class.clone());
+                *c.pairs
+                    .entry((before.unwrap_or_else(|| "reset".into()), class))
+                    .or_default() += 1;
+            }
+            BusOp::Input {
+                input,
+                asserted: true,
+            } if state == ChipState::Moving => {
+                *c.inputs_while_moving.entry(input.name()).or_default() += 1;
+                if let Some(p) = phase {
+                    *c.during_ramp
+                        .entry((input.name().to_string(), p))
+                        .or_default() += 1;
+                }
+            }
+            _ => {}
+        }
+        // Oracle breaks are the fuzz targets' business, not coverage's.
+        let _ = self.k.apply(op);
+        let board = self.k.board();
+        let error = match board.read_status().field() {
+            StatusField::Error(e) => Some(e.number()),
+            _ => None,
+        };
+        if let Some(e) = error {
+            *c.errors.entry(e).or_default() += 1;
+            if self.last_error != Some(e) {
+                let by = self.last_command.clone().unwrap_or_else(|| "reset".into());
+                *c.errors_by_command.entry((by, e)).or_default() += 1;
+            }
+        }
+        self.last_error = error;
+        let pins = &board.record().pins;
+        let ended = pins
+            .get(self.pins_seen..)
+            .unwrap_or_default()
+            .iter()
+            .any(|p| p.pin == crate::protocol::Pin::Busy && p.value == 0);
+        self.pins_seen = pins.len();
+        if ended {
+            let f = board.chip().finish_status();
+            let kind = MoveKind::ALL
+                .iter()
+                .find(|m| m.code() == f.op_code())
+                .map_or("?", |m| m.name());
+            let cause = if f.alarm() {
+                "alarm"
+            } else if f.limit() {
+                "limit"
+            } else if f.high_speed_limit() {
+                "high-speed limit"
+            } else if f.stop_command() {
+                "stop command"
+            } else {
+                "completed"
+            };
+            *c.finishes
+                .entry((kind.to_string(), cause.to_string()))
+                .or_default() += 1;
+        }
+    }
+}
+
+/// Where the ramp of the move under way is, from the pulses it has put
+/// out (3-4-2): none yet, its intervals shrinking (accelerating), even
+/// (at speed) or growing (decelerating). The record merges evenly spaced
+/// pulses into one run, so the last two runs' spacings tell.
+fn ramp_phase(record: &OutputRecord) -> &'static str {
+    let started = record.moves.last().map(|m| m.at);
+    let runs: Vec<&crate::protocol::PulseRun> = record
+        .runs
+        .iter()
+        .rev()
+        .take_while(|r| started.is_none_or(|s| r.start >= s))
+        .take(2)
+        .collect();
+    let spacing = |i: usize| -> Option<Duration> {
+        let r = runs.get(i)?;
+        match r.count {
+            0 | 1 => runs.get(i + 1).map(|p| r.start.saturating_since(p.last())),
+            n => Some(r.span.scale(1, u64::from(n - 1))),
+        }
+    };
+    match (runs.first(), spacing(0), spacing(1)) {
+        (None, _, _) => "before its first pulse",
+        (Some(r), _, _) if r.count >= 3 => "at speed",
+        (_, Some(last), Some(before)) if last < before => "accelerating",
+        (_, Some(last), Some(before)) if last > before => "decelerating",
+        _ => "at speed",
+    }
 }
 
 impl Coverage {
@@ -119,76 +271,53 @@ impl Coverage {
             ..Coverage::default()
         };
         for ops in inputs {
-            c.add(ops);
+            let Some(mut w) = Walk::new() else {
+                continue;
+            };
+            for op in ops {
+                w.step(&mut c, *op);
+            }
         }
         c
     }
 
-    fn add(&mut self, ops: &[BusOp]) {
-        let Ok(mut k) = Checker::new(ModelConfig::default()) else {
-            return;
-        };
-        // Pin events already looked at: only new ones can be a move's end.
-        let mut pins_seen = 0;
-        for op in ops {
-            let board = k.board();
-            // The state as the host sees it (through the board), and the
-            // model's own view of whether it was initialized.
-            let state = if board.read_status().busy() {
-                ChipState::Moving
-            } else if board.chip().initialized() {
-                ChipState::Idle
-            } else {
-                ChipState::Uninitialized
-            };
-            match *op {
-                BusOp::Command(b) => {
-                    *self.commands.entry((command_class(b), state)).or_default() += 1;
-                }
-                BusOp::Input {
-                    input,
-                    asserted: true,
-                } if state == ChipState::Moving => {
-                    *self.inputs_while_moving.entry(input.name()).or_default() += 1;
-                }
-                _ => {}
-            }
-            // Oracle breaks are the fuzz targets' business, not coverage's.
-            let _ = k.apply(*op);
-            let board = k.board();
-            if let StatusField::Error(e) = board.read_status().field() {
-                *self.errors.entry(e.number()).or_default() += 1;
-            }
-            let pins = &board.record().pins;
-            let ended = pins
-                .get(pins_seen..)
-                .unwrap_or_default()
-                .iter()
-                .any(|p| p.pin == crate::protocol::Pin::Busy && p.value == 0);
-            pins_seen = pins.len();
-            if ended {
-                let f = board.chip().finish_status();
-                let kind = MoveKind::ALL
-                    .iter()
-                    .find(|m| m.code() == f.op_code())
-                    .map_or("?", |m| m.name());
-                let cause = if f.alarm() {
-                    "alarm"
-                } else if f.limit() {
-                    "limit"
-                } else if f.high_speed_limit() {
-                    "high-speed limit"
-                } else if f.stop_command() {
-                    "stop command"
-                } else {
-                    "completed"
-                };
-                *self
-                    .finishes
-                    .entry((kind.to_string(), cause.to_string()))
-                    .or_default() += 1;
-            }
-        }
+    /// Every cell reached, one name each: the features a guided campaign
+    /// is fed ([`super::guided`]), and how two campaigns' coverage
+    /// compares.
+    pub fn cells(&self) -> std::collections::BTreeSet<String> {
+        let mut f = std::collections::BTreeSet::new();
+        f.extend(
+            self.commands
+                .keys()
+                .map(|(class, state)| format!("command {class} while {}", state.name())),
+        );
+        f.extend(self.errors.keys().map(|e| format!("error {e}")));
+        f.extend(
+            self.finishes
+                .keys()
+                .map(|(kind, cause)| format!("{kind} ended by {cause}")),
+        );
+        f.extend(
+            self.inputs_while_moving
+                .keys()
+                .map(|i| format!("{i} during a move")),
+        );
+        f.extend(
+            self.pairs
+                .keys()
+                .map(|(a, b)| format!("command {b} after {a}")),
+        );
+        f.extend(
+            self.errors_by_command
+                .keys()
+                .map(|(c, e)| format!("error {e} after command {c}")),
+        );
+        f.extend(
+            self.during_ramp
+                .keys()
+                .map(|(what, phase)| format!("{what} during a move {phase}")),
+        );
+        f
     }
 
     /// The report, with what was never reached listed after each table.

@@ -5,12 +5,15 @@
 //! counts exactly). The seed alone replays a run.
 
 use super::actions::{self, Action};
+use super::reference;
 use crate::backend::{EmuTarget, Op, Reply, Target, TargetError, TargetErrorKind};
+use crate::bus_program::BusOp;
 use crate::compare::{compare_from, Divergence, Resume, Tolerances};
 use crate::console::{self, ConsoleOptions};
 use crate::emu::ModelConfig;
 use crate::protocol::{OutputMark, OutputRecord, Status, Straps};
-use crate::trace::{Event, EventKind, Trace};
+use crate::time::{Duration, Instant};
+use crate::trace::{uncertainty_detail, Event, EventKind, Trace, UNCERTAINTY};
 use rand::{Rng, SeedableRng};
 use std::fmt::Write as _;
 
@@ -145,11 +148,42 @@ struct Side<'a> {
     /// whole.
     capture: OutputRecord,
     mark: OutputMark,
+    /// The last action's traffic as bus ops, and the time of its last
+    /// reply (the target's clock since its chip reset).
+    ops: Vec<BusOp>,
+    at: Instant,
+    /// The last action's replies.
+    replies: Vec<Reply>,
 }
 
 impl Side<'_> {
+    /// Runs `ops` (one action's, `stmts` as written) in one batch; the
+    /// closing status read's status.
     fn run(&mut self, stmts: &[console::Stmt], ops: &[Op]) -> Result<Status, TargetError> {
         let (replies, capture) = self.target.execute_then_capture_since(ops, self.mark)?;
+        self.take(stmts, ops, replies, capture)
+    }
+
+    /// Runs `ops` as [`Side::run`] does, each begun no earlier than
+    /// `starts` says ([`reference::run_at`]).
+    fn run_at(
+        &mut self,
+        stmts: &[console::Stmt],
+        ops: &[Op],
+        starts: &[Instant],
+    ) -> Result<Status, TargetError> {
+        let replies = reference::run_at(self.target, ops, starts, self.at)?;
+        let (_, capture) = self.target.execute_then_capture_since(&[], self.mark)?;
+        self.take(stmts, ops, replies, capture)
+    }
+
+    fn take(
+        &mut self,
+        stmts: &[console::Stmt],
+        ops: &[Op],
+        replies: Vec<Reply>,
+        capture: OutputRecord,
+    ) -> Result<Status, TargetError> {
         if replies.len() != ops.len() {
             return Err(TargetError::new(
                 TargetErrorKind::Other,
@@ -160,7 +194,14 @@ impl Side<'_> {
                 ),
             ));
         }
+        self.ops.clear();
         for (s, r) in stmts.iter().zip(&replies) {
+            let gap = r.at().saturating_since(self.at);
+            if gap > Duration::ZERO {
+                self.ops.push(BusOp::Advance(gap));
+            }
+            self.at = self.at.max(r.at());
+            self.ops.extend(bus_op(*s, r));
             if let Some(kind) = console::bus_event(*s, r) {
                 self.bus.push(Event {
                     at: r.at(),
@@ -169,7 +210,8 @@ impl Side<'_> {
             }
         }
         self.capture = capture;
-        match replies.last() {
+        self.replies = replies;
+        match self.replies.last() {
             Some(Reply::Status { status, .. }) => Ok(*status),
             other => Err(TargetError::new(
                 TargetErrorKind::Other,
@@ -187,7 +229,11 @@ impl Side<'_> {
         let empty = OutputRecord::default();
         let capture = if with_capture { &self.capture } else { &empty };
         let info = self.target.info();
-        Trace::new(name, "-", info.name.as_str(), info.straps, Vec::new()).assemble(
+        // The target's declared uncertainty, which the compare widens each
+        // timing by: a board measured through a bridge is not exact.
+        let u = self.target.uncertainty();
+        let details = vec![(UNCERTAINTY.to_string(), uncertainty_detail(&u))];
+        Trace::new(name, "-", info.name.as_str(), info.straps, details).assemble(
             self.bus.clone(),
             capture,
             Vec::new(),
@@ -215,6 +261,36 @@ impl Side<'_> {
     }
 }
 
+/// What a statement did on the bus, as the bus op that does it
+/// ([`crate::bus_program`]): a write or read that happened, an input
+/// driven; nothing for a wait (its time is the gap before the next) or
+/// an access that timed out.
+fn bus_op(s: console::Stmt, r: &Reply) -> Option<BusOp> {
+    use console::Stmt;
+    match (s, r) {
+        (Stmt::WriteCommand { byte, .. }, Reply::Written { .. }) => Some(BusOp::Command(byte)),
+        (Stmt::WriteData { byte, .. }, Reply::Written { .. }) => Some(BusOp::Data(byte)),
+        (Stmt::ReadStatus, _) => Some(BusOp::ReadStatus),
+        (Stmt::ReadData { .. }, Reply::Data { .. }) => Some(BusOp::ReadData),
+        (Stmt::Set { input, asserted }, _) => Some(BusOp::Input { input, asserted }),
+        _ => None,
+    }
+}
+
+/// Where a differential run is, told after each action.
+#[derive(Debug)]
+pub struct Step<'a> {
+    /// Actions done.
+    pub actions: usize,
+    /// The target's own time since its chip reset: a budget of board time
+    /// is spent against it.
+    pub board_time: Duration,
+    /// The action's traffic on the reference emulator as bus ops, the
+    /// time between them included: what [`super::campaign::Walk`] counts
+    /// the run's domain coverage from.
+    pub ops: &'a [BusOp],
+}
+
 /// A differential run's settings.
 #[derive(Debug, Clone, Default)]
 pub struct DiffSettings {
@@ -233,7 +309,7 @@ pub fn run(
     target: &mut dyn Target,
     acts: impl IntoIterator<Item = Action>,
     s: &DiffSettings,
-    mut progress: impl FnMut(usize) -> bool,
+    mut progress: impl FnMut(&Step<'_>) -> bool,
 ) -> Result<Option<Departure>, TargetError> {
     let mut reference = EmuTarget::new(s.straps, s.reference.clone()).map_err(|e| {
         TargetError::new(TargetErrorKind::Other, format!("reference emulator: {e}"))
@@ -244,18 +320,25 @@ pub fn run(
         bus: Vec::new(),
         capture: OutputRecord::default(),
         mark: OutputMark::default(),
+        ops: Vec::new(),
+        at: Instant::ZERO,
+        replies: Vec::new(),
     };
     let mut want = Side {
         target: &mut reference,
         bus: Vec::new(),
         capture: OutputRecord::default(),
         mark: OutputMark::default(),
+        ops: Vec::new(),
+        at: Instant::ZERO,
+        replies: Vec::new(),
     };
     // What was compared before the windows begin: each compare looks at
     // what came since the last time both sides were at rest and agreed, so
     // a run costs time linear in its length.
     let mut from = Resume::default();
     let mut last = 0;
+    let mut at_rest = true;
     for (i, a) in acts.into_iter().enumerate() {
         last = i;
         let mut stmts = a.stmts();
@@ -266,10 +349,21 @@ pub fn run(
             .iter()
             .map(|st| console::to_op(*st, &s.console))
             .collect();
-        let idle = !want.run(&stmts, &ops)?.busy();
+        // The board first; the reference then meets each input when the
+        // board's chip did.
+        let before = got.at;
         got.run(&stmts, &ops)?;
+        let exact = got.target.uncertainty() == crate::backend::Uncertainty::ZERO;
+        let starts = reference::starts(&ops, &got.replies, before, exact);
+        let status = want.run_at(&stmts, &ops, &starts)?;
         // Pulses are compared when the chip is idle, so a board's clock
-        // a hair off the emulator's cannot split a move differently.
+        // a hair off the emulator's cannot split a move differently; and
+        // with no byte waiting for it (IBF = 0): a move command written
+        // while the chip was busy starts when the chip takes it (3-1-1),
+        // which a bridge, recording moves from the bus, has already
+        // recorded at the write (note N47).
+        let idle = reference::at_rest(status);
+        at_rest = idle;
         match compare_from(
             &want.trace("differential", idle),
             &got.trace("differential", idle),
@@ -289,14 +383,20 @@ pub fn run(
             }
             Ok(_) => {}
         }
-        if !progress(i + 1) {
+        let step = Step {
+            actions: i + 1,
+            board_time: got.at.saturating_since(Instant::ZERO),
+            ops: &want.ops,
+        };
+        if !progress(&step) {
             break;
         }
     }
-    // At the end, everything since the last checkpoint.
+    // At the end, everything since the last checkpoint: the capture too
+    // if the chip is at rest (as after each action).
     if let Err(divergence) = compare_from(
-        &want.trace("differential", true),
-        &got.trace("differential", true),
+        &want.trace("differential", at_rest),
+        &got.trace("differential", at_rest),
         &s.tolerances,
         &from,
     ) {
@@ -438,7 +538,7 @@ mod tests {
             let mut t = emu(cfg);
             let mut seen = 0;
             let d = run(&mut t, program(5).take(20_000), &s, |n| {
-                seen = n;
+                seen = n.actions;
                 true
             });
             assert_eq!(d.expect("runs"), None, "{fault:?}");

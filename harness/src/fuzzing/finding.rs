@@ -63,17 +63,40 @@ pub fn minimize_by(
     invariant: Invariant,
     mut judge: impl FnMut(&[BusOp]) -> Option<Violation>,
 ) -> Option<Minimized> {
+    let (ops, violation, tries) = minimize_while(
+        ops,
+        |ops| judge(ops).filter(|v| v.invariant == invariant),
+        |v| Some(v.op),
+    )?;
+    Some(Minimized {
+        ops,
+        violation,
+        tries,
+    })
+}
+
+/// Shrinks `ops` as [`minimize`] does while `judge` finds what it looks
+/// for (`Some`), whatever that is: an invariant's break, a departure from
+/// the model. `shows_at` is the op where a find shows, if known: nothing
+/// after it is kept. The ops, the last find, and the tries.
+pub fn minimize_while<T>(
+    ops: &[BusOp],
+    mut judge: impl FnMut(&[BusOp]) -> Option<T>,
+    shows_at: impl Fn(&T) -> Option<usize>,
+) -> Option<(Vec<BusOp>, T, usize)> {
     let mut tries = 0;
-    let mut breaks = |ops: &[BusOp]| -> Option<Violation> {
+    let mut breaks = |ops: &[BusOp]| -> Option<T> {
         tries += 1;
-        judge(ops).filter(|v| v.invariant == invariant)
+        judge(ops)
     };
     let mut best = ops.to_vec();
     let mut v = breaks(&best)?;
     loop {
         let before = best.clone();
         // Nothing after the op where the break shows matters.
-        best.truncate(v.op + 1);
+        if let Some(op) = shows_at(&v) {
+            best.truncate(op + 1);
+        }
         drop_chunks(&mut best, |cand| {
             v = breaks(&cand)?;
             Some(cand)
@@ -132,11 +155,7 @@ pub fn minimize_by(
             break;
         }
     }
-    Some(Minimized {
-        ops: best,
-        violation: v,
-        tries,
-    })
+    Some((best, v, tries))
 }
 
 /// Shrinks `ops` while the two models still disagree: drops chunks of

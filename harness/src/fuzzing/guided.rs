@@ -16,9 +16,12 @@
 //! one that does not is kept apart as flaky.
 
 use super::campaign::Coverage;
+use super::reference;
 use crate::backend::power::{busy_after_reset, silent, CycleError, Power};
 use crate::backend::{Op, Reply, Target, TargetError, TargetErrorKind};
 use crate::bus_program::{self, BusOp};
+use crate::compare::{Divergence, Tolerances};
+use crate::emu::ModelConfig;
 use crate::invariants::replay::{judge, probed_ops, Found};
 use crate::time::Duration;
 use rand::rngs::StdRng;
@@ -50,6 +53,10 @@ pub struct Settings {
     /// Without feedback: every input a mutation of a seed, nothing kept
     /// (the blind baseline a guided campaign is measured against).
     pub blind: bool,
+    /// The reference model each execution is held against besides the
+    /// invariants ([`reference::departure`]); `None`: the invariants
+    /// alone.
+    pub model: Option<ModelConfig>,
 }
 
 impl Default for Settings {
@@ -62,6 +69,7 @@ impl Default for Settings {
             seed: 1,
             dictionary: default_dictionary(),
             blind: false,
+            model: Some(ModelConfig::default()),
         }
     }
 }
@@ -102,6 +110,9 @@ pub struct Finding {
 pub enum What {
     /// An invariant broke, judged on the board's own answers.
     Break(Found),
+    /// The board's answers departed from the reference model's, the model
+    /// run on the board's timeline ([`reference::departure`]).
+    Departs(Divergence),
     /// The board hung under the input (its bridge silent, or its chip
     /// BUSY after a chip reset), and was brought back as `recovery` says.
     Hang { hang: String, recovery: String },
@@ -112,6 +123,7 @@ impl What {
     pub fn name(&self) -> String {
         match self {
             What::Break(f) => f.violation.invariant.to_string(),
+            What::Departs(d) => departure_name(d),
             What::Hang { .. } => "hang".into(),
         }
     }
@@ -121,9 +133,33 @@ impl std::fmt::Display for What {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             What::Break(found) => write!(f, "{} (at {})", found.violation, found.at),
+            What::Departs(d) => write!(
+                f,
+                "departs from the model at {}: {}: model {}, board {} (allowed {})",
+                d.at, d.quantity, d.golden, d.got, d.allowed
+            ),
             What::Hang { hang, recovery } => write!(f, "the board hung: {hang}; {recovery}"),
         }
     }
+}
+
+/// A departure's name in a file name: `departs-` and what departed,
+/// without its numbers (`pin aux change 1: time` is
+/// `departs-pin-aux-change`), so that one kind of departure has one name.
+pub fn departure_name(d: &Divergence) -> String {
+    let what = d.quantity.split([':', '(']).next().unwrap_or_default();
+    let words: Vec<String> = what
+        .split_whitespace()
+        .filter(|w| !w.chars().all(|c| c.is_ascii_digit()))
+        .map(|w| {
+            w.chars()
+                .filter(|c| c.is_ascii_alphanumeric() || *c == '-')
+                .collect::<String>()
+                .to_lowercase()
+        })
+        .filter(|w| !w.is_empty())
+        .collect();
+    format!("departs-{}", words.join("-"))
 }
 
 /// What a campaign did.
@@ -174,27 +210,9 @@ pub fn name(input: &[u8]) -> String {
 }
 
 /// The coverage features an input reaches on the reference model: its
-/// domain coverage ([`Coverage`]), one name per cell reached.
+/// domain coverage's cells ([`Coverage::cells`]).
 pub fn features(ops: &[BusOp]) -> BTreeSet<String> {
-    let c = Coverage::of(&[ops.to_vec()]);
-    let mut f = BTreeSet::new();
-    f.extend(
-        c.commands
-            .keys()
-            .map(|(class, state)| format!("command {class} while {}", state.name())),
-    );
-    f.extend(c.errors.keys().map(|e| format!("error {e}")));
-    f.extend(
-        c.finishes
-            .keys()
-            .map(|(kind, cause)| format!("{kind} ended by {cause}")),
-    );
-    f.extend(
-        c.inputs_while_moving
-            .keys()
-            .map(|i| format!("{i} during a move")),
-    );
-    f
+    Coverage::of(&[ops.to_vec()]).cells()
 }
 
 /// The ops of `input` that a campaign runs: at most `max_ops`, and none
@@ -216,11 +234,13 @@ pub fn bounded_ops(input: &[u8], s: &Settings) -> Vec<BusOp> {
 
 /// Runs `ops` on `target` from a chip reset, in one batch with its
 /// capture (one round trip on a board that takes the batch whole), and
-/// judges them: the break, if any, and the board time it took.
+/// judges them: the invariant broken, else where the board departs from
+/// `model` (when given) on its own timeline; and the board time it took.
 pub fn execute(
     target: &mut dyn Target,
     ops: &[BusOp],
-) -> Result<(Option<Found>, Duration), TargetError> {
+    model: Option<&ModelConfig>,
+) -> Result<(Option<What>, Duration), TargetError> {
     let mut batch = Vec::with_capacity(1 + ops.len() * 3);
     batch.push(Op::Reset);
     batch.extend(probed_ops(ops));
@@ -245,7 +265,21 @@ pub fn execute(
         target.straps(),
     )
     .map_err(|m| TargetError::new(crate::backend::TargetErrorKind::Other, m))?;
-    Ok((found, took))
+    if let Some(found) = found {
+        return Ok((Some(What::Break(found)), took));
+    }
+    let Some(model) = model else {
+        return Ok((None, took));
+    };
+    let board = reference::Answers {
+        ops: &batch,
+        replies: &replies,
+        capture: &capture,
+        straps: target.straps(),
+        uncertainty: target.uncertainty(),
+    };
+    let departs = reference::departure(&board, model, &Tolerances::default())?;
+    Ok((departs.map(What::Departs), took))
 }
 
 /// Runs a campaign on `target` from `seeds` until its budget of board
@@ -261,7 +295,8 @@ pub fn run(
     let mut rng = StdRng::seed_from_u64(s.seed);
     let mut stats = Stats::default();
     let mut seen: BTreeSet<String> = BTreeSet::new();
-    let mut corpus: Vec<Vec<u8>> = Vec::new();
+    // What mutation found, with the board time each took.
+    let mut corpus: Vec<(Vec<u8>, Duration)> = Vec::new();
     let seeds: Vec<&Vec<u8>> = seeds.iter().filter(|x| !x.is_empty()).collect();
     if seeds.is_empty() {
         return Err(TargetError::new(
@@ -279,14 +314,24 @@ pub fn run(
             // Half the time an input that reached something new (what
             // guides), else a seed (what keeps the variety).
             let finds = !s.blind && !corpus.is_empty() && rng.random_bool(0.5);
-            let pool: Vec<&Vec<u8>> = match finds {
-                true => corpus.iter().collect(),
-                false => seeds.clone(),
-            };
-            mutate(&mut rng, &pool, s)
+            match finds {
+                // Of two finds drawn, the one that took less board time:
+                // a campaign spends its budget where inputs are quick.
+                true => {
+                    let a = &corpus[rng.random_range(0..corpus.len())];
+                    let b = &corpus[rng.random_range(0..corpus.len())];
+                    let base = if a.1 <= b.1 { a } else { b };
+                    let others: Vec<&Vec<u8>> = corpus.iter().map(|(x, _)| x).collect();
+                    mutate(&mut rng, &base.0, &others, s)
+                }
+                false => {
+                    let base = seeds[rng.random_range(0..seeds.len())];
+                    mutate(&mut rng, base, &seeds, s)
+                }
+            }
         };
         let ops = bounded_ops(&input, s);
-        let (found, took) = match execute(target, &ops) {
+        let (found, took) = match execute(target, &ops, s.model.as_ref()) {
             Ok(x) => x,
             Err(e) => {
                 // The board hung under the input: brought back, the input
@@ -322,7 +367,7 @@ pub fn run(
                 // The seeds stay in the pool anyway: the corpus keeps what
                 // mutation found.
                 if !s.blind && !is_seed {
-                    corpus.push(input.clone());
+                    corpus.push((input.clone(), took));
                 }
                 stats.corpus = corpus.len();
                 if !on(Event::NewCoverage {
@@ -335,7 +380,7 @@ pub fn run(
         }
         if let Some(found) = found {
             // Run again at once: a break the board repeats is a finding.
-            let (again, took) = match execute(target, &ops) {
+            let (again, took) = match execute(target, &ops, s.model.as_ref()) {
                 Ok(x) => x,
                 Err(e) => {
                     bring_back(target, power.as_deref_mut(), e)?;
@@ -344,15 +389,14 @@ pub fn run(
             };
             stats.executions += 1;
             stats.board_time += took.max(MIN_EXECUTION);
-            let repeated =
-                again.is_some_and(|a| a.violation.invariant == found.violation.invariant);
+            let repeated = again.is_some_and(|a| a.name() == found.name());
             match repeated {
                 true => stats.findings += 1,
                 false => stats.flaky += 1,
             }
             let finding = Finding {
                 input: input.clone(),
-                what: What::Break(found),
+                what: found,
                 repeated,
             };
             if !on(Event::Finding(&finding)) {
@@ -366,32 +410,51 @@ pub fn run(
     Ok(stats)
 }
 
-/// Shrinks `ops` on `target` while they break `invariant` there, as
-/// [`finding::minimize`](super::finding::minimize) does on the emulator:
-/// each try is an execution on the target, from a chip reset. `None` when
-/// they do not break it to begin with; the first error of the target ends
-/// it.
+/// A finding shrunk ([`shrink_on`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Shrunk {
+    pub ops: Vec<BusOp>,
+    /// What the shrunk ops still find.
+    pub what: What,
+    /// Executions spent.
+    pub tries: usize,
+}
+
+/// Shrinks `ops` on `target` while they find what is named `name` there
+/// ([`What::name`]: the same invariant broken, the same kind of departure
+/// from `model`), as [`finding::minimize`](super::finding::minimize)
+/// does on the emulator: each try an execution on the target, from a
+/// chip reset. `None` when they do not find it to begin with; the first
+/// error of the target ends it.
 pub fn shrink_on(
     target: &mut dyn Target,
     ops: &[BusOp],
-    invariant: crate::invariants::ids::Invariant,
-) -> Result<Option<super::finding::Minimized>, TargetError> {
+    model: Option<&ModelConfig>,
+    name: &str,
+) -> Result<Option<Shrunk>, TargetError> {
     let mut failed = None;
-    let small = super::finding::minimize_by(ops, invariant, |ops| {
-        if failed.is_some() {
-            return None;
-        }
-        match execute(target, ops) {
-            Ok((found, _)) => found.map(|f| f.violation),
-            Err(e) => {
-                failed = Some(e);
-                None
+    let small = super::finding::minimize_while(
+        ops,
+        |ops| {
+            if failed.is_some() {
+                return None;
             }
-        }
-    });
+            match execute(target, ops, model) {
+                Ok((what, _)) => what.filter(|w| w.name() == name),
+                Err(e) => {
+                    failed = Some(e);
+                    None
+                }
+            }
+        },
+        |what| match what {
+            What::Break(f) => Some(f.violation.op),
+            _ => None,
+        },
+    );
     match failed {
         Some(e) => Err(e),
-        None => Ok(small),
+        None => Ok(small.map(|(ops, what, tries)| Shrunk { ops, what, tries })),
     }
 }
 
@@ -449,14 +512,11 @@ fn bring_back(
     }
 }
 
-/// A mutation of an input of `pool`: a few of libFuzzer's kinds (a bit
-/// flipped, a byte set, bytes inserted or erased, a dictionary entry put
-/// in, a piece of another input spliced in, whole ops reordered).
-pub fn mutate(rng: &mut StdRng, pool: &[&Vec<u8>], s: &Settings) -> Vec<u8> {
-    let mut x: Vec<u8> = match pool.is_empty() {
-        true => Vec::new(),
-        false => pool[rng.random_range(0..pool.len())].clone(),
-    };
+/// A mutation of `base`: a few of libFuzzer's kinds (a bit flipped, a
+/// byte set, bytes inserted or erased, a dictionary entry put in, a piece
+/// of an input of `pool` spliced in, whole ops reordered).
+pub fn mutate(rng: &mut StdRng, base: &[u8], pool: &[&Vec<u8>], s: &Settings) -> Vec<u8> {
+    let mut x: Vec<u8> = base.to_vec();
     for _ in 0..rng.random_range(1..=4) {
         let at = |rng: &mut StdRng, x: &Vec<u8>| rng.random_range(0..=x.len());
         match rng.random_range(0..7) {
@@ -586,7 +646,8 @@ mod tests {
         ]);
         let ops = bounded_ops(&input, &s);
         assert_eq!(ops.len(), 2);
-        let (found, took) = execute(&mut emu(&[]), &ops).expect("runs");
+        let (found, took) =
+            execute(&mut emu(&[]), &ops, Some(&ModelConfig::default())).expect("runs");
         assert_eq!(found, None);
         assert!(
             took >= Duration::from_millis(10) && took < Duration::from_millis(11),
@@ -615,6 +676,7 @@ mod tests {
     fn a_catalogued_fault_is_found_and_repeats() {
         let s = Settings {
             budget: Duration::from_secs(600),
+            model: None,
             ..Settings::default()
         };
         let mut findings = Vec::new();
@@ -637,6 +699,70 @@ mod tests {
         assert!(f.repeated);
         assert_eq!(f.what.name(), "remaining-pulses");
         let ops = bus_program::decode(&f.input);
-        assert_eq!(execute(&mut emu(&[]), &ops).expect("runs").0, None);
+        assert_eq!(
+            execute(&mut emu(&[]), &ops, Some(&ModelConfig::default()))
+                .expect("runs")
+                .0,
+            None
+        );
+    }
+
+    /// A board fault no invariant sees (error 6 reported for a command
+    /// during BUSY, where Table 3-2 gives error 1) is found as a departure
+    /// from the model, run on the board's timeline; the same campaign on
+    /// a clean board finds nothing, and without the model finds nothing
+    /// either.
+    #[test]
+    fn a_fault_only_the_model_sees_is_found_as_a_departure() {
+        let s = Settings {
+            budget: Duration::from_secs(60),
+            ..Settings::default()
+        };
+        let first = |faults: &[&str], s: &Settings| {
+            let mut found = None;
+            run(&mut emu(faults), None, &corpus(), s, |e| {
+                if let Event::Finding(f) = e {
+                    found = Some(f.clone());
+                }
+                found.is_none()
+            })
+            .expect("runs");
+            found
+        };
+        let f = first(&["swap-error-1-6"], &s).expect("a departure");
+        assert!(f.repeated);
+        assert!(f.what.name().starts_with("departs-"), "{}", f.what);
+        assert!(
+            f.what.to_string().contains("departs from the model"),
+            "{}",
+            f.what
+        );
+        assert_eq!(first(&[], &s), None);
+        let blind_to_it = Settings { model: None, ..s };
+        assert_eq!(first(&["swap-error-1-6"], &blind_to_it), None);
+    }
+
+    /// One kind of departure has one name, without its numbers.
+    #[test]
+    fn a_departure_is_named_by_what_departed() {
+        let d = |q: &str| Divergence {
+            at: crate::time::Instant::ZERO,
+            quantity: q.into(),
+            golden: "1".into(),
+            got: "2".into(),
+            allowed: "equal".into(),
+        };
+        assert_eq!(
+            departure_name(&d("pin aux change 1: time, from the write before it")),
+            "departs-pin-aux-change"
+        );
+        assert_eq!(
+            departure_name(&d("bus transaction 24 (rs 0x00): status")),
+            "departs-bus-transaction"
+        );
+        assert_eq!(
+            departure_name(&d("number of moves")),
+            "departs-number-of-moves"
+        );
     }
 }

@@ -17,6 +17,9 @@
 //!   suite (`ppmc fuzz seeds`).
 //! - [`differential`]: seeded runs of typed actions on a target beside the
 //!   reference emulator (`ppmc fuzz run`).
+//! - [`reference`](mod@reference): the reference model run beside a board on the
+//!   board's timeline, and where the two depart (what differential runs
+//!   and campaigns judge a board by besides the invariants).
 //! - [`guided`]: a campaign of `bus_bytes` inputs on any target, judged by
 //!   the invariants on the board's own answers, guided by the model's
 //!   coverage, on a budget of board time (`ppmc fuzz campaign`).
@@ -26,5 +29,6 @@ pub mod campaign;
 pub mod differential;
 pub mod finding;
 pub mod guided;
+pub mod reference;
 pub mod seeds;
 pub mod targets;

@@ -102,6 +102,7 @@ impl<L: Link> BridgeTarget<L> {
                     link: self.link.name(),
                     was: self.clock,
                     now: at,
+                    op: op.to_string(),
                 });
             }
             self.clock = at;

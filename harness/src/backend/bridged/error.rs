@@ -93,11 +93,13 @@ pub enum BridgeError {
         /// What became of the ABORT sent for it.
         abort: AbortOutcome,
     },
-    #[error("{link}: the bridge's clock went back from {was} to {now} without a chip reset: the bridge restarted behind the open port and the chip's state is unknown")]
+    #[error("{link}: the bridge's clock went back from {was} to {now} without a chip reset (its reply to `{op}`): the bridge restarted behind the open port and the chip's state is unknown")]
     ClockWentBack {
         link: String,
         was: Instant,
         now: Instant,
+        /// The op whose reply went back.
+        op: String,
     },
     #[error("{link}: health check failed: {detail}")]
     Unhealthy { link: String, detail: String },

@@ -716,7 +716,7 @@ fn a_long_differential_run_holds_a_window_of_the_capture_on_both_sides() {
     };
     let mut seen = 0;
     let d = run(&mut t, program(5).take(20_000), &s, |n| {
-        seen = n;
+        seen = n.actions;
         true
     });
     assert_eq!(d.expect("runs"), None);
