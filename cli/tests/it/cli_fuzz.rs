@@ -233,8 +233,10 @@ fn triage_buckets_and_coverage_reports() {
 
 /// Issue 45: a guided campaign against a board (a bridge-sim whose chip
 /// outputs its pulses the wrong way, 3-3) finds the fault within a minute
-/// of board time and writes it where it says; the same campaign against
-/// the clean chip finds nothing (no false alarm); its corpus resumes.
+/// of board time and writes it where it says; the finding replays on the
+/// emulator, the bridge-sim and the twin, shrinks, and becomes a
+/// regression scenario; the same campaign against the clean chip finds
+/// nothing (no false alarm); its corpus resumes.
 #[test]
 fn a_guided_campaign_finds_a_faulty_board_and_not_a_clean_one() {
     let dir = scratch("campaign");
@@ -302,6 +304,16 @@ fn a_guided_campaign_finds_a_faulty_board_and_not_a_clean_one() {
     assert_eq!(code, Some(1), "{on_emu}");
     assert_eq!(t_emu, t_board, "{on_emu}{on_board}");
     assert_eq!(replay("emu").0, Some(0));
+    // And on the twin (the bridge's own board code on a model of its
+    // RP2350, in front of a chip with the same fault): the same invariant
+    // breaks, at the twin's own pace.
+    let twin =
+        ppmc_test_support::served::Served::start("run-twin", &["--chip-fault", "dir-inverted"]);
+    let on_twin = format!("serial:{}", twin.link.display());
+    let (code, said, _) = replay(&on_twin);
+    assert_eq!(code, Some(1), "{said}");
+    assert!(said.contains(": breaks phase-pattern after op "), "{said}");
+    drop(twin);
 
     // It shrinks on the board (the clean emulator does not break), and
     // becomes a regression scenario that fails on the faulty chip.

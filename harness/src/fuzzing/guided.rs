@@ -23,6 +23,7 @@ use crate::bus_program::{self, BusOp};
 use crate::compare::{Divergence, Tolerances};
 use crate::emu::ModelConfig;
 use crate::invariants::replay::{judge, probed_ops, Found};
+use crate::protocol::OutputRecord;
 use crate::time::Duration;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -261,7 +262,7 @@ pub fn execute(
     let found = judge(
         ops,
         replies.get(1..).unwrap_or_default(),
-        &capture,
+        &busy_at_its_earliest(&capture, &replies, target.uncertainty()),
         target.straps(),
     )
     .map_err(|m| TargetError::new(crate::backend::TargetErrorKind::Other, m))?;
@@ -280,6 +281,45 @@ pub fn execute(
     };
     let departs = reference::departure(&board, model, &Tolerances::default())?;
     Ok((departs.map(What::Departs), took))
+}
+
+/// The capture with each rise of BUSY a bridge found by reading the
+/// status register moved back to just after the read before it, where
+/// that read came longer than a poll's pass (`2 × polled + access`)
+/// earlier: a bridge reads no status while it waits out a delay, so a
+/// rise it stamps at the first read after lies anywhere in the gap
+/// (`docs/bridge-protocol.md` section 4), and the invariants, which take
+/// the line as exact, are judged on its earliest. An exact capture (the
+/// emulator's, bridge-sim's) is as it was.
+fn busy_at_its_earliest(
+    capture: &OutputRecord,
+    replies: &[Reply],
+    u: crate::backend::Uncertainty,
+) -> OutputRecord {
+    let pass = u.polled.saturating_mul(2) + u.access;
+    if u.polled == Duration::ZERO {
+        return capture.clone();
+    }
+    let looks: Vec<crate::time::Instant> = replies
+        .iter()
+        .filter_map(|r| match r {
+            Reply::Status { at, .. } => Some(*at),
+            _ => None,
+        })
+        .collect();
+    let mut c = capture.clone();
+    for p in c.pins.iter_mut() {
+        if p.pin != crate::protocol::Pin::Busy || p.value != 1 {
+            continue;
+        }
+        let before = looks.iter().rev().find(|t| **t < p.at);
+        if let Some(t) = before.filter(|t| p.at.saturating_since(**t) > pass) {
+            p.at = *t + Duration::from_nanos(1);
+        }
+    }
+    // The record keeps its pins in time order.
+    c.pins.sort_by_key(|p| p.at);
+    c
 }
 
 /// Runs a campaign on `target` from `seeds` until its budget of board
@@ -764,5 +804,40 @@ mod tests {
             departure_name(&d("number of moves")),
             "departs-number-of-moves"
         );
+    }
+
+    /// BUSY's rise as a bridge stamps it, at the first status read after a
+    /// delay, is judged at its earliest (just after the read before), so
+    /// the move's first pulses in the gap are inside BUSY (3-3: BUSY
+    /// covers the pulses); a rise a read saw within a poll's pass, and
+    /// every rise of an exact capture, stay where they are.
+    #[test]
+    fn a_busy_rise_found_after_a_gap_in_status_reads_is_judged_at_its_earliest() {
+        use crate::protocol::{Pin, PinEvent, Status};
+        use crate::time::Instant;
+        let us = |n: u64| Instant::from_nanos(n * 1_000);
+        let status = |at| Reply::Status {
+            at,
+            status: Status(0),
+        };
+        let rise = |at| PinEvent {
+            at,
+            pin: Pin::Busy,
+            value: 1,
+        };
+        let mut capture = OutputRecord::default();
+        capture.pins.push(rise(us(9_000)));
+        capture.pins.push(rise(us(9_501)));
+        let replies = [status(us(1_000)), status(us(9_500))];
+        let bridge = crate::backend::Uncertainty {
+            access: Duration::from_nanos(134),
+            polled: Duration::from_nanos(1_500),
+            ..Default::default()
+        };
+        let judged = busy_at_its_earliest(&capture, &replies, bridge);
+        assert_eq!(judged.pins[0].at, us(1_000) + Duration::from_nanos(1));
+        assert_eq!(judged.pins[1].at, us(9_501));
+        let exact = busy_at_its_earliest(&capture, &replies, Default::default());
+        assert_eq!(exact.pins, capture.pins);
     }
 }

@@ -365,3 +365,46 @@ fn a_sampled_change_seen_as_the_board_code_idles_is_stamped_within_its_uncertain
         u.access
     );
 }
+
+/// Issue 45: a guided campaign against the twin (the bridge's own board
+/// code in front of a clean chip), each input from a chip reset, judged
+/// by the invariants and against the model on the twin's timeline, runs
+/// at least 40 executions per board-second (70 % of the chip's floor of
+/// about 60 with an initialization each, Table 3-3's 16.5 ms) and spends
+/// its whole budget of the twin's time.
+#[test]
+fn a_guided_campaign_on_the_twin_runs_40_executions_per_board_second() {
+    use ppmc::fuzzing::guided::{self, Event, Settings};
+    use ppmc::time::Duration;
+    let twin = Served::start("run-twin", &[]);
+    let mut t = twin.target();
+    // The seeds `ppmc fuzz campaign` starts from: the suite's bus traffic.
+    let seeds = ppmc::fuzzing::seeds::suite_traffic(&ppmc_scenarios::all()).expect("the seeds");
+    let s = Settings {
+        budget: Duration::from_secs(3),
+        max_input_time: Duration::from_millis(25),
+        ..Settings::default()
+    };
+    let mut findings = Vec::new();
+    let stats = guided::run(&mut t, None, &seeds, &s, |e| {
+        if let Event::Finding(f) = e {
+            findings.push(f.what.to_string());
+        }
+        true
+    })
+    .expect("the campaign runs");
+    // Not asserted: what it finds. On this good board it raises false
+    // alarms of kinds named in docs/performance.md ("Against the twin"):
+    // the judges do not yet take every path of the bridge's uncertainty
+    // into account (moves recorded from the bus, among others).
+    eprintln!(
+        "{} findings on the clean twin: {findings:#?}",
+        findings.len()
+    );
+    assert!(
+        stats.per_board_second() >= 40.0,
+        "{:.1} executions per board-second: {stats:?}",
+        stats.per_board_second()
+    );
+    assert!(stats.board_time >= s.budget, "{stats:?}");
+}

@@ -38,9 +38,7 @@ pub(super) const ANCHOR: u32 = bus_cycle::step(0xFF, bus_cycle::IDLE, false, 400
 /// The cycles from a read of the clock to the player's taking of a step
 /// pushed right after it: the step worked out, a look at the FIFO's level
 /// and the push. On the image on rp2350-emu, 20 left an aimed write 0.36
-/// us (54 cycles) late. An estimate, the image's: a CPU that pushes sooner
-/// has its cycle held back by the setup step ([`Board::cycle`]), never
-/// early.
+/// us (54 cycles) late.
 const PUSH_CYCLES: u64 = 70;
 
 impl<H: Hal> Board<H> {
@@ -86,9 +84,6 @@ impl<H: Hal> Board<H> {
             limit: CYCLE_DEADLINE_US as u32 * (self.sysclk_hz / 1_000_000),
             free: self.player_free.saturating_sub(base).min(1 << 30) as u32,
         };
-        // Where an aimed cycle's moment must be (cycles), and the cycles
-        // from its first step's pull to it.
-        let mut aimed: Option<(u64, u64)> = None;
         if let Some(t) = aim {
             // The cycle's moment at tick `t`: an anchor step, whose start
             // its push tells, then a wait step timed from it.
@@ -102,7 +97,6 @@ impl<H: Hal> Board<H> {
             let fits = anchor + u64::from(bus_cycle::MAX_COUNT + bus_cycle::STEP_CYCLES) + before;
             self.approach(goal.saturating_sub(fits) / 2);
             while self.hal.cycles() + fits < goal {}
-            aimed = Some((goal, before));
             let step = u64::from(bus_cycle::STEP_CYCLES);
             // When the player takes what is pushed now: after the steps
             // it still has (a status read's recovery), at the earliest.
@@ -131,35 +125,8 @@ impl<H: Hal> Board<H> {
         }
         let mut moment = 0;
         for (i, w) in steps.words().iter().enumerate() {
-            let pull = match aimed {
-                // Never before its aim: the wait step of a cycle the CPU
-                // came to behind is timed by PUSH_CYCLES, and a CPU that
-                // pushed sooner (the twin's, 25 cycles) had the player
-                // take it sooner, and the cycle came up to 0.3 us before
-                // a delay's end: a reply back in time, which the host
-                // refuses. So the setup step is worked out once the FIFO
-                // has room, from a reading of the clock: the player takes
-                // it then at the earliest, or when it is free, and the
-                // setup lasts what the cycle still comes early by (a
-                // longer setup, as the bus has while the player waits for
-                // a step). Late by the push alone when the player is idle.
-                Some((goal, before)) if i == 0 => {
-                    if p.room(&mut self.hal).is_none() {
-                        return self.player_stuck(c);
-                    }
-                    let soonest = p.free.max(self.hal.fine().wrapping_sub(p.f0) + 1);
-                    let early = goal.saturating_sub(base + u64::from(soonest) + before);
-                    // The setup step's count (it never samples), longer.
-                    let count = (u64::from(w >> 22) + early).min(u64::from(bus_cycle::MAX_COUNT));
-                    p.put(
-                        &mut self.hal,
-                        bus_cycle::step(*w as u8, w >> 8, false, count as u32),
-                    )
-                }
-                _ => match p.push(&mut self.hal, *w) {
-                    Some(pull) => pull,
-                    None => return self.player_stuck(c),
-                },
+            let Some(pull) = p.push(&mut self.hal, *w) else {
+                return self.player_stuck(c);
             };
             if i == c.moment_step() {
                 moment = pull + bus_cycle::PINS_AT;
@@ -344,29 +311,15 @@ impl Player {
     /// past the deadline.
     #[inline(always)]
     fn push(&mut self, hal: &mut impl Hal, w: u32) -> Option<u32> {
-        self.room(hal)?;
-        Some(self.put(hal, w))
-    }
-
-    /// Waits until the player's TX FIFO has room; `None` past the
-    /// deadline.
-    #[inline(always)]
-    fn room(&self, hal: &mut impl Hal) -> Option<()> {
         while hal.bus_tx_full() {
             if self.late(hal) {
                 return None;
             }
         }
-        Some(())
-    }
-
-    /// [`Player::push`] once the FIFO has room ([`Player::room`]).
-    #[inline(always)]
-    fn put(&mut self, hal: &mut impl Hal, w: u32) -> u32 {
         let pushed = hal.bus_push_fine(w).wrapping_sub(self.f0);
         let pull = self.free.max(pushed + 1);
         self.free = pull + bus_cycle::step_cycles(w);
-        pull
+        Some(pull)
     }
 
     #[inline(always)]
