@@ -359,6 +359,14 @@ impl PlainChip {
         }
     }
 
+    /// The energized pattern, stop switching's chopping aside: what the
+    /// record's phases show (the chopping is its own pin).
+    fn pattern_now(&self) -> u8 {
+        self.shown
+            .filter(|_| self.energized)
+            .map_or(0, |w| w.pattern(self.step))
+    }
+
     fn phases_now(&self) -> u8 {
         let Some(w) = self.shown.filter(|_| self.energized) else {
             return 0;
@@ -498,7 +506,7 @@ impl PlainChip {
                 }
             }
             Event::PhasesSet { epoch } if epoch == self.epoch => {
-                let was = self.phases_now();
+                let was = self.pattern_now();
                 self.energized = true;
                 self.show_phases_from(was);
             }
@@ -521,7 +529,7 @@ impl PlainChip {
                 self.set_pin(Pin::Auxo, v);
             }
             Event::ExcitationOff { epoch } if epoch == self.epoch => {
-                let was = self.phases_now();
+                let was = self.pattern_now();
                 self.energized = false;
                 self.shown = None;
                 self.step = 0;
