@@ -282,6 +282,17 @@ impl Uncertainty {
         }
     }
 
+    /// A pass of the loop that polls the status register (up to twice
+    /// `polled`) and an access after it: how long after the chip changed a
+    /// flag a bridge may act on it, or stamp the change, where it reads
+    /// the status register steadily. Zero for exact times.
+    pub fn poll_pass(&self) -> Duration {
+        match self.polled > Duration::ZERO {
+            true => self.polled.saturating_mul(2) + self.access,
+            false => Duration::ZERO,
+        }
+    }
+
     /// Each path at least `floor` (a timer's tick: no time on the wire is
     /// surer than that).
     pub fn at_least(self, floor: Duration) -> Uncertainty {

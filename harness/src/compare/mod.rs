@@ -873,6 +873,15 @@ end
         assert_eq!(late.got, "60.000us");
     }
 
+    /// A trace of scenario `name` (`section`) at the reference straps,
+    /// `text` its details after the straps and its events.
+    fn trace_of(name: &str, section: &str, text: &str) -> Trace {
+        let t = format!(
+            "ppmc-trace 1\nscenario {name}\nsection {section}\ntarget t\ndetail sysclk_hz 16000000\ndetail csel high\ndetail vsel high\ndetail ext_clock_hz none\n{text}end\n"
+        );
+        Trace::parse(&t).expect("parses")
+    }
+
     /// A change the chip makes on its own between two writes (AUX* on,
     /// Table 3-3, for an AUX ON command taken from the input buffer when
     /// an initialization ends, 3-1-1) comes after the second write on the
@@ -883,12 +892,7 @@ end
     /// it). An AUX* late past the band and the lag still departs.
     #[test]
     fn a_change_between_writes_is_timed_from_the_same_write_on_both_sides() {
-        let trace = |text: &str| {
-            let t = format!(
-                "ppmc-trace 1\nscenario aux\nsection 3-5-2\ntarget t\ndetail sysclk_hz 16000000\ndetail csel high\ndetail vsel high\ndetail ext_clock_hz none\n{text}end\n"
-            );
-            Trace::parse(&t).expect("parses")
-        };
+        let trace = |text: &str| trace_of("aux", "3-5-2", text);
         let golden = trace(
             "events
 0.000us reset
@@ -938,12 +942,7 @@ events
     /// read just before it, still departs.
     #[test]
     fn a_busy_change_stamped_after_a_long_gap_in_status_reads_is_a_range() {
-        let trace = |text: &str| {
-            let t = format!(
-                "ppmc-trace 1\nscenario busy\nsection 3-3-5\ntarget t\ndetail sysclk_hz 16000000\ndetail csel high\ndetail vsel high\ndetail ext_clock_hz none\n{text}end\n"
-            );
-            Trace::parse(&t).expect("parses")
-        };
+        let trace = |text: &str| trace_of("busy", "3-3-5", text);
         let golden = |read: &str| {
             trace(&format!(
                 "events

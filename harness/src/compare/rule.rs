@@ -73,11 +73,7 @@ impl Unsure {
     /// strobe (an access). Zero on an exact trace, whose writes come as
     /// IBF falls.
     pub(super) fn strobe_lag(&self) -> (Duration, Duration) {
-        let lag = |u: &Uncertainty| match u.polled > Duration::ZERO {
-            true => u.polled.saturating_mul(2) + u.access,
-            false => Duration::ZERO,
-        };
-        (lag(&self.golden), lag(&self.got))
+        (self.golden.poll_pass(), self.got.poll_pass())
     }
 
     /// A wait for a flag: from an access to the poll that saw it.

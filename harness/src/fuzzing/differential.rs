@@ -13,7 +13,7 @@ use crate::console::{self, ConsoleOptions};
 use crate::emu::ModelConfig;
 use crate::protocol::{OutputMark, OutputRecord, Status, Straps};
 use crate::time::{Duration, Instant};
-use crate::trace::{uncertainty_detail, Event, EventKind, Trace, UNCERTAINTY};
+use crate::trace::{uncertainty_entry, Event, EventKind, Trace};
 use rand::{Rng, SeedableRng};
 use std::fmt::Write as _;
 
@@ -232,7 +232,7 @@ impl Side<'_> {
         // The target's declared uncertainty, which the compare widens each
         // timing by: a board measured through a bridge is not exact.
         let u = self.target.uncertainty();
-        let details = vec![(UNCERTAINTY.to_string(), uncertainty_detail(&u))];
+        let details = vec![uncertainty_entry(&u)];
         Trace::new(name, "-", info.name.as_str(), info.straps, details).assemble(
             self.bus.clone(),
             capture,
@@ -339,6 +339,8 @@ pub fn run(
     let mut from = Resume::default();
     let mut last = 0;
     let mut at_rest = true;
+    // A board whose times are exact waited for its flags as the model does.
+    let exact = got.target.uncertainty() == crate::backend::Uncertainty::ZERO;
     for (i, a) in acts.into_iter().enumerate() {
         last = i;
         let mut stmts = a.stmts();
@@ -353,7 +355,6 @@ pub fn run(
         // board's chip did.
         let before = got.at;
         got.run(&stmts, &ops)?;
-        let exact = got.target.uncertainty() == crate::backend::Uncertainty::ZERO;
         let starts = reference::starts(&ops, &got.replies, before, exact);
         let status = want.run_at(&stmts, &ops, &starts)?;
         // Pulses are compared when the chip is idle, so a board's clock

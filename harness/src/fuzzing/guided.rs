@@ -296,8 +296,8 @@ fn busy_at_its_earliest(
     replies: &[Reply],
     u: crate::backend::Uncertainty,
 ) -> OutputRecord {
-    let pass = u.polled.saturating_mul(2) + u.access;
-    if u.polled == Duration::ZERO {
+    let pass = u.poll_pass();
+    if pass == Duration::ZERO {
         return capture.clone();
     }
     let looks: Vec<crate::time::Instant> = replies

@@ -11,7 +11,7 @@ use crate::compare::{compare, Divergence, Tolerances};
 use crate::emu::ModelConfig;
 use crate::protocol::{OutputRecord, Status, Straps};
 use crate::time::{Duration, Instant};
-use crate::trace::{uncertainty_detail, BusEvent, Event, EventKind, Trace, UNCERTAINTY};
+use crate::trace::{uncertainty_entry, BusEvent, Event, EventKind, Trace};
 
 /// When each of `ops` began on a board whose times are `exact` or not,
 /// from its `replies` (`before`: when the op before the first ended): a
@@ -124,7 +124,7 @@ pub fn departure(
                 })
             })
             .collect();
-        let details = vec![(UNCERTAINTY.to_string(), uncertainty_detail(u))];
+        let details = vec![uncertainty_entry(u)];
         Trace::new("campaign", "-", name, board.straps, details).assemble(
             bus,
             if at_rest { capture } else { &empty },

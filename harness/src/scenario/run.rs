@@ -148,10 +148,7 @@ pub fn run_scenario(
     // An instrument that is not exact says how unsure its times are.
     let mut details = info.extra.clone();
     if uncertainty != Uncertainty::ZERO {
-        details.push((
-            crate::trace::UNCERTAINTY.to_string(),
-            crate::trace::uncertainty_detail(&uncertainty),
-        ));
+        details.push(crate::trace::uncertainty_entry(&uncertainty));
     }
     let trace = capture.map(|c| {
         Trace::new(

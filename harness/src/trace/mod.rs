@@ -38,7 +38,7 @@ mod uncertainty;
 
 pub use figures::figures;
 use uncertainty::parse_uncertainty;
-pub use uncertainty::{uncertainty_detail, UNCERTAINTY};
+pub use uncertainty::{uncertainty_detail, uncertainty_entry, UNCERTAINTY};
 
 /// The format version written in the first line.
 pub const TRACE_VERSION: u32 = 1;

@@ -25,6 +25,12 @@ pub fn uncertainty_detail(u: &Uncertainty) -> String {
     )
 }
 
+/// The `uncertainty` detail of a trace whose times are as sure as `u`:
+/// its name and text, as a trace's details hold them.
+pub fn uncertainty_entry(u: &Uncertainty) -> (String, String) {
+    (UNCERTAINTY.to_string(), uncertainty_detail(u))
+}
+
 /// Reads an `uncertainty` detail's text.
 pub(super) fn parse_uncertainty(text: &str) -> Result<Uncertainty, String> {
     let mut u = Uncertainty::ZERO;
