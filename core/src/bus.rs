@@ -355,6 +355,17 @@ pub trait Bus {
         OutputMark::default()
     }
 
+    /// Called before the record is served to a host: settles what it
+    /// holds tentatively, reading the chip if need be, and says how many of
+    /// its last move records are still tentative, which are not served yet
+    /// (a bridge that keeps its move records from the bus, by
+    /// `move_tracker`, knows a move was taken only once a status read shows
+    /// IBF = 0 after its last byte; a record served is never withdrawn).
+    /// The default: nothing is tentative.
+    fn settle_record(&mut self) -> usize {
+        0
+    }
+
     /// The chip's straps (system clock, CSEL, VSEL, external clock).
     fn straps(&self) -> Straps;
 

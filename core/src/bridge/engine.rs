@@ -74,6 +74,10 @@ pub struct BridgeEngine<B> {
     /// host had fetched): the host's positions count from the reset, the
     /// bus's record from here.
     forgotten: OutputMark,
+    /// The record's last move records the bus holds tentatively
+    /// ([`Bus::settle_record`]), as of the last capture served: not served
+    /// yet.
+    tentative: usize,
     /// The host session of the last HELLO (0: none yet).
     host: u32,
     /// The last request that was not a HELLO, LINK or RESEND, and the
@@ -113,6 +117,7 @@ impl<B: Bus> BridgeEngine<B> {
             virtual_time,
             capture_capacity: u32::MAX,
             forgotten: OutputMark::default(),
+            tentative: 0,
             host: 0,
             last: None,
             control: None,
@@ -369,6 +374,7 @@ impl<B: Bus> BridgeEngine<B> {
                     }
                     Ok(()) => match replies.finish() {
                         Ok(mut bytes) => {
+                            self.tentative = self.bus.settle_record();
                             // The capture takes what room the replies leave.
                             let mut max = max;
                             loop {
@@ -433,7 +439,10 @@ impl<B: Bus> BridgeEngine<B> {
             } => match (self.overrun(), self.let_go(runs, pins, moves)) {
                 (Some(held), _) => self.overrun_error(held),
                 (None, Some(gone)) => gone,
-                (None, None) => Response::Capture(self.chunk(runs, pins, moves, max)),
+                (None, None) => {
+                    self.tentative = self.bus.settle_record();
+                    Response::Capture(self.chunk(runs, pins, moves, max))
+                }
             },
             Request::BatchCapture { .. } => Response::Error {
                 code: BridgeErrorCode::Malformed,
@@ -688,9 +697,11 @@ impl<B: Bus> BridgeEngine<B> {
     }
 
     /// Up to `max` capture records of each kind from these positions on
-    /// (counted from the last reset; [`Self::let_go`] has run).
+    /// (counted from the last reset; [`Self::let_go`] has run), but for
+    /// tentative move records.
     fn chunk(&self, runs: u32, pins: u32, moves: u32, max: u16) -> CaptureChunk {
         let rec = self.bus.record();
+        let settled = rec.moves.len().saturating_sub(self.tentative);
         let gone = self.forgotten;
         let (runs, pins, moves) = (
             runs.saturating_sub(gone.runs as u32),
@@ -704,7 +715,7 @@ impl<B: Bus> BridgeEngine<B> {
         };
         let (r0, r1) = take(runs, rec.runs.len(), CHUNK_RUNS.min(max));
         let (p0, p1) = take(pins, rec.pins.len(), CHUNK_PINS.min(max));
-        let (m0, m1) = take(moves, rec.moves.len(), CHUNK_MOVES.min(max));
+        let (m0, m1) = take(moves, settled, CHUNK_MOVES.min(max));
         CaptureChunk {
             runs: rec.runs[r0..r1].to_vec(),
             pins: rec.pins[p0..p1].to_vec(),
@@ -718,7 +729,7 @@ impl<B: Bus> BridgeEngine<B> {
                 })
                 .collect(),
             overwritten_bytes: rec.overwritten_bytes,
-            more: r1 < rec.runs.len() || p1 < rec.pins.len() || m1 < rec.moves.len(),
+            more: r1 < rec.runs.len() || p1 < rec.pins.len() || m1 < settled,
         }
     }
 }
@@ -750,7 +761,7 @@ mod tests {
         Response::decode(&payload, Timer::NANOS).expect("decodes")
     }
 
-    fn ask(s: &mut BridgeEngine<EmuBus>, seq: u8, req: &Request) -> Response {
+    fn ask<B: Bus>(s: &mut BridgeEngine<B>, seq: u8, req: &Request) -> Response {
         let out = s.on_bytes(&frame::encode(&req.encode(seq, Timer::NANOS)));
         let mut d = FrameDecoder::new();
         d.extend(&out);
@@ -1143,6 +1154,47 @@ mod tests {
                 ..
             }
         ));
+    }
+
+    /// A bridge that keeps its move records from the bus knows a move was
+    /// taken only once a status read shows IBF = 0 after its last byte
+    /// (Section 3-1-1; the chip takes a byte no sooner than 6 us after its
+    /// write, N11): until then the record is not served, so a record
+    /// served is never withdrawn; the capture asked later brings it.
+    #[test]
+    fn a_move_record_is_served_once_a_status_read_shows_the_chip_took_it() {
+        use crate::bridge::move_tracker::Tracked;
+        let bus = EmuBus::new(Straps::default(), ModelConfig::default()).expect("emu");
+        let mut s = BridgeEngine::new(Tracked::new(bus), 42, true, "test-bridge");
+        let capture = |s: &mut BridgeEngine<Tracked<EmuBus>>, seq, ops: Vec<Op>| {
+            let Response::BatchCapture { capture, .. } = ask(
+                s,
+                seq,
+                &Request::BatchCapture {
+                    ops,
+                    runs: 0,
+                    pins: 0,
+                    moves: 0,
+                    max: 60,
+                },
+            ) else {
+                panic!("batch-capture reply");
+            };
+            capture
+        };
+        capture(&mut s, 1, init_ops());
+        // A single step (0x4A, no parameters): its code is its last byte,
+        // and the engine's own status read comes while IBF is still 1.
+        let step = Op::WriteCommand {
+            byte: 0x4A,
+            wait_ibf: Some(Duration::from_secs(1)),
+        };
+        let first = capture(&mut s, 2, vec![step]);
+        assert_eq!(first.moves.len(), 0, "not served while tentative");
+        assert!(!first.more);
+        assert_eq!(s.bus().record().moves.len(), 1, "held");
+        let later = capture(&mut s, 3, vec![Op::Delay(Duration::from_micros(50))]);
+        assert_eq!(later.moves.len(), 1, "settled by the bridge's own read");
     }
 
     /// Initialization, then a constant-speed move (Section 3-3-5) of

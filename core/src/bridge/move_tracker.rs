@@ -8,9 +8,15 @@
 //! - A move record is written at the final byte of a move command (its
 //!   `at`: that byte's write), with the kind, direction, POUT mode and step
 //!   count from the command and its parameters (Sections 3-3-3 to 3-3-8).
-//! - The first status read after it settles it: the error flag means the
-//!   chip refused the command (Table 3-2: during BUSY, before an
-//!   initialization) and the record is withdrawn.
+//! - The first status read after it that shows IBF = 0 settles it: the
+//!   chip has taken the byte then (Section 3-1-1), and the error flag means
+//!   it refused the command (Table 3-2: during BUSY, before an
+//!   initialization; N6: an error is raised as the byte is taken), so the
+//!   record is withdrawn. A read that still shows IBF = 1 shows the state
+//!   from before the byte, the error of a command before included, and
+//!   settles nothing. Until settled, a record is tentative: the last one,
+//!   never served to a host ([`Bus::settle_record`]). A byte written before
+//!   it is settled (no wait for IBF = 0) keeps it.
 //! - The winding is that of the first initialization since reset whose
 //!   data the chip accepts (Section 3-2, Table 3-2 errors 4 and 5), settled
 //!   the same way; a software reset that is not the AUX ON quirk
@@ -91,6 +97,12 @@ impl MoveTracker {
         at: Instant,
         phases: u8,
     ) {
+        // A byte after a tentative one's: the status reads from here on
+        // tell of this byte too (N6: an unasked-for data byte raises an
+        // error of its own). A bridge that waits for IBF = 0 before each
+        // write has settled it by the wait's reads; one that writes on
+        // regardless keeps the record, as the chip most often takes it.
+        self.tentative = None;
         let (cmd, params) = if command {
             let cmd = Command::decode(byte);
             self.params = None;
@@ -186,9 +198,19 @@ impl MoveTracker {
         self.tentative = Some(Tentative::Move);
     }
 
+    /// How many of the record's last move records are tentative: their
+    /// last byte written, but no status read since has shown the chip take
+    /// it (0 or 1).
+    pub fn unsettled(&self) -> usize {
+        usize::from(self.tentative == Some(Tentative::Move))
+    }
+
     /// The bridge read the status register.
     pub fn on_status(&mut self, rec: &mut OutputRecord, status: Status) {
         self.busy = status.busy();
+        if status.ibf() {
+            return; // the byte not taken yet: nothing to settle by
+        }
         let Some(t) = self.tentative.take() else {
             return;
         };
@@ -214,8 +236,8 @@ impl MoveTracker {
 
 /// A [`Bus`] whose move records are kept by a [`MoveTracker`] from the
 /// bus traffic, as a bridge firmware keeps them, instead of by the chip
-/// behind it: `ppmc bridge-sim --track-moves`, and the test that the
-/// tracker agrees with the reference model on the whole suite.
+/// behind it: for the test that the tracker agrees with the reference
+/// model on the whole suite.
 #[derive(Debug, Clone)]
 pub struct Tracked<B> {
     inner: B,
@@ -305,6 +327,15 @@ impl<B: Bus> Bus for Tracked<B> {
         &self.record
     }
 
+    /// A tentative move record is settled by a status read of its own, as
+    /// the board code does before it serves its capture.
+    fn settle_record(&mut self) -> usize {
+        if self.tracker.unsettled() > 0 {
+            self.run(Op::ReadStatus);
+        }
+        self.tracker.unsettled()
+    }
+
     fn straps(&self) -> Straps {
         self.inner.straps()
     }
@@ -352,5 +383,45 @@ mod tests {
         init(&mut t, &mut rec, 0x22, 0);
         t.reset();
         assert!(!t.stop_switching(), "a reset forgets it");
+    }
+
+    /// A zero-parameter move (`code`, Section 3-3) written at 10 us.
+    fn move_code(t: &mut MoveTracker, rec: &mut OutputRecord, code: u8) {
+        t.on_write(rec, true, code, Instant::from_nanos(10_000), 0);
+    }
+
+    /// Section 3-1-1 and N6: a status read that still shows IBF = 1 shows
+    /// the chip before it took the byte, with the error of the command
+    /// before; only a read with IBF = 0 says whether the move was refused.
+    #[test]
+    fn a_move_is_settled_by_the_first_status_read_with_ibf_0() {
+        let (mut t, mut rec) = (MoveTracker::new(), OutputRecord::default());
+        init(&mut t, &mut rec, 0x02, 0);
+        // Continuous high-speed: no parameters, the code is its last byte.
+        let m = MoveCommand::new(
+            MoveKind::ContinuousHigh,
+            crate::protocol::Direction::Cw,
+            false,
+        );
+        let code = Command::Move(m).encode();
+        // The command before was refused: its error shows until the chip
+        // takes this code.
+        move_code(&mut t, &mut rec, code);
+        t.on_status(&mut rec, Status(Status::ERROR | Status::IBF | 0x10));
+        assert_eq!(rec.moves.len(), 1, "a stale error withdraws nothing");
+        assert_eq!(t.unsettled(), 1);
+        t.on_status(&mut rec, Status(Status::BUSY));
+        assert_eq!((rec.moves.len(), t.unsettled()), (1, 0), "taken: kept");
+
+        // Refused while BUSY (error 1), seen only once IBF is 0.
+        move_code(&mut t, &mut rec, code);
+        t.on_status(&mut rec, Status(Status::IBF | Status::BUSY));
+        assert_eq!((rec.moves.len(), t.unsettled()), (2, 1), "not settled yet");
+        t.on_status(&mut rec, Status(Status::ERROR | Status::BUSY | 0x10));
+        assert_eq!(
+            (rec.moves.len(), t.unsettled()),
+            (1, 0),
+            "refused: withdrawn"
+        );
     }
 }

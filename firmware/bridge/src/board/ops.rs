@@ -584,6 +584,22 @@ impl<H: Hal> Bus for Board<H> {
         &self.record
     }
 
+    /// A move whose last byte no status read has seen the chip take (IBF
+    /// = 0) is settled by a status read of the board's own: the chip takes
+    /// a byte within microseconds (Section 3-1-1), and a status read
+    /// changes nothing in it.
+    fn settle_record(&mut self) -> usize {
+        if self.tracker.unsettled() > 0 && self.fault.is_none() {
+            if core::mem::take(&mut self.batch_done) {
+                self.hal.resync();
+            }
+            self.early_status = None;
+            self.read_status(None);
+            self.batch_done = true;
+        }
+        self.tracker.unsettled()
+    }
+
     fn uncertainty(&self) -> ppmc_core::bus::Uncertainty {
         Board::uncertainty(self)
     }
