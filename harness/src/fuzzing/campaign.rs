@@ -8,7 +8,7 @@ use crate::emu::ModelConfig;
 use crate::invariants::ids::Invariant;
 use crate::invariants::oracle::Checker;
 use crate::invariants::rules::Violation;
-use crate::protocol::{Command, ErrorCode, Input, MoveKind, OutputRecord, StatusField};
+use crate::protocol::{Command, ErrorCode, Input, MoveKind, OutputRecord, Register, StatusField};
 use crate::time::Duration;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -119,7 +119,21 @@ pub struct Coverage {
     /// (command class or input, ramp phase) -> count: what was written
     /// or asserted during a move, by where its ramp was (3-4-2).
     pub during_ramp: BTreeMap<(String, &'static str), u64>,
+    /// Finish status reads (3-4-1: the command taken, then its byte
+    /// read), by what the register held for them: a finish to report (the
+    /// polling flag set), a finish read already (the flag cleared by the
+    /// read before), or none yet.
+    pub finish_reads: BTreeMap<&'static str, u64>,
 }
+
+/// What a finish status read found in the register (3-4-1): a finish
+/// to report (the polling flag set), a finish read already (the flag
+/// cleared by the read before), no move ended yet.
+const FINISH_READS: [&str; 3] = [
+    "with a finish to report",
+    "again after a finish",
+    "before any finish",
+];
 
 /// A walk of one input on the clean model, op by op, counting what each
 /// reached into a [`Coverage`]: what [`Coverage::of`] does for a whole
@@ -133,6 +147,11 @@ pub struct Walk {
     last_command: Option<String>,
     /// The error number the status register showed after the last op.
     last_error: Option<u8>,
+    /// A move has ended since the reset.
+    a_move_ended: bool,
+    /// What the last finish status read command found to load, until
+    /// its byte is read.
+    finish_read: Option<&'static str>,
 }
 
 impl Walk {
@@ -144,6 +163,8 @@ impl Walk {
             pins_seen: 0,
             last_command: None,
             last_error: None,
+            a_move_ended: false,
+            finish_read: None,
         })
     }
 
@@ -170,10 +191,24 @@ impl Walk {
                 if let Some(p) = phase {
                     *c.during_ramp.entry((class.clone(), p)).or_default() += 1;
                 }
+                let reads_finish = Command::decode(b) == Command::Read(Register::FinishStatus);
+                self.finish_read = (reads_finish && state != ChipState::Moving).then(|| {
+                    match (board.chip().finish_status().polling(), self.a_move_ended) {
+                        (true, _) => FINISH_READS[0],
+                        (false, true) => FINISH_READS[1],
+                        (false, false) => FINISH_READS[2],
+                    }
+                });
                 let before = self.last_command.replace(class.clone());
                 *c.pairs
                     .entry((before.unwrap_or_else(|| "reset".into()), class))
                     .or_default() += 1;
+            }
+            // The byte a finish status read loaded, read.
+            BusOp::ReadData => {
+                if let Some(what) = self.finish_read.take() {
+                    *c.finish_reads.entry(what).or_default() += 1;
+                }
             }
             BusOp::Input {
                 input,
@@ -211,6 +246,7 @@ impl Walk {
             .any(|p| p.pin == crate::protocol::Pin::Busy && p.value == 0);
         self.pins_seen = pins.len();
         if ended {
+            self.a_move_ended = true;
             let f = board.chip().finish_status();
             let kind = MoveKind::ALL
                 .iter()
@@ -317,6 +353,11 @@ impl Coverage {
                 .keys()
                 .map(|(what, phase)| format!("{what} during a move {phase}")),
         );
+        f.extend(
+            self.finish_reads
+                .keys()
+                .map(|what| format!("finish status read {what}")),
+        );
         f
     }
 
@@ -377,6 +418,16 @@ impl Coverage {
                 never.push(i.name().to_string());
             }
             let _ = writeln!(s, "| {} | {n} |", i.name());
+        }
+        let _ = writeln!(s, "\nNever reached: {}.\n", list(&never));
+        s.push_str("## Finish status reads (3-4-1)\n\n| the register held | reads |\n|---|---:|\n");
+        let mut never = Vec::new();
+        for what in FINISH_READS {
+            let n = self.finish_reads.get(what).copied().unwrap_or(0);
+            if n == 0 {
+                never.push(what.to_string());
+            }
+            let _ = writeln!(s, "| {what} | {n} |");
         }
         let _ = writeln!(s, "\nNever reached: {}.", list(&never));
         s

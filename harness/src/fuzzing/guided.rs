@@ -17,6 +17,7 @@
 
 use super::campaign::Coverage;
 use super::reference;
+use super::schedule::Pool;
 use crate::backend::power::{busy_after_reset, silent, CycleError, Power};
 use crate::backend::{Op, Reply, Target, TargetError, TargetErrorKind};
 use crate::bus_program::{self, BusOp};
@@ -28,6 +29,10 @@ use crate::time::Duration;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use std::collections::BTreeSet;
+
+/// The share of a guided campaign's inputs that mutate a seed drawn
+/// uniformly, besides those the pool draws by rarity (seeds included).
+const SEED_SHARE: f64 = 0.0;
 
 /// The least board time an execution counts: a board whose clock does not
 /// move (an input of nothing) still uses up a budget.
@@ -308,13 +313,20 @@ fn busy_at_its_earliest(
         })
         .collect();
     let mut c = capture.clone();
+    // BUSY's change before: a rise comes after the fall before it, which
+    // the bridge saw at a read of its own.
+    let mut last_change = None;
     for p in c.pins.iter_mut() {
-        if p.pin != crate::protocol::Pin::Busy || p.value != 1 {
+        if p.pin != crate::protocol::Pin::Busy {
+            continue;
+        }
+        let was = last_change.replace(p.at);
+        if p.value != 1 {
             continue;
         }
         let before = looks.iter().rev().find(|t| **t < p.at);
         if let Some(t) = before.filter(|t| p.at.saturating_since(**t) > pass) {
-            p.at = *t + Duration::from_nanos(1);
+            p.at = (*t).max(was.unwrap_or(*t)) + Duration::from_nanos(1);
         }
     }
     // The record keeps its pins in time order.
@@ -335,8 +347,10 @@ pub fn run(
     let mut rng = StdRng::seed_from_u64(s.seed);
     let mut stats = Stats::default();
     let mut seen: BTreeSet<String> = BTreeSet::new();
-    // What mutation found, with the board time each took.
-    let mut corpus: Vec<(Vec<u8>, Duration)> = Vec::new();
+    // The seeds and what mutation found, each with the features it
+    // reached and the board time it took: what a guided campaign draws
+    // from ([`Pool::draw`]).
+    let mut pool = Pool::new();
     let seeds: Vec<&Vec<u8>> = seeds.iter().filter(|x| !x.is_empty()).collect();
     if seeds.is_empty() {
         return Err(TargetError::new(
@@ -351,20 +365,20 @@ pub fn run(
             next_seed += 1;
             seeds[next_seed - 1].clone()
         } else {
-            // Half the time an input that reached something new (what
-            // guides), else a seed (what keeps the variety).
-            let finds = !s.blind && !corpus.is_empty() && rng.random_bool(0.5);
-            match finds {
-                // Of two finds drawn, the one that took less board time:
-                // a campaign spends its budget where inputs are quick.
-                true => {
-                    let a = &corpus[rng.random_range(0..corpus.len())];
-                    let b = &corpus[rng.random_range(0..corpus.len())];
-                    let base = if a.1 <= b.1 { a } else { b };
-                    let others: Vec<&Vec<u8>> = corpus.iter().map(|(x, _)| x).collect();
-                    mutate(&mut rng, &base.0, &others, s)
+            let drawn = match s.blind || rng.random_bool(SEED_SHARE) {
+                false => pool.draw(&mut rng),
+                true => None,
+            };
+            match drawn {
+                // An input drawn by the rarity of what it reached, and how
+                // quick it is.
+                Some(base) => {
+                    let others: Vec<&Vec<u8>> = pool.inputs().collect();
+                    mutate(&mut rng, &base.input, &others, s)
                 }
-                false => {
+                // A seed, uniformly: what keeps the variety, and all a
+                // blind campaign mutates.
+                None => {
                     let base = seeds[rng.random_range(0..seeds.len())];
                     mutate(&mut rng, base, &seeds, s)
                 }
@@ -397,19 +411,18 @@ pub fn run(
         // Coverage is measured in both modes; only a guided campaign keeps
         // what reached something new.
         {
-            let new: Vec<String> = features(&ops)
-                .into_iter()
-                .filter(|f| !seen.contains(f))
-                .collect();
+            let reached = features(&ops);
+            let ids = pool.note(&reached);
+            let new: Vec<String> = reached.into_iter().filter(|f| !seen.contains(f)).collect();
+            if is_seed && !s.blind {
+                pool.keep(input.clone(), took, ids);
+            } else if !new.is_empty() && !s.blind {
+                pool.keep(input.clone(), took, ids);
+                stats.corpus += 1;
+            }
             if !new.is_empty() {
                 stats.features += new.len();
                 seen.extend(new.iter().cloned());
-                // The seeds stay in the pool anyway: the corpus keeps what
-                // mutation found.
-                if !s.blind && !is_seed {
-                    corpus.push((input.clone(), took));
-                }
-                stats.corpus = corpus.len();
                 if !on(Event::NewCoverage {
                     input: &input,
                     new: new.len(),
@@ -554,12 +567,13 @@ fn bring_back(
 
 /// A mutation of `base`: a few of libFuzzer's kinds (a bit flipped, a
 /// byte set, bytes inserted or erased, a dictionary entry put in, a piece
-/// of an input of `pool` spliced in, whole ops reordered).
+/// of an input of `pool` spliced in), and some of whole ops (a run of ops
+/// done again, a wait shortened, an op moved).
 pub fn mutate(rng: &mut StdRng, base: &[u8], pool: &[&Vec<u8>], s: &Settings) -> Vec<u8> {
     let mut x: Vec<u8> = base.to_vec();
     for _ in 0..rng.random_range(1..=4) {
         let at = |rng: &mut StdRng, x: &Vec<u8>| rng.random_range(0..=x.len());
-        match rng.random_range(0..7) {
+        match rng.random_range(0..9) {
             0 if !x.is_empty() => {
                 let i = rng.random_range(0..x.len());
                 x[i] ^= 1 << rng.random_range(0..8);
@@ -591,6 +605,35 @@ pub fn mutate(rng: &mut StdRng, base: &[u8], pool: &[&Vec<u8>], s: &Settings) ->
                     let b = rng.random_range(a..=other.len());
                     let i = at(rng, &x);
                     x.splice(i..i, other[a..b].iter().copied());
+                }
+            }
+            7 => {
+                // Whole ops: a run of them done again right after itself
+                // (a second read of what the first read cleared, a
+                // command given twice).
+                let mut ops = bus_program::decode(&x);
+                if !ops.is_empty() {
+                    let a = rng.random_range(0..ops.len());
+                    let b = (a + rng.random_range(1..=6)).min(ops.len());
+                    let again: Vec<BusOp> = ops[a..b].to_vec();
+                    ops.splice(b..b, again);
+                    x = bus_program::encode(&ops);
+                }
+            }
+            8 => {
+                // A wait shortened: the same ops sooner, and quicker on
+                // the board (a move stopped earlier in its ramp).
+                let mut ops = bus_program::decode(&x);
+                let waits: Vec<usize> = (0..ops.len())
+                    .filter(|&i| matches!(ops[i], BusOp::Advance(_)))
+                    .collect();
+                if !waits.is_empty() {
+                    let i = waits[rng.random_range(0..waits.len())];
+                    if let BusOp::Advance(d) = ops[i] {
+                        let keep = rng.random_range(0..=u64::from(u8::MAX));
+                        ops[i] = BusOp::Advance(d.scale(keep, 256));
+                    }
+                    x = bus_program::encode(&ops);
                 }
             }
             _ => {
@@ -825,9 +868,17 @@ mod tests {
             pin: Pin::Busy,
             value: 1,
         };
+        let fall = |at| PinEvent {
+            value: 0,
+            ..rise(at)
+        };
         let mut capture = OutputRecord::default();
         capture.pins.push(rise(us(9_000)));
         capture.pins.push(rise(us(9_501)));
+        // A move that ended, and the next, found after a gap too: its
+        // rise is no earlier than the fall before it.
+        capture.pins.push(fall(us(9_600)));
+        capture.pins.push(rise(us(20_000)));
         let replies = [status(us(1_000)), status(us(9_500))];
         let bridge = crate::backend::Uncertainty {
             access: Duration::from_nanos(134),
@@ -837,6 +888,9 @@ mod tests {
         let judged = busy_at_its_earliest(&capture, &replies, bridge);
         assert_eq!(judged.pins[0].at, us(1_000) + Duration::from_nanos(1));
         assert_eq!(judged.pins[1].at, us(9_501));
+        assert_eq!(judged.pins[3].at, us(9_600) + Duration::from_nanos(1));
+        let busy: Vec<u8> = judged.pins.iter().map(|p| p.value).collect();
+        assert_eq!(busy, [1, 1, 0, 1], "the line's changes keep their order");
         let exact = busy_at_its_earliest(&capture, &replies, Default::default());
         assert_eq!(exact.pins, capture.pins);
     }

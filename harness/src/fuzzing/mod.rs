@@ -22,7 +22,8 @@
 //!   and campaigns judge a board by besides the invariants).
 //! - [`guided`]: a campaign of `bus_bytes` inputs on any target, judged by
 //!   the invariants on the board's own answers, guided by the model's
-//!   coverage, on a budget of board time (`ppmc fuzz campaign`).
+//!   coverage, on a budget of board time (`ppmc fuzz campaign`);
+//!   [`schedule`]: which input it mutates next.
 
 pub mod actions;
 pub mod campaign;
@@ -30,5 +31,6 @@ pub mod differential;
 pub mod finding;
 pub mod guided;
 pub mod reference;
+pub mod schedule;
 pub mod seeds;
 pub mod targets;
