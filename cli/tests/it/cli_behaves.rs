@@ -202,6 +202,7 @@ fn each_scripts_help_is_its_header_comment_and_starts_nothing() {
         "scripts/network-figures",
         "scripts/fuzz-figures",
         "scripts/judge-figures",
+        "scripts/campaign-figures",
     ] {
         let path = root.join(script);
         let source = std::fs::read_to_string(&path).expect("the script");

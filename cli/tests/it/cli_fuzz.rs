@@ -420,3 +420,41 @@ fn a_campaign_without_seeds_is_a_usage_error() {
         text(&out.stderr)
     );
 }
+
+/// `scripts/campaign-figures`, which makes the table of
+/// `docs/performance.md` ("A guided campaign against a board"), at a
+/// second of board time and one seed: a row for every fault of the
+/// matrix, the clean chip with no false alarm in any of the three, a
+/// Table 3-2 error swap found by both campaigns at once.
+#[test]
+fn the_campaign_figures_script_has_a_row_for_every_fault() {
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/campaign-figures");
+    let out = std::process::Command::new(script)
+        .args(["1s", "50ms", "1"])
+        .env("PPMC", env!("CARGO_BIN_EXE_ppmc"))
+        .output()
+        .expect("the script runs");
+    let said = text(&out.stdout);
+    assert!(out.status.success(), "{said}{}", text(&out.stderr));
+    let row = |name: &str| {
+        said.lines()
+            .find(|l| l.starts_with(&format!("| {name} |")))
+            .unwrap_or_else(|| panic!("no row {name}:\n{said}"))
+            .to_string()
+    };
+    assert_eq!(
+        row("clean: false alarms"),
+        "| clean: false alarms | 0 of 1 | 0 of 1 | 0 of 1 |"
+    );
+    assert!(
+        row("params-not-counted")
+            .starts_with("| params-not-counted | 1 of 1 (0.0 s) | 1 of 1 (0.0 s) |"),
+        "{said}"
+    );
+    let faults = text(&ppmc(&["fault-matrix", "--list"]).stdout)
+        .lines()
+        .filter(|l| l.starts_with("| `"))
+        .count();
+    // The header, its rule, three rows of the clean chip, one a fault.
+    assert_eq!(said.lines().count(), 2 + 3 + faults, "{said}");
+}

@@ -44,7 +44,7 @@ const FILES: [&str; 15] = [
 const ELSEWHERE: [(&str, &str); 42] = [
     (
         "PPMC=target/release/ppmc scripts/campaign-figures",
-        "by hand (84 runs of a minute of board time each against bridge-sim: a guided and a blind campaign and the --seed stream for each of 28 chips; its figures in docs/performance.md)",
+        "by hand (405 runs of a minute of board time each against bridge-sim: a guided and a blind campaign and the --seed stream, five seeds each, for each of 27 chips; its figures in docs/performance.md); at a second of board time and one seed in cli/tests/it/cli_fuzz.rs",
     ),
     (
         "scripts/bridge-sim-power",

@@ -32,7 +32,7 @@ use std::collections::BTreeSet;
 
 /// The share of a guided campaign's inputs that mutate a seed drawn
 /// uniformly, besides those the pool draws by rarity (seeds included).
-const SEED_SHARE: f64 = 0.0;
+const SEED_SHARE: f64 = 0.25;
 
 /// The least board time an execution counts: a board whose clock does not
 /// move (an input of nothing) still uses up a budget.
