@@ -87,7 +87,50 @@ pub struct Answers<'a> {
 /// rest (BUSY and IBF clear: nothing under way, no byte waiting), so that
 /// a board's clock a hair off the model's cannot split a move
 /// differently; the bus (every status and data byte, every wait) always.
+///
+/// A board whose times are not exact stamps each access within its
+/// declared `access` of when the chip saw it, so two accesses within
+/// `2 × access` of one of the chip's latencies may have met the chip
+/// either way round: a byte written 6 us after the one before, a read
+/// 20 us after a register read command. Those latencies are the model's
+/// own (N11: the datasheet gives none), so a departure is also judged
+/// against the model with them `2 × access` shorter and longer, and is a
+/// departure only when it departs from all three.
 pub fn departure(
+    board: &Answers<'_>,
+    model: &ModelConfig,
+    tol: &Tolerances,
+) -> Result<Option<Divergence>, TargetError> {
+    let Some(first) = departure_from(board, model, tol)? else {
+        return Ok(None);
+    };
+    let slack = board.uncertainty.access.saturating_mul(2);
+    if slack == Duration::ZERO {
+        return Ok(Some(first));
+    }
+    let shifted = |f: fn(Duration, Duration) -> Duration| {
+        let at_least = |d: Duration| d.max(Duration::from_nanos(1));
+        ModelConfig {
+            byte_pickup: at_least(f(model.byte_pickup, slack)),
+            obf_ready: at_least(f(model.obf_ready, slack)),
+            obf_next: at_least(f(model.obf_next, slack)),
+            ..model.clone()
+        }
+    };
+    for m in [
+        shifted(Duration::saturating_sub),
+        shifted(Duration::saturating_add),
+    ] {
+        // A latency moved past another it must stay below is no model.
+        if m.validate().is_ok() && departure_from(board, &m, tol)?.is_none() {
+            return Ok(None);
+        }
+    }
+    Ok(Some(first))
+}
+
+/// [`departure`] from one model.
+fn departure_from(
     board: &Answers<'_>,
     model: &ModelConfig,
     tol: &Tolerances,
@@ -139,4 +182,56 @@ pub fn departure(
 /// A status that says the chip is at rest: not BUSY, no byte waiting.
 pub fn at_rest(status: Status) -> bool {
     !status.busy() && !status.ibf()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A "board" that is the model with its byte pickup (N11: a latency
+    /// the datasheet does not give) 100 ns sooner, given a command and,
+    /// 5.95 us later, a data byte: it takes the command before the data
+    /// byte replaces it (3-1-1 (2)), the model 6 us after its write does
+    /// not. Stamped within 134 ns (`access`), the two writes may have met
+    /// the chip either way round: no departure. Stamped within 10 ns, they
+    /// could not have: a departure.
+    #[test]
+    fn a_race_within_the_boards_stamps_is_no_departure() {
+        let model = ModelConfig::default();
+        let early = ModelConfig {
+            byte_pickup: model.byte_pickup.saturating_sub(Duration::from_nanos(100)),
+            ..model.clone()
+        };
+        let mut board = EmuTarget::new(Straps::default(), early).expect("emulator");
+        let ops = [
+            Op::Reset,
+            Op::WriteCommand {
+                byte: 0x02,
+                wait_ibf: None,
+            },
+            Op::Delay(Duration::from_nanos(5_950)),
+            Op::WriteData {
+                byte: 100,
+                wait_ibf: None,
+            },
+            Op::Delay(Duration::from_micros(20)),
+            Op::ReadStatus,
+        ];
+        let (replies, capture) = board.execute_then_capture(&ops).expect("runs");
+        let answers = |access: u64| Answers {
+            ops: &ops,
+            replies: &replies,
+            capture: &capture,
+            straps: Straps::default(),
+            uncertainty: Uncertainty {
+                access: Duration::from_nanos(access),
+                ..Uncertainty::default()
+            },
+        };
+        let tol = Tolerances::default();
+        let sure = departure(&answers(10), &model, &tol).expect("judged");
+        assert!(sure.is_some(), "the status tells the race apart");
+        let unsure = departure(&answers(134), &model, &tol).expect("judged");
+        assert_eq!(unsure, None);
+    }
 }
