@@ -15,8 +15,11 @@
 //!   record is withdrawn. A read that still shows IBF = 1 shows the state
 //!   from before the byte, the error of a command before included, and
 //!   settles nothing. Until settled, a record is tentative: the last one,
-//!   never served to a host ([`Bus::settle_record`]). A byte written before
-//!   it is settled (no wait for IBF = 0) keeps it.
+//!   never served to a host ([`Bus::settle_record`]).
+//! - A byte written while the last status read since the byte before
+//!   showed IBF = 1 replaces that byte (3-1-1 (2)): what the byte before
+//!   did (a parameter counted, a command begun, a record) is undone. With
+//!   no read between, the byte before is taken as taken.
 //! - The winding is that of the first initialization since reset whose
 //!   data the chip accepts (Section 3-2, Table 3-2 errors 4 and 5), settled
 //!   the same way; a software reset that is not the AUX ON quirk
@@ -61,6 +64,22 @@ pub struct MoveTracker {
     /// BUSY as the last status read showed it.
     busy: bool,
     tentative: Option<Tentative>,
+    /// The last status read since the last write showed that byte still
+    /// in the input buffer (IBF = 1).
+    still_waiting: bool,
+    /// What the tracker knew before the last write, to undo it if the
+    /// next write replaced that byte.
+    before_last: Option<Before>,
+}
+
+/// The tracker's knowledge before a write, and the record's moves then.
+#[derive(Debug, Clone, Copy)]
+struct Before {
+    params: Option<(Command, [u8; 4], u8)>,
+    winding: Option<(Winding, OutputLogic)>,
+    initialized: bool,
+    switching: bool,
+    moves: usize,
 }
 
 impl MoveTracker {
@@ -97,12 +116,31 @@ impl MoveTracker {
         at: Instant,
         phases: u8,
     ) {
-        // A byte after a tentative one's: the status reads from here on
-        // tell of this byte too (N6: an unasked-for data byte raises an
-        // error of its own). A bridge that waits for IBF = 0 before each
-        // write has settled it by the wait's reads; one that writes on
-        // regardless keeps the record, as the chip most often takes it.
+        // The byte before this one, if a status read since showed it still
+        // in the input buffer (IBF = 1), is replaced by this one and never
+        // seen by the chip (3-1-1 (2)): what it did is undone (a parameter
+        // counted, a command begun, a record made). Else a record it made
+        // stays: settled by a read with IBF = 0 (a bridge that waits for
+        // IBF = 0 before each write settles so), or, with no read since,
+        // kept, as the chip most often takes a byte before the next. The
+        // status reads from here on tell of this byte (N6: an unasked-for
+        // data byte raises an error of its own).
+        if let Some(b) = self.before_last.take().filter(|_| self.still_waiting) {
+            self.params = b.params;
+            self.winding = b.winding;
+            self.initialized = b.initialized;
+            self.switching = b.switching;
+            rec.moves.truncate(b.moves);
+        }
         self.tentative = None;
+        self.still_waiting = false;
+        self.before_last = Some(Before {
+            params: self.params,
+            winding: self.winding,
+            initialized: self.initialized,
+            switching: self.switching,
+            moves: rec.moves.len(),
+        });
         let (cmd, params) = if command {
             let cmd = Command::decode(byte);
             self.params = None;
@@ -208,15 +246,21 @@ impl MoveTracker {
     /// The bridge read the status register.
     pub fn on_status(&mut self, rec: &mut OutputRecord, status: Status) {
         self.busy = status.busy();
+        self.still_waiting = status.ibf();
         if status.ibf() {
             return; // the byte not taken yet: nothing to settle by
         }
         let Some(t) = self.tentative.take() else {
             return;
         };
-        if !status.error_flag() {
-            return; // settled: the chip took it
+        if status.error_flag() {
+            self.withdraw(rec, t); // refused
         }
+    }
+
+    /// Undoes a tentative record: the chip refused its command, or never
+    /// took its last byte.
+    fn withdraw(&mut self, rec: &mut OutputRecord, t: Tentative) {
         match t {
             Tentative::Move => {
                 rec.moves.pop();
@@ -422,6 +466,54 @@ mod tests {
             (rec.moves.len(), t.unsettled()),
             (1, 0),
             "refused: withdrawn"
+        );
+    }
+
+    /// Section 3-1-1 (2): a byte written while IBF is 1 replaces the one
+    /// there, which the chip never sees. A move whose code a read showed
+    /// still waiting, then written over, never started; one written over
+    /// with no read between is kept (the chip most often takes a byte
+    /// before the next).
+    #[test]
+    fn a_move_written_over_while_it_waited_is_withdrawn() {
+        let (mut t, mut rec) = (MoveTracker::new(), OutputRecord::default());
+        init(&mut t, &mut rec, 0x02, 0);
+        let m = MoveCommand::new(
+            MoveKind::ContinuousHigh,
+            crate::protocol::Direction::Cw,
+            false,
+        );
+        let code = Command::Move(m).encode();
+        move_code(&mut t, &mut rec, code);
+        t.on_status(&mut rec, Status(Status::IBF));
+        move_code(&mut t, &mut rec, code);
+        assert_eq!(
+            rec.moves.len(),
+            1,
+            "the first replaced, the second tentative"
+        );
+        move_code(&mut t, &mut rec, code);
+        assert_eq!(rec.moves.len(), 2, "no read between: the second kept");
+        t.on_status(&mut rec, Status(Status::BUSY));
+        assert_eq!((rec.moves.len(), t.unsettled()), (2, 0));
+
+        // A parameter written over is one parameter: an accel/decel move
+        // (three) is made by its fourth data byte here.
+        let (mut t, mut rec) = (MoveTracker::new(), OutputRecord::default());
+        init(&mut t, &mut rec, 0x02, 0);
+        let m = MoveCommand::new(MoveKind::AccelDecel, crate::protocol::Direction::Cw, false);
+        t.on_write(&mut rec, true, Command::Move(m).encode(), Instant::ZERO, 0);
+        t.on_write(&mut rec, false, 10, Instant::ZERO, 0);
+        t.on_status(&mut rec, Status(Status::IBF | 0x20));
+        for b in [20, 0] {
+            t.on_write(&mut rec, false, b, Instant::ZERO, 0);
+        }
+        assert!(rec.moves.is_empty(), "two parameters taken of three");
+        t.on_write(&mut rec, false, 0, Instant::ZERO, 0);
+        assert_eq!(rec.moves.len(), 1);
+        assert_eq!(
+            rec.moves[0].steps,
+            PulseCount::from_bytes([20, 0, 0]).steps()
         );
     }
 }

@@ -264,6 +264,10 @@ pub fn execute(
     let took = replies
         .last()
         .map_or(Duration::ZERO, |r| Duration::from_nanos(r.at().as_nanos()));
+    // BUSY as a bridge that polls it may have missed it, for both judges;
+    // its rises at their earliest for the invariants (the compare takes a
+    // polled change as a range of its own).
+    let capture = busy_the_polling_missed(&capture, &replies, target.uncertainty());
     let found = judge(
         ops,
         replies.get(1..).unwrap_or_default(),
@@ -332,6 +336,93 @@ fn busy_at_its_earliest(
     // The record keeps its pins in time order.
     c.pins.sort_by_key(|p| p.at);
     c
+}
+
+/// The capture with a BUSY pulse the polling missed added around a
+/// move's pulses where the line stayed at 0 and no status read among
+/// them saw BUSY at 0 (a move begun and ended between two reads). An
+/// exact capture is as it was.
+fn busy_the_polling_missed(
+    capture: &OutputRecord,
+    replies: &[Reply],
+    u: crate::backend::Uncertainty,
+) -> OutputRecord {
+    let mut c = capture.clone();
+    if u.poll_pass() == Duration::ZERO {
+        return c;
+    }
+    // Pulses with the line at 0 and no change of it among them, where no
+    // status read between their first and last showed BUSY = 0: a move
+    // begun and ended between two reads, which polling cannot see. The
+    // line is taken as 1 around them (and only so: a read that saw 0
+    // among them is a break).
+    let zero_reads: Vec<crate::time::Instant> = replies
+        .iter()
+        .filter_map(|r| match r {
+            Reply::Status { at, status } if !status.busy() => Some(*at),
+            _ => None,
+        })
+        .collect();
+    let mut unseen: Vec<(crate::time::Instant, crate::time::Instant)> = Vec::new();
+    for r in &c.runs {
+        if busy_level(&c, r.start) {
+            continue;
+        }
+        match unseen.last_mut() {
+            // Runs in a row with no change of the line between.
+            Some((_, end))
+                if !c
+                    .pins
+                    .iter()
+                    .any(|p| is_busy(p) && p.at > *end && p.at <= r.start) =>
+            {
+                *end = r.last();
+            }
+            _ => unseen.push((r.start, r.last())),
+        }
+    }
+    let one = Duration::from_nanos(1);
+    for (start, end) in unseen {
+        let seen_zero = zero_reads
+            .iter()
+            .any(|t| *t > start + u.access && *t + u.access < end);
+        let changes = c
+            .pins
+            .iter()
+            .any(|p| is_busy(p) && p.at >= start && p.at <= end);
+        if seen_zero || changes {
+            continue;
+        }
+        // The fall where a bridge that saw the rise would have stamped it:
+        // at the first read after that showed BUSY at 0.
+        let fall = zero_reads
+            .iter()
+            .find(|t| **t > end)
+            .copied()
+            .unwrap_or(end + one);
+        for (at, value) in [(start - one, 1), (fall, 0)] {
+            c.pins.push(crate::protocol::PinEvent {
+                at,
+                pin: crate::protocol::Pin::Busy,
+                value,
+            });
+        }
+    }
+    c.pins.sort_by_key(|p| p.at);
+    c
+}
+
+fn is_busy(p: &crate::protocol::PinEvent) -> bool {
+    p.pin == crate::protocol::Pin::Busy
+}
+
+/// The level of the capture's BUSY line at `t` (changes at `t` included).
+fn busy_level(c: &OutputRecord, t: crate::time::Instant) -> bool {
+    c.pins
+        .iter()
+        .rev()
+        .find(|p| is_busy(p) && p.at <= t)
+        .is_some_and(|p| p.value != 0)
 }
 
 /// Runs a campaign on `target` from `seeds` until its budget of board
@@ -893,5 +984,54 @@ mod tests {
         assert_eq!(busy, [1, 1, 0, 1], "the line's changes keep their order");
         let exact = busy_at_its_earliest(&capture, &replies, Default::default());
         assert_eq!(exact.pins, capture.pins);
+    }
+
+    /// A single step (Section 3-3-3) begun and ended between two status
+    /// reads leaves no BUSY change in a bridge's capture, which finds BUSY
+    /// by reading the status register: its pulse is judged inside a BUSY
+    /// the polling missed (3-1-1 (3)), unless a read among its pulses saw
+    /// BUSY at 0.
+    #[test]
+    fn pulses_between_two_reads_are_inside_a_busy_the_polling_missed() {
+        use crate::protocol::{Direction, PulseRun, Status};
+        use crate::time::Instant;
+        let us = |n: u64| Instant::from_nanos(n * 1_000);
+        let status = |at, busy: bool| Reply::Status {
+            at,
+            status: Status(if busy { Status::BUSY } else { 0 }),
+        };
+        let mut capture = OutputRecord::default();
+        capture.runs.push(PulseRun {
+            start: us(100),
+            count: 3,
+            dir: Direction::Cw,
+            span: Duration::from_micros(200),
+            jitter: Duration::ZERO,
+        });
+        let bridge = crate::backend::Uncertainty {
+            access: Duration::from_nanos(134),
+            polled: Duration::from_nanos(1_500),
+            ..Default::default()
+        };
+        let between = [status(us(10), false), status(us(1_000), false)];
+        let judged = busy_the_polling_missed(&capture, &between, bridge);
+        let line: Vec<(Instant, u8)> = judged.pins.iter().map(|p| (p.at, p.value)).collect();
+        let one = Duration::from_nanos(1);
+        assert_eq!(
+            line,
+            [(us(100) - one, 1), (us(1_000), 0)],
+            "fell by the read after"
+        );
+        // A read among the pulses that saw BUSY at 0: no BUSY is made up.
+        let among = [status(us(10), false), status(us(200), false)];
+        assert!(busy_at_its_earliest(&capture, &among, bridge)
+            .pins
+            .is_empty());
+        // An exact capture is judged as it is.
+        assert!(
+            busy_the_polling_missed(&capture, &between, Default::default())
+                .pins
+                .is_empty()
+        );
     }
 }
