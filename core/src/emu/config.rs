@@ -152,6 +152,73 @@ impl ModelConfig {
     }
 }
 
+impl ModelConfig {
+    /// The configuration with every latency passed through `f`: the chip
+    /// keeps its latencies in its board's firmware time
+    /// ([`crate::protocol::Straps::firmware_time`]), scaled once when it is
+    /// made rather than at every use.
+    pub fn map_latencies(&self, f: impl Fn(Duration) -> Duration) -> ModelConfig {
+        let ModelConfig {
+            byte_pickup,
+            obf_ready,
+            obf_next,
+            busy_rise,
+            init_outputs,
+            init_time_min,
+            init_time_max,
+            accel_first_pout,
+            accel_first_pout_triangle_max,
+            constant_first_pout,
+            single_step_pout,
+            single_step_done,
+            decel_stop,
+            hs_limit_accel,
+            hs_limit_cruise,
+            remaining_calc,
+            interrupt_delay,
+            next_command,
+            hold_on,
+            aux_switch,
+            aux_output,
+            excitation_off,
+            switching_on,
+            switching_off,
+            accel_curve,
+            faults,
+            board,
+        } = self.clone();
+        ModelConfig {
+            byte_pickup: f(byte_pickup),
+            obf_ready: f(obf_ready),
+            obf_next: f(obf_next),
+            busy_rise: f(busy_rise),
+            init_outputs: f(init_outputs),
+            init_time_min: f(init_time_min),
+            init_time_max: f(init_time_max),
+            accel_first_pout: f(accel_first_pout),
+            accel_first_pout_triangle_max: f(accel_first_pout_triangle_max),
+            constant_first_pout: f(constant_first_pout),
+            single_step_pout: f(single_step_pout),
+            single_step_done: f(single_step_done),
+            decel_stop: f(decel_stop),
+            hs_limit_accel: f(hs_limit_accel),
+            hs_limit_cruise: f(hs_limit_cruise),
+            remaining_calc: f(remaining_calc),
+            interrupt_delay: f(interrupt_delay),
+            next_command: f(next_command),
+            hold_on: f(hold_on),
+            aux_switch: f(aux_switch),
+            aux_output: f(aux_output),
+            excitation_off: f(excitation_off),
+            switching_on: f(switching_on),
+            switching_off: f(switching_off),
+            accel_curve,
+            faults,
+            board,
+        }
+    }
+}
+
 /// A model configuration whose latencies contradict each other.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ConfigError {

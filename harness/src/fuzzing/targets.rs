@@ -57,12 +57,17 @@ pub fn frame_decoder(data: &[u8]) {
 /// `docs/invariants.md` checked after every op. A break panics with the
 /// invariant's id first, so libFuzzer's crash message buckets it.
 pub fn bus_bytes(data: &[u8]) {
-    bus_bytes_with(data, ModelConfig::default());
+    verdict(oracle::check_ops_default(bus_program::ops(data)));
 }
 
 /// [`bus_bytes()`] on a model with a configuration (e.g. an injected fault).
 pub fn bus_bytes_with(data: &[u8], cfg: ModelConfig) {
-    match oracle::check_ops(bus_program::ops(data), cfg) {
+    verdict(oracle::check_ops(bus_program::ops(data), cfg));
+}
+
+/// A `bus_bytes` input's verdict: a panic on a break.
+fn verdict(v: Result<Option<crate::invariants::rules::Violation>, crate::emu::ChipError>) {
+    match v {
         Ok(None) => {}
         Ok(Some(v)) => panic!("invariant {v}"),
         Err(e) => panic!("the model refused its configuration: {e}"),

@@ -38,6 +38,30 @@ pub fn check_ops(
     Ok(verdict)
 }
 
+/// [`check_ops`] on the default model ([`ModelConfig::default`]), as the
+/// `bus_bytes` fuzz target runs every input. Its checker is made once per
+/// thread and only reset between inputs: no configuration is built,
+/// compared or validated per input, work (and coverage counters, each a
+/// feature libFuzzer collects after every run) that told nothing about
+/// the input.
+pub fn check_ops_default(
+    ops: impl IntoIterator<Item = BusOp>,
+) -> Result<Option<Violation>, ChipError> {
+    thread_local! {
+        static DEFAULT: Cell<Option<Box<Checker>>> = const { Cell::new(None) };
+    }
+    let mut c = match DEFAULT.take() {
+        Some(mut c) => {
+            c.reset();
+            c
+        }
+        None => Box::new(Checker::new(ModelConfig::default())?),
+    };
+    let verdict = c.run(ops);
+    DEFAULT.set(Some(c));
+    Ok(verdict)
+}
+
 /// The oracle on the emulator: a fresh chip, fed one op at a time, each
 /// judged as it goes; [`Checker::finish`] judges the whole record.
 #[derive(Debug)]

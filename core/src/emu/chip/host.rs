@@ -18,7 +18,7 @@ impl Chip {
             written: self.now,
         });
         if !self.pick_starved {
-            let at = (self.now + self.fw(self.cfg.byte_pickup)).max(self.proc_free_at);
+            let at = (self.now + self.fw_cfg.byte_pickup).max(self.proc_free_at);
             self.schedule_pick(at);
         }
     }
@@ -42,7 +42,7 @@ impl Chip {
         let at = self
             .now
             .max(self.proc_free_at)
-            .max(inb.written + self.fw(self.cfg.byte_pickup));
+            .max(inb.written + self.fw_cfg.byte_pickup);
         self.schedule_pick(at);
     }
 
@@ -69,7 +69,7 @@ impl Chip {
         }
         self.inbuf = None;
         self.taken_written = inb.written;
-        let base = self.now - self.fw(self.cfg.byte_pickup);
+        let base = self.now - self.fw_cfg.byte_pickup;
         match inb.kind {
             ByteKind::Command => self.on_command(Command::decode(inb.byte), base),
             ByteKind::Data => self.on_data(inb.byte, base),
@@ -99,13 +99,13 @@ impl Chip {
             Command::DecelStop(_) => self.stop_command_decel(base),
             Command::SoftwareReset(_) if busy && self.cfg.faults.reset_quirk_missing => {}
             Command::SoftwareReset(_) | Command::AuxOn(_) if busy => {
-                self.schedule(base + self.fw(self.cfg.aux_switch), Timer::Aux(true));
+                self.schedule(base + self.fw_cfg.aux_switch, Timer::Aux(true));
             }
             Command::AuxOn(_) => {
-                self.schedule(base + self.fw(self.cfg.aux_switch), Timer::Aux(true));
+                self.schedule(base + self.fw_cfg.aux_switch, Timer::Aux(true));
             }
             Command::AuxOff(_) => {
-                self.schedule(base + self.fw(self.cfg.aux_switch), Timer::Aux(false));
+                self.schedule(base + self.fw_cfg.aux_switch, Timer::Aux(false));
             }
             Command::SoftwareReset(_) => self.software_reset(base),
             Command::AuxOutput => self.expect_params(cmd),
@@ -176,7 +176,7 @@ impl Chip {
             }
             Command::AuxOutput => {
                 let bits = buf[0] & 0x0F;
-                self.schedule(base + self.fw(self.cfg.aux_output), Timer::Auxo(bits));
+                self.schedule(base + self.fw_cfg.aux_output, Timer::Auxo(bits));
             }
             _ => {}
         }
@@ -210,7 +210,7 @@ impl Chip {
             Register::AuxInputs => ([AuxInputStatus::from_inputs(self.inputs).0, 0, 0], 1),
         };
         self.out_pending.extend(&bytes[..len]);
-        self.schedule(base + self.fw(self.cfg.obf_ready), Timer::ObfReady);
+        self.schedule(base + self.fw_cfg.obf_ready, Timer::ObfReady);
     }
 
     // ----- initialization and reset (Sections 3-2, 3-5-4) ----------------
@@ -273,7 +273,7 @@ impl Chip {
         let done = base + self.fw(init_time);
         self.proc_free_at = self.proc_free_at.max(done);
         self.schedule(
-            base + self.fw(self.cfg.init_outputs),
+            base + self.fw_cfg.init_outputs,
             Timer::InitOutputs { epoch },
         );
         self.schedule(done, Timer::InitDone { epoch });
@@ -284,7 +284,7 @@ impl Chip {
         self.config_epoch += 1;
         let epoch = self.config_epoch;
         self.schedule(
-            base + self.fw(self.cfg.excitation_off),
+            base + self.fw_cfg.excitation_off,
             Timer::ExcitationOff { epoch },
         );
     }

@@ -119,6 +119,9 @@ enum Timer {
 pub struct Chip {
     straps: Straps,
     cfg: ModelConfig,
+    /// `cfg` with its latencies in this board's firmware time
+    /// ([`Straps::firmware_time`]), scaled once.
+    fw_cfg: ModelConfig,
     now: Instant,
     timers: Vec<(Instant, u64, Timer)>,
     timer_seq: u64,
@@ -182,6 +185,17 @@ pub struct Chip {
     ramp_cache: RampCache,
 }
 
+/// What [`Chip::reset`] keeps of a chip for the fresh one: the memory of
+/// its timers, its record and its output buffer (emptied), and its ramp
+/// cache.
+#[derive(Default)]
+struct Kept {
+    timers: Vec<(Instant, u64, Timer)>,
+    record: OutputRecord,
+    out_pending: VecDeque<u8>,
+    ramp_cache: RampCache,
+}
+
 /// A cache, not state: shown as its size only, so a reset chip prints as
 /// a new one.
 #[derive(Clone, Default)]
@@ -198,14 +212,29 @@ impl Chip {
     pub fn new(straps: Straps, cfg: ModelConfig) -> Result<Chip, ChipError> {
         straps.validate()?;
         cfg.validate()?;
-        Ok(Chip {
-            switch_on: straps.firmware_time(cfg.switching_on),
-            switch_off: straps.firmware_time(cfg.switching_off),
+        let fw_cfg = cfg.map_latencies(|d| straps.firmware_time(d));
+        Ok(Chip::fresh(straps, cfg, fw_cfg, Kept::default()))
+    }
+
+    /// The chip out of power-on reset with straps and a configuration
+    /// already validated (and its latencies in firmware time, `fw_cfg`),
+    /// taking over the memory of `kept`.
+    fn fresh(straps: Straps, cfg: ModelConfig, fw_cfg: ModelConfig, kept: Kept) -> Chip {
+        let Kept {
+            timers,
+            record,
+            out_pending,
+            ramp_cache,
+        } = kept;
+        Chip {
+            switch_on: fw_cfg.switching_on,
+            switch_off: fw_cfg.switching_off,
             initializing: false,
             straps,
             cfg,
+            fw_cfg,
             now: Instant::ZERO,
-            timers: Vec::new(),
+            timers,
             timer_seq: 0,
             inbuf: None,
             pick_timer: None,
@@ -214,7 +243,7 @@ impl Chip {
             proc_free_at: Instant::ZERO,
             field: StatusField::ParamsRemaining(0),
             expect: Expect::Command,
-            out_pending: VecDeque::new(),
+            out_pending,
             obf: false,
             out_latch: 0,
             winding: None,
@@ -238,31 +267,28 @@ impl Chip {
             remaining: 0,
             motion: None,
             motion_seq: 0,
-            record: OutputRecord::default(),
-            ramp_cache: RampCache::default(),
-        })
+            record,
+            ramp_cache,
+        }
     }
 
     /// Back to the chip [`Chip::new`] made, with the same straps and
     /// configuration, keeping the memory of its record and its timers: a
     /// fuzz target runs a fresh chip for every input.
     pub fn reset(&mut self) {
-        let mut timers = core::mem::take(&mut self.timers);
-        let mut record = core::mem::take(&mut self.record);
-        let mut out_pending = core::mem::take(&mut self.out_pending);
-        let ramp_cache = self.keep_ramp();
-        timers.clear();
-        record.clear();
-        out_pending.clear();
-        // `new` took these straps and this configuration when it made
-        // this chip.
-        if let Ok(fresh) = Chip::new(self.straps, self.cfg.clone()) {
-            *self = fresh;
-        }
-        self.timers = timers;
-        self.record = record;
-        self.out_pending = out_pending;
-        self.ramp_cache = ramp_cache;
+        let mut kept = Kept {
+            timers: core::mem::take(&mut self.timers),
+            record: core::mem::take(&mut self.record),
+            out_pending: core::mem::take(&mut self.out_pending),
+            ramp_cache: self.keep_ramp(),
+        };
+        kept.timers.clear();
+        kept.record.clear();
+        kept.out_pending.clear();
+        // `new` validated these straps and this configuration when it made
+        // this chip: a fuzz target resets it for every input, and checking
+        // them again each time cost it time and coverage counters.
+        *self = Chip::fresh(self.straps, self.cfg.clone(), self.fw_cfg.clone(), kept);
     }
 
     /// The ramp worth keeping: the one in force (it may have computed more
@@ -350,7 +376,7 @@ impl Chip {
         if self.obf {
             self.obf = self.cfg.faults.obf_sticky;
             if !self.out_pending.is_empty() {
-                let at = self.now + self.fw(self.cfg.obf_next);
+                let at = self.now + self.fw_cfg.obf_next;
                 self.schedule(at, Timer::ObfReady);
             }
         }
@@ -598,7 +624,7 @@ impl Chip {
         };
         self.proc_free_at = self.proc_free_at.max(next);
         let epoch = self.hold_epoch;
-        let hold_at = m.last_pulse.unwrap_or(now) + self.fw(self.cfg.hold_on);
+        let hold_at = m.last_pulse.unwrap_or(now) + self.fw_cfg.hold_on;
         self.schedule(hold_at, Timer::HoldOn { epoch });
         self.serve_again();
     }

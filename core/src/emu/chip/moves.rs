@@ -100,7 +100,7 @@ impl Chip {
             winding: if cmd.pout { None } else { self.winding },
         });
         self.motion = Some(motion);
-        let rise = base + self.fw(self.cfg.busy_rise);
+        let rise = base + self.fw_cfg.busy_rise;
         self.proc_free_at = self.proc_free_at.max(rise);
         self.schedule(rise, Timer::BusyRise { id });
     }
@@ -133,7 +133,7 @@ impl Chip {
             m.decel_requested = true;
         }
         self.schedule(
-            base + self.fw(self.cfg.decel_stop),
+            base + self.fw_cfg.decel_stop,
             Timer::DecelStart {
                 id,
                 cause: StopCause::StopCommand,
@@ -179,15 +179,15 @@ impl Chip {
             return;
         }
         let latency = if at_speed {
-            self.cfg.hs_limit_cruise
+            self.fw_cfg.hs_limit_cruise
         } else {
-            self.cfg.hs_limit_accel
+            self.fw_cfg.hs_limit_accel
         };
         let id = m.id;
         if let Some(m) = self.motion.as_mut() {
             m.decel_requested = true;
         }
-        let at = self.now + self.fw(latency);
+        let at = self.now + latency;
         self.schedule(
             at,
             Timer::DecelStart {
@@ -372,12 +372,12 @@ impl Chip {
         }
         if done {
             let (end, free) = if kind == MoveKind::SingleStep {
-                let done = base + self.fw(self.cfg.single_step_done);
+                let done = base + self.fw_cfg.single_step_done;
                 (done, done)
             } else {
                 (
-                    last + self.fw(self.cfg.interrupt_delay),
-                    last + self.fw(self.cfg.next_command),
+                    last + self.fw_cfg.interrupt_delay,
+                    last + self.fw_cfg.next_command,
                 )
             };
             self.schedule(end, Timer::Terminate { id });
