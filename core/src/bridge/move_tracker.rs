@@ -16,10 +16,11 @@
 //!   from before the byte, the error of a command before included, and
 //!   settles nothing. Until settled, a record is tentative: the last one,
 //!   never served to a host ([`Bus::settle_record`]).
-//! - A byte written while the last status read since the byte before
-//!   showed IBF = 1 replaces that byte (3-1-1 (2)): what the byte before
-//!   did (a parameter counted, a command begun, a record) is undone. With
-//!   no read between, the byte before is taken as taken.
+//! - A byte written within 3 us of a status read (since the byte before)
+//!   that showed IBF = 1 replaces that byte (3-1-1 (2)): what the byte
+//!   before did (a parameter counted, a command begun, a record) is
+//!   undone. With no read between, or an older one, the byte before is
+//!   taken as taken.
 //! - The winding is that of the first initialization since reset whose
 //!   data the chip accepts (Section 3-2, Table 3-2 errors 4 and 5), settled
 //!   the same way; a software reset that is not the AUX ON quirk
@@ -35,6 +36,13 @@ use crate::protocol::{
     Status, Straps, Winding,
 };
 use crate::time::Instant;
+
+/// A write this soon after a status read that showed the byte before
+/// still waiting (IBF = 1) replaced it: the chip takes a byte within
+/// microseconds once it may (N11: 6 us after its write when idle), so a
+/// read older than this says little of the byte at the write, which is
+/// then taken as taken. A campaign reads the status right before each op.
+const REPLACED_WITHIN: crate::time::Duration = crate::time::Duration::from_micros(3);
 
 /// What a tentative record was, to undo it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -64,9 +72,9 @@ pub struct MoveTracker {
     /// BUSY as the last status read showed it.
     busy: bool,
     tentative: Option<Tentative>,
-    /// The last status read since the last write showed that byte still
-    /// in the input buffer (IBF = 1).
-    still_waiting: bool,
+    /// When the last status read since the last write showed that byte
+    /// still in the input buffer (IBF = 1).
+    waiting_seen: Option<Instant>,
     /// What the tracker knew before the last write, to undo it if the
     /// next write replaced that byte.
     before_last: Option<Before>,
@@ -125,7 +133,10 @@ impl MoveTracker {
         // kept, as the chip most often takes a byte before the next. The
         // status reads from here on tell of this byte (N6: an unasked-for
         // data byte raises an error of its own).
-        if let Some(b) = self.before_last.take().filter(|_| self.still_waiting) {
+        let replaced = self
+            .waiting_seen
+            .is_some_and(|t| at.saturating_since(t) <= REPLACED_WITHIN);
+        if let Some(b) = self.before_last.take().filter(|_| replaced) {
             self.params = b.params;
             self.winding = b.winding;
             self.initialized = b.initialized;
@@ -133,7 +144,7 @@ impl MoveTracker {
             rec.moves.truncate(b.moves);
         }
         self.tentative = None;
-        self.still_waiting = false;
+        self.waiting_seen = None;
         self.before_last = Some(Before {
             params: self.params,
             winding: self.winding,
@@ -243,10 +254,10 @@ impl MoveTracker {
         usize::from(self.tentative == Some(Tentative::Move))
     }
 
-    /// The bridge read the status register.
-    pub fn on_status(&mut self, rec: &mut OutputRecord, status: Status) {
+    /// The bridge read the status register at `at`.
+    pub fn on_status(&mut self, rec: &mut OutputRecord, status: Status, at: Instant) {
         self.busy = status.busy();
-        self.still_waiting = status.ibf();
+        self.waiting_seen = status.ibf().then_some(at);
         if status.ibf() {
             return; // the byte not taken yet: nothing to settle by
         }
@@ -361,7 +372,7 @@ impl<B: Bus> Bus for Tracked<B> {
                 | Reply::AwaitTimedOut { status, .. }
                 | Reply::WriteTimedOut { status, .. }
                 | Reply::ReadTimedOut { status, .. },
-            ) => self.tracker.on_status(&mut self.record, status),
+            ) => self.tracker.on_status(&mut self.record, status, reply.at()),
             _ => {}
         }
         reply
@@ -408,7 +419,7 @@ mod tests {
         for b in [0x64, 0x14, 0x64, 0x00] {
             t.on_write(rec, false, b, Instant::ZERO, 0);
         }
-        t.on_status(rec, Status(status));
+        t.on_status(rec, Status(status), Instant::ZERO);
     }
 
     /// Section 3-2, bit 5 of the initialization code: stop switching as the
@@ -429,9 +440,13 @@ mod tests {
         assert!(!t.stop_switching(), "a reset forgets it");
     }
 
+    fn us(n: u64) -> Instant {
+        Instant::from_nanos(n * 1_000)
+    }
+
     /// A zero-parameter move (`code`, Section 3-3) written at 10 us.
     fn move_code(t: &mut MoveTracker, rec: &mut OutputRecord, code: u8) {
-        t.on_write(rec, true, code, Instant::from_nanos(10_000), 0);
+        t.on_write(rec, true, code, us(10), 0);
     }
 
     /// Section 3-1-1 and N6: a status read that still shows IBF = 1 shows
@@ -451,17 +466,21 @@ mod tests {
         // The command before was refused: its error shows until the chip
         // takes this code.
         move_code(&mut t, &mut rec, code);
-        t.on_status(&mut rec, Status(Status::ERROR | Status::IBF | 0x10));
+        t.on_status(&mut rec, Status(Status::ERROR | Status::IBF | 0x10), us(11));
         assert_eq!(rec.moves.len(), 1, "a stale error withdraws nothing");
         assert_eq!(t.unsettled(), 1);
-        t.on_status(&mut rec, Status(Status::BUSY));
+        t.on_status(&mut rec, Status(Status::BUSY), us(11));
         assert_eq!((rec.moves.len(), t.unsettled()), (1, 0), "taken: kept");
 
         // Refused while BUSY (error 1), seen only once IBF is 0.
         move_code(&mut t, &mut rec, code);
-        t.on_status(&mut rec, Status(Status::IBF | Status::BUSY));
+        t.on_status(&mut rec, Status(Status::IBF | Status::BUSY), us(11));
         assert_eq!((rec.moves.len(), t.unsettled()), (2, 1), "not settled yet");
-        t.on_status(&mut rec, Status(Status::ERROR | Status::BUSY | 0x10));
+        t.on_status(
+            &mut rec,
+            Status(Status::ERROR | Status::BUSY | 0x10),
+            us(11),
+        );
         assert_eq!(
             (rec.moves.len(), t.unsettled()),
             (1, 0),
@@ -485,7 +504,7 @@ mod tests {
         );
         let code = Command::Move(m).encode();
         move_code(&mut t, &mut rec, code);
-        t.on_status(&mut rec, Status(Status::IBF));
+        t.on_status(&mut rec, Status(Status::IBF), us(11));
         move_code(&mut t, &mut rec, code);
         assert_eq!(
             rec.moves.len(),
@@ -494,22 +513,32 @@ mod tests {
         );
         move_code(&mut t, &mut rec, code);
         assert_eq!(rec.moves.len(), 2, "no read between: the second kept");
-        t.on_status(&mut rec, Status(Status::BUSY));
+        t.on_status(&mut rec, Status(Status::BUSY), us(11));
         assert_eq!((rec.moves.len(), t.unsettled()), (2, 0));
+        // A read that showed the code waiting, long before the next write:
+        // the chip has taken it since (N11), and the move stays.
+        move_code(&mut t, &mut rec, code);
+        t.on_status(&mut rec, Status(Status::IBF | Status::BUSY), us(11));
+        t.on_write(&mut rec, true, code, us(1_000), 0);
+        assert_eq!(
+            rec.moves.len(),
+            4,
+            "the move before kept, this one tentative"
+        );
 
         // A parameter written over is one parameter: an accel/decel move
         // (three) is made by its fourth data byte here.
         let (mut t, mut rec) = (MoveTracker::new(), OutputRecord::default());
         init(&mut t, &mut rec, 0x02, 0);
         let m = MoveCommand::new(MoveKind::AccelDecel, crate::protocol::Direction::Cw, false);
-        t.on_write(&mut rec, true, Command::Move(m).encode(), Instant::ZERO, 0);
-        t.on_write(&mut rec, false, 10, Instant::ZERO, 0);
-        t.on_status(&mut rec, Status(Status::IBF | 0x20));
+        t.on_write(&mut rec, true, Command::Move(m).encode(), us(1), 0);
+        t.on_write(&mut rec, false, 10, us(10), 0);
+        t.on_status(&mut rec, Status(Status::IBF | 0x20), us(11));
         for b in [20, 0] {
-            t.on_write(&mut rec, false, b, Instant::ZERO, 0);
+            t.on_write(&mut rec, false, b, us(12), 0);
         }
         assert!(rec.moves.is_empty(), "two parameters taken of three");
-        t.on_write(&mut rec, false, 0, Instant::ZERO, 0);
+        t.on_write(&mut rec, false, 0, us(30), 0);
         assert_eq!(rec.moves.len(), 1);
         assert_eq!(
             rec.moves[0].steps,

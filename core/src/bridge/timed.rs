@@ -141,6 +141,12 @@ impl<B: Bus> Bus for Timed<B> {
         &self.record
     }
 
+    fn settle_record(&mut self) -> usize {
+        let tentative = self.inner.settle_record();
+        self.sync();
+        tentative
+    }
+
     fn straps(&self) -> Straps {
         self.inner.straps()
     }

@@ -98,7 +98,8 @@ impl Pool {
         rarity * quick / (quick + e.took.as_nanos() as f64)
     }
 
-    /// An entry drawn by [`Pool::weight`]; `None` from an empty pool.
+    /// An entry drawn by its weight (the rarity of its features, less for a
+    /// slow input); `None` from an empty pool.
     pub fn draw(&self, rng: &mut StdRng) -> Option<&Entry> {
         let weights: Vec<f64> = self.entries.iter().map(|e| self.weight(e)).collect();
         let total: f64 = weights.iter().sum();

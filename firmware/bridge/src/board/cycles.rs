@@ -184,7 +184,8 @@ impl<H: Hal> Board<H> {
     /// and a change of BUSY.
     pub(super) fn note_status(&mut self, t: u64, status: Status) {
         self.wrote = false;
-        self.tracker.on_status(&mut self.record, status);
+        let at = self.at(t);
+        self.tracker.on_status(&mut self.record, status, at);
         let prev = core::mem::replace(&mut self.last_status, t);
         if status.busy() != self.busy {
             self.busy = status.busy();

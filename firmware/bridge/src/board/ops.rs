@@ -594,7 +594,11 @@ impl<H: Hal> Bus for Board<H> {
                 self.hal.resync();
             }
             self.early_status = None;
+            // A read of the board's own: the next request's ops are timed
+            // from the op before it, and a write's pulses still guarded.
+            let (moment, wrote) = (self.moment, self.wrote);
             self.read_status(None);
+            (self.moment, self.wrote) = (moment, wrote);
             self.batch_done = true;
         }
         self.tracker.unsettled()
