@@ -10,7 +10,7 @@ use alloc::format;
 use alloc::string::String;
 use ppmc_core::bus::{Op, Reply};
 use ppmc_core::protocol::{Pin, Status};
-use ppmc_core::time::Duration;
+use ppmc_core::time::{Duration, Instant};
 
 /// Two status reads at most this far apart (ns) are a wait's loop: a flag
 /// that changed between them is stamped halfway, within half of it (the
@@ -184,7 +184,13 @@ impl<H: Hal> Board<H> {
     /// and a change of BUSY.
     pub(super) fn note_status(&mut self, t: u64, status: Status) {
         self.wrote = false;
-        let at = self.at(t);
+        // The read's time only where the tracker keeps it (a byte seen
+        // waiting): a status wait's every pass costs the image's CPU.
+        let at = if status.ibf() {
+            self.at(t)
+        } else {
+            Instant::ZERO
+        };
         self.tracker.on_status(&mut self.record, status, at);
         let prev = core::mem::replace(&mut self.last_status, t);
         if status.busy() != self.busy {
