@@ -321,7 +321,7 @@ fn busy_at_its_earliest(
     // the bridge saw at a read of its own.
     let mut last_change = None;
     for p in c.pins.iter_mut() {
-        if p.pin != crate::protocol::Pin::Busy {
+        if !is_busy(p) {
             continue;
         }
         let was = last_change.replace(p.at);
@@ -365,7 +365,7 @@ fn busy_the_polling_missed(
         .collect();
     let mut unseen: Vec<(crate::time::Instant, crate::time::Instant)> = Vec::new();
     for r in &c.runs {
-        if busy_level(&c, r.start) {
+        if crate::invariants::capture::busy_level(&c, r.start) {
             continue;
         }
         match unseen.last_mut() {
@@ -423,15 +423,6 @@ fn polls_busy(u: crate::backend::Uncertainty) -> bool {
 
 fn is_busy(p: &crate::protocol::PinEvent) -> bool {
     p.pin == crate::protocol::Pin::Busy
-}
-
-/// The level of the capture's BUSY line at `t` (changes at `t` included).
-fn busy_level(c: &OutputRecord, t: crate::time::Instant) -> bool {
-    c.pins
-        .iter()
-        .rev()
-        .find(|p| is_busy(p) && p.at <= t)
-        .is_some_and(|p| p.value != 0)
 }
 
 /// Runs a campaign on `target` from `seeds` until its budget of board
@@ -514,11 +505,10 @@ pub fn run(
             let reached = features(&ops);
             let ids = pool.note(&reached);
             let new: Vec<String> = reached.into_iter().filter(|f| !seen.contains(f)).collect();
-            if is_seed && !s.blind {
+            // The seeds, and what reached something new, for drawing.
+            if !s.blind && (is_seed || !new.is_empty()) {
                 pool.keep(input.clone(), took, ids);
-            } else if !new.is_empty() && !s.blind {
-                pool.keep(input.clone(), took, ids);
-                stats.corpus += 1;
+                stats.corpus += usize::from(!is_seed);
             }
             if !new.is_empty() {
                 stats.features += new.len();
@@ -1033,7 +1023,7 @@ mod tests {
         );
         // A read among the pulses that saw BUSY at 0: no BUSY is made up.
         let among = [status(us(10), false), status(us(200), false)];
-        assert!(busy_at_its_earliest(&capture, &among, bridge)
+        assert!(busy_the_polling_missed(&capture, &among, bridge)
             .pins
             .is_empty());
         // An exact capture is judged as it is, and so is one whose bridge

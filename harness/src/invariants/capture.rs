@@ -8,7 +8,7 @@ use crate::protocol::capture::{OutputRecord, Pin, PulseRun};
 use crate::time::{Duration, Instant};
 
 /// The level of the recorded BUSY line at `t` (changes at `t` included).
-pub(super) fn busy_level(rec: &OutputRecord, t: Instant) -> bool {
+pub(crate) fn busy_level(rec: &OutputRecord, t: Instant) -> bool {
     rec.pins
         .iter()
         .rev()
