@@ -74,10 +74,6 @@ pub struct BridgeEngine<B> {
     /// host had fetched): the host's positions count from the reset, the
     /// bus's record from here.
     forgotten: OutputMark,
-    /// The record's last move records the bus holds tentatively
-    /// ([`Bus::settle_record`]), as of the last capture served: not served
-    /// yet.
-    tentative: usize,
     /// The host session of the last HELLO (0: none yet).
     host: u32,
     /// The last request that was not a HELLO, LINK or RESEND, and the
@@ -117,7 +113,6 @@ impl<B: Bus> BridgeEngine<B> {
             virtual_time,
             capture_capacity: u32::MAX,
             forgotten: OutputMark::default(),
-            tentative: 0,
             host: 0,
             last: None,
             control: None,
@@ -374,11 +369,11 @@ impl<B: Bus> BridgeEngine<B> {
                     }
                     Ok(()) => match replies.finish() {
                         Ok(mut bytes) => {
-                            self.tentative = self.bus.settle_record();
+                            let tentative = self.bus.settle_record();
                             // The capture takes what room the replies leave.
                             let mut max = max;
                             loop {
-                                let chunk = self.chunk(runs, pins, moves, max);
+                                let chunk = self.chunk(runs, pins, moves, max, tentative);
                                 let capture = capture_bytes(&chunk, self.timer);
                                 if max <= 1 || bytes.len() + capture.len() <= MAX_REPLY {
                                     bytes.extend_from_slice(&capture);
@@ -388,8 +383,10 @@ impl<B: Bus> BridgeEngine<B> {
                             }
                         }
                         // Too long with the least capture too.
+                        // (Its size with every record counted: nothing is
+                        // served, so nothing need be settled.)
                         Err(len) => {
-                            let chunk = self.chunk(runs, pins, moves, 1);
+                            let chunk = self.chunk(runs, pins, moves, 1, 0);
                             self.overflow(seq, len + capture_bytes(&chunk, self.timer).len())
                         }
                     },
@@ -440,8 +437,8 @@ impl<B: Bus> BridgeEngine<B> {
                 (Some(held), _) => self.overrun_error(held),
                 (None, Some(gone)) => gone,
                 (None, None) => {
-                    self.tentative = self.bus.settle_record();
-                    Response::Capture(self.chunk(runs, pins, moves, max))
+                    let tentative = self.bus.settle_record();
+                    Response::Capture(self.chunk(runs, pins, moves, max, tentative))
                 }
             },
             Request::BatchCapture { .. } => Response::Error {
@@ -697,11 +694,11 @@ impl<B: Bus> BridgeEngine<B> {
     }
 
     /// Up to `max` capture records of each kind from these positions on
-    /// (counted from the last reset; [`Self::let_go`] has run), but for
-    /// tentative move records.
-    fn chunk(&self, runs: u32, pins: u32, moves: u32, max: u16) -> CaptureChunk {
+    /// (counted from the last reset; [`Self::let_go`] has run), but for the
+    /// last `tentative` move records ([`Bus::settle_record`]).
+    fn chunk(&self, runs: u32, pins: u32, moves: u32, max: u16, tentative: usize) -> CaptureChunk {
         let rec = self.bus.record();
-        let settled = rec.moves.len().saturating_sub(self.tentative);
+        let settled = rec.moves.len().saturating_sub(tentative);
         let gone = self.forgotten;
         let (runs, pins, moves) = (
             runs.saturating_sub(gone.runs as u32),
@@ -1109,6 +1106,18 @@ mod tests {
         assert!(detail.contains("let go"), "{detail}");
     }
 
+    /// A batch of `ops`, with the capture from the last reset on (up to
+    /// 60 records of each kind).
+    fn from_the_reset(ops: Vec<Op>) -> Request {
+        Request::BatchCapture {
+            ops,
+            runs: 0,
+            pins: 0,
+            moves: 0,
+            max: 60,
+        }
+    }
+
     #[test]
     fn batch_capture_runs_the_ops_then_returns_the_capture_after_them() {
         let mut s = server();
@@ -1122,17 +1131,9 @@ mod tests {
             },
             Op::Delay(Duration::from_millis(5)),
         ]);
-        let Response::BatchCapture { replies, capture } = ask(
-            &mut s,
-            1,
-            &Request::BatchCapture {
-                ops: ops.clone(),
-                runs: 0,
-                pins: 0,
-                moves: 0,
-                max: 60,
-            },
-        ) else {
+        let Response::BatchCapture { replies, capture } =
+            ask(&mut s, 1, &from_the_reset(ops.clone()))
+        else {
             panic!("batch-capture reply");
         };
         assert_eq!(replies.len(), ops.len());
@@ -1140,13 +1141,7 @@ mod tests {
         assert_eq!(capture.moves.len(), rec.moves.len());
         assert_eq!(capture.runs, rec.runs);
         assert!(!capture.moves.is_empty(), "the step's move is in the chunk");
-        let too_many = Request::BatchCapture {
-            ops: vec![Op::ReadStatus; usize::from(MAX_BATCH_OPS) + 1],
-            runs: 0,
-            pins: 0,
-            moves: 0,
-            max: 60,
-        };
+        let too_many = from_the_reset(vec![Op::ReadStatus; usize::from(MAX_BATCH_OPS) + 1]);
         assert!(matches!(
             ask(&mut s, 2, &too_many),
             Response::Error {
@@ -1167,17 +1162,7 @@ mod tests {
         let bus = EmuBus::new(Straps::default(), ModelConfig::default()).expect("emu");
         let mut s = BridgeEngine::new(Tracked::new(bus), 42, true, "test-bridge");
         let capture = |s: &mut BridgeEngine<Tracked<EmuBus>>, seq, ops: Vec<Op>| {
-            let Response::BatchCapture { capture, .. } = ask(
-                s,
-                seq,
-                &Request::BatchCapture {
-                    ops,
-                    runs: 0,
-                    pins: 0,
-                    moves: 0,
-                    max: 60,
-                },
-            ) else {
+            let Response::BatchCapture { capture, .. } = ask(s, seq, &from_the_reset(ops)) else {
                 panic!("batch-capture reply");
             };
             capture

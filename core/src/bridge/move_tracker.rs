@@ -44,17 +44,14 @@ use crate::time::Instant;
 /// then taken as taken. A campaign reads the status right before each op.
 const REPLACED_WITHIN: crate::time::Duration = crate::time::Duration::from_micros(3);
 
-/// What a tentative record was, to undo it.
+/// What a tentative record is: undone, if the chip refuses it, from
+/// what the tracker knew before its last byte ([`Before`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Tentative {
     /// A move record, the last of the record's moves.
     Move,
-    /// An initialization, with the winding and logic before it.
-    Init {
-        before: Option<(Winding, OutputLogic)>,
-        was_initialized: bool,
-        was_switching: bool,
-    },
+    /// An initialization: the winding, logic and stop switching it set.
+    Init,
 }
 
 /// Keeps a record's move records from the bus traffic a bridge sees.
@@ -138,10 +135,7 @@ impl MoveTracker {
             .is_some_and(|t| at.saturating_since(t) <= REPLACED_WITHIN);
         if let Some(b) = self.before_last.take().filter(|_| replaced) {
             self.params = b.params;
-            self.winding = b.winding;
-            self.initialized = b.initialized;
-            self.switching = b.switching;
-            rec.moves.truncate(b.moves);
+            self.undo(rec, b);
         }
         self.tentative = None;
         self.waiting_seen = None;
@@ -193,11 +187,7 @@ impl MoveTracker {
                     && data.rl < 255
                     && (PA_MIN..=PA_MAX).contains(&data.pa);
                 if ok && !self.busy {
-                    self.tentative = Some(Tentative::Init {
-                        before: self.winding,
-                        was_initialized: self.initialized,
-                        was_switching: self.switching,
-                    });
+                    self.tentative = Some(Tentative::Init);
                     self.switching = c.stop_switching;
                     if self.winding.is_none() {
                         let w = Winding {
@@ -261,31 +251,21 @@ impl MoveTracker {
         if status.ibf() {
             return; // the byte not taken yet: nothing to settle by
         }
-        let Some(t) = self.tentative.take() else {
-            return;
-        };
-        if status.error_flag() {
-            self.withdraw(rec, t); // refused
+        if self.tentative.take().is_some() && status.error_flag() {
+            // Refused: undone, its bytes taken all the same.
+            if let Some(b) = self.before_last {
+                self.undo(rec, b);
+            }
         }
     }
 
-    /// Undoes a tentative record: the chip refused its command, or never
-    /// took its last byte.
-    fn withdraw(&mut self, rec: &mut OutputRecord, t: Tentative) {
-        match t {
-            Tentative::Move => {
-                rec.moves.pop();
-            }
-            Tentative::Init {
-                before,
-                was_initialized,
-                was_switching,
-            } => {
-                self.winding = before;
-                self.initialized = was_initialized;
-                self.switching = was_switching;
-            }
-        }
+    /// Back to what the tracker knew before a write (`b`), a record that
+    /// write made withdrawn, but for the parameters expected.
+    fn undo(&mut self, rec: &mut OutputRecord, b: Before) {
+        self.winding = b.winding;
+        self.initialized = b.initialized;
+        self.switching = b.switching;
+        rec.moves.truncate(b.moves);
     }
 }
 
@@ -444,6 +424,17 @@ mod tests {
         Instant::from_nanos(n * 1_000)
     }
 
+    /// A continuous high-speed move's code (Section 3-3-7): no
+    /// parameters, the code is its last byte.
+    fn continuous_high() -> u8 {
+        let m = MoveCommand::new(
+            MoveKind::ContinuousHigh,
+            crate::protocol::Direction::Cw,
+            false,
+        );
+        Command::Move(m).encode()
+    }
+
     /// A zero-parameter move (`code`, Section 3-3) written at 10 us.
     fn move_code(t: &mut MoveTracker, rec: &mut OutputRecord, code: u8) {
         t.on_write(rec, true, code, us(10), 0);
@@ -456,13 +447,7 @@ mod tests {
     fn a_move_is_settled_by_the_first_status_read_with_ibf_0() {
         let (mut t, mut rec) = (MoveTracker::new(), OutputRecord::default());
         init(&mut t, &mut rec, 0x02, 0);
-        // Continuous high-speed: no parameters, the code is its last byte.
-        let m = MoveCommand::new(
-            MoveKind::ContinuousHigh,
-            crate::protocol::Direction::Cw,
-            false,
-        );
-        let code = Command::Move(m).encode();
+        let code = continuous_high();
         // The command before was refused: its error shows until the chip
         // takes this code.
         move_code(&mut t, &mut rec, code);
@@ -497,12 +482,7 @@ mod tests {
     fn a_move_written_over_while_it_waited_is_withdrawn() {
         let (mut t, mut rec) = (MoveTracker::new(), OutputRecord::default());
         init(&mut t, &mut rec, 0x02, 0);
-        let m = MoveCommand::new(
-            MoveKind::ContinuousHigh,
-            crate::protocol::Direction::Cw,
-            false,
-        );
-        let code = Command::Move(m).encode();
+        let code = continuous_high();
         move_code(&mut t, &mut rec, code);
         t.on_status(&mut rec, Status(Status::IBF), us(11));
         move_code(&mut t, &mut rec, code);
