@@ -140,8 +140,18 @@ pub enum Pin {
     /// initialization and excitation off).
     Phases,
     /// Stop switching (chopping) of the phase outputs: 1 = active.
+    /// A bridge that samples S1..S5 infers it from the chopping it sees
+    /// ([`SWITCHING_WINDOW`]).
     Switching,
 }
+
+/// How late a bridge that samples S1..S5 with its CPU may report stop
+/// switching (`docs/bridge-protocol.md`, pin code 7): it reports the
+/// chopping from its first edge, Diagram 3-5's ON stretch after it began
+/// (at most about 0.8 ms at 16 MHz, Equations 3-5 and 3-6), and its end
+/// when this long passes with no edge. A stretch of stop switching that
+/// ends before its first edge shows nothing to see.
+pub const SWITCHING_WINDOW: crate::time::Duration = crate::time::Duration::from_micros(1000);
 
 impl Pin {
     pub const ALL: [Pin; 8] = [

@@ -12,6 +12,7 @@ pub mod timing;
 
 pub use capture::{
     EdgeRuns, MoveStart, OutputMark, OutputRecord, Pin, PinEvent, Pins, PulseRun, PulseSummary,
+    SWITCHING_WINDOW,
 };
 pub use command::{
     ClockSource, Command, Direction, Excitation, InitCommand, InitData, MotorType, MoveCommand,

@@ -91,6 +91,17 @@ impl Unsure {
         self.both(|u| u.edge + u.edge)
     }
 
+    /// Whether a side reports stop switching (SWITCHING) by inference
+    /// from S1..S5 sampled by its CPU (its sampled outputs less sure than
+    /// its edges), as a board's bridge does: reported up to two
+    /// [`crate::protocol::SWITCHING_WINDOW`]s late, and not at all for a
+    /// stretch that ends before the chopping's first edge. Such a
+    /// SWITCHING is not compared change by change (`docs/conformance.md`).
+    pub(super) fn infers_switching(&self) -> bool {
+        let infers = |u: &Uncertainty| u.sampled > u.edge;
+        infers(&self.golden) || infers(&self.got)
+    }
+
     /// A pin's change, from the write that started the move.
     pub(super) fn pin(&self, pin: Pin) -> Duration {
         self.both(|u| u.access + u.of_pin(pin))

@@ -366,6 +366,88 @@ fn a_sampled_change_seen_as_the_board_code_idles_is_stamped_within_its_uncertain
     );
 }
 
+/// Section 3-5-1 through the board code: an initialization that asks for
+/// stop switching (bit 5), then 30 ms in a wait for OBF that never comes
+/// (the board code looks at the outputs at every pass and samples them
+/// every 200 us). The twin reports SWITCHING on once, at the chopping's
+/// first edge (Diagram 3-5's 65 us ON stretch after the model's HOLD ON,
+/// within its sampled uncertainty), and no phase change after the
+/// initialization's: sampled alone, the 174 us chopping beat with the
+/// 200 us samples, and the board code recorded a phase change every
+/// 12 ms, all to the same pattern (the differential run found it).
+#[test]
+fn stop_switching_is_reported_once_from_its_first_edge_however_the_samples_fall() {
+    use ppmc::backend::{Op, Reply, Target};
+    use ppmc::fuzzing::reference::{run_at, starts};
+    use ppmc::protocol::{OutputRecord, Pin};
+    use ppmc::time::{Duration, Instant};
+    let twin = Served::start("run-twin", &[]);
+    let mut t = twin.target();
+    let mut emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+    let wait = Some(Duration::from_millis(10));
+    let wc = |byte| Op::WriteCommand {
+        byte,
+        wait_ibf: wait,
+    };
+    let wd = |byte| Op::WriteData {
+        byte,
+        wait_ibf: wait,
+    };
+    let batches = [
+        vec![Op::Reset],
+        vec![wc(0x22), wd(100), wd(20), wd(100), wd(0), Op::ReadStatus],
+        vec![
+            Op::ReadData {
+                wait_obf: Some(Duration::from_millis(30)),
+            },
+            Op::ReadStatus,
+        ],
+    ];
+    let (mut twin_at, mut emu_at) = (Instant::ZERO, Instant::ZERO);
+    for ops in &batches {
+        let replies = t.execute(ops).expect("the twin runs it");
+        let begun = starts(ops, &replies, twin_at, false);
+        let on_emu = run_at(&mut emu, ops, &begun, emu_at).expect("the model runs it");
+        twin_at = replies.last().map_or(twin_at, Reply::at);
+        emu_at = on_emu.last().map_or(emu_at, Reply::at);
+    }
+    let of = |r: &OutputRecord, pin: Pin| -> Vec<(Instant, u8)> {
+        r.pins
+            .iter()
+            .filter(|e| e.pin == pin)
+            .map(|e| (e.at, e.value))
+            .collect()
+    };
+    let (got, want) = (
+        t.capture().expect("the twin's capture"),
+        emu.capture().expect("the model's capture"),
+    );
+    let (chop, model_chop) = (of(&got, Pin::Switching), of(&want, Pin::Switching));
+    assert_eq!(
+        model_chop.len(),
+        1,
+        "the model chops to the end: {model_chop:?}"
+    );
+    assert_eq!(chop.len(), 1, "SWITCHING on once: {chop:?}");
+    let values = |v: Vec<(Instant, u8)>| v.into_iter().map(|(_, x)| x).collect::<Vec<u8>>();
+    assert_eq!(
+        values(of(&got, Pin::Phases)),
+        values(of(&want, Pin::Phases)),
+        "the phase pattern changes only where the model's does: {:?}",
+        of(&got, Pin::Phases)
+    );
+    let u = t.uncertainty();
+    let late = chop[0].0.saturating_since(model_chop[0].0);
+    let first_edge = Duration::from_micros(65);
+    assert!(
+        chop[0].0 >= model_chop[0].0
+            && late.max(first_edge).saturating_sub(late.min(first_edge)) <= u.sampled + u.access,
+        "SWITCHING on at {} on the twin, {} in the model: {late} after, the first edge {first_edge} after",
+        chop[0].0,
+        model_chop[0].0
+    );
+}
+
 /// Issue 45: a guided campaign against the twin (the bridge's own board
 /// code in front of a clean chip), each input from a chip reset, judged
 /// by the invariants and against the model on the twin's timeline, runs

@@ -110,7 +110,8 @@ impl<H: Hal> Board<H> {
         // by now (or by the pin read that saw it first): stamped halfway,
         // within half the bracket ([`Board::longest_bracket`]).
         let since = core::mem::replace(&mut self.unchanged, sampled);
-        let end = match self.changed_by.take() {
+        let seen = self.changed_by.take();
+        let end = match seen {
             Some((c, w)) if w == word && word != self.last_word => c.max(since).min(sampled),
             _ => sampled,
         };
@@ -123,7 +124,7 @@ impl<H: Hal> Board<H> {
         // `sample` looks for one that came since the drain).
         let stepped = self.last_pulse + SETTLE_TICKS >= before;
         let recorded = self.pending.len();
-        self.sample(word, changed, sampled, stepped);
+        self.sample(word, changed, sampled, stepped, seen.map(|(_, w)| w));
         // How sure the stamps of the changes recorded are (steps are not).
         if self.pending.len() > recorded {
             self.longest_bracket = self.longest_bracket.max(bracket);

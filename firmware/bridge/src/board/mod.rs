@@ -134,8 +134,12 @@ pub struct Board<H: Hal> {
     lost: bool,
     /// Stop switching seen: the phases chopping on and off while stopped.
     switching: bool,
-    /// When S1..S5 last went all off or came back from it (ticks).
+    /// When S1..S5 last went all off or came back from it while the chip
+    /// may chop them (ticks).
     last_toggle: Option<u64>,
+    /// The energized pattern the record last gave (S, pin code 6): a
+    /// change is recorded only when the value changes.
+    recorded_s: u8,
     /// The bridge's own hardware failed: what.
     fault: Option<String>,
     /// Capture overruns since boot (each restarted the counters).
@@ -215,6 +219,7 @@ impl<H: Hal> Board<H> {
             lost: false,
             switching: false,
             last_toggle: None,
+            recorded_s: 0,
             fault: None,
             overruns: 0,
             abort: None,
@@ -222,7 +227,7 @@ impl<H: Hal> Board<H> {
         bus.leads = ops::Lag::ALL.map(|k| bus.work_out_lead(k));
         let word = bus.hal.read_high_pins() & pins::SAMPLED_HIGH;
         let now = bus.now_ticks();
-        bus.sample(word, bus.at(now), now, false);
+        bus.sample(word, bus.at(now), now, false, None);
         bus.last_word = word;
         bus
     }

@@ -251,6 +251,7 @@ impl<H: Hal> Board<H> {
         self.busy = false;
         self.switching = false;
         self.last_toggle = None;
+        self.recorded_s = self.energized(self.last_s);
         Reply::ResetDone {
             at: self.at(self.epoch),
         }

@@ -5,12 +5,12 @@
 use super::Board;
 use crate::hal::{Counter, Hal};
 use crate::pins;
-use ppmc_core::protocol::{Direction, OutputLogic, Pin, Pins};
+use ppmc_core::protocol::{Direction, OutputLogic, Pin, Pins, SWITCHING_WINDOW};
 use ppmc_core::time::Instant;
 
-/// Phases that go off and on again within this (ticks at 75 MHz: 1 ms)
-/// are being chopped (stop switching), not switched.
-const CHOP_TICKS: u64 = 75_000;
+/// Stop switching ends when no toggle comes for [`SWITCHING_WINDOW`]
+/// (ticks at 75 MHz).
+const CHOP_TICKS: u64 = SWITCHING_WINDOW.as_nanos() * 3 / 40;
 
 /// S1..S5 (S1 in bit 4), AUXO0..3 asserted (bit i: AUXOi) and DIR, from
 /// [`Hal::read_high_pins`]'s word.
@@ -31,56 +31,72 @@ fn high(word: u16, g: u32) -> bool {
 }
 
 impl<H: Hal> Board<H> {
-    /// Records changes of the outputs the CPU samples.
+    /// Records changes of the outputs the CPU samples: `word` now (tick
+    /// `now`; a change in it stamped `at`), and `sighted`, other levels
+    /// seen between this sample and the last (a status wait looks at the
+    /// outputs at every pass and samples them only now and then).
     ///
     /// S1..S5 change with every step of a move; the protocol records their
     /// pattern only when it changes otherwise (initialization, excitation
     /// off), so a change with pulses since the last sample is a step and
     /// is not recorded (`stepped`: the capture took pulses since the last
-    /// sample). Stop switching chops the phases off and on while
-    /// stopped: toggles closer than 1 ms are recorded as SWITCHING on, and
-    /// a millisecond without one as SWITCHING off. (A heuristic of the
-    /// firmware, not yet checked on hardware: docs/bridge-hardware.md.)
-    pub(super) fn sample(&mut self, word: u16, at: Instant, now: u64, stepped: bool) {
+    /// sample). Stop switching chops the phases off and on while the
+    /// motor is stopped: from HOLD ON until BUSY rises, after an
+    /// initialization that asked for it (Section 3-2, bit 5; 3-5-1). A
+    /// toggle then is recorded as SWITCHING on, and HOLD off or
+    /// [`SWITCHING_WINDOW`] without one as SWITCHING off. (Not yet checked
+    /// on hardware: docs/bridge-hardware.md.)
+    pub(super) fn sample(
+        &mut self,
+        word: u16,
+        at: Instant,
+        now: u64,
+        stepped: bool,
+        sighted: Option<u16>,
+    ) {
         let (s, auxo, dir) = sampled_levels(word);
-        if s != self.last_s {
-            let (was, is) = (self.energized(self.last_s), self.energized(s));
-            let toggle = was == 0 || is == 0;
-            // Only an initialization that asked for it makes the chip
-            // chop (Section 3-2, bit 5), never before the first one.
-            // A toggle before the last chip reset is no partner: the
-            // phases an initialization right after a reset turns on are
-            // not chopping.
-            let chopping = toggle
-                && self.tracker.stop_switching()
-                && self
-                    .last_toggle
-                    .is_some_and(|t| now.saturating_sub(t) < CHOP_TICKS);
-            // A toggle while the chip was not asked to chop (before the
-            // initialization that asks, after a software reset) is no
-            // partner either.
-            if toggle {
-                self.last_toggle = self.tracker.stop_switching().then_some(now);
+        // A toggle: the phases all off, or back on from it. One sighted
+        // between samples counts too: sampled every 200 us, a chopping of
+        // 174 us (Diagram 3-5's default) shows the sample its levels
+        // changing only as the two beat, some 12 ms apart.
+        let dark = |levels: u8| self.energized(levels) == 0;
+        let toggled = |levels: u8| levels != self.last_s && (dark(levels) || dark(self.last_s));
+        let toggle = toggled(s) || sighted.is_some_and(|w| toggled(sampled_levels(w).0));
+        let hold = self.sm_level(Pin::Hold);
+        let may_chop = self.tracker.stop_switching() && hold;
+        if toggle && may_chop {
+            self.last_toggle = Some(now);
+            if !self.switching {
+                self.switching = true;
+                self.pin(at, Pin::Switching, 1);
             }
-            self.last_s = s;
-            if chopping {
-                if !self.switching {
-                    self.switching = true;
-                    self.pin(at, Pin::Switching, 1);
-                }
-            } else if !stepped && self.hal.capture_peek(Counter::Pout, 0).is_none() {
-                // Not a step unless a POUT word came since the drain: a CPU
-                // as quick as the RP2350's reads the outputs before the
-                // pulse's word is in its ring.
-                self.pin(at, Pin::Phases, is);
+        } else {
+            if self.switching && !may_chop {
+                // Where HOLD went off (a move began, a software reset).
+                let off = self.last_change(Pin::Hold).unwrap_or(at);
+                self.switching_off(off.min(at));
             }
-        } else if self.switching
-            && self
-                .last_toggle
-                .is_none_or(|t| now.saturating_sub(t) >= CHOP_TICKS)
-        {
-            self.switching = false;
-            self.pin(at, Pin::Switching, 0);
+            if s != self.last_s
+                && !self.switching
+                && !stepped
+                && self.hal.capture_peek(Counter::Pout, 0).is_none()
+                && self.energized(s) != self.recorded_s
+            {
+                // Not a step unless a POUT word came since the drain: a
+                // CPU as quick as the RP2350's reads the outputs before
+                // the pulse's word is in its ring.
+                self.recorded_s = self.energized(s);
+                self.pin(at, Pin::Phases, self.recorded_s);
+            }
+        }
+        self.last_s = s;
+        let quiet = self
+            .last_toggle
+            .is_none_or(|t| now.saturating_sub(t) >= CHOP_TICKS);
+        if self.switching && quiet {
+            // The chopping stopped (an initialization is being processed)
+            // up to a window ago.
+            self.switching_off(at);
         }
         if auxo != self.last_auxo {
             self.last_auxo = auxo;
@@ -129,6 +145,26 @@ impl<H: Hal> Board<H> {
             dir: Direction::from_bit(dir),
             busy: self.busy,
         }
+    }
+
+    /// When `pin` last changed, as far as the record and the changes on
+    /// their way to it say.
+    fn last_change(&self, pin: Pin) -> Option<Instant> {
+        self.pending
+            .iter()
+            .rev()
+            .chain(self.record.pins.iter().rev())
+            .find(|p| p.pin == pin)
+            .map(|p| p.at)
+    }
+
+    /// Records SWITCHING off at `at`, or where the record already is, if
+    /// later: the record stays in time order.
+    fn switching_off(&mut self, at: Instant) {
+        let floor = self.record.pins.last().map_or(at, |p| p.at);
+        self.switching = false;
+        self.last_toggle = None;
+        self.pin(at.max(floor), Pin::Switching, 0);
     }
 
     /// The level of a PIO-captured pin: its last change.
