@@ -76,13 +76,27 @@ impl Served {
     }
 
     /// [`Served::target`] with `opts`.
+    ///
+    /// A port just let go of may still be locked for a moment: the lock
+    /// (serialport's `flock`) belongs to the open file, and a child that
+    /// another test thread forks in that moment holds a copy until its
+    /// `exec` closes it (CI found the QEMU board's port busy so when a
+    /// test opened it again at once). Busy is tried again for up to 5 s.
     pub fn target_with(&self, opts: BridgeOptions) -> BridgeTarget<SerialLink> {
         let path = self.link.to_str().expect("utf-8 path");
-        BridgeTarget::open(
-            SerialLink::open(path, 115_200).expect("the pty opens"),
-            opts,
-        )
-        .expect("the bridge answers HELLO")
+        let began = std::time::Instant::now();
+        let link = loop {
+            match SerialLink::open(path, 115_200) {
+                Err(e)
+                    if e.kind() == std::io::ErrorKind::ResourceBusy
+                        && began.elapsed() < Duration::from_secs(5) =>
+                {
+                    std::thread::sleep(Duration::from_millis(50));
+                }
+                other => break other.expect("the pty opens"),
+            }
+        };
+        BridgeTarget::open(link, opts).expect("the bridge answers HELLO")
     }
 }
 

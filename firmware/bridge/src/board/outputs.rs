@@ -62,8 +62,12 @@ impl<H: Hal> Board<H> {
         let dark = |levels: u8| self.energized(levels) == 0;
         let toggled = |levels: u8| levels != self.last_s && (dark(levels) || dark(self.last_s));
         let toggle = toggled(s) || sighted.is_some_and(|w| toggled(sampled_levels(w).0));
-        let hold = self.sm_level(Pin::Hold);
-        let may_chop = self.tracker.stop_switching() && hold;
+        // HOLD's level is looked up in the record only where it matters: a
+        // sample between toggles, with no chopping seen, costs no more
+        // than before (the image samples in every wait).
+        let may_chop = (toggle || self.switching)
+            && self.tracker.stop_switching()
+            && self.sm_level(Pin::Hold);
         if toggle && may_chop {
             self.last_toggle = Some(now);
             if !self.switching {
