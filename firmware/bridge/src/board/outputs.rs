@@ -65,9 +65,8 @@ impl<H: Hal> Board<H> {
         // HOLD's level is looked up in the record only where it matters: a
         // sample between toggles, with no chopping seen, costs no more
         // than before (the image samples in every wait).
-        let may_chop = (toggle || self.switching)
-            && self.tracker.stop_switching()
-            && self.sm_level(Pin::Hold);
+        let may_chop =
+            (toggle || self.switching) && self.tracker.stop_switching() && self.sm_level(Pin::Hold);
         if toggle && may_chop {
             self.last_toggle = Some(now);
             if !self.switching {
