@@ -102,6 +102,15 @@ impl Unsure {
         infers(&self.golden) || infers(&self.got)
     }
 
+    /// Whether the compared side finds BUSY by reading the status
+    /// register (its polled flags less sure than an access: the RP2350
+    /// bridge, its twin; `ppmc bridge-sim` declares them alike): a BUSY
+    /// that rises and falls between two of its reads leaves no change in
+    /// its capture.
+    pub(super) fn got_polls_busy(&self) -> bool {
+        self.got.polled > self.got.access
+    }
+
     /// A pin's change, from the write that started the move.
     pub(super) fn pin(&self, pin: Pin) -> Duration {
         self.both(|u| u.access + u.of_pin(pin))
