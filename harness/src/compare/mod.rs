@@ -35,7 +35,10 @@ pub use rule::{Graded, MarginalComparison};
 use crate::protocol::{Pin, PulseRun, Straps, TimingId};
 use crate::time::{Duration, Instant};
 use crate::trace::{BusEvent, EventKind, Trace};
-use causes::{first_look, judge_change, wait_diverges, Anchor, Causes, PinSlack, Timing, Wait};
+use causes::{
+    busy_seen_by_reads, first_look, judge_change, wait_diverges, Anchor, Causes, PinSlack, Timing,
+    Wait,
+};
 use rule::{First, Unsure};
 use std::collections::BTreeMap;
 use std::fmt;
@@ -736,36 +739,6 @@ fn compare_pins(
             }
         }
     }
-}
-
-/// The golden side's BUSY changes as a side that finds BUSY by reading
-/// the status register can see them: a rise and the fall after it with no
-/// status read of that side between them (a read, or a wait on a flag)
-/// leave no change in its capture, and are dropped. A move short enough
-/// to begin and end between two reads (a single step's 112 us, Table 3-3,
-/// in a wait of milliseconds) is found by its pulses, not by BUSY.
-fn busy_seen_by_reads(
-    gs: &[(Instant, u8, Causes)],
-    reads: &[(Instant, BusEvent, Causes)],
-) -> Vec<(Instant, u8, Causes)> {
-    let read_between = |from: Instant, to: Instant| {
-        reads.iter().any(|(t, e, _)| {
-            matches!(e, BusEvent::ReadStatus(_) | BusEvent::Await { .. }) && *t >= from && *t <= to
-        })
-    };
-    let mut kept = Vec::with_capacity(gs.len());
-    let mut i = 0;
-    while i < gs.len() {
-        if let (Some(rise), Some(fall)) = (gs.get(i), gs.get(i + 1)) {
-            if rise.1 == 1 && fall.1 == 0 && !read_between(rise.0, fall.0) {
-                i += 2;
-                continue;
-            }
-        }
-        kept.push(gs[i]);
-        i += 1;
-    }
-    kept
 }
 
 fn compare_measures(
