@@ -282,6 +282,15 @@ impl Uncertainty {
         }
     }
 
+    /// Whether BUSY is found by reading the status register, its polled
+    /// flags less sure than an access (the RP2350 bridge, its twin): a
+    /// BUSY that rises and falls between two reads leaves no change in the
+    /// capture. `ppmc bridge-sim` declares them alike, and sees BUSY as
+    /// exactly as its own accesses.
+    pub fn polls_busy(&self) -> bool {
+        self.polled > self.access
+    }
+
     /// A pass of the loop that polls the status register (up to twice
     /// `polled`) and an access after it: how long after the chip changed a
     /// flag a bridge may act on it, or stamp the change, where it reads

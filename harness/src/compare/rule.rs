@@ -103,12 +103,9 @@ impl Unsure {
     }
 
     /// Whether the compared side finds BUSY by reading the status
-    /// register (its polled flags less sure than an access: the RP2350
-    /// bridge, its twin; `ppmc bridge-sim` declares them alike): a BUSY
-    /// that rises and falls between two of its reads leaves no change in
-    /// its capture.
+    /// register ([`Uncertainty::polls_busy`]).
     pub(super) fn got_polls_busy(&self) -> bool {
-        self.got.polled > self.got.access
+        self.got.polls_busy()
     }
 
     /// A pin's change, from the write that started the move.

@@ -307,7 +307,7 @@ fn busy_at_its_earliest(
     u: crate::backend::Uncertainty,
 ) -> OutputRecord {
     let pass = u.poll_pass();
-    if !polls_busy(u) {
+    if !u.polls_busy() {
         return capture.clone();
     }
     let looks: Vec<crate::time::Instant> = replies
@@ -349,7 +349,7 @@ fn busy_the_polling_missed(
     u: crate::backend::Uncertainty,
 ) -> OutputRecord {
     let mut c = capture.clone();
-    if !polls_busy(u) {
+    if !u.polls_busy() {
         return c;
     }
     // Pulses with the line at 0 and no change of it among them, where no
@@ -411,15 +411,6 @@ fn busy_the_polling_missed(
     }
     c.pins.sort_by_key(|p| p.at);
     c
-}
-
-/// Whether a bridge finds BUSY by polling the status register, as far
-/// as its declared uncertainty tells: a flag found by polling is less sure
-/// than an access (the twin, a board: 1.5 us against 134 ns). One that
-/// declares them alike (`ppmc bridge-sim`, one tick each) sees BUSY as
-/// exactly as its own accesses.
-fn polls_busy(u: crate::backend::Uncertainty) -> bool {
-    u.polled > u.access
 }
 
 fn is_busy(p: &crate::protocol::PinEvent) -> bool {

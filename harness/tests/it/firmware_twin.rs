@@ -299,6 +299,54 @@ fn after_a_stop_in_the_long_move_the_next_host_opens_the_twin_at_once() {
     common::served::stopped_in_the_long_move_then_reopened(&twin, "e3_data_without_a_command");
 }
 
+/// A write of the command (or data) register that waits up to 10 ms for
+/// IBF = 0, as the flowcharts write.
+fn wc(byte: u8) -> ppmc::backend::Op {
+    ppmc::backend::Op::WriteCommand {
+        byte,
+        wait_ibf: Some(ppmc::time::Duration::from_millis(10)),
+    }
+}
+
+/// [`wc`] for the data register.
+fn wd(byte: u8) -> ppmc::backend::Op {
+    ppmc::backend::Op::WriteData {
+        byte,
+        wait_ibf: Some(ppmc::time::Duration::from_millis(10)),
+    }
+}
+
+/// Runs `batches` on a fresh twin and on the reference emulator on the
+/// twin's timeline (each op begun when the twin began it): the twin's
+/// capture, the model's, and the twin's declared uncertainty.
+fn on_the_twin_and_the_model(
+    batches: &[Vec<ppmc::backend::Op>],
+) -> (
+    ppmc::protocol::OutputRecord,
+    ppmc::protocol::OutputRecord,
+    ppmc::backend::Uncertainty,
+) {
+    use ppmc::backend::{Reply, Target};
+    use ppmc::fuzzing::reference::{run_at, starts};
+    use ppmc::time::Instant;
+    let twin = Served::start("run-twin", &[]);
+    let mut t = twin.target();
+    let mut emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
+    let (mut twin_at, mut emu_at) = (Instant::ZERO, Instant::ZERO);
+    for ops in batches {
+        let replies = t.execute(ops).expect("the twin runs it");
+        let begun = starts(ops, &replies, twin_at, false);
+        let on_emu = run_at(&mut emu, ops, &begun, emu_at).expect("the model runs it");
+        twin_at = replies.last().map_or(twin_at, Reply::at);
+        emu_at = on_emu.last().map_or(emu_at, Reply::at);
+    }
+    (
+        t.capture().expect("the twin's capture"),
+        emu.capture().expect("the model's capture"),
+        t.uncertainty(),
+    )
+}
+
 /// A change of a sampled output is stamped within the `sampled` the board
 /// declares, even where the board code sees it as it begins to idle: AUXO
 /// set 14 us after its data byte (3-5-5, Table 3-3) just as a software
@@ -310,38 +358,17 @@ fn after_a_stop_in_the_long_move_the_next_host_opens_the_twin_at_once() {
 /// began it).
 #[test]
 fn a_sampled_change_seen_as_the_board_code_idles_is_stamped_within_its_uncertainty() {
-    use ppmc::backend::{Op, Reply, Target};
-    use ppmc::fuzzing::reference::{run_at, starts};
+    use ppmc::backend::Op;
     use ppmc::protocol::Pin;
     use ppmc::time::{Duration, Instant};
-    let twin = Served::start("run-twin", &[]);
-    let mut t = twin.target();
-    let mut emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
-    let wait = Some(Duration::from_millis(10));
-    let wc = |byte| Op::WriteCommand {
-        byte,
-        wait_ibf: wait,
-    };
-    let wd = |byte| Op::WriteData {
-        byte,
-        wait_ibf: wait,
-    };
-    let batches = [
+    let (got, want, u) = on_the_twin_and_the_model(&[
         vec![Op::Reset],
         vec![wc(0x02), wd(100), wd(20), wd(100), wd(0), Op::ReadStatus],
         vec![Op::Delay(Duration::from_millis(20)), Op::ReadStatus],
         vec![wc(0x86), wd(0x04), Op::ReadStatus],
         vec![wc(0xC0), Op::ReadStatus],
         vec![Op::Delay(Duration::from_millis(1)), Op::ReadStatus],
-    ];
-    let (mut twin_at, mut emu_at) = (Instant::ZERO, Instant::ZERO);
-    for ops in &batches {
-        let replies = t.execute(ops).expect("the twin runs it");
-        let begun = starts(ops, &replies, twin_at, false);
-        let on_emu = run_at(&mut emu, ops, &begun, emu_at).expect("the model runs it");
-        twin_at = replies.last().map_or(twin_at, Reply::at);
-        emu_at = on_emu.last().map_or(emu_at, Reply::at);
-    }
+    ]);
     let auxo = |r: &ppmc::protocol::OutputRecord| -> Vec<Instant> {
         r.pins
             .iter()
@@ -349,10 +376,8 @@ fn a_sampled_change_seen_as_the_board_code_idles_is_stamped_within_its_uncertain
             .map(|e| e.at)
             .collect()
     };
-    let got = auxo(&t.capture().expect("the twin's capture"));
-    let want = auxo(&emu.capture().expect("the model's capture"));
+    let (got, want) = (auxo(&got), auxo(&want));
     assert_eq!((got.len(), want.len()), (1, 1), "{got:?} {want:?}");
-    let u = t.uncertainty();
     let off = got[0]
         .saturating_since(want[0])
         .max(want[0].saturating_since(got[0]));
@@ -377,23 +402,10 @@ fn a_sampled_change_seen_as_the_board_code_idles_is_stamped_within_its_uncertain
 /// 12 ms, all to the same pattern (the differential run found it).
 #[test]
 fn stop_switching_is_reported_once_from_its_first_edge_however_the_samples_fall() {
-    use ppmc::backend::{Op, Reply, Target};
-    use ppmc::fuzzing::reference::{run_at, starts};
+    use ppmc::backend::Op;
     use ppmc::protocol::{OutputRecord, Pin};
     use ppmc::time::{Duration, Instant};
-    let twin = Served::start("run-twin", &[]);
-    let mut t = twin.target();
-    let mut emu = EmuTarget::new(Straps::default(), ModelConfig::default()).expect("emulator");
-    let wait = Some(Duration::from_millis(10));
-    let wc = |byte| Op::WriteCommand {
-        byte,
-        wait_ibf: wait,
-    };
-    let wd = |byte| Op::WriteData {
-        byte,
-        wait_ibf: wait,
-    };
-    let batches = [
+    let (got, want, u) = on_the_twin_and_the_model(&[
         vec![Op::Reset],
         vec![wc(0x22), wd(100), wd(20), wd(100), wd(0), Op::ReadStatus],
         vec![
@@ -402,15 +414,7 @@ fn stop_switching_is_reported_once_from_its_first_edge_however_the_samples_fall(
             },
             Op::ReadStatus,
         ],
-    ];
-    let (mut twin_at, mut emu_at) = (Instant::ZERO, Instant::ZERO);
-    for ops in &batches {
-        let replies = t.execute(ops).expect("the twin runs it");
-        let begun = starts(ops, &replies, twin_at, false);
-        let on_emu = run_at(&mut emu, ops, &begun, emu_at).expect("the model runs it");
-        twin_at = replies.last().map_or(twin_at, Reply::at);
-        emu_at = on_emu.last().map_or(emu_at, Reply::at);
-    }
+    ]);
     let of = |r: &OutputRecord, pin: Pin| -> Vec<(Instant, u8)> {
         r.pins
             .iter()
@@ -418,10 +422,6 @@ fn stop_switching_is_reported_once_from_its_first_edge_however_the_samples_fall(
             .map(|e| (e.at, e.value))
             .collect()
     };
-    let (got, want) = (
-        t.capture().expect("the twin's capture"),
-        emu.capture().expect("the model's capture"),
-    );
     let (chop, model_chop) = (of(&got, Pin::Switching), of(&want, Pin::Switching));
     assert_eq!(
         model_chop.len(),
@@ -436,7 +436,6 @@ fn stop_switching_is_reported_once_from_its_first_edge_however_the_samples_fall(
         "the phase pattern changes only where the model's does: {:?}",
         of(&got, Pin::Phases)
     );
-    let u = t.uncertainty();
     let late = chop[0].0.saturating_since(model_chop[0].0);
     let first_edge = Duration::from_micros(65);
     assert!(

@@ -5,7 +5,7 @@
 use super::Board;
 use crate::hal::{Counter, Hal};
 use crate::pins;
-use ppmc_core::protocol::{Direction, OutputLogic, Pin, Pins, SWITCHING_WINDOW};
+use ppmc_core::protocol::{Direction, OutputLogic, Pin, PinEvent, Pins, SWITCHING_WINDOW};
 use ppmc_core::time::Instant;
 
 /// Stop switching ends when no toggle comes for [`SWITCHING_WINDOW`]
@@ -76,7 +76,7 @@ impl<H: Hal> Board<H> {
         } else {
             if self.switching && !may_chop {
                 // Where HOLD went off (a move began, a software reset).
-                let off = self.last_change(Pin::Hold).unwrap_or(at);
+                let off = self.last_change(Pin::Hold).map_or(at, |p| p.at);
                 self.switching_off(off.min(at));
             }
             if s != self.last_s
@@ -150,15 +150,14 @@ impl<H: Hal> Board<H> {
         }
     }
 
-    /// When `pin` last changed, as far as the record and the changes on
-    /// their way to it say.
-    fn last_change(&self, pin: Pin) -> Option<Instant> {
+    /// `pin`'s last change, as far as the record and the changes on their
+    /// way to it say.
+    fn last_change(&self, pin: Pin) -> Option<&PinEvent> {
         self.pending
             .iter()
             .rev()
             .chain(self.record.pins.iter().rev())
             .find(|p| p.pin == pin)
-            .map(|p| p.at)
     }
 
     /// Records SWITCHING off at `at`, or where the record already is, if
@@ -172,11 +171,6 @@ impl<H: Hal> Board<H> {
 
     /// The level of a PIO-captured pin: its last change.
     fn sm_level(&self, pin: Pin) -> bool {
-        self.pending
-            .iter()
-            .rev()
-            .chain(self.record.pins.iter().rev())
-            .find(|p| p.pin == pin)
-            .is_some_and(|p| p.value == 1)
+        self.last_change(pin).is_some_and(|p| p.value == 1)
     }
 }
